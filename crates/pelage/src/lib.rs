@@ -1,0 +1,20 @@
+//! pelage: a fur toolkit.
+//!
+//! This crate is the library: everything that is not GPU, window or command
+//! line. It is organised by concept, one folder a layer:
+//!
+//! - [`mesh`]: the surface hair grows on: [`Mesh`], [`SurfacePoint`], loaders
+//!   (OBJ, PLY, glTF), topology and midpoint subdivision.
+//! - [`map`]: [`Map`], a scalar field over UV (constant, image, noise). Every
+//!   groom parameter is a map (Sik, section 4: "every user parameter … is
+//!   also specified by a texture").
+//!
+//! The library never prints. Every fallible call returns a typed error that
+//! names the file (or mesh) and, where there is one, the line or element.
+#![warn(missing_docs)]
+
+pub mod map;
+pub mod mesh;
+
+pub use map::{Map, MapError};
+pub use mesh::{Mesh, MeshError, SurfacePoint, TangentFrame};

@@ -1,0 +1,225 @@
+//! glTF 2.0 / GLB reader (through the gltf crate): every triangle primitive
+//! of the default scene (or of every scene, or every mesh when there is no
+//! scene), with node transforms applied, merged into one mesh.
+//!
+//! glTF splits vertices wherever any attribute differs, so a UV seam becomes
+//! an open border. pelage welds vertices whose positions are bit-identical
+//! and keeps the UVs per corner, so a closed model stays closed for the
+//! topology-based algorithms (style mesh colouring, boundary reports).
+
+use super::{Mesh, MeshError, MeshErrorKind, Uvs};
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use gltf::mesh::Mode;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Reads a glTF or GLB from bytes; `base` is the folder external buffers
+/// are resolved against (None for self-contained files).
+pub(super) fn parse(name: &str, bytes: &[u8], base: Option<&Path>) -> Result<Mesh, MeshError> {
+    let whole = |msg: String| MeshError::whole(name, MeshErrorKind::Syntax(msg));
+    let gltf = gltf::Gltf::from_slice(bytes)
+        .map_err(|e| whole(format!("not a readable glTF file: {e}")))?;
+    let buffers = gltf::import_buffers(&gltf.document, base, gltf.blob.clone())
+        .map_err(|e| whole(format!("cannot load the glTF's buffers: {e}")))?;
+    let doc = &gltf.document;
+
+    // (mesh, world_from_mesh) pairs to merge.
+    let mut instances: Vec<(gltf::Mesh, Mat4)> = Vec::new();
+    let scenes: Vec<gltf::Scene> = match doc.default_scene() {
+        Some(s) => vec![s],
+        None => doc.scenes().collect(),
+    };
+    if scenes.is_empty() {
+        instances.extend(doc.meshes().map(|m| (m, Mat4::IDENTITY)));
+    }
+    for scene in scenes {
+        let mut stack: Vec<(gltf::Node, Mat4)> =
+            scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+        while let Some((node, parent)) = stack.pop() {
+            let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+            if let Some(mesh) = node.mesh() {
+                instances.push((mesh, world));
+            }
+            stack.extend(node.children().map(|c| (c, world)));
+        }
+    }
+
+    let mut positions: Vec<Vec3> = Vec::new();
+    let mut normal_sums: Vec<Vec3> = Vec::new();
+    let mut welded: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut uv_values: Vec<Vec2> = Vec::new();
+    let mut uv_triangles: Vec<[u32; 3]> = Vec::new();
+    let mut all_have_normals = true;
+    let mut uv_presence: Option<bool> = None;
+
+    for (mesh, world) in instances {
+        let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
+        for primitive in mesh.primitives() {
+            let what = format!("mesh {} primitive {}", mesh.index(), primitive.index());
+            if !matches!(
+                primitive.mode(),
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                continue; // points and lines carry no surface
+            }
+            for (_, accessor) in primitive.attributes() {
+                check_accessor(&accessor, &buffers).map_err(|m| whole(format!("{what}: {m}")))?;
+            }
+            if let Some(a) = primitive.indices() {
+                check_accessor(&a, &buffers).map_err(|m| whole(format!("{what}: {m}")))?;
+            }
+            let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            let local: Vec<Vec3> = reader
+                .read_positions()
+                .ok_or_else(|| whole(format!("{what} has no POSITION attribute")))?
+                .map(Vec3::from)
+                .collect();
+            let normals: Option<Vec<Vec3>> =
+                reader.read_normals().map(|n| n.map(Vec3::from).collect());
+            let uvs: Option<Vec<Vec2>> = reader
+                .read_tex_coords(0)
+                .map(|t| t.into_f32().map(Vec2::from).collect());
+            match uv_presence {
+                None => uv_presence = Some(uvs.is_some()),
+                Some(p) if p != uvs.is_some() => {
+                    return Err(MeshError::whole(
+                        name,
+                        MeshErrorKind::Unsupported(format!(
+                            "{what} {} TEXCOORD_0 but earlier primitives {}; pelage needs UVs on all primitives or on none",
+                            if uvs.is_some() { "has" } else { "has no" },
+                            if p { "do" } else { "do not" }
+                        )),
+                    ));
+                }
+                Some(_) => {}
+            }
+            all_have_normals &= normals.is_some();
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..local.len() as u32).collect(),
+            };
+            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= local.len()) {
+                return Err(MeshError::whole(
+                    name,
+                    MeshErrorKind::IndexOutOfRange {
+                        what: "vertex",
+                        what_plural: "vertices",
+                        index: i64::from(bad),
+                        count: local.len(),
+                        hint: "",
+                    },
+                ));
+            }
+
+            // Weld this primitive's vertices into the merged mesh.
+            let uv_base = uv_values.len() as u32;
+            let mut remap = Vec::with_capacity(local.len());
+            for (k, p) in local.iter().enumerate() {
+                let p = world.transform_point3(*p);
+                if !p.is_finite() {
+                    let kind = MeshErrorKind::NonFinite {
+                        what: "vertex position",
+                    };
+                    return Err(MeshError::whole(name, kind));
+                }
+                let next = positions.len() as u32;
+                let id = *welded.entry(p.to_array().map(f32::to_bits)).or_insert(next);
+                if id == next {
+                    positions.push(p);
+                    normal_sums.push(Vec3::ZERO);
+                }
+                if let Some(n) = &normals {
+                    normal_sums[id as usize] += (normal_matrix * n[k]).normalize_or_zero();
+                }
+                remap.push(id);
+            }
+            if let Some(uvs) = uvs {
+                uv_values.extend(uvs);
+            }
+            for tri in triangle_indices(primitive.mode(), &indices) {
+                triangles.push(tri.map(|i| remap[i as usize]));
+                if uv_presence == Some(true) {
+                    uv_triangles.push(tri.map(|i| uv_base + i));
+                }
+            }
+        }
+    }
+
+    if triangles.is_empty() {
+        return Err(MeshError::whole(
+            name,
+            MeshErrorKind::Empty("no triangle primitives"),
+        ));
+    }
+    let normals = all_have_normals.then(|| {
+        let computed = super::area_weighted_normals(&positions, &triangles);
+        normal_sums
+            .into_iter()
+            .zip(computed)
+            .map(|(s, c)| {
+                if s.is_finite() {
+                    s.try_normalize().unwrap_or(c)
+                } else {
+                    s
+                }
+            })
+            .collect()
+    });
+    let uvs = (uv_presence == Some(true)).then_some(Uvs::PerCorner {
+        values: uv_values,
+        indices: uv_triangles,
+    });
+    Mesh::new(name, positions, triangles, normals, uvs)
+}
+
+/// The gltf crate's readers index buffers without bounds checks of their
+/// own; this checks that the accessor's bytes lie inside its view and the
+/// view inside its buffer, so a malformed file is an error, not a panic.
+fn check_accessor(accessor: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Result<(), String> {
+    let Some(view) = accessor.view() else {
+        return Err(format!(
+            "accessor {} has no buffer view (sparse accessors are not supported)",
+            accessor.index()
+        ));
+    };
+    let buffer_len = buffers.get(view.buffer().index()).map_or(0, |b| b.0.len());
+    if view.offset() + view.length() > buffer_len {
+        return Err(format!(
+            "buffer view {} reaches past the end of its buffer",
+            view.index()
+        ));
+    }
+    let element = accessor.size();
+    let stride = view.stride().unwrap_or(element);
+    let count = accessor.count();
+    if count > 0 && accessor.offset() + stride * (count - 1) + element > view.length() {
+        return Err(format!(
+            "accessor {} reaches past the end of its buffer view",
+            accessor.index()
+        ));
+    }
+    Ok(())
+}
+
+fn triangle_indices(mode: Mode, indices: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::TriangleStrip => (2..indices.len())
+            .map(|k| {
+                // Alternate winding so every strip triangle faces the same way.
+                if k % 2 == 0 {
+                    [indices[k - 2], indices[k - 1], indices[k]]
+                } else {
+                    [indices[k - 1], indices[k - 2], indices[k]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (2..indices.len())
+            .map(|k| [indices[0], indices[k - 1], indices[k]])
+            .collect(),
+        _ => indices
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+    }
+}

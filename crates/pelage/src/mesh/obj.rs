@@ -1,0 +1,282 @@
+//! Wavefront OBJ reader: `v`, `vt`, `vn` and `f` (any polygon, fan
+//! triangulated; `v`, `v/vt`, `v//vn`, `v/vt/vn`; negative = relative
+//! indices). Other statements (groups, materials, smoothing, lines) are
+//! ignored.
+//!
+//! Hand-written rather than tobj (a departure from DESIGN.md, recorded in
+//! ARCHITECTURE.md): tobj's errors carry no line numbers, and every error
+//! here names its line. It also keeps position and UV indices apart, so UV
+//! seams do not split vertices and topology stays as modelled.
+
+use super::{Mesh, MeshError, MeshErrorKind, Uvs};
+use glam::{Vec2, Vec3};
+
+/// Parses OBJ text. `name` is what errors call the file.
+pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    // First pass: count vertices, UVs and normals, so that every face index
+    // can be checked at its own line even when it refers forwards.
+    let (mut v_total, mut vt_total, mut vn_total) = (0usize, 0usize, 0usize);
+    for line in bytes.split(|&b| b == b'\n') {
+        let line = line.trim_ascii_start();
+        match line {
+            [b'v', b' ' | b'\t', ..] => v_total += 1,
+            [b'v', b't', b' ' | b'\t', ..] => vt_total += 1,
+            [b'v', b'n', b' ' | b'\t', ..] => vn_total += 1,
+            _ => {}
+        }
+    }
+    let totals = [v_total, vt_total, vn_total];
+
+    let mut positions = Vec::with_capacity(v_total);
+    let mut uv_values = Vec::with_capacity(vt_total);
+    let mut file_normals = Vec::with_capacity(vn_total);
+    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(v_total * 2);
+    let mut uv_triangles: Vec<[u32; 3]> = Vec::new();
+    let mut normal_triangles: Vec<[u32; 3]> = Vec::new();
+    // Whether faces carry UVs / normals, and the line of the first face,
+    // so that a file mixing faces with and without UVs can be reported.
+    let mut face_layout: Option<(bool, bool, usize)> = None;
+    let mut normals_on_all_faces = true;
+    let mut corners: Vec<[Option<u32>; 3]> = Vec::with_capacity(8);
+
+    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+        let line_no = i + 1;
+        let err = |kind| MeshError::at_line(name, line_no, kind);
+        let raw = match raw.iter().position(|&b| b == b'#') {
+            Some(hash) => &raw[..hash],
+            None => raw,
+        };
+        let line = std::str::from_utf8(raw).map_err(|_| {
+            err(MeshErrorKind::Syntax(
+                "the line is not valid UTF-8 text".into(),
+            ))
+        })?;
+        let mut tokens = line.split_ascii_whitespace();
+        match tokens.next() {
+            Some("v") => {
+                let [x, y, z] = numbers::<3>(&mut tokens, "a vertex (v x y z)").map_err(err)?;
+                let p = Vec3::new(x, y, z);
+                if !p.is_finite() {
+                    return Err(err(MeshErrorKind::NonFinite {
+                        what: "vertex position",
+                    }));
+                }
+                positions.push(p);
+            }
+            Some("vt") => {
+                let [u] =
+                    numbers::<1>(&mut tokens, "a texture coordinate (vt u v)").map_err(err)?;
+                let v = match tokens.next() {
+                    Some(t) => number(t).map_err(err)?,
+                    None => 0.0,
+                };
+                let uv = Vec2::new(u, v);
+                if !uv.is_finite() {
+                    return Err(err(MeshErrorKind::NonFinite {
+                        what: "texture coordinate",
+                    }));
+                }
+                uv_values.push(uv);
+            }
+            Some("vn") => {
+                let [x, y, z] = numbers::<3>(&mut tokens, "a normal (vn x y z)").map_err(err)?;
+                let n = Vec3::new(x, y, z);
+                if !n.is_finite() {
+                    return Err(err(MeshErrorKind::NonFinite {
+                        what: "vertex normal",
+                    }));
+                }
+                file_normals.push(n);
+            }
+            Some("f") => {
+                corners.clear();
+                for token in tokens {
+                    corners.push(face_corner(token, &totals).map_err(err)?);
+                }
+                if corners.len() < 3 {
+                    return Err(err(MeshErrorKind::Syntax(format!(
+                        "a face needs at least 3 vertices, this one has {}",
+                        corners.len()
+                    ))));
+                }
+                let has_uv = corners.iter().all(|c| c[1].is_some());
+                let has_normal = corners.iter().all(|c| c[2].is_some());
+                if corners.iter().any(|c| c[1].is_some()) && !has_uv {
+                    return Err(err(MeshErrorKind::Syntax(
+                        "some corners of this face have texture coordinates and some do not".into(),
+                    )));
+                }
+                match face_layout {
+                    None => face_layout = Some((has_uv, has_normal, line_no)),
+                    Some((uv_before, _, first_line)) if uv_before != has_uv => {
+                        let (with, without) = if has_uv {
+                            ("this", "earlier")
+                        } else {
+                            ("earlier", "this")
+                        };
+                        return Err(err(MeshErrorKind::Unsupported(format!(
+                            "{with} face has texture coordinates but the {without} face (first at line {first_line}) has none; pelage needs UVs on all faces or on none"
+                        ))));
+                    }
+                    Some(_) => {}
+                }
+                normals_on_all_faces &= has_normal;
+                // Fan triangulation, as most OBJ readers do for convex polygons.
+                for k in 1..corners.len() - 1 {
+                    let tri = [corners[0], corners[k], corners[k + 1]];
+                    triangles.push(tri.map(|c| c[0].expect("position index is required")));
+                    if has_uv {
+                        uv_triangles.push(tri.map(|c| c[1].expect("checked above")));
+                    }
+                    if has_normal {
+                        normal_triangles.push(tri.map(|c| c[2].expect("checked above")));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+
+    if positions.is_empty() {
+        return Err(MeshError::whole(
+            name,
+            MeshErrorKind::Empty("no vertices (no 'v' lines)"),
+        ));
+    }
+    if triangles.is_empty() {
+        return Err(MeshError::whole(
+            name,
+            MeshErrorKind::Empty("no faces (no 'f' lines)"),
+        ));
+    }
+    let uvs = face_layout
+        .filter(|&(has_uv, _, _)| has_uv)
+        .map(|_| Uvs::PerCorner {
+            values: uv_values,
+            indices: uv_triangles,
+        });
+    // File normals are per corner; pelage keeps one smooth normal per vertex
+    // (hair follows the smooth surface), so corners are averaged. Where they
+    // cancel out, the area-weighted normal is used instead.
+    let normals = normals_on_all_faces.then(|| {
+        let computed = super::area_weighted_normals(&positions, &triangles);
+        let mut sums = vec![Vec3::ZERO; positions.len()];
+        for (tri, ntri) in triangles.iter().zip(&normal_triangles) {
+            for k in 0..3 {
+                sums[tri[k] as usize] += file_normals[ntri[k] as usize].normalize_or_zero();
+            }
+        }
+        sums.into_iter()
+            .zip(computed)
+            .map(|(s, c)| s.try_normalize().unwrap_or(c))
+            .collect()
+    });
+    Mesh::new(name, positions, triangles, normals, uvs)
+}
+
+/// Parses `N` numbers from `tokens`; `what` describes the statement for the
+/// error when there are too few.
+fn numbers<'a, const N: usize>(
+    tokens: &mut impl Iterator<Item = &'a str>,
+    what: &str,
+) -> Result<[f32; N], MeshErrorKind> {
+    let mut out = [0.0; N];
+    for (k, slot) in out.iter_mut().enumerate() {
+        let token = tokens
+            .next()
+            .ok_or_else(|| MeshErrorKind::Syntax(format!("{what} needs {N} numbers, found {k}")))?;
+        *slot = number(token)?;
+    }
+    Ok(out)
+}
+
+fn number(token: &str) -> Result<f32, MeshErrorKind> {
+    token
+        .parse::<f32>()
+        .map_err(|_| MeshErrorKind::Syntax(format!("cannot read {token:?} as a number")))
+}
+
+/// One face corner, `v`, `v/vt`, `v//vn` or `v/vt/vn`, resolved to 0-based
+/// indices checked against the file's totals of v, vt and vn.
+fn face_corner(token: &str, totals: &[usize; 3]) -> Result<[Option<u32>; 3], MeshErrorKind> {
+    const KINDS: [(&str, &str); 3] = [("vertex", "vertices"), ("uv", "uvs"), ("normal", "normals")];
+    let mut out = [None; 3];
+    let mut parts = token.split('/');
+    for (k, slot) in out.iter_mut().enumerate() {
+        let Some(part) = parts.next() else { break };
+        if part.is_empty() {
+            if k == 0 {
+                return Err(MeshErrorKind::Syntax(format!(
+                    "face corner {token:?} has no vertex index"
+                )));
+            }
+            continue;
+        }
+        let raw: i64 = part.parse().map_err(|_| {
+            MeshErrorKind::Syntax(format!(
+                "cannot read {part:?} in face corner {token:?} as an index"
+            ))
+        })?;
+        let count = totals[k];
+        let (what, what_plural) = KINDS[k];
+        let out_of_range = |hint| MeshErrorKind::IndexOutOfRange {
+            what,
+            what_plural,
+            index: raw,
+            count,
+            hint,
+        };
+        // OBJ indices are 1-based; negative ones count back from the end.
+        let resolved = match raw {
+            0 => return Err(out_of_range("; OBJ indices start at 1")),
+            r if r > 0 => r - 1,
+            r => count as i64 + r,
+        };
+        if resolved < 0 || resolved >= count as i64 {
+            return Err(out_of_range(""));
+        }
+        *slot = Some(resolved as u32);
+    }
+    if parts.next().is_some() {
+        return Err(MeshErrorKind::Syntax(format!(
+            "face corner {token:?} has more than three '/'-separated indices"
+        )));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quad_is_fan_triangulated_with_uvs_per_corner() {
+        let text = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
+        let m = parse("quad.obj", text).unwrap();
+        assert_eq!(m.triangles(), &[[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(m.triangle_uvs(1).unwrap()[2], Vec2::new(0.0, 1.0));
+        assert!((m.surface_area() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn negative_indices_are_relative() {
+        let m = parse("rel.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n").unwrap();
+        assert_eq!(m.triangles(), &[[0, 1, 2]]);
+    }
+
+    #[test]
+    fn file_normals_are_used() {
+        let text = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 -1\nf 1//1 2//1 3//1\n";
+        let m = parse("n.obj", text).unwrap();
+        assert_eq!(m.normals()[0], Vec3::NEG_Z);
+    }
+
+    #[test]
+    fn index_zero_is_reported_at_its_line() {
+        let err = parse("zero.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 0 1 2\n").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "zero.obj:5: vertex index 0 is out of range: there are 3 vertices; OBJ indices start at 1"
+        );
+    }
+}
