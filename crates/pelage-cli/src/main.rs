@@ -1,1 +1,44 @@
-fn main() {}
+//! `pelage`: the command-line tool over the pelage library.
+//!
+//! A thin binary: it parses arguments (clap), calls the library, and owns
+//! everything the library must not do: printing, progress, exit codes.
+//! Errors print as `error: …` followed by their causes, and exit with 2.
+
+mod commands;
+mod format;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// pelage: a fur toolkit. Grooming (hair roots, guides, operators, USD out)
+/// and real-time shell fur, from published methods.
+#[derive(Debug, Parser)]
+#[command(name = "pelage", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Print what a mesh is made of: counts, bounds, area, UVs, defects.
+    Info(commands::info::InfoArgs),
+    /// Run the demo on the embedded Spot mesh.
+    Demo(commands::demo::DemoArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(args) => commands::info::run(&args),
+        Command::Demo(args) => commands::demo::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            // `{:#}` prints the whole cause chain on one line: "a: b: c".
+            eprintln!("error: {err:#}");
+            ExitCode::from(2)
+        }
+    }
+}

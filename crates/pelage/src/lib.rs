@@ -8,11 +8,14 @@
 //! - [`map`]: [`Map`], a scalar field over UV (constant, image, noise). Every
 //!   groom parameter is a map (Sik, section 4: "every user parameter … is
 //!   also specified by a texture").
+//! - [`assets`]: the embedded demo mesh (Spot), so every command works with
+//!   no files at hand.
 //!
 //! The library never prints. Every fallible call returns a typed error that
 //! names the file (or mesh) and, where there is one, the line or element.
 #![warn(missing_docs)]
 
+pub mod assets;
 pub mod map;
 pub mod mesh;
 

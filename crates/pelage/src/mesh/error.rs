@@ -46,7 +46,7 @@ pub enum MeshErrorKind {
     #[error("{0}")]
     Syntax(String),
     /// An index refers to an element that does not exist.
-    #[error("{what} index {index} is out of range: there are {count} {what_plural}{hint}")]
+    #[error("{what} index {index} is out of range: {}{hint}", count_of(*.count, .what, .what_plural))]
     IndexOutOfRange {
         /// What is indexed: "vertex", "uv", "normal".
         what: &'static str,
@@ -76,36 +76,47 @@ pub enum MeshErrorKind {
     Inconsistent(String),
 }
 
+/// "there is 1 vertex" / "there are 3 vertices".
+fn count_of(count: usize, singular: &str, plural: &str) -> String {
+    match count {
+        1 => format!("there is 1 {singular}"),
+        n => format!("there are {n} {plural}"),
+    }
+}
+
 /// A mesh could not be loaded or built. Displays as
 /// `FILE[:LINE | : ELEMENT N]: what is wrong`.
+///
+/// Boxed inside, so `Result<Mesh, MeshError>` stays small on the happy path.
 #[derive(Debug)]
-pub struct MeshError {
-    /// The file path, or a name such as `embedded spot` for meshes not read
-    /// from a file.
-    pub source_name: String,
-    /// Where in it.
-    pub location: Location,
-    /// What is wrong.
-    pub kind: MeshErrorKind,
+pub struct MeshError(Box<MeshErrorInner>);
+
+#[derive(Debug)]
+struct MeshErrorInner {
+    source_name: String,
+    location: Location,
+    kind: MeshErrorKind,
 }
 
 impl MeshError {
+    /// An error at `location` of `source_name` (a path, or a name such as
+    /// `embedded spot` for meshes not read from a file).
+    pub fn new(source_name: impl Into<String>, location: Location, kind: MeshErrorKind) -> Self {
+        Self(Box::new(MeshErrorInner {
+            source_name: source_name.into(),
+            location,
+            kind,
+        }))
+    }
+
     /// An error about the whole file or mesh.
     pub fn whole(source_name: impl Into<String>, kind: MeshErrorKind) -> Self {
-        Self {
-            source_name: source_name.into(),
-            location: Location::Whole,
-            kind,
-        }
+        Self::new(source_name, Location::Whole, kind)
     }
 
     /// An error at a 1-based line of a text file.
     pub fn at_line(source_name: impl Into<String>, line: usize, kind: MeshErrorKind) -> Self {
-        Self {
-            source_name: source_name.into(),
-            location: Location::Line(line),
-            kind,
-        }
+        Self::new(source_name, Location::Line(line), kind)
     }
 
     /// An error at an element (`vertex 12`, `triangle 3`).
@@ -115,25 +126,41 @@ impl MeshError {
         index: usize,
         kind: MeshErrorKind,
     ) -> Self {
-        Self {
-            source_name: source_name.into(),
-            location: Location::Element {
-                kind: element,
-                index,
-            },
-            kind,
-        }
+        let location = Location::Element {
+            kind: element,
+            index,
+        };
+        Self::new(source_name, location, kind)
+    }
+
+    /// The file path or mesh name.
+    pub fn source_name(&self) -> &str {
+        &self.0.source_name
+    }
+
+    /// Where in it.
+    pub fn location(&self) -> &Location {
+        &self.0.location
+    }
+
+    /// What is wrong.
+    pub fn kind(&self) -> &MeshErrorKind {
+        &self.0.kind
     }
 }
 
 impl fmt::Display for MeshError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}{}: {}", self.source_name, self.location, self.kind)
+        write!(
+            f,
+            "{}{}: {}",
+            self.0.source_name, self.0.location, self.0.kind
+        )
     }
 }
 
 impl std::error::Error for MeshError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        std::error::Error::source(&self.kind)
+        std::error::Error::source(&self.0.kind)
     }
 }

@@ -310,7 +310,8 @@ fn triangle_areas(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Vec<f32>, usiz
                 .max((p2 - p1).length_squared())
                 .max((p0 - p2).length_squared());
             let repeated = a == b || b == c || c == a;
-            if repeated || !(doubled > DEGENERATE_RELATIVE_AREA * longest_sq) {
+            let too_thin = doubled <= DEGENERATE_RELATIVE_AREA * longest_sq || doubled.is_nan();
+            if repeated || too_thin {
                 degenerate += 1;
                 0.0
             } else {

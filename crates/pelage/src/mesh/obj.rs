@@ -109,13 +109,13 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
                 match face_layout {
                     None => face_layout = Some((has_uv, has_normal, line_no)),
                     Some((uv_before, _, first_line)) if uv_before != has_uv => {
-                        let (with, without) = if has_uv {
-                            ("this", "earlier")
+                        let (this, earlier) = if has_uv {
+                            ("has", "have none")
                         } else {
-                            ("earlier", "this")
+                            ("has no", "have them")
                         };
                         return Err(err(MeshErrorKind::Unsupported(format!(
-                            "{with} face has texture coordinates but the {without} face (first at line {first_line}) has none; pelage needs UVs on all faces or on none"
+                            "this face {this} texture coordinates (vt) and the faces before it (from line {first_line}) {earlier}; pelage needs UVs on all faces or on none"
                         ))));
                     }
                     Some(_) => {}

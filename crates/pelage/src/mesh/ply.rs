@@ -163,21 +163,31 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
 
 fn parse_error(name: &str, e: ply_rs_bw::parser::ParseError) -> MeshError {
     let full = e.to_string();
+    // ply-rs prefixes "Line N: " (pelage puts the line after the file name)
+    // and quotes the offending line over several lines; make it one line.
     let message = match e.line() {
-        // ply-rs prefixes "Line N: "; pelage puts the line after the file name.
         Some(line) => full
             .strip_prefix(&format!("Line {line}: "))
-            .unwrap_or(&full)
-            .to_string(),
-        None => full,
+            .unwrap_or(&full),
+        None => &full,
     };
-    let kind = if e.kind() == std::io::ErrorKind::UnexpectedEof {
-        MeshErrorKind::Inconsistent(format!(
+    let message = message
+        .replace("\n'", "'")
+        .replace("\n\t", " ")
+        .replace('\n', " ");
+    // What follows "Error:" is the inner parser's debug dump, not for people.
+    let message = match message.find(" Error:") {
+        Some(cut) => message[..cut].to_string(),
+        None => message,
+    };
+    if e.kind() == std::io::ErrorKind::UnexpectedEof {
+        // Binary bodies have no lines; the message names the element.
+        let kind = MeshErrorKind::Inconsistent(format!(
             "the file ends before all the elements its header announces (truncated?): {message}"
-        ))
-    } else {
-        MeshErrorKind::Syntax(format!("not a readable PLY file: {message}"))
-    };
+        ));
+        return MeshError::whole(name, kind);
+    }
+    let kind = MeshErrorKind::Syntax(format!("not a readable PLY file: {message}"));
     match e.line() {
         Some(line) => MeshError::at_line(name, line, kind),
         None => MeshError::whole(name, kind),

@@ -1,0 +1,16 @@
+//! One module per subcommand: its arguments (clap) and its `run`.
+
+pub mod demo;
+pub mod info;
+
+use anyhow::Context;
+use pelage::Mesh;
+use std::path::Path;
+
+/// Loads the mesh at `path`, or the embedded Spot when there is none.
+pub fn load_mesh(path: Option<&Path>) -> anyhow::Result<Mesh> {
+    match path {
+        Some(path) => Mesh::load(path).context("cannot load the mesh"),
+        None => Ok(pelage::assets::spot()),
+    }
+}

@@ -1,0 +1,122 @@
+//! The `pelage` binary as a user runs it: output, errors, exit codes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn pelage(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pelage"))
+        .args(args)
+        .output()
+        .expect("the pelage binary runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn repo(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(path)
+}
+
+fn blub() -> String {
+    repo("../shared/data/meshes/blub_triangulated.obj")
+        .display()
+        .to_string()
+}
+
+/// The value column of `pelage info`'s row `label`.
+fn row<'a>(table: &'a str, label: &str) -> &'a str {
+    table
+        .lines()
+        .find(|l| l.starts_with(label) && l[label.len()..].starts_with("  "))
+        .unwrap_or_else(|| panic!("no row {label:?} in\n{table}"))[label.len()..]
+        .trim()
+}
+
+#[test]
+fn info_on_blub_reports_its_counts() {
+    let out = pelage(&["info", &blub()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let table = stdout(&out);
+    assert_eq!(row(&table, "triangles"), "14,208");
+    assert_eq!(row(&table, "vertices"), "7,106");
+    assert!(row(&table, "UVs").starts_with("yes"));
+    assert_eq!(row(&table, "boundary edges"), "0");
+}
+
+#[test]
+fn info_on_subdivided_blub_has_four_times_the_triangles_and_the_same_area() {
+    let json = |args: &[&str]| {
+        let out = pelage(args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stdout(&out)
+    };
+    let field = |text: &str, key: &str| -> f64 {
+        let start = text.find(&format!("\"{key}\":")).unwrap() + key.len() + 3;
+        let end = text[start..].find([',', '}']).unwrap() + start;
+        text[start..end].parse().unwrap()
+    };
+    let base = json(&["info", "--json", &blub()]);
+    let fine = json(&["info", "--json", "--subdivide", "1", &blub()]);
+    assert_eq!(field(&fine, "triangles"), 4.0 * field(&base, "triangles"));
+    let (a0, a1) = (field(&base, "surface_area"), field(&fine, "surface_area"));
+    assert!((a1 - a0).abs() / a0 < 1e-5, "{a0} vs {a1}");
+}
+
+#[test]
+fn info_without_a_mesh_describes_the_embedded_spot() {
+    let out = pelage(&["info"]);
+    assert!(out.status.success());
+    let table = stdout(&out);
+    assert_eq!(row(&table, "mesh"), "embedded spot");
+    assert_eq!(row(&table, "triangles"), "5,856");
+}
+
+#[test]
+fn a_bad_file_is_an_error_with_its_name_and_line_and_exit_code_2() {
+    let bad = repo("tests/data/bad/obj_index_zero.obj");
+    let out = pelage(&["info", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(err.starts_with("error: cannot load the mesh: "), "{err}");
+    assert!(
+        err.contains("obj_index_zero.obj:5: vertex index 0 is out of range"),
+        "{err}"
+    );
+    assert!(stdout(&out).is_empty());
+}
+
+#[test]
+fn version_and_help_work() {
+    let out = pelage(&["--version"]);
+    assert!(out.status.success());
+    assert_eq!(
+        stdout(&out).trim(),
+        format!("pelage {}", env!("CARGO_PKG_VERSION"))
+    );
+    let out = pelage(&["--help"]);
+    assert!(out.status.success());
+    for command in ["info", "demo"] {
+        assert!(stdout(&out).contains(command));
+    }
+}
+
+#[test]
+fn demo_runs_on_the_embedded_asset_from_any_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_pelage"))
+        .arg("demo")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains("embedded spot"));
+    assert!(text.contains("subdivided ×2: 93,696 triangles"));
+}
