@@ -8,6 +8,8 @@
 //! - [`map`]: [`Map`], a scalar field over UV (constant, image, noise). Every
 //!   groom parameter is a map (Sik, section 4: "every user parameter … is
 //!   also specified by a texture").
+//! - [`sample`]: hair roots: points distributed by a density map (Sik §3),
+//!   deterministic by `(seed, index)`.
 //! - [`assets`]: the embedded demo mesh (Spot), so every command works with
 //!   no files at hand.
 //!
@@ -18,6 +20,7 @@
 pub mod assets;
 pub mod map;
 pub mod mesh;
+pub mod sample;
 
 pub use map::{Map, MapError};
 pub use mesh::{Mesh, MeshError, SurfacePoint, TangentFrame};

@@ -73,6 +73,28 @@ impl Wrap {
     }
 }
 
+/// How texels are interpolated between their centres.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Filter {
+    /// Bilinear between the four nearest texel centres (smooth).
+    #[default]
+    Bilinear,
+    /// The texel the UV falls in (piecewise constant: a painted zero stays
+    /// exactly zero up to the texel's edge).
+    Nearest,
+}
+
+impl Filter {
+    /// Parses `bilinear`/`linear` or `nearest`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "bilinear" | "linear" => Some(Self::Bilinear),
+            "nearest" => Some(Self::Nearest),
+            _ => None,
+        }
+    }
+}
+
 /// One channel of an image as f32 texels, rows from the top.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImageMap {
@@ -80,6 +102,7 @@ pub struct ImageMap {
     height: u32,
     texels: Vec<f32>,
     wrap: Wrap,
+    filter: Filter,
 }
 
 impl ImageMap {
@@ -147,6 +170,7 @@ impl ImageMap {
             height,
             texels,
             wrap,
+            filter: Filter::Bilinear,
         })
     }
 
@@ -170,13 +194,49 @@ impl ImageMap {
         self.wrap
     }
 
+    /// The filter.
+    pub fn filter(&self) -> Filter {
+        self.filter
+    }
+
+    /// The same map with another filter.
+    pub fn with_filter(mut self, filter: Filter) -> Self {
+        self.filter = filter;
+        self
+    }
+
+    /// The largest texel value (an upper bound of the filtered map).
+    pub fn max_texel(&self) -> f32 {
+        self.texels
+            .iter()
+            .copied()
+            .fold(f32::NEG_INFINITY, f32::max)
+    }
+
     /// The texel at column `x`, row `y` (from the top).
     pub fn texel(&self, x: u32, y: u32) -> f32 {
         self.texels[y as usize * self.width as usize + x as usize]
     }
 
-    /// Bilinearly filtered value at `uv`; v = 0 is the bottom row.
+    /// Filtered value at `uv`; v = 0 is the bottom row.
     pub fn eval(&self, uv: Vec2) -> f32 {
+        match self.filter {
+            Filter::Bilinear => self.eval_bilinear(uv),
+            Filter::Nearest => self.eval_nearest(uv),
+        }
+    }
+
+    fn eval_nearest(&self, uv: Vec2) -> f32 {
+        let x = (uv.x * self.width as f32).floor() as i64;
+        let y = ((1.0 - uv.y) * self.height as f32).floor() as i64;
+        let (x, y) = (
+            self.wrap.index(x, self.width),
+            self.wrap.index(y, self.height),
+        );
+        self.texels[y * self.width as usize + x]
+    }
+
+    fn eval_bilinear(&self, uv: Vec2) -> f32 {
         let x = uv.x * self.width as f32 - 0.5;
         let y = (1.0 - uv.y) * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
@@ -209,6 +269,18 @@ mod tests {
         assert_eq!(m.eval(Vec2::new(0.75, 0.75)), 2.0);
         assert_eq!(m.eval(Vec2::new(0.25, 0.25)), 3.0); // bottom-left
         assert_eq!(m.eval(Vec2::new(0.5, 0.5)), 2.5); // bilinear centre
+    }
+
+    #[test]
+    fn nearest_is_constant_over_each_texel() {
+        let m = ImageMap::from_texels(2, 2, vec![1.0, 2.0, 3.0, 4.0], Wrap::Clamp)
+            .unwrap()
+            .with_filter(Filter::Nearest);
+        assert_eq!(m.eval(Vec2::new(0.01, 0.99)), 1.0);
+        assert_eq!(m.eval(Vec2::new(0.49, 0.51)), 1.0);
+        assert_eq!(m.eval(Vec2::new(0.51, 0.51)), 2.0);
+        assert_eq!(m.eval(Vec2::new(0.49, 0.49)), 3.0);
+        assert_eq!(m.max_texel(), 4.0);
     }
 
     #[test]

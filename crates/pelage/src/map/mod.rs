@@ -15,7 +15,7 @@ mod image;
 mod noise;
 mod spec;
 
-pub use self::image::{Channel, ImageMap, Wrap};
+pub use self::image::{Channel, Filter, ImageMap, Wrap};
 pub use self::noise::NoiseMap;
 
 use crate::mesh::{Mesh, SurfacePoint};
@@ -95,6 +95,32 @@ impl Map {
             Map::Constant(c) => *c,
             Map::Image(image) => image.eval(uv),
             Map::Noise(noise) => noise.eval(uv),
+        }
+    }
+
+    /// A value no evaluation exceeds: the constant, the largest texel, or
+    /// `offset + |scale|` for noise (fBm is normalised to [−1, 1]).
+    pub fn upper_bound(&self) -> f32 {
+        match self {
+            Map::Constant(c) => *c,
+            Map::Image(image) => image.max_texel(),
+            Map::Noise(noise) => noise.offset + noise.scale.abs(),
+        }
+    }
+
+    /// How finely the map varies, as a texel grid `(width, height)` over
+    /// the unit UV square: the image size, or for noise four samples per
+    /// cell of its finest octave; `None` for a constant. Samplers subdivide
+    /// triangles until each covers at most one such texel (Sik §3.1).
+    pub fn resolution(&self) -> Option<(u32, u32)> {
+        match self {
+            Map::Constant(_) => None,
+            Map::Image(image) => Some((image.width(), image.height())),
+            Map::Noise(noise) => {
+                let finest = noise.frequency.abs() * 2f32.powi(noise.octaves as i32 - 1);
+                let n = (4.0 * finest).ceil().clamp(1.0, 65_536.0) as u32;
+                Some((n, n))
+            }
         }
     }
 

@@ -2,12 +2,12 @@
 //!
 //! - a number: `0.5` (a constant);
 //! - an image: `density.png`, with optional `:channel` (`luminance`, `r`,
-//!   `g`, `b`, `a`) and `:wrap` (`repeat`, `clamp`) suffixes in any order,
-//!   e.g. `mask.exr:a:clamp`;
+//!   `g`, `b`, `a`), `:wrap` (`repeat`, `clamp`) and `:filter` (`bilinear`,
+//!   `nearest`) suffixes in any order, e.g. `mask.exr:a:clamp:nearest`;
 //! - noise: `noise` or `noise:frequency=8,octaves=4,seed=3,offset=0.5,scale=0.5`
 //!   (any subset of the keys; `freq` is accepted for `frequency`).
 
-use super::{Channel, ImageMap, Map, MapError, MapErrorKind, NoiseMap, Wrap};
+use super::{Channel, Filter, ImageMap, Map, MapError, MapErrorKind, NoiseMap, Wrap};
 use std::path::Path;
 
 impl Map {
@@ -45,11 +45,14 @@ impl Map {
         let mut path = spec;
         let mut channel = None;
         let mut wrap = None;
+        let mut filter = None;
         while let Some((head, suffix)) = path.rsplit_once(':') {
             if let (None, Some(c)) = (channel, Channel::parse(suffix)) {
                 channel = Some(c);
             } else if let (None, Some(w)) = (wrap, Wrap::parse(suffix)) {
                 wrap = Some(w);
+            } else if let (None, Some(f)) = (filter, Filter::parse(suffix)) {
+                filter = Some(f);
             } else {
                 break;
             }
@@ -59,7 +62,8 @@ impl Map {
             Some(dir) if Path::new(path).is_relative() => dir.join(path),
             _ => Path::new(path).to_path_buf(),
         };
-        ImageMap::load(&full, channel.unwrap_or_default(), wrap.unwrap_or_default()).map(Map::Image)
+        ImageMap::load(&full, channel.unwrap_or_default(), wrap.unwrap_or_default())
+            .map(|image| Map::Image(image.with_filter(filter.unwrap_or_default())))
     }
 }
 
@@ -142,11 +146,12 @@ mod tests {
             .unwrap()
             .save(&path)
             .unwrap();
-        let spec = format!("{}:a:clamp", path.display());
+        let spec = format!("{}:a:nearest:clamp", path.display());
         let Map::Image(img) = Map::parse(&spec).unwrap() else {
             panic!()
         };
         assert_eq!(img.wrap(), Wrap::Clamp);
+        assert_eq!(img.filter(), Filter::Nearest);
         assert!((img.texel(0, 0) - 0.2).abs() < 1e-6);
         let Map::Image(img) = Map::parse_with_base("m.png:r", Some(dir.path())).unwrap() else {
             panic!()
