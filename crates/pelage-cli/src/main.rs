@@ -25,6 +25,8 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Run the demo on the embedded Spot mesh.
     Demo(commands::demo::DemoArgs),
+    /// Measure a capability against its paper's figures.
+    Bench(commands::bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -32,6 +34,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
+        Command::Bench(args) => commands::bench::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -65,12 +65,54 @@ impl Wrap {
         }
     }
 
-    fn index(self, i: i64, n: u32) -> usize {
+    /// The texel holding coordinate `c` (in image widths) on an axis of `n`.
+    #[inline]
+    fn nearest(self, c: f32, n: u32) -> usize {
+        let c = match self {
+            Self::Repeat => c - floor(c),
+            Self::Clamp => c,
+        };
+        (floor(c * n as f32).max(0.0) as usize).min(n as usize - 1)
+    }
+
+    /// The two texels around coordinate `c` (in image widths) on an axis
+    /// of `n` texels and the blend between them. No division and no libm
+    /// call: this is the density sampler's innermost work.
+    #[inline]
+    fn bilinear(self, c: f32, n: u32) -> (usize, usize, f32) {
+        let last = n as i32 - 1;
         match self {
-            Self::Repeat => i.rem_euclid(i64::from(n)) as usize,
-            Self::Clamp => i.clamp(0, i64::from(n) - 1) as usize,
+            Self::Repeat => {
+                // Into [0, 1); rounding may give exactly 1, handled below.
+                let c = c - floor(c);
+                let x = c * n as f32 - 0.5;
+                let x0 = floor(x);
+                let i = x0 as i32;
+                let a = if i < 0 { last } else { i.min(last) };
+                let b = if i >= last { 0 } else { i + 1 };
+                (a as usize, b as usize, x - x0)
+            }
+            Self::Clamp => {
+                let x = c * n as f32 - 0.5;
+                let x0 = floor(x);
+                let i = x0 as i32;
+                (
+                    i.clamp(0, last) as usize,
+                    (i + 1).clamp(0, last) as usize,
+                    x - x0,
+                )
+            }
         }
     }
+}
+
+/// `x.floor()` without a libm call: Rust's baseline x86-64 target has no
+/// SSE4.1 rounding instruction, and texture lookups are the density
+/// sampler's hot path. Exact for |x| < 2³¹.
+#[inline]
+fn floor(x: f32) -> f32 {
+    let t = x as i32 as f32;
+    if t > x { t - 1.0 } else { t }
 }
 
 /// How texels are interpolated between their centres.
@@ -227,32 +269,18 @@ impl ImageMap {
     }
 
     fn eval_nearest(&self, uv: Vec2) -> f32 {
-        let x = (uv.x * self.width as f32).floor() as i64;
-        let y = ((1.0 - uv.y) * self.height as f32).floor() as i64;
-        let (x, y) = (
-            self.wrap.index(x, self.width),
-            self.wrap.index(y, self.height),
-        );
+        let x = self.wrap.nearest(uv.x, self.width);
+        let y = self.wrap.nearest(1.0 - uv.y, self.height);
         self.texels[y * self.width as usize + x]
     }
 
     fn eval_bilinear(&self, uv: Vec2) -> f32 {
-        let x = uv.x * self.width as f32 - 0.5;
-        let y = (1.0 - uv.y) * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let xs = [
-            self.wrap.index(x0, self.width),
-            self.wrap.index(x0 + 1, self.width),
-        ];
-        let ys = [
-            self.wrap.index(y0, self.height),
-            self.wrap.index(y0 + 1, self.height),
-        ];
-        let at = |xi: usize, yi: usize| self.texels[ys[yi] * self.width as usize + xs[xi]];
-        let top = at(0, 0) + fx * (at(1, 0) - at(0, 0));
-        let bottom = at(0, 1) + fx * (at(1, 1) - at(0, 1));
+        let (x0, x1, fx) = self.wrap.bilinear(uv.x, self.width);
+        let (y0, y1, fy) = self.wrap.bilinear(1.0 - uv.y, self.height);
+        let row = self.width as usize;
+        let (r0, r1) = (&self.texels[y0 * row..], &self.texels[y1 * row..]);
+        let top = r0[x0] + fx * (r0[x1] - r0[x0]);
+        let bottom = r1[x0] + fx * (r1[x1] - r1[x0]);
         top + fy * (bottom - top)
     }
 }

@@ -27,42 +27,52 @@ pub struct AliasTable {
 impl AliasTable {
     /// Builds the table of `weights` (non-negative, not all zero).
     pub fn new(weights: impl IntoIterator<Item = f64>) -> Self {
-        let weights: Vec<f64> = weights.into_iter().collect();
-        let n = weights.len();
-        let total: f64 = weights.iter().sum();
+        // Scaled in place so the average bin holds exactly 1.
+        let mut scaled: Vec<f64> = weights.into_iter().collect();
+        let n = scaled.len();
+        let total: f64 = scaled.iter().sum();
         assert!(total > 0.0, "AliasTable needs a positive total weight");
-        // Scaled so the average bin holds exactly 1.
-        let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
+        let factor = n as f64 / total;
+        scaled.iter_mut().for_each(|w| *w *= factor);
+
         let mut bins: Vec<AliasBin> = (0..n as u32)
             .map(|i| AliasBin {
                 threshold: u32::MAX,
                 alias: i,
             })
             .collect();
-        let mut small: Vec<u32> = Vec::new();
-        let mut large: Vec<u32> = Vec::new();
+        // Vose's two work lists share one buffer: "small" (< 1) grows up
+        // from the front, "large" (≥ 1) down from the back. Together they
+        // never hold more than n entries, so nothing reallocates.
+        let mut work = vec![0u32; n];
+        let (mut small, mut large) = (0usize, n);
         for (i, &p) in scaled.iter().enumerate() {
             if p < 1.0 {
-                small.push(i as u32)
+                work[small] = i as u32;
+                small += 1;
             } else {
-                large.push(i as u32)
+                large -= 1;
+                work[large] = i as u32;
             }
         }
-        while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
-            small.pop();
-            let p = scaled[s as usize];
-            bins[s as usize] = AliasBin {
-                threshold: (p * 4_294_967_296.0).round().min(u32::MAX as f64) as u32,
+        while small > 0 && large < n {
+            small -= 1;
+            let s = work[small] as usize;
+            let l = work[large];
+            let p = scaled[s];
+            bins[s] = AliasBin {
+                threshold: (p * 4_294_967_296.0 + 0.5).min(u32::MAX as f64) as u32,
                 alias: l,
             };
             scaled[l as usize] -= 1.0 - p;
             if scaled[l as usize] < 1.0 {
-                large.pop();
-                small.push(l);
+                large += 1;
+                work[small] = l;
+                small += 1;
             }
         }
-        // What remains holds 1 up to rounding: keep itself always (the
-        // default bin, alias = itself, so the 2⁻³² coin case is harmless).
+        // What remains holds 1 up to rounding: it keeps itself always (the
+        // default bin has alias = itself, so the 2⁻³² coin case is harmless).
         Self { bins }
     }
 
@@ -79,7 +89,24 @@ impl AliasTable {
     /// Selects a record from 64 random bits.
     #[inline]
     pub fn select(&self, bits: u64) -> usize {
-        let bin = (((bits >> 32) * self.bins.len() as u64) >> 32) as usize;
+        self.resolve(self.bin_of(bits), bits)
+    }
+
+    /// The bin that `bits` draws (the first of the two steps of `select`).
+    #[inline]
+    pub fn bin_of(&self, bits: u64) -> usize {
+        (((bits >> 32) * self.bins.len() as u64) >> 32) as usize
+    }
+
+    /// The bin itself, for prefetching.
+    #[inline]
+    pub fn bin(&self, bin: usize) -> &AliasBin {
+        &self.bins[bin]
+    }
+
+    /// The record that `bits` selects in `bin` (the second step).
+    #[inline]
+    pub fn resolve(&self, bin: usize, bits: u64) -> usize {
         let b = self.bins[bin];
         if (bits as u32) < b.threshold {
             bin

@@ -37,7 +37,7 @@ impl CdfGrid {
             .iter()
             .map(|w| {
                 running += w;
-                ((running / total) * FULL as f64).round().min(FULL as f64) as u32
+                ((running / total) * FULL as f64 + 0.5).min(FULL as f64) as u32
             })
             .collect();
         if let Some(last) = cdf.last_mut() {
@@ -81,17 +81,56 @@ impl CdfGrid {
     /// `argmin_i F(i) > ξ` with `ξ` uniform in [0, F(last)).
     #[inline]
     pub fn select(&self, bits: u64) -> usize {
-        let xi = ((bits >> 32) * FULL) >> 32;
-        let (lo, hi) = if self.cell_begin.is_empty() {
+        self.search(bits, self.range_of(bits))
+    }
+
+    /// The grid cell's entry that `bits` falls in (for prefetching), or the
+    /// first CDF entry without a grid.
+    #[inline]
+    pub fn cell_entry(&self, bits: u64) -> &u32 {
+        if self.cell_begin.is_empty() {
+            &self.cdf[0]
+        } else {
+            &self.cell_begin[self.cell_of(Self::xi(bits))]
+        }
+    }
+
+    /// The index range of the CDF that `bits` can select (first step).
+    #[inline]
+    pub fn range_of(&self, bits: u64) -> (usize, usize) {
+        if self.cell_begin.is_empty() {
             (0, self.cdf.len() - 1)
         } else {
-            let cell = ((xi * self.cell_count() as u64) >> 32) as usize;
+            let cell = self.cell_of(Self::xi(bits));
             (
                 self.cell_begin[cell] as usize,
                 self.cell_begin[cell + 1] as usize,
             )
-        };
+        }
+    }
+
+    /// The CDF entry at `i`, for prefetching.
+    #[inline]
+    pub fn entry(&self, i: usize) -> &u32 {
+        &self.cdf[i]
+    }
+
+    /// Bisection inside `(lo, hi)` (second step).
+    #[inline]
+    pub fn search(&self, bits: u64, (lo, hi): (usize, usize)) -> usize {
+        let xi = Self::xi(bits);
         lo + self.cdf[lo..=hi].partition_point(|&f| u64::from(f) <= xi)
+    }
+
+    /// ξ uniform in [0, F(last)) from the high 32 bits.
+    #[inline]
+    fn xi(bits: u64) -> u64 {
+        ((bits >> 32) * FULL) >> 32
+    }
+
+    #[inline]
+    fn cell_of(&self, xi: u64) -> usize {
+        ((xi * self.cell_count() as u64) >> 32) as usize
     }
 
     /// Probability of record `i` as the selector realises it.

@@ -7,7 +7,7 @@
 //! - [`RejectionSampler`]: the paper's baseline (§3.4.1).
 //!
 //! Both implement [`SurfaceSampler`]: sample `i` is a pure function of
-//! `(seed, i)` ([`SampleRng`]), and each sampler gives its probability
+//! `(seed, i)` ([`PairDraws`], [`SampleRng`]), and each sampler gives its probability
 //! density per unit area, pbrt style, so tests compare histograms with it.
 //! [`sample_range`] generates any index range in parallel.
 //!
@@ -25,7 +25,7 @@ pub use alias::{AliasBin, AliasTable};
 pub use cdf::CdfGrid;
 pub use density::{DensitySampler, DensitySamplerOptions, Selector, SubTriangleRecord};
 pub use rejection::RejectionSampler;
-pub use rng::{SampleRng, mix64};
+pub use rng::{PairDraws, SampleRng, mix64, open_unit_pair};
 
 use crate::mesh::SurfacePoint;
 use rayon::prelude::*;
@@ -39,6 +39,30 @@ pub trait SurfaceSampler: Sync {
     /// Probability density per unit area at `point`, normalised over the
     /// mesh (0 where the sampler never goes).
     fn pdf(&self, point: SurfacePoint) -> f64;
+
+    /// Fills `out` with samples `first..first + out.len()`. The same
+    /// points as calling [`SurfaceSampler::sample`] for each index; a
+    /// sampler may override it to overlap the memory reads of many samples.
+    fn sample_block(&self, seed: u64, first: u64, out: &mut [SurfacePoint]) {
+        for (k, slot) in out.iter_mut().enumerate() {
+            *slot = self.sample(seed, first + k as u64);
+        }
+    }
+}
+
+/// Asks the CPU to start loading the cache line holding `value`; a hint
+/// with no effect on results.
+#[inline(always)]
+pub(crate) fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: prefetching is only a hint; it never faults, even for
+    // addresses that are not mapped, and `value` is a valid reference.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>((value as *const T).cast::<i8>());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
 }
 
 /// Samples `range` of stream `seed` in parallel (rayon's current pool).
@@ -63,12 +87,13 @@ pub fn sample_into<S: SurfaceSampler + ?Sized>(
     out: &mut [SurfacePoint],
 ) {
     const CHUNK: usize = 16 * 1024;
+    const BLOCK: usize = 64;
     out.par_chunks_mut(CHUNK)
         .enumerate()
         .for_each(|(c, chunk)| {
             let start = first + (c * CHUNK) as u64;
-            for (k, slot) in chunk.iter_mut().enumerate() {
-                *slot = sampler.sample(seed, start + k as u64);
+            for (b, block) in chunk.chunks_mut(BLOCK).enumerate() {
+                sampler.sample_block(seed, start + (b * BLOCK) as u64, block);
             }
         });
 }

@@ -3,10 +3,17 @@
 //! on any number of threads, with identical results (DESIGN.md,
 //! "Deterministic by hair id").
 //!
-//! Each `(seed, index)` pair is hashed into a SplitMix64 state; the stream
-//! then steps SplitMix64 (Steele et al. 2014), whose output function is a
-//! strong 64-bit mixer. A sample draws a handful of numbers, far below the
-//! distance at which two hashed streams could overlap.
+//! Two forms, both SplitMix64 (Steele et al. 2014, "Fast splittable
+//! pseudorandom number generators"), whose output is a strong 64-bit mix of
+//! a counter:
+//!
+//! - [`PairDraws`]: a sample that needs exactly two 64-bit draws takes
+//!   outputs `2i` and `2i + 1` of the stream keyed by the seed: two mixes,
+//!   no state. The density sampler uses it.
+//! - [`SampleRng`]: a sample that needs an unknown number of draws (the
+//!   rejection sampler) gets its own stream, started at a hash of
+//!   `(seed, index)`; it draws a handful of numbers, far below the distance
+//!   at which two hashed streams could overlap.
 
 /// The random stream of one sample (or one hair).
 #[derive(Debug, Clone)]
@@ -23,6 +30,44 @@ pub fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
+}
+
+/// Exactly two 64-bit draws per sample index: SplitMix64's outputs `2i`
+/// and `2i + 1` of the stream whose start the seed gives.
+#[derive(Debug, Clone, Copy)]
+pub struct PairDraws {
+    start: u64,
+}
+
+impl PairDraws {
+    /// The stream of `seed`.
+    #[inline]
+    pub fn new(seed: u64) -> Self {
+        Self {
+            start: mix64(seed ^ 0x243F_6A88_85A3_08D3),
+        }
+    }
+
+    /// The two draws of sample `index`.
+    #[inline]
+    pub fn draws(&self, index: u64) -> [u64; 2] {
+        let position = self
+            .start
+            .wrapping_add(index.wrapping_mul(2).wrapping_mul(GOLDEN_GAMMA));
+        [
+            mix64(position.wrapping_add(GOLDEN_GAMMA)),
+            mix64(position.wrapping_add(GOLDEN_GAMMA.wrapping_mul(2))),
+        ]
+    }
+}
+
+/// Two uniform numbers in (0, 1) from one 64-bit draw (24 bits each).
+#[inline]
+pub fn open_unit_pair(bits: u64) -> [f32; 2] {
+    [
+        open_unit((bits >> 40) as u32),
+        open_unit(((bits >> 8) & 0xFF_FFFF) as u32),
+    ]
 }
 
 /// `(k + ½) / 2²⁴` for a 24-bit `k`; exact in f32.
@@ -58,11 +103,7 @@ impl SampleRng {
     /// Two independent uniform numbers in (0, 1) from one 64-bit draw.
     #[inline]
     pub fn uniform_f32_pair(&mut self) -> [f32; 2] {
-        let bits = self.next_u64();
-        [
-            open_unit((bits >> 40) as u32),
-            open_unit(((bits >> 8) & 0xFF_FFFF) as u32),
-        ]
+        open_unit_pair(self.next_u64())
     }
 }
 
@@ -85,6 +126,18 @@ mod tests {
             SampleRng::new(7, 1).next_u64(),
             SampleRng::new(7, 2).next_u64()
         );
+    }
+
+    #[test]
+    fn pair_draws_do_not_repeat_across_neighbouring_samples() {
+        let d = PairDraws::new(5);
+        let mut seen = std::collections::HashSet::new();
+        for i in 0..10_000 {
+            for x in d.draws(i) {
+                assert!(seen.insert(x), "draw repeated at sample {i}");
+            }
+        }
+        assert_ne!(PairDraws::new(5).draws(0), PairDraws::new(6).draws(0));
     }
 
     #[test]

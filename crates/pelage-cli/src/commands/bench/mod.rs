@@ -1,0 +1,57 @@
+//! `pelage bench <what>`: the benchmarks. Each prints our figures beside
+//! the paper's (and, where there is one, a peer's measured in the same
+//! run) as a table, or as one JSON object with `--json`.
+//!
+//! Machines here are small and noisy: every figure is the median of several
+//! runs, and comparisons are ratios taken within one run.
+
+pub mod sampler;
+
+use clap::{Args, Subcommand};
+use std::time::Instant;
+
+/// Arguments of `pelage bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    pub what: BenchWhat,
+}
+
+/// What to measure.
+#[derive(Debug, Subcommand)]
+pub enum BenchWhat {
+    /// Root sampling (Sik §3, Tables 1–3, Figs. 8–9).
+    Sampler(sampler::SamplerBenchArgs),
+}
+
+pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    match &args.what {
+        BenchWhat::Sampler(a) => sampler::run(a),
+    }
+}
+
+/// Median wall time in seconds of `runs` calls of `f` (after one warm-up
+/// call when `warm_up`), and the last result.
+pub fn median_seconds<T>(runs: usize, warm_up: bool, mut f: impl FnMut() -> T) -> (f64, T) {
+    if warm_up {
+        drop(f());
+    }
+    let mut times = Vec::with_capacity(runs);
+    let mut last = None;
+    for _ in 0..runs.max(1) {
+        let start = Instant::now();
+        let value = f();
+        times.push(start.elapsed().as_secs_f64());
+        last = Some(value);
+    }
+    times.sort_by(f64::total_cmp);
+    (times[times.len() / 2], last.expect("at least one run"))
+}
+
+/// Runs `f` on a rayon pool of `threads` threads.
+pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> anyhow::Result<T> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
+    Ok(pool.install(f))
+}

@@ -1,0 +1,488 @@
+//! `pelage bench sampler`: the structure of Sik's Tables 1–3 and Figs. 8–9
+//! on the shared meshes (blub ×1 ≈ the bunny's size, spot ×2, spot ×4 ≈
+//! Buddha), Perlin density textures at 512²–2048², grid sizes 0–400 %,
+//! density means 1.0 / 0.5 / 0.25 / 0.1, for CDF + grid, alias and
+//! rejection side by side, with the paper's figures in a column.
+
+use super::{median_seconds, on_threads};
+use crate::format::thousands;
+use anyhow::Context;
+use clap::Args;
+use pelage::map::{ImageMap, Map, NoiseMap, Wrap};
+use pelage::mesh::{Mesh, SurfacePoint};
+use pelage::sample::{
+    DensitySampler, DensitySamplerOptions, RejectionSampler, Selector, SubTriangleRecord,
+    SurfaceSampler, sample_into,
+};
+use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Arguments of `pelage bench sampler`.
+#[derive(Debug, Args)]
+pub struct SamplerBenchArgs {
+    /// A reduced run that finishes in under 30 s.
+    #[arg(long)]
+    pub quick: bool,
+    /// Print one JSON object instead of tables.
+    #[arg(long)]
+    pub json: bool,
+    /// Folder with blub_triangulated.obj (the shared test meshes).
+    #[arg(long, default_value = "../shared/data/meshes")]
+    pub meshes: PathBuf,
+}
+
+struct Plan {
+    samples: usize,
+    runs: usize,
+    resolutions: Vec<u32>,
+    grids: Vec<u32>,
+    models: Vec<(&'static str, u32)>,
+}
+
+/// A Perlin density texture like the paper's: fBm noise baked into an image,
+/// values in [0, 1], scaled so its mean is `mean` (1.0 = uniform).
+fn perlin_texture(size: u32, mean: f32) -> Map {
+    if mean >= 1.0 {
+        return Map::Constant(1.0);
+    }
+    let noise = NoiseMap::new(8.0, 4, 1, 0.5, 0.5);
+    let texels: Vec<f32> = (0..size * size)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i % size, i / size);
+            let uv = glam::Vec2::new(
+                (x as f32 + 0.5) / size as f32,
+                1.0 - (y as f32 + 0.5) / size as f32,
+            );
+            noise.eval(uv).clamp(0.0, 1.0)
+        })
+        .collect();
+    let average = texels.iter().map(|&t| f64::from(t)).sum::<f64>() / texels.len() as f64;
+    let scale = (f64::from(mean) / average) as f32;
+    let texels = texels.into_iter().map(|t| (t * scale).min(1.0)).collect();
+    Map::Image(
+        ImageMap::from_texels(size, size, texels, Wrap::Repeat).expect("texture size is valid"),
+    )
+}
+
+fn options(selector: Selector) -> DensitySamplerOptions {
+    DensitySamplerOptions {
+        selector,
+        ..Default::default()
+    }
+}
+
+/// Samples per second: median over runs of filling a buffer of `n`.
+fn rate(
+    sampler: &(impl SurfaceSampler + ?Sized),
+    n: usize,
+    runs: usize,
+    threads: usize,
+) -> anyhow::Result<f64> {
+    let mut buffer = vec![SurfacePoint::default(); n];
+    let (seconds, ()) = on_threads(threads, || {
+        median_seconds(runs, true, || sample_into(sampler, 1, 0, &mut buffer))
+    })?;
+    Ok(n as f64 / seconds)
+}
+
+struct Row {
+    cells: Vec<String>,
+}
+
+fn table(title: &str, header: &[&str], rows: &[Row]) -> String {
+    let mut widths: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for r in rows {
+        for (w, c) in widths.iter_mut().zip(&r.cells) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let mut out = format!("\n{title}\n");
+    let line = |cells: Vec<&str>| {
+        cells
+            .iter()
+            .zip(&widths)
+            .map(|(c, w)| format!("{c:>w$}"))
+            .collect::<Vec<_>>()
+            .join("  ")
+    };
+    let _ = writeln!(out, "{}", line(header.to_vec()));
+    for r in rows {
+        let _ = writeln!(
+            out,
+            "{}",
+            line(r.cells.iter().map(String::as_str).collect())
+        );
+    }
+    out
+}
+
+fn mega(x: f64) -> String {
+    format!("{:.1} M/s", x / 1e6)
+}
+
+fn mb(bytes: usize) -> String {
+    format!("{:.2} MB", bytes as f64 / 1e6)
+}
+
+pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
+    let plan = if args.quick {
+        Plan {
+            samples: 2_000_000,
+            runs: 3,
+            resolutions: vec![1024],
+            grids: vec![0, 100],
+            models: vec![("blub ×1", 1)],
+        }
+    } else {
+        Plan {
+            samples: 10_000_000,
+            runs: 5,
+            resolutions: vec![512, 1024, 2048],
+            grids: vec![0, 13, 25, 50, 100, 200, 400],
+            models: vec![("blub ×1", 1), ("spot ×2", 2), ("spot ×4", 4)],
+        }
+    };
+    let threads = rayon::current_num_threads();
+    let blub_path = args.meshes.join("blub_triangulated.obj");
+    let blub = Mesh::load(&blub_path)
+        .with_context(|| {
+            format!("the sampler benchmark needs blub (give the folder with --meshes)")
+        })?
+        .subdivided(1);
+    let spot = pelage::assets::spot();
+    let mesh_for = |name: &str, k: u32| {
+        if name.starts_with("blub") {
+            blub.clone()
+        } else {
+            spot.subdivided(k)
+        }
+    };
+
+    let mut report = String::new();
+    let mut json: Vec<(String, String)> = Vec::new();
+    let _ = writeln!(
+        report,
+        "pelage bench sampler{} — {threads} threads, {} samples per rate, median of {} runs",
+        if args.quick { " --quick" } else { "" },
+        thousands(plan.samples as u64),
+        plan.runs
+    );
+    let _ = writeln!(
+        report,
+        "blub ×1: {} triangles. Paper: one core of a 3.07 GHz PC (2012); bunny 69k triangles.",
+        thousands(blub.triangle_count() as u64)
+    );
+
+    // Headline case: blub ×1, 1024² Perlin, the default selector.
+    let perlin_1024 = perlin_texture(1024, 0.5);
+    let (pre_s, sampler) = median_seconds(plan.runs, true, || {
+        DensitySampler::new(&blub, &perlin_1024, DensitySamplerOptions::default())
+    });
+    let sampler = sampler?;
+    let rate_1t = rate(&sampler, plan.samples, plan.runs, 1)?;
+    let rate_all = rate(&sampler, plan.samples, plan.runs, threads)?;
+    let rows = vec![
+        Row {
+            cells: vec![
+                "preprocess".into(),
+                format!("{:.1} ms", pre_s * 1e3),
+                "70 ms".into(),
+                "≤ 20 ms".into(),
+            ],
+        },
+        Row {
+            cells: vec![
+                "records".into(),
+                thousands(sampler.records().len() as u64),
+                "—".into(),
+                "".into(),
+            ],
+        },
+        Row {
+            cells: vec![
+                "bytes per record".into(),
+                std::mem::size_of::<SubTriangleRecord>().to_string(),
+                "12".into(),
+                "≤ 12".into(),
+            ],
+        },
+        Row {
+            cells: vec![
+                "memory".into(),
+                mb(sampler.memory_bytes()),
+                "5.33 MB".into(),
+                "".into(),
+            ],
+        },
+        Row {
+            cells: vec![
+                "samples/s, 1 thread".into(),
+                mega(rate_1t),
+                "6.3 M/s".into(),
+                "≥ 60 M/s".into(),
+            ],
+        },
+        Row {
+            cells: vec![
+                format!("samples/s, {threads} threads"),
+                mega(rate_all),
+                "—".into(),
+                "Blender 5 ≈ 10 M/s on 2 threads".into(),
+            ],
+        },
+    ];
+    report += &table(
+        "Headline: blub ×1, 1024² Perlin density, alias selector (default)",
+        &["", "pelage", "paper", "target"],
+        &rows,
+    );
+    json.push(("preprocess_s".into(), format!("{pre_s:.6}")));
+    json.push((
+        "bytes_per_record".into(),
+        std::mem::size_of::<SubTriangleRecord>().to_string(),
+    ));
+    json.push(("records".into(), sampler.records().len().to_string()));
+    json.push(("memory_bytes".into(), sampler.memory_bytes().to_string()));
+    json.push(("samples_per_s_1t".into(), format!("{rate_1t:.0}")));
+    json.push(("samples_per_s_all_threads".into(), format!("{rate_all:.0}")));
+    json.push(("threads".into(), threads.to_string()));
+    drop(sampler);
+
+    // Table 1: grid size, uniform density on blub ×1.
+    let paper_t1 = [
+        (0, "2.37 M/s", "0.054 s", "1.33 MB"),
+        (13, "5.86 M/s", "0.055 s", "1.47 MB"),
+        (25, "5.95 M/s", "0.057 s", "1.60 MB"),
+        (50, "5.89 M/s", "0.058 s", "1.86 MB"),
+        (100, "6.39 M/s", "0.059 s", "2.39 MB"),
+        (200, "6.53 M/s", "0.061 s", "3.45 MB"),
+        (400, "6.45 M/s", "0.066 s", "5.57 MB"),
+    ];
+    let uniform = Map::Constant(1.0);
+    let mut rows = Vec::new();
+    for &grid in &plan.grids {
+        let (pre, s) = median_seconds(plan.runs, true, || {
+            DensitySampler::new(
+                &blub,
+                &uniform,
+                options(Selector::CdfGrid { grid_percent: grid }),
+            )
+        });
+        let s = s?;
+        let r = rate(&s, plan.samples, plan.runs, 1)?;
+        let paper = paper_t1.iter().find(|p| p.0 == grid);
+        rows.push(Row {
+            cells: vec![
+                format!("CDF, grid {grid} %"),
+                mega(r),
+                format!("{:.1} ms", pre * 1e3),
+                mb(s.memory_bytes()),
+                paper.map_or("—", |p| p.1).into(),
+                paper.map_or("—", |p| p.2).into(),
+                paper.map_or("—", |p| p.3).into(),
+            ],
+        });
+    }
+    let (pre, s) = median_seconds(plan.runs, true, || {
+        DensitySampler::new(&blub, &uniform, options(Selector::Alias))
+    });
+    let s = s?;
+    let alias_uniform = rate(&s, plan.samples, plan.runs, 1)?;
+    rows.push(Row {
+        cells: vec![
+            "alias".into(),
+            mega(alias_uniform),
+            format!("{:.1} ms", pre * 1e3),
+            mb(s.memory_bytes()),
+            "—".into(),
+            "—".into(),
+            "—".into(),
+        ],
+    });
+    report += &table(
+        "Table 1: selector and grid size, uniform density, blub ×1, 1 thread",
+        &[
+            "selector",
+            "samples/s",
+            "preprocess",
+            "memory",
+            "paper samples/s",
+            "paper CDF",
+            "paper memory",
+        ],
+        &rows,
+    );
+
+    // Table 2: models, 1024² Perlin.
+    let paper_t2 = [
+        "0.070 s, 2.39 MB (bunny 69k)",
+        "0.127 s, 8.68 MB (dragon 202k)",
+        "0.25 s, 51.26 MB (Buddha 1087k)",
+    ];
+    let mut rows = Vec::new();
+    for (k, &(name, level)) in plan.models.iter().enumerate() {
+        let mesh = mesh_for(name, level);
+        let (pre, s) = median_seconds(plan.runs, true, || {
+            DensitySampler::new(&mesh, &perlin_1024, DensitySamplerOptions::default())
+        });
+        let s = s?;
+        let r = rate(&s, plan.samples, plan.runs, 1)?;
+        rows.push(Row {
+            cells: vec![
+                name.into(),
+                thousands(mesh.triangle_count() as u64),
+                thousands(s.records().len() as u64),
+                format!("{:.1} ms", pre * 1e3),
+                mb(s.memory_bytes()),
+                mega(r),
+                paper_t2[k].into(),
+            ],
+        });
+        if name == "spot ×4" {
+            json.push(("spot4_preprocess_s".into(), format!("{pre:.6}")));
+        }
+    }
+    report += &table(
+        "Table 2: models, 1024² Perlin density, alias, 1 thread",
+        &[
+            "model",
+            "triangles",
+            "records",
+            "preprocess",
+            "memory",
+            "samples/s",
+            "paper",
+        ],
+        &rows,
+    );
+
+    // Table 3: texture resolution, blub ×1.
+    let paper_t3 = [
+        (512, "6.76 M/s, 0.019 s, 4.49 MB"),
+        (1024, "6.31 M/s, 0.070 s, 5.33 MB"),
+        (2048, "5.00 M/s, 0.253 s, 31.26 MB"),
+    ];
+    let mut rows = Vec::new();
+    for &res in &plan.resolutions {
+        let map = if res == 1024 {
+            perlin_1024.clone()
+        } else {
+            perlin_texture(res, 0.5)
+        };
+        for selector in [Selector::CdfGrid { grid_percent: 100 }, Selector::Alias] {
+            let (pre, s) = median_seconds(plan.runs, true, || {
+                DensitySampler::new(&blub, &map, options(selector))
+            });
+            let s = s?;
+            let r = rate(&s, plan.samples, plan.runs, 1)?;
+            let label = match selector {
+                Selector::Alias => "alias",
+                _ => "CDF + grid 100 %",
+            };
+            rows.push(Row {
+                cells: vec![
+                    format!("{res}²"),
+                    label.into(),
+                    thousands(s.records().len() as u64),
+                    format!("{:.1} ms", pre * 1e3),
+                    mb(s.memory_bytes()),
+                    mega(r),
+                    paper_t3
+                        .iter()
+                        .find(|p| p.0 == res)
+                        .map_or("—", |p| p.1)
+                        .into(),
+                ],
+            });
+        }
+    }
+    report += &table(
+        "Table 3: density texture resolution, blub ×1, 1 thread",
+        &[
+            "texture",
+            "selector",
+            "records",
+            "preprocess",
+            "memory",
+            "samples/s",
+            "paper",
+        ],
+        &rows,
+    );
+
+    // Figs. 8–9: against rejection sampling at several density means.
+    let means: &[f32] = if args.quick {
+        &[1.0, 0.1]
+    } else {
+        &[1.0, 0.5, 0.25, 0.1]
+    };
+    let mut rows = Vec::new();
+    for &mean in means {
+        let map = perlin_texture(1024, mean);
+        let (cdf_pre, cdf) = median_seconds(plan.runs, false, || {
+            DensitySampler::new(
+                &blub,
+                &map,
+                options(Selector::CdfGrid { grid_percent: 100 }),
+            )
+        });
+        let cdf = cdf?;
+        let (alias_pre, alias) = median_seconds(plan.runs, false, || {
+            DensitySampler::new(&blub, &map, options(Selector::Alias))
+        });
+        let alias = alias?;
+        let rejection = RejectionSampler::new(&blub, &map)?;
+        let cdf_rate = rate(&cdf, plan.samples, plan.runs, 1)?;
+        let alias_rate = rate(&alias, plan.samples, plan.runs, 1)?;
+        let rejection_n = (plan.samples / 4).max(100_000);
+        let rejection_rate = rate(&rejection, rejection_n, plan.runs, 1)?;
+        // Including preprocess, for one million samples (the paper's solid lines).
+        let with_pre = |pre: f64, r: f64| 1e6 / (pre + 1e6 / r);
+        rows.push(Row {
+            cells: vec![
+                format!("{mean}"),
+                mega(cdf_rate),
+                mega(alias_rate),
+                mega(rejection_rate),
+                format!("{:.1}×", alias_rate / rejection_rate),
+                format!(
+                    "{} / {}",
+                    mega(with_pre(cdf_pre, cdf_rate)),
+                    mega(with_pre(alias_pre, alias_rate))
+                ),
+            ],
+        });
+        if mean == 0.1 {
+            json.push((
+                "rejection_samples_per_s_1t_mean_0_1".into(),
+                format!("{rejection_rate:.0}"),
+            ));
+            json.push((
+                "alias_over_rejection_mean_0_1".into(),
+                format!("{:.2}", alias_rate / rejection_rate),
+            ));
+        }
+    }
+    report += &table(
+        "Figs. 8–9: against rejection sampling, blub ×1, 1024² Perlin, 1 thread (paper: rejection falls linearly with the mean; target ≥ 20× at 0.1)",
+        &[
+            "mean",
+            "CDF + grid",
+            "alias",
+            "rejection",
+            "alias / rejection",
+            "1 M samples incl. preprocess (CDF / alias)",
+        ],
+        &rows,
+    );
+
+    if args.json {
+        let body: Vec<String> = json.iter().map(|(k, v)| format!("\"{k}\":{v}")).collect();
+        println!("{{{}}}", body.join(","));
+    } else {
+        print!("{report}");
+    }
+    Ok(())
+}
