@@ -147,9 +147,7 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
     let blub_path = args.meshes.join("blub_triangulated.obj");
     let blub = Mesh::load(&blub_path)
-        .with_context(|| {
-            format!("the sampler benchmark needs blub (give the folder with --meshes)")
-        })?
+        .context("the sampler benchmark needs blub (give the folder with --meshes)")?
         .subdivided(1);
     let spot = pelage::assets::spot();
     let mesh_for = |name: &str, k: u32| {
