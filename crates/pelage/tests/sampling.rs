@@ -620,3 +620,31 @@ fn unusable_densities_are_errors_naming_the_mesh() {
     );
     assert!(DensitySampler::new(&no_uvs, &Map::Constant(1.0), Default::default()).is_ok());
 }
+
+#[test]
+fn block_pipeline_gives_exactly_the_points_of_single_samples() {
+    let spot = pelage::assets::spot();
+    let map = Map::Noise(NoiseMap::default());
+    for selector in [
+        Selector::Alias,
+        Selector::CdfGrid { grid_percent: 50 },
+        Selector::CdfGrid { grid_percent: 0 },
+    ] {
+        let options = DensitySamplerOptions {
+            selector,
+            ..Default::default()
+        };
+        let sampler = DensitySampler::new(&spot, &map, options).unwrap();
+        // An odd length and an odd start, so partial blocks are covered.
+        let mut block = vec![SurfacePoint::default(); 1_003];
+        sampler.sample_block(11, 517, &mut block);
+        for (k, p) in block.iter().enumerate() {
+            assert_eq!(
+                *p,
+                sampler.sample(11, 517 + k as u64),
+                "{selector:?}, sample {}",
+                517 + k
+            );
+        }
+    }
+}

@@ -41,34 +41,38 @@ impl AliasTable {
                 alias: i,
             })
             .collect();
-        // Vose's two work lists share one buffer: "small" (< 1) grows up
-        // from the front, "large" (≥ 1) down from the back. Together they
-        // never hold more than n entries, so nothing reallocates.
-        let mut work = vec![0u32; n];
-        let (mut small, mut large) = (0usize, n);
-        for (i, &p) in scaled.iter().enumerate() {
-            if p < 1.0 {
-                work[small] = i as u32;
-                small += 1;
-            } else {
-                large -= 1;
-                work[large] = i as u32;
-            }
-        }
-        while small > 0 && large < n {
-            small -= 1;
-            let s = work[small] as usize;
-            let l = work[large];
+        // Vose's pairing done as a sweep: `small` and `large` scan forward
+        // for the next bin below / at or above 1. Both only move forward,
+        // so the 20 MB of bins and weights are read in order instead of at
+        // random as with Vose's stacks, several times faster here.
+        let next_small =
+            |from: usize, scaled: &[f64]| (from..n).find(|&i| scaled[i] < 1.0).unwrap_or(n);
+        let next_large =
+            |from: usize, scaled: &[f64]| (from..n).find(|&i| scaled[i] >= 1.0).unwrap_or(n);
+        let mut scan = next_small(0, &scaled);
+        let mut s = scan;
+        let mut large = next_large(0, &scaled);
+        while s < n && large < n {
             let p = scaled[s];
             bins[s] = AliasBin {
                 threshold: (p * 4_294_967_296.0 + 0.5).min(u32::MAX as f64) as u32,
-                alias: l,
+                alias: large as u32,
             };
-            scaled[l as usize] -= 1.0 - p;
-            if scaled[l as usize] < 1.0 {
-                large += 1;
-                work[small] = l;
-                small += 1;
+            scaled[large] -= 1.0 - p;
+            // `s` was either the scan's entry (then the scan moves on) or
+            // an earlier donor (then the scan's entry is still waiting).
+            if s == scan {
+                scan = next_small(scan + 1, &scaled);
+            }
+            s = scan;
+            if scaled[large] < 1.0 {
+                // The donor is now small itself. If the scan has passed it,
+                // pair it next; otherwise the scan reaches it (or just did).
+                let donor = large;
+                large = next_large(large + 1, &scaled);
+                if donor < scan {
+                    s = donor;
+                }
             }
         }
         // What remains holds 1 up to rounding: it keeps itself always (the
@@ -115,6 +119,11 @@ impl AliasTable {
         }
     }
 
+    /// The bins, in record order.
+    pub fn bins(&self) -> &[AliasBin] {
+        &self.bins
+    }
+
     /// Bytes the table occupies.
     pub fn memory_bytes(&self) -> usize {
         self.bins.len() * std::mem::size_of::<AliasBin>()
@@ -147,6 +156,45 @@ mod tests {
         }
         // 5 positive bins: 4 degrees of freedom, 0.001 quantile 18.5.
         assert!(chi2 < 18.5, "chi2 {chi2} counts {counts:?}");
+    }
+
+    /// The probability each record receives, read off the table: its own
+    /// bin's keep share plus every share aliased to it.
+    fn realised(table: &AliasTable) -> Vec<f64> {
+        let n = table.len() as f64;
+        let mut p = vec![0.0; table.len()];
+        for (i, b) in table.bins().iter().enumerate() {
+            let keep = f64::from(b.threshold) / 4_294_967_296.0;
+            p[i] += keep / n;
+            p[b.alias as usize] += (1.0 - keep) / n;
+        }
+        p
+    }
+
+    #[test]
+    fn table_realises_the_weights_exactly() {
+        for seed in 0..20u64 {
+            let n = 1 + (seed * 977 % 5000) as usize;
+            let weights: Vec<f64> = (0..n as u64)
+                .map(|i| {
+                    let r = SampleRng::new(seed, i).uniform_f32() as f64;
+                    // Many zeros and a wide range of sizes.
+                    if r < 0.2 { 0.0 } else { r.powi(6) * 1000.0 }
+                })
+                .collect();
+            let total: f64 = weights.iter().sum();
+            if total == 0.0 {
+                continue;
+            }
+            let table = AliasTable::new(weights.iter().copied());
+            for (k, (w, p)) in weights.iter().zip(realised(&table)).enumerate() {
+                assert!(
+                    (p - w / total).abs() < 1e-8,
+                    "seed {seed}, n {n}, record {k}: {p} vs {}",
+                    w / total
+                );
+            }
+        }
     }
 
     #[test]

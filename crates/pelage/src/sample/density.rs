@@ -70,7 +70,25 @@ impl Default for DensitySamplerOptions {
 #[derive(Debug, Clone)]
 enum SelectorTable {
     Cdf(CdfGrid),
-    Alias(AliasTable),
+    /// One entry per record: its alias bin fused with its own triangle and
+    /// position, so a sample that keeps its bin reads one cache line.
+    Alias(Vec<AliasedRecord>),
+}
+
+/// An alias bin with a copy of its record's triangle and position.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(16))]
+struct AliasedRecord {
+    threshold: u32,
+    alias: u32,
+    triangle: u32,
+    position: u32,
+}
+
+/// The alias bin that 64 random bits draw among `n`.
+#[inline]
+fn alias_bin(bits: u64, n: usize) -> usize {
+    (((bits >> 32) * n as u64) >> 32) as usize
 }
 
 /// Samples points on a mesh with a density given by a [`Map`] (Sik §3).
@@ -160,7 +178,22 @@ impl<'m> DensitySampler<'m> {
             Selector::CdfGrid { grid_percent } => {
                 SelectorTable::Cdf(CdfGrid::new(weights, grid_percent))
             }
-            Selector::Alias => SelectorTable::Alias(AliasTable::new(weights)),
+            Selector::Alias => {
+                let table = AliasTable::new(weights);
+                SelectorTable::Alias(
+                    table
+                        .bins()
+                        .iter()
+                        .zip(&records)
+                        .map(|(bin, r)| AliasedRecord {
+                            threshold: bin.threshold,
+                            alias: bin.alias,
+                            triangle: r.triangle,
+                            position: r.position,
+                        })
+                        .collect(),
+                )
+            }
         };
         Ok(Self {
             mesh,
@@ -198,7 +231,7 @@ impl<'m> DensitySampler<'m> {
     pub fn memory_bytes(&self) -> usize {
         let selector = match &self.selector {
             SelectorTable::Cdf(c) => c.memory_bytes(),
-            SelectorTable::Alias(a) => a.memory_bytes(),
+            SelectorTable::Alias(a) => a.len() * std::mem::size_of::<AliasedRecord>(),
         };
         self.records.len() * std::mem::size_of::<SubTriangleRecord>()
             + selector
@@ -213,16 +246,15 @@ impl<'m> DensitySampler<'m> {
 }
 
 impl DensitySampler<'_> {
-    /// Fig. 6 steps 2–3: a uniform point in record `k`'s sub-triangle
-    /// (from the 48 bits of `bits` it uses), mapped to its mesh triangle's
-    /// barycentrics.
+    /// Fig. 6 steps 2–3: a uniform point in the sub-triangle at
+    /// `position` of `triangle` (from 48 bits of `bits`), mapped to the
+    /// triangle's barycentrics.
     #[inline]
-    fn point_in(&self, k: usize, bits: u64) -> SurfacePoint {
-        let record = self.records[k];
-        let sub = self.positions.get(record.position);
+    fn point_in(&self, triangle: u32, position: u32, bits: u64) -> SurfacePoint {
+        let sub = self.positions.get(position);
         let b = sub.to_parent(warp::sample_uniform_triangle(open_unit_pair(bits)));
         SurfacePoint {
-            tri: record.triangle,
+            tri: triangle,
             bary: [b.x, b.y],
         }
     }
@@ -237,11 +269,22 @@ impl SurfaceSampler for DensitySampler<'_> {
     #[inline]
     fn sample(&self, seed: u64, index: u64) -> SurfacePoint {
         let [select, place] = PairDraws::new(seed).draws(index);
-        let k = match &self.selector {
-            SelectorTable::Cdf(c) => c.select(select),
-            SelectorTable::Alias(a) => a.select(select),
+        let (triangle, position) = match &self.selector {
+            SelectorTable::Cdf(c) => {
+                let r = self.records[c.select(select)];
+                (r.triangle, r.position)
+            }
+            SelectorTable::Alias(entries) => {
+                let e = entries[alias_bin(select, entries.len())];
+                let e = if (select as u32) < e.threshold {
+                    e
+                } else {
+                    entries[e.alias as usize]
+                };
+                (e.triangle, e.position)
+            }
         };
-        self.point_in(k, place)
+        self.point_in(triangle, position, place)
     }
 
     /// The same points as `sample`, in stages over a block: every stage
@@ -259,16 +302,32 @@ impl SurfaceSampler for DensitySampler<'_> {
             let n = block.len();
             let mut draws = [[0u64; 2]; BLOCK];
             let mut chosen = [0usize; BLOCK];
+            let mut picked = [(0u32, 0u32); BLOCK];
             match &self.selector {
-                SelectorTable::Alias(table) => {
+                SelectorTable::Alias(entries) => {
                     for i in 0..n {
                         draws[i] = stream.draws(first + i as u64);
-                        chosen[i] = table.bin_of(draws[i][0]);
-                        prefetch(table.bin(chosen[i]));
+                        chosen[i] = alias_bin(draws[i][0], entries.len());
+                        prefetch(&entries[chosen[i]]);
                     }
+                    // Most samples keep their bin and are done here; the
+                    // others fetch their alias's entry in one more stage.
+                    let mut aliased = [0u8; BLOCK];
+                    let mut count = 0;
                     for i in 0..n {
-                        chosen[i] = table.resolve(chosen[i], draws[i][0]);
-                        prefetch(&self.records[chosen[i]]);
+                        let e = entries[chosen[i]];
+                        if (draws[i][0] as u32) < e.threshold {
+                            picked[i] = (e.triangle, e.position);
+                        } else {
+                            chosen[i] = e.alias as usize;
+                            prefetch(&entries[chosen[i]]);
+                            aliased[count] = i as u8;
+                            count += 1;
+                        }
+                    }
+                    for &i in &aliased[..count] {
+                        let e = entries[chosen[i as usize]];
+                        picked[i as usize] = (e.triangle, e.position);
                     }
                 }
                 SelectorTable::Cdf(cdf) => {
@@ -285,10 +344,15 @@ impl SurfaceSampler for DensitySampler<'_> {
                         chosen[i] = cdf.search(draws[i][0], ranges[i]);
                         prefetch(&self.records[chosen[i]]);
                     }
+                    for i in 0..n {
+                        let r = self.records[chosen[i]];
+                        picked[i] = (r.triangle, r.position);
+                    }
                 }
             }
             for i in 0..n {
-                block[i] = self.point_in(chosen[i], draws[i][1]);
+                let (triangle, position) = picked[i];
+                block[i] = self.point_in(triangle, position, draws[i][1]);
             }
         }
     }
