@@ -23,6 +23,8 @@ struct Cli {
 enum Command {
     /// Print what a mesh is made of: counts, bounds, area, UVs, defects.
     Info(commands::info::InfoArgs),
+    /// Place points (hair roots) on a mesh with a density map; write a PLY.
+    Sample(commands::sample::SampleArgs),
     /// Run the demo on the embedded Spot mesh.
     Demo(commands::demo::DemoArgs),
     /// Measure a capability against its paper's figures.
@@ -33,6 +35,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
+        Command::Sample(args) => commands::sample::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
     };

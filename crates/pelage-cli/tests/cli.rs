@@ -120,3 +120,52 @@ fn demo_runs_on_the_embedded_asset_from_any_folder() {
     assert!(text.contains("embedded spot"));
     assert!(text.contains("subdivided ×2: 93,696 triangles"));
 }
+
+#[test]
+fn sample_gives_byte_identical_files_on_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |threads: &str, name: &str| {
+        let path = dir.path().join(name);
+        let out = Command::new(env!("CARGO_BIN_EXE_pelage"))
+            .args([
+                "sample",
+                "-n",
+                "300000",
+                "--seed",
+                "9",
+                "--density",
+                "noise:frequency=5",
+            ])
+            .arg("-o")
+            .arg(&path)
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(stdout(&out).starts_with("wrote 300,000 points on embedded spot"));
+        std::fs::read(path).unwrap()
+    };
+    let one = run("1", "one.ply");
+    let two = run("2", "two.ply");
+    assert!(one == two, "the files differ between 1 and 2 threads");
+    // Header + 300,000 × (xyz, normal, st, triangle).
+    assert!(one.len() > 300_000 * 36);
+}
+
+#[test]
+fn sample_with_zero_density_fails_naming_the_mesh_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("roots.ply");
+    let out = Command::new(env!("CARGO_BIN_EXE_pelage"))
+        .args(["sample", "-n", "10", "--density", "0", "-o"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).starts_with("error: embedded spot: the density is zero everywhere"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!path.exists());
+}

@@ -10,6 +10,7 @@
 //!   also specified by a texture").
 //! - [`sample`]: hair roots: points distributed by a density map (Sik §3),
 //!   deterministic by `(seed, index)`.
+//! - [`io`]: writers, all atomic (temporary file, then rename).
 //! - [`assets`]: the embedded demo mesh (Spot), so every command works with
 //!   no files at hand.
 //!
@@ -18,6 +19,7 @@
 #![warn(missing_docs)]
 
 pub mod assets;
+pub mod io;
 pub mod map;
 pub mod mesh;
 pub mod sample;

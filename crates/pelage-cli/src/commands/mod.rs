@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod demo;
 pub mod info;
+pub mod sample;
 
 use anyhow::Context;
 use pelage::Mesh;
