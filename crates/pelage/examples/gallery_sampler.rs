@@ -68,7 +68,9 @@ impl Frame {
         let skin = Vec3::new(0.86, 0.80, 0.72);
         for t in 0..mesh.triangle_count() {
             let tri = mesh.triangles()[t];
-            let corners = mesh.triangle_positions(t).map(|p| camera.project(p, self.w, self.h));
+            let corners = mesh
+                .triangle_positions(t)
+                .map(|p| camera.project(p, self.w, self.h));
             let normals = tri.map(|v| mesh.normals()[v as usize]);
             let [(a, za), (b, zb), (c, zc)] = corners;
             let area = (b - a).perp_dot(c - a);
@@ -76,7 +78,10 @@ impl Frame {
                 continue;
             }
             let lo = a.min(b).min(c).max(Vec2::ZERO);
-            let hi = a.max(b).max(c).min(Vec2::new(self.w as f32 - 1.0, self.h as f32 - 1.0));
+            let hi = a
+                .max(b)
+                .max(c)
+                .min(Vec2::new(self.w as f32 - 1.0, self.h as f32 - 1.0));
             for y in lo.y as usize..=hi.y as usize {
                 for x in lo.x as usize..=hi.x as usize {
                     let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
@@ -90,7 +95,8 @@ impl Frame {
                     let i = y * self.w + x;
                     if z > self.depth[i] {
                         self.depth[i] = z;
-                        let n = (w0 * normals[0] + w1 * normals[1] + w2 * normals[2]).normalize_or_zero();
+                        let n = (w0 * normals[0] + w1 * normals[1] + w2 * normals[2])
+                            .normalize_or_zero();
                         // Two-sided Lambert plus ambient.
                         let lambert = n.dot(light).abs();
                         self.color[i] = skin * (0.35 + 0.65 * lambert);
@@ -174,12 +180,14 @@ fn render(mesh: &Mesh, points: &[SurfacePoint]) -> Vec<Vec3> {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let spot = with_side_uvs(&pelage::assets::spot());
 
-    let uniform = DensitySampler::new(&spot, &Map::Constant(1.0), DensitySamplerOptions::default())?;
+    let uniform =
+        DensitySampler::new(&spot, &Map::Constant(1.0), DensitySamplerOptions::default())?;
     let uniform_points = sample_range(&uniform, 11, 0..SAMPLES);
 
     // A 256-texel ramp from 0 on the left to 1 on the right.
     let ramp: Vec<f32> = (0..256).map(|x| (x as f32 + 0.5) / 256.0).collect();
-    let gradient = Map::Image(ImageMap::from_texels(256, 1, ramp, Wrap::Clamp)?.with_filter(Filter::Bilinear));
+    let gradient =
+        Map::Image(ImageMap::from_texels(256, 1, ramp, Wrap::Clamp)?.with_filter(Filter::Bilinear));
     let gradient_sampler = DensitySampler::new(&spot, &gradient, DensitySamplerOptions::default())?;
     let gradient_points = sample_range(&gradient_sampler, 11, 0..SAMPLES);
 
@@ -187,16 +195,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let right = render(&spot, &gradient_points);
     let gap = 16;
     let total_w = 2 * WIDTH + gap;
-    let mut image = image::RgbImage::from_pixel(total_w as u32, HEIGHT as u32, image::Rgb([255, 255, 255]));
+    let mut image =
+        image::RgbImage::from_pixel(total_w as u32, HEIGHT as u32, image::Rgb([255, 255, 255]));
     for (offset, panel) in [(0, &left), (WIDTH + gap, &right)] {
         for y in 0..HEIGHT {
             for x in 0..WIDTH {
                 let c = panel[y * WIDTH + x].clamp(Vec3::ZERO, Vec3::ONE) * 255.0;
-                image.put_pixel((offset + x) as u32, y as u32, image::Rgb([c.x as u8, c.y as u8, c.z as u8]));
+                image.put_pixel(
+                    (offset + x) as u32,
+                    y as u32,
+                    image::Rgb([c.x as u8, c.y as u8, c.z as u8]),
+                );
             }
         }
     }
-    let out = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/gallery/sik-fig11-12-spot.png");
+    let out = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../docs/gallery/sik-fig11-12-spot.png");
     std::fs::create_dir_all(out.parent().expect("has a folder"))?;
     image.save(&out)?;
     println!("wrote {}", out.display());

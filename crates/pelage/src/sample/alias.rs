@@ -24,59 +24,82 @@ pub struct AliasTable {
     bins: Vec<AliasBin>,
 }
 
+/// Where an alias table's bins are written: the plain [`AliasBin`]s of an
+/// [`AliasTable`], or a structure that keeps each bin beside its record
+/// (the density sampler's fused entries).
+pub trait AliasBins {
+    /// Sets bin `i`: keep it when the coin is below `threshold`, else take
+    /// `alias`. Bins never set keep themselves.
+    fn set(&mut self, i: usize, threshold: u32, alias: u32);
+}
+
+impl AliasBins for [AliasBin] {
+    fn set(&mut self, i: usize, threshold: u32, alias: u32) {
+        self[i] = AliasBin { threshold, alias };
+    }
+}
+
+/// Fills `bins` (one per weight, each initially keeping itself) with
+/// Walker's alias table of `weights` (non-negative, not all zero).
+pub fn build_alias_bins(
+    weights: impl IntoIterator<Item = f64>,
+    bins: &mut (impl AliasBins + ?Sized),
+) {
+    // Scaled in place so the average bin holds exactly 1.
+    let mut scaled: Vec<f64> = weights.into_iter().collect();
+    let n = scaled.len();
+    let total: f64 = scaled.iter().sum();
+    assert!(total > 0.0, "an alias table needs a positive total weight");
+    let factor = n as f64 / total;
+    scaled.iter_mut().for_each(|w| *w *= factor);
+
+    // Vose's pairing done as a sweep: `small` and `large` scan forward
+    // for the next bin below / at or above 1. Both only move forward,
+    // so the 20 MB of bins and weights are read in order instead of at
+    // random as with Vose's stacks, several times faster here.
+    let next_small =
+        |from: usize, scaled: &[f64]| (from..n).find(|&i| scaled[i] < 1.0).unwrap_or(n);
+    let next_large =
+        |from: usize, scaled: &[f64]| (from..n).find(|&i| scaled[i] >= 1.0).unwrap_or(n);
+    let mut scan = next_small(0, &scaled);
+    let mut s = scan;
+    let mut large = next_large(0, &scaled);
+    while s < n && large < n {
+        let p = scaled[s];
+        let threshold = (p * 4_294_967_296.0 + 0.5).min(u32::MAX as f64) as u32;
+        bins.set(s, threshold, large as u32);
+        scaled[large] -= 1.0 - p;
+        // `s` was either the scan's entry (then the scan moves on) or
+        // an earlier donor (then the scan's entry is still waiting).
+        if s == scan {
+            scan = next_small(scan + 1, &scaled);
+        }
+        s = scan;
+        if scaled[large] < 1.0 {
+            // The donor is now small itself. If the scan has passed it,
+            // pair it next; otherwise the scan reaches it (or just did).
+            let donor = large;
+            large = next_large(large + 1, &scaled);
+            if donor < scan {
+                s = donor;
+            }
+        }
+    }
+    // What remains holds 1 up to rounding: it keeps itself always (a bin
+    // never set has alias = itself, so the 2⁻³² coin case is harmless).
+}
+
 impl AliasTable {
     /// Builds the table of `weights` (non-negative, not all zero).
     pub fn new(weights: impl IntoIterator<Item = f64>) -> Self {
-        // Scaled in place so the average bin holds exactly 1.
-        let mut scaled: Vec<f64> = weights.into_iter().collect();
-        let n = scaled.len();
-        let total: f64 = scaled.iter().sum();
-        assert!(total > 0.0, "AliasTable needs a positive total weight");
-        let factor = n as f64 / total;
-        scaled.iter_mut().for_each(|w| *w *= factor);
-
-        let mut bins: Vec<AliasBin> = (0..n as u32)
+        let weights: Vec<f64> = weights.into_iter().collect();
+        let mut bins: Vec<AliasBin> = (0..weights.len() as u32)
             .map(|i| AliasBin {
                 threshold: u32::MAX,
                 alias: i,
             })
             .collect();
-        // Vose's pairing done as a sweep: `small` and `large` scan forward
-        // for the next bin below / at or above 1. Both only move forward,
-        // so the 20 MB of bins and weights are read in order instead of at
-        // random as with Vose's stacks, several times faster here.
-        let next_small =
-            |from: usize, scaled: &[f64]| (from..n).find(|&i| scaled[i] < 1.0).unwrap_or(n);
-        let next_large =
-            |from: usize, scaled: &[f64]| (from..n).find(|&i| scaled[i] >= 1.0).unwrap_or(n);
-        let mut scan = next_small(0, &scaled);
-        let mut s = scan;
-        let mut large = next_large(0, &scaled);
-        while s < n && large < n {
-            let p = scaled[s];
-            bins[s] = AliasBin {
-                threshold: (p * 4_294_967_296.0 + 0.5).min(u32::MAX as f64) as u32,
-                alias: large as u32,
-            };
-            scaled[large] -= 1.0 - p;
-            // `s` was either the scan's entry (then the scan moves on) or
-            // an earlier donor (then the scan's entry is still waiting).
-            if s == scan {
-                scan = next_small(scan + 1, &scaled);
-            }
-            s = scan;
-            if scaled[large] < 1.0 {
-                // The donor is now small itself. If the scan has passed it,
-                // pair it next; otherwise the scan reaches it (or just did).
-                let donor = large;
-                large = next_large(large + 1, &scaled);
-                if donor < scan {
-                    s = donor;
-                }
-            }
-        }
-        // What remains holds 1 up to rounding: it keeps itself always (the
-        // default bin has alias = itself, so the 2⁻³² coin case is harmless).
+        build_alias_bins(weights, bins.as_mut_slice());
         Self { bins }
     }
 

@@ -3,7 +3,7 @@
 //! selection by CDF + uniform grid (Fig. 7) or by an alias table, and a
 //! uniform point in the chosen sub-triangle (Fig. 6).
 
-use super::alias::AliasTable;
+use super::alias::{AliasBins, build_alias_bins};
 use super::cdf::CdfGrid;
 use super::rng::{PairDraws, open_unit_pair};
 use super::subtriangle::{MAX_LEVEL, PositionTable, SubTriangle, WHOLE_TRIANGLE, child_index};
@@ -83,6 +83,13 @@ struct AliasedRecord {
     alias: u32,
     triangle: u32,
     position: u32,
+}
+
+impl AliasBins for [AliasedRecord] {
+    fn set(&mut self, i: usize, threshold: u32, alias: u32) {
+        self[i].threshold = threshold;
+        self[i].alias = alias;
+    }
 }
 
 /// The alias bin that 64 random bits draw among `n`.
@@ -179,20 +186,18 @@ impl<'m> DensitySampler<'m> {
                 SelectorTable::Cdf(CdfGrid::new(weights, grid_percent))
             }
             Selector::Alias => {
-                let table = AliasTable::new(weights);
-                SelectorTable::Alias(
-                    table
-                        .bins()
-                        .iter()
-                        .zip(&records)
-                        .map(|(bin, r)| AliasedRecord {
-                            threshold: bin.threshold,
-                            alias: bin.alias,
-                            triangle: r.triangle,
-                            position: r.position,
-                        })
-                        .collect(),
-                )
+                let mut entries: Vec<AliasedRecord> = records
+                    .iter()
+                    .enumerate()
+                    .map(|(i, r)| AliasedRecord {
+                        threshold: u32::MAX,
+                        alias: i as u32,
+                        triangle: r.triangle,
+                        position: r.position,
+                    })
+                    .collect();
+                build_alias_bins(weights, entries.as_mut_slice());
+                SelectorTable::Alias(entries)
             }
         };
         Ok(Self {

@@ -21,7 +21,7 @@ mod rng;
 pub mod subtriangle;
 pub mod warp;
 
-pub use alias::{AliasBin, AliasTable};
+pub use alias::{AliasBin, AliasBins, AliasTable, build_alias_bins};
 pub use cdf::CdfGrid;
 pub use density::{DensitySampler, DensitySamplerOptions, Selector, SubTriangleRecord};
 pub use rejection::RejectionSampler;
