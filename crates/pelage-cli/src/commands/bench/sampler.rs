@@ -11,9 +11,13 @@ use clap::Args;
 use pelage::map::{ImageMap, Map, NoiseMap, Wrap};
 use pelage::mesh::{Mesh, SurfacePoint};
 use pelage::sample::{
-    DensitySampler, DensitySamplerOptions, RejectionSampler, Selector, SubTriangleRecord,
-    SurfaceSampler, sample_into,
+    AliasTable, CdfGrid, DensitySampler, DensitySamplerOptions, RejectionSampler, Selector,
+    SubTriangleRecord, SurfaceSampler, mix64, sample_into,
 };
+use rand::SeedableRng;
+use rand::rngs::SmallRng;
+use rand_distr::Distribution;
+use rand_distr::weighted::WeightedAliasIndex;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -246,6 +250,95 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
     json.push(("samples_per_s_1t".into(), format!("{rate_1t:.0}")));
     json.push(("samples_per_s_all_threads".into(), format!("{rate_all:.0}")));
     json.push(("threads".into(), threads.to_string()));
+
+    // The selectors alone against a peer, rand_distr's WeightedAliasIndex,
+    // on the same weights, in plain loops (no prefetching on either side).
+    let weights: Vec<f64> = sampler
+        .records()
+        .iter()
+        .map(|r| f64::from(r.probability))
+        .collect();
+    let selections = plan.samples;
+    let (ours_build, ours) =
+        median_seconds(plan.runs, true, || AliasTable::new(weights.iter().copied()));
+    let (ours_select, _) = median_seconds(plan.runs, true, || {
+        let mut sum = 0usize;
+        for i in 0..selections as u64 {
+            sum = sum.wrapping_add(ours.select(mix64(i)));
+        }
+        std::hint::black_box(sum)
+    });
+    let (cdf_build, cdf) = median_seconds(plan.runs, true, || {
+        CdfGrid::new(weights.iter().copied(), 100)
+    });
+    let (cdf_select, _) = median_seconds(plan.runs, true, || {
+        let mut sum = 0usize;
+        for i in 0..selections as u64 {
+            sum = sum.wrapping_add(cdf.select(mix64(i)));
+        }
+        std::hint::black_box(sum)
+    });
+    let peer_weights: Vec<f32> = sampler.records().iter().map(|r| r.probability).collect();
+    let (peer_build, peer) = median_seconds(plan.runs, true, || {
+        WeightedAliasIndex::new(peer_weights.clone()).expect("the weights are valid")
+    });
+    let (peer_select, _) = median_seconds(plan.runs, true, || {
+        let mut rng = SmallRng::seed_from_u64(1);
+        let mut sum = 0usize;
+        for _ in 0..selections {
+            sum = sum.wrapping_add(peer.sample(&mut rng));
+        }
+        std::hint::black_box(sum)
+    });
+    let per_s = |seconds: f64| mega(selections as f64 / seconds);
+    let rows = vec![
+        Row {
+            cells: vec![
+                "pelage AliasTable".into(),
+                format!("{:.1} ms", ours_build * 1e3),
+                per_s(ours_select),
+                mb(ours.memory_bytes()),
+            ],
+        },
+        Row {
+            cells: vec![
+                "pelage CdfGrid, grid 100 %".into(),
+                format!("{:.1} ms", cdf_build * 1e3),
+                per_s(cdf_select),
+                mb(cdf.memory_bytes()),
+            ],
+        },
+        // rand_distr keeps an f32 and a u32 per weight (its documentation).
+        Row {
+            cells: vec![
+                "rand_distr WeightedAliasIndex<f32>".into(),
+                format!("{:.1} ms", peer_build * 1e3),
+                per_s(peer_select),
+                mb(peer_weights.len() * 8),
+            ],
+        },
+    ];
+    report += &table(
+        &format!(
+            "Selectors alone on the headline's {} weights, plain loop, 1 thread (peer measured in this run)",
+            thousands(weights.len() as u64)
+        ),
+        &["selector", "build", "selections/s", "memory"],
+        &rows,
+    );
+    json.push((
+        "alias_select_per_s".into(),
+        format!("{:.0}", selections as f64 / ours_select),
+    ));
+    json.push((
+        "rand_distr_alias_select_per_s".into(),
+        format!("{:.0}", selections as f64 / peer_select),
+    ));
+    json.push(("alias_build_s".into(), format!("{ours_build:.6}")));
+    json.push((
+        "rand_distr_alias_build_s".into(),
+        format!("{peer_build:.6}"),
+    ));
     drop(sampler);
 
     // Table 1: grid size, uniform density on blub ×1.
