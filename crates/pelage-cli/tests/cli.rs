@@ -119,6 +119,11 @@ fn demo_runs_on_the_embedded_asset_from_any_folder() {
     let text = stdout(&out);
     assert!(text.contains("embedded spot"));
     assert!(text.contains("subdivided ×2: 93,696 triangles"));
+    assert!(text.contains("1,000,000 hair roots"));
+    let roots = dir.path().join("pelage-demo/roots.ply");
+    let bytes = std::fs::read(&roots).expect("the demo writes pelage-demo/roots.ply");
+    assert!(bytes.starts_with(b"ply\nformat binary_little_endian 1.0\n"));
+    assert!(bytes.len() > 36_000_000);
 }
 
 #[test]

@@ -1,17 +1,34 @@
 //! `pelage demo`: pelage on the embedded Spot mesh, with no files needed.
 //!
-//! For now it shows the mesh layer (what `pelage info` reports) and says
-//! what the demo will grow into as the groom, export and GPU layers land.
+//! Today it shows the mesh layer and root sampling: a summary of Spot, then
+//! a million hair roots from a noise density, written to
+//! `./pelage-demo/roots.ply`. The groom, export and GPU issues grow it into
+//! the full demo (hairs, USD, a preview picture).
 
 use super::info::MeshSummary;
+use crate::format::thousands;
+use anyhow::Context;
 use clap::Args;
+use pelage::Map;
+use pelage::io::write_points_ply;
+use pelage::sample::{DensitySampler, DensitySamplerOptions, sample_range};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Arguments of `pelage demo`.
 #[derive(Debug, Args)]
-pub struct DemoArgs {}
+pub struct DemoArgs {
+    /// Folder the demo writes into.
+    #[arg(long, default_value = "pelage-demo")]
+    pub out: PathBuf,
+}
 
-pub fn run(_args: &DemoArgs) -> anyhow::Result<()> {
+/// Roots the demo places.
+const ROOTS: u64 = 1_000_000;
+/// The density the demo uses, as a user would write it.
+const DENSITY: &str = "noise:frequency=6,octaves=3,seed=2,offset=0.5,scale=0.5";
+
+pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     let spot = pelage::assets::spot();
     println!(
@@ -22,13 +39,31 @@ pub fn run(_args: &DemoArgs) -> anyhow::Result<()> {
     let fine = spot.subdivided(2);
     println!(
         "\nsubdivided ×2: {} triangles, area {:.6} (unchanged: {:.6})",
-        crate::format::thousands(fine.triangle_count() as u64),
+        thousands(fine.triangle_count() as u64),
         fine.surface_area(),
         spot.surface_area()
     );
+
+    let density = Map::parse(DENSITY)?;
+    let sampling = Instant::now();
+    let sampler = DensitySampler::new(&spot, &density, DensitySamplerOptions::default())?;
+    let roots = sample_range(&sampler, 1, 0..ROOTS);
+    let sampled = sampling.elapsed();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create the folder {}", args.out.display()))?;
+    let path = args.out.join("roots.ply");
+    write_points_ply(&path, &spot, &roots)?;
+    println!(
+        "\n{} hair roots with density {DENSITY}\n  ({} sub-triangle records) in {:.1} ms → {}",
+        thousands(ROOTS),
+        thousands(sampler.records().len() as u64),
+        sampled.as_secs_f64() * 1e3,
+        path.display()
+    );
     println!("done in {:.2} s\n", start.elapsed().as_secs_f64());
-    println!("Coming as the next layers land: hair roots from a density map (Sik),");
-    println!("guide interpolation, clump/curl/noise operators, 200,000 hairs written");
-    println!("to ./pelage-demo/ as USD, and a preview picture of the result.");
+    println!("Try: pelage sample --help, pelage bench sampler --quick.");
+    println!("Coming as the next layers land: guide interpolation, clump/curl/noise");
+    println!("operators, 200,000 hairs written to ./pelage-demo/ as USD, and a");
+    println!("preview picture of the result.");
     Ok(())
 }
