@@ -25,6 +25,8 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Place points (hair roots) on a mesh with a density map; write a PLY.
     Sample(commands::sample::SampleArgs),
+    /// Render a mesh or a point cloud to a PNG (headless GPU).
+    Render(commands::render::RenderArgs),
     /// Run the demo on the embedded Spot mesh.
     Demo(commands::demo::DemoArgs),
     /// Measure a capability against its paper's figures.
@@ -36,6 +38,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
         Command::Sample(args) => commands::sample::run(&args),
+        Command::Render(args) => commands::render::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
     };

@@ -124,6 +124,11 @@ fn demo_runs_on_the_embedded_asset_from_any_folder() {
     let bytes = std::fs::read(&roots).expect("the demo writes pelage-demo/roots.ply");
     assert!(bytes.starts_with(b"ply\nformat binary_little_endian 1.0\n"));
     assert!(bytes.len() > 36_000_000);
+    // The preview needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() {
+        let png = image::open(dir.path().join("pelage-demo/preview.png")).expect("a preview PNG");
+        assert_eq!((png.width(), png.height()), (1280, 720));
+    }
 }
 
 #[test]

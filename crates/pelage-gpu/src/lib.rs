@@ -1,7 +1,75 @@
-//! pelage-gpu: the wgpu renderer (shell fur, strand and point preview,
-//! headless and windowed), with its WGSL in `src/shaders/`.
+//! pelage-gpu: the wgpu renderer. Everything pelage makes can be looked at
+//! through it: the skin mesh, points (hair roots, samples) and, with the
+//! groom issue, curves. It renders headless into an image (CI, render
+//! farms without GPUs, docs) and, with the viewer issue, into a window,
+//! with the same pipelines. WGSL lives in `src/shaders/`.
 //!
-//! Its own crate because wgpu is the heaviest dependency by far: the library
-//! and its tests build without it. It is empty until the GPU-layer issue
-//! (the renderer) lands; the foundation only reserves its place in the
-//! workspace so the layout matches ARCHITECTURE.md from the start.
+//! Its own crate because wgpu is the heaviest dependency by far: the
+//! library and its tests build without it.
+//!
+//! Without a GPU, Mesa's software Vulkan driver (lavapipe; Debian package
+//! `mesa-vulkan-drivers`) serves: CI renders for real with it.
+
+mod camera;
+mod context;
+mod renderer;
+
+pub use camera::Camera;
+pub use context::GpuContext;
+pub use renderer::{PreviewScene, PreviewStyle, Renderer};
+
+/// The renderer could not run.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum GpuError {
+    /// No adapter: no GPU, and no software Vulkan driver either.
+    #[error(
+        "no GPU adapter found ({0}); for a software renderer install Mesa's Vulkan drivers (Debian/Ubuntu: apt-get install mesa-vulkan-drivers), or choose a backend with WGPU_BACKEND=vulkan|gl"
+    )]
+    NoAdapter(String),
+    /// The adapter refused to create a device.
+    #[error("the GPU adapter {adapter} could not open a device: {message}")]
+    Device {
+        /// The adapter's name.
+        adapter: String,
+        /// wgpu's message.
+        message: String,
+    },
+    /// Reading the rendered image back failed.
+    #[error("reading the rendered image back from the GPU failed: {0}")]
+    Readback(String),
+    /// The requested image size is not possible.
+    #[error("an image of {width}×{height} pixels cannot be rendered (1 to {max} per side)")]
+    Size {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+        /// The adapter's limit.
+        max: u32,
+    },
+}
+
+/// The WGSL sources, for offline validation (see the tests).
+pub const SHADERS: &[(&str, &str)] = &[
+    ("mesh.wgsl", include_str!("shaders/mesh.wgsl")),
+    ("points.wgsl", include_str!("shaders/points.wgsl")),
+];
+
+#[cfg(test)]
+mod tests {
+    /// Every shader parses and validates with naga, with no GPU needed.
+    #[test]
+    fn shaders_validate_with_naga() {
+        for (name, source) in super::SHADERS {
+            let module = naga::front::wgsl::parse_str(source)
+                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::default(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        }
+    }
+}

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod demo;
 pub mod info;
+pub mod render;
 pub mod sample;
 
 use anyhow::Context;

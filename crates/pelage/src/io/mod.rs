@@ -9,7 +9,7 @@ mod atomic;
 mod points_ply;
 
 pub use atomic::write_atomically;
-pub use points_ply::{PointsPly, write_points_ply};
+pub use points_ply::{PointsPly, ply_has_faces, read_points_ply, write_points_ply};
 
 use std::path::PathBuf;
 

@@ -91,6 +91,74 @@ pub fn write_points_ply(
     })
 }
 
+/// Reads the positions of a PLY point cloud (a `vertex` element with
+/// `x y z`; faces, if any, are ignored). Errors name the file and the
+/// line or vertex.
+pub fn read_points_ply(path: &Path) -> Result<Vec<glam::Vec3>, crate::MeshError> {
+    use crate::mesh::MeshErrorKind;
+    use ply_rs_bw::parser::Parser;
+    use ply_rs_bw::ply::{DefaultElement, Property};
+    let name = path.display().to_string();
+    let bytes =
+        std::fs::read(path).map_err(|e| crate::MeshError::whole(&name, MeshErrorKind::Io(e)))?;
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut std::io::Cursor::new(bytes))
+        .map_err(|e| {
+            let kind = MeshErrorKind::Syntax(format!("not a readable PLY file: {e}"));
+            crate::MeshError::whole(&name, kind)
+        })?;
+    let vertices = ply.payload.get("vertex").ok_or_else(|| {
+        crate::MeshError::whole(
+            &name,
+            MeshErrorKind::Inconsistent("the file has no 'vertex' element".into()),
+        )
+    })?;
+    vertices
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let get = |k: &str| match v.get(k) {
+                Some(Property::Float(x)) => Some(*x),
+                Some(Property::Double(x)) => Some(*x as f32),
+                _ => None,
+            };
+            match (get("x"), get("y"), get("z")) {
+                (Some(x), Some(y), Some(z)) if x.is_finite() && y.is_finite() && z.is_finite() => {
+                    Ok(glam::Vec3::new(x, y, z))
+                }
+                _ => Err(crate::MeshError::at_element(
+                    &name,
+                    "vertex",
+                    i,
+                    MeshErrorKind::Syntax(
+                        "x, y and z must be finite float or double values".into(),
+                    ),
+                )),
+            }
+        })
+        .collect()
+}
+
+/// Whether a PLY file describes points (no faces) rather than a mesh.
+pub fn ply_has_faces(path: &Path) -> std::io::Result<bool> {
+    use std::io::BufRead;
+    let file = std::io::BufReader::new(std::fs::File::open(path)?);
+    for line in file.split(b'\n') {
+        let line = line?;
+        if line.starts_with(b"end_header") {
+            break;
+        }
+        if let Some(rest) = line.strip_prefix(b"element face ") {
+            return Ok(std::str::from_utf8(rest)
+                .ok()
+                .and_then(|n| n.trim().parse::<u64>().ok())
+                .unwrap_or(0)
+                > 0);
+        }
+    }
+    Ok(false)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -116,6 +184,9 @@ mod tests {
             Property::Float(x) => x,
             _ => panic!("{k} is not a float"),
         };
+        let read = read_points_ply(&path).unwrap();
+        assert_eq!(read.len(), 100);
+        assert!(!ply_has_faces(&path).unwrap());
         for (p, v) in points.iter().zip(vertices) {
             let position = p.position(&spot);
             assert_eq!(

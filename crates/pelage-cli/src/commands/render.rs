@@ -1,0 +1,119 @@
+//! `pelage render`: a picture of a mesh or a point cloud (headless, wgpu).
+
+use super::load_mesh;
+use anyhow::Context;
+use clap::Args;
+use pelage::io::{ply_has_faces, read_points_ply, write_atomically};
+use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
+use std::path::{Path, PathBuf};
+
+/// Arguments of `pelage render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// A mesh (.obj, .ply, .gltf, .glb) or a points PLY (as `pelage
+    /// sample` writes). Without it, the embedded Spot.
+    pub file: Option<PathBuf>,
+    /// A mesh to draw under the points (for a points file).
+    #[arg(long)]
+    pub mesh: Option<PathBuf>,
+    /// Output PNG.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Camera position, X,Y,Z (default: framed automatically).
+    #[arg(long, value_parser = parse_vec3)]
+    pub eye: Option<[f32; 3]>,
+    /// Camera target, X,Y,Z (default: the centre of what is drawn).
+    #[arg(long, value_parser = parse_vec3)]
+    pub target: Option<[f32; 3]>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 30.0)]
+    pub fov: f32,
+    /// Point radius in pixels.
+    #[arg(long, default_value_t = 1.5)]
+    pub point_radius: f32,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?} is not WIDTHxHEIGHT, e.g. 1280x720"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("{v:?} is not a whole number"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
+    let parts: Vec<f32> = s
+        .split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<f32>()
+                .map_err(|_| format!("{v:?} is not a number"))
+        })
+        .collect::<Result<_, _>>()?;
+    <[f32; 3]>::try_from(parts).map_err(|_| format!("{s:?} is not X,Y,Z"))
+}
+
+fn is_points_file(path: &Path) -> anyhow::Result<bool> {
+    let ply = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
+    Ok(ply && !ply_has_faces(path).with_context(|| format!("cannot read {}", path.display()))?)
+}
+
+pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
+    let (points, mesh) = match &args.file {
+        Some(file) if is_points_file(file)? => {
+            let points = read_points_ply(file).context("cannot load the points")?;
+            let mesh = args
+                .mesh
+                .as_deref()
+                .map(|m| load_mesh(Some(m)))
+                .transpose()?;
+            (points, mesh)
+        }
+        file => (Vec::new(), Some(load_mesh(file.as_deref())?)),
+    };
+    let scene = PreviewScene {
+        mesh: mesh.as_ref(),
+        points: &points,
+    };
+    let (width, height) = args.size;
+    let camera = match (args.eye, scene.bounds()) {
+        (Some(eye), Some((lo, hi))) => Some(Camera {
+            eye: eye.into(),
+            target: args.target.map_or(0.5 * (lo + hi), Into::into),
+            fov_y_degrees: args.fov,
+        }),
+        _ => None,
+    };
+    let style = PreviewStyle {
+        point_radius: args.point_radius,
+        ..Default::default()
+    };
+    let ctx = GpuContext::headless()?;
+    let renderer = Renderer::new(&ctx);
+    let image = renderer.render(&ctx, &scene, &style, camera, width, height)?;
+    write_atomically(&args.output, |out| {
+        image
+            .write_to(out, image::ImageFormat::Png)
+            .map_err(std::io::Error::other)
+    })?;
+    println!(
+        "wrote {} ({width}×{height}, {} on {})",
+        args.output.display(),
+        match (&mesh, points.len()) {
+            (Some(m), 0) => m.name().to_string(),
+            (Some(m), n) => format!("{n} points on {}", m.name()),
+            (None, n) => format!("{n} points"),
+        },
+        ctx.adapter_name()
+    );
+    Ok(())
+}

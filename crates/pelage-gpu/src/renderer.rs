@@ -1,0 +1,394 @@
+//! The preview renderer: the skin mesh (lit) and points (discs) into an
+//! image, multisampled, with depth.
+
+use crate::{Camera, GpuContext, GpuError};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use pelage::Mesh;
+use wgpu::util::DeviceExt;
+
+/// Multisampling: 4 samples per pixel (every Vulkan device supports 4).
+const SAMPLES: u32 = 4;
+/// Stored sRGB-encoded; shaders work in linear light.
+const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// What to draw.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PreviewScene<'a> {
+    /// The skin, if any.
+    pub mesh: Option<&'a Mesh>,
+    /// Points (hair roots, samples) in world space.
+    pub points: &'a [Vec3],
+}
+
+impl PreviewScene<'_> {
+    /// Bounds of everything drawn, or `None` for an empty scene.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut bounds = self.mesh.map(Mesh::bounds);
+        for &p in self.points {
+            bounds = Some(match bounds {
+                Some((lo, hi)) => (lo.min(p), hi.max(p)),
+                None => (p, p),
+            });
+        }
+        bounds
+    }
+}
+
+/// Colours (linear RGB) and sizes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PreviewStyle {
+    /// Where nothing is drawn.
+    pub background: [f32; 3],
+    /// The skin.
+    pub skin: [f32; 3],
+    /// Points.
+    pub point: [f32; 3],
+    /// Point radius in pixels.
+    pub point_radius: f32,
+}
+
+impl Default for PreviewStyle {
+    fn default() -> Self {
+        Self {
+            background: [1.0, 1.0, 1.0],
+            skin: [0.70, 0.60, 0.48],
+            point: [0.30, 0.01, 0.005],
+            point_radius: 1.5,
+        }
+    }
+}
+
+/// The uniform block both shaders read (`struct Frame` in the WGSL).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct FrameUniforms {
+    view_proj: [[f32; 4]; 4],
+    light_dir: [f32; 4],
+    skin_color: [f32; 4],
+    point_color: [f32; 4],
+    viewport: [f32; 4],
+}
+
+/// Draws preview scenes into images. Build once, render many times.
+#[derive(Debug)]
+pub struct Renderer {
+    frame_layout: wgpu::BindGroupLayout,
+    mesh_pipeline: wgpu::RenderPipeline,
+    points_pipeline: wgpu::RenderPipeline,
+}
+
+impl Renderer {
+    /// Compiles the shaders and builds the pipelines.
+    pub fn new(ctx: &GpuContext) -> Self {
+        let device = &ctx.device;
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("preview"),
+            bind_group_layouts: &[Some(&frame_layout)],
+            immediate_size: 0,
+        });
+        let shader = |name: &str, source: &str| {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            })
+        };
+        let mesh_shader = shader("mesh.wgsl", include_str!("shaders/mesh.wgsl"));
+        let points_shader = shader("points.wgsl", include_str!("shaders/points.wgsl"));
+        let pipeline = |module: &wgpu::ShaderModule,
+                        buffers: &[Option<wgpu::VertexBufferLayout>],
+                        alpha_to_coverage: bool| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("preview"),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState {
+                    count: SAMPLES,
+                    mask: !0,
+                    alpha_to_coverage_enabled: alpha_to_coverage,
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let mesh_pipeline = pipeline(
+            &mesh_shader,
+            &[Some(wgpu::VertexBufferLayout {
+                array_stride: 24,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+            })],
+            false,
+        );
+        let points_pipeline = pipeline(
+            &points_shader,
+            &[Some(wgpu::VertexBufferLayout {
+                array_stride: 12,
+                step_mode: wgpu::VertexStepMode::Instance,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+            })],
+            true,
+        );
+        Self {
+            frame_layout,
+            mesh_pipeline,
+            points_pipeline,
+        }
+    }
+
+    /// Renders `scene` into a `width × height` image. Without a camera the
+    /// scene is framed automatically.
+    pub fn render(
+        &self,
+        ctx: &GpuContext,
+        scene: &PreviewScene,
+        style: &PreviewStyle,
+        camera: Option<Camera>,
+        width: u32,
+        height: u32,
+    ) -> Result<image::RgbaImage, GpuError> {
+        let max = ctx.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(GpuError::Size { width, height, max });
+        }
+        let device = &ctx.device;
+        let aspect = width as f32 / height as f32;
+        let (lo, hi) = scene
+            .bounds()
+            .unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
+        let camera = camera.unwrap_or_else(|| Camera::framing(lo, hi, aspect));
+        let radius =
+            (0.5 * (hi - lo)).length().max(1e-6) + (0.5 * (lo + hi) - camera.target).length();
+        let clip_from_world = camera.clip_from_world(aspect, radius);
+        // Key light above and to the left of the camera, so form reads.
+        let view = (camera.eye - camera.target).normalize();
+        let side = view.cross(Vec3::Y).normalize_or_zero();
+        let light = view + 0.9 * Vec3::Y + 0.6 * side;
+        let uniforms = FrameUniforms {
+            view_proj: clip_from_world.to_cols_array_2d(),
+            light_dir: light.normalize().extend(0.0).to_array(),
+            skin_color: [style.skin[0], style.skin[1], style.skin[2], 1.0],
+            point_color: [
+                style.point[0],
+                style.point[1],
+                style.point[2],
+                style.point_radius,
+            ],
+            // Points are pulled towards the camera by 0.2 % of clip w.
+            viewport: [width as f32, height as f32, 0.002, 0.0],
+        };
+        let uniform_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("frame"),
+            contents: bytemuck::bytes_of(&uniforms),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let frame = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &self.frame_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform_buffer.as_entire_binding(),
+            }],
+        });
+
+        let target = |samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("preview target"),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let multisampled = target(
+            SAMPLES,
+            COLOR_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let resolved = target(
+            1,
+            COLOR_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let depth = target(
+            SAMPLES,
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let views = [&multisampled, &resolved, &depth].map(|t| t.create_view(&Default::default()));
+
+        let mesh_buffers = scene.mesh.map(|mesh| {
+            let vertices: Vec<f32> = mesh
+                .positions()
+                .iter()
+                .zip(mesh.normals())
+                .flat_map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z])
+                .collect();
+            let indices: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
+            let vertex = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("mesh vertices"),
+                contents: bytemuck::cast_slice(&vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            let index = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("mesh indices"),
+                contents: bytemuck::cast_slice(&indices),
+                usage: wgpu::BufferUsages::INDEX,
+            });
+            (vertex, index, indices.len() as u32)
+        });
+        let point_buffer = (!scene.points.is_empty()).then(|| {
+            let flat: Vec<f32> = scene.points.iter().flat_map(|p| p.to_array()).collect();
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("points"),
+                contents: bytemuck::cast_slice(&flat),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
+        });
+
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let [r, g, b] = style.background.map(f64::from);
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("preview"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &views[0],
+                    depth_slice: None,
+                    resolve_target: Some(&views[1]),
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
+                        store: wgpu::StoreOp::Discard,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &views[2],
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, &frame, &[]);
+            if let Some((vertex, index, count)) = &mesh_buffers {
+                pass.set_pipeline(&self.mesh_pipeline);
+                pass.set_vertex_buffer(0, vertex.slice(..));
+                pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..*count, 0, 0..1);
+            }
+            if let Some(points) = &point_buffer {
+                pass.set_pipeline(&self.points_pipeline);
+                pass.set_vertex_buffer(0, points.slice(..));
+                pass.draw(0..6, 0..scene.points.len() as u32);
+            }
+        }
+
+        // Rows of a texture-to-buffer copy are padded to 256 bytes.
+        let row = width * 4;
+        let padded_row =
+            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: u64::from(padded_row) * u64::from(height),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &resolved,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(height),
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+        ctx.queue.submit([encoder.finish()]);
+
+        let (sender, receiver) = std::sync::mpsc::channel();
+        readback.map_async(wgpu::MapMode::Read, .., move |result| {
+            let _ = sender.send(result);
+        });
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        receiver
+            .recv()
+            .map_err(|e| GpuError::Readback(e.to_string()))?
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let mapped = readback
+            .get_mapped_range(..)
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let mut pixels = Vec::with_capacity((row * height) as usize);
+        for y in 0..height as usize {
+            let start = y * padded_row as usize;
+            pixels.extend_from_slice(&mapped[start..start + row as usize]);
+        }
+        drop(mapped);
+        readback.unmap();
+        image::RgbaImage::from_raw(width, height, pixels)
+            .ok_or_else(|| GpuError::Readback("the image size does not match".into()))
+    }
+}

@@ -1,0 +1,153 @@
+//! Headless renders, checked for properties of the image a person would
+//! see, not just that a file exists. They need a GPU adapter: lavapipe
+//! (Mesa's software Vulkan) serves without a GPU. With
+//! `PELAGE_REQUIRE_GPU=1` (CI) a missing adapter fails the tests; without
+//! it they are skipped with a message.
+
+use glam::Vec3;
+use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
+use std::sync::OnceLock;
+
+fn gpu() -> Option<&'static (GpuContext, Renderer)> {
+    static GPU: OnceLock<Option<(GpuContext, Renderer)>> = OnceLock::new();
+    GPU.get_or_init(|| match GpuContext::headless() {
+        Ok(ctx) => {
+            let renderer = Renderer::new(&ctx);
+            eprintln!("rendering on {}", ctx.adapter_name());
+            Some((ctx, renderer))
+        }
+        Err(e) if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() => {
+            panic!("PELAGE_REQUIRE_GPU is set and there is no adapter: {e}")
+        }
+        Err(e) => {
+            eprintln!("SKIPPED: no GPU adapter ({e})");
+            None
+        }
+    })
+    .as_ref()
+}
+
+const WHITE: [u8; 4] = [255, 255, 255, 255];
+
+fn is(pixel: &image::Rgba<u8>, rgb: [u8; 3], tolerance: u8) -> bool {
+    pixel.0[..3]
+        .iter()
+        .zip(rgb)
+        .all(|(a, b)| a.abs_diff(b) <= tolerance)
+}
+
+#[test]
+fn spot_fills_the_middle_and_leaves_the_corners_background() {
+    let Some((ctx, renderer)) = gpu() else { return };
+    let spot = pelage::assets::spot();
+    let scene = PreviewScene {
+        mesh: Some(&spot),
+        points: &[],
+    };
+    let image = renderer
+        .render(ctx, &scene, &PreviewStyle::default(), None, 320, 240)
+        .unwrap();
+    for (x, y) in [(0, 0), (319, 0), (0, 239), (319, 239)] {
+        assert_eq!(image.get_pixel(x, y).0, WHITE, "corner ({x}, {y})");
+    }
+    let skin = image.pixels().filter(|p| p.0 != WHITE).count() as f64;
+    let fraction = skin / (320.0 * 240.0);
+    // Auto-framing: the mesh is big in the picture but not cut off.
+    assert!(
+        (0.10..0.7).contains(&fraction),
+        "skin covers {fraction:.3} of the image"
+    );
+    // Shaded, not flat: the skin shows a range of brightness.
+    let brightness: Vec<u32> = image
+        .pixels()
+        .filter(|p| p.0 != WHITE)
+        .map(|p| p.0[..3].iter().map(|&c| u32::from(c)).sum())
+        .collect();
+    let (lo, hi) = (
+        brightness.iter().min().unwrap(),
+        brightness.iter().max().unwrap(),
+    );
+    assert!(hi - lo > 90, "skin brightness spans only {lo}..{hi}");
+}
+
+#[test]
+fn a_point_covers_about_a_disc_of_its_radius() {
+    let Some((ctx, renderer)) = gpu() else { return };
+    // A grid of points far apart, seen head-on.
+    let points: Vec<Vec3> = (0..5)
+        .flat_map(|i| (0..5).map(move |j| Vec3::new(i as f32 - 2.0, j as f32 - 2.0, 0.0)))
+        .collect();
+    let style = PreviewStyle {
+        point: [0.0, 0.0, 1.0],
+        point_radius: 4.0,
+        ..Default::default()
+    };
+    let camera = Camera {
+        eye: Vec3::new(0.0, 0.0, 20.0),
+        target: Vec3::ZERO,
+        fov_y_degrees: 30.0,
+    };
+    let scene = PreviewScene {
+        mesh: None,
+        points: &points,
+    };
+    let image = renderer
+        .render(ctx, &scene, &style, Some(camera), 256, 256)
+        .unwrap();
+    let blue = image.pixels().filter(|p| is(p, [0, 0, 255], 40)).count() as f64;
+    let expected = 25.0 * std::f64::consts::PI * 16.0;
+    assert!(
+        (blue - expected).abs() < 0.3 * expected,
+        "{blue} point pixels, expected about {expected:.0}"
+    );
+    // The centre point lands in the middle of the image.
+    assert!(is(image.get_pixel(128, 128), [0, 0, 255], 40));
+}
+
+#[test]
+fn points_behind_the_mesh_are_hidden_and_points_in_front_are_seen() {
+    let Some((ctx, renderer)) = gpu() else { return };
+    let spot = pelage::assets::spot();
+    let (lo, hi) = spot.bounds();
+    let center = 0.5 * (lo + hi);
+    let camera = Camera {
+        eye: center + Vec3::new(6.0, 0.0, 0.0),
+        target: center,
+        fov_y_degrees: 30.0,
+    };
+    let style = PreviewStyle {
+        point: [0.0, 0.0, 1.0],
+        point_radius: 6.0,
+        ..Default::default()
+    };
+    let render = |p: Vec3| {
+        let points = [p];
+        let scene = PreviewScene {
+            mesh: Some(&spot),
+            points: &points,
+        };
+        renderer
+            .render(ctx, &scene, &style, Some(camera), 200, 200)
+            .unwrap()
+    };
+    let count =
+        |image: &image::RgbaImage| image.pixels().filter(|p| is(p, [0, 0, 255], 40)).count();
+    // Centre of the body, on the far side (−x) and on the near side (+x).
+    let behind = render(Vec3::new(lo.x - 0.05, center.y, center.z));
+    let in_front = render(Vec3::new(hi.x + 0.05, center.y, center.z));
+    assert_eq!(count(&behind), 0, "a point behind the mesh shows through");
+    assert!(
+        count(&in_front) > 50,
+        "a point in front of the mesh is not drawn"
+    );
+}
+
+#[test]
+fn impossible_sizes_are_errors() {
+    let Some((ctx, renderer)) = gpu() else { return };
+    let scene = PreviewScene::default();
+    let err = renderer
+        .render(ctx, &scene, &PreviewStyle::default(), None, 0, 10)
+        .unwrap_err();
+    assert!(err.to_string().contains("cannot be rendered"), "{err}");
+}
