@@ -68,6 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let scene = PreviewScene {
             mesh: Some(&spot),
             points: &points,
+            curves: None,
         };
         renderer.render(&ctx, &scene, &style, Some(camera), WIDTH, HEIGHT)
     };

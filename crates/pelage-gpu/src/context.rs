@@ -31,7 +31,9 @@ impl GpuContext {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("pelage"),
             required_features: wgpu::Features::empty(),
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            // Everything the adapter offers: a million preview curves need a
+            // vertex buffer of a few hundred MB.
+            required_limits: adapter.limits(),
             ..Default::default()
         }))
         .map_err(|e| GpuError::Device {

@@ -16,6 +16,7 @@ mod renderer;
 
 pub use camera::Camera;
 pub use context::GpuContext;
+pub use pelage::Curves;
 pub use renderer::{PreviewScene, PreviewStyle, Renderer};
 
 /// The renderer could not run.
@@ -50,11 +51,40 @@ pub enum GpuError {
     },
 }
 
-/// The WGSL sources, for offline validation (see the tests).
+/// The WGSL of each pipeline: the shared `Frame` uniform block
+/// (`frame.wgsl`) followed by the pipeline's own shader.
 pub const SHADERS: &[(&str, &str)] = &[
-    ("mesh.wgsl", include_str!("shaders/mesh.wgsl")),
-    ("points.wgsl", include_str!("shaders/points.wgsl")),
+    (
+        "mesh.wgsl",
+        concat!(
+            include_str!("shaders/frame.wgsl"),
+            include_str!("shaders/mesh.wgsl")
+        ),
+    ),
+    (
+        "points.wgsl",
+        concat!(
+            include_str!("shaders/frame.wgsl"),
+            include_str!("shaders/points.wgsl")
+        ),
+    ),
+    (
+        "curves.wgsl",
+        concat!(
+            include_str!("shaders/frame.wgsl"),
+            include_str!("shaders/curves.wgsl")
+        ),
+    ),
 ];
+
+/// The WGSL source of the named shader (with its prelude).
+pub(crate) fn shader_source(name: &str) -> &'static str {
+    SHADERS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| *s)
+        .expect("the shader exists")
+}
 
 #[cfg(test)]
 mod tests {

@@ -1,10 +1,10 @@
-//! The preview renderer: the skin mesh (lit) and points (discs) into an
-//! image, multisampled, with depth.
+//! The preview renderer: the skin mesh (lit), points (discs) and curves
+//! (Kajiya-Kay ribbons) into an image, multisampled, with depth.
 
 use crate::{Camera, GpuContext, GpuError};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use pelage::Mesh;
+use pelage::{Curves, Mesh};
 use wgpu::util::DeviceExt;
 
 /// Multisampling: 4 samples per pixel (every Vulkan device supports 4).
@@ -20,13 +20,16 @@ pub struct PreviewScene<'a> {
     pub mesh: Option<&'a Mesh>,
     /// Points (hair roots, samples) in world space.
     pub points: &'a [Vec3],
+    /// Hair curves, drawn as ribbons of their widths.
+    pub curves: Option<&'a Curves>,
 }
 
 impl PreviewScene<'_> {
     /// Bounds of everything drawn, or `None` for an empty scene.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let mut bounds = self.mesh.map(Mesh::bounds);
-        for &p in self.points {
+        let curve_points = self.curves.map_or(&[][..], |c| c.points());
+        for &p in self.points.iter().chain(curve_points) {
             bounds = Some(match bounds {
                 Some((lo, hi)) => (lo.min(p), hi.max(p)),
                 None => (p, p),
@@ -47,6 +50,10 @@ pub struct PreviewStyle {
     pub point: [f32; 3],
     /// Point radius in pixels.
     pub point_radius: f32,
+    /// Hair.
+    pub hair: [f32; 3],
+    /// Strength of the hair's specular highlight.
+    pub hair_specular: f32,
 }
 
 impl Default for PreviewStyle {
@@ -56,6 +63,8 @@ impl Default for PreviewStyle {
             skin: [0.70, 0.60, 0.48],
             point: [0.30, 0.01, 0.005],
             point_radius: 1.5,
+            hair: [0.35, 0.17, 0.07],
+            hair_specular: 0.25,
         }
     }
 }
@@ -69,6 +78,8 @@ struct FrameUniforms {
     skin_color: [f32; 4],
     point_color: [f32; 4],
     viewport: [f32; 4],
+    eye: [f32; 4],
+    hair_color: [f32; 4],
 }
 
 /// Draws preview scenes into images. Build once, render many times.
@@ -77,6 +88,7 @@ pub struct Renderer {
     frame_layout: wgpu::BindGroupLayout,
     mesh_pipeline: wgpu::RenderPipeline,
     points_pipeline: wgpu::RenderPipeline,
+    curves_pipeline: wgpu::RenderPipeline,
 }
 
 impl Renderer {
@@ -107,8 +119,9 @@ impl Renderer {
                 source: wgpu::ShaderSource::Wgsl(source.into()),
             })
         };
-        let mesh_shader = shader("mesh.wgsl", include_str!("shaders/mesh.wgsl"));
-        let points_shader = shader("points.wgsl", include_str!("shaders/points.wgsl"));
+        let mesh_shader = shader("mesh.wgsl", crate::shader_source("mesh.wgsl"));
+        let points_shader = shader("points.wgsl", crate::shader_source("points.wgsl"));
+        let curves_shader = shader("curves.wgsl", crate::shader_source("curves.wgsl"));
         let pipeline = |module: &wgpu::ShaderModule,
                         buffers: &[Option<wgpu::VertexBufferLayout>],
                         alpha_to_coverage: bool| {
@@ -170,10 +183,20 @@ impl Renderer {
             })],
             true,
         );
+        let curves_pipeline = pipeline(
+            &curves_shader,
+            &[Some(wgpu::VertexBufferLayout {
+                array_stride: 32,
+                step_mode: wgpu::VertexStepMode::Instance,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4],
+            })],
+            true,
+        );
         Self {
             frame_layout,
             mesh_pipeline,
             points_pipeline,
+            curves_pipeline,
         }
     }
 
@@ -215,8 +238,21 @@ impl Renderer {
                 style.point[2],
                 style.point_radius,
             ],
-            // Points are pulled towards the camera by 0.2 % of clip w.
-            viewport: [width as f32, height as f32, 0.002, 0.0],
+            // Points are pulled towards the camera by 0.2 % of clip w; the
+            // focal length in pixels turns world widths into pixels.
+            viewport: [
+                width as f32,
+                height as f32,
+                0.002,
+                0.5 * height as f32 * clip_from_world.y_axis.y,
+            ],
+            eye: camera.eye.extend(1.0).to_array(),
+            hair_color: [
+                style.hair[0],
+                style.hair[1],
+                style.hair[2],
+                style.hair_specular,
+            ],
         };
         let uniform_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame"),
@@ -294,6 +330,36 @@ impl Renderer {
             })
         });
 
+        let segment_buffer = scene
+            .curves
+            .filter(|c| c.segment_count() > 0)
+            .map(|curves| {
+                let (points, widths) = (curves.points(), curves.widths());
+                let mut segments: Vec<f32> = Vec::with_capacity(curves.segment_count() * 8);
+                for i in 0..curves.curve_count() {
+                    let range = curves.range(i);
+                    for k in range.start..range.end.saturating_sub(1) {
+                        let (a, b) = (points[k], points[k + 1]);
+                        segments.extend_from_slice(&[
+                            a.x,
+                            a.y,
+                            a.z,
+                            widths[k],
+                            b.x,
+                            b.y,
+                            b.z,
+                            widths[k + 1],
+                        ]);
+                    }
+                }
+                let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("curve segments"),
+                    contents: bytemuck::cast_slice(&segments),
+                    usage: wgpu::BufferUsages::VERTEX,
+                });
+                (buffer, (segments.len() / 8) as u32)
+            });
+
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let [r, g, b] = style.background.map(f64::from);
@@ -326,6 +392,11 @@ impl Renderer {
                 pass.set_vertex_buffer(0, vertex.slice(..));
                 pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..*count, 0, 0..1);
+            }
+            if let Some((segments, count)) = &segment_buffer {
+                pass.set_pipeline(&self.curves_pipeline);
+                pass.set_vertex_buffer(0, segments.slice(..));
+                pass.draw(0..6, 0..*count);
             }
             if let Some(points) = &point_buffer {
                 pass.set_pipeline(&self.points_pipeline);

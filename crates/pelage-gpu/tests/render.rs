@@ -43,6 +43,7 @@ fn spot_fills_the_middle_and_leaves_the_corners_background() {
     let scene = PreviewScene {
         mesh: Some(&spot),
         points: &[],
+        curves: None,
     };
     let image = renderer
         .render(ctx, &scene, &PreviewStyle::default(), None, 320, 240)
@@ -90,6 +91,7 @@ fn a_point_covers_about_a_disc_of_its_radius() {
     let scene = PreviewScene {
         mesh: None,
         points: &points,
+        curves: None,
     };
     let image = renderer
         .render(ctx, &scene, &style, Some(camera), 256, 256)
@@ -125,6 +127,7 @@ fn points_behind_the_mesh_are_hidden_and_points_in_front_are_seen() {
         let scene = PreviewScene {
             mesh: Some(&spot),
             points: &points,
+            curves: None,
         };
         renderer
             .render(ctx, &scene, &style, Some(camera), 200, 200)
@@ -150,4 +153,109 @@ fn impossible_sizes_are_errors() {
         .render(ctx, &scene, &PreviewStyle::default(), None, 0, 10)
         .unwrap_err();
     assert!(err.to_string().contains("cannot be rendered"), "{err}");
+}
+
+/// A straight curve along x from −1 to 1 (9 points) of constant `width`.
+fn straight_curve(width: f32) -> pelage::Curves {
+    let points: Vec<Vec3> = (0..9)
+        .map(|i| Vec3::new(-1.0 + i as f32 * 0.25, 0.0, 0.0))
+        .collect();
+    pelage::Curves::new(points, vec![width; 9], vec![0, 9]).unwrap()
+}
+
+/// Covered area in pixels of black hair on white: each pixel's darkness,
+/// in linear light, is its coverage.
+fn covered_pixels(image: &image::RgbaImage) -> f64 {
+    let linear = |c: u8| {
+        let c = f64::from(c) / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    image.pixels().map(|p| 1.0 - linear(p.0[0])).sum()
+}
+
+fn render_curve(curves: &pelage::Curves, style: &PreviewStyle) -> Option<image::RgbaImage> {
+    let (ctx, renderer) = gpu()?;
+    let camera = Camera {
+        eye: Vec3::new(0.0, 0.0, 10.0),
+        target: Vec3::ZERO,
+        fov_y_degrees: 30.0,
+    };
+    let scene = PreviewScene {
+        mesh: None,
+        points: &[],
+        curves: Some(curves),
+    };
+    Some(
+        renderer
+            .render(ctx, &scene, style, Some(camera), 400, 400)
+            .unwrap(),
+    )
+}
+
+/// Pixels per world unit at distance 10 with a 30° field of view on 400 px.
+fn pixels_per_unit() -> f64 {
+    200.0 / (15f64.to_radians().tan()) / 10.0
+}
+
+#[test]
+fn a_ribbon_covers_its_width_times_its_length() {
+    let black = PreviewStyle {
+        hair: [0.0, 0.0, 0.0],
+        hair_specular: 0.0,
+        ..Default::default()
+    };
+    let Some(image) = render_curve(&straight_curve(0.05), &black) else {
+        return;
+    };
+    let expected = 2.0 * pixels_per_unit() * 0.05 * pixels_per_unit();
+    let covered = covered_pixels(&image);
+    assert!(
+        (covered - expected).abs() < 0.15 * expected,
+        "covered {covered:.0} px², expected {expected:.0}"
+    );
+}
+
+#[test]
+fn a_hair_thinner_than_a_pixel_thins_instead_of_vanishing() {
+    let black = PreviewStyle {
+        hair: [0.0, 0.0, 0.0],
+        hair_specular: 0.0,
+        ..Default::default()
+    };
+    // 0.37 pixels wide: drawn one pixel wide at 0.37 coverage.
+    let Some(image) = render_curve(&straight_curve(0.005), &black) else {
+        return;
+    };
+    let expected = 2.0 * pixels_per_unit() * 0.005 * pixels_per_unit();
+    let covered = covered_pixels(&image);
+    assert!(
+        covered > 0.5 * expected && covered < 1.6 * expected,
+        "covered {covered:.0} px², expected {expected:.0}"
+    );
+}
+
+#[test]
+fn hair_is_drawn_in_its_colour() {
+    let red = PreviewStyle {
+        hair: [0.8, 0.05, 0.05],
+        hair_specular: 0.0,
+        ..Default::default()
+    };
+    let Some(image) = render_curve(&straight_curve(0.2), &red) else {
+        return;
+    };
+    let center = image.get_pixel(200, 200).0;
+    assert!(
+        center[0] > 120 && center[1] < 90 && center[2] < 90,
+        "centre pixel {center:?}"
+    );
+    assert_eq!(
+        image.get_pixel(200, 20).0,
+        WHITE,
+        "background above the hair"
+    );
 }

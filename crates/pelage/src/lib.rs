@@ -10,6 +10,8 @@
 //!   also specified by a texture").
 //! - [`sample`]: hair roots: points distributed by a density map (Sik §3),
 //!   deterministic by `(seed, index)`.
+//! - [`curves`]: [`Curves`], hair curves as structure of arrays with an
+//!   offsets array (Blender's `CurvesGeometry`, USD `BasisCurves`).
 //! - [`io`]: writers, all atomic (temporary file, then rename).
 //! - [`assets`]: the embedded demo mesh (Spot), so every command works with
 //!   no files at hand.
@@ -19,10 +21,12 @@
 #![warn(missing_docs)]
 
 pub mod assets;
+pub mod curves;
 pub mod io;
 pub mod map;
 pub mod mesh;
 pub mod sample;
 
+pub use curves::Curves;
 pub use map::{Map, MapError};
 pub use mesh::{Mesh, MeshError, SurfacePoint, TangentFrame};

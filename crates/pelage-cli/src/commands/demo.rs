@@ -41,6 +41,7 @@ fn render_preview(
     let scene = PreviewScene {
         mesh: Some(spot),
         points: &points,
+        curves: None,
     };
     let image =
         Renderer::new(&ctx).render(&ctx, &scene, &PreviewStyle::default(), None, 1280, 720)?;

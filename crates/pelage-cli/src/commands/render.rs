@@ -83,6 +83,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let scene = PreviewScene {
         mesh: mesh.as_ref(),
         points: &points,
+        curves: None,
     };
     let (width, height) = args.size;
     let camera = match (args.eye, scene.bounds()) {

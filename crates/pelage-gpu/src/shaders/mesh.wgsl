@@ -2,21 +2,6 @@
 // ambient), the surface hair grows on. Mirrors nothing in pelage::shell:
 // it is preview shading only.
 
-struct Frame {
-    view_proj: mat4x4<f32>,
-    // xyz: direction towards the light (unit), w: unused.
-    light_dir: vec4<f32>,
-    // rgb: skin colour, a: unused.
-    skin_color: vec4<f32>,
-    // rgb: point colour, a: point radius in pixels.
-    point_color: vec4<f32>,
-    // xy: viewport size in pixels, z: depth pull towards the camera for
-    // points (in clip w units), w: unused.
-    viewport: vec4<f32>,
-};
-
-@group(0) @binding(0) var<uniform> frame: Frame;
-
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,

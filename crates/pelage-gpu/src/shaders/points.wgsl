@@ -2,16 +2,6 @@
 // pixels, anti-aliased through alpha-to-coverage, pulled slightly towards
 // the camera so that points on the skin win the depth test against it.
 
-struct Frame {
-    view_proj: mat4x4<f32>,
-    light_dir: vec4<f32>,
-    skin_color: vec4<f32>,
-    point_color: vec4<f32>,
-    viewport: vec4<f32>,
-};
-
-@group(0) @binding(0) var<uniform> frame: Frame;
-
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     // The corner of the quad in disc radii, (−1..1, −1..1).

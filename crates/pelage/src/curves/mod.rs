@@ -1,0 +1,203 @@
+//! Hair curves as structure of arrays with one offsets array, like
+//! Blender's `CurvesGeometry` and USD's `BasisCurves`: curve `i` is
+//! `points[offsets[i]..offsets[i + 1]]`, and every per-point attribute is
+//! sliced the same way.
+//!
+//! This module holds the data type; Catmull-Rom evaluation,
+//! rotation-minimizing frames and per-part bounds come with the groom
+//! issue.
+
+use glam::Vec3;
+
+/// Curves: points, per-point widths, and an offsets array one longer than
+/// the number of curves.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Curves {
+    points: Vec<Vec3>,
+    widths: Vec<f32>,
+    offsets: Vec<u32>,
+}
+
+/// Curves could not be built from their arrays.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
+pub enum CurvesError {
+    /// The offsets do not start at 0, decrease, or do not end at the point count.
+    #[error(
+        "curve offsets must start at 0, never decrease and end at the point count ({points}); offset {index} is {value}"
+    )]
+    BadOffsets {
+        /// The offending offset's index.
+        index: usize,
+        /// Its value.
+        value: u32,
+        /// The number of points.
+        points: usize,
+    },
+    /// Per-point attributes of the wrong length.
+    #[error("{what}: {got} values for {points} points")]
+    Length {
+        /// The attribute.
+        what: &'static str,
+        /// Its length.
+        got: usize,
+        /// The number of points.
+        points: usize,
+    },
+    /// A NaN or infinite value.
+    #[error("{what} of point {index} is not finite")]
+    NonFinite {
+        /// The attribute.
+        what: &'static str,
+        /// The point.
+        index: usize,
+    },
+}
+
+impl Curves {
+    /// Builds curves, checking offsets, lengths and finiteness.
+    pub fn new(
+        points: Vec<Vec3>,
+        widths: Vec<f32>,
+        offsets: Vec<u32>,
+    ) -> Result<Self, CurvesError> {
+        let n = points.len();
+        if widths.len() != n {
+            return Err(CurvesError::Length {
+                what: "widths",
+                got: widths.len(),
+                points: n,
+            });
+        }
+        let bad = |index: usize| CurvesError::BadOffsets {
+            index,
+            value: offsets.get(index).copied().unwrap_or(0),
+            points: n,
+        };
+        if offsets.first() != Some(&0) {
+            return Err(bad(0));
+        }
+        if let Some(i) = offsets.windows(2).position(|w| w[1] < w[0]) {
+            return Err(bad(i + 1));
+        }
+        if *offsets.last().expect("checked non-empty") as usize != n {
+            return Err(bad(offsets.len() - 1));
+        }
+        if let Some(index) = points.iter().position(|p| !p.is_finite()) {
+            return Err(CurvesError::NonFinite {
+                what: "position",
+                index,
+            });
+        }
+        if let Some(index) = widths.iter().position(|w| !w.is_finite()) {
+            return Err(CurvesError::NonFinite {
+                what: "width",
+                index,
+            });
+        }
+        Ok(Self {
+            points,
+            widths,
+            offsets,
+        })
+    }
+
+    /// Number of curves.
+    pub fn curve_count(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// All points.
+    pub fn points(&self) -> &[Vec3] {
+        &self.points
+    }
+
+    /// All widths (one per point).
+    pub fn widths(&self) -> &[f32] {
+        &self.widths
+    }
+
+    /// The offsets array (`curve_count() + 1` entries).
+    pub fn offsets(&self) -> &[u32] {
+        &self.offsets
+    }
+
+    /// The point range of curve `i`.
+    pub fn range(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i] as usize..self.offsets[i + 1] as usize
+    }
+
+    /// Number of segments (consecutive point pairs within curves).
+    pub fn segment_count(&self) -> usize {
+        (0..self.curve_count())
+            .map(|i| self.range(i).len().saturating_sub(1))
+            .sum()
+    }
+
+    /// Axis-aligned bounds of the points, or `None` without points.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let first = *self.points.first()?;
+        Some(
+            self.points
+                .iter()
+                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn literal_offsets_slice_points_like_blender_tests_do() {
+        // Curves of 1, 2, 10, 1, 2 and 10 points (Blender's test layout).
+        let offsets = vec![0, 1, 3, 13, 14, 16, 26];
+        let points: Vec<Vec3> = (0..26).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect();
+        let curves = Curves::new(points, vec![0.1; 26], offsets).unwrap();
+        assert_eq!(curves.curve_count(), 6);
+        assert_eq!(curves.range(2), 3..13);
+        // Single-point curves have no segment.
+        assert_eq!(curves.segment_count(), 0 + 1 + 9 + 0 + 1 + 9);
+        assert_eq!(
+            curves.bounds(),
+            Some((Vec3::ZERO, Vec3::new(25.0, 0.0, 0.0)))
+        );
+    }
+
+    #[test]
+    fn bad_arrays_are_errors() {
+        let p = || vec![Vec3::ZERO; 3];
+        assert!(matches!(
+            Curves::new(p(), vec![0.1; 2], vec![0, 3]),
+            Err(CurvesError::Length { .. })
+        ));
+        assert!(matches!(
+            Curves::new(p(), vec![0.1; 3], vec![0, 2]),
+            Err(CurvesError::BadOffsets { .. })
+        ));
+        assert!(matches!(
+            Curves::new(p(), vec![0.1; 3], vec![0, 2, 1, 3]),
+            Err(CurvesError::BadOffsets { index: 2, .. })
+        ));
+        assert!(matches!(
+            Curves::new(p(), vec![0.1; 3], vec![1, 3]),
+            Err(CurvesError::BadOffsets { index: 0, .. })
+        ));
+        let mut nan = p();
+        nan[1].y = f32::NAN;
+        assert_eq!(
+            Curves::new(nan, vec![0.1; 3], vec![0, 3]),
+            Err(CurvesError::NonFinite {
+                what: "position",
+                index: 1
+            })
+        );
+        assert!(
+            Curves::new(Vec::new(), Vec::new(), vec![0])
+                .unwrap()
+                .bounds()
+                .is_none()
+        );
+    }
+}
