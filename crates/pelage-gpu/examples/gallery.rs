@@ -4,6 +4,9 @@
 //! - `sik-fig11-12-spot.png`: Sik's Figs. 11–12 on Spot — 8,000 uniform
 //!   samples (left) and 8,000 samples of a density rising from left to
 //!   right (right).
+//! - `preview-strands-spot.png`: the curve preview — 150,000 straight
+//!   strands along the normals, roots from a noise density, Kajiya-Kay
+//!   ribbons (no groom operators yet).
 //!
 //! ```sh
 //! cargo run --release -p pelage-gpu --example gallery
@@ -86,5 +89,33 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         out.display(),
         ctx.adapter_name()
     );
+
+    let plain = pelage::assets::spot();
+    let density = Map::parse("noise:frequency=5,octaves=2,seed=4,offset=0.6,scale=0.5")?;
+    let roots_sampler = DensitySampler::new(&plain, &density, DensitySamplerOptions::default())?;
+    let roots = sample_range(&roots_sampler, 3, 0..150_000);
+    let strands = pelage::Curves::along_normals(&plain, &roots, 0.06, 8, 0.002, 0.0004);
+    let scene = PreviewScene {
+        mesh: Some(&plain),
+        points: &[],
+        curves: Some(&strands),
+    };
+    // Close on the head, where ribbons are several pixels wide.
+    let close = Camera {
+        eye: Vec3::new(1.45, 0.85, 0.05),
+        target: Vec3::new(0.0, 0.45, -0.45),
+        fov_y_degrees: 30.0,
+    };
+    let image = renderer.render(
+        &ctx,
+        &scene,
+        &PreviewStyle::default(),
+        Some(close),
+        1280,
+        720,
+    )?;
+    let out = out.with_file_name("preview-strands-spot.png");
+    image.save(&out)?;
+    println!("wrote {}", out.display());
     Ok(())
 }

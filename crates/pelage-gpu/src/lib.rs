@@ -17,7 +17,7 @@ mod renderer;
 pub use camera::Camera;
 pub use context::GpuContext;
 pub use pelage::Curves;
-pub use renderer::{PreviewScene, PreviewStyle, Renderer};
+pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer};
 
 /// The renderer could not run.
 #[derive(Debug, thiserror::Error)]

@@ -64,7 +64,7 @@ impl Default for PreviewStyle {
             point: [0.30, 0.01, 0.005],
             point_radius: 1.5,
             hair: [0.35, 0.17, 0.07],
-            hair_specular: 0.25,
+            hair_specular: 0.12,
         }
     }
 }
@@ -80,6 +80,15 @@ struct FrameUniforms {
     viewport: [f32; 4],
     eye: [f32; 4],
     hair_color: [f32; 4],
+}
+
+/// A scene's geometry on the GPU (see [`Renderer::upload`]).
+#[derive(Debug)]
+pub struct GpuScene {
+    mesh: Option<(wgpu::Buffer, wgpu::Buffer, u32)>,
+    points: Option<(wgpu::Buffer, u32)>,
+    segments: Option<(wgpu::Buffer, u32)>,
+    bounds: Option<(Vec3, Vec3)>,
 }
 
 /// Draws preview scenes into images. Build once, render many times.
@@ -211,6 +220,92 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<image::RgbaImage, GpuError> {
+        let uploaded = self.upload(ctx, scene);
+        self.render_uploaded(ctx, &uploaded, style, camera, width, height)
+    }
+
+    /// Copies a scene's geometry to the GPU, to be drawn any number of
+    /// times by [`Renderer::render_uploaded`].
+    pub fn upload(&self, ctx: &GpuContext, scene: &PreviewScene) -> GpuScene {
+        let device = &ctx.device;
+        let mesh_buffers = scene.mesh.map(|mesh| {
+            let vertices: Vec<f32> = mesh
+                .positions()
+                .iter()
+                .zip(mesh.normals())
+                .flat_map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z])
+                .collect();
+            let indices: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
+            let vertex = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("mesh vertices"),
+                contents: bytemuck::cast_slice(&vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            let index = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("mesh indices"),
+                contents: bytemuck::cast_slice(&indices),
+                usage: wgpu::BufferUsages::INDEX,
+            });
+            (vertex, index, indices.len() as u32)
+        });
+        let point_buffer = (!scene.points.is_empty()).then(|| {
+            let flat: Vec<f32> = scene.points.iter().flat_map(|p| p.to_array()).collect();
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("points"),
+                contents: bytemuck::cast_slice(&flat),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
+        });
+
+        let segment_buffer = scene
+            .curves
+            .filter(|c| c.segment_count() > 0)
+            .map(|curves| {
+                let (points, widths) = (curves.points(), curves.widths());
+                let mut segments: Vec<f32> = Vec::with_capacity(curves.segment_count() * 8);
+                for i in 0..curves.curve_count() {
+                    let range = curves.range(i);
+                    for k in range.start..range.end.saturating_sub(1) {
+                        let (a, b) = (points[k], points[k + 1]);
+                        segments.extend_from_slice(&[
+                            a.x,
+                            a.y,
+                            a.z,
+                            widths[k],
+                            b.x,
+                            b.y,
+                            b.z,
+                            widths[k + 1],
+                        ]);
+                    }
+                }
+                let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("curve segments"),
+                    contents: bytemuck::cast_slice(&segments),
+                    usage: wgpu::BufferUsages::VERTEX,
+                });
+                (buffer, (segments.len() / 8) as u32)
+            });
+
+        GpuScene {
+            mesh: mesh_buffers,
+            points: point_buffer.map(|b| (b, scene.points.len() as u32)),
+            segments: segment_buffer,
+            bounds: scene.bounds(),
+        }
+    }
+
+    /// Draws an uploaded scene into a `width × height` image and reads it
+    /// back. Without a camera the scene is framed automatically.
+    pub fn render_uploaded(
+        &self,
+        ctx: &GpuContext,
+        scene: &GpuScene,
+        style: &PreviewStyle,
+        camera: Option<Camera>,
+        width: u32,
+        height: u32,
+    ) -> Result<image::RgbaImage, GpuError> {
         let max = ctx.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(GpuError::Size { width, height, max });
@@ -218,7 +313,7 @@ impl Renderer {
         let device = &ctx.device;
         let aspect = width as f32 / height as f32;
         let (lo, hi) = scene
-            .bounds()
+            .bounds
             .unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
         let camera = camera.unwrap_or_else(|| Camera::framing(lo, hi, aspect));
         let radius =
@@ -301,65 +396,6 @@ impl Renderer {
         );
         let views = [&multisampled, &resolved, &depth].map(|t| t.create_view(&Default::default()));
 
-        let mesh_buffers = scene.mesh.map(|mesh| {
-            let vertices: Vec<f32> = mesh
-                .positions()
-                .iter()
-                .zip(mesh.normals())
-                .flat_map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z])
-                .collect();
-            let indices: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
-            let vertex = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("mesh vertices"),
-                contents: bytemuck::cast_slice(&vertices),
-                usage: wgpu::BufferUsages::VERTEX,
-            });
-            let index = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("mesh indices"),
-                contents: bytemuck::cast_slice(&indices),
-                usage: wgpu::BufferUsages::INDEX,
-            });
-            (vertex, index, indices.len() as u32)
-        });
-        let point_buffer = (!scene.points.is_empty()).then(|| {
-            let flat: Vec<f32> = scene.points.iter().flat_map(|p| p.to_array()).collect();
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("points"),
-                contents: bytemuck::cast_slice(&flat),
-                usage: wgpu::BufferUsages::VERTEX,
-            })
-        });
-
-        let segment_buffer = scene
-            .curves
-            .filter(|c| c.segment_count() > 0)
-            .map(|curves| {
-                let (points, widths) = (curves.points(), curves.widths());
-                let mut segments: Vec<f32> = Vec::with_capacity(curves.segment_count() * 8);
-                for i in 0..curves.curve_count() {
-                    let range = curves.range(i);
-                    for k in range.start..range.end.saturating_sub(1) {
-                        let (a, b) = (points[k], points[k + 1]);
-                        segments.extend_from_slice(&[
-                            a.x,
-                            a.y,
-                            a.z,
-                            widths[k],
-                            b.x,
-                            b.y,
-                            b.z,
-                            widths[k + 1],
-                        ]);
-                    }
-                }
-                let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("curve segments"),
-                    contents: bytemuck::cast_slice(&segments),
-                    usage: wgpu::BufferUsages::VERTEX,
-                });
-                (buffer, (segments.len() / 8) as u32)
-            });
-
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let [r, g, b] = style.background.map(f64::from);
@@ -387,21 +423,21 @@ impl Renderer {
                 multiview_mask: None,
             });
             pass.set_bind_group(0, &frame, &[]);
-            if let Some((vertex, index, count)) = &mesh_buffers {
+            if let Some((vertex, index, count)) = &scene.mesh {
                 pass.set_pipeline(&self.mesh_pipeline);
                 pass.set_vertex_buffer(0, vertex.slice(..));
                 pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..*count, 0, 0..1);
             }
-            if let Some((segments, count)) = &segment_buffer {
+            if let Some((segments, count)) = &scene.segments {
                 pass.set_pipeline(&self.curves_pipeline);
                 pass.set_vertex_buffer(0, segments.slice(..));
                 pass.draw(0..6, 0..*count);
             }
-            if let Some(points) = &point_buffer {
+            if let Some((points, count)) = &scene.points {
                 pass.set_pipeline(&self.points_pipeline);
                 pass.set_vertex_buffer(0, points.slice(..));
-                pass.draw(0..6, 0..scene.points.len() as u32);
+                pass.draw(0..6, 0..*count);
             }
         }
 

@@ -134,6 +134,34 @@ impl Curves {
             .sum()
     }
 
+    /// Straight strands grown from `roots` along the surface normal:
+    /// `points_per_curve` points (at least 2) over `length`, widths tapering
+    /// linearly from `root_width` to `tip_width`. The simplest groom — what
+    /// benchmarks and previews use before guides exist.
+    pub fn along_normals(
+        mesh: &crate::Mesh,
+        roots: &[crate::SurfacePoint],
+        length: f32,
+        points_per_curve: usize,
+        root_width: f32,
+        tip_width: f32,
+    ) -> Self {
+        let n = points_per_curve.max(2);
+        let mut points = Vec::with_capacity(roots.len() * n);
+        let mut widths = Vec::with_capacity(roots.len() * n);
+        for root in roots {
+            let (p, normal) = (root.position(mesh), root.normal(mesh));
+            for k in 0..n {
+                let t = k as f32 / (n - 1) as f32;
+                points.push(p + normal * (t * length));
+                // Weighted form: exactly the root and tip widths at the ends.
+                widths.push((1.0 - t) * root_width + t * tip_width);
+            }
+        }
+        let offsets = (0..=roots.len() as u32).map(|i| i * n as u32).collect();
+        Self::new(points, widths, offsets).expect("finite roots give valid curves")
+    }
+
     /// Axis-aligned bounds of the points, or `None` without points.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let first = *self.points.first()?;
@@ -158,11 +186,37 @@ mod tests {
         assert_eq!(curves.curve_count(), 6);
         assert_eq!(curves.range(2), 3..13);
         // Single-point curves have no segment.
-        assert_eq!(curves.segment_count(), 0 + 1 + 9 + 0 + 1 + 9);
+        let sizes = [1, 2, 10, 1, 2, 10];
+        assert_eq!(
+            curves.segment_count(),
+            sizes.iter().map(|n| n - 1).sum::<usize>()
+        );
         assert_eq!(
             curves.bounds(),
             Some((Vec3::ZERO, Vec3::new(25.0, 0.0, 0.0)))
         );
+    }
+
+    #[test]
+    fn strands_along_normals_start_at_their_roots_and_taper() {
+        let spot = crate::assets::spot();
+        let roots = [
+            crate::SurfacePoint::new(10, [0.2, 0.3]),
+            crate::SurfacePoint::new(99, [0.5, 0.1]),
+        ];
+        let curves = Curves::along_normals(&spot, &roots, 0.1, 5, 0.01, 0.002);
+        assert_eq!((curves.curve_count(), curves.points().len()), (2, 10));
+        for (i, root) in roots.iter().enumerate() {
+            let r = curves.range(i);
+            assert_eq!(curves.points()[r.start], root.position(&spot));
+            let tip = curves.points()[r.end - 1] - root.position(&spot);
+            assert!((tip.length() - 0.1).abs() < 1e-6);
+            assert!(tip.normalize().dot(root.normal(&spot)) > 0.9999);
+            assert_eq!(
+                (curves.widths()[r.start], curves.widths()[r.end - 1]),
+                (0.01, 0.002)
+            );
+        }
     }
 
     #[test]

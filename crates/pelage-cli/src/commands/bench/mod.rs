@@ -5,6 +5,7 @@
 //! Machines here are small and noisy: every figure is the median of several
 //! runs, and comparisons are ratios taken within one run.
 
+pub mod render;
 pub mod sampler;
 
 use clap::{Args, Subcommand};
@@ -22,11 +23,14 @@ pub struct BenchArgs {
 pub enum BenchWhat {
     /// Root sampling (Sik §3, Tables 1–3, Figs. 8–9).
     Sampler(sampler::SamplerBenchArgs),
+    /// Preview renderer frame time: skin alone, with 100 k and 1 M curves.
+    Render(render::RenderBenchArgs),
 }
 
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     match &args.what {
         BenchWhat::Sampler(a) => sampler::run(a),
+        BenchWhat::Render(a) => render::run(a),
     }
 }
 

@@ -1,0 +1,109 @@
+//! `pelage bench render`: frame time of the preview renderer at 1280×720
+//! for the skin alone and with 100 k / 1 M hair curves (8 points each,
+//! grown along the normal from roots on spot ×1), on whatever adapter is
+//! present. A frame is draw + resolve + read-back of the image; uploading
+//! the geometry is timed separately.
+
+use super::median_seconds;
+use crate::format::thousands;
+use clap::Args;
+use pelage::sample::{DensitySampler, DensitySamplerOptions, sample_range};
+use pelage::{Curves, Map};
+use pelage_gpu::{GpuContext, PreviewScene, PreviewStyle, Renderer};
+
+/// Arguments of `pelage bench render`.
+#[derive(Debug, Args)]
+pub struct RenderBenchArgs {
+    /// A reduced run (100 k curves only, 3 frames each).
+    #[arg(long)]
+    pub quick: bool,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(args: &RenderBenchArgs) -> anyhow::Result<()> {
+    let ctx = GpuContext::headless()?;
+    let renderer = Renderer::new(&ctx);
+    let spot = pelage::assets::spot();
+    let (width, height) = (1280, 720);
+    let runs = if args.quick { 3 } else { 5 };
+    let style = PreviewStyle::default();
+    let sampler =
+        DensitySampler::new(&spot, &Map::Constant(1.0), DensitySamplerOptions::default())?;
+
+    let frame = |scene: &PreviewScene| -> anyhow::Result<(f64, f64)> {
+        let (upload_s, uploaded) = median_seconds(1, false, || renderer.upload(&ctx, scene));
+        let (frame_s, image) = median_seconds(runs, true, || {
+            renderer.render_uploaded(&ctx, &uploaded, &style, None, width, height)
+        });
+        image?;
+        Ok((upload_s, frame_s))
+    };
+    let skin_scene = PreviewScene {
+        mesh: Some(&spot),
+        points: &[],
+        curves: None,
+    };
+    let (_, skin_s) = frame(&skin_scene)?;
+    let counts: &[u64] = if args.quick {
+        &[100_000]
+    } else {
+        &[100_000, 1_000_000]
+    };
+    let mut rows = Vec::new();
+    let mut json = vec![
+        format!("\"adapter\":{:?}", ctx.adapter_name()),
+        format!("\"software_adapter\":{}", ctx.is_software()),
+        format!("\"skin_ms\":{:.3}", skin_s * 1e3),
+    ];
+    for &count in counts {
+        let roots = sample_range(&sampler, 5, 0..count);
+        let curves = Curves::along_normals(&spot, &roots, 0.05, 8, 0.0015, 0.0003);
+        let scene = PreviewScene {
+            mesh: Some(&spot),
+            points: &[],
+            curves: Some(&curves),
+        };
+        let (upload_s, frame_s) = frame(&scene)?;
+        rows.push((count, curves.segment_count(), upload_s, frame_s));
+        let key = if count == 1_000_000 {
+            "curves_1m_ms".to_string()
+        } else {
+            format!("curves_{}k_ms", count / 1000)
+        };
+        json.push(format!("\"{key}\":{:.3}", frame_s * 1e3));
+    }
+    if args.json {
+        println!("{{{}}}", json.join(","));
+        return Ok(());
+    }
+    println!(
+        "pelage bench render — {width}×{height}, median of {runs} frames, on {}",
+        ctx.adapter_name()
+    );
+    println!("frame = draw + MSAA resolve + read-back; upload timed once, separately\n");
+    println!(
+        "{:>12}  {:>11}  {:>10}  {:>10}  {:>9}",
+        "scene", "segments", "upload", "frame", "÷ skin"
+    );
+    println!(
+        "{:>12}  {:>11}  {:>10}  {:>7.1} ms  {:>9}",
+        "skin",
+        "—",
+        "—",
+        skin_s * 1e3,
+        "1.0×"
+    );
+    for (count, segments, upload_s, frame_s) in rows {
+        println!(
+            "{:>12}  {:>11}  {:>7.1} ms  {:>7.1} ms  {:>8.1}×",
+            format!("+{} curves", thousands(count)),
+            thousands(segments as u64),
+            upload_s * 1e3,
+            frame_s * 1e3,
+            frame_s / skin_s
+        );
+    }
+    Ok(())
+}
