@@ -264,6 +264,18 @@ fn alias(mesh: &Mesh, map: &Map) -> DensitySampler<'static> {
     DensitySampler::new(leak_mesh(mesh), map, options).unwrap()
 }
 
+/// The three methods on one mesh and map, by name.
+fn all_methods(mesh: &Mesh, map: &'static Map) -> Vec<(&'static str, Box<dyn SurfaceSampler>)> {
+    vec![
+        ("subdivision+grid", Box::new(subdivision(mesh, map))),
+        ("alias", Box::new(alias(mesh, map))),
+        (
+            "rejection",
+            Box::new(RejectionSampler::new(leak_mesh(mesh), map).unwrap()),
+        ),
+    ]
+}
+
 // The samplers borrow their mesh; the tests keep both for the whole run.
 fn leak_mesh(mesh: &Mesh) -> &'static Mesh {
     Box::leak(Box::new(mesh.clone()))
@@ -276,14 +288,7 @@ fn all_methods_match_exact_probabilities_per_triangle_and_per_texel() {
         let map: &'static Map = Box::leak(Box::new(map));
         let per_triangle = exact_triangle_probabilities(&mesh, map);
         let per_texel = exact_texel_probabilities(map);
-        let samplers: Vec<(&str, Box<dyn SurfaceSampler>)> = vec![
-            ("subdivision+grid", Box::new(subdivision(&mesh, map))),
-            ("alias", Box::new(alias(&mesh, map))),
-            (
-                "rejection",
-                Box::new(RejectionSampler::new(leak_mesh(&mesh), map).unwrap()),
-            ),
-        ];
+        let samplers = all_methods(&mesh, map);
         for (method, sampler) in samplers {
             let points: Vec<SurfacePoint> = (0..SAMPLES).map(|i| sampler.sample(42, i)).collect();
             assert_fits(
@@ -356,14 +361,7 @@ fn spot_with_constant_density_is_uniform_by_area_for_all_methods() {
         .iter()
         .map(|a| f64::from(*a) / total)
         .collect();
-    let samplers: Vec<(&str, Box<dyn SurfaceSampler>)> = vec![
-        ("subdivision+grid", Box::new(subdivision(&spot, map))),
-        ("alias", Box::new(alias(&spot, map))),
-        (
-            "rejection",
-            Box::new(RejectionSampler::new(leak_mesh(&spot), map).unwrap()),
-        ),
-    ];
+    let samplers = all_methods(&spot, map);
     for (method, sampler) in samplers {
         let points = sample_range(sampler.as_ref(), 3, 0..SAMPLES);
         assert_fits(
@@ -477,14 +475,7 @@ fn zero_density_regions_and_degenerate_triangles_get_no_samples() {
         .unwrap()
         .with_filter(Filter::Nearest);
     let map: &'static Map = Box::leak(Box::new(Map::Image(half)));
-    let samplers: Vec<(&str, Box<dyn SurfaceSampler>)> = vec![
-        ("subdivision+grid", Box::new(subdivision(&mesh, map))),
-        ("alias", Box::new(alias(&mesh, map))),
-        (
-            "rejection",
-            Box::new(RejectionSampler::new(leak_mesh(&mesh), map).unwrap()),
-        ),
-    ];
+    let samplers = all_methods(&mesh, map);
     for (method, sampler) in samplers {
         let counts = counts_per_triangle(&mesh, &sample_range(sampler.as_ref(), 1, 0..200_000));
         assert_eq!(

@@ -261,23 +261,22 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
     let selections = plan.samples;
     let (ours_build, ours) =
         median_seconds(plan.runs, true, || AliasTable::new(weights.iter().copied()));
-    let (ours_select, _) = median_seconds(plan.runs, true, || {
-        let mut sum = 0usize;
-        for i in 0..selections as u64 {
-            sum = sum.wrapping_add(ours.select(mix64(i)));
-        }
-        std::hint::black_box(sum)
-    });
+    // Selections in a plain loop, summed so none is optimised away.
+    let time_selections = |select: &dyn Fn(u64) -> usize| {
+        median_seconds(plan.runs, true, || {
+            let mut sum = 0usize;
+            for i in 0..selections as u64 {
+                sum = sum.wrapping_add(select(mix64(i)));
+            }
+            std::hint::black_box(sum)
+        })
+        .0
+    };
+    let ours_select = time_selections(&|bits| ours.select(bits));
     let (cdf_build, cdf) = median_seconds(plan.runs, true, || {
         CdfGrid::new(weights.iter().copied(), 100)
     });
-    let (cdf_select, _) = median_seconds(plan.runs, true, || {
-        let mut sum = 0usize;
-        for i in 0..selections as u64 {
-            sum = sum.wrapping_add(cdf.select(mix64(i)));
-        }
-        std::hint::black_box(sum)
-    });
+    let cdf_select = time_selections(&|bits| cdf.select(bits));
     let peer_weights: Vec<f32> = sampler.records().iter().map(|r| r.probability).collect();
     let (peer_build, peer) = median_seconds(plan.runs, true, || {
         WeightedAliasIndex::new(peer_weights.clone()).expect("the weights are valid")
