@@ -311,6 +311,7 @@ fn all_methods_match_exact_probabilities_per_triangle_and_per_texel() {
 fn a_sampler_that_ignores_area_fails_the_test() {
     struct IgnoresArea {
         weights: Vec<f64>,
+        areas: Vec<f64>,
     }
     impl SurfaceSampler for IgnoresArea {
         fn sample(&self, seed: u64, index: u64) -> SurfacePoint {
@@ -328,8 +329,11 @@ fn a_sampler_that_ignores_area_fails_the_test() {
                 bary,
             }
         }
-        fn pdf(&self, _: SurfacePoint) -> f64 {
-            unimplemented!("not needed")
+        /// Its own (wrong) density: triangle weight over the total, spread
+        /// uniformly over the triangle.
+        fn pdf(&self, p: SurfacePoint) -> f64 {
+            let total: f64 = self.weights.iter().sum();
+            self.weights[p.tri as usize] / total / self.areas[p.tri as usize]
         }
     }
     let mesh = quadtree_square();
@@ -341,7 +345,12 @@ fn a_sampler_that_ignores_area_fails_the_test() {
             .zip(mesh.triangle_areas())
             .map(|(p, a)| p / f64::from(*a))
             .collect();
-        let wrong = IgnoresArea { weights };
+        let areas = mesh
+            .triangle_areas()
+            .iter()
+            .map(|&a| f64::from(a))
+            .collect();
+        let wrong = IgnoresArea { weights, areas };
         let points: Vec<SurfacePoint> = (0..SAMPLES).map(|i| wrong.sample(7, i)).collect();
         let (chi2, dof) = chi_square(&counts_per_triangle(&mesh, &points), &exact);
         assert!(
