@@ -72,6 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             mesh: Some(&spot),
             points: &points,
             curves: None,
+            skin_texture: None,
         };
         renderer.render(&ctx, &scene, &style, Some(camera), WIDTH, HEIGHT)
     };
@@ -99,6 +100,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mesh: Some(&plain),
         points: &[],
         curves: Some(&strands),
+        skin_texture: None,
     };
     // Close on the head, where ribbons are several pixels wide.
     let close = Camera {

@@ -22,6 +22,9 @@ pub struct PreviewScene<'a> {
     pub points: &'a [Vec3],
     /// Hair curves, drawn as ribbons of their widths.
     pub curves: Option<&'a Curves>,
+    /// A colour texture for the skin (sRGB), read at the mesh's UVs;
+    /// ignored for meshes without UVs.
+    pub skin_texture: Option<&'a image::RgbaImage>,
 }
 
 impl PreviewScene<'_> {
@@ -85,7 +88,12 @@ struct FrameUniforms {
 /// A scene's geometry on the GPU (see [`Renderer::upload`]).
 #[derive(Debug)]
 pub struct GpuScene {
-    mesh: Option<(wgpu::Buffer, wgpu::Buffer, u32)>,
+    /// Vertices, and indices with their count (none: draw unindexed).
+    mesh: Option<(wgpu::Buffer, Option<wgpu::Buffer>, u32)>,
+    skin_texture: wgpu::BindGroup,
+    /// Whether the skin is coloured by a texture (then the style's skin
+    /// colour is not applied on top).
+    textured: bool,
     points: Option<(wgpu::Buffer, u32)>,
     segments: Option<(wgpu::Buffer, u32)>,
     bounds: Option<(Vec3, Vec3)>,
@@ -95,6 +103,8 @@ pub struct GpuScene {
 #[derive(Debug)]
 pub struct Renderer {
     frame_layout: wgpu::BindGroupLayout,
+    texture_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
     mesh_pipeline: wgpu::RenderPipeline,
     points_pipeline: wgpu::RenderPipeline,
     curves_pipeline: wgpu::RenderPipeline,
@@ -117,9 +127,39 @@ impl Renderer {
                 count: None,
             }],
         });
+        let texture_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("skin texture"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("skin"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        // One layout for all pipelines; points and curves ignore group 1.
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("preview"),
-            bind_group_layouts: &[Some(&frame_layout)],
+            bind_group_layouts: &[Some(&frame_layout), Some(&texture_layout)],
             immediate_size: 0,
         });
         let shader = |name: &str, source: &str| {
@@ -177,9 +217,9 @@ impl Renderer {
         let mesh_pipeline = pipeline(
             &mesh_shader,
             &[Some(wgpu::VertexBufferLayout {
-                array_stride: 24,
+                array_stride: 32,
                 step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
             })],
             false,
         );
@@ -203,6 +243,8 @@ impl Renderer {
         );
         Self {
             frame_layout,
+            texture_layout,
+            sampler,
             mesh_pipeline,
             points_pipeline,
             curves_pipeline,
@@ -228,25 +270,81 @@ impl Renderer {
     /// times by [`Renderer::render_uploaded`].
     pub fn upload(&self, ctx: &GpuContext, scene: &PreviewScene) -> GpuScene {
         let device = &ctx.device;
+        // Textured meshes are drawn one vertex per triangle corner, since
+        // their UVs may be per corner; untextured ones stay indexed.
+        let textured = scene.skin_texture.is_some() && scene.mesh.is_some_and(Mesh::has_uvs);
         let mesh_buffers = scene.mesh.map(|mesh| {
-            let vertices: Vec<f32> = mesh
-                .positions()
-                .iter()
-                .zip(mesh.normals())
-                .flat_map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z])
-                .collect();
-            let indices: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
+            let mut vertices: Vec<f32> = Vec::new();
+            let indices: Option<Vec<u32>> = if textured {
+                vertices.reserve(mesh.triangle_count() * 24);
+                for t in 0..mesh.triangle_count() {
+                    let uvs = mesh.triangle_uvs(t).expect("textured meshes have UVs");
+                    for (k, &v) in mesh.triangles()[t].iter().enumerate() {
+                        let (p, n) = (mesh.positions()[v as usize], mesh.normals()[v as usize]);
+                        vertices
+                            .extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, uvs[k].x, uvs[k].y]);
+                    }
+                }
+                None
+            } else {
+                vertices.reserve(mesh.vertex_count() * 8);
+                for (p, n) in mesh.positions().iter().zip(mesh.normals()) {
+                    vertices.extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, 0.0, 0.0]);
+                }
+                Some(mesh.triangles().iter().flatten().copied().collect())
+            };
             let vertex = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("mesh vertices"),
                 contents: bytemuck::cast_slice(&vertices),
                 usage: wgpu::BufferUsages::VERTEX,
             });
-            let index = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("mesh indices"),
-                contents: bytemuck::cast_slice(&indices),
-                usage: wgpu::BufferUsages::INDEX,
+            let count = indices
+                .as_ref()
+                .map_or(mesh.triangle_count() as u32 * 3, |i| i.len() as u32);
+            let index = indices.map(|indices| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("mesh indices"),
+                    contents: bytemuck::cast_slice(&indices),
+                    usage: wgpu::BufferUsages::INDEX,
+                })
             });
-            (vertex, index, indices.len() as u32)
+            (vertex, index, count)
+        });
+        let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4]));
+        let texture_image = scene.skin_texture.filter(|_| textured).unwrap_or(&white);
+        let texture = device.create_texture_with_data(
+            &ctx.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("skin texture"),
+                size: wgpu::Extent3d {
+                    width: texture_image.width(),
+                    height: texture_image.height(),
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba8UnormSrgb,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            texture_image.as_raw(),
+        );
+        let view = texture.create_view(&Default::default());
+        let skin_texture = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("skin texture"),
+            layout: &self.texture_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+            ],
         });
         let point_buffer = (!scene.points.is_empty()).then(|| {
             let flat: Vec<f32> = scene.points.iter().flat_map(|p| p.to_array()).collect();
@@ -289,6 +387,8 @@ impl Renderer {
 
         GpuScene {
             mesh: mesh_buffers,
+            skin_texture,
+            textured,
             points: point_buffer.map(|b| (b, scene.points.len() as u32)),
             segments: segment_buffer,
             bounds: scene.bounds(),
@@ -326,7 +426,11 @@ impl Renderer {
         let uniforms = FrameUniforms {
             view_proj: clip_from_world.to_cols_array_2d(),
             light_dir: light.normalize().extend(0.0).to_array(),
-            skin_color: [style.skin[0], style.skin[1], style.skin[2], 1.0],
+            skin_color: if scene.textured {
+                [1.0; 4]
+            } else {
+                [style.skin[0], style.skin[1], style.skin[2], 1.0]
+            },
             point_color: [
                 style.point[0],
                 style.point[1],
@@ -423,11 +527,17 @@ impl Renderer {
                 multiview_mask: None,
             });
             pass.set_bind_group(0, &frame, &[]);
+            pass.set_bind_group(1, &scene.skin_texture, &[]);
             if let Some((vertex, index, count)) = &scene.mesh {
                 pass.set_pipeline(&self.mesh_pipeline);
                 pass.set_vertex_buffer(0, vertex.slice(..));
-                pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..*count, 0, 0..1);
+                match index {
+                    Some(index) => {
+                        pass.set_index_buffer(index.slice(..), wgpu::IndexFormat::Uint32);
+                        pass.draw_indexed(0..*count, 0, 0..1);
+                    }
+                    None => pass.draw(0..*count, 0..1),
+                }
             }
             if let Some((segments, count)) = &scene.segments {
                 pass.set_pipeline(&self.curves_pipeline);

@@ -44,6 +44,7 @@ fn spot_fills_the_middle_and_leaves_the_corners_background() {
         mesh: Some(&spot),
         points: &[],
         curves: None,
+        skin_texture: None,
     };
     let image = renderer
         .render(ctx, &scene, &PreviewStyle::default(), None, 320, 240)
@@ -92,6 +93,7 @@ fn a_point_covers_about_a_disc_of_its_radius() {
         mesh: None,
         points: &points,
         curves: None,
+        skin_texture: None,
     };
     let image = renderer
         .render(ctx, &scene, &style, Some(camera), 256, 256)
@@ -128,6 +130,7 @@ fn points_behind_the_mesh_are_hidden_and_points_in_front_are_seen() {
             mesh: Some(&spot),
             points: &points,
             curves: None,
+            skin_texture: None,
         };
         renderer
             .render(ctx, &scene, &style, Some(camera), 200, 200)
@@ -188,6 +191,7 @@ fn render_curve(curves: &pelage::Curves, style: &PreviewStyle) -> Option<image::
         mesh: None,
         points: &[],
         curves: Some(curves),
+        skin_texture: None,
     };
     Some(
         renderer
@@ -257,5 +261,48 @@ fn hair_is_drawn_in_its_colour() {
         image.get_pixel(200, 20).0,
         WHITE,
         "background above the hair"
+    );
+}
+
+#[test]
+fn a_skin_texture_colours_the_mesh_at_its_uvs() {
+    let Some((ctx, renderer)) = gpu() else { return };
+    let spot = pelage::assets::spot();
+    let texture = image::load_from_memory(pelage::assets::SPOT_TEXTURE_PNG)
+        .unwrap()
+        .to_rgba8();
+    let white_skin = PreviewStyle {
+        skin: [1.0, 1.0, 1.0],
+        ..Default::default()
+    };
+    let render = |skin_texture| {
+        let scene = PreviewScene {
+            mesh: Some(&spot),
+            points: &[],
+            curves: None,
+            skin_texture,
+        };
+        renderer
+            .render(ctx, &scene, &white_skin, None, 320, 240)
+            .unwrap()
+    };
+    // Spot's texture has dark patches; a lit white skin never falls below
+    // its ambient (about 137 in sRGB), so dark pixels come from the texture.
+    let dark = |image: &image::RgbaImage| {
+        image
+            .pixels()
+            .filter(|p| p.0[..3].iter().all(|&c| c < 90))
+            .count()
+    };
+    let (plain, textured) = (render(None), render(Some(&texture)));
+    assert_eq!(
+        dark(&plain),
+        0,
+        "an untextured white skin has no dark pixels"
+    );
+    assert!(
+        dark(&textured) > 400,
+        "only {} dark pixels with the texture",
+        dark(&textured)
     );
 }

@@ -38,10 +38,12 @@ fn render_preview(
     use pelage_gpu::{GpuContext, PreviewScene, PreviewStyle, Renderer};
     let ctx = GpuContext::headless()?;
     let points: Vec<glam::Vec3> = roots.iter().map(|p| p.position(spot)).collect();
+    let texture = image::load_from_memory(pelage::assets::SPOT_TEXTURE_PNG)?.to_rgba8();
     let scene = PreviewScene {
         mesh: Some(spot),
         points: &points,
         curves: None,
+        skin_texture: Some(&texture),
     };
     let image =
         Renderer::new(&ctx).render(&ctx, &scene, &PreviewStyle::default(), None, 1280, 720)?;

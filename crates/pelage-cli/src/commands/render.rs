@@ -34,6 +34,13 @@ pub struct RenderArgs {
     /// Point radius in pixels.
     #[arg(long, default_value_t = 1.5)]
     pub point_radius: f32,
+    /// A colour texture (PNG) for the mesh, read at its UVs. The embedded
+    /// Spot uses its own unless `--no-texture`.
+    #[arg(long)]
+    pub texture: Option<PathBuf>,
+    /// Draw the embedded Spot without its texture.
+    #[arg(long)]
+    pub no_texture: bool,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -80,10 +87,23 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         file => (Vec::new(), Some(load_mesh(file.as_deref())?)),
     };
+    let uses_embedded_spot = args.file.is_none() || (args.mesh.is_none() && !points.is_empty());
+    let texture = match &args.texture {
+        Some(path) => Some(
+            image::open(path)
+                .with_context(|| format!("cannot read the texture {}", path.display()))?
+                .to_rgba8(),
+        ),
+        None if uses_embedded_spot && args.file.is_none() && !args.no_texture => {
+            Some(image::load_from_memory(pelage::assets::SPOT_TEXTURE_PNG)?.to_rgba8())
+        }
+        None => None,
+    };
     let scene = PreviewScene {
         mesh: mesh.as_ref(),
         points: &points,
         curves: None,
+        skin_texture: texture.as_ref(),
     };
     let (width, height) = args.size;
     let camera = match (args.eye, scene.bounds()) {

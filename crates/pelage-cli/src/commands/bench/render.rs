@@ -44,6 +44,7 @@ pub fn run(args: &RenderBenchArgs) -> anyhow::Result<()> {
         mesh: Some(&spot),
         points: &[],
         curves: None,
+        skin_texture: None,
     };
     let (_, skin_s) = frame(&skin_scene)?;
     let counts: &[u64] = if args.quick {
@@ -64,6 +65,7 @@ pub fn run(args: &RenderBenchArgs) -> anyhow::Result<()> {
             mesh: Some(&spot),
             points: &[],
             curves: Some(&curves),
+            skin_texture: None,
         };
         let (upload_s, frame_s) = frame(&scene)?;
         rows.push((count, curves.segment_count(), upload_s, frame_s));
