@@ -255,8 +255,7 @@ impl Mesh {
     /// The mesh's unique undirected edges with the number of triangles using
     /// each; built on first use and cached.
     pub fn edges(&self) -> &EdgeList {
-        self.edges
-            .get_or_init(|| EdgeList::build(&self.triangles, self.positions.len()))
+        self.edges.get_or_init(|| EdgeList::build(&self.triangles))
     }
 }
 

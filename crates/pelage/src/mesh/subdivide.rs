@@ -64,7 +64,7 @@ impl Mesh {
             Uvs::PerCorner { values, indices } => {
                 // UV corners are welded along UV edges, not position edges:
                 // across a seam the two sides keep their own midpoints.
-                let uv_edges = EdgeList::build(indices, values.len());
+                let uv_edges = EdgeList::build(indices);
                 let m = values.len() as u32;
                 let mut new_values = values.clone();
                 new_values.extend(

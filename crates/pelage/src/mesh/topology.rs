@@ -19,7 +19,7 @@ pub struct EdgeList {
 
 impl EdgeList {
     /// Builds the edge list of `triangles`.
-    pub fn build(triangles: &[[u32; 3]], _vertex_count: usize) -> Self {
+    pub fn build(triangles: &[[u32; 3]]) -> Self {
         let mut keys: Vec<u64> = Vec::with_capacity(triangles.len() * 3);
         for &[a, b, c] in triangles {
             for (u, v) in [(a, b), (b, c), (c, a)] {
