@@ -87,14 +87,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         file => (Vec::new(), Some(load_mesh(file.as_deref())?)),
     };
-    let uses_embedded_spot = args.file.is_none() || (args.mesh.is_none() && !points.is_empty());
     let texture = match &args.texture {
         Some(path) => Some(
             image::open(path)
                 .with_context(|| format!("cannot read the texture {}", path.display()))?
                 .to_rgba8(),
         ),
-        None if uses_embedded_spot && args.file.is_none() && !args.no_texture => {
+        // Without FILE the mesh is the embedded Spot: use its own texture.
+        None if args.file.is_none() && !args.no_texture => {
             Some(image::load_from_memory(pelage::assets::SPOT_TEXTURE_PNG)?.to_rgba8())
         }
         None => None,

@@ -97,7 +97,7 @@ pub fn write_points_ply(
 pub fn read_points_ply(path: &Path) -> Result<Vec<glam::Vec3>, crate::MeshError> {
     use crate::mesh::MeshErrorKind;
     use ply_rs_bw::parser::Parser;
-    use ply_rs_bw::ply::{DefaultElement, Property};
+    use ply_rs_bw::ply::DefaultElement;
     let name = path.display().to_string();
     let bytes =
         std::fs::read(path).map_err(|e| crate::MeshError::whole(&name, MeshErrorKind::Io(e)))?;
@@ -117,11 +117,7 @@ pub fn read_points_ply(path: &Path) -> Result<Vec<glam::Vec3>, crate::MeshError>
         .iter()
         .enumerate()
         .map(|(i, v)| {
-            let get = |k: &str| match v.get(k) {
-                Some(Property::Float(x)) => Some(*x),
-                Some(Property::Double(x)) => Some(*x as f32),
-                _ => None,
-            };
+            let get = |k: &str| crate::mesh::ply_scalar(v.get(k));
             match (get("x"), get("y"), get("z")) {
                 (Some(x), Some(y), Some(z)) if x.is_finite() && y.is_finite() && z.is_finite() => {
                     Ok(glam::Vec3::new(x, y, z))
@@ -130,9 +126,7 @@ pub fn read_points_ply(path: &Path) -> Result<Vec<glam::Vec3>, crate::MeshError>
                     &name,
                     "vertex",
                     i,
-                    MeshErrorKind::Syntax(
-                        "x, y and z must be finite float or double values".into(),
-                    ),
+                    MeshErrorKind::Syntax("x, y and z must be finite numbers".into()),
                 )),
             }
         })

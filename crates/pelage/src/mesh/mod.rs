@@ -23,6 +23,7 @@ mod topology;
 
 pub use error::{Location, MeshError, MeshErrorKind};
 pub use load::MeshFormat;
+pub(crate) use ply::scalar as ply_scalar;
 pub use surface_point::{SurfacePoint, TangentFrame};
 pub use topology::{EdgeList, TopologyReport, VertexAdjacency};
 

@@ -198,7 +198,8 @@ fn not_a_number(key: &str) -> MeshErrorKind {
     MeshErrorKind::Syntax(format!("property '{key}' is missing or not a number"))
 }
 
-fn scalar(p: Option<&Property>) -> Option<f32> {
+/// A numeric PLY property as f32 (lists and missing properties: `None`).
+pub(crate) fn scalar(p: Option<&Property>) -> Option<f32> {
     Some(match p? {
         Property::Char(v) => f32::from(*v),
         Property::UChar(v) => f32::from(*v),

@@ -110,26 +110,26 @@ pub struct DensitySampler<'m> {
     positions: PositionTable,
 }
 
-/// What a chunk of triangles contributes.
-struct Chunk {
-    records: Vec<SubTriangleRecord>,
-    /// Records per triangle.
-    counts: Vec<u32>,
-    total: f64,
+/// Fig. 5's output for a whole mesh: the records, where each triangle's
+/// start, and their total probability. The density sampler selects among
+/// them; the rejection sampler only needs the total (and the validation).
+pub(crate) struct SubTriangleRecords {
+    pub(crate) records: Vec<SubTriangleRecord>,
+    /// Records of triangle t are `records[first_record[t]..first_record[t + 1]]`.
+    pub(crate) first_record: Vec<u32>,
+    /// Sum of the probabilities: ∫ density dA by the centroid rule.
+    pub(crate) total: f64,
 }
 
-impl<'m> DensitySampler<'m> {
-    /// Builds the distribution (the paper's preprocess). Errors name the
-    /// mesh: a map that needs UVs on a mesh without them, a negative or NaN
-    /// density (with the triangle and UV), a density that is zero everywhere.
-    pub fn new(
-        mesh: &'m Mesh,
-        density: &Map,
-        options: DensitySamplerOptions,
-    ) -> Result<Self, SampleError> {
+impl SubTriangleRecords {
+    /// Subdivides every triangle (in parallel, fixed chunks, so the result
+    /// never depends on threads). Errors name the mesh: a map that needs
+    /// UVs on a mesh without them, a negative or NaN density (with the
+    /// triangle and UV), a density that is zero everywhere.
+    pub(crate) fn build(mesh: &Mesh, density: &Map, max_level: u32) -> Result<Self, SampleError> {
         // Refuses maps that need UVs on meshes without them.
         density.on_mesh(mesh)?;
-        let max_level = options.max_level.min(MAX_LEVEL);
+        let max_level = max_level.min(MAX_LEVEL);
         let texels = density.resolution();
 
         // Triangles are independent: build in parallel, in fixed chunks
@@ -180,6 +180,36 @@ impl<'m> DensitySampler<'m> {
                 mesh: mesh.name().to_string(),
             });
         }
+        Ok(Self {
+            records,
+            first_record,
+            total,
+        })
+    }
+}
+
+/// What a chunk of triangles contributes.
+struct Chunk {
+    records: Vec<SubTriangleRecord>,
+    /// Records per triangle.
+    counts: Vec<u32>,
+    total: f64,
+}
+
+impl<'m> DensitySampler<'m> {
+    /// Builds the distribution (the paper's preprocess). Errors name the
+    /// mesh: a map that needs UVs on a mesh without them, a negative or NaN
+    /// density (with the triangle and UV), a density that is zero everywhere.
+    pub fn new(
+        mesh: &'m Mesh,
+        density: &Map,
+        options: DensitySamplerOptions,
+    ) -> Result<Self, SampleError> {
+        let SubTriangleRecords {
+            records,
+            first_record,
+            total,
+        } = SubTriangleRecords::build(mesh, density, options.max_level)?;
         let weights = records.iter().map(|r| f64::from(r.probability));
         let selector = match options.selector {
             Selector::CdfGrid { grid_percent } => {

@@ -7,7 +7,7 @@
 //! distribution exact and equals the paper's test whenever the map ≤ 1.
 
 use super::cdf::CdfGrid;
-use super::density::{DensitySampler, DensitySamplerOptions};
+use super::density::{DensitySamplerOptions, SubTriangleRecords};
 use super::rng::SampleRng;
 use super::{SampleError, SurfaceSampler, warp};
 use crate::map::{Map, MapOnMesh};
@@ -30,12 +30,14 @@ pub struct RejectionSampler<'m> {
 impl<'m> RejectionSampler<'m> {
     /// Builds the area CDF. The density is validated (and its integral,
     /// needed by [`SurfaceSampler::pdf`], computed) with the same
-    /// sub-triangle quadrature as [`DensitySampler`], so an all-zero,
+    /// sub-triangle quadrature as [`DensitySampler`](super::DensitySampler), so an all-zero,
     /// negative or NaN density is an error here too, instead of a sampler
     /// that never accepts.
     pub fn new(mesh: &'m Mesh, density: &'m Map) -> Result<Self, SampleError> {
         let map = density.on_mesh(mesh)?;
-        let quadrature = DensitySampler::new(mesh, density, DensitySamplerOptions::default())?;
+        // The records alone: no selector is built.
+        let quadrature =
+            SubTriangleRecords::build(mesh, density, DensitySamplerOptions::default().max_level)?;
         let triangles: Vec<u32> = (0..mesh.triangle_count() as u32)
             .filter(|&t| mesh.triangle_areas()[t as usize] > 0.0)
             .collect();
@@ -51,7 +53,7 @@ impl<'m> RejectionSampler<'m> {
             area_cdf,
             triangles,
             acceptance_scale: 1.0 / density.upper_bound().max(1.0),
-            normalisation: quadrature.total_probability(),
+            normalisation: quadrature.total,
         })
     }
 }
