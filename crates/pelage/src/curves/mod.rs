@@ -3,19 +3,31 @@
 //! `points[offsets[i]..offsets[i + 1]]`, and every per-point attribute is
 //! sliced the same way.
 //!
+//! Besides positions and widths, curves carry the optional attributes
+//! renderers read (DESIGN.md's data model): per point a normal (ribbon
+//! orientation), a colour and an opacity; per curve its root on the mesh
+//! ([`SurfacePoint`]), the root's UV, and a stable id.
+//!
 //! This module holds the data type; Catmull-Rom evaluation,
 //! rotation-minimizing frames and per-part bounds come with the groom
 //! issue.
 
-use glam::Vec3;
+use crate::SurfacePoint;
+use glam::{Vec2, Vec3};
 
 /// Curves: points, per-point widths, and an offsets array one longer than
-/// the number of curves.
+/// the number of curves, plus optional per-point and per-curve attributes.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Curves {
     points: Vec<Vec3>,
     widths: Vec<f32>,
     offsets: Vec<u32>,
+    normals: Option<Vec<Vec3>>,
+    colors: Option<Vec<Vec3>>,
+    opacities: Option<Vec<f32>>,
+    roots: Option<Vec<SurfacePoint>>,
+    root_uvs: Option<Vec<Vec2>>,
+    ids: Option<Vec<u64>>,
 }
 
 /// Curves could not be built from their arrays.
@@ -43,6 +55,16 @@ pub enum CurvesError {
         got: usize,
         /// The number of points.
         points: usize,
+    },
+    /// Per-curve attributes of the wrong length.
+    #[error("{what}: {got} values for {curves} curves")]
+    CurveLength {
+        /// The attribute.
+        what: &'static str,
+        /// Its length.
+        got: usize,
+        /// The number of curves.
+        curves: usize,
     },
     /// A NaN or infinite value.
     #[error("{what} of point {index} is not finite")]
@@ -99,7 +121,140 @@ impl Curves {
             points,
             widths,
             offsets,
+            ..Self::default()
         })
+    }
+
+    /// Adds per-point normals (the orientation of flat ribbons; USD
+    /// `normals`).
+    pub fn with_normals(mut self, normals: Vec<Vec3>) -> Result<Self, CurvesError> {
+        self.check_per_point(
+            "normals",
+            normals.len(),
+            normals.iter().position(|n| !n.is_finite()),
+        )?;
+        self.normals = Some(normals);
+        Ok(self)
+    }
+
+    /// Adds per-point linear RGB colours.
+    pub fn with_colors(mut self, colors: Vec<Vec3>) -> Result<Self, CurvesError> {
+        self.check_per_point(
+            "colors",
+            colors.len(),
+            colors.iter().position(|c| !c.is_finite()),
+        )?;
+        self.colors = Some(colors);
+        Ok(self)
+    }
+
+    /// Adds per-point opacities (1 = opaque).
+    pub fn with_opacities(mut self, opacities: Vec<f32>) -> Result<Self, CurvesError> {
+        let bad = opacities.iter().position(|o| !o.is_finite());
+        self.check_per_point("opacities", opacities.len(), bad)?;
+        self.opacities = Some(opacities);
+        Ok(self)
+    }
+
+    /// Adds each curve's root on the mesh it grows from.
+    pub fn with_roots(mut self, roots: Vec<SurfacePoint>) -> Result<Self, CurvesError> {
+        self.check_per_curve("roots", roots.len())?;
+        self.roots = Some(roots);
+        Ok(self)
+    }
+
+    /// Adds each curve's root UV (USD writes it as the uniform `st`).
+    pub fn with_root_uvs(mut self, uvs: Vec<Vec2>) -> Result<Self, CurvesError> {
+        self.check_per_curve("root UVs", uvs.len())?;
+        if let Some(index) = uvs.iter().position(|uv| !uv.is_finite()) {
+            return Err(CurvesError::NonFinite {
+                what: "root UV",
+                index,
+            });
+        }
+        self.root_uvs = Some(uvs);
+        Ok(self)
+    }
+
+    /// Adds each curve's stable id (the same hair keeps its id across
+    /// parts, threads and re-runs with the same seed).
+    pub fn with_ids(mut self, ids: Vec<u64>) -> Result<Self, CurvesError> {
+        self.check_per_curve("ids", ids.len())?;
+        self.ids = Some(ids);
+        Ok(self)
+    }
+
+    /// Checks a per-point attribute's length; `first_non_finite` is the
+    /// index of its first NaN or infinite value, if any.
+    fn check_per_point(
+        &self,
+        what: &'static str,
+        got: usize,
+        first_non_finite: Option<usize>,
+    ) -> Result<(), CurvesError> {
+        if got != self.points.len() {
+            return Err(CurvesError::Length {
+                what,
+                got,
+                points: self.points.len(),
+            });
+        }
+        if let Some(index) = first_non_finite {
+            return Err(CurvesError::NonFinite { what, index });
+        }
+        Ok(())
+    }
+
+    fn check_per_curve(&self, what: &'static str, got: usize) -> Result<(), CurvesError> {
+        if got != self.curve_count() {
+            return Err(CurvesError::CurveLength {
+                what,
+                got,
+                curves: self.curve_count(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Per-point normals, if any.
+    pub fn normals(&self) -> Option<&[Vec3]> {
+        self.normals.as_deref()
+    }
+
+    /// Per-point colours, if any.
+    pub fn colors(&self) -> Option<&[Vec3]> {
+        self.colors.as_deref()
+    }
+
+    /// Per-point opacities, if any.
+    pub fn opacities(&self) -> Option<&[f32]> {
+        self.opacities.as_deref()
+    }
+
+    /// Per-curve roots on the mesh, if any.
+    pub fn roots(&self) -> Option<&[SurfacePoint]> {
+        self.roots.as_deref()
+    }
+
+    /// Per-curve root UVs, if any.
+    pub fn root_uvs(&self) -> Option<&[Vec2]> {
+        self.root_uvs.as_deref()
+    }
+
+    /// Per-curve ids, if any.
+    pub fn ids(&self) -> Option<&[u64]> {
+        self.ids.as_deref()
+    }
+
+    /// The number of points of the shortest and the longest curve
+    /// (`(0, 0)` without curves).
+    pub fn point_count_range(&self) -> (usize, usize) {
+        (0..self.curve_count())
+            .map(|i| self.range(i).len())
+            .fold(None, |acc: Option<(usize, usize)>, n| {
+                Some(acc.map_or((n, n), |(lo, hi)| (lo.min(n), hi.max(n))))
+            })
+            .unwrap_or((0, 0))
     }
 
     /// Number of curves.
@@ -252,6 +407,51 @@ mod tests {
                 .unwrap()
                 .bounds()
                 .is_none()
+        );
+    }
+
+    #[test]
+    fn optional_attributes_are_checked_against_points_and_curves() {
+        let c = || {
+            Curves::new(
+                vec![Vec3::ZERO, Vec3::Y, Vec3::X],
+                vec![0.1; 3],
+                vec![0, 2, 3],
+            )
+            .unwrap()
+        };
+        assert_eq!(c().point_count_range(), (1, 2));
+        assert_eq!(
+            c().with_colors(vec![Vec3::ONE; 2]),
+            Err(CurvesError::Length {
+                what: "colors",
+                got: 2,
+                points: 3
+            })
+        );
+        assert_eq!(
+            c().with_ids(vec![1, 2, 3]),
+            Err(CurvesError::CurveLength {
+                what: "ids",
+                got: 3,
+                curves: 2
+            })
+        );
+        assert_eq!(
+            c().with_opacities(vec![1.0, f32::NAN, 1.0]),
+            Err(CurvesError::NonFinite {
+                what: "opacities",
+                index: 1
+            })
+        );
+        let full = c()
+            .with_normals(vec![Vec3::Z; 3])
+            .and_then(|c| c.with_root_uvs(vec![Vec2::ZERO, Vec2::ONE]))
+            .and_then(|c| c.with_ids(vec![7, 9]))
+            .unwrap();
+        assert_eq!(
+            (full.normals().unwrap().len(), full.ids(), full.colors()),
+            (3, Some(&[7u64, 9][..]), None)
         );
     }
 }
