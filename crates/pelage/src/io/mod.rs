@@ -1,15 +1,38 @@
-//! Writing what pelage makes: files are written to a temporary name beside
-//! the target and renamed on success ([`write_atomically`]), so an error or
-//! a kill never leaves a truncated file under the real name.
+//! Reading and writing curves and points. Every writer writes to a
+//! temporary name beside the target and renames on success
+//! ([`write_atomically`]), so an error or a kill never leaves a truncated
+//! file under the real name.
 //!
-//! Writers so far: [`PointsPly`] (sampled points with normals, UVs and
-//! triangle indices).
+//! - [`read_curves`] / [`write_curves`]: curves by extension (`.usda`,
+//!   `.usd`, `.usdc` read only, `.hair`, `.ply`, `.rib` and `.pbrt` write
+//!   only).
+//! - USD: [`UsdaWriter`] streams usda (BasisCurves per part, optional skin
+//!   mesh); [`read_usd_curves`] reads usda and usdc (Blender's export too).
+//! - [`HairFile`]: Cem Yuksel's `.hair`, byte for byte.
+//! - [`write_curves_ply`] / [`read_curves_ply`]: curves as PLY polylines.
+//! - [`write_rib`] / [`write_pbrt`]: RenderMan and pbrt-v4 scene text.
+//! - [`PointsPly`]: sampled points with normals, UVs and triangle indices.
 
 mod atomic;
+mod curves_file;
+mod curves_ply;
+mod hair;
 mod points_ply;
+mod read_error;
+mod render_text;
+mod text;
+mod usd_read;
+mod usda;
 
 pub use atomic::write_atomically;
+pub use curves_file::{CurvesExport, CurvesFormat, join, read_curves, write_curves};
+pub use curves_ply::{read_curves_ply, write_curves_ply};
+pub use hair::{HairFile, HairWriteError};
 pub use points_ply::{PointsPly, ply_has_faces, read_points_ply, write_points_ply};
+pub use read_error::{CurvesReadError, CurvesReadErrorKind};
+pub use render_text::{bezier_control_points, write_pbrt, write_rib};
+pub use usd_read::{DEFAULT_WIDTH, read_usd_curves};
+pub use usda::{CurveBasis, UpAxis, UsdOptions, UsdWrap, UsdWriteError, UsdaWriter};
 
 use std::path::PathBuf;
 

@@ -1,0 +1,162 @@
+//! Curves files by extension: one entry point to read guides or any curves
+//! pelage understands, and one to write a finished groom in any format.
+
+use super::read_error::{CurvesReadError, CurvesReadErrorKind};
+use super::{
+    HairFile, UsdOptions, UsdaWriter, WriteError, read_curves_ply, read_usd_curves,
+    write_atomically, write_curves_ply, write_pbrt, write_rib,
+};
+use crate::{Curves, Mesh};
+use std::path::Path;
+
+/// A curves file format, chosen by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CurvesFormat {
+    /// `.usda` (and `.usd` when writing: text USD; reading sniffs text or
+    /// binary).
+    Usda,
+    /// `.usdc`: read only (see docs/usd.md).
+    Usdc,
+    /// Cem Yuksel's `.hair`.
+    Hair,
+    /// `.ply` with vertex and edge elements.
+    Ply,
+    /// RenderMan `.rib`: write only.
+    Rib,
+    /// pbrt-v4 `.pbrt`: write only.
+    Pbrt,
+}
+
+impl CurvesFormat {
+    /// The format a path's extension names, if any.
+    pub fn from_path(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "usda" | "usd" => Self::Usda,
+            "usdc" => Self::Usdc,
+            "hair" => Self::Hair,
+            "ply" => Self::Ply,
+            "rib" => Self::Rib,
+            "pbrt" => Self::Pbrt,
+            _ => return None,
+        })
+    }
+}
+
+/// Reads curves from a `.usda`, `.usdc`, `.usd`, `.hair` or `.ply` file.
+pub fn read_curves(path: &Path) -> Result<Curves, CurvesReadError> {
+    let unknown = || {
+        let extension = path
+            .extension()
+            .map(|e| e.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        CurvesReadError::whole(path, CurvesReadErrorKind::UnknownFormat { extension })
+    };
+    match CurvesFormat::from_path(path).ok_or_else(unknown)? {
+        CurvesFormat::Usda | CurvesFormat::Usdc => read_usd_curves(path),
+        CurvesFormat::Hair => HairFile::read(path)?.to_curves(path),
+        CurvesFormat::Ply => read_curves_ply(path),
+        CurvesFormat::Rib | CurvesFormat::Pbrt => Err(unknown()),
+    }
+}
+
+/// How [`write_curves`] writes.
+#[derive(Debug, Clone, Default)]
+pub struct CurvesExport<'a> {
+    /// USD stage options; their basis also applies to RIB and pbrt.
+    pub usd: UsdOptions,
+    /// The skin, written beside the curves in USD (`--with-mesh`).
+    pub mesh: Option<&'a Mesh>,
+}
+
+/// Writes `parts` (name, curves) to `path` in the format its extension
+/// names, atomically. USD gets one prim per part; the other formats hold
+/// one set of curves, so the parts are written one after another.
+pub fn write_curves<'c>(
+    path: &Path,
+    parts: impl IntoIterator<Item = (String, &'c Curves)>,
+    export: &CurvesExport,
+) -> Result<(), WriteError> {
+    let fail = |message: String| WriteError {
+        path: path.to_path_buf(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
+    };
+    let format = CurvesFormat::from_path(path).ok_or_else(|| {
+        fail(
+            "unknown curves format; pelage writes .usda (or .usd), .hair, .ply, .rib and .pbrt"
+                .into(),
+        )
+    })?;
+    let basis = export.usd.basis;
+    match format {
+        CurvesFormat::Usdc => Err(fail(
+            "pelage writes text USD only (.usda or .usd); see docs/usd.md".into(),
+        )),
+        CurvesFormat::Usda => write_atomically(path, |out| {
+            let other = std::io::Error::other;
+            let mut usd = UsdaWriter::new(out, &export.usd).map_err(other)?;
+            if let Some(mesh) = export.mesh {
+                usd.write_mesh("skin", mesh).map_err(other)?;
+            }
+            for (name, curves) in parts {
+                usd.write_part(&name, curves).map_err(other)?;
+            }
+            usd.finish().map_err(other)?;
+            Ok(())
+        }),
+        CurvesFormat::Hair | CurvesFormat::Ply => {
+            // One array for the whole file: join the parts.
+            let joined =
+                join(parts.into_iter().map(|(_, c)| c)).map_err(|e| fail(e.to_string()))?;
+            if format == CurvesFormat::Hair {
+                let hair = HairFile::from_curves(&joined).map_err(|e| fail(e.to_string()))?;
+                hair.write(path)
+            } else {
+                write_atomically(path, |out| write_curves_ply(out, &joined))
+            }
+        }
+        CurvesFormat::Rib | CurvesFormat::Pbrt => write_atomically(path, |out| {
+            for (_, curves) in parts {
+                match format {
+                    CurvesFormat::Rib => write_rib(out, curves, basis)?,
+                    _ => write_pbrt(out, curves, basis)?,
+                }
+            }
+            Ok(())
+        }),
+    }
+}
+
+/// Concatenates curves, keeping only the attributes every part has.
+pub fn join<'c>(
+    parts: impl IntoIterator<Item = &'c Curves>,
+) -> Result<Curves, crate::curves::CurvesError> {
+    let parts: Vec<&Curves> = parts.into_iter().collect();
+    let mut points = Vec::new();
+    let mut widths = Vec::new();
+    let mut offsets = vec![0u32];
+    for c in &parts {
+        let base = points.len() as u32;
+        points.extend_from_slice(c.points());
+        widths.extend_from_slice(c.widths());
+        offsets.extend(c.offsets()[1..].iter().map(|o| o + base));
+    }
+    let mut joined = Curves::new(points, widths, offsets)?;
+    if parts.iter().all(|c| c.colors().is_some()) && !parts.is_empty() {
+        joined = joined.with_colors(
+            parts
+                .iter()
+                .flat_map(|c| c.colors().unwrap().iter().copied())
+                .collect(),
+        )?;
+    }
+    if parts.iter().all(|c| c.opacities().is_some()) && !parts.is_empty() {
+        joined = joined.with_opacities(
+            parts
+                .iter()
+                .flat_map(|c| c.opacities().unwrap().iter().copied())
+                .collect(),
+        )?;
+    }
+    Ok(joined)
+}

@@ -1,0 +1,262 @@
+//! Curves from USD (usda or usdc): every `BasisCurves` prim of the layer,
+//! in path order, concatenated, with its ancestors' transforms applied — what
+//! pelage's writer and Blender's USD export write.
+//!
+//! The layer is parsed by the `openusd` crate (pure Rust). Only the file's
+//! own layer is read: references, payloads and sublayers are not followed,
+//! and animated points must be exported as one frame. Widths are read as
+//! `vertex` (or `varying` on linear curves), `uniform` or `constant`;
+//! curves without widths get [`DEFAULT_WIDTH`].
+
+use super::read_error::{CurvesReadError, CurvesReadErrorKind as Kind};
+use crate::Curves;
+use crate::mesh::Location;
+use glam::{DMat4, DVec3};
+use openusd::sdf::{self, AbstractData, SpecType, Value};
+use std::path::Path;
+
+/// Width given to curves whose file has no widths.
+pub const DEFAULT_WIDTH: f32 = 0.01;
+
+/// Reads every `BasisCurves` prim of a usda or usdc file into one
+/// [`Curves`] (points in world space).
+pub fn read_usd_curves(path: &Path) -> Result<Curves, CurvesReadError> {
+    let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
+    let data: Box<dyn AbstractData> = if bytes.starts_with(b"PXR-USDC") {
+        openusd::usdc::read_file(path).map_err(|e| parse_error(path, &e))?
+    } else if bytes.starts_with(b"#usda") {
+        Box::new(openusd::usda::read_file(path).map_err(|e| parse_error(path, &e))?)
+    } else {
+        return Err(CurvesReadError::new(
+            path,
+            Location::Line(1),
+            Kind::Syntax("not a USD file: it starts with neither '#usda' nor 'PXR-USDC'".into()),
+        ));
+    };
+    let data = data.as_ref();
+    let mut prims: Vec<sdf::Path> = data
+        .spec_paths()
+        .into_iter()
+        .filter(|p| data.spec_type(p) == Some(SpecType::Prim))
+        .filter(|p| token(data, p, "typeName").as_deref() == Some("BasisCurves"))
+        .collect();
+    prims.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+    if prims.is_empty() {
+        return Err(CurvesReadError::whole(
+            path,
+            Kind::Empty(" (no BasisCurves prim)"),
+        ));
+    }
+    let (mut points, mut widths, mut offsets) = (Vec::new(), Vec::new(), vec![0u32]);
+    for prim in &prims {
+        let fail = |kind| CurvesReadError::whole(path, kind);
+        let at = |what: &str| format!("{}: {what}", prim.as_str());
+        let counts: Vec<i32> = match attribute(data, prim, "curveVertexCounts") {
+            Some(Value::IntVec(v)) => v,
+            Some(_) => {
+                return Err(fail(Kind::Unsupported(at(
+                    "curveVertexCounts is not int[]",
+                ))));
+            }
+            None => return Err(fail(Kind::Inconsistent(at("no curveVertexCounts")))),
+        };
+        let prim_points = match attribute(data, prim, "points") {
+            Some(Value::Vec3fVec(v)) => v
+                .iter()
+                .map(|p| DVec3::new(p.x.into(), p.y.into(), p.z.into()))
+                .collect(),
+            Some(Value::Vec3dVec(v)) => v
+                .iter()
+                .map(|p| DVec3::new(p.x, p.y, p.z))
+                .collect::<Vec<_>>(),
+            Some(_) => {
+                return Err(fail(Kind::Unsupported(at(
+                    "points are neither float3[] nor double3[]",
+                ))));
+            }
+            None if has_time_samples(data, prim, "points") => {
+                return Err(fail(Kind::Unsupported(at(
+                    "points are animated (time samples only); export a single frame",
+                ))));
+            }
+            None => return Err(fail(Kind::Inconsistent(at("no points")))),
+        };
+        if let Some(i) = counts.iter().position(|&c| c < 1) {
+            return Err(fail(Kind::Inconsistent(at(&format!(
+                "curveVertexCounts[{i}] is {}",
+                counts[i]
+            )))));
+        }
+        let total: i64 = counts.iter().map(|&c| c as i64).sum();
+        if total != prim_points.len() as i64 {
+            return Err(fail(Kind::Inconsistent(at(&format!(
+                "curveVertexCounts add up to {total} but there are {} points",
+                prim_points.len()
+            )))));
+        }
+        let transform = world_transform(data, prim).map_err(|m| fail(Kind::Unsupported(at(&m))))?;
+        let prim_widths =
+            read_widths(data, prim, &counts).map_err(|m| fail(Kind::Inconsistent(at(&m))))?;
+        let base = points.len() as u32;
+        points.extend(
+            prim_points
+                .iter()
+                .map(|&p| transform.transform_point3(p).as_vec3()),
+        );
+        widths.extend(prim_widths);
+        let mut end = base;
+        for c in counts {
+            end += c as u32;
+            offsets.push(end);
+        }
+    }
+    Curves::new(points, widths, offsets).map_err(|e| CurvesReadError::whole(path, e.into()))
+}
+
+/// Splits openusd's `PATH:LINE: COL: message` into a line location.
+fn parse_error(path: &Path, error: &dyn std::fmt::Display) -> CurvesReadError {
+    let text = format!("{error:#}");
+    let shown = path.display().to_string();
+    let parsed = text
+        .strip_prefix(&shown)
+        .and_then(|r| r.strip_prefix(':'))
+        .and_then(|r| r.split_once(':'))
+        .and_then(|(line, rest)| Some((line.trim().parse::<usize>().ok()?, rest.trim_start())));
+    if let Some((line, rest)) = parsed {
+        // openusd puts the column before the message.
+        let message = match rest.split_once(": ") {
+            Some((column, message)) if column.parse::<usize>().is_ok() => message,
+            _ => rest,
+        };
+        return CurvesReadError::new(
+            path,
+            Location::Line(line),
+            Kind::Syntax(message.to_string()),
+        );
+    }
+    CurvesReadError::whole(path, Kind::Syntax(text))
+}
+
+fn attribute(data: &dyn AbstractData, prim: &sdf::Path, name: &str) -> Option<Value> {
+    let property = prim.append_property(name).ok()?;
+    data.try_field(&property, "default")
+        .ok()
+        .flatten()
+        .map(|v| v.into_owned())
+}
+
+fn has_time_samples(data: &dyn AbstractData, prim: &sdf::Path, name: &str) -> bool {
+    prim.append_property(name)
+        .is_ok_and(|p| data.has_field(&p, "timeSamples"))
+}
+
+fn token(data: &dyn AbstractData, path: &sdf::Path, field: &str) -> Option<String> {
+    match data.try_field(path, field).ok().flatten()?.as_ref() {
+        Value::Token(t) => Some(t.as_str().to_string()),
+        Value::String(s) => Some(s.clone()),
+        _ => None,
+    }
+}
+
+fn metadata_token(
+    data: &dyn AbstractData,
+    prim: &sdf::Path,
+    name: &str,
+    field: &str,
+) -> Option<String> {
+    token(data, &prim.append_property(name).ok()?, field)
+}
+
+/// Widths as one value per point, from any interpolation USD allows on
+/// curves whose varying count equals the vertex count (linear, pinned).
+fn read_widths(
+    data: &dyn AbstractData,
+    prim: &sdf::Path,
+    counts: &[i32],
+) -> Result<Vec<f32>, String> {
+    let n_points: usize = counts.iter().map(|&c| c as usize).sum();
+    let values: Vec<f32> = match attribute(data, prim, "widths") {
+        None => return Ok(vec![DEFAULT_WIDTH; n_points]),
+        Some(Value::FloatVec(v)) => v,
+        Some(Value::DoubleVec(v)) => v.iter().map(|&w| w as f32).collect(),
+        Some(Value::Float(w)) => vec![w],
+        Some(_) => return Err("widths are not float[]".into()),
+    };
+    let interpolation =
+        metadata_token(data, prim, "widths", "interpolation").unwrap_or_else(|| "vertex".into());
+    match interpolation.as_str() {
+        "constant" if values.len() == 1 => Ok(vec![values[0]; n_points]),
+        "uniform" if values.len() == counts.len() => Ok(counts
+            .iter()
+            .zip(&values)
+            .flat_map(|(&c, &w)| std::iter::repeat_n(w, c as usize))
+            .collect()),
+        "vertex" | "varying" if values.len() == n_points => Ok(values),
+        _ if values.len() == 1 => Ok(vec![values[0]; n_points]),
+        other => Err(format!(
+            "{} widths with {other} interpolation for {} curves of {n_points} points; pelage reads constant, uniform and per-vertex widths",
+            values.len(),
+            counts.len()
+        )),
+    }
+}
+
+/// The prim's transform to world space: its own and its ancestors'
+/// `xformOpOrder`, composed parent first.
+fn world_transform(data: &dyn AbstractData, prim: &sdf::Path) -> Result<DMat4, String> {
+    let mut chain: Vec<sdf::Path> = prim.ancestors().filter(|p| !p.is_abs_root()).collect();
+    chain.sort_by_key(|p| p.as_str().len());
+    let mut world = DMat4::IDENTITY;
+    for path in chain {
+        world *= local_transform(data, &path)?;
+    }
+    Ok(world)
+}
+
+fn local_transform(data: &dyn AbstractData, prim: &sdf::Path) -> Result<DMat4, String> {
+    let order = match attribute(data, prim, "xformOpOrder") {
+        Some(Value::TokenVec(ops)) => ops,
+        _ => return Ok(DMat4::IDENTITY),
+    };
+    let mut local = DMat4::IDENTITY;
+    for op in &order {
+        let op = op.as_str();
+        let unsupported = || {
+            format!(
+                "{}: transform op {op:?} is not supported; bake transforms on export",
+                prim.as_str()
+            )
+        };
+        let value = attribute(data, prim, op)
+            .ok_or_else(|| format!("{}: {op} has no value", prim.as_str()))?;
+        let kind = op.strip_prefix("xformOp:").ok_or_else(unsupported)?;
+        let kind = kind.split(':').next().unwrap_or(kind);
+        let m = match (kind, value) {
+            // USD matrices act on row vectors; read as columns they are the
+            // column-vector matrix glam uses.
+            ("transform", Value::Matrix4d(m)) => DMat4::from_cols_array(&m.0),
+            ("translate", v) => DMat4::from_translation(vec3(&v).ok_or_else(unsupported)?),
+            ("scale", v) => DMat4::from_scale(vec3(&v).ok_or_else(unsupported)?),
+            ("rotateXYZ", v) => {
+                let r = vec3(&v)
+                    .ok_or_else(unsupported)?
+                    .to_array()
+                    .map(f64::to_radians);
+                DMat4::from_rotation_z(r[2])
+                    * DMat4::from_rotation_y(r[1])
+                    * DMat4::from_rotation_x(r[0])
+            }
+            _ => return Err(unsupported()),
+        };
+        local *= m;
+    }
+    Ok(local)
+}
+
+fn vec3(value: &Value) -> Option<DVec3> {
+    match value {
+        Value::Vec3d(v) => Some(DVec3::new(v.x, v.y, v.z)),
+        Value::Vec3f(v) => Some(DVec3::new(v.x.into(), v.y.into(), v.z.into())),
+        _ => None,
+    }
+}

@@ -1,0 +1,485 @@
+//! Curves in and out: USD checked by Pixar's own library (usdcheck), round
+//! trips through every format, `.hair` byte for byte, malformed files as
+//! errors naming the file and the field or line.
+//!
+//! The usdcheck tests run `../shared/tools/usdcheck` (it installs usd-core
+//! into a cached venv on first use). Where it is missing or cannot set
+//! itself up they print SKIPPED; with `PELAGE_REQUIRE_USDCHECK=1` (CI) they
+//! fail instead.
+
+use glam::Vec3;
+use pelage::io::{
+    CurveBasis, CurvesExport, CurvesFormat, HairFile, UsdOptions, UsdWrap, UsdaWriter, read_curves,
+    read_usd_curves, write_curves,
+};
+use pelage::{Curves, SurfacePoint};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/good")
+        .join(name)
+}
+
+/// A small groom on Spot with every attribute the USD writer knows.
+fn small_groom(curves: u32, points: usize) -> Curves {
+    let spot = pelage::assets::spot();
+    let roots: Vec<SurfacePoint> = (0..curves)
+        .map(|i| SurfacePoint::new(i * 37 % spot.triangle_count() as u32, [0.25, 0.5]))
+        .collect();
+    let c = Curves::along_normals(&spot, &roots, 0.1, points, 0.01, 0.002);
+    let n = c.points().len();
+    let uvs = roots.iter().map(|r| r.uv(&spot).unwrap()).collect();
+    c.with_normals(
+        (0..n)
+            .map(|i| Vec3::new(1.0, 0.0, i as f32 * 1e-3).normalize())
+            .collect(),
+    )
+    .unwrap()
+    .with_colors(
+        (0..n)
+            .map(|i| Vec3::new(0.5, 0.3, (i % 7) as f32 / 7.0))
+            .collect(),
+    )
+    .unwrap()
+    .with_opacities((0..n).map(|i| 1.0 - (i % 5) as f32 * 0.1).collect())
+    .unwrap()
+    .with_root_uvs(uvs)
+    .unwrap()
+    .with_ids((0..curves as u64).map(|i| i * 7 + 3).collect())
+    .unwrap()
+    .with_roots(roots)
+    .unwrap()
+}
+
+/// Runs usdcheck on `files`; `None` (after printing SKIPPED) where it is
+/// not available and not required.
+fn usdcheck(files: &[&Path]) -> Option<(bool, String)> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/tools/usdcheck");
+    let required = std::env::var_os("PELAGE_REQUIRE_USDCHECK").is_some();
+    if !script.exists() {
+        assert!(
+            !required,
+            "PELAGE_REQUIRE_USDCHECK is set but {} is missing",
+            script.display()
+        );
+        eprintln!("SKIPPED: {} not found", script.display());
+        return None;
+    }
+    let output = Command::new(&script)
+        .args(files)
+        .output()
+        .expect("usdcheck runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    if output.status.code() == Some(2) {
+        assert!(!required, "usdcheck could not set itself up:\n{text}");
+        eprintln!("SKIPPED: usdcheck could not set itself up:\n{text}");
+        return None;
+    }
+    Some((output.status.success(), text))
+}
+
+fn write_usd(path: &Path, parts: &[(&str, &Curves)], options: &UsdOptions, mesh: bool) {
+    let spot = pelage::assets::spot();
+    let export = CurvesExport {
+        usd: options.clone(),
+        mesh: mesh.then_some(&spot),
+    };
+    write_curves(
+        path,
+        parts.iter().map(|(n, c)| (n.to_string(), *c)),
+        &export,
+    )
+    .unwrap();
+}
+
+#[test]
+fn usd_files_pass_pixars_validators_and_inconsistent_ones_fail() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = small_groom(40, 6);
+    let second = small_groom(7, 4);
+    let parts = [("part_0", &groom), ("part_1", &second)];
+    let mut files = Vec::new();
+    for (basis, wrap, label) in [
+        (CurveBasis::Linear, UsdWrap::Pinned, "linear"),
+        (CurveBasis::CatmullRom, UsdWrap::Pinned, "catmullrom_pinned"),
+        (
+            CurveBasis::CatmullRom,
+            UsdWrap::Nonperiodic,
+            "catmullrom_nonperiodic",
+        ),
+    ] {
+        let options = UsdOptions {
+            basis,
+            wrap,
+            ..UsdOptions::default()
+        };
+        for mesh in [false, true] {
+            let path = dir.path().join(format!("{label}_mesh{}.usda", mesh as u8));
+            write_usd(&path, &parts, &options, mesh);
+            files.push(path);
+        }
+    }
+    let refs: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
+    let Some((ok, text)) = usdcheck(&refs) else {
+        return;
+    };
+    assert!(ok, "{text}");
+    for f in &files {
+        let line = format!("{}: ok:", f.display());
+        assert!(text.contains(&line), "no ok for {}:\n{text}", f.display());
+        assert!(text.contains("2 BasisCurves prims, 47 curves"), "{text}");
+    }
+
+    // A test of the test: counts that do not add up must make usdcheck fail.
+    let good = std::fs::read_to_string(&files[0]).unwrap();
+    let bad = good.replacen(
+        "int[] curveVertexCounts = [6, ",
+        "int[] curveVertexCounts = [5, ",
+        1,
+    );
+    assert_ne!(good, bad);
+    let bad_path = dir.path().join("inconsistent.usda");
+    std::fs::write(&bad_path, bad).unwrap();
+    let (ok, text) = usdcheck(&[&bad_path]).unwrap();
+    assert!(!ok, "usdcheck accepted inconsistent counts:\n{text}");
+    assert!(text.contains("curveVertexCounts sum"), "{text}");
+}
+
+#[test]
+fn usd_written_then_read_back_gives_the_same_curves() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = small_groom(25, 5);
+    let second = small_groom(3, 4);
+    let path = dir.path().join("groom.usda");
+    write_usd(
+        &path,
+        &[("a", &groom), ("b", &second)],
+        &UsdOptions::default(),
+        true,
+    );
+    let back = read_curves(&path).unwrap();
+    let joined = pelage::io::join([&groom, &second]).unwrap();
+    assert_eq!(back.offsets(), joined.offsets());
+    for (a, b) in back.points().iter().zip(joined.points()) {
+        assert!((*a - *b).abs().max_element() <= 1e-6, "{a} vs {b}");
+    }
+    assert_eq!(back.widths(), joined.widths());
+}
+
+#[test]
+fn usda_bytes_do_not_depend_on_the_number_of_threads() {
+    // Large enough for several formatting blocks.
+    let groom = small_groom(6000, 16);
+    let write = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut out = Vec::new();
+            let mut usd = UsdaWriter::new(&mut out, &UsdOptions::default()).unwrap();
+            usd.write_part("part_0", &groom).unwrap();
+            usd.finish().unwrap();
+            out
+        })
+    };
+    let one = write(1);
+    assert!(one.len() > 1 << 20);
+    assert!(one == write(2), "1 and 2 threads wrote different bytes");
+}
+
+#[test]
+fn blender_style_usd_is_read_with_its_transforms_from_usda_and_usdc() {
+    // Expected world positions computed by Pixar's library
+    // (UsdGeom.Xformable.ComputeLocalToWorldTransform) for this file.
+    let want = [
+        Vec3::new(11.0, 3.0, 3.0),
+        Vec3::new(11.0, 3.0, 4.0),
+        Vec3::new(11.0, 3.0, 5.0),
+        Vec3::new(10.0, 2.0, 3.0),
+        Vec3::new(10.0, 2.5, 3.5),
+    ];
+    // The .usdc was written from the .usda by usd-core (Sdf.Layer.Export).
+    for name in ["blender_curves.usda", "blender_curves.usdc"] {
+        let curves = read_usd_curves(&data(name)).unwrap();
+        assert_eq!(curves.offsets(), &[0, 3, 5], "{name}");
+        for (a, b) in curves.points().iter().zip(want) {
+            assert!((*a - b).length() < 1e-6, "{name}: {a} vs {b}");
+        }
+        assert_eq!(curves.widths(), &[0.1, 0.05, 0.01, 0.1, 0.01], "{name}");
+    }
+}
+
+#[test]
+fn malformed_usd_is_an_error_naming_the_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("blender_curves.usda")).unwrap();
+    let broken = text.replace(
+        "int[] curveVertexCounts = [3, 2]",
+        "int[] curveVertexCounts = [3, 2,",
+    );
+    let path = dir.path().join("broken.usda");
+    std::fs::write(&path, broken).unwrap();
+    let err = read_curves(&path).unwrap_err().to_string();
+    assert!(err.starts_with(&format!("{}:32:", path.display())), "{err}");
+
+    let wrong = text.replace(
+        "int[] curveVertexCounts = [3, 2]",
+        "int[] curveVertexCounts = [3, 3]",
+    );
+    std::fs::write(&path, wrong).unwrap();
+    let err = read_curves(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("/root/Curves/Curves: curveVertexCounts add up to 6 but there are 5 points"),
+        "{err}"
+    );
+
+    let path = dir.path().join("nothing.usda");
+    std::fs::write(&path, "#usda 1.0\ndef Xform \"x\"\n{\n}\n").unwrap();
+    let err = read_curves(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("nothing.usda: the file holds no curves"),
+        "{err}"
+    );
+
+    let err = read_curves(Path::new("guides.abc"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("unknown curves format \"abc\""), "{err}");
+}
+
+#[test]
+fn usd_writer_refuses_what_usd_cannot_hold() {
+    let short = Curves::new(vec![Vec3::ZERO, Vec3::Y, Vec3::X], vec![0.1; 3], vec![0, 3]).unwrap();
+    let nonperiodic = UsdOptions {
+        wrap: UsdWrap::Nonperiodic,
+        ..UsdOptions::default()
+    };
+    let mut usd = UsdaWriter::new(Vec::new(), &nonperiodic).unwrap();
+    let err = usd.write_part("p", &short).unwrap_err().to_string();
+    assert!(
+        err.contains("curve 0 has 3 points; nonperiodic Catmull-Rom curves need at least 4"),
+        "{err}"
+    );
+    let mut usd = UsdaWriter::new(Vec::new(), &UsdOptions::default()).unwrap();
+    assert!(usd.write_part("9lives", &short).is_err());
+    assert!(usd.write_part("has space", &short).is_err());
+    usd.write_part("ok", &short).unwrap();
+    assert!(
+        usd.write_part("ok", &short)
+            .unwrap_err()
+            .to_string()
+            .contains("already written")
+    );
+}
+
+/// A `.hair` file made field by field: no segments array (every hair has
+/// the default count), transparency and colours, info text.
+fn foreign_hair_file() -> Vec<u8> {
+    let (hairs, segments) = (3u32, 4u32);
+    let points = hairs * (segments + 1);
+    let mut b = b"HAIR".to_vec();
+    for v in [hairs, points, 2 | 8 | 16, segments] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in [0.05f32, 0.25, 0.9, 0.6, 0.3] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    let mut info = [0u8; 88];
+    info[..19].copy_from_slice(b"made by hand, 2026\0");
+    b.extend_from_slice(&info);
+    for i in 0..points {
+        for v in [i as f32, (i * i) as f32 * 0.5, -1.0 / (i + 1) as f32] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for i in 0..points {
+        b.extend_from_slice(&(i as f32 / 100.0).to_le_bytes());
+    }
+    for i in 0..points * 3 {
+        b.extend_from_slice(&(1.0 / (i + 2) as f32).to_le_bytes());
+    }
+    b
+}
+
+#[test]
+fn hair_files_round_trip_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    // A file laid out differently from ours, and one we wrote.
+    let ours = HairFile::from_curves(&small_groom(20, 7))
+        .unwrap()
+        .to_bytes();
+    for (name, bytes) in [("foreign.hair", foreign_hair_file()), ("ours.hair", ours)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, &bytes).unwrap();
+        let hair = HairFile::read(&path).unwrap();
+        let again = dir.path().join(format!("again_{name}"));
+        hair.write(&again).unwrap();
+        assert!(
+            std::fs::read(&again).unwrap() == bytes,
+            "{name} changed on the round trip"
+        );
+    }
+    let foreign = HairFile::parse(&foreign_hair_file(), Path::new("f.hair")).unwrap();
+    let curves = foreign.to_curves(Path::new("f.hair")).unwrap();
+    assert_eq!((curves.curve_count(), curves.points().len()), (3, 15));
+    assert_eq!(curves.widths()[3], 0.05, "no thickness array: the default");
+    assert_eq!(curves.opacities().unwrap()[1], 1.0 - 0.01);
+    // Curves → .hair → curves keeps points, widths, colours and opacities.
+    let groom = small_groom(10, 5);
+    let path = dir.path().join("groom.hair");
+    write_curves(&path, [("p".to_string(), &groom)], &CurvesExport::default()).unwrap();
+    let back = read_curves(&path).unwrap();
+    assert_eq!(
+        (back.points(), back.widths(), back.offsets()),
+        (groom.points(), groom.widths(), groom.offsets())
+    );
+    assert_eq!(back.colors(), groom.colors());
+    for (a, b) in back
+        .opacities()
+        .unwrap()
+        .iter()
+        .zip(groom.opacities().unwrap())
+    {
+        assert!((a - b).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn truncated_or_inconsistent_hair_files_are_errors_naming_the_field() {
+    let path = Path::new("cut.hair");
+    let bytes = foreign_hair_file();
+    for cut in 0..bytes.len() {
+        let err = HairFile::parse(&bytes[..cut], path)
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("cut.hair: "), "{err}");
+        if cut >= 128 {
+            assert!(
+                err.contains("truncated or its counts are wrong"),
+                "cut at {cut}: {err}"
+            );
+        }
+    }
+    // The point count disagrees with hairs × (default segments + 1).
+    let mut wrong = bytes.clone();
+    wrong[16..20].copy_from_slice(&5u32.to_le_bytes());
+    let err = HairFile::parse(&wrong, path).unwrap_err().to_string();
+    assert!(
+        err.contains(
+            "header field 'point count' says 15 points but the default segment count implies 18"
+        ),
+        "{err}"
+    );
+    let mut extra = bytes.clone();
+    extra.extend_from_slice(&[0; 8]);
+    let err = HairFile::parse(&extra, path).unwrap_err().to_string();
+    assert!(err.contains("8 bytes follow the last array"), "{err}");
+    let mut magic = bytes;
+    magic[0] = b'h';
+    assert!(
+        HairFile::parse(&magic, path)
+            .unwrap_err()
+            .to_string()
+            .contains("does not start with \"HAIR\"")
+    );
+}
+
+#[test]
+fn ply_curves_round_trip_and_edges_in_any_order_make_the_same_chains() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = small_groom(12, 5);
+    let path = dir.path().join("groom.ply");
+    write_curves(&path, [("p".to_string(), &groom)], &CurvesExport::default()).unwrap();
+    let back = read_curves(&path).unwrap();
+    assert_eq!(
+        (back.points(), back.widths(), back.offsets()),
+        (groom.points(), groom.widths(), groom.offsets())
+    );
+
+    // Edges listed backwards still chain root to tip.
+    let ascii = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                 element edge 2\nproperty int vertex1\nproperty int vertex2\nend_header\n\
+                 0 0 0\n0 1 0\n0 2 0\n5 5 5\n1 2\n0 1\n";
+    let path = dir.path().join("ascii.ply");
+    std::fs::write(&path, ascii).unwrap();
+    let c = read_curves(&path).unwrap();
+    assert_eq!(c.offsets(), &[0, 3, 4]);
+    assert_eq!(c.points()[2], Vec3::new(0.0, 2.0, 0.0));
+    // A branch is an error naming the edge.
+    std::fs::write(&path, ascii.replace("1 2\n0 1\n", "0 2\n0 1\n")).unwrap();
+    let err = read_curves(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("ascii.ply: edge 1: edge 0–1 makes a branch"),
+        "{err}"
+    );
+}
+
+#[test]
+fn rib_and_pbrt_are_written_for_every_curve() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = small_groom(30, 5);
+    for ext in ["rib", "pbrt"] {
+        let path = dir.path().join(format!("groom.{ext}"));
+        write_curves(&path, [("p".to_string(), &groom)], &CurvesExport::default()).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        if ext == "pbrt" {
+            assert_eq!(text.matches("Shape \"curve\"").count(), 30);
+            // 4 segments of 3 control points + 1, 3 numbers each.
+            let first = text.lines().nth(1).unwrap();
+            let p = first.split('[').nth(1).unwrap().split(']').next().unwrap();
+            assert_eq!(p.split_whitespace().count(), 13 * 3, "{first}");
+        } else {
+            assert!(text.contains("Curves \"cubic\" [7 7 7"), "{}", &text[..200]);
+            assert!(text.contains("\"varying color Cs\""));
+        }
+    }
+    assert_eq!(
+        CurvesFormat::from_path(Path::new("x.USDA")),
+        Some(CurvesFormat::Usda)
+    );
+    let err = write_curves(
+        Path::new("x.usdc"),
+        [("p".to_string(), &groom)],
+        &CurvesExport::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("text USD only"), "{err}");
+}
+
+#[test]
+fn root_uvs_and_ids_reach_the_usd_file() {
+    let mut out = Vec::new();
+    let groom = small_groom(3, 2);
+    let mut usd = UsdaWriter::new(&mut out, &UsdOptions::default()).unwrap();
+    usd.write_part("p", &groom).unwrap();
+    usd.finish().unwrap();
+    let text = String::from_utf8(out).unwrap();
+    assert!(
+        text.contains(
+            "int[] primvars:hair_id = [3, 10, 17] (\n            interpolation = \"uniform\""
+        ),
+        "{text}"
+    );
+    let uv = groom.root_uvs().unwrap()[0];
+    assert!(
+        text.contains(&format!("texCoord2f[] primvars:st = [({}, {})", uv.x, uv.y)),
+        "{text}"
+    );
+    let big = groom.clone().with_ids(vec![1 << 40, 0, 1]).unwrap();
+    let mut out = Vec::new();
+    let mut usd = UsdaWriter::new(&mut out, &UsdOptions::default()).unwrap();
+    usd.write_part("p", &big).unwrap();
+    assert!(
+        String::from_utf8(out)
+            .unwrap()
+            .contains("int64[] primvars:hair_id = [1099511627776, 0, 1]")
+    );
+}
