@@ -25,8 +25,10 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Place points (hair roots) on a mesh with a density map; write a PLY.
     Sample(commands::sample::SampleArgs),
-    /// Render a mesh or a point cloud to a PNG (headless GPU).
+    /// Render a mesh, a point cloud or curves to a PNG (headless GPU).
     Render(commands::render::RenderArgs),
+    /// Convert curves between formats (USD, .hair, PLY, RIB, pbrt).
+    Convert(commands::convert::ConvertArgs),
     /// Run the demo on the embedded Spot mesh.
     Demo(commands::demo::DemoArgs),
     /// Measure a capability against its paper's figures.
@@ -39,6 +41,7 @@ fn main() -> ExitCode {
         Command::Info(args) => commands::info::run(&args),
         Command::Sample(args) => commands::sample::run(&args),
         Command::Render(args) => commands::render::run(&args),
+        Command::Convert(args) => commands::convert::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
     };

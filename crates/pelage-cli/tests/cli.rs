@@ -124,6 +124,12 @@ fn demo_runs_on_the_embedded_asset_from_any_folder() {
     let bytes = std::fs::read(&roots).expect("the demo writes pelage-demo/roots.ply");
     assert!(bytes.starts_with(b"ply\nformat binary_little_endian 1.0\n"));
     assert!(bytes.len() > 36_000_000);
+    let strands = pelage::io::read_curves(&dir.path().join("pelage-demo/strands.usda"))
+        .expect("the demo writes readable strands.usda");
+    assert_eq!(
+        (strands.curve_count(), strands.points().len()),
+        (100_000, 500_000)
+    );
     // The preview needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
     if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() {
         let png = image::open(dir.path().join("pelage-demo/preview.png")).expect("a preview PNG");
@@ -178,4 +184,98 @@ fn sample_with_zero_density_fails_naming_the_mesh_and_writes_nothing() {
         stderr(&out)
     );
     assert!(!path.exists());
+}
+
+#[test]
+fn convert_goes_through_every_format_and_keeps_the_curves() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = repo("crates/pelage/tests/data/good/blender_curves.usdc");
+    let original = pelage::io::read_curves(&input).unwrap();
+    let mut from = input.display().to_string();
+    for ext in ["hair", "ply", "usda"] {
+        let to = dir.path().join(format!("c.{ext}")).display().to_string();
+        let out = pelage(&["convert", &from, &to]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(
+            stdout(&out).contains("2 curves, 5 points, 2–3 points a curve"),
+            "{}",
+            stdout(&out)
+        );
+        let back = pelage::io::read_curves(Path::new(&to)).unwrap();
+        assert_eq!(
+            (back.points(), back.widths(), back.offsets()),
+            (original.points(), original.widths(), original.offsets()),
+            "{ext}"
+        );
+        from = to;
+    }
+    for ext in ["rib", "pbrt"] {
+        let to = dir.path().join(format!("c.{ext}")).display().to_string();
+        assert!(pelage(&["convert", &from, &to]).status.success());
+    }
+    let usd = dir.path().join("m.usda").display().to_string();
+    let out = pelage(&[
+        "convert",
+        &from,
+        &usd,
+        "--with-mesh",
+        "spot",
+        "--basis",
+        "linear",
+        "--up-axis",
+        "z",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&usd).unwrap();
+    assert!(
+        text.contains("def Mesh \"skin\"")
+            && text.contains("upAxis = \"Z\"")
+            && text.contains("type = \"linear\"")
+    );
+
+    let out = pelage(&["convert", &from, "x.abc"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        stderr(&out).matches("unknown curves format").count(),
+        1,
+        "{}",
+        stderr(&out)
+    );
+    let out = pelage(&["convert", "missing.hair", "x.usda"]);
+    assert!(
+        stderr(&out).contains("missing.hair: cannot read the file"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn render_draws_a_curves_file() {
+    // Needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_none() {
+        eprintln!("SKIPPED: set PELAGE_REQUIRE_GPU=1 to run render tests through the CLI");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("curves.png");
+    let input = repo("crates/pelage/tests/data/good/blender_curves.usda");
+    let out = pelage(&[
+        "render",
+        input.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "160x120",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("2 curves"), "{}", stdout(&out));
+    let image = image::open(&png).unwrap().to_rgba8();
+    // Background in the corner, hair somewhere.
+    let background = *image.get_pixel(0, 0);
+    assert!(image.pixels().any(|p| {
+        p.0[..3]
+            .iter()
+            .zip(&background.0[..3])
+            .any(|(a, b)| a.abs_diff(*b) > 60)
+    }));
 }

@@ -1,18 +1,20 @@
 //! `pelage demo`: pelage on the embedded Spot mesh, with no files needed.
 //!
-//! Today it shows the mesh layer and root sampling: a summary of Spot, then
-//! a million hair roots from a noise density, written to
-//! `./pelage-demo/roots.ply`, and a picture of them, `preview.png` (skipped
-//! with a message where no GPU adapter exists). The groom and export
-//! issues grow it into the full demo (hairs, USD).
+//! Today it shows the mesh layer, root sampling and curve export: a summary
+//! of Spot, then a million hair roots from a noise density, written to
+//! `./pelage-demo/roots.ply`; the first 100,000 grown into straight,
+//! tapering strands and written as USD with the skin
+//! (`./pelage-demo/strands.usda`); and a picture of them, `preview.png`
+//! (skipped with a message where no GPU adapter exists). The groom issue
+//! grows it into the full demo (guides, operators).
 
 use super::info::MeshSummary;
 use crate::format::thousands;
 use anyhow::Context;
 use clap::Args;
-use pelage::Map;
-use pelage::io::write_points_ply;
+use pelage::io::{CurvesExport, write_curves, write_points_ply};
 use pelage::sample::{DensitySampler, DensitySamplerOptions, sample_range};
+use pelage::{Curves, Map};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -26,23 +28,37 @@ pub struct DemoArgs {
 
 /// Roots the demo places.
 const ROOTS: u64 = 1_000_000;
+/// Of those, how many grow into strands.
+const STRANDS: usize = 100_000;
 /// The density the demo uses, as a user would write it.
 const DENSITY: &str = "noise:frequency=6,octaves=3,seed=2,offset=0.5,scale=0.5";
 
-/// Renders roots on the skin to `path`; returns the adapter's name.
+/// Straight strands along the normals of `roots`, tapering, with their
+/// root UVs and ids (the simplest groom, until guides and operators land).
+fn strands(spot: &pelage::Mesh, roots: &[pelage::SurfacePoint]) -> anyhow::Result<Curves> {
+    let uvs = roots
+        .iter()
+        .map(|r| r.uv(spot).unwrap_or_default())
+        .collect();
+    Ok(Curves::along_normals(spot, roots, 0.04, 5, 0.004, 0.0005)
+        .with_root_uvs(uvs)?
+        .with_ids((0..roots.len() as u64).collect())?
+        .with_roots(roots.to_vec())?)
+}
+
+/// Renders strands on the skin to `path`; returns the adapter's name.
 fn render_preview(
     spot: &pelage::Mesh,
-    roots: &[pelage::SurfacePoint],
+    strands: &Curves,
     path: &std::path::Path,
 ) -> anyhow::Result<String> {
     use pelage_gpu::{GpuContext, PreviewScene, PreviewStyle, Renderer};
     let ctx = GpuContext::headless()?;
-    let points: Vec<glam::Vec3> = roots.iter().map(|p| p.position(spot)).collect();
     let texture = image::load_from_memory(pelage::assets::SPOT_TEXTURE_PNG)?.to_rgba8();
     let scene = PreviewScene {
         mesh: Some(spot),
-        points: &points,
-        curves: None,
+        points: &[],
+        curves: Some(strands),
         skin_texture: Some(&texture),
     };
     let image =
@@ -87,19 +103,32 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         sampled.as_secs_f64() * 1e3,
         path.display()
     );
+    let strands = strands(&spot, &roots[..STRANDS])?;
+    let usd = args.out.join("strands.usda");
+    let export = CurvesExport {
+        mesh: Some(&spot),
+        ..CurvesExport::default()
+    };
+    write_curves(&usd, [("strands".to_string(), &strands)], &export)?;
+    println!(
+        "{} of them grown into straight strands (5 points, Catmull-Rom) → {} with the skin",
+        thousands(STRANDS as u64),
+        usd.display()
+    );
     let preview = args.out.join("preview.png");
-    match render_preview(&spot, &roots[..20_000], &preview) {
+    match render_preview(&spot, &strands, &preview) {
         Ok(adapter) => println!(
-            "preview of 20,000 of them → {} (rendered on {adapter})",
+            "preview of the strands → {} (rendered on {adapter})",
             preview.display()
         ),
         // The demo still did its job; say why there is no picture.
         Err(e) => println!("preview skipped: {e:#}"),
     }
     println!("done in {:.2} s\n", start.elapsed().as_secs_f64());
-    println!("Try: pelage sample --help, pelage bench sampler --quick.");
-    println!("Coming as the next layers land: guide interpolation, clump/curl/noise");
-    println!("operators, 200,000 hairs written to ./pelage-demo/ as USD, previewed");
-    println!("as curves.");
+    println!("Try: pelage render pelage-demo/strands.usda --mesh spot -o strands.png,");
+    println!(
+        "     pelage convert pelage-demo/strands.usda strands.hair, pelage bench sampler --quick."
+    );
+    println!("Coming as the next layers land: guides, interpolation, clump/curl/noise operators.");
     Ok(())
 }

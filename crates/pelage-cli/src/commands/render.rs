@@ -1,19 +1,22 @@
-//! `pelage render`: a picture of a mesh or a point cloud (headless, wgpu).
+//! `pelage render`: a picture of a mesh, a point cloud or curves (headless,
+//! wgpu).
 
 use super::load_mesh;
 use anyhow::Context;
 use clap::Args;
-use pelage::io::{ply_has_faces, read_points_ply, write_atomically};
+use pelage::io::{CurvesFormat, ply_element_count, read_curves, read_points_ply, write_atomically};
 use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `pelage render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// A mesh (.obj, .ply, .gltf, .glb) or a points PLY (as `pelage
-    /// sample` writes). Without it, the embedded Spot.
+    /// A mesh (.obj, .ply, .gltf, .glb), a points PLY (as `pelage sample`
+    /// writes) or curves (.usda, .usdc, .usd, .hair, or a PLY with edges).
+    /// Without it, the embedded Spot.
     pub file: Option<PathBuf>,
-    /// A mesh to draw under the points (for a points file).
+    /// A mesh to draw under the points or curves (`spot` for the embedded
+    /// one).
     #[arg(long)]
     pub mesh: Option<PathBuf>,
     /// Output PNG.
@@ -67,25 +70,49 @@ fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
     <[f32; 3]>::try_from(parts).map_err(|_| format!("{s:?} is not X,Y,Z"))
 }
 
-fn is_points_file(path: &Path) -> anyhow::Result<bool> {
-    let ply = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
-    Ok(ply && !ply_has_faces(path).with_context(|| format!("cannot read {}", path.display()))?)
+/// What a file given to `pelage render` holds.
+#[derive(Debug, PartialEq)]
+enum FileKind {
+    Mesh,
+    Points,
+    Curves,
+}
+
+fn file_kind(path: &Path) -> anyhow::Result<FileKind> {
+    let count = |element| {
+        ply_element_count(path, element).with_context(|| format!("cannot read {}", path.display()))
+    };
+    Ok(match CurvesFormat::from_path(path) {
+        Some(CurvesFormat::Ply) if count("face")? > 0 => FileKind::Mesh,
+        Some(CurvesFormat::Ply) if count("edge")? > 0 => FileKind::Curves,
+        Some(CurvesFormat::Ply) => FileKind::Points,
+        Some(_) => FileKind::Curves,
+        None => FileKind::Mesh,
+    })
 }
 
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
-    let (points, mesh) = match &args.file {
-        Some(file) if is_points_file(file)? => {
-            let points = read_points_ply(file).context("cannot load the points")?;
-            let mesh = args
-                .mesh
-                .as_deref()
-                .map(|m| load_mesh(Some(m)))
-                .transpose()?;
-            (points, mesh)
+    let under = || -> anyhow::Result<Option<pelage::Mesh>> {
+        match args.mesh.as_deref() {
+            None => Ok(None),
+            Some(m) if m == Path::new("spot") => Ok(Some(load_mesh(None)?)),
+            Some(m) => Ok(Some(load_mesh(Some(m))?)),
         }
-        file => (Vec::new(), Some(load_mesh(file.as_deref())?)),
+    };
+    let kind = match &args.file {
+        Some(file) => file_kind(file)?,
+        None => FileKind::Mesh,
+    };
+    let (points, curves, mesh) = match (&args.file, kind) {
+        (Some(file), FileKind::Points) => {
+            let points = read_points_ply(file).context("cannot load the points")?;
+            (points, None, under()?)
+        }
+        (Some(file), FileKind::Curves) => {
+            let curves = read_curves(file).context("cannot load the curves")?;
+            (Vec::new(), Some(curves), under()?)
+        }
+        (file, _) => (Vec::new(), None, Some(load_mesh(file.as_deref())?)),
     };
     let texture = match &args.texture {
         Some(path) => Some(
@@ -93,8 +120,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
                 .with_context(|| format!("cannot read the texture {}", path.display()))?
                 .to_rgba8(),
         ),
-        // Without FILE the mesh is the embedded Spot: use its own texture.
-        None if args.file.is_none() && !args.no_texture => {
+        // The embedded Spot gets its own texture.
+        None if (args.file.is_none() || args.mesh.as_deref() == Some(Path::new("spot")))
+            && !args.no_texture =>
+        {
             Some(image::load_from_memory(pelage::assets::SPOT_TEXTURE_PNG)?.to_rgba8())
         }
         None => None,
@@ -102,7 +131,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let scene = PreviewScene {
         mesh: mesh.as_ref(),
         points: &points,
-        curves: None,
+        curves: curves.as_ref(),
         skin_texture: texture.as_ref(),
     };
     let (width, height) = args.size;
@@ -129,10 +158,17 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     println!(
         "wrote {} ({width}×{height}, {} on {})",
         args.output.display(),
-        match (&mesh, points.len()) {
-            (Some(m), 0) => m.name().to_string(),
-            (Some(m), n) => format!("{n} points on {}", m.name()),
-            (None, n) => format!("{n} points"),
+        match (&mesh, points.len(), &curves) {
+            (mesh, _, Some(c)) => format!(
+                "{} curves{}",
+                c.curve_count(),
+                mesh.as_ref()
+                    .map(|m| format!(" on {}", m.name()))
+                    .unwrap_or_default()
+            ),
+            (Some(m), 0, None) => m.name().to_string(),
+            (Some(m), n, None) => format!("{n} points on {}", m.name()),
+            (None, n, None) => format!("{n} points"),
         },
         ctx.adapter_name()
     );

@@ -13,9 +13,9 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> Result<(), WriteError> {
-    let fail = |source| WriteError {
+    let fail = |error| WriteError {
         path: path.to_path_buf(),
-        source,
+        error,
     };
     let name = path
         .file_name()

@@ -79,7 +79,7 @@ pub fn write_curves<'c>(
 ) -> Result<(), WriteError> {
     let fail = |message: String| WriteError {
         path: path.to_path_buf(),
-        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
+        error: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
     };
     let format = CurvesFormat::from_path(path).ok_or_else(|| {
         fail(

@@ -28,7 +28,9 @@ pub use atomic::write_atomically;
 pub use curves_file::{CurvesExport, CurvesFormat, join, read_curves, write_curves};
 pub use curves_ply::{read_curves_ply, write_curves_ply};
 pub use hair::{HairFile, HairWriteError};
-pub use points_ply::{PointsPly, ply_has_faces, read_points_ply, write_points_ply};
+pub use points_ply::{
+    PointsPly, ply_element_count, ply_has_faces, read_points_ply, write_points_ply,
+};
 pub use read_error::{CurvesReadError, CurvesReadErrorKind};
 pub use render_text::{bezier_control_points, write_pbrt, write_rib};
 pub use usd_read::{DEFAULT_WIDTH, read_usd_curves};
@@ -36,13 +38,13 @@ pub use usda::{CurveBasis, UpAxis, UsdOptions, UsdWrap, UsdWriteError, UsdaWrite
 
 use std::path::PathBuf;
 
-/// A file could not be written. Names the file.
+/// A file could not be written. Names the file and says what went wrong
+/// (in its message, so a cause chain does not repeat it).
 #[derive(Debug, thiserror::Error)]
-#[error("cannot write {}: {source}", path.display())]
+#[error("cannot write {}: {error}", path.display())]
 pub struct WriteError {
     /// The file that was being written.
     pub path: PathBuf,
     /// What went wrong.
-    #[source]
-    pub source: std::io::Error,
+    pub error: std::io::Error,
 }

@@ -133,24 +133,31 @@ pub fn read_points_ply(path: &Path) -> Result<Vec<glam::Vec3>, crate::MeshError>
         .collect()
 }
 
-/// Whether a PLY file describes points (no faces) rather than a mesh.
+/// Whether a PLY file describes a mesh (it has faces) rather than points
+/// or curves.
 pub fn ply_has_faces(path: &Path) -> std::io::Result<bool> {
+    Ok(ply_element_count(path, "face")? > 0)
+}
+
+/// The count a PLY header declares for `element` (0 when it declares
+/// none), read from the header alone.
+pub fn ply_element_count(path: &Path, element: &str) -> std::io::Result<u64> {
     use std::io::BufRead;
     let file = std::io::BufReader::new(std::fs::File::open(path)?);
+    let prefix = format!("element {element} ");
     for line in file.split(b'\n') {
         let line = line?;
         if line.starts_with(b"end_header") {
             break;
         }
-        if let Some(rest) = line.strip_prefix(b"element face ") {
+        if let Some(rest) = line.strip_prefix(prefix.as_bytes()) {
             return Ok(std::str::from_utf8(rest)
                 .ok()
                 .and_then(|n| n.trim().parse::<u64>().ok())
-                .unwrap_or(0)
-                > 0);
+                .unwrap_or(0));
         }
     }
-    Ok(false)
+    Ok(0)
 }
 
 #[cfg(test)]

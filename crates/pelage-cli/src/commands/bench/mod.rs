@@ -5,6 +5,7 @@
 //! Machines here are small and noisy: every figure is the median of several
 //! runs, and comparisons are ratios taken within one run.
 
+pub mod io;
 pub mod render;
 pub mod sampler;
 
@@ -25,12 +26,15 @@ pub enum BenchWhat {
     Sampler(sampler::SamplerBenchArgs),
     /// Preview renderer frame time: skin alone, with 100 k and 1 M curves.
     Render(render::RenderBenchArgs),
+    /// Writing a large groom as usda, part by part: throughput and peak memory.
+    Io(io::IoBenchArgs),
 }
 
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     match &args.what {
         BenchWhat::Sampler(a) => sampler::run(a),
         BenchWhat::Render(a) => render::run(a),
+        BenchWhat::Io(a) => io::run(a),
     }
 }
 
