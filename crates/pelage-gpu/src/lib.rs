@@ -18,6 +18,8 @@ pub use camera::Camera;
 pub use context::GpuContext;
 pub use pelage::Curves;
 pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer};
+/// wgpu itself, so callers (a window, the viewer) build surfaces with the same version.
+pub use wgpu;
 
 /// The renderer could not run.
 #[derive(Debug, thiserror::Error)]
@@ -39,6 +41,9 @@ pub enum GpuError {
     /// Reading the rendered image back failed.
     #[error("reading the rendered image back from the GPU failed: {0}")]
     Readback(String),
+    /// Images are read back only from 8-bit RGBA or BGRA targets.
+    #[error("images can be read back from Rgba8/Bgra8 renderers only, not {0}")]
+    Format(String),
     /// The requested image size is not possible.
     #[error("an image of {width}×{height} pixels cannot be rendered (1 to {max} per side)")]
     Size {

@@ -108,11 +108,21 @@ pub struct Renderer {
     mesh_pipeline: wgpu::RenderPipeline,
     points_pipeline: wgpu::RenderPipeline,
     curves_pipeline: wgpu::RenderPipeline,
+    format: wgpu::TextureFormat,
 }
 
 impl Renderer {
-    /// Compiles the shaders and builds the pipelines.
+    /// Compiles the shaders and builds the pipelines for offscreen images
+    /// ([`render`](Self::render), [`render_uploaded`](Self::render_uploaded)).
     pub fn new(ctx: &GpuContext) -> Self {
+        Self::for_format(ctx, COLOR_FORMAT)
+    }
+
+    /// Builds the pipelines for targets of `format`, e.g. a window
+    /// surface's preferred format (`Bgra8UnormSrgb` on most platforms); draw
+    /// with [`encode`](Self::encode). Use an sRGB format: the shaders write
+    /// linear colour.
+    pub fn for_format(ctx: &GpuContext, format: wgpu::TextureFormat) -> Self {
         let device = &ctx.device;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
@@ -205,7 +215,7 @@ impl Renderer {
                     entry_point: Some("fs_main"),
                     compilation_options: Default::default(),
                     targets: &[Some(wgpu::ColorTargetState {
-                        format: COLOR_FORMAT,
+                        format,
                         blend: None,
                         write_mask: wgpu::ColorWrites::ALL,
                     })],
@@ -248,7 +258,13 @@ impl Renderer {
             mesh_pipeline,
             points_pipeline,
             curves_pipeline,
+            format,
         }
+    }
+
+    /// The colour format the pipelines draw into.
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.format
     }
 
     /// Renders `scene` into a `width × height` image. Without a camera the
@@ -406,10 +422,65 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<image::RgbaImage, GpuError> {
-        let max = ctx.device.limits().max_texture_dimension_2d;
-        if width == 0 || height == 0 || width > max || height > max {
-            return Err(GpuError::Size { width, height, max });
+        check_size(ctx, width, height)?;
+        use wgpu::TextureFormat as F;
+        let bgra = match self.format {
+            F::Rgba8UnormSrgb | F::Rgba8Unorm => false,
+            F::Bgra8UnormSrgb | F::Bgra8Unorm => true,
+            format => return Err(GpuError::Format(format!("{format:?}"))),
+        };
+        let resolved = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("preview image"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let view = resolved.create_view(&Default::default());
+        self.encode(
+            ctx,
+            &mut encoder,
+            scene,
+            style,
+            camera,
+            &view,
+            width,
+            height,
+        )?;
+        let mut image = read_back(ctx, encoder, &resolved, width, height)?;
+        if bgra {
+            image.pixels_mut().for_each(|p| p.0.swap(0, 2));
         }
+        Ok(image)
+    }
+
+    /// Records the drawing of an uploaded scene into `target`, a
+    /// single-sampled view of this renderer's [`format`](Self::format) and
+    /// `width × height` — an offscreen texture or a window surface's
+    /// current texture. The renderer draws into its own multisampled colour
+    /// and depth targets and resolves into `target`; submit the encoder
+    /// (and present the surface texture) afterwards.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        style: &PreviewStyle,
+        camera: Option<Camera>,
+        target: &wgpu::TextureView,
+        width: u32,
+        height: u32,
+    ) -> Result<(), GpuError> {
+        check_size(ctx, width, height)?;
         let device = &ctx.device;
         let aspect = width as f32 / height as f32;
         let (lo, hi) = scene
@@ -467,40 +538,31 @@ impl Renderer {
             }],
         });
 
-        let target = |samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("preview target"),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: samples,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let multisampled = target(
-            SAMPLES,
-            COLOR_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        );
-        let resolved = target(
-            1,
-            COLOR_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        );
-        let depth = target(
+        let target_texture =
+            |samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
+                device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("preview target"),
+                    size: wgpu::Extent3d {
+                        width,
+                        height,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: samples,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+            };
+        let multisampled =
+            target_texture(SAMPLES, self.format, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let depth = target_texture(
             SAMPLES,
             DEPTH_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         );
-        let views = [&multisampled, &resolved, &depth].map(|t| t.create_view(&Default::default()));
-
-        let mut encoder = device.create_command_encoder(&Default::default());
+        let views = [&multisampled, &depth].map(|t| t.create_view(&Default::default()));
         {
             let [r, g, b] = style.background.map(f64::from);
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -508,14 +570,14 @@ impl Renderer {
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: &views[0],
                     depth_slice: None,
-                    resolve_target: Some(&views[1]),
+                    resolve_target: Some(target),
                     ops: wgpu::Operations {
                         load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
                         store: wgpu::StoreOp::Discard,
                     },
                 })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &views[2],
+                    view: &views[1],
                     depth_ops: Some(wgpu::Operations {
                         load: wgpu::LoadOp::Clear(1.0),
                         store: wgpu::StoreOp::Discard,
@@ -550,62 +612,83 @@ impl Renderer {
                 pass.draw(0..6, 0..*count);
             }
         }
-
-        // Rows of a texture-to-buffer copy are padded to 256 bytes.
-        let row = width * 4;
-        let padded_row =
-            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: u64::from(padded_row) * u64::from(height),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: &resolved,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded_row),
-                    rows_per_image: Some(height),
-                },
-            },
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-        );
-        ctx.queue.submit([encoder.finish()]);
-
-        let (sender, receiver) = std::sync::mpsc::channel();
-        readback.map_async(wgpu::MapMode::Read, .., move |result| {
-            let _ = sender.send(result);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        receiver
-            .recv()
-            .map_err(|e| GpuError::Readback(e.to_string()))?
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let mapped = readback
-            .get_mapped_range(..)
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let mut pixels = Vec::with_capacity((row * height) as usize);
-        for y in 0..height as usize {
-            let start = y * padded_row as usize;
-            pixels.extend_from_slice(&mapped[start..start + row as usize]);
-        }
-        drop(mapped);
-        readback.unmap();
-        image::RgbaImage::from_raw(width, height, pixels)
-            .ok_or_else(|| GpuError::Readback("the image size does not match".into()))
+        Ok(())
     }
+}
+
+fn check_size(ctx: &GpuContext, width: u32, height: u32) -> Result<(), GpuError> {
+    let max = ctx.device.limits().max_texture_dimension_2d;
+    if width == 0 || height == 0 || width > max || height > max {
+        return Err(GpuError::Size { width, height, max });
+    }
+    Ok(())
+}
+
+/// Copies `texture` (4 bytes a pixel) into a buffer, submits `encoder` and returns
+/// the pixels.
+fn read_back(
+    ctx: &GpuContext,
+    mut encoder: wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    width: u32,
+    height: u32,
+) -> Result<image::RgbaImage, GpuError> {
+    let device = &ctx.device;
+
+    // Rows of a texture-to-buffer copy are padded to 256 bytes.
+    let row = width * 4;
+    let padded_row =
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: u64::from(padded_row) * u64::from(height),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &readback,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded_row),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+    );
+    ctx.queue.submit([encoder.finish()]);
+
+    let (sender, receiver) = std::sync::mpsc::channel();
+    readback.map_async(wgpu::MapMode::Read, .., move |result| {
+        let _ = sender.send(result);
+    });
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    receiver
+        .recv()
+        .map_err(|e| GpuError::Readback(e.to_string()))?
+        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    let mapped = readback
+        .get_mapped_range(..)
+        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    let mut pixels = Vec::with_capacity((row * height) as usize);
+    for y in 0..height as usize {
+        let start = y * padded_row as usize;
+        pixels.extend_from_slice(&mapped[start..start + row as usize]);
+    }
+    drop(mapped);
+    readback.unmap();
+    image::RgbaImage::from_raw(width, height, pixels)
+        .ok_or_else(|| GpuError::Readback("the image size does not match".into()))
 }

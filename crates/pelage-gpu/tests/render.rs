@@ -306,3 +306,40 @@ fn a_skin_texture_colours_the_mesh_at_its_uvs() {
         dark(&textured)
     );
 }
+
+#[test]
+fn a_surface_format_renderer_draws_the_same_picture_through_encode() {
+    // Window surfaces are Bgra8UnormSrgb on most platforms; the renderer
+    // built for that format must draw what the offscreen one draws.
+    let Some((ctx, rgba)) = gpu() else { return };
+    let bgra = Renderer::for_format(ctx, wgpu::TextureFormat::Bgra8UnormSrgb);
+    assert_eq!(bgra.format(), wgpu::TextureFormat::Bgra8UnormSrgb);
+    let spot = pelage::assets::spot();
+    let roots: Vec<pelage::SurfacePoint> = (0..300)
+        .map(|i| pelage::SurfacePoint::new(i * 17, [0.3, 0.3]))
+        .collect();
+    let curves = pelage::Curves::along_normals(&spot, &roots, 0.1, 4, 0.01, 0.002);
+    let scene = PreviewScene {
+        mesh: Some(&spot),
+        points: &[],
+        curves: Some(&curves),
+        skin_texture: None,
+    };
+    let style = PreviewStyle::default();
+    let a = rgba.render(ctx, &scene, &style, None, 200, 150).unwrap();
+    let b = bgra.render(ctx, &scene, &style, None, 200, 150).unwrap();
+    let differing = a
+        .pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 1))
+        .count();
+    assert_eq!(differing, 0, "BGRA and RGBA renders differ");
+    assert!(
+        a.pixels().any(|p| p.0 != a.get_pixel(0, 0).0),
+        "nothing was drawn"
+    );
+    let err = Renderer::for_format(ctx, wgpu::TextureFormat::Rgba16Float)
+        .render(ctx, &scene, &style, None, 8, 8)
+        .unwrap_err();
+    assert!(err.to_string().contains("Rgba16Float"), "{err}");
+}
