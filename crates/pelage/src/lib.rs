@@ -12,7 +12,12 @@
 //!   deterministic by `(seed, index)`.
 //! - [`curves`]: [`Curves`], hair curves as structure of arrays with an
 //!   offsets array (Blender's `CurvesGeometry`, USD `BasisCurves`).
-//! - [`io`]: writers, all atomic (temporary file, then rename).
+//! - [`guides`]: [`guides::Guides`], artist guide curves bound to the mesh
+//!   (from a file, with a report of what was left out, or grown).
+//! - [`interp`]: guide interpolation — Shepard over a kd-tree (Sik §4.2.2)
+//!   and the style mesh (Furtility).
+//! - [`io`]: curves and points in and out (USD, .hair, PLY, RIB, pbrt),
+//!   every writer atomic (temporary file, then rename).
 //! - [`assets`]: the embedded demo mesh (Spot), so every command works with
 //!   no files at hand.
 //!
@@ -22,6 +27,8 @@
 
 pub mod assets;
 pub mod curves;
+pub mod guides;
+pub mod interp;
 pub mod io;
 pub mod map;
 pub mod mesh;

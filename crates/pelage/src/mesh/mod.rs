@@ -12,6 +12,7 @@
 //! counted in [`Mesh::degenerate_triangle_count`], and given an area of
 //! exactly zero, so every area-weighted sampler gives them zero probability.
 
+mod closest;
 mod error;
 mod gltf;
 mod load;
@@ -21,6 +22,7 @@ mod subdivide;
 mod surface_point;
 mod topology;
 
+pub use closest::{ClosestPoint, TriangleBvh, closest_on_triangle};
 pub use error::{Location, MeshError, MeshErrorKind};
 pub use load::MeshFormat;
 pub(crate) use ply::scalar as ply_scalar;

@@ -1,0 +1,170 @@
+//! Guide interpolation: each hair's shape as a weighted sum of guide shapes.
+//!
+//! Two ways of choosing the guides and their weights, behind one small
+//! interface ([`GuideWeights`]) so the groom generator picks one by name
+//! ([`InterpolationMethod`]):
+//!
+//! - [`Shepard`]: the k nearest guide roots in space from a kd-tree,
+//!   inverse-distance weights (Sik §4.2.2, Stubble; Shepard 1968).
+//! - [`StyleMesh`]: the Furtility talk's style mesh, built from the surface
+//!   by geodesic colouring; a hair takes the barycentric weights of its
+//!   closest point on it. It exists because Shepard fails on thin parts: a
+//!   hair on one side of an ear must not follow a guide on the other side.
+//!
+//! Shapes are combined in the hair's own frame: each guide's offsets from
+//! its root are turned by the smallest rotation that takes the guide's root
+//! normal to the hair's root normal, then weighted. So hairs follow the
+//! surface's curvature, and a hair at a guide's root is that guide exactly.
+//! (Frames built from UV tangents would flip across UV seams; the minimal
+//! rotation between two normals has no seams.)
+
+mod shepard;
+mod style_mesh;
+
+pub use shepard::Shepard;
+pub use style_mesh::{LostGuide, StyleMesh, StyleMeshOptions};
+
+use crate::guides::Guides;
+use crate::mesh::{Mesh, SurfacePoint};
+use glam::{Quat, Vec3};
+
+/// One guide's share of a hair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GuideWeight {
+    /// The guide's index.
+    pub guide: u32,
+    /// Its weight (non-negative; a hair's weights sum to 1).
+    pub weight: f32,
+}
+
+/// Chooses guides and weights for a hair root.
+pub trait GuideWeights: Send + Sync {
+    /// Replaces `out` with the guides and weights of a hair rooted at
+    /// `root` (world space). Weights are non-negative and sum to 1.
+    fn weights(&self, root: Vec3, out: &mut Vec<GuideWeight>);
+}
+
+/// An interpolation method by name, as groom files spell it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum InterpolationMethod {
+    /// `shepard`: k nearest guides, weights `1 / d^power`, guides beyond
+    /// `radius` (if any) ignored.
+    Shepard {
+        /// Guides per hair.
+        k: usize,
+        /// Distance exponent.
+        power: f32,
+        /// Largest distance at which a guide counts.
+        radius: Option<f32>,
+    },
+    /// `style-mesh`: Furtility's style mesh.
+    StyleMesh(StyleMeshOptions),
+}
+
+impl InterpolationMethod {
+    /// The method called `name` with its default parameters: `shepard`
+    /// (k = 4, power = 2) or `style-mesh`.
+    pub fn by_name(name: &str) -> Option<Self> {
+        match name {
+            "shepard" => Some(Self::Shepard {
+                k: 4,
+                power: 2.0,
+                radius: None,
+            }),
+            "style-mesh" | "style_mesh" => Some(Self::StyleMesh(StyleMeshOptions::default())),
+            _ => None,
+        }
+    }
+}
+
+/// Guides ready to shape hairs with one method.
+pub struct Interpolator<'g> {
+    guides: &'g Guides,
+    /// Each guide's offsets from its root.
+    offsets: Vec<Vec3>,
+    /// Each guide's root normal.
+    normals: Vec<Vec3>,
+    weights: Box<dyn GuideWeights + 'g>,
+}
+
+impl<'g> Interpolator<'g> {
+    /// Prepares `guides` (bound to `mesh`) for interpolation by `method`.
+    pub fn new(mesh: &Mesh, guides: &'g Guides, method: &InterpolationMethod) -> Self {
+        let weights: Box<dyn GuideWeights> = match method {
+            InterpolationMethod::Shepard { k, power, radius } => {
+                Box::new(Shepard::new(mesh, guides, *k, *power, *radius))
+            }
+            InterpolationMethod::StyleMesh(options) => {
+                Box::new(StyleMesh::build(mesh, guides, options))
+            }
+        };
+        Self::with_weights(mesh, guides, weights)
+    }
+
+    /// Prepares `guides` with a weighting of your own.
+    pub fn with_weights(
+        mesh: &Mesh,
+        guides: &'g Guides,
+        weights: Box<dyn GuideWeights + 'g>,
+    ) -> Self {
+        let mut offsets = Vec::with_capacity(guides.curves().points().len());
+        for i in 0..guides.len() {
+            let g = guides.guide(i);
+            offsets.extend(g.iter().map(|p| *p - g[0]));
+        }
+        let normals = guides.roots().iter().map(|r| r.normal(mesh)).collect();
+        Self {
+            guides,
+            offsets,
+            normals,
+            weights,
+        }
+    }
+
+    /// The guides.
+    pub fn guides(&self) -> &Guides {
+        self.guides
+    }
+
+    /// The weighting.
+    pub fn weighting(&self) -> &dyn GuideWeights {
+        self.weights.as_ref()
+    }
+
+    /// Shapes the hair rooted at `root` into `out` (`points_per_guide`
+    /// points, `out[0]` the root), using `scratch` for the weights.
+    pub fn hair(
+        &self,
+        mesh: &Mesh,
+        root: SurfacePoint,
+        scratch: &mut Vec<GuideWeight>,
+        out: &mut [Vec3],
+    ) {
+        let (position, normal) = (root.position(mesh), root.normal(mesh));
+        self.weights.weights(position, scratch);
+        self.shape(scratch, position, normal, out);
+    }
+
+    /// Shapes a hair at `position` with surface normal `normal` from given
+    /// weights.
+    pub fn shape(&self, weights: &[GuideWeight], position: Vec3, normal: Vec3, out: &mut [Vec3]) {
+        let n = self.guides.points_per_guide();
+        out.iter_mut().for_each(|p| *p = Vec3::ZERO);
+        for w in weights {
+            let g = w.guide as usize;
+            let turn = Quat::from_rotation_arc(self.normals[g], normal);
+            for (o, offset) in out.iter_mut().zip(&self.offsets[g * n..(g + 1) * n]) {
+                *o += w.weight * (turn * *offset);
+            }
+        }
+        out.iter_mut().for_each(|p| *p += position);
+    }
+}
+
+/// Normalises weights to sum 1 (they must be non-negative, not all zero).
+fn normalise(out: &mut [GuideWeight]) {
+    let total: f32 = out.iter().map(|w| w.weight).sum();
+    if total > 0.0 {
+        out.iter_mut().for_each(|w| w.weight /= total);
+    }
+}

@@ -1,0 +1,344 @@
+//! The style mesh of Furtility's Mesh Style GOP (Andrus & Manca, SIGGRAPH
+//! 2015 talk), built from the surface as the talk describes:
+//!
+//! 1. Each guide marks the mesh vertex nearest its root.
+//! 2. Every vertex is coloured with the nearest guide by distance along
+//!    mesh edges: a multi-source Dijkstra from the marked vertices, where a
+//!    colour passes to a neighbour only while it is the closest that
+//!    neighbour has seen.
+//! 3. Cells are the groups of identically coloured vertices; the style
+//!    mesh has an edge between two guides whose cells share a border, and
+//!    a triangle for every mesh triangle whose corners carry three
+//!    different colours.
+//! 4. A hair takes the barycentric coordinates of its closest point on the
+//!    style mesh as weights over that triangle's three guides, so a hair at
+//!    a guide's root reproduces the guide exactly.
+//!
+//! Gaps: border edges that no three-colour triangle uses (two cells
+//! meeting along a strip with no third cell at either end) join the
+//! closest-point set as segments, and a guide whose cell touches no other
+//! (alone on an island) as a point, so every guide and every adjacency can
+//! be the closest feature. Closest points only need a "well-defined closest
+//! point function" (the talk), so non-manifold and degenerate style
+//! triangles are fine.
+//!
+//! Failure case, reported not hidden: two guides nearest the same vertex
+//! (denser than the mesh, e.g. more than three guides in a triangle). The
+//! farther one is listed in [`StyleMesh::lost`] with the vertex and the
+//! guide that kept it. With [`StyleMeshOptions::split_shared`] (the talk's
+//! suggested fix) the triangle under each such guide is split locally
+//! (1 → 3 at the guide root), so every guide gets its own vertex.
+
+use super::{GuideWeight, GuideWeights, normalise};
+use crate::guides::Guides;
+use crate::mesh::{EdgeList, Mesh, TriangleBvh, VertexAdjacency};
+use glam::Vec3;
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashSet};
+
+/// Options of the style mesh.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StyleMeshOptions {
+    /// Split the mesh triangle under each guide that lost its vertex, so
+    /// every guide gets a vertex of its own.
+    pub split_shared: bool,
+}
+
+/// A guide the style mesh could not use.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LostGuide {
+    /// The guide.
+    pub guide: u32,
+    /// The vertex it was nearest.
+    pub vertex: u32,
+    /// The guide nearer that vertex, which kept it.
+    pub kept_by: u32,
+}
+
+impl std::fmt::Display for LostGuide {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "guide {} is not used: vertex {} is nearest to it and to guide {}, which is nearer; \
+             guides are denser than the mesh there (split_shared gives each guide its own vertex)",
+            self.guide, self.vertex, self.kept_by
+        )
+    }
+}
+
+/// Furtility's style mesh over a set of guides.
+pub struct StyleMesh {
+    /// Guide root positions (the style mesh's vertices).
+    positions: Vec<Vec3>,
+    /// Style triangles (guide indices); segments and points are triangles
+    /// with repeated corners.
+    triangles: Vec<[u32; 3]>,
+    /// How many of `triangles` are real (three distinct guides).
+    real_triangles: usize,
+    /// Guide pairs whose cells share a border.
+    edges: Vec<[u32; 2]>,
+    /// The colour (guide) of each vertex of the mesh the colouring ran on;
+    /// `u32::MAX` where no guide reaches.
+    colours: Vec<u32>,
+    lost: Vec<LostGuide>,
+    bvh: TriangleBvh,
+}
+
+impl StyleMesh {
+    /// Builds the style mesh of `guides` on `mesh`.
+    pub fn build(mesh: &Mesh, guides: &Guides, options: &StyleMeshOptions) -> Self {
+        let positions: Vec<Vec3> = guides.roots().iter().map(|r| r.position(mesh)).collect();
+        // 1. Each guide marks the corner of its root triangle nearest to it.
+        let nearest_corner = |g: usize| {
+            let tri = mesh.triangles()[guides.roots()[g].tri as usize];
+            *tri.iter()
+                .min_by(|&&a, &&b| {
+                    let da = (mesh.positions()[a as usize] - positions[g]).length_squared();
+                    let db = (mesh.positions()[b as usize] - positions[g]).length_squared();
+                    da.total_cmp(&db).then(a.cmp(&b))
+                })
+                .expect("three corners")
+        };
+        let mut marks: Vec<(u32, u32)> = (0..guides.len())
+            .map(|g| (nearest_corner(g), g as u32))
+            .collect();
+        let lost = conflicts(&marks, &positions, mesh.positions());
+        let (colours, triangles_of_colouring) = if options.split_shared && !lost.is_empty() {
+            let (vertices, triangles) = split_under(mesh, guides, &lost, &positions, &mut marks);
+            let adjacency =
+                VertexAdjacency::from_edges(&EdgeList::build(&triangles), vertices.len());
+            let lost_none: Vec<LostGuide> = Vec::new();
+            let colours = colour(&vertices, &adjacency, &marks, &lost_none);
+            (colours, Some((triangles, lost_none)))
+        } else {
+            let colours = colour(mesh.positions(), &mesh.vertex_adjacency(), &marks, &lost);
+            (colours, None)
+        };
+        let (lost, mesh_triangles): (Vec<LostGuide>, &[[u32; 3]]) = match &triangles_of_colouring {
+            Some((t, l)) => (l.clone(), t.as_slice()),
+            None => (lost, mesh.triangles()),
+        };
+        // 3. Style edges and triangles from the colouring.
+        let mut triangles = Vec::new();
+        let mut seen_triangles = HashSet::new();
+        let mut edges = HashSet::new();
+        for t in mesh_triangles {
+            let c = t.map(|v| colours[v as usize]);
+            if c.contains(&u32::MAX) {
+                continue;
+            }
+            for (a, b) in [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])] {
+                if a != b {
+                    edges.insert([a.min(b), a.max(b)]);
+                }
+            }
+            if c[0] != c[1] && c[1] != c[2] && c[0] != c[2] {
+                let mut key = c;
+                key.sort_unstable();
+                if seen_triangles.insert(key) {
+                    triangles.push(c);
+                }
+            }
+        }
+        let real_triangles = triangles.len();
+        let mut edges: Vec<[u32; 2]> = edges.into_iter().collect();
+        edges.sort_unstable();
+        // Gaps: edges in no triangle become segments, lone guides points.
+        let mut covered_edges = HashSet::new();
+        let mut touched = vec![false; guides.len()];
+        for t in &triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                covered_edges.insert([a.min(b), a.max(b)]);
+            }
+            t.iter().for_each(|&g| touched[g as usize] = true);
+        }
+        for e in &edges {
+            if !covered_edges.contains(e) {
+                triangles.push([e[0], e[1], e[1]]);
+                touched[e[0] as usize] = true;
+                touched[e[1] as usize] = true;
+            }
+        }
+        let lost_set: HashSet<u32> = lost.iter().map(|l| l.guide).collect();
+        for (g, &t) in touched.iter().enumerate() {
+            if !t && !lost_set.contains(&(g as u32)) {
+                triangles.push([g as u32; 3]);
+            }
+        }
+        let bvh = TriangleBvh::new(&positions, &triangles);
+        Self {
+            positions,
+            triangles,
+            real_triangles,
+            edges,
+            colours,
+            lost,
+            bvh,
+        }
+    }
+
+    /// Guides the style mesh could not use, with the reason.
+    pub fn lost(&self) -> &[LostGuide] {
+        &self.lost
+    }
+
+    /// Style triangles with three distinct guides.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles[..self.real_triangles]
+    }
+
+    /// Everything hairs can be closest to: the triangles, then segments
+    /// (`[a, b, b]`) and points (`[g, g, g]`) that close gaps.
+    pub fn closest_point_set(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// Guide pairs whose cells share a border.
+    pub fn edges(&self) -> &[[u32; 2]] {
+        &self.edges
+    }
+
+    /// The guide colouring each vertex of the mesh the colouring ran on
+    /// (`u32::MAX`: no guide reaches it). With `split_shared` and lost
+    /// guides, the split mesh has extra vertices at the end.
+    pub fn colours(&self) -> &[u32] {
+        &self.colours
+    }
+
+    /// The style mesh's vertices: the guide roots.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+}
+
+impl GuideWeights for StyleMesh {
+    fn weights(&self, root: Vec3, out: &mut Vec<GuideWeight>) {
+        out.clear();
+        let Some(hit) = self.bvh.closest(root) else {
+            return;
+        };
+        let t = self.triangles[hit.triangle as usize];
+        for (guide, weight) in t.into_iter().zip(hit.weights) {
+            let weight = weight.max(0.0);
+            match out.iter_mut().find(|w| w.guide == guide) {
+                Some(w) => w.weight += weight,
+                None if weight > 0.0 => out.push(GuideWeight { guide, weight }),
+                None => {}
+            }
+        }
+        normalise(out);
+    }
+}
+
+/// Guides whose vertex a nearer guide also marks (ties: the lower index
+/// keeps it). `marks` are (vertex, guide).
+fn conflicts(marks: &[(u32, u32)], roots: &[Vec3], vertices: &[Vec3]) -> Vec<LostGuide> {
+    let mut by_vertex = marks.to_vec();
+    let d = |(v, g): (u32, u32)| (roots[g as usize] - vertices[v as usize]).length_squared();
+    by_vertex.sort_by(|&a, &b| {
+        a.0.cmp(&b.0)
+            .then(d(a).total_cmp(&d(b)))
+            .then(a.1.cmp(&b.1))
+    });
+    let mut lost = Vec::new();
+    for pair in by_vertex.windows(2) {
+        // `pair[0]` is the winner for runs of equal vertices.
+        if pair[0].0 == pair[1].0 {
+            let winner = by_vertex
+                .iter()
+                .find(|m| m.0 == pair[1].0)
+                .expect("the run's first")
+                .1;
+            lost.push(LostGuide {
+                guide: pair[1].1,
+                vertex: pair[1].0,
+                kept_by: winner,
+            });
+        }
+    }
+    lost.sort_by_key(|l| l.guide);
+    lost
+}
+
+/// Step 2, multi-source Dijkstra along mesh edges: each vertex gets the
+/// guide with the shortest edge path to it (ties: the lower guide index, so
+/// the result does not depend on the order of work).
+fn colour(
+    vertices: &[Vec3],
+    adjacency: &VertexAdjacency,
+    marks: &[(u32, u32)],
+    lost: &[LostGuide],
+) -> Vec<u32> {
+    let lost: HashSet<u32> = lost.iter().map(|l| l.guide).collect();
+    let mut distance = vec![f32::INFINITY; vertices.len()];
+    let mut colour = vec![u32::MAX; vertices.len()];
+    let mut heap = BinaryHeap::new();
+    for &(v, g) in marks {
+        if lost.contains(&g) {
+            continue;
+        }
+        distance[v as usize] = 0.0;
+        colour[v as usize] = g;
+        heap.push(Reverse((0u32, g, v)));
+    }
+    while let Some(Reverse((d_bits, g, v))) = heap.pop() {
+        let d = f32::from_bits(d_bits);
+        if d > distance[v as usize] || colour[v as usize] != g {
+            continue;
+        }
+        for &n in adjacency.neighbors(v as usize) {
+            let nd = d + (vertices[n as usize] - vertices[v as usize]).length();
+            let (cur_d, cur_g) = (distance[n as usize], colour[n as usize]);
+            if nd < cur_d || (nd == cur_d && g < cur_g) {
+                distance[n as usize] = nd;
+                colour[n as usize] = g;
+                // Non-negative floats order like their bit patterns.
+                heap.push(Reverse((nd.to_bits(), g, n)));
+            }
+        }
+    }
+    colour
+}
+
+/// The talk's fix for guides denser than the mesh: a copy of the mesh in
+/// which the triangle under each lost guide is split 1 → 3 at the guide's
+/// root, which becomes that guide's own vertex. Guides in the same
+/// triangle split the sub-triangle they fall in, in turn.
+fn split_under(
+    mesh: &Mesh,
+    guides: &Guides,
+    lost: &[LostGuide],
+    roots: &[Vec3],
+    marks: &mut [(u32, u32)],
+) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut vertices = mesh.positions().to_vec();
+    let mut triangles = mesh.triangles().to_vec();
+    // Sub-triangles of each split original triangle.
+    let mut pieces: std::collections::HashMap<u32, Vec<usize>> = Default::default();
+    for l in lost {
+        let g = l.guide as usize;
+        let tri = guides.roots()[g].tri;
+        let candidates = pieces.entry(tri).or_insert_with(|| vec![tri as usize]);
+        // The piece containing the root: the one it is closest to.
+        let &piece = candidates
+            .iter()
+            .min_by(|&&a, &&b| {
+                let d = |t: usize| {
+                    let c = triangles[t].map(|v| vertices[v as usize]);
+                    (crate::mesh::closest_on_triangle(roots[g], c).0 - roots[g]).length_squared()
+                };
+                d(a).total_cmp(&d(b)).then(a.cmp(&b))
+            })
+            .expect("at least the triangle itself");
+        let [a, b, c] = triangles[piece];
+        let v = vertices.len() as u32;
+        vertices.push(roots[g]);
+        triangles[piece] = [a, b, v];
+        triangles.push([b, c, v]);
+        triangles.push([c, a, v]);
+        let n = triangles.len();
+        candidates.extend([n - 2, n - 1]);
+        marks[g] = (v, l.guide);
+    }
+    (vertices, triangles)
+}
