@@ -27,6 +27,8 @@ enum Command {
     Sample(commands::sample::SampleArgs),
     /// Render a mesh, a point cloud or curves to a PNG (headless GPU).
     Render(commands::render::RenderArgs),
+    /// Grow guide curves on a mesh, or bind guides from a file to it.
+    Guides(commands::guides::GuidesArgs),
     /// Convert curves between formats (USD, .hair, PLY, RIB, pbrt).
     Convert(commands::convert::ConvertArgs),
     /// Run the demo on the embedded Spot mesh.
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
         Command::Sample(args) => commands::sample::run(&args),
         Command::Render(args) => commands::render::run(&args),
         Command::Convert(args) => commands::convert::run(&args),
+        Command::Guides(args) => commands::guides::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
     };

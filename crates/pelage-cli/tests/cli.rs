@@ -279,3 +279,44 @@ fn render_draws_a_curves_file() {
             .any(|(a, b)| a.abs_diff(*b) > 60)
     }));
 }
+
+#[test]
+fn guides_are_grown_and_bound_back_with_far_ones_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let grown = dir.path().join("g.usda").display().to_string();
+    let out = pelage(&[
+        "guides", "-n", "50", "--comb", "0,0,1", "--points", "5", "-o", &grown,
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("grew 50 guides of 5 points on embedded spot"),
+        "{}",
+        stdout(&out)
+    );
+    // Move one guide's root off the surface: it is left out, by index.
+    let mut text = std::fs::read_to_string(&grown).unwrap();
+    let start = text.find("point3f[] points = [").unwrap() + "point3f[] points = [".len();
+    let end = start + text[start..].find(')').unwrap() + 1;
+    text.replace_range(start..end, "(50, 50, 50)");
+    let moved = dir.path().join("moved.usda");
+    std::fs::write(&moved, text).unwrap();
+    let bound = dir.path().join("b.hair").display().to_string();
+    let out = pelage(&["guides", "--from", moved.to_str().unwrap(), "-o", &bound]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("bound 49 of 50 guides"),
+        "{}",
+        stdout(&out)
+    );
+    assert!(
+        stderr(&out).contains("warning:") && stderr(&out).contains("guide 0 left out: its root is"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(
+        pelage::io::read_curves(Path::new(&bound))
+            .unwrap()
+            .curve_count(),
+        49
+    );
+}

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod convert;
 pub mod demo;
+pub mod guides;
 pub mod info;
 pub mod render;
 pub mod sample;

@@ -58,7 +58,7 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((parse(w)?, parse(h)?))
 }
 
-fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
+pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
     let parts: Vec<f32> = s
         .split(',')
         .map(|v| {

@@ -69,26 +69,24 @@ impl TriangleBvh {
     /// The closest point to `p` on any triangle, or `None` without
     /// triangles. Ties go to the triangle met first (deterministic).
     pub fn closest(&self, p: Vec3) -> Option<ClosestPoint> {
-        let mut best: Option<ClosestPoint> = None;
-        let mut best_d = f32::INFINITY;
-        let mut stack = [0u32; 64];
-        let mut top = 0usize;
         if self.nodes.is_empty() {
             return None;
         }
-        stack[top] = 0;
-        top += 1;
+        let mut best: Option<ClosestPoint> = None;
+        let mut best_d = f32::INFINITY;
+        // (node, squared distance to its box), nearest child on top.
+        let mut stack = [(0u32, 0.0f32); 64];
+        let mut top = 1usize;
         while top > 0 {
             top -= 1;
-            let current = stack[top];
-            let node = self.nodes[current as usize];
-            if box_distance_squared(node.lo, node.hi, p) > best_d {
+            let (current, box_d) = stack[top];
+            if box_d > best_d {
                 continue;
             }
+            let node = self.nodes[current as usize];
             if node.count > 0 {
-                let range =
-                    node.start_or_right as usize..(node.start_or_right + node.count) as usize;
-                for slot in range {
+                let start = node.start_or_right as usize;
+                for slot in start..start + node.count as usize {
                     let (point, weights) = closest_on_triangle(p, self.corners[slot]);
                     let d = (point - p).length_squared();
                     if d < best_d {
@@ -102,18 +100,22 @@ impl TriangleBvh {
                     }
                 }
             } else {
-                // Visit the nearer child first; push it last.
                 let (left, right) = (current + 1, node.start_or_right);
                 let dl = self.box_distance(left, p);
                 let dr = self.box_distance(right, p);
                 let (near, far) = if dl <= dr {
-                    (left, right)
+                    ((left, dl), (right, dr))
                 } else {
-                    (right, left)
+                    ((right, dr), (left, dl))
                 };
-                stack[top] = far;
-                stack[top + 1] = near;
-                top += 2;
+                if far.1 <= best_d {
+                    stack[top] = far;
+                    top += 1;
+                }
+                if near.1 <= best_d {
+                    stack[top] = near;
+                    top += 1;
+                }
             }
         }
         best

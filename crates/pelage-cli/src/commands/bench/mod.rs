@@ -5,6 +5,7 @@
 //! Machines here are small and noisy: every figure is the median of several
 //! runs, and comparisons are ratios taken within one run.
 
+pub mod interp;
 pub mod io;
 pub mod render;
 pub mod sampler;
@@ -26,6 +27,8 @@ pub enum BenchWhat {
     Sampler(sampler::SamplerBenchArgs),
     /// Preview renderer frame time: skin alone, with 100 k and 1 M curves.
     Render(render::RenderBenchArgs),
+    /// Guide interpolation: style-mesh build and weights, Shepard k = 4, 8.
+    Interp(interp::InterpBenchArgs),
     /// Writing a large groom as usda, part by part: throughput and peak memory.
     Io(io::IoBenchArgs),
 }
@@ -35,6 +38,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Sampler(a) => sampler::run(a),
         BenchWhat::Render(a) => render::run(a),
         BenchWhat::Io(a) => io::run(a),
+        BenchWhat::Interp(a) => interp::run(a),
     }
 }
 

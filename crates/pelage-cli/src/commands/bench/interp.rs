@@ -1,0 +1,127 @@
+//! `pelage bench interp`: guide interpolation on a production-sized case —
+//! 5,000 guides on spot ×4 (1.5 M triangles), the guide count the Furtility
+//! talk quotes for a furry character. Style-mesh build time (cold: the
+//! mesh's edge list is built too; warm: it is cached on the mesh, as when a
+//! groom is regenerated), and the time to weigh one hair: style mesh
+//! (closest point on the style mesh) and Shepard with k = 4 and 8 (kd-tree
+//! query). One thread; hair roots from the density sampler.
+
+use super::{median_seconds, on_threads};
+use crate::format::thousands;
+use clap::Args;
+use glam::Vec3;
+use pelage::Map;
+use pelage::guides::{GuideGrowth, Guides};
+use pelage::interp::{GuideWeight, GuideWeights, Shepard, StyleMesh, StyleMeshOptions};
+use pelage::sample::{DensitySampler, DensitySamplerOptions, sample_range};
+
+/// Arguments of `pelage bench interp`.
+#[derive(Debug, Args)]
+pub struct InterpBenchArgs {
+    /// A reduced run (spot ×2, 1,000 guides, 100,000 hairs).
+    #[arg(long)]
+    pub quick: bool,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn ns_per_hair(method: &dyn GuideWeights, roots: &[Vec3], runs: usize) -> f64 {
+    let mut w: Vec<GuideWeight> = Vec::with_capacity(16);
+    let (seconds, checksum) = median_seconds(runs, true, || {
+        let mut checksum = 0u64;
+        for &r in roots {
+            method.weights(r, &mut w);
+            checksum = checksum.wrapping_add(w[0].guide as u64);
+        }
+        checksum
+    });
+    std::hint::black_box(checksum);
+    seconds * 1e9 / roots.len() as f64
+}
+
+pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
+    let (levels, guide_count, hair_count, runs) = if args.quick {
+        (2, 1_000, 100_000u64, 3)
+    } else {
+        (4, 5_000, 1_000_000, 5)
+    };
+    let mesh = pelage::assets::spot().subdivided(levels);
+    let guides = Guides::grow(
+        &mesh,
+        &GuideGrowth {
+            count: guide_count,
+            comb: Vec3::new(0.0, 0.0, 1.0),
+            ..GuideGrowth::default()
+        },
+    )?;
+    let sampler =
+        DensitySampler::new(&mesh, &Map::Constant(1.0), DensitySamplerOptions::default())?;
+    let roots: Vec<Vec3> = sample_range(&sampler, 77, 0..hair_count)
+        .iter()
+        .map(|r| r.position(&mesh))
+        .collect();
+    let options = StyleMeshOptions::default();
+    let figures = on_threads(1, || {
+        let (cold_s, _) = median_seconds(1, false, || StyleMesh::build(&mesh, &guides, &options));
+        let (warm_s, style) =
+            median_seconds(runs, false, || StyleMesh::build(&mesh, &guides, &options));
+        let style_ns = ns_per_hair(&style, &roots, runs);
+        let shepard4 = ns_per_hair(&Shepard::new(&mesh, &guides, 4, 2.0, None), &roots, runs);
+        let shepard8 = ns_per_hair(&Shepard::new(&mesh, &guides, 8, 2.0, None), &roots, runs);
+        (
+            cold_s,
+            warm_s,
+            style_ns,
+            shepard4,
+            shepard8,
+            style.triangles().len(),
+            style.lost().len(),
+        )
+    })?;
+    let (cold_s, warm_s, style_ns, shepard4, shepard8, triangles, lost) = figures;
+    if args.json {
+        println!(
+            "{{\"triangles\":{},\"guides\":{guide_count},\"hairs\":{hair_count},\"style_mesh_build_s\":{warm_s:.4},\"style_mesh_build_cold_s\":{cold_s:.4},\"style_mesh_triangles\":{triangles},\"style_mesh_lost_guides\":{lost},\"style_mesh_ns_per_hair\":{style_ns:.1},\"shepard_k4_ns_per_hair\":{shepard4:.1},\"shepard_k8_ns_per_hair\":{shepard8:.1}}}",
+            mesh.triangle_count()
+        );
+        return Ok(());
+    }
+    println!(
+        "pelage bench interp — {} guides on spot ×{levels} ({} triangles), {} hairs, 1 thread, median of {runs}\n",
+        thousands(guide_count as u64),
+        thousands(mesh.triangle_count() as u64),
+        thousands(hair_count)
+    );
+    println!("{:<34} {:>12} {:>12}", "", "pelage", "target");
+    println!(
+        "{:<34} {:>9.1} ms {:>9} ms",
+        "style mesh build (edges cached)",
+        warm_s * 1e3,
+        "≤ 150"
+    );
+    println!(
+        "{:<34} {:>9.1} ms {:>12}",
+        "style mesh build (cold, with edges)",
+        cold_s * 1e3,
+        "—"
+    );
+    println!(
+        "{:<34} {:>9.1} ns {:>9} ns",
+        "style mesh weights, per hair", style_ns, "≤ 100"
+    );
+    println!(
+        "{:<34} {:>9.1} ns {:>12}",
+        "Shepard k = 4, per hair", shepard4, "—"
+    );
+    println!(
+        "{:<34} {:>9.1} ns {:>12}",
+        "Shepard k = 8, per hair", shepard8, "—"
+    );
+    println!(
+        "\nstyle mesh: {} triangles over {} guides; {lost} guides lost (sharing a vertex with a nearer guide)",
+        thousands(triangles as u64),
+        thousands(guide_count as u64)
+    );
+    Ok(())
+}
