@@ -4,7 +4,9 @@
 //! mesh's edge list is built too; warm: it is cached on the mesh, as when a
 //! groom is regenerated), and the time to weigh one hair: style mesh
 //! (closest point on the style mesh) and Shepard with k = 4 and 8 (kd-tree
-//! query). One thread; hair roots from the density sampler.
+//! query). The build runs on the default thread pool (its edge lengths are
+//! computed in parallel; the search is sequential), the weights on one
+//! thread; hair roots from the density sampler.
 
 use super::{median_seconds, on_threads};
 use crate::format::thousands;
@@ -88,7 +90,7 @@ pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     println!(
-        "pelage bench interp — {} guides on spot ×{levels} ({} triangles), {} hairs, 1 thread, median of {runs}\n",
+        "pelage bench interp — {} guides on spot ×{levels} ({} triangles), {} hairs, weights on 1 thread, median of {runs}\n",
         thousands(guide_count as u64),
         thousands(mesh.triangle_count() as u64),
         thousands(hair_count)
