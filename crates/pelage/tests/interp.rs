@@ -301,3 +301,54 @@ fn methods_are_found_by_name() {
     ));
     assert!(InterpolationMethod::by_name("nearest").is_none());
 }
+
+#[test]
+fn a_guide_alone_on_an_island_still_shapes_the_hairs_there() {
+    // Two plates far apart, one guide on the small one: its cell touches
+    // no other, so the style mesh holds it as a point, and hairs on that
+    // plate take it alone (a degenerate style mesh still has a closest
+    // point).
+    let big = thin_plate(20, 0.02);
+    let small = thin_plate(4, 0.02);
+    let offset = Vec3::new(5.0, 0.0, 0.0);
+    let mut positions = big.positions().to_vec();
+    let base = positions.len() as u32;
+    positions.extend(small.positions().iter().map(|p| *p + offset));
+    let mut triangles = big.triangles().to_vec();
+    triangles.extend(small.triangles().iter().map(|t| t.map(|v| v + base)));
+    let mesh = Mesh::new("two plates", positions, triangles, None, None).unwrap();
+    let mut points = Vec::new();
+    let mut offsets = vec![0u32];
+    for root in [
+        Vec3::new(0.3, 0.3, 0.01),
+        Vec3::new(0.7, 0.6, 0.01),
+        Vec3::new(0.5, 0.5, 0.01) + offset,
+    ] {
+        points.extend([root, root + Vec3::new(0.0, 0.0, 0.1)]);
+        offsets.push(points.len() as u32);
+    }
+    let curves = Curves::new(points, vec![0.01; 6], offsets).unwrap();
+    let (guides, report) = Guides::bind(&mesh, &curves, 2, 1e-4);
+    assert_eq!(report.kept, 3);
+    let style = StyleMesh::build(&mesh, &guides, &StyleMeshOptions::default());
+    assert!(
+        style.closest_point_set().contains(&[2, 2, 2]),
+        "{:?}",
+        style.closest_point_set()
+    );
+    let mut w = Vec::new();
+    style.weights(Vec3::new(0.9, 0.1, 0.01) + offset, &mut w);
+    assert_eq!(
+        w,
+        vec![GuideWeight {
+            guide: 2,
+            weight: 1.0
+        }]
+    );
+    // The two guides on the big plate share a border: a segment, no
+    // triangle; a hair between them mixes just those two.
+    assert!(style.triangles().is_empty());
+    style.weights(Vec3::new(0.5, 0.45, 0.01), &mut w);
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(w.iter().all(|w| w.guide < 2));
+}
