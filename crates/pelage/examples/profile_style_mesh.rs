@@ -1,6 +1,8 @@
 //! Profiling harness for the style mesh (`perf record` it): build on spot
-//! ×4 with 5,000 guides, then weigh a million hairs.
-use pelage::interp::{GuideWeights, StyleMesh};
+//! ×4 with 5,000 guides, then weigh a million hairs on the skin and by
+//! position alone.
+use pelage::interp::{GuideWeights, HairRoot, StyleMesh};
+
 fn main() {
     let mesh = pelage::assets::spot().subdivided(4);
     let growth = pelage::guides::GuideGrowth {
@@ -19,19 +21,18 @@ fn main() {
     let sampler =
         pelage::sample::DensitySampler::new(&mesh, &pelage::Map::Constant(1.0), Default::default())
             .unwrap();
-    let roots: Vec<glam::Vec3> = pelage::sample::sample_range(&sampler, 3, 0..1_000_000)
-        .iter()
-        .map(|r| r.position(&mesh))
-        .collect();
-    let mut w = Vec::new();
-    let t = std::time::Instant::now();
-    let mut sum = 0.0;
-    for r in &roots {
-        style.weights(*r, &mut w);
-        sum += w[0].weight;
+    let samples = pelage::sample::sample_range(&sampler, 3, 0..1_000_000);
+    let on_skin: Vec<HairRoot> = samples.iter().map(|r| HairRoot::on(&mesh, *r)).collect();
+    let anywhere: Vec<HairRoot> = on_skin.iter().map(|r| HairRoot::at(r.position)).collect();
+    for (label, roots) in [("on the skin", &on_skin), ("by position", &anywhere)] {
+        let mut w = Vec::new();
+        let t = std::time::Instant::now();
+        let mut sum = 0.0;
+        for r in roots {
+            style.weights(*r, &mut w);
+            sum += w[0].weight;
+        }
+        let ns = t.elapsed().as_secs_f64() * 1e9 / roots.len() as f64;
+        eprintln!("weights {label}: {ns:.1} ns/hair ({sum})");
     }
-    eprintln!(
-        "weights {:.1} ns/hair ({sum})",
-        t.elapsed().as_secs_f64() * 1e9 / roots.len() as f64
-    );
 }

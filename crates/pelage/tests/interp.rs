@@ -6,9 +6,10 @@
 use glam::Vec3;
 use pelage::guides::{GuideGrowth, Guides};
 use pelage::interp::{
-    GuideWeight, GuideWeights, InterpolationMethod, Interpolator, Shepard, StyleMesh,
+    GuideWeight, GuideWeights, HairRoot, InterpolationMethod, Interpolator, Shepard, StyleMesh,
     StyleMeshOptions,
 };
+use pelage::mesh::TriangleBvh;
 use pelage::{Curves, Mesh, SurfacePoint};
 
 fn methods() -> [InterpolationMethod; 2] {
@@ -82,8 +83,14 @@ fn weights_are_non_negative_and_sum_to_one() {
     let mut w: Vec<GuideWeight> = Vec::new();
     for i in 0..2000u32 {
         let root = SurfacePoint::new(i * 7 % spot.triangle_count() as u32, [0.3, 0.4]);
-        for method in [&shepard as &dyn GuideWeights, &style] {
-            method.weights(root.position(&spot), &mut w);
+        let on_skin = HairRoot::on(&spot, root);
+        let anywhere = HairRoot::at(on_skin.position);
+        for (method, root) in [
+            (&shepard as &dyn GuideWeights, on_skin),
+            (&style, on_skin),
+            (&style, anywhere),
+        ] {
+            method.weights(root, &mut w);
             assert!(!w.is_empty());
             assert!(w.iter().all(|w| w.weight >= 0.0), "{w:?}");
             let sum: f32 = w.iter().map(|w| w.weight).sum();
@@ -214,6 +221,7 @@ fn on_a_thin_plate_the_style_mesh_keeps_each_side_to_its_guides_and_shepard_does
     );
     let (mut w, mut hair) = (Vec::new(), vec![Vec3::ZERO; 4]);
     let (mut shepard_wrong, mut hairs) = (0.0f32, 0);
+    let skin = TriangleBvh::new(plate.positions(), plate.triangles());
     for j in 0..12 {
         for i in 0..12 {
             // Hairs on top, away from the rim.
@@ -222,19 +230,30 @@ fn on_a_thin_plate_the_style_mesh_keeps_each_side_to_its_guides_and_shepard_does
                 0.2 + 0.6 * j as f32 / 11.0,
                 0.5 * thickness,
             );
-            style.weights(root, &mut w);
-            let wrong: f32 = w.iter().filter(|w| w.guide >= 25).map(|w| w.weight).sum();
-            assert_eq!(
-                wrong, 0.0,
-                "style-mesh hair at {root} takes weight from the underside: {w:?}"
-            );
+            // On the skin (its own cells) and by position alone (closest
+            // point on the whole style mesh): both stay on top.
+            let triangle = skin.closest(root).unwrap().triangle;
+            for hair_root in [
+                HairRoot {
+                    position: root,
+                    triangle: Some(triangle),
+                },
+                HairRoot::at(root),
+            ] {
+                style.weights(hair_root, &mut w);
+                let wrong: f32 = w.iter().filter(|w| w.guide >= 25).map(|w| w.weight).sum();
+                assert_eq!(
+                    wrong, 0.0,
+                    "style-mesh hair at {hair_root:?} takes weight from the underside: {w:?}"
+                );
+            }
             interp_style.shape(&w, root, Vec3::Z, &mut hair);
             assert!(
                 hair[3].x - root.x > 0.14,
                 "style-mesh hair at {root} is not combed +x: {hair:?}"
             );
 
-            shepard.weights(root, &mut w);
+            shepard.weights(HairRoot::at(root), &mut w);
             shepard_wrong += w
                 .iter()
                 .filter(|w| w.guide >= 25)
@@ -337,7 +356,7 @@ fn a_guide_alone_on_an_island_still_shapes_the_hairs_there() {
         style.closest_point_set()
     );
     let mut w = Vec::new();
-    style.weights(Vec3::new(0.9, 0.1, 0.01) + offset, &mut w);
+    style.weights(HairRoot::at(Vec3::new(0.9, 0.1, 0.01) + offset), &mut w);
     assert_eq!(
         w,
         vec![GuideWeight {
@@ -348,7 +367,107 @@ fn a_guide_alone_on_an_island_still_shapes_the_hairs_there() {
     // The two guides on the big plate share a border: a segment, no
     // triangle; a hair between them mixes just those two.
     assert!(style.triangles().is_empty());
-    style.weights(Vec3::new(0.5, 0.45, 0.01), &mut w);
+    style.weights(HairRoot::at(Vec3::new(0.5, 0.45, 0.01)), &mut w);
     assert_eq!(w.len(), 2, "{w:?}");
     assert!(w.iter().all(|w| w.guide < 2));
+}
+
+#[test]
+fn hairs_on_the_skin_mostly_pick_the_same_style_triangle_as_the_global_closest_point() {
+    // The cell-local search looks only at the hair's own cells; the closest
+    // point on the whole style mesh may lie elsewhere only near cell
+    // borders. Count how often the two agree on the guides.
+    let (spot, guides) = spot_guides();
+    let style = StyleMesh::build(&spot, &guides, &StyleMeshOptions::default());
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    let mut same = 0;
+    let n = 5000u32;
+    for i in 0..n {
+        let root = SurfacePoint::new(i * 7919 % spot.triangle_count() as u32, [0.25, 0.35]);
+        let on_skin = HairRoot::on(&spot, root);
+        style.weights(on_skin, &mut a);
+        style.weights(HairRoot::at(on_skin.position), &mut b);
+        let guides = |w: &[GuideWeight]| {
+            let mut g: Vec<u32> = w.iter().map(|w| w.guide).collect();
+            g.sort_unstable();
+            g
+        };
+        same += (guides(&a) == guides(&b)) as u32;
+    }
+    let agreement = same as f32 / n as f32;
+    eprintln!(
+        "cell-local and global closest points agree on {:.1} % of hairs",
+        100.0 * agreement
+    );
+    assert!(agreement > 0.9, "{agreement}");
+}
+
+/// Reference colouring: one multi-source Dijkstra with a binary heap, as
+/// the talk describes it (a colour passes on while it is the closest seen).
+fn reference_colours(mesh: &Mesh, style: &StyleMesh) -> Vec<u32> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    let adjacency = mesh.vertex_adjacency();
+    let p = mesh.positions();
+    let mut best = vec![(f32::INFINITY, u32::MAX); p.len()];
+    let mut heap = BinaryHeap::new();
+    for (g, root) in style.positions().iter().enumerate() {
+        // The seed: the vertex of colour g nearest the guide's root (the
+        // marked vertex, the nearest corner of the root's triangle).
+        let seed = style
+            .colours()
+            .iter()
+            .enumerate()
+            .filter(|&(_, &c)| c == g as u32)
+            .min_by(|a, b| {
+                (p[a.0] - *root)
+                    .length_squared()
+                    .total_cmp(&(p[b.0] - *root).length_squared())
+            })
+            .map(|(v, _)| v);
+        if let Some(v) = seed {
+            best[v] = (0.0, g as u32);
+            heap.push(Reverse((0u32, g as u32, v as u32)));
+        }
+    }
+    while let Some(Reverse((d, g, v))) = heap.pop() {
+        let d = f32::from_bits(d);
+        if best[v as usize] != (d, g) {
+            continue;
+        }
+        for &n in adjacency.neighbors(v as usize) {
+            let nd = d + (p[n as usize] - p[v as usize]).length();
+            let (cd, cg) = best[n as usize];
+            if nd < cd || (nd == cd && g < cg) {
+                best[n as usize] = (nd, g);
+                heap.push(Reverse((nd.to_bits(), g, n)));
+            }
+        }
+    }
+    best.into_iter().map(|(_, g)| g).collect()
+}
+
+#[test]
+fn the_parallel_colouring_equals_one_dijkstra_on_any_number_of_threads() {
+    let spot = pelage::assets::spot().subdivided(1);
+    let guides = Guides::grow(
+        &spot,
+        &GuideGrowth {
+            count: 150,
+            ..GuideGrowth::default()
+        },
+    )
+    .unwrap();
+    let build = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| StyleMesh::build(&spot, &guides, &StyleMeshOptions::default()))
+    };
+    let (one, two) = (build(1), build(2));
+    assert_eq!(one.colours(), two.colours());
+    assert_eq!(one.triangles(), two.triangles());
+    assert!(one.lost().is_empty(), "{:?}", one.lost());
+    assert_eq!(one.colours(), reference_colours(&spot, &one).as_slice());
 }

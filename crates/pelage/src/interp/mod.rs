@@ -37,11 +37,40 @@ pub struct GuideWeight {
     pub weight: f32,
 }
 
+/// Where a hair grows: its root in world space and, when it is on the
+/// skin, the skin triangle it lies on (the style mesh uses it to look only
+/// at the hair's own cells).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HairRoot {
+    /// The root position.
+    pub position: Vec3,
+    /// The skin triangle under the root, if known.
+    pub triangle: Option<u32>,
+}
+
+impl HairRoot {
+    /// A root on the skin.
+    pub fn on(mesh: &Mesh, point: SurfacePoint) -> Self {
+        Self {
+            position: point.position(mesh),
+            triangle: Some(point.tri),
+        }
+    }
+
+    /// A root known only by its position.
+    pub fn at(position: Vec3) -> Self {
+        Self {
+            position,
+            triangle: None,
+        }
+    }
+}
+
 /// Chooses guides and weights for a hair root.
 pub trait GuideWeights: Send + Sync {
     /// Replaces `out` with the guides and weights of a hair rooted at
-    /// `root` (world space). Weights are non-negative and sum to 1.
-    fn weights(&self, root: Vec3, out: &mut Vec<GuideWeight>);
+    /// `root`. Weights are non-negative and sum to 1.
+    fn weights(&self, root: HairRoot, out: &mut Vec<GuideWeight>);
 }
 
 /// An interpolation method by name, as groom files spell it.
@@ -140,9 +169,9 @@ impl<'g> Interpolator<'g> {
         scratch: &mut Vec<GuideWeight>,
         out: &mut [Vec3],
     ) {
-        let (position, normal) = (root.position(mesh), root.normal(mesh));
-        self.weights.weights(position, scratch);
-        self.shape(scratch, position, normal, out);
+        let hair_root = HairRoot::on(mesh, root);
+        self.weights.weights(hair_root, scratch);
+        self.shape(scratch, hair_root.position, root.normal(mesh), out);
     }
 
     /// Shapes a hair at `position` with surface normal `normal` from given

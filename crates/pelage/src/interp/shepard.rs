@@ -4,10 +4,9 @@
 //! root takes that guide alone; with a radius, guides farther away are
 //! ignored, and a hair with none inside takes its nearest guide alone.
 
-use super::{GuideWeight, GuideWeights, normalise};
+use super::{GuideWeight, GuideWeights, HairRoot, normalise};
 use crate::guides::Guides;
 use crate::mesh::Mesh;
-use glam::Vec3;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZeroUsize;
 
@@ -38,11 +37,11 @@ impl Shepard {
 }
 
 impl GuideWeights for Shepard {
-    fn weights(&self, root: Vec3, out: &mut Vec<GuideWeight>) {
+    fn weights(&self, root: HairRoot, out: &mut Vec<GuideWeight>) {
         out.clear();
         let Some(tree) = &self.tree else { return };
         let nearest = tree
-            .query(&root.to_array())
+            .query(&root.position.to_array())
             .nearest_n::<SquaredEuclidean<f32>>(self.k)
             .execute();
         for (i, hit) in nearest.iter().enumerate() {

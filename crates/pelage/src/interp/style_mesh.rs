@@ -14,6 +14,14 @@
 //!    style mesh as weights over that triangle's three guides, so a hair at
 //!    a guide's root reproduces the guide exactly.
 //!
+//! Which closest point: a hair on the skin looks only at the style
+//! primitives incident to the guides colouring its skin triangle's corners
+//! — its own cells. That keeps the search on the hair's side of the
+//! surface (a thin part's other side can never win, however the style
+//! mesh bends) and tests a handful of triangles instead of walking a tree.
+//! A root off the skin (or in a part no guide reaches) uses the closest
+//! point on the whole style mesh (a BVH).
+//!
 //! Gaps: border edges that no three-colour triangle uses (two cells
 //! meeting along a strip with no third cell at either end) join the
 //! closest-point set as segments, and a guide whose cell touches no other
@@ -29,10 +37,12 @@
 //! suggested fix) the triangle under each such guide is split locally
 //! (1 → 3 at the guide root), so every guide gets its own vertex.
 
-use super::{GuideWeight, GuideWeights, normalise};
+use super::{GuideWeight, GuideWeights, HairRoot, normalise};
 use crate::guides::Guides;
-use crate::mesh::{EdgeList, Mesh, TriangleBvh, VertexAdjacency};
+use crate::mesh::{EdgeList, Mesh, TriangleBvh, VertexAdjacency, closest_on_triangle};
 use glam::Vec3;
+use rayon::prelude::*;
+use std::collections::HashMap;
 use std::collections::HashSet;
 
 /// Options of the style mesh.
@@ -81,6 +91,15 @@ pub struct StyleMesh {
     colours: Vec<u32>,
     lost: Vec<LostGuide>,
     bvh: TriangleBvh,
+    /// Corner positions of each primitive of `triangles`.
+    corners: Vec<[Vec3; 3]>,
+    /// Per guide, the primitives it is a corner of (CSR).
+    incident_offsets: Vec<u32>,
+    incident: Vec<u32>,
+    /// Per skin triangle, the colours of its corners.
+    triangle_colours: Vec<[u32; 3]>,
+    /// Guides given their own vertex inside a skin triangle by the split.
+    split_colours: HashMap<u32, Vec<u32>>,
 }
 
 impl StyleMesh {
@@ -102,6 +121,17 @@ impl StyleMesh {
             .map(|g| (nearest_corner(g), g as u32))
             .collect();
         let lost = conflicts(&marks, &positions, mesh.positions());
+        let split_colours: HashMap<u32, Vec<u32>> = if options.split_shared {
+            let mut m: HashMap<u32, Vec<u32>> = HashMap::new();
+            for l in &lost {
+                m.entry(guides.roots()[l.guide as usize].tri)
+                    .or_default()
+                    .push(l.guide);
+            }
+            m
+        } else {
+            HashMap::new()
+        };
         let (colours, triangles_of_colouring) = if options.split_shared && !lost.is_empty() {
             let (vertices, triangles) = split_under(mesh, guides, &lost, &positions, &mut marks);
             let adjacency =
@@ -165,6 +195,36 @@ impl StyleMesh {
             }
         }
         let bvh = TriangleBvh::new(&positions, &triangles);
+        let corners = triangles
+            .iter()
+            .map(|t| t.map(|g| positions[g as usize]))
+            .collect();
+        let mut incident_offsets = vec![0u32; guides.len() + 1];
+        for t in &triangles {
+            for (k, &g) in t.iter().enumerate() {
+                if !t[..k].contains(&g) {
+                    incident_offsets[g as usize + 1] += 1;
+                }
+            }
+        }
+        for g in 0..guides.len() {
+            incident_offsets[g + 1] += incident_offsets[g];
+        }
+        let mut fill = incident_offsets.clone();
+        let mut incident = vec![0u32; *incident_offsets.last().unwrap() as usize];
+        for (i, t) in triangles.iter().enumerate() {
+            for (k, &g) in t.iter().enumerate() {
+                if !t[..k].contains(&g) {
+                    incident[fill[g as usize] as usize] = i as u32;
+                    fill[g as usize] += 1;
+                }
+            }
+        }
+        let triangle_colours = mesh
+            .triangles()
+            .par_iter()
+            .map(|t| t.map(|v| colours[v as usize]))
+            .collect();
         Self {
             positions,
             triangles,
@@ -173,6 +233,11 @@ impl StyleMesh {
             colours,
             lost,
             bvh,
+            corners,
+            incident_offsets,
+            incident,
+            triangle_colours,
+            split_colours,
         }
     }
 
@@ -210,14 +275,57 @@ impl StyleMesh {
     }
 }
 
+impl StyleMesh {
+    /// The closest point among the primitives incident to the guides of
+    /// the skin triangle's corners: (primitive, weights), or `None` when
+    /// no guide colours them.
+    fn closest_in_cells(&self, root: Vec3, triangle: u32) -> Option<(u32, [f32; 3])> {
+        let colours = self.triangle_colours.get(triangle as usize)?;
+        let extra = if self.split_colours.is_empty() {
+            None
+        } else {
+            self.split_colours.get(&triangle)
+        };
+        let mut best: Option<(f32, u32, [f32; 3])> = None;
+        let mut seen = [u32::MAX; 3];
+        let guides = colours.iter().chain(extra.into_iter().flatten());
+        for (k, &g) in guides.enumerate() {
+            if g == u32::MAX || seen.contains(&g) {
+                continue;
+            }
+            if k < 3 {
+                seen[k] = g;
+            }
+            let range = self.incident_offsets[g as usize] as usize
+                ..self.incident_offsets[g as usize + 1] as usize;
+            for &prim in &self.incident[range] {
+                let (point, weights) = closest_on_triangle(root, self.corners[prim as usize]);
+                let d = (point - root).length_squared();
+                // Ties: the lower primitive, whatever order cells come in.
+                if best.is_none_or(|(bd, bp, _)| d < bd || (d == bd && prim < bp)) {
+                    best = Some((d, prim, weights));
+                }
+            }
+        }
+        best.map(|(_, prim, weights)| (prim, weights))
+    }
+}
+
 impl GuideWeights for StyleMesh {
-    fn weights(&self, root: Vec3, out: &mut Vec<GuideWeight>) {
+    fn weights(&self, root: HairRoot, out: &mut Vec<GuideWeight>) {
         out.clear();
-        let Some(hit) = self.bvh.closest(root) else {
+        let found = root
+            .triangle
+            .and_then(|t| self.closest_in_cells(root.position, t))
+            .or_else(|| {
+                let hit = self.bvh.closest(root.position)?;
+                Some((hit.triangle, hit.weights))
+            });
+        let Some((prim, weights)) = found else {
             return;
         };
-        let t = self.triangles[hit.triangle as usize];
-        for (guide, weight) in t.into_iter().zip(hit.weights) {
+        let t = self.triangles[prim as usize];
+        for (guide, weight) in t.into_iter().zip(weights) {
             let weight = weight.max(0.0);
             match out.iter_mut().find(|w| w.guide == guide) {
                 Some(w) => w.weight += weight,
@@ -259,19 +367,29 @@ fn conflicts(marks: &[(u32, u32)], roots: &[Vec3], vertices: &[Vec3]) -> Vec<Los
     lost
 }
 
-/// Step 2, multi-source Dijkstra along mesh edges: each vertex gets the
-/// guide with the shortest edge path to it (ties: the lower guide index, so
-/// the result does not depend on the order of work).
+/// Step 2, colouring: each vertex gets the guide with the shortest edge
+/// path to it (ties: the lower guide index).
+///
+/// Computed as one Dijkstra search per guide, all in parallel, over shared
+/// `(distance, guide)` labels updated with an atomic minimum. A search
+/// stops expanding wherever another guide is nearer: if a vertex `u` on
+/// the path from guide `g` to `v` is nearer to `h`, then so is `v`
+/// (`d_h(v) ≤ d_h(u) + d(u, v) < d_g(u) + d(u, v) = d_g(v)`), so nothing is
+/// lost, and each search stays inside its own cell and its border. The
+/// result is the unique smallest label of every vertex, so it does not
+/// depend on the number of threads or the order of work — and the local
+/// searches are kinder to the cache than one global frontier.
 fn colour(
     vertices: &[Vec3],
     adjacency: &VertexAdjacency,
     marks: &[(u32, u32)],
     lost: &[LostGuide],
 ) -> Vec<u32> {
-    use rayon::prelude::*;
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
     let lost: HashSet<u32> = lost.iter().map(|l| l.guide).collect();
-    // Edge lengths in adjacency order, computed in parallel, so the
-    // sequential search reads them in order instead of chasing positions.
+    // Edge lengths in adjacency order, so searches read them in order.
     let lengths: Vec<f32> = (0..vertices.len())
         .into_par_iter()
         .flat_map_iter(|v| {
@@ -282,97 +400,52 @@ fn colour(
                 .map(move |&n| (vertices[n as usize] - p).length())
         })
         .collect();
-    // Distance and colour side by side: one cache line per visit.
-    let mut state = vec![(f32::INFINITY, u32::MAX); vertices.len()];
-    let mut heap = RadixHeap::default();
-    for &(v, g) in marks {
-        if lost.contains(&g) {
-            continue;
-        }
-        state[v as usize] = (0.0, g);
-        heap.push(0, (g, v));
+    // Label = distance bits (non-negative floats order like their bits)
+    // above the guide index: the smallest label is the nearest guide, ties
+    // to the lower index.
+    let label = |d: f32, g: u32| (u64::from(d.to_bits()) << 32) | u64::from(g);
+    let state: Vec<AtomicU64> = (0..vertices.len())
+        .map(|_| AtomicU64::new(u64::MAX))
+        .collect();
+    let seeds: Vec<(u32, u32)> = marks
+        .iter()
+        .copied()
+        .filter(|(_, g)| !lost.contains(g))
+        .collect();
+    for &(v, g) in &seeds {
+        state[v as usize].fetch_min(label(0.0, g), Relaxed);
     }
-    while let Some((d_bits, (g, v))) = heap.pop() {
-        let d = f32::from_bits(d_bits);
-        if state[v as usize] != (d, g) {
-            continue;
-        }
-        let range =
-            adjacency.offsets[v as usize] as usize..adjacency.offsets[v as usize + 1] as usize;
-        for (&n, &length) in adjacency.neighbors[range.clone()]
-            .iter()
-            .zip(&lengths[range])
-        {
-            let nd = d + length;
-            let (cur_d, cur_g) = state[n as usize];
-            if nd < cur_d || (nd == cur_d && g < cur_g) {
-                state[n as usize] = (nd, g);
-                // Non-negative floats order like their bit patterns.
-                heap.push(nd.to_bits(), (g, n));
+    seeds
+        .par_iter()
+        .for_each_init(BinaryHeap::new, |heap, &(seed, g)| {
+            heap.clear();
+            heap.push(Reverse((0u32, seed)));
+            while let Some(Reverse((d_bits, v))) = heap.pop() {
+                let d = f32::from_bits(d_bits);
+                if state[v as usize].load(Relaxed) != label(d, g) {
+                    continue;
+                }
+                let range = adjacency.offsets[v as usize] as usize
+                    ..adjacency.offsets[v as usize + 1] as usize;
+                for (&n, &length) in adjacency.neighbors[range.clone()]
+                    .iter()
+                    .zip(&lengths[range])
+                {
+                    let nd = d + length;
+                    let key = label(nd, g);
+                    if key < state[n as usize].fetch_min(key, Relaxed) {
+                        heap.push(Reverse((nd.to_bits(), n)));
+                    }
+                }
             }
-        }
-    }
-    state.into_iter().map(|(_, g)| g).collect()
-}
-
-/// A monotone priority queue on `u32` keys (Ahuja et al.'s radix heap):
-/// Dijkstra never pushes a key below the last one popped, so each item
-/// moves down at most 32 buckets in all, and pushes are O(1). About twice
-/// as fast as a binary heap here, where the frontier is large.
-struct RadixHeap<T> {
-    /// Bucket `i > 0` holds keys whose highest bit differing from `last` is
-    /// bit `i - 1`; bucket 0 holds keys equal to `last`.
-    buckets: [Vec<(u32, T)>; 33],
-    last: u32,
-    len: usize,
-}
-
-impl<T> Default for RadixHeap<T> {
-    fn default() -> Self {
-        Self {
-            buckets: std::array::from_fn(|_| Vec::new()),
-            last: 0,
-            len: 0,
-        }
-    }
-}
-
-impl<T: Copy> RadixHeap<T> {
-    fn bucket(&self, key: u32) -> usize {
-        (32 - (key ^ self.last).leading_zeros()) as usize
-    }
-
-    fn push(&mut self, key: u32, value: T) {
-        debug_assert!(key >= self.last, "radix heaps are monotone");
-        let b = self.bucket(key);
-        self.buckets[b].push((key, value));
-        self.len += 1;
-    }
-
-    fn pop(&mut self) -> Option<(u32, T)> {
-        if self.len == 0 {
-            return None;
-        }
-        if self.buckets[0].is_empty() {
-            let i = (1..33)
-                .find(|&i| !self.buckets[i].is_empty())
-                .expect("len > 0");
-            let items = std::mem::take(&mut self.buckets[i]);
-            self.last = items.iter().map(|&(k, _)| k).min().expect("non-empty");
-            for (k, v) in &items {
-                let b = self.bucket(*k);
-                self.buckets[b].push((*k, *v));
-            }
-            // Keep the emptied bucket's allocation.
-            let mut items = items;
-            items.clear();
-            if self.buckets[i].is_empty() {
-                self.buckets[i] = items;
-            }
-        }
-        self.len -= 1;
-        self.buckets[0].pop()
-    }
+        });
+    state
+        .into_iter()
+        .map(|s| {
+            let s = s.into_inner();
+            if s == u64::MAX { u32::MAX } else { s as u32 }
+        })
+        .collect()
 }
 
 /// The talk's fix for guides denser than the mesh: a copy of the mesh in

@@ -3,10 +3,11 @@
 //! talk quotes for a furry character. Style-mesh build time (cold: the
 //! mesh's edge list is built too; warm: it is cached on the mesh, as when a
 //! groom is regenerated), and the time to weigh one hair: style mesh
-//! (closest point on the style mesh) and Shepard with k = 4 and 8 (kd-tree
-//! query). The build runs on the default thread pool (its edge lengths are
-//! computed in parallel; the search is sequential), the weights on one
-//! thread; hair roots from the density sampler.
+//! (closest point among the style triangles of the hair's own cells; and,
+//! by position alone, on the whole style mesh through a BVH) and Shepard
+//! with k = 4 and 8 (kd-tree query). The build runs on the default thread
+//! pool (one search per guide, in parallel), the weights on one thread;
+//! hair roots from the density sampler.
 
 use super::{median_seconds, on_threads};
 use crate::format::thousands;
@@ -14,7 +15,7 @@ use clap::Args;
 use glam::Vec3;
 use pelage::Map;
 use pelage::guides::{GuideGrowth, Guides};
-use pelage::interp::{GuideWeight, GuideWeights, Shepard, StyleMesh, StyleMeshOptions};
+use pelage::interp::{GuideWeight, GuideWeights, HairRoot, Shepard, StyleMesh, StyleMeshOptions};
 use pelage::sample::{DensitySampler, DensitySamplerOptions, sample_range};
 
 /// Arguments of `pelage bench interp`.
@@ -28,7 +29,7 @@ pub struct InterpBenchArgs {
     pub json: bool,
 }
 
-fn ns_per_hair(method: &dyn GuideWeights, roots: &[Vec3], runs: usize) -> f64 {
+fn ns_per_hair(method: &dyn GuideWeights, roots: &[HairRoot], runs: usize) -> f64 {
     let mut w: Vec<GuideWeight> = Vec::with_capacity(16);
     let (seconds, checksum) = median_seconds(runs, true, || {
         let mut checksum = 0u64;
@@ -59,38 +60,36 @@ pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
     )?;
     let sampler =
         DensitySampler::new(&mesh, &Map::Constant(1.0), DensitySamplerOptions::default())?;
-    let roots: Vec<Vec3> = sample_range(&sampler, 77, 0..hair_count)
+    let roots: Vec<HairRoot> = sample_range(&sampler, 77, 0..hair_count)
         .iter()
-        .map(|r| r.position(&mesh))
+        .map(|r| HairRoot::on(&mesh, *r))
         .collect();
+    let positions: Vec<HairRoot> = roots.iter().map(|r| HairRoot::at(r.position)).collect();
     let options = StyleMeshOptions::default();
-    let figures = on_threads(1, || {
-        let (cold_s, _) = median_seconds(1, false, || StyleMesh::build(&mesh, &guides, &options));
-        let (warm_s, style) =
-            median_seconds(runs, false, || StyleMesh::build(&mesh, &guides, &options));
-        let style_ns = ns_per_hair(&style, &roots, runs);
-        let shepard4 = ns_per_hair(&Shepard::new(&mesh, &guides, 4, 2.0, None), &roots, runs);
-        let shepard8 = ns_per_hair(&Shepard::new(&mesh, &guides, 8, 2.0, None), &roots, runs);
+    // The build on the default pool (its searches run in parallel), the
+    // per-hair weights on one thread.
+    let (cold_s, _) = median_seconds(1, false, || StyleMesh::build(&mesh, &guides, &options));
+    let (warm_s, style) =
+        median_seconds(runs, false, || StyleMesh::build(&mesh, &guides, &options));
+    let (style_ns, style_bvh_ns, shepard4, shepard8) = on_threads(1, || {
         (
-            cold_s,
-            warm_s,
-            style_ns,
-            shepard4,
-            shepard8,
-            style.triangles().len(),
-            style.lost().len(),
+            ns_per_hair(&style, &roots, runs),
+            ns_per_hair(&style, &positions, runs),
+            ns_per_hair(&Shepard::new(&mesh, &guides, 4, 2.0, None), &roots, runs),
+            ns_per_hair(&Shepard::new(&mesh, &guides, 8, 2.0, None), &roots, runs),
         )
     })?;
-    let (cold_s, warm_s, style_ns, shepard4, shepard8, triangles, lost) = figures;
+    let (triangles, lost) = (style.triangles().len(), style.lost().len());
+    let threads = rayon::current_num_threads();
     if args.json {
         println!(
-            "{{\"triangles\":{},\"guides\":{guide_count},\"hairs\":{hair_count},\"style_mesh_build_s\":{warm_s:.4},\"style_mesh_build_cold_s\":{cold_s:.4},\"style_mesh_triangles\":{triangles},\"style_mesh_lost_guides\":{lost},\"style_mesh_ns_per_hair\":{style_ns:.1},\"shepard_k4_ns_per_hair\":{shepard4:.1},\"shepard_k8_ns_per_hair\":{shepard8:.1}}}",
+            "{{\"triangles\":{},\"guides\":{guide_count},\"hairs\":{hair_count},\"threads\":{threads},\"style_mesh_build_s\":{warm_s:.4},\"style_mesh_build_cold_s\":{cold_s:.4},\"style_mesh_triangles\":{triangles},\"style_mesh_lost_guides\":{lost},\"style_mesh_ns_per_hair\":{style_ns:.1},\"style_mesh_bvh_ns_per_hair\":{style_bvh_ns:.1},\"shepard_k4_ns_per_hair\":{shepard4:.1},\"shepard_k8_ns_per_hair\":{shepard8:.1}}}",
             mesh.triangle_count()
         );
         return Ok(());
     }
     println!(
-        "pelage bench interp — {} guides on spot ×{levels} ({} triangles), {} hairs, weights on 1 thread, median of {runs}\n",
+        "pelage bench interp — {} guides on spot ×{levels} ({} triangles), {} hairs; build on {threads} threads, weights on 1; median of {runs}\n",
         thousands(guide_count as u64),
         thousands(mesh.triangle_count() as u64),
         thousands(hair_count)
@@ -111,6 +110,10 @@ pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
     println!(
         "{:<34} {:>9.1} ns {:>9} ns",
         "style mesh weights, per hair", style_ns, "≤ 100"
+    );
+    println!(
+        "{:<34} {:>9.1} ns {:>12}",
+        "  by position only (BVH)", style_bvh_ns, "—"
     );
     println!(
         "{:<34} {:>9.1} ns {:>12}",
