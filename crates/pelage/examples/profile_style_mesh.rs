@@ -21,7 +21,12 @@ fn main() {
     let sampler =
         pelage::sample::DensitySampler::new(&mesh, &pelage::Map::Constant(1.0), Default::default())
             .unwrap();
-    let samples = pelage::sample::sample_range(&sampler, 3, 0..1_000_000);
+    let mut samples = pelage::sample::sample_range(&sampler, 3, 0..1_000_000);
+    // SORTED=1: hairs in skin-triangle order, as a generator working part
+    // by part over the mesh would meet them.
+    if std::env::var_os("SORTED").is_some() {
+        samples.sort_by_key(|s| s.tri);
+    }
     let on_skin: Vec<HairRoot> = samples.iter().map(|r| HairRoot::on(&mesh, *r)).collect();
     let anywhere: Vec<HairRoot> = on_skin.iter().map(|r| HairRoot::at(r.position)).collect();
     for (label, roots) in [("on the skin", &on_skin), ("by position", &anywhere)] {

@@ -19,6 +19,9 @@
 //! — its own cells. That keeps the search on the hair's side of the
 //! surface (a thin part's other side can never win, however the style
 //! mesh bends) and tests a handful of triangles instead of walking a tree.
+//! Among those, the nearest triangle whose plane projection contains the
+//! root wins (two dot products a triangle); only where none contains it
+//! (near a fold) are closest points on edges and corners computed.
 //! A root off the skin (or in a part no guide reaches) uses the closest
 //! point on the whole style mesh (a BVH).
 //!
@@ -93,6 +96,8 @@ pub struct StyleMesh {
     bvh: TriangleBvh,
     /// Corner positions of each primitive of `triangles`.
     corners: Vec<[Vec3; 3]>,
+    /// Each primitive prepared for projecting a point onto its plane.
+    projections: Vec<Projection>,
     /// Per guide, the primitives it is a corner of (CSR).
     incident_offsets: Vec<u32>,
     incident: Vec<u32>,
@@ -147,15 +152,22 @@ impl StyleMesh {
             Some((t, l)) => (l.clone(), t.as_slice()),
             None => (lost, mesh.triangles()),
         };
-        // 3. Style edges and triangles from the colouring.
+        // 3. Style edges and triangles from the colouring: only triangles
+        // on cell borders matter; find them in parallel, keep the first of
+        // each guide triple in mesh order.
+        let border: Vec<(usize, [u32; 3])> = mesh_triangles
+            .par_iter()
+            .enumerate()
+            .filter_map(|(i, t)| {
+                let c = t.map(|v| colours[v as usize]);
+                let border = !c.contains(&u32::MAX) && (c[0] != c[1] || c[1] != c[2]);
+                border.then_some((i, c))
+            })
+            .collect();
         let mut triangles = Vec::new();
         let mut seen_triangles = HashSet::new();
         let mut edges = HashSet::new();
-        for t in mesh_triangles {
-            let c = t.map(|v| colours[v as usize]);
-            if c.contains(&u32::MAX) {
-                continue;
-            }
+        for &(_, c) in &border {
             for (a, b) in [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])] {
                 if a != b {
                     edges.insert([a.min(b), a.max(b)]);
@@ -195,10 +207,11 @@ impl StyleMesh {
             }
         }
         let bvh = TriangleBvh::new(&positions, &triangles);
-        let corners = triangles
+        let corners: Vec<[Vec3; 3]> = triangles
             .iter()
             .map(|t| t.map(|g| positions[g as usize]))
             .collect();
+        let projections = corners.iter().map(|&c| Projection::new(c)).collect();
         let mut incident_offsets = vec![0u32; guides.len() + 1];
         for t in &triangles {
             for (k, &g) in t.iter().enumerate() {
@@ -234,6 +247,7 @@ impl StyleMesh {
             lost,
             bvh,
             corners,
+            projections,
             incident_offsets,
             incident,
             triangle_colours,
@@ -286,10 +300,14 @@ impl StyleMesh {
         } else {
             self.split_colours.get(&triangle)
         };
-        let mut best: Option<(f32, u32, [f32; 3])> = None;
         let mut seen = [u32::MAX; 3];
-        let guides = colours.iter().chain(extra.into_iter().flatten());
-        for (k, &g) in guides.enumerate() {
+        let mut candidates = [0u32; 64];
+        let mut count = 0;
+        for (k, &g) in colours
+            .iter()
+            .chain(extra.into_iter().flatten())
+            .enumerate()
+        {
             if g == u32::MAX || seen.contains(&g) {
                 continue;
             }
@@ -299,15 +317,89 @@ impl StyleMesh {
             let range = self.incident_offsets[g as usize] as usize
                 ..self.incident_offsets[g as usize + 1] as usize;
             for &prim in &self.incident[range] {
+                if count < candidates.len() {
+                    candidates[count] = prim;
+                    count += 1;
+                }
+            }
+        }
+        let candidates = &candidates[..count];
+        // Fast path: the nearest candidate whose triangle contains the
+        // root's projection onto its plane — the closest point whenever the
+        // skin under the root is not folded over the style mesh.
+        let mut best: Option<(f32, u32, [f32; 3])> = None;
+        for &prim in candidates {
+            if let Some((d, weights)) = self.projections[prim as usize].inside(root)
+                && best.is_none_or(|(bd, bp, _)| d < bd || (d == bd && prim < bp))
+            {
+                best = Some((d, prim, weights));
+            }
+        }
+        if best.is_none() {
+            // Exact closest point among the candidates (edges, corners,
+            // segments and points).
+            for &prim in candidates {
                 let (point, weights) = closest_on_triangle(root, self.corners[prim as usize]);
                 let d = (point - root).length_squared();
-                // Ties: the lower primitive, whatever order cells come in.
                 if best.is_none_or(|(bd, bp, _)| d < bd || (d == bd && prim < bp)) {
                     best = Some((d, prim, weights));
                 }
             }
         }
         best.map(|(_, prim, weights)| (prim, weights))
+    }
+}
+
+/// A triangle prepared for barycentric projection (Ericson §3.4): the
+/// coordinates of a point's projection onto the triangle's plane from two
+/// dot products.
+#[derive(Debug, Clone, Copy)]
+struct Projection {
+    a: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    d00: f32,
+    d01: f32,
+    d11: f32,
+    /// `1 / (d00 d11 − d01²)`; not finite for degenerate primitives.
+    inverse: f32,
+}
+
+impl Projection {
+    fn new([a, b, c]: [Vec3; 3]) -> Self {
+        let (e1, e2) = (b - a, c - a);
+        let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let denominator = d00 * d11 - d01 * d01;
+        let inverse = if denominator > 1e-12 * (d00 * d11).max(f32::MIN_POSITIVE) {
+            1.0 / denominator
+        } else {
+            f32::NAN
+        };
+        Self {
+            a,
+            e1,
+            e2,
+            d00,
+            d01,
+            d11,
+            inverse,
+        }
+    }
+
+    /// Squared distance to the plane and the barycentric weights, when the
+    /// projection of `p` falls inside the triangle.
+    fn inside(&self, p: Vec3) -> Option<(f32, [f32; 3])> {
+        let v2 = p - self.a;
+        let (d20, d21) = (v2.dot(self.e1), v2.dot(self.e2));
+        let v = (self.d11 * d20 - self.d01 * d21) * self.inverse;
+        let w = (self.d00 * d21 - self.d01 * d20) * self.inverse;
+        let u = 1.0 - v - w;
+        // NaN (degenerate) fails these comparisons.
+        if u >= 0.0 && v >= 0.0 && w >= 0.0 {
+            Some(((v2 - v * self.e1 - w * self.e2).length_squared(), [u, v, w]))
+        } else {
+            None
+        }
     }
 }
 
@@ -375,7 +467,9 @@ fn conflicts(marks: &[(u32, u32)], roots: &[Vec3], vertices: &[Vec3]) -> Vec<Los
 /// stops expanding wherever another guide is nearer: if a vertex `u` on
 /// the path from guide `g` to `v` is nearer to `h`, then so is `v`
 /// (`d_h(v) ≤ d_h(u) + d(u, v) < d_g(u) + d(u, v) = d_g(v)`), so nothing is
-/// lost, and each search stays inside its own cell and its border. The
+/// lost, and each search stays inside its own cell and its border (the
+/// searches advance together, band by band of distance, so none runs ahead
+/// into cells not yet claimed). The
 /// result is the unique smallest label of every vertex, so it does not
 /// depend on the number of threads or the order of work — and the local
 /// searches are kinder to the cache than one global frontier.
@@ -415,30 +509,51 @@ fn colour(
     for &(v, g) in &seeds {
         state[v as usize].fetch_min(label(0.0, g), Relaxed);
     }
-    seeds
-        .par_iter()
-        .for_each_init(BinaryHeap::new, |heap, &(seed, g)| {
-            heap.clear();
-            heap.push(Reverse((0u32, seed)));
-            while let Some(Reverse((d_bits, v))) = heap.pop() {
-                let d = f32::from_bits(d_bits);
-                if state[v as usize].load(Relaxed) != label(d, g) {
-                    continue;
-                }
-                let range = adjacency.offsets[v as usize] as usize
-                    ..adjacency.offsets[v as usize + 1] as usize;
-                for (&n, &length) in adjacency.neighbors[range.clone()]
-                    .iter()
-                    .zip(&lengths[range])
-                {
-                    let nd = d + length;
-                    let key = label(nd, g);
-                    if key < state[n as usize].fetch_min(key, Relaxed) {
-                        heap.push(Reverse((nd.to_bits(), n)));
+    // The searches advance in lockstep, one distance band at a time: a
+    // search that ran ahead alone would flood cells its neighbours have not
+    // claimed yet. A band of two mean edge lengths keeps the overlap small
+    // and the rounds few.
+    let mean_edge = lengths.iter().sum::<f32>() / lengths.len().max(1) as f32;
+    let band = if mean_edge > 0.0 {
+        2.0 * mean_edge
+    } else {
+        f32::INFINITY
+    };
+    let mut frontiers: Vec<BinaryHeap<Reverse<(u32, u32)>>> = seeds
+        .iter()
+        .map(|&(v, _)| BinaryHeap::from([Reverse((0u32, v))]))
+        .collect();
+    let mut limit = band;
+    while frontiers.iter().any(|f| !f.is_empty()) {
+        frontiers
+            .par_iter_mut()
+            .zip(&seeds)
+            .for_each(|(heap, &(_, g))| {
+                while let Some(&Reverse((d_bits, v))) = heap.peek() {
+                    let d = f32::from_bits(d_bits);
+                    if d >= limit {
+                        break;
+                    }
+                    heap.pop();
+                    if state[v as usize].load(Relaxed) != label(d, g) {
+                        continue;
+                    }
+                    let range = adjacency.offsets[v as usize] as usize
+                        ..adjacency.offsets[v as usize + 1] as usize;
+                    for (&n, &length) in adjacency.neighbors[range.clone()]
+                        .iter()
+                        .zip(&lengths[range])
+                    {
+                        let nd = d + length;
+                        let key = label(nd, g);
+                        if key < state[n as usize].fetch_min(key, Relaxed) {
+                            heap.push(Reverse((nd.to_bits(), n)));
+                        }
                     }
                 }
-            }
-        });
+            });
+        limit += band;
+    }
     state
         .into_iter()
         .map(|s| {

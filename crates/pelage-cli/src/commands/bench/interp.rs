@@ -3,8 +3,10 @@
 //! talk quotes for a furry character. Style-mesh build time (cold: the
 //! mesh's edge list is built too; warm: it is cached on the mesh, as when a
 //! groom is regenerated), and the time to weigh one hair: style mesh
-//! (closest point among the style triangles of the hair's own cells; and,
-//! by position alone, on the whole style mesh through a BVH) and Shepard
+//! (closest point among the style triangles of the hair's own cells, hairs
+//! in skin-triangle order as a generator meets them, and in the sampler's
+//! random order; and, by position alone, on the whole style mesh through a
+//! BVH) and Shepard
 //! with k = 4 and 8 (kd-tree query). The build runs on the default thread
 //! pool (one search per guide, in parallel), the weights on one thread;
 //! hair roots from the density sampler.
@@ -65,14 +67,19 @@ pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
         .map(|r| HairRoot::on(&mesh, *r))
         .collect();
     let positions: Vec<HairRoot> = roots.iter().map(|r| HairRoot::at(r.position)).collect();
+    // The same hairs in skin-triangle order, as a generator walking the
+    // mesh meets them (the sampler's order is random by design).
+    let mut sorted = roots.clone();
+    sorted.sort_by_key(|r| r.triangle);
     let options = StyleMeshOptions::default();
     // The build on the default pool (its searches run in parallel), the
     // per-hair weights on one thread.
     let (cold_s, _) = median_seconds(1, false, || StyleMesh::build(&mesh, &guides, &options));
     let (warm_s, style) =
         median_seconds(runs, false, || StyleMesh::build(&mesh, &guides, &options));
-    let (style_ns, style_bvh_ns, shepard4, shepard8) = on_threads(1, || {
+    let (style_sorted_ns, style_ns, style_bvh_ns, shepard4, shepard8) = on_threads(1, || {
         (
+            ns_per_hair(&style, &sorted, runs),
             ns_per_hair(&style, &roots, runs),
             ns_per_hair(&style, &positions, runs),
             ns_per_hair(&Shepard::new(&mesh, &guides, 4, 2.0, None), &roots, runs),
@@ -83,7 +90,7 @@ pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
     if args.json {
         println!(
-            "{{\"triangles\":{},\"guides\":{guide_count},\"hairs\":{hair_count},\"threads\":{threads},\"style_mesh_build_s\":{warm_s:.4},\"style_mesh_build_cold_s\":{cold_s:.4},\"style_mesh_triangles\":{triangles},\"style_mesh_lost_guides\":{lost},\"style_mesh_ns_per_hair\":{style_ns:.1},\"style_mesh_bvh_ns_per_hair\":{style_bvh_ns:.1},\"shepard_k4_ns_per_hair\":{shepard4:.1},\"shepard_k8_ns_per_hair\":{shepard8:.1}}}",
+            "{{\"triangles\":{},\"guides\":{guide_count},\"hairs\":{hair_count},\"threads\":{threads},\"style_mesh_build_s\":{warm_s:.4},\"style_mesh_build_cold_s\":{cold_s:.4},\"style_mesh_triangles\":{triangles},\"style_mesh_lost_guides\":{lost},\"style_mesh_ns_per_hair\":{style_sorted_ns:.1},\"style_mesh_random_order_ns_per_hair\":{style_ns:.1},\"style_mesh_bvh_ns_per_hair\":{style_bvh_ns:.1},\"shepard_k4_ns_per_hair\":{shepard4:.1},\"shepard_k8_ns_per_hair\":{shepard8:.1}}}",
             mesh.triangle_count()
         );
         return Ok(());
@@ -109,7 +116,11 @@ pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
     );
     println!(
         "{:<34} {:>9.1} ns {:>9} ns",
-        "style mesh weights, per hair", style_ns, "≤ 100"
+        "style mesh weights, per hair", style_sorted_ns, "≤ 100"
+    );
+    println!(
+        "{:<34} {:>9.1} ns {:>12}",
+        "  hairs in random order", style_ns, "—"
     );
     println!(
         "{:<34} {:>9.1} ns {:>12}",
