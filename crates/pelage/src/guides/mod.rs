@@ -16,8 +16,8 @@ use glam::Vec3;
 /// Guide curves bound to a mesh, all with the same number of points.
 #[derive(Debug, Clone)]
 pub struct Guides {
+    /// The guides, their roots attached (`Curves::roots` is always set).
     curves: Curves,
-    roots: Vec<SurfacePoint>,
     points_per_guide: usize,
 }
 
@@ -171,11 +171,10 @@ impl Guides {
             .map(|i| i * points as u32)
             .collect();
         let curves = Curves::new(pts, widths, offsets).expect("resampled finite guides");
-        let curves = curves.with_roots(roots.clone()).expect("one root a guide");
+        let curves = curves.with_roots(roots).expect("one root a guide");
         (
             Self {
                 curves,
-                roots,
                 points_per_guide: points,
             },
             report,
@@ -210,10 +209,9 @@ impl Guides {
             widths.extend((0..n).map(|k| growth.width * (1.0 - 0.8 * k as f32 / (n - 1) as f32)));
         }
         let offsets = (0..=roots.len() as u32).map(|i| i * n as u32).collect();
-        let curves = Curves::new(points, widths, offsets)?.with_roots(roots.clone())?;
+        let curves = Curves::new(points, widths, offsets)?.with_roots(roots)?;
         Ok(Self {
             curves,
-            roots,
             points_per_guide: n,
         })
     }
@@ -225,17 +223,19 @@ impl Guides {
 
     /// Each guide's root on the mesh.
     pub fn roots(&self) -> &[SurfacePoint] {
-        &self.roots
+        self.curves
+            .roots()
+            .expect("guides always carry their roots")
     }
 
     /// Number of guides.
     pub fn len(&self) -> usize {
-        self.roots.len()
+        self.curves.curve_count()
     }
 
     /// Whether there are no guides.
     pub fn is_empty(&self) -> bool {
-        self.roots.is_empty()
+        self.curves.curve_count() == 0
     }
 
     /// Points of every guide.

@@ -126,48 +126,36 @@ impl StyleMesh {
             .map(|g| (nearest_corner(g), g as u32))
             .collect();
         let lost = conflicts(&marks, &positions, mesh.positions());
-        let split_colours: HashMap<u32, Vec<u32>> = if options.split_shared {
-            let mut m: HashMap<u32, Vec<u32>> = HashMap::new();
+        // 2. The colouring, on the mesh itself or, with the split fix, on a
+        // copy split under each lost guide (then no guide is lost).
+        let mut split_colours: HashMap<u32, Vec<u32>> = HashMap::new();
+        let (colours, split_triangles, lost) = if options.split_shared && !lost.is_empty() {
             for l in &lost {
-                m.entry(guides.roots()[l.guide as usize].tri)
-                    .or_default()
-                    .push(l.guide);
+                let tri = guides.roots()[l.guide as usize].tri;
+                split_colours.entry(tri).or_default().push(l.guide);
             }
-            m
-        } else {
-            HashMap::new()
-        };
-        let (colours, triangles_of_colouring) = if options.split_shared && !lost.is_empty() {
             let (vertices, triangles) = split_under(mesh, guides, &lost, &positions, &mut marks);
             let adjacency =
                 VertexAdjacency::from_edges(&EdgeList::build(&triangles), vertices.len());
-            let lost_none: Vec<LostGuide> = Vec::new();
-            let colours = colour(&vertices, &adjacency, &marks, &lost_none);
-            (colours, Some((triangles, lost_none)))
+            let colours = colour(&vertices, &adjacency, &marks, &[]);
+            (colours, Some(triangles), Vec::new())
         } else {
             let colours = colour(mesh.positions(), &mesh.vertex_adjacency(), &marks, &lost);
-            (colours, None)
+            (colours, None, lost)
         };
-        let (lost, mesh_triangles): (Vec<LostGuide>, &[[u32; 3]]) = match &triangles_of_colouring {
-            Some((t, l)) => (l.clone(), t.as_slice()),
-            None => (lost, mesh.triangles()),
-        };
+        let mesh_triangles = split_triangles.as_deref().unwrap_or(mesh.triangles());
         // 3. Style edges and triangles from the colouring: only triangles
         // on cell borders matter; find them in parallel, keep the first of
         // each guide triple in mesh order.
-        let border: Vec<(usize, [u32; 3])> = mesh_triangles
+        let border: Vec<[u32; 3]> = mesh_triangles
             .par_iter()
-            .enumerate()
-            .filter_map(|(i, t)| {
-                let c = t.map(|v| colours[v as usize]);
-                let border = !c.contains(&u32::MAX) && (c[0] != c[1] || c[1] != c[2]);
-                border.then_some((i, c))
-            })
+            .map(|t| t.map(|v| colours[v as usize]))
+            .filter(|c| !c.contains(&u32::MAX) && (c[0] != c[1] || c[1] != c[2]))
             .collect();
         let mut triangles = Vec::new();
         let mut seen_triangles = HashSet::new();
         let mut edges = HashSet::new();
-        for &(_, c) in &border {
+        for &c in &border {
             for (a, b) in [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])] {
                 if a != b {
                     edges.insert([a.min(b), a.max(b)]);
@@ -290,6 +278,15 @@ impl StyleMesh {
 }
 
 impl StyleMesh {
+    /// The style primitives guide `g` is a corner of.
+    fn incident_to(&self, g: u32) -> &[u32] {
+        let (start, end) = (
+            self.incident_offsets[g as usize],
+            self.incident_offsets[g as usize + 1],
+        );
+        &self.incident[start as usize..end as usize]
+    }
+
     /// The closest point among the primitives incident to the guides of
     /// the skin triangle's corners: (primitive, weights), or `None` when
     /// no guide colours them.
@@ -300,45 +297,36 @@ impl StyleMesh {
         } else {
             self.split_colours.get(&triangle)
         };
-        let mut seen = [u32::MAX; 3];
-        let mut candidates = [0u32; 64];
-        let mut count = 0;
-        for (k, &g) in colours
-            .iter()
-            .chain(extra.into_iter().flatten())
-            .enumerate()
-        {
-            if g == u32::MAX || seen.contains(&g) {
-                continue;
-            }
-            if k < 3 {
-                seen[k] = g;
-            }
-            let range = self.incident_offsets[g as usize] as usize
-                ..self.incident_offsets[g as usize + 1] as usize;
-            for &prim in &self.incident[range] {
-                if count < candidates.len() {
-                    candidates[count] = prim;
-                    count += 1;
-                }
+        // The primitives incident to the distinct guides of the corners
+        // (and to any guide split inside), as a few slices: plain loops
+        // over them keep this hot path tight.
+        let mut lists: [&[u32]; 3] = [&[]; 3];
+        for k in 0..3 {
+            let g = colours[k];
+            if g != u32::MAX && !colours[..k].contains(&g) {
+                lists[k] = self.incident_to(g);
             }
         }
-        let candidates = &candidates[..count];
+        let extra_lists: Vec<&[u32]> = extra
+            .map(|gs| gs.iter().map(|&g| self.incident_to(g)).collect())
+            .unwrap_or_default();
         // Fast path: the nearest candidate whose triangle contains the
         // root's projection onto its plane — the closest point whenever the
         // skin under the root is not folded over the style mesh.
         let mut best: Option<(f32, u32, [f32; 3])> = None;
-        for &prim in candidates {
-            if let Some((d, weights)) = self.projections[prim as usize].inside(root)
-                && best.is_none_or(|(bd, bp, _)| d < bd || (d == bd && prim < bp))
-            {
-                best = Some((d, prim, weights));
+        for list in lists.iter().chain(&extra_lists) {
+            for &prim in *list {
+                if let Some((d, weights)) = self.projections[prim as usize].inside(root)
+                    && best.is_none_or(|(bd, bp, _)| d < bd || (d == bd && prim < bp))
+                {
+                    best = Some((d, prim, weights));
+                }
             }
         }
         if best.is_none() {
             // Exact closest point among the candidates (edges, corners,
             // segments and points).
-            for &prim in candidates {
+            for &prim in lists.iter().chain(&extra_lists).flat_map(|l| l.iter()) {
                 let (point, weights) = closest_on_triangle(root, self.corners[prim as usize]);
                 let d = (point - root).length_squared();
                 if best.is_none_or(|(bd, bp, _)| d < bd || (d == bd && prim < bp)) {
@@ -439,20 +427,17 @@ fn conflicts(marks: &[(u32, u32)], roots: &[Vec3], vertices: &[Vec3]) -> Vec<Los
             .then(d(a).total_cmp(&d(b)))
             .then(a.1.cmp(&b.1))
     });
+    // In each run of one vertex the first (nearest) guide keeps it.
     let mut lost = Vec::new();
-    for pair in by_vertex.windows(2) {
-        // `pair[0]` is the winner for runs of equal vertices.
-        if pair[0].0 == pair[1].0 {
-            let winner = by_vertex
-                .iter()
-                .find(|m| m.0 == pair[1].0)
-                .expect("the run's first")
-                .1;
-            lost.push(LostGuide {
-                guide: pair[1].1,
-                vertex: pair[1].0,
-                kept_by: winner,
-            });
+    let mut winner = by_vertex.first().copied();
+    for &(vertex, guide) in by_vertex.iter().skip(1) {
+        match winner {
+            Some((v, kept_by)) if v == vertex => lost.push(LostGuide {
+                guide,
+                vertex,
+                kept_by,
+            }),
+            _ => winner = Some((vertex, guide)),
         }
     }
     lost.sort_by_key(|l| l.guide);

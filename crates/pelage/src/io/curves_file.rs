@@ -142,21 +142,21 @@ pub fn join<'c>(
         offsets.extend(c.offsets()[1..].iter().map(|o| o + base));
     }
     let mut joined = Curves::new(points, widths, offsets)?;
-    if parts.iter().all(|c| c.colors().is_some()) && !parts.is_empty() {
-        joined = joined.with_colors(
-            parts
-                .iter()
-                .flat_map(|c| c.colors().unwrap().iter().copied())
-                .collect(),
-        )?;
+    if let Some(colors) = concat_all(&parts, Curves::colors) {
+        joined = joined.with_colors(colors)?;
     }
-    if parts.iter().all(|c| c.opacities().is_some()) && !parts.is_empty() {
-        joined = joined.with_opacities(
-            parts
-                .iter()
-                .flat_map(|c| c.opacities().unwrap().iter().copied())
-                .collect(),
-        )?;
+    if let Some(opacities) = concat_all(&parts, Curves::opacities) {
+        joined = joined.with_opacities(opacities)?;
     }
     Ok(joined)
+}
+
+/// One attribute of every part, concatenated; `None` unless every part
+/// (and at least one) has it.
+fn concat_all<T: Copy>(
+    parts: &[&Curves],
+    attribute: impl Fn(&Curves) -> Option<&[T]>,
+) -> Option<Vec<T>> {
+    let slices: Option<Vec<&[T]>> = parts.iter().map(|c| attribute(c)).collect();
+    slices.filter(|s| !s.is_empty()).map(|s| s.concat())
 }

@@ -94,7 +94,7 @@ fn write_groom(args: &IoBenchArgs, hairs: u64) -> anyhow::Result<Run> {
     let path = args
         .dir
         .join(format!("pelage-bench-io-{}.usda", std::process::id()));
-    let (mut write, mut generate) = (Duration::ZERO, Duration::ZERO);
+    let mut generate = Duration::ZERO;
     reset_peak_rss();
     let start = Instant::now();
     write_atomically(&path, |out| {
@@ -117,7 +117,7 @@ fn write_groom(args: &IoBenchArgs, hairs: u64) -> anyhow::Result<Run> {
         Ok(())
     })?;
     // Writing includes the final flush, fsync and rename.
-    write += start.elapsed() - generate;
+    let write = start.elapsed() - generate;
     let peak = peak_rss();
     let bytes = std::fs::metadata(&path)
         .with_context(|| format!("cannot read {}", path.display()))?
