@@ -27,6 +27,8 @@ enum Command {
     Sample(commands::sample::SampleArgs),
     /// Render a mesh, a point cloud or curves to a PNG (headless GPU).
     Render(commands::render::RenderArgs),
+    /// Grow a groom file's hairs (guides, operators, parts) and write them.
+    Groom(commands::groom::GroomArgs),
     /// Grow guide curves on a mesh, or bind guides from a file to it.
     Guides(commands::guides::GuidesArgs),
     /// Convert curves between formats (USD, .hair, PLY, RIB, pbrt).
@@ -45,6 +47,7 @@ fn main() -> ExitCode {
         Command::Render(args) => commands::render::run(&args),
         Command::Convert(args) => commands::convert::run(&args),
         Command::Guides(args) => commands::guides::run(&args),
+        Command::Groom(args) => commands::groom::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
     };

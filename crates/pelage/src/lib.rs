@@ -16,6 +16,9 @@
 //!   (from a file, with a report of what was left out, or grown).
 //! - [`interp`]: guide interpolation — Shepard over a kd-tree (Sik §4.2.2)
 //!   and the style mesh (Furtility).
+//! - [`groom`]: the groom generator: groom files (TOML), operators
+//!   (noise, frizz, clump, curl, cut, length, strands, width, colour),
+//!   parts, deterministic generation (Sik §4).
 //! - [`io`]: curves and points in and out (USD, .hair, PLY, RIB, pbrt),
 //!   every writer atomic (temporary file, then rename).
 //! - [`assets`]: the embedded demo mesh (Spot), so every command works with
@@ -27,6 +30,7 @@
 
 pub mod assets;
 pub mod curves;
+pub mod groom;
 pub mod guides;
 pub mod interp;
 pub mod io;

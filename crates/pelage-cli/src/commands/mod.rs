@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod convert;
 pub mod demo;
+pub mod groom;
 pub mod guides;
 pub mod info;
 pub mod render;

@@ -8,9 +8,10 @@
 //! orientation), a colour and an opacity; per curve its root on the mesh
 //! ([`SurfacePoint`]), the root's UV, and a stable id.
 //!
-//! This module holds the data type; Catmull-Rom evaluation,
-//! rotation-minimizing frames and per-part bounds come with the groom
-//! issue.
+//! [`frames`] holds Catmull-Rom tangents and rotation-minimizing frames
+//! (Wang et al. 2008) for the per-point normals.
+
+pub mod frames;
 
 use crate::SurfacePoint;
 use glam::{Vec2, Vec3};

@@ -79,6 +79,54 @@ impl NoiseMap {
     }
 }
 
+impl NoiseMap {
+    /// One octave of 3D Perlin noise (Perlin 2002: quintic fade, the twelve
+    /// edge-direction gradients), in about [−1, 1]; the groom's noise
+    /// operator displaces hair points with it.
+    pub fn perlin3(&self, p: glam::Vec3) -> f32 {
+        let cell = p.floor();
+        let f = p - cell;
+        let [xi, yi, zi] = [cell.x, cell.y, cell.z].map(|c| (c as i64 & 255) as usize);
+        let perm = &self.permutation;
+        let hash = |x: usize, y: usize, z: usize| perm[perm[perm[x] as usize + y] as usize + z];
+        let fade = |t: f32| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+        let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
+        let g = |dx: usize, dy: usize, dz: usize| {
+            gradient3(
+                hash(xi + dx, yi + dy, zi + dz),
+                f.x - dx as f32,
+                f.y - dy as f32,
+                f.z - dz as f32,
+            )
+        };
+        let lerp = |a: f32, b: f32, t: f32| a + t * (b - a);
+        let x00 = lerp(g(0, 0, 0), g(1, 0, 0), u);
+        let x10 = lerp(g(0, 1, 0), g(1, 1, 0), u);
+        let x01 = lerp(g(0, 0, 1), g(1, 0, 1), u);
+        let x11 = lerp(g(0, 1, 1), g(1, 1, 1), u);
+        lerp(lerp(x00, x10, v), lerp(x01, x11, v), w)
+    }
+}
+
+/// Dot product of the offset with one of Perlin's twelve gradients (the
+/// cube's edge midpoints; 16 hash values, four repeated).
+fn gradient3(hash: u8, x: f32, y: f32, z: f32) -> f32 {
+    match hash & 15 {
+        0 | 12 => x + y,
+        1 | 14 => -x + y,
+        2 => x - y,
+        3 => -x - y,
+        4 => x + z,
+        5 => -x + z,
+        6 => x - z,
+        7 => -x - z,
+        8 => y + z,
+        9 | 13 => -y + z,
+        10 => y - z,
+        _ => -y - z,
+    }
+}
+
 /// Dot product of the offset with one of eight gradients: the four axis
 /// directions and four diagonals scaled to unit length. Noise built this way
 /// reaches about ±1.

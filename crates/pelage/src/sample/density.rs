@@ -108,6 +108,7 @@ pub struct DensitySampler<'m> {
     total: f64,
     selector: SelectorTable,
     positions: PositionTable,
+    options: DensitySamplerOptions,
 }
 
 /// Fig. 5's output for a whole mesh: the records, where each triangle's
@@ -210,6 +211,42 @@ impl<'m> DensitySampler<'m> {
             first_record,
             total,
         } = SubTriangleRecords::build(mesh, density, options.max_level)?;
+        Ok(Self::from_records(
+            mesh,
+            records,
+            first_record,
+            total,
+            options,
+        ))
+    }
+
+    /// The same distribution restricted to `triangles` (ascending, no
+    /// repeats) and renormalised: where one part of a groom places its
+    /// roots. `None` if the density is zero on all of them.
+    pub fn restricted(&self, triangles: &[u32]) -> Option<DensitySampler<'m>> {
+        debug_assert!(triangles.windows(2).all(|w| w[0] < w[1]));
+        let mut records = Vec::new();
+        let mut first_record = vec![0u32; self.first_record.len()];
+        let mut next = triangles.iter().peekable();
+        for t in 0..self.mesh.triangle_count() {
+            if next.next_if(|&&k| k as usize == t).is_some() {
+                let range = self.first_record[t] as usize..self.first_record[t + 1] as usize;
+                records.extend_from_slice(&self.records[range]);
+            }
+            first_record[t + 1] = records.len() as u32;
+        }
+        let total: f64 = records.iter().map(|r| f64::from(r.probability)).sum();
+        (total > 0.0)
+            .then(|| Self::from_records(self.mesh, records, first_record, total, self.options))
+    }
+
+    fn from_records(
+        mesh: &'m Mesh,
+        records: Vec<SubTriangleRecord>,
+        first_record: Vec<u32>,
+        total: f64,
+        options: DensitySamplerOptions,
+    ) -> Self {
         let weights = records.iter().map(|r| f64::from(r.probability));
         let selector = match options.selector {
             Selector::CdfGrid { grid_percent } => {
@@ -230,14 +267,15 @@ impl<'m> DensitySampler<'m> {
                 SelectorTable::Alias(entries)
             }
         };
-        Ok(Self {
+        Self {
             mesh,
             records,
             first_record,
             total,
             selector,
             positions: PositionTable::new(),
-        })
+            options,
+        }
     }
 
     /// The sub-triangle records (zero-probability ones are left out).

@@ -1,0 +1,225 @@
+//! `pelage groom`: grows a groom file's hairs and writes them, part by part
+//! (`--part K/N` for one run of a farm, `--assemble` to tie the runs'
+//! files together in one USD layer).
+
+use crate::format::thousands;
+use anyhow::{Context, bail};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use pelage::groom::{Groom, part_file, part_slice, write_assembly};
+use pelage::io::{CurveBasis, CurvesExport, UsdOptions};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Arguments of `pelage groom`.
+#[derive(Debug, Args)]
+pub struct GroomArgs {
+    /// The groom file (TOML; see docs/groom-format.md).
+    pub file: PathBuf,
+    /// Output (.usda default; .hair, .ply, .rib, .pbrt). Default: the
+    /// file's `[output] path`, or the groom file's name with .usda.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Grow only run K of N (1-based): a contiguous share of the parts,
+    /// written to OUTPUT with `.part-K-of-N` before the extension.
+    #[arg(long, value_name = "K/N", value_parser = parse_part)]
+    pub part: Option<(usize, usize)>,
+    /// Instead of growing: write OUTPUT as a USD layer referencing every
+    /// part file `OUTPUT.part-K-of-N.usda` beside it, with extents.
+    #[arg(long, conflicts_with = "part")]
+    pub assemble: bool,
+    /// Worker threads (default: all cores). The output is identical for
+    /// any number.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Override the groom file's seed.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Do not print the progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn parse_part(s: &str) -> Result<(usize, usize), String> {
+    let (k, n) = s
+        .split_once('/')
+        .ok_or_else(|| format!("{s:?}: write the part as K/N, e.g. 3/8"))?;
+    let (k, n): (usize, usize) = (
+        k.trim()
+            .parse()
+            .map_err(|_| format!("{k:?} is not a whole number"))?,
+        n.trim()
+            .parse()
+            .map_err(|_| format!("{n:?} is not a whole number"))?,
+    );
+    if n == 0 || k == 0 || k > n {
+        return Err(format!("{s}: K must be 1 to N (runs are numbered from 1)"));
+    }
+    Ok((k, n))
+}
+
+pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
+    if let Some(threads) = args.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.max(1))
+            .build_global()
+            .context("cannot set up the worker threads")?;
+    }
+    let start = Instant::now();
+    let groom = Groom::load(&args.file)?;
+    let output = args.output.clone().unwrap_or_else(|| groom.output_path());
+    if args.assemble {
+        return assemble(&output);
+    }
+    if let Some(report) = groom.bind_report() {
+        for dropped in &report.dropped {
+            eprintln!("warning: guides: {dropped}");
+        }
+    }
+    let generator = groom.generator(args.seed)?;
+    let prepared = start.elapsed();
+    let parts = generator.parts().len();
+    let (range, path) = match args.part {
+        Some((k, n)) => {
+            if n > parts {
+                bail!(
+                    "--part {k}/{n}: the groom has {parts} parts, so at most {parts} runs; set [roots] parts in {} for more",
+                    args.file.display()
+                );
+            }
+            (part_slice(k, n, parts), part_file(&output, k, n))
+        }
+        None => (0..parts, output.clone()),
+    };
+    let file = groom.file();
+    let basis = match file.output.basis.as_deref() {
+        None | Some("catmull-rom") | Some("catmullRom") => CurveBasis::CatmullRom,
+        Some("linear") => CurveBasis::Linear,
+        Some(other) => bail!(
+            "{}: output.basis {other:?}: the bases are \"catmull-rom\" and \"linear\"",
+            args.file.display()
+        ),
+    };
+    let export = CurvesExport {
+        usd: UsdOptions {
+            basis,
+            ..UsdOptions::default()
+        },
+        mesh: file.output.with_mesh.then(|| groom.mesh()),
+    };
+    let planned: u64 = generator.parts()[range.clone()]
+        .iter()
+        .map(|p| p.hair_count)
+        .sum();
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        let bar = ProgressBar::new(range.len() as u64);
+        bar.set_style(
+            ProgressStyle::with_template("{bar:40} part {pos}/{len}, {msg} {eta} left")
+                .expect("the template is valid"),
+        );
+        bar
+    };
+    println!(
+        "{}: {} hairs on {} ({} triangles) from {} guides, {} parts; operators: {}",
+        args.file.display(),
+        thousands(planned),
+        groom.mesh().name(),
+        thousands(groom.mesh().triangle_count() as u64),
+        thousands(groom.guides().len() as u64),
+        range.len(),
+        match generator.operators().len() {
+            0 => "none".to_string(),
+            _ => generator
+                .operators()
+                .iter()
+                .map(|o| o.name())
+                .collect::<Vec<_>>()
+                .join(" → "),
+        }
+    );
+    let growing = Instant::now();
+    let mut done = 0u64;
+    let summary = generator.write(&path, range.clone(), &export, |_, curves| {
+        done += curves.curve_count() as u64;
+        bar.set_message(format!("{} hairs", thousands(done)));
+        bar.inc(1);
+    })?;
+    bar.finish_and_clear();
+    let seconds = growing.elapsed().as_secs_f64();
+    println!(
+        "{} hairs, {} points in {} parts → {} in {:.2} s ({:.2} M hairs/s; setup {:.2} s)",
+        thousands(summary.hairs),
+        thousands(summary.points),
+        range.len(),
+        path.display(),
+        seconds,
+        summary.hairs as f64 / seconds / 1e6,
+        prepared.as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Finds `OUTPUT.part-K-of-N.usda` for one N and every K, and writes the
+/// root layer.
+fn assemble(output: &Path) -> anyhow::Result<()> {
+    let folder = match output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let stem = output
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .context("the output needs a file name")?;
+    let mut runs: Option<usize> = None;
+    for entry in
+        std::fs::read_dir(&folder).with_context(|| format!("cannot list {}", folder.display()))?
+    {
+        let name = entry?.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let Some(rest) = name.strip_prefix(&format!("{stem}.part-")) else {
+            continue;
+        };
+        let Some((_, n)) = rest.split_once("-of-") else {
+            continue;
+        };
+        let Some(n) = n.split('.').next().and_then(|n| n.parse::<usize>().ok()) else {
+            continue;
+        };
+        match runs {
+            Some(m) if m != n => bail!(
+                "{}: part files of two different farm runs (of {m} and of {n}); remove one set",
+                folder.display()
+            ),
+            _ => runs = Some(n),
+        }
+    }
+    let n = runs.with_context(|| {
+        format!(
+            "no part files {stem}.part-K-of-N.* in {}; run `pelage groom FILE --part K/N` first",
+            folder.display()
+        )
+    })?;
+    let files: Vec<PathBuf> = (1..=n).map(|k| part_file(output, k, n)).collect();
+    if let Some(missing) = files.iter().find(|f| !f.exists()) {
+        bail!(
+            "{} is missing: run {} of {n} has not finished",
+            missing.display(),
+            { files.iter().position(|f| f == missing).unwrap_or(0) + 1 }
+        );
+    }
+    let (lo, hi) = write_assembly(output, &files)?;
+    println!(
+        "{} → {} part files referenced, extent ({:.4}, {:.4}, {:.4}) to ({:.4}, {:.4}, {:.4})",
+        output.display(),
+        n,
+        lo.x,
+        lo.y,
+        lo.z,
+        hi.x,
+        hi.y,
+        hi.z
+    );
+    Ok(())
+}

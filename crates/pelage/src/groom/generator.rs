@@ -1,0 +1,699 @@
+//! The groom generator: [`Groom`] (a loaded groom file) and [`Generator`]
+//! (prepared to grow parts). See the module docs of [`crate::groom`] for
+//! the path of one hair.
+
+use super::file::{
+    ColorSpec, GroomError, GroomErrorKind, GroomFile, GroomSource, MapValue, OpSpec, OpacitySpec,
+    WidthSpec,
+};
+use super::ops::{
+    Clump, ClumpCentres, Color, Curl, Cut, Frizz, HairBatch, Length, Noise, Opacity, Operator,
+    RootContext, RootToTip, Scratch, Strands, Width,
+};
+use super::parts::{Part, PartLayout};
+use crate::curves::Curves;
+use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
+use crate::guides::{BindReport, GuideGrowth, Guides};
+use crate::interp::{GuideWeight, InterpolationMethod, Interpolator, StyleMeshOptions};
+use crate::map::Map;
+use crate::mesh::{Mesh, SurfacePoint};
+use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, sample_range};
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Hairs per part when the groom file does not say.
+pub const HAIRS_PER_PART: u64 = 100_000;
+
+/// Hairs a worker grows between hand-overs (fixed, so results never depend
+/// on the number of threads).
+const CHUNK: usize = 2048;
+
+/// A groom file loaded: the file, its mesh and guides.
+pub struct Groom {
+    source: GroomSource,
+    file: GroomFile,
+    mesh: Mesh,
+    guides: Guides,
+    bind_report: Option<BindReport>,
+}
+
+impl std::fmt::Debug for Groom {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Groom")
+            .field("path", &self.source.path)
+            .field("mesh", &self.mesh.name())
+            .field("guides", &self.guides.len())
+            .finish()
+    }
+}
+
+impl Groom {
+    /// Reads, parses and loads the groom file at `path`.
+    pub fn load(path: &Path) -> Result<Self, GroomError> {
+        Self::from_source(GroomSource::read(path)?)
+    }
+
+    /// Loads a groom from its text (`path` names it in errors and is the
+    /// base of relative paths).
+    pub fn from_text(
+        path: impl Into<PathBuf>,
+        text: impl Into<String>,
+    ) -> Result<Self, GroomError> {
+        Self::from_source(GroomSource {
+            path: path.into(),
+            text: text.into(),
+        })
+    }
+
+    /// Parses the source, loads the mesh and the guides.
+    pub fn from_source(source: GroomSource) -> Result<Self, GroomError> {
+        let file = source.parse()?;
+        let mesh = load_mesh(&source, &file)?;
+        let (guides, bind_report) = load_guides(&source, &file, &mesh)?;
+        Ok(Self {
+            source,
+            file,
+            mesh,
+            guides,
+            bind_report,
+        })
+    }
+
+    /// The parsed file.
+    pub fn file(&self) -> &GroomFile {
+        &self.file
+    }
+
+    /// The file's path and text.
+    pub fn source(&self) -> &GroomSource {
+        &self.source
+    }
+
+    /// The mesh hairs grow on.
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    /// The guides, bound to the mesh.
+    pub fn guides(&self) -> &Guides {
+        &self.guides
+    }
+
+    /// When the guides came from a file: what binding them kept and left
+    /// out.
+    pub fn bind_report(&self) -> Option<&BindReport> {
+        self.bind_report.as_ref()
+    }
+
+    /// Where the curves go: `[output] path` relative to the groom file, or
+    /// the groom file's name with `.usda`.
+    pub fn output_path(&self) -> PathBuf {
+        match &self.file.output.path {
+            Some(p) => self.source.folder().join(p),
+            None => self.source.path.with_extension("usda"),
+        }
+    }
+
+    /// The number of parts: `[roots] parts`, or one per
+    /// [`HAIRS_PER_PART`] hairs.
+    pub fn part_count(&self) -> usize {
+        match &self.file.roots.parts {
+            Some(p) => (*p.get_ref()).max(1) as usize,
+            None => self
+                .file
+                .roots
+                .count
+                .get_ref()
+                .div_ceil(HAIRS_PER_PART)
+                .max(1) as usize,
+        }
+    }
+
+    /// Prepares generation: the root sampler and part layout, the
+    /// interpolator (the style mesh is built here), the operator chain and
+    /// its clump centres. `seed` overrides the file's.
+    pub fn generator(&self, seed: Option<u64>) -> Result<Generator<'_>, GroomError> {
+        Generator::new(self, seed)
+    }
+
+    fn map(&self, value: &MapValue) -> Result<Map, GroomError> {
+        let map = self.source.map(value)?;
+        map.on_mesh(&self.mesh)
+            .map_err(|e| self.source.error_at(value.span(), GroomErrorKind::Map(e)))?;
+        Ok(map)
+    }
+}
+
+fn load_mesh(source: &GroomSource, file: &GroomFile) -> Result<Mesh, GroomError> {
+    let path = &file.mesh.path;
+    let mesh = if path.get_ref() == "spot" {
+        crate::assets::spot()
+    } else {
+        Mesh::load(source.folder().join(path.get_ref()))
+            .map_err(|e| source.error_at(path.span(), GroomErrorKind::Mesh(e)))?
+    };
+    Ok(match file.mesh.subdivide {
+        0 => mesh,
+        n => mesh.subdivided(n),
+    })
+}
+
+fn load_guides(
+    source: &GroomSource,
+    file: &GroomFile,
+    mesh: &Mesh,
+) -> Result<(Guides, Option<BindReport>), GroomError> {
+    let section = &file.guides;
+    let invalid =
+        |span, message: &str| source.error_at(span, GroomErrorKind::Invalid(message.to_string()));
+    match (&section.file, &section.generate) {
+        (Some(path), None) => {
+            let full = source.folder().join(path.get_ref());
+            let curves = crate::io::read_curves(&full)
+                .map_err(|e| source.error_at(path.span(), GroomErrorKind::Guides(e)))?;
+            let (guides, report) = Guides::bind(mesh, &curves, section.points, section.tolerance);
+            if guides.is_empty() {
+                return Err(invalid(
+                    path.span(),
+                    "no guide is within the tolerance of the mesh; check that the guides belong to this mesh, or raise [guides] tolerance",
+                ));
+            }
+            Ok((guides, Some(report)))
+        }
+        (None, Some(generate)) => {
+            let map = |v: &MapValue| {
+                let m = source.map(v)?;
+                m.on_mesh(mesh)
+                    .map_err(|e| source.error_at(v.span(), GroomErrorKind::Map(e)))?;
+                Ok::<_, GroomError>(m)
+            };
+            let growth = GuideGrowth {
+                count: generate.count.max(1),
+                density: map(&generate.density)?,
+                length: map(&generate.length)?,
+                comb: Vec3::from(generate.comb),
+                gravity: generate.gravity,
+                points: section.points,
+                width: 0.004,
+                seed: generate.seed,
+            };
+            let guides = Guides::grow(mesh, &growth).map_err(|e| {
+                source.error_at(generate.length.span(), GroomErrorKind::GuideGrowth(e))
+            })?;
+            Ok((guides, None))
+        }
+        _ => Err(GroomError::new(
+            source.path.clone(),
+            None,
+            Some("guides".into()),
+            GroomErrorKind::Invalid(
+                "give exactly one of `file = \"guides.usda\"` or a [guides.generate] table".into(),
+            ),
+        )),
+    }
+}
+
+/// What a generated part holds, for progress and summaries.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GroomSummary {
+    /// Hairs (curves) written.
+    pub hairs: u64,
+    /// Points written.
+    pub points: u64,
+}
+
+/// A groom prepared for generation. Shared by every thread; [`Self::part`]
+/// may be called in any order, any number of times.
+pub struct Generator<'g> {
+    groom: &'g Groom,
+    sampler: DensitySampler<'g>,
+    layout: PartLayout,
+    interpolator: Interpolator<'g>,
+    ops: Vec<Operator>,
+    base: Vec<Operator>,
+    points: usize,
+    colors: bool,
+    opacities: bool,
+    normals: bool,
+    seed: u64,
+}
+
+impl std::fmt::Debug for Generator<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Generator")
+            .field("parts", &self.layout.len())
+            .field(
+                "ops",
+                &self.ops.iter().map(Operator::name).collect::<Vec<_>>(),
+            )
+            .finish()
+    }
+}
+
+/// Per-thread buffers.
+#[derive(Default)]
+struct Workspace {
+    weights: Vec<GuideWeight>,
+    shape: Vec<Vec3>,
+    batch: HairBatch,
+    scratch: Scratch,
+}
+
+impl<'g> Generator<'g> {
+    fn new(groom: &'g Groom, seed: Option<u64>) -> Result<Self, GroomError> {
+        let file = &groom.file;
+        let source = &groom.source;
+        let mesh = &groom.mesh;
+        let seed = seed.unwrap_or(file.roots.seed);
+        let count = *file.roots.count.get_ref();
+        if count == 0 {
+            return Err(source.error_at(
+                file.roots.count.span(),
+                GroomErrorKind::Invalid("the hair count must be at least 1".into()),
+            ));
+        }
+        let points = *file.finish.points.get_ref();
+        if points < 2 {
+            return Err(source.error_at(
+                file.finish.points.span(),
+                GroomErrorKind::Invalid("hairs need at least 2 points".into()),
+            ));
+        }
+        let density = groom.map(&file.roots.density)?;
+        let sampler = DensitySampler::new(mesh, &density, DensitySamplerOptions::default())
+            .map_err(|e| source.error_at(file.roots.density.span(), GroomErrorKind::Sample(e)))?;
+        let layout = PartLayout::new(
+            mesh,
+            |t| sampler.triangle_probability(t),
+            count,
+            groom.part_count(),
+        );
+
+        let method = &file.interpolation;
+        let interpolation = match method.method.get_ref().as_str() {
+            "shepard" => InterpolationMethod::Shepard {
+                k: method.k.max(1),
+                power: method.power,
+                radius: method.radius,
+            },
+            "style-mesh" | "style_mesh" => InterpolationMethod::StyleMesh(StyleMeshOptions {
+                split_shared: method.split_shared,
+            }),
+            other => {
+                return Err(source.error_at(
+                    method.method.span(),
+                    GroomErrorKind::Invalid(format!(
+                        "unknown interpolation method {other:?}; the methods are \"shepard\" and \"style-mesh\""
+                    )),
+                ));
+            }
+        };
+        let interpolator = Interpolator::new(mesh, &groom.guides, &interpolation);
+
+        let mut base = vec![Operator::Width(Width(width_spec(
+            groom,
+            &file.finish.width,
+        )?))];
+        if let Some(color) = &file.finish.color {
+            base.push(Operator::Color(color_spec(groom, color)?));
+        }
+        if let Some(opacity) = &file.finish.opacity {
+            base.push(Operator::Opacity(Opacity(opacity_spec(groom, opacity)?)));
+        }
+        let mut generator = Self {
+            groom,
+            sampler,
+            layout,
+            interpolator,
+            ops: Vec::with_capacity(file.ops.len()),
+            base,
+            points,
+            colors: file.finish.color.is_some(),
+            opacities: file.finish.opacity.is_some(),
+            normals: file.finish.normals,
+            seed,
+        };
+        for (k, spec) in file.ops.iter().enumerate() {
+            let op = generator.operator(k, spec)?;
+            generator.colors |= matches!(op, Operator::Color(_));
+            generator.opacities |= matches!(op, Operator::Opacity(_));
+            generator.ops.push(op);
+        }
+        Ok(generator)
+    }
+
+    /// Builds operator `k` (clump centres are grown through the operators
+    /// before it, which are already in `self.ops`).
+    fn operator(&self, k: usize, spec: &OpSpec) -> Result<Operator, GroomError> {
+        let groom = self.groom;
+        let m = |v: &MapValue| groom.map(v);
+        // Each operator's own random streams: the file's seed mixed with
+        // its position in the chain and its seed key.
+        let op_seed = |s: u64| mix64(self.seed ^ mix64((k as u64 + 1) << 32 ^ s));
+        Ok(match spec {
+            OpSpec::Noise(s) => Operator::Noise(Noise::new(
+                m(&s.amplitude)?,
+                m(&s.frequency)?,
+                s.ramp.clone(),
+                op_seed(s.seed),
+            )),
+            OpSpec::Frizz(s) => Operator::Frizz(Frizz::new(
+                m(&s.amplitude)?,
+                m(&s.frequency)?,
+                m(&s.fraction)?,
+                s.ramp.clone(),
+                op_seed(s.seed),
+            )),
+            OpSpec::Curl(s) => Operator::Curl(Curl::new(
+                m(&s.radius)?,
+                m(&s.turns)?,
+                s.ramp.clone(),
+                op_seed(s.seed),
+            )),
+            OpSpec::Cut(s) => Operator::Cut(Cut::new(m(&s.at)?)),
+            OpSpec::Length(s) => {
+                Operator::Length(Length::new(m(&s.scale)?, m(&s.jitter)?, op_seed(s.seed)))
+            }
+            OpSpec::Strands(s) => {
+                if *s.count.get_ref() == 0 {
+                    return Err(groom.source.error_at(
+                        s.count.span(),
+                        GroomErrorKind::Invalid("a strand needs at least 1 hair".into()),
+                    ));
+                }
+                Operator::Strands(Strands::new(
+                    *s.count.get_ref(),
+                    m(&s.root_spread)?,
+                    m(&s.tip_spread)?,
+                    m(&s.twist)?,
+                    op_seed(s.seed),
+                ))
+            }
+            OpSpec::Width(s) => Operator::Width(Width(width_spec(groom, s)?)),
+            OpSpec::Color(s) => Operator::Color(color_spec(groom, s)?),
+            OpSpec::Opacity(s) => Operator::Opacity(Opacity(opacity_spec(groom, s)?)),
+            OpSpec::Clump(s) => {
+                let count = *s.count.get_ref();
+                if count == 0 {
+                    return Err(groom.source.error_at(
+                        s.count.span(),
+                        GroomErrorKind::Invalid("a clump operator needs at least 1 clump".into()),
+                    ));
+                }
+                let density = m(&s.density)?;
+                let sampler =
+                    DensitySampler::new(&groom.mesh, &density, DensitySamplerOptions::default())
+                        .map_err(|e| {
+                            groom
+                                .source
+                                .error_at(s.density.span(), GroomErrorKind::Sample(e))
+                        })?;
+                let roots = sample_range(&sampler, op_seed(s.seed), 0..count);
+                let centres = self.clump_centres(k, &roots);
+                Operator::Clump(Clump::new(
+                    centres,
+                    m(&s.rate)?,
+                    s.ramp.clone(),
+                    s.size.as_ref().map(m).transpose()?,
+                ))
+            }
+        })
+    }
+
+    /// Grows the centre hairs of the clump operator at chain position `k`
+    /// through the operators before it. Centre ids live apart from hair ids
+    /// (top bits set), so their random numbers are their own.
+    fn clump_centres(&self, k: usize, roots: &[SurfacePoint]) -> ClumpCentres {
+        let mesh = &self.groom.mesh;
+        let shapes: Vec<Vec<Vec3>> = roots
+            .par_chunks(256)
+            .enumerate()
+            .map_init(Workspace::default, |ws, (c, chunk)| {
+                let mut out = Vec::with_capacity(chunk.len() * self.points);
+                for (i, root) in chunk.iter().enumerate() {
+                    let id = (1u64 << 63) | ((k as u64) << 40) | (c * 256 + i) as u64;
+                    self.grow(*root, id, &self.ops[..k], ws);
+                    match ws.batch.hairs().first() {
+                        Some(hair) => out.extend_from_slice(&hair.points),
+                        // Cut away entirely: the centre is its interpolated shape.
+                        None => out.extend_from_slice(&ws.scratch.points[..self.points]),
+                    }
+                }
+                out
+            })
+            .collect();
+        let positions = roots.iter().map(|r| r.position(mesh)).collect();
+        ClumpCentres::new(positions, shapes.concat(), self.points)
+    }
+
+    /// The groom.
+    pub fn groom(&self) -> &'g Groom {
+        self.groom
+    }
+
+    /// The parts, in order.
+    pub fn parts(&self) -> &[Part] {
+        self.layout.parts()
+    }
+
+    /// The operator chain.
+    pub fn operators(&self) -> &[Operator] {
+        &self.ops
+    }
+
+    /// Points per hair.
+    pub fn points_per_hair(&self) -> usize {
+        self.points
+    }
+
+    /// Hair `id` grown from `root` through `ops` into `ws.batch`.
+    fn grow(&self, root: SurfacePoint, id: u64, ops: &[Operator], ws: &mut Workspace) {
+        let mesh = &self.groom.mesh;
+        let context = RootContext {
+            point: root,
+            position: root.position(mesh),
+            normal: root.normal(mesh),
+            uv: root.uv(mesh).unwrap_or(Vec2::ZERO),
+        };
+        let guide_points = self.groom.guides.points_per_guide();
+        ws.shape.resize(guide_points, Vec3::ZERO);
+        self.interpolator
+            .hair(mesh, root, &mut ws.weights, &mut ws.shape);
+        let hair = ws.batch.reset();
+        hair.id = id;
+        hair.points.clear();
+        if guide_points == self.points {
+            hair.points.extend_from_slice(&ws.shape);
+        } else {
+            resample_uniform(&ws.shape, self.points, &mut hair.points);
+        }
+        hair.colors.clear();
+        hair.opacities.clear();
+        // The pre-operator shape, for clump centres cut away entirely.
+        ws.scratch.points.clear();
+        ws.scratch.points.extend_from_slice(&hair.points);
+        for op in self.base.iter().chain(ops) {
+            op.apply(&mut ws.batch, &context, &mut ws.scratch);
+            if ws.batch.is_empty() {
+                break;
+            }
+        }
+    }
+
+    /// Roots of part `p`: sampled in the part's triangles with the part's
+    /// own stream, ordered by triangle (so neighbouring hairs are grown
+    /// together), numbered from the part's first hair id.
+    pub fn part_roots(&self, p: usize) -> Vec<SurfacePoint> {
+        let part = &self.layout.parts()[p];
+        if part.hair_count == 0 {
+            return Vec::new();
+        }
+        let Some(sampler) = self.sampler.restricted(&part.triangles) else {
+            return Vec::new();
+        };
+        let stream = mix64(self.seed ^ mix64(0x9A27 + p as u64));
+        let mut roots = sample_range(&sampler, stream, 0..part.hair_count);
+        roots.par_sort_unstable_by_key(|r| (r.tri, r.bary[0].to_bits(), r.bary[1].to_bits()));
+        roots
+    }
+
+    /// Grows part `p`: its curves with per-point widths, normals (unless
+    /// turned off), colours and opacities (when the groom has them), roots,
+    /// root UVs (meshes with UVs) and ids. Identical on any thread count.
+    pub fn part(&self, p: usize) -> Curves {
+        let part = &self.layout.parts()[p];
+        let roots = self.part_roots(p);
+        let chunks: Vec<PartChunk> = roots
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map_init(Workspace::default, |ws, (c, chunk)| {
+                let first = part.first_hair + (c * CHUNK) as u64;
+                self.grow_chunk(chunk, first, ws)
+            })
+            .collect();
+        PartChunk::concat(chunks, self.groom.mesh.has_uvs())
+    }
+
+    fn grow_chunk(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) -> PartChunk {
+        let mesh = &self.groom.mesh;
+        let n = self.points;
+        let mut out = PartChunk::with_capacity(roots.len(), n, self);
+        let mut tangents = vec![Vec3::ZERO; n];
+        let mut frame = vec![Vec3::ZERO; n];
+        for (i, root) in roots.iter().enumerate() {
+            self.grow(*root, first_id + i as u64, &self.ops, ws);
+            let normal = root.normal(mesh);
+            for hair in ws.batch.hairs() {
+                out.points.extend_from_slice(&hair.points);
+                out.widths.extend_from_slice(&hair.widths);
+                if self.colors {
+                    out.colors.extend_from_slice(&hair.colors);
+                }
+                if self.opacities {
+                    out.opacities.extend_from_slice(&hair.opacities);
+                }
+                if self.normals {
+                    catmull_rom_tangents(&hair.points, &mut tangents);
+                    rotation_minimizing_normals(&hair.points, &tangents, normal, &mut frame);
+                    out.normals.extend_from_slice(&frame);
+                }
+                out.counts.push(hair.points.len() as u32);
+                out.ids.push(hair.id);
+                out.roots.push(*root);
+            }
+        }
+        out
+    }
+}
+
+/// Hairs grown by one worker, in order.
+struct PartChunk {
+    points: Vec<Vec3>,
+    widths: Vec<f32>,
+    normals: Vec<Vec3>,
+    colors: Vec<Vec3>,
+    opacities: Vec<f32>,
+    counts: Vec<u32>,
+    ids: Vec<u64>,
+    roots: Vec<SurfacePoint>,
+    has_normals: bool,
+    has_colors: bool,
+    has_opacities: bool,
+}
+
+impl PartChunk {
+    fn with_capacity(hairs: usize, n: usize, g: &Generator) -> Self {
+        let per_point = |on: bool| if on { hairs * n } else { 0 };
+        Self {
+            points: Vec::with_capacity(hairs * n),
+            widths: Vec::with_capacity(hairs * n),
+            normals: Vec::with_capacity(per_point(g.normals)),
+            colors: Vec::with_capacity(per_point(g.colors)),
+            opacities: Vec::with_capacity(per_point(g.opacities)),
+            counts: Vec::with_capacity(hairs),
+            ids: Vec::with_capacity(hairs),
+            roots: Vec::with_capacity(hairs),
+            has_normals: g.normals,
+            has_colors: g.colors,
+            has_opacities: g.opacities,
+        }
+    }
+
+    fn concat(chunks: Vec<PartChunk>, uvs: bool) -> Curves {
+        let total_points: usize = chunks.iter().map(|c| c.points.len()).sum();
+        let total_curves: usize = chunks.iter().map(|c| c.counts.len()).sum();
+        let (has_normals, has_colors, has_opacities) =
+            chunks.first().map_or((false, false, false), |c| {
+                (c.has_normals, c.has_colors, c.has_opacities)
+            });
+        let mut points = Vec::with_capacity(total_points);
+        let mut widths = Vec::with_capacity(total_points);
+        let mut normals = Vec::with_capacity(if has_normals { total_points } else { 0 });
+        let mut colors = Vec::with_capacity(if has_colors { total_points } else { 0 });
+        let mut opacities = Vec::with_capacity(if has_opacities { total_points } else { 0 });
+        let mut offsets = Vec::with_capacity(total_curves + 1);
+        offsets.push(0u32);
+        let mut ids = Vec::with_capacity(total_curves);
+        let mut roots = Vec::with_capacity(total_curves);
+        for c in chunks {
+            points.extend_from_slice(&c.points);
+            widths.extend_from_slice(&c.widths);
+            normals.extend_from_slice(&c.normals);
+            colors.extend_from_slice(&c.colors);
+            opacities.extend_from_slice(&c.opacities);
+            for n in c.counts {
+                offsets.push(offsets.last().expect("starts at 0") + n);
+            }
+            ids.extend_from_slice(&c.ids);
+            roots.extend_from_slice(&c.roots);
+        }
+        // The generator builds consistent arrays; a failure here is a bug.
+        let mut curves = Curves::new(points, widths, offsets).expect("consistent part arrays");
+        if has_normals {
+            curves = curves.with_normals(normals).expect("one normal a point");
+        }
+        if has_colors {
+            curves = curves.with_colors(colors).expect("one colour a point");
+        }
+        if has_opacities {
+            curves = curves
+                .with_opacities(opacities)
+                .expect("one opacity a point");
+        }
+        curves = curves.with_ids(ids).expect("one id a curve");
+        let _ = uvs;
+        curves.with_roots(roots).expect("one root a curve")
+    }
+}
+
+/// `n` points evenly spaced in the parameter of the polyline `shape`
+/// (linear interpolation between its points).
+fn resample_uniform(shape: &[Vec3], n: usize, out: &mut Vec<Vec3>) {
+    let m = shape.len();
+    if m < 2 {
+        out.extend(std::iter::repeat_n(
+            shape.first().copied().unwrap_or_default(),
+            n,
+        ));
+        return;
+    }
+    out.extend((0..n).map(|k| {
+        let x = k as f32 / (n - 1) as f32 * (m - 1) as f32;
+        let j = (x as usize).min(m - 2);
+        shape[j].lerp(shape[j + 1], x - j as f32)
+    }));
+}
+
+fn width_spec(groom: &Groom, s: &WidthSpec) -> Result<RootToTip, GroomError> {
+    Ok(RootToTip {
+        root: groom.map(&s.root)?,
+        tip: groom.map(&s.tip)?,
+        ramp: s.ramp.clone(),
+        jitter: groom.map(&s.jitter)?,
+        seed: s.seed,
+    })
+}
+
+fn opacity_spec(groom: &Groom, s: &OpacitySpec) -> Result<RootToTip, GroomError> {
+    Ok(RootToTip {
+        root: groom.map(&s.root)?,
+        tip: groom.map(&s.tip)?,
+        ramp: s.ramp.clone(),
+        jitter: groom.map(&s.jitter)?,
+        seed: s.seed,
+    })
+}
+
+fn color_spec(groom: &Groom, s: &ColorSpec) -> Result<Color, GroomError> {
+    let three = |c: &[MapValue; 3]| -> Result<[Map; 3], GroomError> {
+        Ok([groom.map(&c[0])?, groom.map(&c[1])?, groom.map(&c[2])?])
+    };
+    Ok(Color {
+        root: three(&s.root)?,
+        tip: three(&s.tip)?,
+        ramp: s.ramp.clone(),
+        jitter: groom.map(&s.jitter)?,
+        seed: s.seed,
+    })
+}

@@ -1,0 +1,255 @@
+//! Displacement operators: `noise` (Sik §4.2.2, Fig. 15: "random vectors
+//! generated from Perlin noise added to the hair curve's vertices"),
+//! `frizz` (per-hair random high-frequency wiggle) and `curl` (a helix
+//! around the hair's path, the shape of Silva et al. Eq. 4).
+
+use super::{Hair, RootContext, Scratch, param};
+use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
+use crate::groom::file::Ramp;
+use crate::map::{Map, NoiseMap};
+use crate::sample::SampleRng;
+use glam::Vec3;
+use std::f32::consts::TAU;
+
+/// Offsets of the three noise components' fields, far apart so the
+/// components are uncorrelated.
+const COMPONENT_OFFSETS: [Vec3; 3] = [
+    Vec3::ZERO,
+    Vec3::new(71.3, 19.1, 43.7),
+    Vec3::new(-37.9, 83.3, -11.7),
+];
+
+/// A smooth random vector field in space: three Perlin noises.
+#[derive(Debug, Clone)]
+struct VectorNoise(NoiseMap);
+
+impl VectorNoise {
+    fn new(seed: u64) -> Self {
+        Self(NoiseMap::new(1.0, 1, seed, 0.0, 1.0))
+    }
+
+    /// Each component in about [−1, 1].
+    #[inline]
+    fn at(&self, p: Vec3) -> Vec3 {
+        Vec3::new(
+            self.0.perlin3(p + COMPONENT_OFFSETS[0]),
+            self.0.perlin3(p + COMPONENT_OFFSETS[1]),
+            self.0.perlin3(p + COMPONENT_OFFSETS[2]),
+        )
+    }
+}
+
+/// `noise`: every point moves by a Perlin vector field sampled at its
+/// position: `p += amplitude · ramp(t) · N(frequency · p)`. The field is
+/// continuous in space, so neighbouring hairs wave alike (the look of
+/// Stubble's Fig. 15); `ramp` keeps roots on the skin (linear by default).
+#[derive(Debug, Clone)]
+pub struct Noise {
+    field: VectorNoise,
+    amplitude: Map,
+    frequency: Map,
+    ramp: Ramp,
+}
+
+impl Noise {
+    /// A noise operator.
+    pub fn new(amplitude: Map, frequency: Map, ramp: Ramp, seed: u64) -> Self {
+        Self {
+            field: VectorNoise::new(seed),
+            amplitude,
+            frequency,
+            ramp,
+        }
+    }
+
+    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext) {
+        let amplitude = self.amplitude.eval(root.uv);
+        if amplitude == 0.0 {
+            return;
+        }
+        let frequency = self.frequency.eval(root.uv);
+        let n = hair.points.len();
+        for (j, p) in hair.points.iter_mut().enumerate() {
+            let a = amplitude * self.ramp.at(param(j, n));
+            if a != 0.0 {
+                *p += a * self.field.at(*p * frequency);
+            }
+        }
+    }
+}
+
+/// `frizz`: a share of the hairs (`fraction`) each wiggle on their own:
+/// `p += amplitude · ramp(t) · N(φ + frequency · t · X)`, where `φ` is a
+/// random point of the noise field drawn per hair, so hairs side by side
+/// frizz differently (unlike `noise`), `frequency` wiggles along the hair.
+#[derive(Debug, Clone)]
+pub struct Frizz {
+    field: VectorNoise,
+    amplitude: Map,
+    frequency: Map,
+    fraction: Map,
+    ramp: Ramp,
+    seed: u64,
+}
+
+impl Frizz {
+    /// A frizz operator.
+    pub fn new(amplitude: Map, frequency: Map, fraction: Map, ramp: Ramp, seed: u64) -> Self {
+        Self {
+            field: VectorNoise::new(seed ^ 0xF122),
+            amplitude,
+            frequency,
+            fraction,
+            ramp,
+            seed,
+        }
+    }
+
+    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext) {
+        let mut rng = SampleRng::new(self.seed ^ 0xF122_F122, hair.id);
+        if rng.uniform_f32() >= self.fraction.eval(root.uv) {
+            return;
+        }
+        let amplitude = self.amplitude.eval(root.uv);
+        let frequency = self.frequency.eval(root.uv);
+        let [a, b] = rng.uniform_f32_pair();
+        let phase = Vec3::new(a, b, rng.uniform_f32()) * 256.0;
+        let n = hair.points.len();
+        for (j, p) in hair.points.iter_mut().enumerate() {
+            let t = param(j, n);
+            *p += amplitude * self.ramp.at(t) * self.field.at(phase + Vec3::X * (frequency * t));
+        }
+    }
+}
+
+/// `curl`: a helix around the hair's path, Silva et al. Eq. 4 with the
+/// curve parameter for `h`: `p += α(t) (cos(2π·turns·t + φ) r + sin(…) b)`
+/// with `α(t) = radius · ramp(t)` (Silva: `K_α h`, a linear ramp), `r` the
+/// rotation-minimizing normal along the hair and `b = T × r`, `φ` a random
+/// phase per hair. The frame does not twist, so the helix turns exactly
+/// `turns` times; resolve it with enough points per hair.
+#[derive(Debug, Clone)]
+pub struct Curl {
+    radius: Map,
+    turns: Map,
+    ramp: Ramp,
+    seed: u64,
+}
+
+impl Curl {
+    /// A curl operator.
+    pub fn new(radius: Map, turns: Map, ramp: Ramp, seed: u64) -> Self {
+        Self {
+            radius,
+            turns,
+            ramp,
+            seed,
+        }
+    }
+
+    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
+        let radius = self.radius.eval(root.uv);
+        if radius == 0.0 {
+            return;
+        }
+        let turns = self.turns.eval(root.uv);
+        let phase = TAU * SampleRng::new(self.seed ^ 0xC0_11, hair.id).uniform_f32();
+        let n = hair.points.len();
+        scratch.tangents.resize(n, Vec3::ZERO);
+        scratch.frame.resize(n, Vec3::ZERO);
+        catmull_rom_tangents(&hair.points, &mut scratch.tangents);
+        rotation_minimizing_normals(
+            &hair.points,
+            &scratch.tangents,
+            root.normal.any_orthonormal_vector(),
+            &mut scratch.frame,
+        );
+        for (j, p) in hair.points.iter_mut().enumerate() {
+            let t = param(j, n);
+            let alpha = radius * self.ramp.at(t);
+            let (s, c) = (TAU * turns * t + phase).sin_cos();
+            let r = scratch.frame[j];
+            let b = scratch.tangents[j].cross(r);
+            *p += alpha * (c * r + s * b);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_hairs::{root, straight};
+    use super::*;
+
+    #[test]
+    fn noise_keeps_the_root_and_is_coherent_in_space() {
+        let op = Noise::new(Map::Constant(0.1), Map::Constant(3.0), Ramp::default(), 4);
+        let mut a = straight(1, 16, 1.0);
+        op.apply(&mut a, &root());
+        assert_eq!(a.points[0], Vec3::ZERO, "a linear ramp leaves the root");
+        let moved = (a.points[15] - Vec3::Z).length();
+        assert!(moved > 1e-3 && moved <= 0.1 * 3f32.sqrt() * 1.01, "{moved}");
+        // A neighbouring hair (another id, 1e-3 away) moves almost alike;
+        // noise is a field in space, not per hair.
+        let mut b = straight(2, 16, 1.0);
+        b.points.iter_mut().for_each(|p| *p += Vec3::X * 1e-3);
+        op.apply(&mut b, &root());
+        let db = b.points[15] - Vec3::Z - Vec3::X * 1e-3;
+        assert!((db - (a.points[15] - Vec3::Z)).length() < 0.1 * 0.05);
+    }
+
+    #[test]
+    fn frizz_differs_per_hair_and_respects_fraction() {
+        let op = Frizz::new(
+            Map::Constant(0.05),
+            Map::Constant(6.0),
+            Map::Constant(1.0),
+            Ramp::default(),
+            0,
+        );
+        let (mut a, mut b) = (straight(1, 16, 1.0), straight(2, 16, 1.0));
+        op.apply(&mut a, &root());
+        op.apply(&mut b, &root());
+        assert!((a.points[15] - b.points[15]).length() > 1e-3, "per hair");
+        let mut again = straight(1, 16, 1.0);
+        op.apply(&mut again, &root());
+        assert_eq!(again, a, "same id, same frizz");
+        let none = Frizz::new(
+            Map::Constant(0.05),
+            Map::Constant(6.0),
+            Map::Constant(0.0),
+            Ramp::default(),
+            0,
+        );
+        let mut c = straight(3, 16, 1.0);
+        none.apply(&mut c, &root());
+        assert_eq!(c, straight(3, 16, 1.0), "fraction 0 frizzes nothing");
+    }
+
+    #[test]
+    fn curl_is_a_helix_of_the_given_radius_and_turns() {
+        // Straight hair up Z, constant ramp: every point lies at exactly
+        // `radius` from the axis, at its own height, and the angle turns
+        // 2 full times root to tip.
+        let op = Curl::new(Map::Constant(0.05), Map::Constant(2.0), Ramp::Power(0.0), 9);
+        let n = 65;
+        let mut hair = straight(1, n, 1.0);
+        op.apply(&mut hair, &root(), &mut Scratch::default());
+        let mut angle = 0.0f32;
+        for j in 0..n {
+            let p = hair.points[j];
+            assert!((p.truncate().length() - 0.05).abs() < 1e-5, "{j}: {p}");
+            assert!((p.z - param(j, n)).abs() < 1e-6);
+            if j > 0 {
+                let q = hair.points[j - 1].truncate();
+                angle += q.angle_to(p.truncate());
+            }
+        }
+        assert!((angle.abs() - 2.0 * TAU).abs() < 1e-3, "{angle}");
+        // Silva's linear ramp: the radius grows from 0 at the root.
+        let linear = Curl::new(Map::Constant(0.05), Map::Constant(2.0), Ramp::default(), 9);
+        let mut hair = straight(1, n, 1.0);
+        linear.apply(&mut hair, &root(), &mut Scratch::default());
+        assert!(hair.points[0].length() < 1e-7);
+        assert!((hair.points[32].truncate().length() - 0.025).abs() < 1e-5);
+    }
+}

@@ -1,0 +1,283 @@
+//! Groom operators: the ordered chain every hair passes through after
+//! interpolation (Sik §4.2.2's noise, colour, width, strands and cut;
+//! Furtility's idea of a chain of groom operators; clump and curl as
+//! XGen, Houdini and Silva Eq. 4 shape them).
+//!
+//! An operator works on a [`HairBatch`]: the hairs grown from one root —
+//! one hair, or several once [`Strands`] has split it. Every random number
+//! comes from a stream keyed by the operator's seed and the hair's id
+//! ([`SampleRng`]), so a hair is the same whichever thread, part or run
+//! makes it (DESIGN.md, "Deterministic by hair id"). Parameters are
+//! [`Map`]s read at the root's UV.
+//!
+//! Points are indexed root to tip; `t = j / (n − 1)` is point `j`'s curve
+//! parameter, the `t` of every root-to-tip [`Ramp`].
+
+mod clump;
+mod displace;
+mod look;
+mod strands;
+mod trim;
+
+pub use clump::{Clump, ClumpCentres};
+pub use displace::{Curl, Frizz, Noise};
+pub use look::{Color, Opacity, Width};
+pub use strands::Strands;
+pub use trim::{Cut, Length};
+
+use crate::groom::file::Ramp;
+use crate::map::Map;
+use crate::mesh::SurfacePoint;
+use crate::sample::SampleRng;
+use glam::{Vec2, Vec3};
+
+/// One hair while operators shape it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Hair {
+    /// Stable id (a strand's hairs get `id · count + k`).
+    pub id: u64,
+    /// Points, root first.
+    pub points: Vec<Vec3>,
+    /// Per-point widths.
+    pub widths: Vec<f32>,
+    /// Per-point colours (empty: none).
+    pub colors: Vec<Vec3>,
+    /// Per-point opacities (empty: none).
+    pub opacities: Vec<f32>,
+}
+
+impl Hair {
+    /// Copies `other` into `self`, reusing `self`'s buffers.
+    pub fn copy_from(&mut self, other: &Hair) {
+        self.id = other.id;
+        for (dst, src) in [
+            (&mut self.points, &other.points),
+            (&mut self.colors, &other.colors),
+        ] {
+            dst.clear();
+            dst.extend_from_slice(src);
+        }
+        for (dst, src) in [
+            (&mut self.widths, &other.widths),
+            (&mut self.opacities, &other.opacities),
+        ] {
+            dst.clear();
+            dst.extend_from_slice(src);
+        }
+    }
+}
+
+/// The hairs grown from one root. Slots beyond `len` keep their buffers
+/// for reuse, so the chain allocates nothing per hair once warm.
+#[derive(Debug, Clone, Default)]
+pub struct HairBatch {
+    hairs: Vec<Hair>,
+    len: usize,
+}
+
+impl HairBatch {
+    /// The live hairs.
+    pub fn hairs(&self) -> &[Hair] {
+        &self.hairs[..self.len]
+    }
+
+    /// The live hairs, to change.
+    pub fn hairs_mut(&mut self) -> &mut [Hair] {
+        &mut self.hairs[..self.len]
+    }
+
+    /// Empties the batch (keeping buffers) and returns a fresh first hair.
+    pub fn reset(&mut self) -> &mut Hair {
+        self.len = 0;
+        self.push()
+    }
+
+    /// Appends a hair (a reused slot: the caller overwrites every field).
+    pub fn push(&mut self) -> &mut Hair {
+        if self.len == self.hairs.len() {
+            self.hairs.push(Hair::default());
+        }
+        self.len += 1;
+        &mut self.hairs[self.len - 1]
+    }
+
+    /// Keeps the hairs for which `keep` is true, in order.
+    pub fn retain(&mut self, mut keep: impl FnMut(&Hair) -> bool) {
+        let mut kept = 0;
+        for i in 0..self.len {
+            if keep(&self.hairs[i]) {
+                self.hairs.swap(kept, i);
+                kept += 1;
+            }
+        }
+        self.len = kept;
+    }
+
+    /// Number of live hairs.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether no hair is left.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// Where a batch grows: the root on the skin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RootContext {
+    /// The root on the mesh.
+    pub point: SurfacePoint,
+    /// Its position.
+    pub position: Vec3,
+    /// The skin normal there.
+    pub normal: Vec3,
+    /// The UV maps are read at (zero on meshes without UVs, where only
+    /// constant maps are allowed).
+    pub uv: Vec2,
+}
+
+/// Buffers operators share, reused hair after hair.
+#[derive(Debug, Default)]
+pub struct Scratch {
+    pub(crate) tangents: Vec<Vec3>,
+    pub(crate) frame: Vec<Vec3>,
+    pub(crate) points: Vec<Vec3>,
+    pub(crate) floats: Vec<f32>,
+    pub(crate) bases: HairBatch,
+}
+
+/// One operator of the chain.
+#[derive(Debug)]
+pub enum Operator {
+    /// Perlin displacement.
+    Noise(Noise),
+    /// Per-hair random high-frequency displacement.
+    Frizz(Frizz),
+    /// Pull toward clump centre hairs.
+    Clump(Clump),
+    /// Helix around the path.
+    Curl(Curl),
+    /// Cut at a curve parameter.
+    Cut(Cut),
+    /// Scale the length.
+    Length(Length),
+    /// Split into strands.
+    Strands(Strands),
+    /// Widths.
+    Width(Width),
+    /// Colours.
+    Color(Color),
+    /// Opacity.
+    Opacity(Opacity),
+}
+
+impl Operator {
+    /// Applies the operator to every hair of `batch`.
+    pub fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
+        match self {
+            Operator::Strands(op) => op.apply(batch, root, scratch),
+            Operator::Cut(op) => op.apply(batch, root, scratch),
+            _ => {
+                for hair in batch.hairs_mut() {
+                    match self {
+                        Operator::Noise(op) => op.apply(hair, root),
+                        Operator::Frizz(op) => op.apply(hair, root),
+                        Operator::Clump(op) => op.apply(hair, root),
+                        Operator::Curl(op) => op.apply(hair, root, scratch),
+                        Operator::Length(op) => op.apply(hair, root),
+                        Operator::Width(op) => op.apply(hair, root),
+                        Operator::Color(op) => op.apply(hair, root),
+                        Operator::Opacity(op) => op.apply(hair, root),
+                        Operator::Strands(_) | Operator::Cut(_) => unreachable!(),
+                    }
+                }
+            }
+        }
+    }
+
+    /// The operator's name as groom files spell it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Operator::Noise(_) => "noise",
+            Operator::Frizz(_) => "frizz",
+            Operator::Clump(_) => "clump",
+            Operator::Curl(_) => "curl",
+            Operator::Cut(_) => "cut",
+            Operator::Length(_) => "length",
+            Operator::Strands(_) => "strands",
+            Operator::Width(_) => "width",
+            Operator::Color(_) => "color",
+            Operator::Opacity(_) => "opacity",
+        }
+    }
+}
+
+/// Curve parameter of point `j` of `n`.
+#[inline]
+pub(crate) fn param(j: usize, n: usize) -> f32 {
+    if n > 1 {
+        j as f32 / (n - 1) as f32
+    } else {
+        0.0
+    }
+}
+
+/// `1 + jitter · (2ξ − 1)`: a per-hair factor varying by ±`jitter`.
+#[inline]
+pub(crate) fn jittered(jitter: f32, rng: &mut SampleRng) -> f32 {
+    if jitter == 0.0 {
+        1.0
+    } else {
+        1.0 + jitter * (2.0 * rng.uniform_f32() - 1.0)
+    }
+}
+
+/// A root-to-tip quantity: `root + ramp(t) · (tip − root)`.
+#[derive(Debug, Clone)]
+pub struct RootToTip {
+    /// Value at the root.
+    pub root: Map,
+    /// Value at the tip.
+    pub tip: Map,
+    /// Profile.
+    pub ramp: Ramp,
+    /// Per-hair random variation, a fraction.
+    pub jitter: Map,
+    /// Seed of the variation.
+    pub seed: u64,
+}
+
+#[cfg(test)]
+pub(crate) mod test_hairs {
+    use super::*;
+
+    /// A straight hair of `n` points from the origin up +Z to height `len`.
+    pub fn straight(id: u64, n: usize, len: f32) -> Hair {
+        Hair {
+            id,
+            points: (0..n).map(|j| Vec3::Z * len * param(j, n)).collect(),
+            widths: vec![0.01; n],
+            colors: Vec::new(),
+            opacities: Vec::new(),
+        }
+    }
+
+    /// The root context of [`straight`]: at the origin, normal +Z.
+    pub fn root() -> RootContext {
+        RootContext {
+            point: SurfacePoint::new(0, [0.3, 0.3]),
+            position: Vec3::ZERO,
+            normal: Vec3::Z,
+            uv: Vec2::new(0.5, 0.5),
+        }
+    }
+
+    /// A batch holding one hair.
+    pub fn batch(hair: Hair) -> HairBatch {
+        let mut b = HairBatch::default();
+        *b.reset() = hair;
+        b
+    }
+}

@@ -1,0 +1,117 @@
+//! `strands` (Sik §4.2.2, Fig. 16): each hair becomes a strand of `count`
+//! hairs around it: "we use the just generated hair as a basic hair around
+//! which all hair from this strand is generated … parameters control the
+//! spread of hair roots and tips from the basic hair, twisting of hair
+//! around the basic hair".
+
+use super::{HairBatch, RootContext, Scratch};
+use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
+use crate::map::Map;
+use crate::sample::SampleRng;
+use glam::Vec3;
+use std::f32::consts::TAU;
+
+/// `strands`: hair `k` of the strand of base hair `b` has id
+/// `b.id · count + k` and points `b(t) + s(t) · ρ · (cos θ(t) r + sin θ(t) B)`,
+/// where `s(t)` runs from `root_spread` to `tip_spread`, `ρ = √ξ` and
+/// `θ(t) = 2π(ξ' + twist · t)` (a uniform point of the unit disc, turned
+/// `twist` times along the hair), `r, B` the base hair's
+/// rotation-minimizing frame. The base hair itself is replaced by its
+/// strand; widths, colours and opacities are inherited.
+#[derive(Debug, Clone)]
+pub struct Strands {
+    count: u32,
+    root_spread: Map,
+    tip_spread: Map,
+    twist: Map,
+    seed: u64,
+}
+
+impl Strands {
+    /// A strands operator (`count` at least 1).
+    pub fn new(count: u32, root_spread: Map, tip_spread: Map, twist: Map, seed: u64) -> Self {
+        Self {
+            count: count.max(1),
+            root_spread,
+            tip_spread,
+            twist,
+            seed,
+        }
+    }
+
+    pub(super) fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
+        let bases = &mut scratch.bases;
+        bases.len = 0;
+        for hair in batch.hairs() {
+            bases.push().copy_from(hair);
+        }
+        let (s0, s1) = (
+            self.root_spread.eval(root.uv),
+            self.tip_spread.eval(root.uv),
+        );
+        let twist = self.twist.eval(root.uv);
+        batch.len = 0;
+        for base in bases.hairs() {
+            let n = base.points.len();
+            scratch.tangents.resize(n, Vec3::ZERO);
+            scratch.frame.resize(n, Vec3::ZERO);
+            catmull_rom_tangents(&base.points, &mut scratch.tangents);
+            rotation_minimizing_normals(
+                &base.points,
+                &scratch.tangents,
+                root.normal.any_orthonormal_vector(),
+                &mut scratch.frame,
+            );
+            for k in 0..u64::from(self.count) {
+                let id = base.id.wrapping_mul(u64::from(self.count)).wrapping_add(k);
+                let [a, b] = SampleRng::new(self.seed ^ 0x57_2A4D, id).uniform_f32_pair();
+                let rho = a.sqrt();
+                let hair = batch.push();
+                hair.copy_from(base);
+                hair.id = id;
+                for (j, p) in hair.points.iter_mut().enumerate() {
+                    let t = super::param(j, n);
+                    let (sin, cos) = (TAU * (b + twist * t)).sin_cos();
+                    let r = scratch.frame[j];
+                    let side = scratch.tangents[j].cross(r);
+                    *p += (s0 + t * (s1 - s0)) * rho * (cos * r + sin * side);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_hairs::{batch, root, straight};
+    use super::*;
+
+    #[test]
+    fn strand_hairs_stay_within_the_spreads_with_distinct_ids() {
+        let op = Strands::new(
+            12,
+            Map::Constant(0.01),
+            Map::Constant(0.1),
+            Map::Constant(0.5),
+            3,
+        );
+        let mut b = batch(straight(5, 9, 1.0));
+        op.apply(&mut b, &root(), &mut Scratch::default());
+        assert_eq!(b.len(), 12);
+        let mut ids: Vec<u64> = b.hairs().iter().map(|h| h.id).collect();
+        ids.dedup();
+        assert_eq!(ids, (60..72).collect::<Vec<_>>());
+        let mut widest_tip = 0.0f32;
+        for hair in b.hairs() {
+            let root_off = hair.points[0].length();
+            let tip_off = (hair.points[8] - Vec3::Z).length();
+            assert!(root_off <= 0.01 + 1e-6 && tip_off <= 0.1 + 1e-6);
+            assert!(
+                hair.points[0].z.abs() < 1e-6,
+                "roots spread in the skin's plane"
+            );
+            widest_tip = widest_tip.max(tip_off);
+        }
+        assert!(widest_tip > 0.05, "the strand opens toward the tip");
+    }
+}

@@ -1,0 +1,200 @@
+//! Writing a groom: parts stream to the writer as they are grown (DESIGN.md
+//! "Streaming"), and a farm's per-part files are tied together by a small
+//! root USD layer ([`write_assembly`]).
+
+use super::generator::{Generator, GroomSummary};
+use crate::curves::Curves;
+use crate::io::{
+    CurvesExport, CurvesFormat, UsdaWriter, WriteError, write_atomically, write_curves,
+};
+use glam::Vec3;
+use std::io::{BufRead, Write};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// The parts run `k` of `n` (1-based `k`) grows: a contiguous slice of the
+/// layout, so the `n` runs together grow every part exactly once, in order.
+pub fn part_slice(k: usize, n: usize, parts: usize) -> Range<usize> {
+    debug_assert!((1..=n).contains(&k));
+    (k - 1) * parts / n..k * parts / n
+}
+
+/// The prim name of part `p` (global index, so files of separate runs
+/// never collide).
+pub fn part_name(p: usize) -> String {
+    format!("part_{p:04}")
+}
+
+/// The file run `k` of `n` writes beside `output`: `groom.usda` →
+/// `groom.part-3-of-8.usda`.
+pub fn part_file(output: &Path, k: usize, n: usize) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("groom");
+    let ext = output
+        .extension()
+        .and_then(|s| s.to_str())
+        .unwrap_or("usda");
+    output.with_file_name(format!("{stem}.part-{k}-of-{n}.{ext}"))
+}
+
+impl Generator<'_> {
+    /// Grows `parts` and writes them to `path` (format by extension),
+    /// atomically. USD streams: a part is written while the next one grows,
+    /// so memory holds about two parts whatever the groom's size. Other
+    /// formats need every curve at once and join the parts first.
+    /// `on_part(p, curves)` is called as each part is done.
+    pub fn write(
+        &self,
+        path: &Path,
+        parts: Range<usize>,
+        export: &CurvesExport,
+        mut on_part: impl FnMut(usize, &Curves) + Send,
+    ) -> Result<GroomSummary, WriteError> {
+        let mut summary = GroomSummary::default();
+        let mut count = |c: &Curves| {
+            summary.hairs += c.curve_count() as u64;
+            summary.points += c.points().len() as u64;
+        };
+        if CurvesFormat::from_path(path) != Some(CurvesFormat::Usda) {
+            let mut grown = Vec::new();
+            for p in parts {
+                let curves = self.part(p);
+                on_part(p, &curves);
+                count(&curves);
+                grown.push((part_name(p), curves));
+            }
+            write_curves(path, grown.iter().map(|(n, c)| (n.clone(), c)), export)?;
+            return Ok(summary);
+        }
+        write_atomically(path, |out| {
+            let other = std::io::Error::other;
+            let mut usd = UsdaWriter::new(out, &export.usd).map_err(other)?;
+            if let Some(mesh) = export.mesh {
+                usd.write_mesh("skin", mesh).map_err(other)?;
+            }
+            std::thread::scope(|scope| {
+                // One part in flight while the previous one is written.
+                let (send, receive) = std::sync::mpsc::sync_channel::<(usize, Curves)>(1);
+                let grower = scope.spawn(move || {
+                    for p in parts {
+                        if send.send((p, self.part(p))).is_err() {
+                            break; // the writer failed and hung up
+                        }
+                    }
+                });
+                for (p, curves) in receive {
+                    usd.write_part(&part_name(p), &curves).map_err(other)?;
+                    on_part(p, &curves);
+                    count(&curves);
+                }
+                grower.join().expect("the part grower does not panic");
+                Ok::<(), std::io::Error>(())
+            })?;
+            usd.finish().map_err(other)?;
+            Ok(())
+        })?;
+        Ok(summary)
+    }
+}
+
+/// Writes a root USD layer at `path` that references every part file (each
+/// a stage whose default prim holds that run's parts) with its extent, so a
+/// renderer loads the whole groom through USD composition. Extents are read
+/// from the part files (pelage writes one per prim); a missing part file is
+/// an error naming it.
+pub fn write_assembly(path: &Path, part_files: &[PathBuf]) -> Result<(Vec3, Vec3), WriteError> {
+    let fail = |file: &Path, message: String| WriteError {
+        path: file.to_path_buf(),
+        error: std::io::Error::other(message),
+    };
+    let mut extents = Vec::with_capacity(part_files.len());
+    for file in part_files {
+        let reader = std::fs::File::open(file)
+            .map(std::io::BufReader::new)
+            .map_err(|e| fail(file, format!("cannot read the part file: {e}")))?;
+        let mut bounds: Option<(Vec3, Vec3)> = None;
+        for line in reader.lines() {
+            let line = line.map_err(|e| fail(file, format!("cannot read the part file: {e}")))?;
+            let Some(values) = line.trim_start().strip_prefix("float3[] extent = ") else {
+                continue;
+            };
+            let numbers: Vec<f32> = values
+                .split(|c: char| !(c.is_ascii_digit() || "-+.eE".contains(c)))
+                .filter(|s| !s.is_empty())
+                .filter_map(|s| s.parse().ok())
+                .collect();
+            if let [a, b, c, d, e, f] = numbers[..] {
+                let (lo, hi) = (Vec3::new(a, b, c), Vec3::new(d, e, f));
+                bounds = Some(match bounds {
+                    Some((l, h)) => (l.min(lo), h.max(hi)),
+                    None => (lo, hi),
+                });
+            }
+        }
+        let bounds = bounds.ok_or_else(|| {
+            fail(
+                file,
+                "no extent found: is this a part file written by pelage groom?".into(),
+            )
+        })?;
+        extents.push(bounds);
+    }
+    let whole = extents
+        .iter()
+        .copied()
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+        .unwrap_or((Vec3::ZERO, Vec3::ZERO));
+    let folder = path.parent().unwrap_or(Path::new(""));
+    write_atomically(path, |out| {
+        let t = |v: Vec3| format!("({}, {}, {})", v.x, v.y, v.z);
+        writeln!(
+            out,
+            "#usda 1.0\n(\n    defaultPrim = \"groom\"\n    doc = \"Written by pelage {}: the parts of a groom, one reference a part file\"\n)\n\ndef Xform \"groom\"\n{{\n    float3[] extentsHint = [{}, {}]",
+            env!("CARGO_PKG_VERSION"),
+            t(whole.0),
+            t(whole.1)
+        )?;
+        for (k, (file, (lo, hi))) in part_files.iter().zip(&extents).enumerate() {
+            // Reference by path relative to the root layer when possible.
+            let shown = file
+                .strip_prefix(folder)
+                .map(|p| format!("./{}", p.display()))
+                .unwrap_or_else(|_| file.display().to_string());
+            writeln!(
+                out,
+                "\n    def Xform \"run_{:04}\" (\n        prepend references = @{shown}@\n    )\n    {{\n        float3[] extentsHint = [{}, {}]\n    }}",
+                k + 1,
+                t(*lo),
+                t(*hi)
+            )?;
+        }
+        writeln!(out, "}}")
+    })?;
+    Ok(whole)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn part_slices_tile_the_layout_for_any_run_count() {
+        for parts in [1, 5, 16, 17] {
+            for n in 1..=parts {
+                let mut next = 0;
+                for k in 1..=n {
+                    let r = part_slice(k, n, parts);
+                    assert_eq!(r.start, next);
+                    next = r.end;
+                }
+                assert_eq!(next, parts);
+            }
+        }
+        assert_eq!(
+            part_file(Path::new("out/groom.usda"), 3, 8),
+            Path::new("out/groom.part-3-of-8.usda")
+        );
+    }
+}

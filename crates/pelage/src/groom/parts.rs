@@ -1,0 +1,177 @@
+//! Parts: the mesh split into spatially compact groups of triangles, each
+//! generated on its own (Sik §4.2.1: "each of these calls is responsible
+//! for generating hair on one selected part of a triangular mesh"; DESIGN.md
+//! "Parts").
+//!
+//! Triangles are ordered along a Morton (Z-order) curve through their
+//! centroids and cut into runs of equal root probability, so parts are
+//! compact and balanced. The layout depends only on the mesh, the density
+//! and the part count — never on threads or machines — and part `p`'s
+//! hairs are numbered from `⌊N·C(p)⌋` to `⌊N·C(p+1)⌋`, `C` the cumulative
+//! probability at the part boundaries, so the parts' hair ids tile
+//! `0..N` exactly.
+
+use crate::mesh::Mesh;
+use glam::Vec3;
+
+/// One part of the mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Part {
+    /// Its triangles, ascending.
+    pub triangles: Vec<u32>,
+    /// Id of its first hair.
+    pub first_hair: u64,
+    /// Number of hairs it grows.
+    pub hair_count: u64,
+}
+
+/// The parts of a groom.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartLayout {
+    parts: Vec<Part>,
+}
+
+impl PartLayout {
+    /// Splits `mesh` into `part_count` parts of about equal weight
+    /// (`triangle_weight(t)`: the probability that a root lands in `t`) and
+    /// shares `hairs` among them.
+    pub fn new(
+        mesh: &Mesh,
+        triangle_weight: impl Fn(usize) -> f64,
+        hairs: u64,
+        part_count: usize,
+    ) -> Self {
+        let part_count = part_count.max(1);
+        let (lo, hi) = mesh.bounds();
+        let extent = (hi - lo).max(Vec3::splat(1e-30));
+        let mut order: Vec<(u64, u32)> = (0..mesh.triangle_count())
+            .map(|t| {
+                let [a, b, c] = mesh.triangle_positions(t);
+                let centroid = ((a + b + c) / 3.0 - lo) / extent;
+                (morton(centroid), t as u32)
+            })
+            .collect();
+        order.sort_unstable();
+        let weights: Vec<f64> = order
+            .iter()
+            .map(|&(_, t)| triangle_weight(t as usize))
+            .collect();
+        let total: f64 = weights.iter().sum();
+
+        let mut parts = Vec::with_capacity(part_count);
+        let mut start = 0usize;
+        let mut cumulative = 0.0f64;
+        let mut first_hair = 0u64;
+        for p in 0..part_count {
+            let target = total * (p + 1) as f64 / part_count as f64;
+            let mut end = start;
+            if p + 1 == part_count {
+                end = order.len();
+                cumulative = total;
+            } else {
+                while end < order.len() && cumulative + weights[end] * 0.5 < target {
+                    cumulative += weights[end];
+                    end += 1;
+                }
+            }
+            let fraction = if total > 0.0 { cumulative / total } else { 1.0 };
+            let last_hair = if p + 1 == part_count {
+                hairs
+            } else {
+                ((hairs as f64 * fraction).floor() as u64).min(hairs)
+            };
+            let mut triangles: Vec<u32> = order[start..end].iter().map(|&(_, t)| t).collect();
+            triangles.sort_unstable();
+            parts.push(Part {
+                triangles,
+                first_hair,
+                hair_count: last_hair - first_hair,
+            });
+            first_hair = last_hair;
+            start = end;
+        }
+        Self { parts }
+    }
+
+    /// The parts, in order.
+    pub fn parts(&self) -> &[Part] {
+        &self.parts
+    }
+
+    /// Number of parts.
+    pub fn len(&self) -> usize {
+        self.parts.len()
+    }
+
+    /// Whether there are no parts (never: a layout has at least one).
+    pub fn is_empty(&self) -> bool {
+        self.parts.is_empty()
+    }
+}
+
+/// 63-bit Morton code of a point of the unit cube (21 bits an axis).
+fn morton(p: Vec3) -> u64 {
+    let scale = ((1u32 << 21) - 1) as f32;
+    let q = |x: f32| spread((x.clamp(0.0, 1.0) * scale) as u64);
+    q(p.x) | (q(p.y) << 1) | (q(p.z) << 2)
+}
+
+/// Spreads the low 21 bits of `x` to every third bit.
+fn spread(mut x: u64) -> u64 {
+    x &= 0x1F_FFFF;
+    x = (x | (x << 32)) & 0x001F_0000_0000_FFFF;
+    x = (x | (x << 16)) & 0x001F_0000_FF00_00FF;
+    x = (x | (x << 8)) & 0x100F_00F0_0F00_F00F;
+    x = (x | (x << 4)) & 0x10C3_0C30_C30C_30C3;
+    x = (x | (x << 2)) & 0x1249_2492_4924_9249;
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn morton_interleaves_axes() {
+        assert_eq!(spread(0b111), 0b1001001);
+        assert!(morton(Vec3::ZERO) < morton(Vec3::splat(0.5)));
+        assert!(morton(Vec3::splat(0.5)) < morton(Vec3::ONE));
+    }
+
+    #[test]
+    fn parts_cover_every_triangle_and_tile_the_hair_ids() {
+        let mesh = crate::assets::spot();
+        let areas = mesh.triangle_areas().to_vec();
+        let total: f64 = areas.iter().map(|&a| f64::from(a)).sum();
+        let layout = PartLayout::new(&mesh, |t| f64::from(areas[t]) / total, 100_003, 7);
+        assert_eq!(layout.len(), 7);
+        let mut all: Vec<u32> = layout
+            .parts()
+            .iter()
+            .flat_map(|p| p.triangles.clone())
+            .collect();
+        all.sort_unstable();
+        assert_eq!(all, (0..mesh.triangle_count() as u32).collect::<Vec<_>>());
+        let mut next = 0;
+        for part in layout.parts() {
+            assert_eq!(part.first_hair, next);
+            next += part.hair_count;
+            // Balanced by area: within a few percent of a seventh each.
+            let share = part.hair_count as f64 / 100_003.0;
+            assert!((share - 1.0 / 7.0).abs() < 0.01, "{share}");
+        }
+        assert_eq!(next, 100_003);
+        // Compact: each part's box is far smaller than the mesh's.
+        let (lo, hi) = mesh.bounds();
+        for part in layout.parts() {
+            let mut b = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+            for &t in &part.triangles {
+                for p in mesh.triangle_positions(t as usize) {
+                    b = (b.0.min(p), b.1.max(p));
+                }
+            }
+            let volume = |l: Vec3, h: Vec3| (h - l).x * (h - l).y * (h - l).z;
+            assert!(volume(b.0, b.1) < 0.6 * volume(lo, hi));
+        }
+    }
+}

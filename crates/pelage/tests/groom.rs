@@ -1,0 +1,227 @@
+//! The groom generator end to end: determinism across threads and parts,
+//! roots that follow the density, every operator in one chain, and errors
+//! that name the groom file's line and key.
+
+use glam::Vec3;
+use pelage::Curves;
+use pelage::groom::{Groom, GroomError};
+use std::collections::HashSet;
+
+const EVERY_OPERATOR: &str = r#"
+[mesh]
+path = "spot"
+
+[roots]
+count = 6000
+density = "noise:frequency=4,seed=3,offset=0.6,scale=0.4"
+seed = 11
+parts = 3
+
+[guides]
+points = 6
+generate = { count = 120, length = 0.05, comb = [0, -1, 0], gravity = 0.2 }
+
+[[ops]]
+clump = { count = 300, rate = 0.6, ramp = "smooth" }
+
+[[ops]]
+clump = { count = 40, rate = 0.3, size = 0.2 }
+
+[[ops]]
+curl = { radius = 0.003, turns = 1.5 }
+
+[[ops]]
+noise = { amplitude = 0.003, frequency = "noise:frequency=2,offset=30,scale=10" }
+
+[[ops]]
+frizz = { amplitude = 0.002, fraction = 0.3 }
+
+[[ops]]
+length = { scale = 1.0, jitter = 0.2 }
+
+[[ops]]
+cut = { at = "noise:frequency=3,offset=0.9,scale=0.3" }
+
+[[ops]]
+strands = { count = 3, root_spread = 0.001, tip_spread = 0.004, twist = 0.5 }
+
+[[ops]]
+width = { root = 0.001, tip = 0.0001, jitter = 0.1 }
+
+[[ops]]
+color = { root = [0.2, 0.1, 0.05], tip = [0.8, 0.7, 0.5], jitter = 0.1 }
+
+[[ops]]
+opacity = { root = 1.0, tip = 0.5 }
+"#;
+
+fn groom(text: &str) -> Groom {
+    Groom::from_text("test.toml", text).expect("the groom loads")
+}
+
+fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+#[test]
+fn output_is_identical_on_one_and_two_threads() {
+    let g = groom(EVERY_OPERATOR);
+    let grow_all = |threads| {
+        in_pool(threads, || {
+            let generator = g.generator(None).unwrap();
+            (0..generator.parts().len())
+                .map(|p| generator.part(p))
+                .collect::<Vec<Curves>>()
+        })
+    };
+    let one = grow_all(1);
+    let two = grow_all(2);
+    assert_eq!(one.len(), 3);
+    for (a, b) in one.iter().zip(&two) {
+        assert!(a.curve_count() > 0);
+        // Bit-identical: compare the bits, not approximate values.
+        let bits = |c: &Curves| -> Vec<u32> {
+            c.points()
+                .iter()
+                .flat_map(|p| p.to_array())
+                .chain(c.widths().iter().copied())
+                .chain(c.normals().unwrap().iter().flat_map(|n| n.to_array()))
+                .chain(c.colors().unwrap().iter().flat_map(|n| n.to_array()))
+                .chain(c.opacities().unwrap().iter().copied())
+                .map(f32::to_bits)
+                .collect()
+        };
+        assert_eq!(bits(a), bits(b));
+        assert_eq!(a.ids(), b.ids());
+        assert_eq!(a.offsets(), b.offsets());
+    }
+}
+
+#[test]
+fn a_part_grown_alone_equals_that_part_of_the_full_run() {
+    let g = groom(EVERY_OPERATOR);
+    let full = g.generator(None).unwrap();
+    let parts: Vec<Curves> = (0..3).map(|p| full.part(p)).collect();
+    // A fresh generator (another process, another machine) asked for the
+    // last part only.
+    let alone = g.generator(None).unwrap().part(2);
+    assert_eq!(alone, parts[2]);
+    // Hair ids are unique over the whole groom and strands multiply them.
+    let ids: HashSet<u64> = parts.iter().flat_map(|c| c.ids().unwrap().to_vec()).collect();
+    let total: usize = parts.iter().map(Curves::curve_count).sum();
+    assert_eq!(ids.len(), total);
+    assert!(total > 3 * 6000 / 2 && total <= 3 * 6000, "{total}");
+    // A different seed gives a different groom.
+    let other = g.generator(Some(12)).unwrap().part(2);
+    assert_ne!(other.points(), parts[2].points());
+}
+
+#[test]
+fn roots_follow_the_density_across_parts() {
+    // Constant density on spot: each triangle's share of roots is its
+    // share of the area. Chi-square over 64 groups of triangles.
+    let g = groom(
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 200000\nparts = 5\n[guides]\npoints = 2\ngenerate = { count = 50, length = 0.02 }\n[finish]\npoints = 2\nnormals = false\n",
+    );
+    let generator = g.generator(None).unwrap();
+    let mesh = g.mesh();
+    let groups = 64;
+    let group_of = |t: u32| t as usize * groups / mesh.triangle_count();
+    let mut observed = vec![0f64; groups];
+    let mut hairs = 0;
+    for p in 0..generator.parts().len() {
+        let part = &generator.parts()[p];
+        let curves = generator.part(p);
+        assert_eq!(curves.curve_count() as u64, part.hair_count);
+        for root in curves.roots().unwrap() {
+            assert!(part.triangles.binary_search(&root.tri).is_ok(), "root outside its part");
+            observed[group_of(root.tri)] += 1.0;
+            hairs += 1;
+        }
+    }
+    assert_eq!(hairs, 200_000);
+    let area = mesh.surface_area();
+    let mut expected = vec![0f64; groups];
+    for (t, a) in mesh.triangle_areas().iter().enumerate() {
+        expected[group_of(t as u32)] += f64::from(*a) / area * hairs as f64;
+    }
+    let chi2: f64 = observed
+        .iter()
+        .zip(&expected)
+        .map(|(o, e)| (o - e).powi(2) / e)
+        .sum();
+    // 63 degrees of freedom: P(χ² > 110) ≈ 2·10⁻⁴.
+    assert!(chi2 < 110.0, "χ² = {chi2}");
+}
+
+#[test]
+fn clumped_tips_meet_at_their_centres() {
+    let g = groom(
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 5000\n[guides]\ngenerate = { count = 80, length = 0.05 }\n[[ops]]\nclump = { count = 25, rate = 1.0 }\n",
+    );
+    let curves = g.generator(None).unwrap().part(0);
+    let tips: HashSet<[u32; 3]> = (0..curves.curve_count())
+        .map(|i| {
+            let tip = curves.points()[curves.range(i).end - 1];
+            (tip * 1e4).round().to_array().map(|x| x as i32 as u32)
+        })
+        .collect();
+    assert!(tips.len() <= 25, "{} distinct tips", tips.len());
+    // Roots stay on the skin.
+    for (i, root) in curves.roots().unwrap().iter().enumerate() {
+        let p = curves.points()[curves.range(i).start];
+        assert!((p - root.position(g.mesh())).length() < 1e-5);
+    }
+}
+
+#[test]
+fn normals_are_unit_and_perpendicular_to_the_hair() {
+    let g = groom(EVERY_OPERATOR);
+    let curves = g.generator(None).unwrap().part(1);
+    let normals = curves.normals().unwrap();
+    for i in 0..curves.curve_count() {
+        let r = curves.range(i);
+        let pts = &curves.points()[r.clone()];
+        for j in 1..pts.len() - 1 {
+            let tangent = (pts[j + 1] - pts[j - 1]).normalize_or_zero();
+            let n = normals[r.start + j];
+            assert!((n.length() - 1.0).abs() < 1e-4);
+            if tangent != Vec3::ZERO {
+                assert!(n.dot(tangent).abs() < 1e-3, "hair {i} point {j}");
+            }
+        }
+    }
+}
+
+fn error(text: &str) -> String {
+    let e: GroomError = Groom::from_text("fur/test.toml", text)
+        .and_then(|g| g.generator(None).map(|_| ()))
+        .unwrap_err();
+    e.to_string()
+}
+
+#[test]
+fn errors_name_the_file_line_and_key() {
+    let missing_mesh = error(
+        "[mesh]\npath = \"nowhere.obj\"\n[roots]\ncount = 10\n[guides]\ngenerate = { count = 5, length = 0.1 }\n",
+    );
+    assert!(missing_mesh.starts_with("fur/test.toml:2:8: mesh.path: "), "{missing_mesh}");
+    assert!(missing_mesh.contains("nowhere.obj"), "{missing_mesh}");
+
+    let method = error(
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\ngenerate = { count = 5, length = 0.1 }\n[interpolation]\nmethod = \"shepherd\"\n",
+    );
+    assert!(method.starts_with("fur/test.toml:8:10: interpolation.method: unknown interpolation method \"shepherd\""), "{method}");
+
+    let guides = error("[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\npoints = 4\n");
+    assert!(guides.contains("guides: give exactly one of"), "{guides}");
+
+    let zero = error(
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\ngenerate = { count = 5, length = 0.1 }\n[[ops]]\nstrands = { count = 0, tip_spread = 0.1 }\n",
+    );
+    assert!(zero.starts_with("fur/test.toml:8:21: ops[0].strands.count:"), "{zero}");
+}
