@@ -320,3 +320,176 @@ fn guides_are_grown_and_bound_back_with_far_ones_reported() {
         49
     );
 }
+
+/// A small groom with every kind of operator path (strands and cut change
+/// hair counts), in three parts.
+const SMALL_GROOM: &str = r#"
+[mesh]
+path = "spot"
+[roots]
+count = 3000
+parts = 3
+density = "noise:frequency=3,offset=0.6,scale=0.4"
+[guides]
+generate = { count = 60, length = 0.05, comb = [0, -1, 0] }
+[[ops]]
+clump = { count = 100, rate = 0.5 }
+[[ops]]
+noise = { amplitude = 0.002, frequency = 20 }
+[[ops]]
+cut = { at = "noise:frequency=2,offset=0.9,scale=0.2" }
+[[ops]]
+strands = { count = 2, tip_spread = 0.003 }
+[finish]
+points = 8
+color = { root = [0.2, 0.1, 0.1], tip = [0.9, 0.8, 0.7] }
+"#;
+
+/// The prims of a pelage USD file: everything inside the default prim.
+fn usd_body(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    let start = text
+        .find("def Xform \"groom\"\n{\n")
+        .expect("the default prim")
+        + 19;
+    let end = text.rfind('}').unwrap();
+    // Prims are separated by blank lines; compare them without.
+    text[start..end]
+        .lines()
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
+}
+
+#[test]
+fn groom_parts_run_separately_concatenate_to_the_full_run_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("fur.toml");
+    std::fs::write(&groom, SMALL_GROOM).unwrap();
+    let full = dir.path().join("full.usda");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["groom", groom.to_str().unwrap(), "--quiet"];
+        args.extend_from_slice(extra);
+        let out = pelage(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stdout(&out)
+    };
+    let summary = run(&["-o", full.to_str().unwrap(), "--threads", "1"]);
+    assert!(summary.contains("in 3 parts"), "{summary}");
+    let two = dir.path().join("two.usda");
+    run(&["-o", two.to_str().unwrap(), "--threads", "2"]);
+    assert!(
+        std::fs::read(&full).unwrap() == std::fs::read(&two).unwrap(),
+        "1 and 2 threads wrote different bytes"
+    );
+
+    let farm = dir.path().join("farm.usda");
+    for k in 1..=3 {
+        run(&["-o", farm.to_str().unwrap(), "--part", &format!("{k}/3")]);
+    }
+    let joined: String = (1..=3)
+        .map(|k| usd_body(&dir.path().join(format!("farm.part-{k}-of-3.usda"))))
+        .collect();
+    assert!(
+        joined == usd_body(&full),
+        "parts concatenated ≠ the full run"
+    );
+
+    // Two runs of three parts: the first run grows part 0, the second 1 and 2.
+    let halves = dir.path().join("halves.usda");
+    run(&["-o", halves.to_str().unwrap(), "--part", "1/2"]);
+    run(&["-o", halves.to_str().unwrap(), "--part", "2/2"]);
+    let joined: String = (1..=2)
+        .map(|k| usd_body(&dir.path().join(format!("halves.part-{k}-of-2.usda"))))
+        .collect();
+    assert!(
+        joined == usd_body(&full),
+        "two runs concatenated ≠ the full run"
+    );
+
+    // The assembly references every run's file with its extent.
+    let out = pelage(&[
+        "groom",
+        groom.to_str().unwrap(),
+        "--assemble",
+        "-o",
+        farm.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let layer = std::fs::read_to_string(&farm).unwrap();
+    for k in 1..=3 {
+        assert!(
+            layer.contains(&format!("@./farm.part-{k}-of-3.usda@")),
+            "{layer}"
+        );
+    }
+    assert_eq!(layer.matches("extentsHint").count(), 4);
+    if let Some((ok, report)) = usdcheck(&[&farm, &full]) {
+        assert!(ok, "{report}");
+    }
+
+    // Asking for more runs than parts says what to do.
+    let out = pelage(&[
+        "groom",
+        groom.to_str().unwrap(),
+        "--part",
+        "2/5",
+        "-o",
+        farm.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("the groom has 3 parts"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn groom_file_errors_name_the_line_and_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("typo.toml");
+    std::fs::write(
+        &groom,
+        SMALL_GROOM.replace(
+            "clump = { count = 100, rate = 0.5 }",
+            "clump = { count = 100, rtae = 0.5 }",
+        ),
+    )
+    .unwrap();
+    let out = pelage(&["groom", groom.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(err.contains("typo.toml:11:"), "{err}");
+    assert!(err.contains("ops[0].clump.rtae"), "{err}");
+    assert!(err.contains("unknown field `rtae`"), "{err}");
+}
+
+/// Runs usdcheck on `files`; `None` (after printing SKIPPED) where it is
+/// not available and not required (PELAGE_REQUIRE_USDCHECK makes it
+/// required, as in CI).
+fn usdcheck(files: &[&Path]) -> Option<(bool, String)> {
+    let script = repo("../shared/tools/usdcheck");
+    let required = std::env::var_os("PELAGE_REQUIRE_USDCHECK").is_some();
+    if !script.exists() {
+        assert!(
+            !required,
+            "PELAGE_REQUIRE_USDCHECK is set but {} is missing",
+            script.display()
+        );
+        eprintln!("SKIPPED: {} not found", script.display());
+        return None;
+    }
+    let output = Command::new(&script)
+        .args(files)
+        .output()
+        .expect("usdcheck runs");
+    let text = format!("{}{}", stdout(&output), stderr(&output));
+    if output.status.code() == Some(2) {
+        assert!(!required, "usdcheck could not set itself up:\n{text}");
+        eprintln!("SKIPPED: usdcheck could not set itself up:\n{text}");
+        return None;
+    }
+    Some((output.status.success(), text))
+}

@@ -111,7 +111,10 @@ fn a_part_grown_alone_equals_that_part_of_the_full_run() {
     let alone = g.generator(None).unwrap().part(2);
     assert_eq!(alone, parts[2]);
     // Hair ids are unique over the whole groom and strands multiply them.
-    let ids: HashSet<u64> = parts.iter().flat_map(|c| c.ids().unwrap().to_vec()).collect();
+    let ids: HashSet<u64> = parts
+        .iter()
+        .flat_map(|c| c.ids().unwrap().to_vec())
+        .collect();
     let total: usize = parts.iter().map(Curves::curve_count).sum();
     assert_eq!(ids.len(), total);
     assert!(total > 3 * 6000 / 2 && total <= 3 * 6000, "{total}");
@@ -138,7 +141,10 @@ fn roots_follow_the_density_across_parts() {
         let curves = generator.part(p);
         assert_eq!(curves.curve_count() as u64, part.hair_count);
         for root in curves.roots().unwrap() {
-            assert!(part.triangles.binary_search(&root.tri).is_ok(), "root outside its part");
+            assert!(
+                part.triangles.binary_search(&root.tri).is_ok(),
+                "root outside its part"
+            );
             observed[group_of(root.tri)] += 1.0;
             hairs += 1;
         }
@@ -209,13 +215,21 @@ fn errors_name_the_file_line_and_key() {
     let missing_mesh = error(
         "[mesh]\npath = \"nowhere.obj\"\n[roots]\ncount = 10\n[guides]\ngenerate = { count = 5, length = 0.1 }\n",
     );
-    assert!(missing_mesh.starts_with("fur/test.toml:2:8: mesh.path: "), "{missing_mesh}");
+    assert!(
+        missing_mesh.starts_with("fur/test.toml:2:8: mesh.path: "),
+        "{missing_mesh}"
+    );
     assert!(missing_mesh.contains("nowhere.obj"), "{missing_mesh}");
 
     let method = error(
         "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\ngenerate = { count = 5, length = 0.1 }\n[interpolation]\nmethod = \"shepherd\"\n",
     );
-    assert!(method.starts_with("fur/test.toml:8:10: interpolation.method: unknown interpolation method \"shepherd\""), "{method}");
+    assert!(
+        method.starts_with(
+            "fur/test.toml:8:10: interpolation.method: unknown interpolation method \"shepherd\""
+        ),
+        "{method}"
+    );
 
     let guides = error("[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\npoints = 4\n");
     assert!(guides.contains("guides: give exactly one of"), "{guides}");
@@ -223,5 +237,8 @@ fn errors_name_the_file_line_and_key() {
     let zero = error(
         "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\ngenerate = { count = 5, length = 0.1 }\n[[ops]]\nstrands = { count = 0, tip_spread = 0.1 }\n",
     );
-    assert!(zero.starts_with("fur/test.toml:8:21: ops[0].strands.count:"), "{zero}");
+    assert!(
+        zero.starts_with("fur/test.toml:8:21: ops[0].strands.count:"),
+        "{zero}"
+    );
 }

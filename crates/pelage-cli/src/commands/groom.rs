@@ -69,7 +69,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     let groom = Groom::load(&args.file)?;
     let output = args.output.clone().unwrap_or_else(|| groom.output_path());
     if args.assemble {
-        return assemble(&output);
+        return assemble(&output, &UsdOptions::default());
     }
     if let Some(report) = groom.bind_report() {
         for dropped in &report.dropped {
@@ -163,7 +163,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
 
 /// Finds `OUTPUT.part-K-of-N.usda` for one N and every K, and writes the
 /// root layer.
-fn assemble(output: &Path) -> anyhow::Result<()> {
+fn assemble(output: &Path, options: &UsdOptions) -> anyhow::Result<()> {
     let folder = match output.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -209,7 +209,7 @@ fn assemble(output: &Path) -> anyhow::Result<()> {
             { files.iter().position(|f| f == missing).unwrap_or(0) + 1 }
         );
     }
-    let (lo, hi) = write_assembly(output, &files)?;
+    let (lo, hi) = write_assembly(output, &files, options)?;
     println!(
         "{} → {} part files referenced, extent ({:.4}, {:.4}, {:.4}) to ({:.4}, {:.4}, {:.4})",
         output.display(),

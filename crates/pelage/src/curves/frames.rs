@@ -61,28 +61,32 @@ pub fn rotation_minimizing_normals(
     }
     out[0] = r;
     for i in 0..n - 1 {
+        // The reflection planes depend on the curve alone, not on `r`, so
+        // their divisions overlap with the previous step's work; only the
+        // two reflections of `r` are in the loop-carried chain.
         let v1 = points[i + 1] - points[i];
         let c1 = v1.dot(v1);
-        let (r_l, t_l) = if c1 > 1e-20 {
-            (
-                r - (2.0 / c1) * v1.dot(r) * v1,
-                tangents[i] - (2.0 / c1) * v1.dot(tangents[i]) * v1,
-            )
-        } else {
-            (r, tangents[i])
-        };
+        let k1 = if c1 > 1e-20 { 2.0 / c1 } else { 0.0 };
+        let t_l = tangents[i] - k1 * v1.dot(tangents[i]) * v1;
         let v2 = tangents[i + 1] - t_l;
         let c2 = v2.dot(v2);
-        r = if c2 > 1e-20 {
-            r_l - (2.0 / c2) * v2.dot(r_l) * v2
-        } else {
-            r_l
-        };
-        // Re-orthogonalise: f32 drift over many points, and tangents that
-        // fell back to a neighbour's.
+        let k2 = if c2 > 1e-20 { 2.0 / c2 } else { 0.0 };
+        let r_l = r - k1 * v1.dot(r) * v1;
+        let reflected = r_l - k2 * v2.dot(r_l) * v2;
+        // Reflections keep `r` unit and perpendicular up to rounding; the
+        // projection only matters where a tangent fell back to a
+        // neighbour's (repeated points). Cleaning up the output, not the
+        // carried vector, keeps it out of the chain.
         let t = tangents[i + 1];
-        r = (r - t * t.dot(r)).normalize_or(t.any_orthonormal_vector());
-        out[i + 1] = r;
+        let projected = reflected - t * t.dot(reflected);
+        let length_squared = projected.length_squared();
+        if length_squared > 1e-12 {
+            r = reflected;
+            out[i + 1] = projected * length_squared.sqrt().recip();
+        } else {
+            r = t.any_orthonormal_vector();
+            out[i + 1] = r;
+        }
     }
 }
 

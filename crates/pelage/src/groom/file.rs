@@ -335,9 +335,17 @@ pub struct NoiseSpec {
     /// Root-to-tip profile of the amplitude.
     #[serde(default)]
     pub ramp: Ramp,
+    /// Noise vectors sampled along each hair, interpolated between (0:
+    /// one at every point).
+    #[serde(default = "default_noise_vectors")]
+    pub vectors: usize,
     /// Seed of the noise field.
     #[serde(default)]
     pub seed: u64,
+}
+
+fn default_noise_vectors() -> usize {
+    5
 }
 
 fn default_noise_frequency() -> MapValue {

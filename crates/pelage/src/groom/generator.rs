@@ -357,6 +357,7 @@ impl<'g> Generator<'g> {
                 m(&s.frequency)?,
                 s.ramp.clone(),
                 op_seed(s.seed),
+                s.vectors,
             )),
             OpSpec::Frizz(s) => Operator::Frizz(Frizz::new(
                 m(&s.amplitude)?,
@@ -524,6 +525,9 @@ impl<'g> Generator<'g> {
     pub fn part(&self, p: usize) -> Curves {
         let part = &self.layout.parts()[p];
         let roots = self.part_roots(p);
+        if self.one_hair_per_root() {
+            return self.part_in_place(&roots, part.first_hair);
+        }
         let chunks: Vec<PartChunk> = roots
             .par_chunks(CHUNK)
             .enumerate()
@@ -533,6 +537,97 @@ impl<'g> Generator<'g> {
             })
             .collect();
         PartChunk::concat(chunks, self.groom.mesh.has_uvs())
+    }
+
+    /// Whether every root grows exactly one hair (no `strands`, no `cut`):
+    /// then a part's arrays have a known size and workers fill them in
+    /// place.
+    fn one_hair_per_root(&self) -> bool {
+        !self
+            .ops
+            .iter()
+            .any(|op| matches!(op, Operator::Strands(_) | Operator::Cut(_)))
+    }
+
+    /// [`Self::part`] when each root grows one hair: the arrays are
+    /// allocated once and each worker writes its chunk's slices.
+    fn part_in_place(&self, roots: &[SurfacePoint], first_hair: u64) -> Curves {
+        let n = self.points;
+        let total = roots.len() * n;
+        let sized = |on: bool| if on { total } else { 0 };
+        let mut points = vec![Vec3::ZERO; total];
+        let mut widths = vec![0f32; total];
+        let mut normals = vec![Vec3::ZERO; sized(self.normals)];
+        let mut colors = vec![Vec3::ZERO; sized(self.colors)];
+        let mut opacities = vec![0f32; sized(self.opacities)];
+        {
+            let mut jobs = Vec::with_capacity(roots.len().div_ceil(CHUNK));
+            let (mut p, mut w, mut nr, mut c, mut o) = (
+                &mut points[..],
+                &mut widths[..],
+                &mut normals[..],
+                &mut colors[..],
+                &mut opacities[..],
+            );
+            for (k, chunk) in roots.chunks(CHUNK).enumerate() {
+                let len = chunk.len() * n;
+                let take = |on: bool| if on { len } else { 0 };
+                let (p0, p1) = std::mem::take(&mut p).split_at_mut(len);
+                let (w0, w1) = std::mem::take(&mut w).split_at_mut(len);
+                let (n0, n1) = std::mem::take(&mut nr).split_at_mut(take(self.normals));
+                let (c0, c1) = std::mem::take(&mut c).split_at_mut(take(self.colors));
+                let (o0, o1) = std::mem::take(&mut o).split_at_mut(take(self.opacities));
+                (p, w, nr, c, o) = (p1, w1, n1, c1, o1);
+                let first = first_hair + (k * CHUNK) as u64;
+                jobs.push((chunk, first, p0, w0, n0, c0, o0));
+            }
+            jobs.into_par_iter().for_each_init(
+                Workspace::default,
+                |ws, (chunk, first, p, w, nr, c, o)| {
+                    let mut tangents = vec![Vec3::ZERO; n];
+                    for (i, root) in chunk.iter().enumerate() {
+                        self.grow(*root, first + i as u64, &self.ops, ws);
+                        let hair = &ws.batch.hairs()[0];
+                        let range = i * n..(i + 1) * n;
+                        p[range.clone()].copy_from_slice(&hair.points);
+                        w[range.clone()].copy_from_slice(&hair.widths);
+                        if self.colors {
+                            c[range.clone()].copy_from_slice(&hair.colors);
+                        }
+                        if self.opacities {
+                            o[range.clone()].copy_from_slice(&hair.opacities);
+                        }
+                        if self.normals {
+                            catmull_rom_tangents(&hair.points, &mut tangents);
+                            rotation_minimizing_normals(
+                                &hair.points,
+                                &tangents,
+                                root.normal(&self.groom.mesh),
+                                &mut nr[range],
+                            );
+                        }
+                    }
+                },
+            );
+        }
+        let offsets = (0..=roots.len() as u32).map(|i| i * n as u32).collect();
+        let ids = (first_hair..first_hair + roots.len() as u64).collect();
+        let mut curves = Curves::new(points, widths, offsets).expect("consistent part arrays");
+        if self.normals {
+            curves = curves.with_normals(normals).expect("one normal a point");
+        }
+        if self.colors {
+            curves = curves.with_colors(colors).expect("one colour a point");
+        }
+        if self.opacities {
+            curves = curves
+                .with_opacities(opacities)
+                .expect("one opacity a point");
+        }
+        curves
+            .with_ids(ids)
+            .and_then(|c| c.with_roots(roots.to_vec()))
+            .expect("one id and root a curve")
     }
 
     fn grow_chunk(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) -> PartChunk {

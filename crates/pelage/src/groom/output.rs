@@ -5,7 +5,8 @@
 use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
-    CurvesExport, CurvesFormat, UsdaWriter, WriteError, write_atomically, write_curves,
+    CurvesExport, CurvesFormat, UpAxis, UsdOptions, UsdaWriter, WriteError, write_atomically,
+    write_curves,
 };
 use glam::Vec3;
 use std::io::{BufRead, Write};
@@ -69,33 +70,46 @@ impl Generator<'_> {
             return Ok(summary);
         }
         write_atomically(path, |out| {
-            let other = std::io::Error::other;
-            let mut usd = UsdaWriter::new(out, &export.usd).map_err(other)?;
-            if let Some(mesh) = export.mesh {
-                usd.write_mesh("skin", mesh).map_err(other)?;
-            }
-            std::thread::scope(|scope| {
-                // One part in flight while the previous one is written.
-                let (send, receive) = std::sync::mpsc::sync_channel::<(usize, Curves)>(1);
-                let grower = scope.spawn(move || {
-                    for p in parts {
-                        if send.send((p, self.part(p))).is_err() {
-                            break; // the writer failed and hung up
-                        }
-                    }
-                });
-                for (p, curves) in receive {
-                    usd.write_part(&part_name(p), &curves).map_err(other)?;
-                    on_part(p, &curves);
-                    count(&curves);
-                }
-                grower.join().expect("the part grower does not panic");
-                Ok::<(), std::io::Error>(())
-            })?;
-            usd.finish().map_err(other)?;
-            Ok(())
+            self.write_usd(out, parts, export, |p, c| {
+                on_part(p, c);
+                count(c);
+            })
         })?;
         Ok(summary)
+    }
+
+    /// Grows `parts` and streams them as USD text to `out`, one part
+    /// written while the next grows (memory: about two parts).
+    pub fn write_usd(
+        &self,
+        out: impl Write,
+        parts: Range<usize>,
+        export: &CurvesExport,
+        mut on_part: impl FnMut(usize, &Curves) + Send,
+    ) -> std::io::Result<()> {
+        let other = std::io::Error::other;
+        let mut usd = UsdaWriter::new(out, &export.usd).map_err(other)?;
+        if let Some(mesh) = export.mesh {
+            usd.write_mesh("skin", mesh).map_err(other)?;
+        }
+        std::thread::scope(|scope| {
+            let (send, receive) = std::sync::mpsc::sync_channel::<(usize, Curves)>(1);
+            let grower = scope.spawn(move || {
+                for p in parts {
+                    if send.send((p, self.part(p))).is_err() {
+                        break; // the writer failed and hung up
+                    }
+                }
+            });
+            for (p, curves) in receive {
+                usd.write_part(&part_name(p), &curves).map_err(other)?;
+                on_part(p, &curves);
+            }
+            grower.join().expect("the part grower does not panic");
+            Ok::<(), std::io::Error>(())
+        })?;
+        usd.finish().map_err(other)?;
+        Ok(())
     }
 }
 
@@ -104,7 +118,11 @@ impl Generator<'_> {
 /// renderer loads the whole groom through USD composition. Extents are read
 /// from the part files (pelage writes one per prim); a missing part file is
 /// an error naming it.
-pub fn write_assembly(path: &Path, part_files: &[PathBuf]) -> Result<(Vec3, Vec3), WriteError> {
+pub fn write_assembly(
+    path: &Path,
+    part_files: &[PathBuf],
+    options: &UsdOptions,
+) -> Result<(Vec3, Vec3), WriteError> {
     let fail = |file: &Path, message: String| WriteError {
         path: file.to_path_buf(),
         error: std::io::Error::other(message),
@@ -151,10 +169,16 @@ pub fn write_assembly(path: &Path, part_files: &[PathBuf]) -> Result<(Vec3, Vec3
         let t = |v: Vec3| format!("({}, {}, {})", v.x, v.y, v.z);
         writeln!(
             out,
-            "#usda 1.0\n(\n    defaultPrim = \"groom\"\n    doc = \"Written by pelage {}: the parts of a groom, one reference a part file\"\n)\n\ndef Xform \"groom\"\n{{\n    float3[] extentsHint = [{}, {}]",
+            "#usda 1.0\n(\n    defaultPrim = \"{root}\"\n    doc = \"Written by pelage {}: the parts of a groom, one reference a part file\"\n    metersPerUnit = {}\n    upAxis = \"{}\"\n)\n\ndef Xform \"{root}\"\n{{\n    float3[] extentsHint = [{}, {}]",
             env!("CARGO_PKG_VERSION"),
+            ryu::Buffer::new().format(options.meters_per_unit),
+            match options.up_axis {
+                UpAxis::Y => "Y",
+                UpAxis::Z => "Z",
+            },
             t(whole.0),
-            t(whole.1)
+            t(whole.1),
+            root = options.root,
         )?;
         for (k, (file, (lo, hi))) in part_files.iter().zip(&extents).enumerate() {
             // Reference by path relative to the root layer when possible.

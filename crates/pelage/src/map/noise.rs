@@ -108,6 +108,36 @@ impl NoiseMap {
     }
 }
 
+impl NoiseMap {
+    /// Three independent octaves of 3D Perlin noise at `p`, one a
+    /// component: the lattice cell and fade weights are shared, each
+    /// component hashes its corners with its own salt. A smooth random
+    /// vector field, each component in about [−1, 1].
+    pub fn perlin3_vector(&self, p: glam::Vec3) -> glam::Vec3 {
+        let cell = p.floor();
+        let f = p - cell;
+        let [xi, yi, zi] = [cell.x, cell.y, cell.z].map(|c| (c as i64 & 255) as usize);
+        let perm = &self.permutation;
+        let fade = |t: f32| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+        let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
+        let lerp = |a: glam::Vec3, b: glam::Vec3, t: f32| a + t * (b - a);
+        let corner = |dx: usize, dy: usize, dz: usize| {
+            let h = perm[perm[perm[xi + dx] as usize + yi + dy] as usize + zi + dz];
+            let (x, y, z) = (f.x - dx as f32, f.y - dy as f32, f.z - dz as f32);
+            glam::Vec3::new(
+                gradient3(h, x, y, z),
+                gradient3(perm[h as usize + 101], x, y, z),
+                gradient3(perm[h as usize + 203], x, y, z),
+            )
+        };
+        let x00 = lerp(corner(0, 0, 0), corner(1, 0, 0), u);
+        let x10 = lerp(corner(0, 1, 0), corner(1, 1, 0), u);
+        let x01 = lerp(corner(0, 0, 1), corner(1, 0, 1), u);
+        let x11 = lerp(corner(0, 1, 1), corner(1, 1, 1), u);
+        lerp(lerp(x00, x10, v), lerp(x01, x11, v), w)
+    }
+}
+
 /// Dot product of the offset with one of Perlin's twelve gradients (the
 /// cube's edge midpoints; 16 hash values, four repeated).
 fn gradient3(hash: u8, x: f32, y: f32, z: f32) -> f32 {

@@ -5,6 +5,7 @@
 //! Machines here are small and noisy: every figure is the median of several
 //! runs, and comparisons are ratios taken within one run.
 
+pub mod groom;
 pub mod interp;
 pub mod io;
 pub mod render;
@@ -29,6 +30,8 @@ pub enum BenchWhat {
     Render(render::RenderBenchArgs),
     /// Guide interpolation: style-mesh build and weights, Shepard k = 4, 8.
     Interp(interp::InterpBenchArgs),
+    /// The groom generator: the Stubble figure (1.6 M hairs) and peak memory.
+    Groom(groom::GroomBenchArgs),
     /// Writing a large groom as usda, part by part: throughput and peak memory.
     Io(io::IoBenchArgs),
 }
@@ -39,6 +42,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Render(a) => render::run(a),
         BenchWhat::Io(a) => io::run(a),
         BenchWhat::Interp(a) => interp::run(a),
+        BenchWhat::Groom(a) => groom::run(a),
     }
 }
 

@@ -11,15 +11,8 @@ use crate::sample::SampleRng;
 use glam::Vec3;
 use std::f32::consts::TAU;
 
-/// Offsets of the three noise components' fields, far apart so the
-/// components are uncorrelated.
-const COMPONENT_OFFSETS: [Vec3; 3] = [
-    Vec3::ZERO,
-    Vec3::new(71.3, 19.1, 43.7),
-    Vec3::new(-37.9, 83.3, -11.7),
-];
-
-/// A smooth random vector field in space: three Perlin noises.
+/// A smooth random vector field in space (three Perlin noises sharing
+/// their lattice, see [`NoiseMap::perlin3_vector`]).
 #[derive(Debug, Clone)]
 struct VectorNoise(NoiseMap);
 
@@ -28,37 +21,42 @@ impl VectorNoise {
         Self(NoiseMap::new(1.0, 1, seed, 0.0, 1.0))
     }
 
-    /// Each component in about [−1, 1].
+    /// Each component in about [−1, 1]. Perlin noise is zero on its
+    /// lattice; the offset keeps round coordinates (a hair along an axis)
+    /// off it.
     #[inline]
     fn at(&self, p: Vec3) -> Vec3 {
-        Vec3::new(
-            self.0.perlin3(p + COMPONENT_OFFSETS[0]),
-            self.0.perlin3(p + COMPONENT_OFFSETS[1]),
-            self.0.perlin3(p + COMPONENT_OFFSETS[2]),
-        )
+        self.0.perlin3_vector(p + Vec3::new(0.371, 0.713, 0.137))
     }
 }
 
-/// `noise`: every point moves by a Perlin vector field sampled at its
-/// position: `p += amplitude · ramp(t) · N(frequency · p)`. The field is
-/// continuous in space, so neighbouring hairs wave alike (the look of
-/// Stubble's Fig. 15); `ramp` keeps roots on the skin (linear by default).
+/// `noise`: the hair moves by a Perlin vector field sampled in space:
+/// `p += amplitude · ramp(t) · N(frequency · p)`. As in Stubble, the field
+/// is sampled at `vectors` points evenly spaced along the hair ("the number
+/// of vectors used on a single hair … are user parameters", Sik §4.2.2)
+/// and the displacement interpolated linearly between them; `vectors = 0`
+/// samples at every point. The field is continuous in space, so
+/// neighbouring hairs wave alike (Stubble's Fig. 15); `ramp` keeps roots on
+/// the skin (linear by default).
 #[derive(Debug, Clone)]
 pub struct Noise {
     field: VectorNoise,
     amplitude: Map,
     frequency: Map,
     ramp: Ramp,
+    vectors: usize,
 }
 
 impl Noise {
-    /// A noise operator.
-    pub fn new(amplitude: Map, frequency: Map, ramp: Ramp, seed: u64) -> Self {
+    /// A noise operator sampling `vectors` noise vectors a hair (0: one a
+    /// point).
+    pub fn new(amplitude: Map, frequency: Map, ramp: Ramp, seed: u64, vectors: usize) -> Self {
         Self {
             field: VectorNoise::new(seed),
             amplitude,
             frequency,
             ramp,
+            vectors,
         }
     }
 
@@ -69,14 +67,45 @@ impl Noise {
         }
         let frequency = self.frequency.eval(root.uv);
         let n = hair.points.len();
+        let m = if self.vectors == 0 || self.vectors >= n {
+            n
+        } else {
+            self.vectors.max(2)
+        };
+        if m == n {
+            for (j, p) in hair.points.iter_mut().enumerate() {
+                let a = amplitude * self.ramp.at(param(j, n));
+                if a != 0.0 {
+                    *p += a * self.field.at(*p * frequency);
+                }
+            }
+            return;
+        }
+        // Noise vectors at m evenly spaced parameters (positions along the
+        // polyline), then each point's displacement between its two.
+        let mut samples = [Vec3::ZERO; MAX_VECTORS];
+        let m = m.min(MAX_VECTORS);
+        for (k, sample) in samples.iter_mut().enumerate().take(m) {
+            let x = param(k, m) * (n - 1) as f32;
+            let j = (x as usize).min(n - 2);
+            let p = hair.points[j].lerp(hair.points[j + 1], x - j as f32);
+            *sample = self.field.at(p * frequency);
+        }
         for (j, p) in hair.points.iter_mut().enumerate() {
-            let a = amplitude * self.ramp.at(param(j, n));
+            let t = param(j, n);
+            let a = amplitude * self.ramp.at(t);
             if a != 0.0 {
-                *p += a * self.field.at(*p * frequency);
+                let x = t * (m - 1) as f32;
+                let k = (x as usize).min(m - 2);
+                *p += a * samples[k].lerp(samples[k + 1], x - k as f32);
             }
         }
     }
 }
+
+/// The most noise vectors a hair samples (more points than this are
+/// interpolated).
+const MAX_VECTORS: usize = 64;
 
 /// `frizz`: a share of the hairs (`fraction`) each wiggle on their own:
 /// `p += amplitude · ramp(t) · N(φ + frequency · t · X)`, where `φ` is a
@@ -182,7 +211,13 @@ mod tests {
 
     #[test]
     fn noise_keeps_the_root_and_is_coherent_in_space() {
-        let op = Noise::new(Map::Constant(0.1), Map::Constant(3.0), Ramp::default(), 4);
+        let op = Noise::new(
+            Map::Constant(0.1),
+            Map::Constant(3.0),
+            Ramp::default(),
+            4,
+            0,
+        );
         let mut a = straight(1, 16, 1.0);
         op.apply(&mut a, &root());
         assert_eq!(a.points[0], Vec3::ZERO, "a linear ramp leaves the root");

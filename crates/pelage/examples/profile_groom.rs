@@ -1,0 +1,31 @@
+//! Profiling harness for the groom generator (`perf record` it): the
+//! `pelage bench groom` groom (spot ×2, 1,000 guides, clump + noise, 16
+//! points, normals, widths), HAIRS hairs (default 400,000) grown in memory.
+//! OPS=none drops the operators, to see interpolation alone.
+use pelage::groom::Groom;
+
+fn main() {
+    let hairs: u64 = std::env::var("HAIRS")
+        .ok()
+        .and_then(|h| h.parse().ok())
+        .unwrap_or(400_000);
+    let ops = if std::env::var("OPS").as_deref() == Ok("none") {
+        ""
+    } else {
+        "[[ops]]\nclump = { count = 4000, rate = 0.6 }\n[[ops]]\nnoise = { amplitude = 0.004, frequency = 30 }\n"
+    };
+    let text = format!(
+        "[mesh]\npath = \"spot\"\nsubdivide = 2\n[roots]\ncount = {hairs}\ndensity = \"noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4\"\n[guides]\npoints = 8\ngenerate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}\n{ops}[finish]\npoints = 16\n"
+    );
+    let groom = Groom::from_text("<profile>", text).unwrap();
+    let t = std::time::Instant::now();
+    let generator = groom.generator(None).unwrap();
+    eprintln!("prepare {:?}", t.elapsed());
+    let t = std::time::Instant::now();
+    let mut n = 0;
+    for p in 0..generator.parts().len() {
+        n += generator.part(p).curve_count();
+    }
+    let s = t.elapsed().as_secs_f64();
+    eprintln!("{n} hairs in {s:.3} s: {:.2} M hairs/s", n as f64 / s / 1e6);
+}
