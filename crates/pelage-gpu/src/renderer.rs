@@ -20,7 +20,8 @@ pub struct PreviewScene<'a> {
     pub mesh: Option<&'a Mesh>,
     /// Points (hair roots, samples) in world space.
     pub points: &'a [Vec3],
-    /// Hair curves, drawn as ribbons of their widths.
+    /// Hair curves, drawn as ribbons of their widths, in their own colours
+    /// where they have them.
     pub curves: Option<&'a Curves>,
     /// A colour texture for the skin (sRGB), read at the mesh's UVs;
     /// ignored for meshes without UVs.
@@ -245,9 +246,14 @@ impl Renderer {
         let curves_pipeline = pipeline(
             &curves_shader,
             &[Some(wgpu::VertexBufferLayout {
-                array_stride: 32,
+                array_stride: 64,
                 step_mode: wgpu::VertexStepMode::Instance,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4],
+                attributes: &wgpu::vertex_attr_array![
+                    0 => Float32x4,
+                    1 => Float32x4,
+                    2 => Float32x4,
+                    3 => Float32x4
+                ],
             })],
             true,
         );
@@ -376,7 +382,13 @@ impl Renderer {
             .filter(|c| c.segment_count() > 0)
             .map(|curves| {
                 let (points, widths) = (curves.points(), curves.widths());
-                let mut segments: Vec<f32> = Vec::with_capacity(curves.segment_count() * 8);
+                // Per-point colours where the curves have them; alpha 0
+                // selects the style's hair colour in the shader.
+                let color = |k: usize| match curves.colors() {
+                    Some(c) => [c[k].x, c[k].y, c[k].z, 1.0],
+                    None => [0.0; 4],
+                };
+                let mut segments: Vec<f32> = Vec::with_capacity(curves.segment_count() * 16);
                 for i in 0..curves.curve_count() {
                     let range = curves.range(i);
                     for k in range.start..range.end.saturating_sub(1) {
@@ -391,6 +403,8 @@ impl Renderer {
                             b.z,
                             widths[k + 1],
                         ]);
+                        segments.extend_from_slice(&color(k));
+                        segments.extend_from_slice(&color(k + 1));
                     }
                 }
                 let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -398,7 +412,7 @@ impl Renderer {
                     contents: bytemuck::cast_slice(&segments),
                     usage: wgpu::BufferUsages::VERTEX,
                 });
-                (buffer, (segments.len() / 8) as u32)
+                (buffer, (segments.len() / 16) as u32)
             });
 
         GpuScene {

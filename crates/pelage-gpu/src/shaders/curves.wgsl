@@ -11,6 +11,11 @@ struct SegmentIn {
     @location(0) a: vec4<f32>,
     // xyz: second point, w: its width.
     @location(1) b: vec4<f32>,
+    // rgb: the first point's colour; a: 1 where the curves have colours,
+    // 0 to use the style's hair colour.
+    @location(2) color_a: vec4<f32>,
+    // The second point's colour.
+    @location(3) color_b: vec4<f32>,
 };
 
 struct VertexOut {
@@ -18,6 +23,7 @@ struct VertexOut {
     @location(0) tangent: vec3<f32>,
     @location(1) world: vec3<f32>,
     @location(2) coverage: f32,
+    @location(3) color: vec4<f32>,
 };
 
 @vertex
@@ -46,6 +52,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32, s: SegmentIn) -> VertexOut {
     out.tangent = s.b.xyz - s.a.xyz;
     out.world = p;
     out.coverage = clamp(width_px, 0.0, 1.0);
+    out.color = mix(s.color_a, s.color_b, t);
     return out;
 }
 
@@ -59,6 +66,7 @@ fn fs_main(v: VertexOut) -> @location(0) vec4<f32> {
     let cos_th = dot(tangent, h);
     let diffuse = sqrt(max(0.0, 1.0 - cos_tl * cos_tl));
     let specular = pow(sqrt(max(0.0, 1.0 - cos_th * cos_th)), 60.0);
-    let color = frame.hair_color.rgb * (0.3 + 0.7 * diffuse) + vec3<f32>(frame.hair_color.a * specular);
+    let base = mix(frame.hair_color.rgb, v.color.rgb, v.color.a);
+    let color = base * (0.3 + 0.7 * diffuse) + vec3<f32>(frame.hair_color.a * specular);
     return vec4<f32>(color, v.coverage);
 }
