@@ -118,18 +118,19 @@ fn demo_runs_on_the_embedded_asset_from_any_folder() {
     assert!(out.status.success(), "{}", stderr(&out));
     let text = stdout(&out);
     assert!(text.contains("embedded spot"));
-    assert!(text.contains("subdivided ×2: 93,696 triangles"));
-    assert!(text.contains("1,000,000 hair roots"));
-    let roots = dir.path().join("pelage-demo/roots.ply");
-    let bytes = std::fs::read(&roots).expect("the demo writes pelage-demo/roots.ply");
-    assert!(bytes.starts_with(b"ply\nformat binary_little_endian 1.0\n"));
-    assert!(bytes.len() > 36_000_000);
-    let strands = pelage::io::read_curves(&dir.path().join("pelage-demo/strands.usda"))
-        .expect("the demo writes readable strands.usda");
-    assert_eq!(
-        (strands.curve_count(), strands.points().len()),
-        (100_000, 500_000)
+    assert!(
+        text.contains("200,000 hairs, 2,400,000 points → pelage-demo/groom.usda"),
+        "{text}"
     );
+    // The groom file it used is there for the user to edit and rerun.
+    let groom = std::fs::read_to_string(dir.path().join("pelage-demo/demo.toml")).unwrap();
+    assert!(groom.contains("[[ops]]\nclump"));
+    assert!(dir.path().join("pelage-demo/spot.png").exists());
+    let usd = std::fs::read(dir.path().join("pelage-demo/groom.usda")).unwrap();
+    assert!(usd.starts_with(b"#usda 1.0\n"));
+    assert!(usd.len() > 100_000_000, "{} bytes", usd.len());
+    let text = String::from_utf8_lossy(&usd[..4096]);
+    assert!(text.contains("def Mesh \"skin\""), "the skin comes first");
     // The preview needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
     if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() {
         let png = image::open(dir.path().join("pelage-demo/preview.png")).expect("a preview PNG");
