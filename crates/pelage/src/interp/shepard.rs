@@ -55,7 +55,12 @@ impl GuideWeights for Shepard {
             if hit.distance > self.radius_squared && i > 0 {
                 break;
             }
-            let weight = hit.distance.powf(-0.5 * self.power);
+            // The usual power 2 needs no powf.
+            let weight = if self.power == 2.0 {
+                hit.distance.recip()
+            } else {
+                hit.distance.powf(-0.5 * self.power)
+            };
             out.push(GuideWeight { guide, weight });
         }
         normalise(out);
