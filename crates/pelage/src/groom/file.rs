@@ -316,11 +316,11 @@ pub enum OpSpec {
     /// Each hair becomes a strand of hairs.
     Strands(StrandsSpec),
     /// Widths root to tip.
-    Width(WidthSpec),
+    Width(RootToTipSpec),
     /// Colours root to tip.
     Color(ColorSpec),
     /// Opacity root to tip.
-    Opacity(OpacitySpec),
+    Opacity(RootToTipSpec),
 }
 
 /// `noise`: see [`crate::groom::ops::Noise`].
@@ -460,13 +460,14 @@ pub struct StrandsSpec {
     pub seed: u64,
 }
 
-/// `width` (and `[finish.width]`): see [`crate::groom::ops::Width`].
+/// A quantity from root to tip: `width` and `opacity` (and
+/// `[finish.width]`, `[finish.opacity]`); see [`crate::groom::ops::Width`].
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct WidthSpec {
-    /// Width at the root (world units).
+pub struct RootToTipSpec {
+    /// Value at the root (a width in world units, or an opacity).
     pub root: MapValue,
-    /// Width at the tip.
+    /// Value at the tip.
     pub tip: MapValue,
     /// Profile from root to tip.
     #[serde(default)]
@@ -498,25 +499,6 @@ pub struct ColorSpec {
     pub seed: u64,
 }
 
-/// `opacity` (and `[finish.opacity]`).
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OpacitySpec {
-    /// Opacity at the root.
-    pub root: MapValue,
-    /// Opacity at the tip.
-    pub tip: MapValue,
-    /// Profile from root to tip.
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Per-hair random variation, a fraction.
-    #[serde(default = "zero")]
-    pub jitter: MapValue,
-    /// Seed of the variation.
-    #[serde(default)]
-    pub seed: u64,
-}
-
 /// `[finish]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -526,11 +508,11 @@ pub struct FinishSection {
     pub points: Spanned<usize>,
     /// Widths before any `width` operator.
     #[serde(default = "default_width")]
-    pub width: WidthSpec,
+    pub width: RootToTipSpec,
     /// Colours (none unless given here or by a `color` operator).
     pub color: Option<ColorSpec>,
     /// Opacity (none unless given here or by an `opacity` operator).
-    pub opacity: Option<OpacitySpec>,
+    pub opacity: Option<RootToTipSpec>,
     /// Per-point ribbon normals from rotation-minimizing frames.
     #[serde(default = "yes")]
     pub normals: bool,
@@ -542,8 +524,8 @@ fn default_points() -> Spanned<usize> {
 fn yes() -> bool {
     true
 }
-fn default_width() -> WidthSpec {
-    WidthSpec {
+fn default_width() -> RootToTipSpec {
+    RootToTipSpec {
         root: Spanned::new(0..0, MapText::Number(0.002)),
         tip: Spanned::new(0..0, MapText::Number(0.0002)),
         ramp: Ramp::default(),

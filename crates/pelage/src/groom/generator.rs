@@ -3,8 +3,7 @@
 //! the path of one hair.
 
 use super::file::{
-    ColorSpec, GroomError, GroomErrorKind, GroomFile, GroomSource, MapValue, OpSpec, OpacitySpec,
-    WidthSpec,
+    ColorSpec, GroomError, GroomErrorKind, GroomFile, GroomSource, MapValue, OpSpec, RootToTipSpec,
 };
 use super::ops::{
     Clump, ClumpCentres, Color, Curl, Cut, Frizz, HairBatch, Length, Noise, Opacity, Operator,
@@ -311,7 +310,7 @@ impl<'g> Generator<'g> {
         };
         let interpolator = Interpolator::new(mesh, &groom.guides, &interpolation);
 
-        let mut base = vec![Operator::Width(Width(width_spec(
+        let mut base = vec![Operator::Width(Width(root_to_tip(
             groom,
             &file.finish.width,
         )?))];
@@ -319,7 +318,7 @@ impl<'g> Generator<'g> {
             base.push(Operator::Color(color_spec(groom, color)?));
         }
         if let Some(opacity) = &file.finish.opacity {
-            base.push(Operator::Opacity(Opacity(opacity_spec(groom, opacity)?)));
+            base.push(Operator::Opacity(Opacity(root_to_tip(groom, opacity)?)));
         }
         let mut generator = Self {
             groom,
@@ -391,9 +390,9 @@ impl<'g> Generator<'g> {
                     op_seed(s.seed),
                 ))
             }
-            OpSpec::Width(s) => Operator::Width(Width(width_spec(groom, s)?)),
+            OpSpec::Width(s) => Operator::Width(Width(root_to_tip(groom, s)?)),
             OpSpec::Color(s) => Operator::Color(color_spec(groom, s)?),
-            OpSpec::Opacity(s) => Operator::Opacity(Opacity(opacity_spec(groom, s)?)),
+            OpSpec::Opacity(s) => Operator::Opacity(Opacity(root_to_tip(groom, s)?)),
             OpSpec::Clump(s) => {
                 let count = *s.count.get_ref();
                 if count == 0 {
@@ -760,17 +759,7 @@ fn resample_uniform(shape: &[Vec3], n: usize, out: &mut Vec<Vec3>) {
     }));
 }
 
-fn width_spec(groom: &Groom, s: &WidthSpec) -> Result<RootToTip, GroomError> {
-    Ok(RootToTip {
-        root: groom.map(&s.root)?,
-        tip: groom.map(&s.tip)?,
-        ramp: s.ramp.clone(),
-        jitter: groom.map(&s.jitter)?,
-        seed: s.seed,
-    })
-}
-
-fn opacity_spec(groom: &Groom, s: &OpacitySpec) -> Result<RootToTip, GroomError> {
+fn root_to_tip(groom: &Groom, s: &RootToTipSpec) -> Result<RootToTip, GroomError> {
     Ok(RootToTip {
         root: groom.map(&s.root)?,
         tip: groom.map(&s.tip)?,

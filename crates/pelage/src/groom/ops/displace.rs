@@ -4,7 +4,6 @@
 //! around the hair's path, the shape of Silva et al. Eq. 4).
 
 use super::{Hair, RootContext, Scratch, param};
-use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
 use crate::groom::file::Ramp;
 use crate::map::{Map, NoiseMap};
 use crate::sample::SampleRng;
@@ -184,15 +183,7 @@ impl Curl {
         let turns = self.turns.eval(root.uv);
         let phase = TAU * SampleRng::new(self.seed ^ 0xC0_11, hair.id).uniform_f32();
         let n = hair.points.len();
-        scratch.tangents.resize(n, Vec3::ZERO);
-        scratch.frame.resize(n, Vec3::ZERO);
-        catmull_rom_tangents(&hair.points, &mut scratch.tangents);
-        rotation_minimizing_normals(
-            &hair.points,
-            &scratch.tangents,
-            root.normal.any_orthonormal_vector(),
-            &mut scratch.frame,
-        );
+        scratch.frame_along(&hair.points, root.normal);
         for (j, p) in hair.points.iter_mut().enumerate() {
             let t = param(j, n);
             let alpha = radius * self.ramp.at(t);

@@ -25,6 +25,7 @@ pub use look::{Color, Opacity, Width};
 pub use strands::Strands;
 pub use trim::{Cut, Length};
 
+use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
 use crate::groom::file::Ramp;
 use crate::map::Map;
 use crate::mesh::SurfacePoint;
@@ -146,6 +147,25 @@ pub struct Scratch {
     pub(crate) points: Vec<Vec3>,
     pub(crate) floats: Vec<f32>,
     pub(crate) bases: HairBatch,
+}
+
+impl Scratch {
+    /// Fills `tangents` and `frame` with the Catmull-Rom tangents and the
+    /// rotation-minimizing normals along `points`, started from any vector
+    /// perpendicular to the skin normal (operators that wrap shapes around
+    /// a hair need a frame that does not twist, not a particular start).
+    pub(crate) fn frame_along(&mut self, points: &[Vec3], skin_normal: Vec3) {
+        let n = points.len();
+        self.tangents.resize(n, Vec3::ZERO);
+        self.frame.resize(n, Vec3::ZERO);
+        catmull_rom_tangents(points, &mut self.tangents);
+        rotation_minimizing_normals(
+            points,
+            &self.tangents,
+            skin_normal.any_orthonormal_vector(),
+            &mut self.frame,
+        );
+    }
 }
 
 /// One operator of the chain.

@@ -5,10 +5,8 @@
 //! around the basic hair".
 
 use super::{HairBatch, RootContext, Scratch};
-use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
 use crate::map::Map;
 use crate::sample::SampleRng;
-use glam::Vec3;
 use std::f32::consts::TAU;
 
 /// `strands`: hair `k` of the strand of base hair `b` has id
@@ -40,7 +38,9 @@ impl Strands {
     }
 
     pub(super) fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
-        let bases = &mut scratch.bases;
+        // Taken out of the scratch (and put back) so the frame buffers can
+        // be borrowed beside it.
+        let mut bases = std::mem::take(&mut scratch.bases);
         bases.len = 0;
         for hair in batch.hairs() {
             bases.push().copy_from(hair);
@@ -53,15 +53,7 @@ impl Strands {
         batch.len = 0;
         for base in bases.hairs() {
             let n = base.points.len();
-            scratch.tangents.resize(n, Vec3::ZERO);
-            scratch.frame.resize(n, Vec3::ZERO);
-            catmull_rom_tangents(&base.points, &mut scratch.tangents);
-            rotation_minimizing_normals(
-                &base.points,
-                &scratch.tangents,
-                root.normal.any_orthonormal_vector(),
-                &mut scratch.frame,
-            );
+            scratch.frame_along(&base.points, root.normal);
             for k in 0..u64::from(self.count) {
                 let id = base.id.wrapping_mul(u64::from(self.count)).wrapping_add(k);
                 let [a, b] = SampleRng::new(self.seed ^ 0x57_2A4D, id).uniform_f32_pair();
@@ -78,6 +70,7 @@ impl Strands {
                 }
             }
         }
+        scratch.bases = bases;
     }
 }
 
@@ -85,6 +78,7 @@ impl Strands {
 mod tests {
     use super::super::test_hairs::{batch, root, straight};
     use super::*;
+    use glam::Vec3;
 
     #[test]
     fn strand_hairs_stay_within_the_spreads_with_distinct_ids() {
