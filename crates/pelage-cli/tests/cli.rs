@@ -494,3 +494,42 @@ fn usdcheck(files: &[&Path]) -> Option<(bool, String)> {
     }
     Some((output.status.success(), text))
 }
+
+#[test]
+fn groom_preview_draws_the_hairs() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("fur.toml");
+    // Blue hair, thick enough to cover pixels: nothing else in the
+    // picture is blue.
+    let blue = SMALL_GROOM.replace(
+        "color = { root = [0.2, 0.1, 0.1], tip = [0.9, 0.8, 0.7] }",
+        "color = { root = [0.05, 0.1, 0.9], tip = [0.05, 0.1, 0.9] }\nwidth = { root = 0.01, tip = 0.005 }",
+    );
+    assert_ne!(blue, SMALL_GROOM);
+    std::fs::write(&groom, blue).unwrap();
+    let png = dir.path().join("fur.png");
+    let out = pelage(&[
+        "groom",
+        groom.to_str().unwrap(),
+        "--quiet",
+        "--preview",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    // The preview needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() {
+        assert!(stdout(&out).contains("preview of"), "{}", stdout(&out));
+        let image = image::open(&png).expect("a preview PNG").to_rgb8();
+        assert_eq!(image.dimensions(), (1280, 720));
+        // Something is drawn over the background (the corner pixel), and
+        // much of it in the hairs' blue.
+        let background = *image.get_pixel(0, 0);
+        let drawn = image.pixels().filter(|p| **p != background).count();
+        assert!(drawn > 1280 * 720 / 20, "{drawn} pixels drawn");
+        let blue = image
+            .pixels()
+            .filter(|p| i32::from(p.0[2]) > i32::from(p.0[0]) + 60)
+            .count();
+        assert!(blue > drawn / 4, "{blue} blue of {drawn} drawn pixels");
+    }
+}

@@ -35,6 +35,10 @@ pub struct GroomArgs {
     /// Override the groom file's seed.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Also draw the hairs on the skin into this PNG (headless GPU; at
+    /// most 300,000 hairs, evenly chosen).
+    #[arg(long, value_name = "PNG")]
+    pub preview: Option<PathBuf>,
     /// Do not print the progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -141,7 +145,13 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     );
     let growing = Instant::now();
     let mut done = 0u64;
+    // Hairs kept for the preview: every `stride`-th of each part.
+    let stride = planned.div_ceil(PREVIEW_HAIRS).max(1) as usize;
+    let mut shown = Vec::new();
     let summary = generator.write(&path, range.clone(), &export, |_, curves| {
+        if args.preview.is_some() {
+            shown.push(curves.every_nth(stride));
+        }
         done += curves.curve_count() as u64;
         bar.set_message(format!("{} hairs", thousands(done)));
         bar.inc(1);
@@ -158,7 +168,49 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         summary.hairs as f64 / seconds / 1e6,
         prepared.as_secs_f64()
     );
+    if let Some(png) = &args.preview {
+        let curves = pelage::io::join(shown.iter())?;
+        match render_preview(groom.mesh(), &curves, png) {
+            Ok(adapter) => println!(
+                "preview of {} hairs → {} (rendered on {adapter})",
+                thousands(curves.curve_count() as u64),
+                png.display()
+            ),
+            Err(e) => eprintln!("warning: no preview: {e:#}"),
+        }
+    }
     Ok(())
+}
+
+/// Hairs the preview draws at most.
+const PREVIEW_HAIRS: u64 = 300_000;
+
+/// Draws `curves` on `mesh` (auto-framed) into `path`; returns the
+/// adapter's name.
+fn render_preview(
+    mesh: &pelage::Mesh,
+    curves: &pelage::Curves,
+    path: &Path,
+) -> anyhow::Result<String> {
+    use pelage_gpu::{GpuContext, PreviewScene, PreviewStyle, Renderer};
+    let ctx = GpuContext::headless()?;
+    let scene = PreviewScene {
+        mesh: Some(mesh),
+        points: &[],
+        curves: Some(curves),
+        skin_texture: None,
+    };
+    let style = PreviewStyle {
+        background: [0.62, 0.66, 0.72],
+        ..PreviewStyle::default()
+    };
+    let image = Renderer::new(&ctx).render(&ctx, &scene, &style, None, 1280, 720)?;
+    pelage::io::write_atomically(path, |out| {
+        image
+            .write_to(out, image::ImageFormat::Png)
+            .map_err(std::io::Error::other)
+    })?;
+    Ok(ctx.adapter_name())
 }
 
 /// Finds `OUTPUT.part-K-of-N.usda` for one N and every K, and writes the

@@ -126,6 +126,30 @@ impl Curves {
         })
     }
 
+    /// Every `step`-th curve (0, step, 2·step, …) with its points, widths
+    /// and colours: a lighter set for previews.
+    pub fn every_nth(&self, step: usize) -> Curves {
+        let step = step.max(1);
+        let (mut points, mut widths, mut colors) = (Vec::new(), Vec::new(), Vec::new());
+        let mut offsets = vec![0u32];
+        for i in (0..self.curve_count()).step_by(step) {
+            let range = self.range(i);
+            points.extend_from_slice(&self.points[range.clone()]);
+            widths.extend_from_slice(&self.widths[range.clone()]);
+            if let Some(c) = &self.colors {
+                colors.extend_from_slice(&c[range]);
+            }
+            offsets.push(points.len() as u32);
+        }
+        Curves {
+            points,
+            widths,
+            offsets,
+            colors: self.colors.is_some().then_some(colors),
+            ..Curves::default()
+        }
+    }
+
     /// Adds per-point normals (the orientation of flat ribbons; USD
     /// `normals`).
     pub fn with_normals(mut self, normals: Vec<Vec3>) -> Result<Self, CurvesError> {
@@ -331,6 +355,19 @@ impl Curves {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn every_nth_keeps_whole_curves_with_their_colours() {
+        let points: Vec<Vec3> = (0..10).map(|i| Vec3::splat(i as f32)).collect();
+        let curves = Curves::new(points, vec![1.0; 10], vec![0, 2, 5, 7, 10])
+            .unwrap()
+            .with_colors((0..10).map(|i| Vec3::X * i as f32).collect())
+            .unwrap();
+        let every_other = curves.every_nth(2);
+        assert_eq!(every_other.offsets(), &[0, 2, 4]);
+        assert_eq!(every_other.points()[2], Vec3::splat(5.0));
+        assert_eq!(every_other.colors().unwrap()[3], Vec3::X * 6.0);
+    }
+
     use super::*;
 
     #[test]
