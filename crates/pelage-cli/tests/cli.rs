@@ -533,3 +533,55 @@ fn groom_preview_draws_the_hairs() {
         assert!(blue > drawn / 4, "{blue} blue of {drawn} drawn pixels");
     }
 }
+
+#[test]
+fn guides_follow_a_comb_map() {
+    let dir = tempfile::tempdir().unwrap();
+    // Red 1, green 0.5: comb along +U everywhere.
+    let flow = dir.path().join("flow.png");
+    image::RgbImage::from_pixel(4, 4, image::Rgb([255, 128, 0]))
+        .save(&flow)
+        .unwrap();
+    let grow = |extra: &[&str], name: &str| {
+        let out_path = dir.path().join(name);
+        let mut args = vec![
+            "guides",
+            "-n",
+            "40",
+            "--points",
+            "4",
+            "-o",
+            out_path.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = pelage(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        pelage::io::read_curves(&out_path).unwrap()
+    };
+    let straight = grow(&[], "straight.usda");
+    let combed = grow(
+        &["--comb-map", flow.to_str().unwrap(), "--comb-strength", "2"],
+        "combed.usda",
+    );
+    // Same roots, bent tips.
+    assert_eq!(straight.curve_count(), combed.curve_count());
+    let moved = (0..straight.curve_count())
+        .filter(|&i| {
+            let (a, b) = (straight.range(i), combed.range(i));
+            assert_eq!(straight.points()[a.start], combed.points()[b.start]);
+            (straight.points()[a.end - 1] - combed.points()[b.end - 1]).length() > 1e-3
+        })
+        .count();
+    assert!(moved > 30, "{moved} of 40 guides bent");
+    // --comb and --comb-map together are refused.
+    let out = pelage(&[
+        "guides",
+        "--comb",
+        "0,0,1",
+        "--comb-map",
+        "x.png",
+        "-o",
+        "g.usda",
+    ]);
+    assert!(!out.status.success());
+}

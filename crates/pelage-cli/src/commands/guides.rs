@@ -1,5 +1,5 @@
 //! `pelage guides`: guide curves for a mesh — grown on it (roots from the
-//! density sampler, combed and pulled by gravity), or read from a file and
+//! density sampler, combed by a direction or a flow map, pulled by gravity), or read from a file and
 //! bound to it (with a report of every guide left out) — written in any
 //! curves format.
 
@@ -10,7 +10,7 @@ use anyhow::Context;
 use clap::Args;
 use glam::Vec3;
 use pelage::Map;
-use pelage::guides::{GuideGrowth, Guides};
+use pelage::guides::{CombMap, GuideGrowth, Guides};
 use pelage::io::{CurvesExport, read_curves, write_curves};
 use std::path::PathBuf;
 
@@ -32,6 +32,14 @@ pub struct GuidesArgs {
     /// its length is the strength.
     #[arg(long, value_parser = parse_vec3)]
     pub comb: Option<[f32; 3]>,
+    /// A flow map instead of --comb: an image whose red and green channels
+    /// give the comb along +U and along N × T at each root's UV (0.5: none);
+    /// the mesh needs UVs.
+    #[arg(long, value_name = "IMAGE", conflicts_with = "comb")]
+    pub comb_map: Option<String>,
+    /// Multiplies the comb map's direction.
+    #[arg(long, default_value_t = 1.0)]
+    pub comb_strength: f32,
     /// Gravity's pull (world −Y) relative to the normal.
     #[arg(long, default_value_t = 0.0)]
     pub gravity: f32,
@@ -78,6 +86,14 @@ pub fn run(args: &GuidesArgs) -> anyhow::Result<()> {
                 density: Map::parse(&args.density).context("cannot read the density map")?,
                 length: Map::parse(&args.length).context("cannot read the length map")?,
                 comb: args.comb.map_or(Vec3::ZERO, Vec3::from),
+                comb_map: match &args.comb_map {
+                    Some(image) => Some(CombMap {
+                        u: Map::parse(&format!("{image}:r")).context("cannot read the comb map")?,
+                        v: Map::parse(&format!("{image}:g")).context("cannot read the comb map")?,
+                        strength: args.comb_strength,
+                    }),
+                    None => None,
+                },
                 gravity: args.gravity,
                 points: args.points,
                 seed: args.seed,

@@ -157,6 +157,9 @@ fn zero() -> MapValue {
 fn seed_one() -> u64 {
     1
 }
+fn one_f32() -> f32 {
+    1.0
+}
 
 /// A whole groom file.
 #[derive(Debug, Clone, Deserialize)]
@@ -247,6 +250,12 @@ pub struct GenerateSection {
     /// Comb direction (world space; its length is the strength).
     #[serde(default)]
     pub comb: [f32; 3],
+    /// A flow map instead of `comb`: two maps, the comb's components along
+    /// +U and along `N × T` (0.5: none), e.g. `["flow.png:r", "flow.png:g"]`.
+    pub comb_map: Option<[MapValue; 2]>,
+    /// Multiplies the flow map's direction.
+    #[serde(default = "one_f32")]
+    pub comb_strength: f32,
     /// Pull toward world −Y.
     #[serde(default)]
     pub gravity: f32,

@@ -12,7 +12,7 @@ use super::ops::{
 use super::parts::{Part, PartLayout};
 use crate::curves::Curves;
 use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
-use crate::guides::{BindReport, GuideGrowth, Guides};
+use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{GuideWeight, InterpolationMethod, Interpolator, StyleMeshOptions};
 use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
@@ -192,6 +192,14 @@ fn load_guides(
                 density: map(&generate.density)?,
                 length: map(&generate.length)?,
                 comb: Vec3::from(generate.comb),
+                comb_map: match &generate.comb_map {
+                    Some([u, v]) => Some(CombMap {
+                        u: map(u)?,
+                        v: map(v)?,
+                        strength: generate.comb_strength,
+                    }),
+                    None => None,
+                },
                 gravity: generate.gravity,
                 points: section.points,
                 width: 0.004,

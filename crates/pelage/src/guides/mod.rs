@@ -80,6 +80,9 @@ pub struct GuideGrowth {
     /// Comb direction (world space); its part along the surface bends the
     /// guide, its length is the strength (0: straight along the normal).
     pub comb: Vec3,
+    /// A comb direction per UV instead of `comb` (a flow map); `None`: use
+    /// `comb`.
+    pub comb_map: Option<CombMap>,
     /// Gravity's pull, world −Y, relative to the normal (0: none).
     pub gravity: f32,
     /// Points per guide (at least 2).
@@ -97,11 +100,38 @@ impl Default for GuideGrowth {
             density: Map::Constant(1.0),
             length: Map::Constant(0.1),
             comb: Vec3::ZERO,
+            comb_map: None,
             gravity: 0.0,
             points: 8,
             width: 0.004,
             seed: 1,
         }
+    }
+}
+
+/// A comb direction painted over the surface, as flow maps are (Houdini,
+/// Unreal, Blender's hair tools): two maps read at the root's UV give the
+/// direction in the surface's UV tangent frame, `(2u − 1) T + (2v − 1) B`
+/// (mid-grey: no comb; red 1 combs along +U), times `strength`. `T` is the
+/// direction of increasing U on the surface, `B = N × T`.
+#[derive(Debug, Clone)]
+pub struct CombMap {
+    /// The component along +U (an image's red channel, say).
+    pub u: Map,
+    /// The component along `N × T` (an image's green channel).
+    pub v: Map,
+    /// Multiplies the direction (1: a full-red texel bends like `comb` of
+    /// length 1).
+    pub strength: f32,
+}
+
+impl CombMap {
+    /// The comb at `root` (in world space, tangent to the surface).
+    pub fn at(&self, mesh: &Mesh, root: SurfacePoint) -> Vec3 {
+        let uv = root.uv(mesh).unwrap_or_default();
+        let frame = root.tangent_frame(mesh);
+        let (a, b) = (2.0 * self.u.eval(uv) - 1.0, 2.0 * self.v.eval(uv) - 1.0);
+        self.strength * (a * frame.tangent + b * frame.bitangent)
     }
 }
 
@@ -190,11 +220,20 @@ impl Guides {
         let sampler = DensitySampler::new(mesh, &growth.density, DensitySamplerOptions::default())?;
         let roots = sample_range(&sampler, growth.seed, 0..growth.count as u64);
         let length = growth.length.on_mesh(mesh)?;
+        if let Some(map) = &growth.comb_map {
+            // Both need UVs to be read; refuse a mesh without them here.
+            map.u.on_mesh(mesh)?;
+            map.v.on_mesh(mesh)?;
+        }
         let n = growth.points.max(2);
         let (mut points, mut widths) = (Vec::new(), Vec::new());
         for root in &roots {
             let (p0, normal) = (root.position(mesh), root.normal(mesh));
-            let comb = growth.comb - normal * normal.dot(growth.comb);
+            let comb = match &growth.comb_map {
+                Some(map) => map.at(mesh, *root),
+                None => growth.comb,
+            };
+            let comb = comb - normal * normal.dot(comb);
             let pull = comb + Vec3::NEG_Y * growth.gravity;
             let step = length.eval(*root).max(0.0) / (n - 1) as f32;
             let mut p = p0;
@@ -294,6 +333,52 @@ pub fn resample_by_arc_length(points: &[Vec3], n: usize) -> Vec<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn comb_map_bends_each_guide_its_own_way() {
+        use crate::map::{ImageMap, Wrap};
+        // Left half of the square combed toward −U, right half toward +U
+        // (red 0 and 1, clamped, nearest); green mid-grey: no V part.
+        let square = crate::mesh::tests::unit_square();
+        let red = ImageMap::from_texels(2, 1, vec![0.0, 1.0], Wrap::Clamp)
+            .unwrap()
+            .with_filter(crate::map::Filter::Nearest);
+        let growth = GuideGrowth {
+            count: 200,
+            length: Map::Constant(0.2),
+            comb_map: Some(CombMap {
+                u: Map::Image(red),
+                v: Map::Constant(0.5),
+                strength: 2.0,
+            }),
+            ..GuideGrowth::default()
+        };
+        let guides = Guides::grow(&square, &growth).unwrap();
+        let (mut left, mut right) = (0, 0);
+        for i in 0..guides.len() {
+            let g = guides.guide(i);
+            let lean = g[g.len() - 1] - g[0];
+            assert!(lean.y.abs() < 1e-5, "no V component");
+            if g[0].x < 0.5 {
+                assert!(lean.x < -0.05, "guide {i} at {} leans {lean}", g[0]);
+                left += 1;
+            } else {
+                assert!(lean.x > 0.05, "guide {i} at {} leans {lean}", g[0]);
+                right += 1;
+            }
+        }
+        assert!(left > 50 && right > 50);
+        // A comb map on a mesh without UVs is refused.
+        let growth = GuideGrowth {
+            comb_map: Some(CombMap {
+                u: Map::Image(ImageMap::from_texels(1, 1, vec![1.0], Wrap::Clamp).unwrap()),
+                v: Map::Constant(0.5),
+                strength: 1.0,
+            }),
+            ..GuideGrowth::default()
+        };
+        assert!(Guides::grow(&crate::mesh::tests::tetrahedron(), &growth).is_err());
+    }
 
     #[test]
     fn resampling_spaces_points_evenly_and_keeps_the_ends() {
