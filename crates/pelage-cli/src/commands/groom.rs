@@ -7,7 +7,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use pelage::groom::{Groom, part_file, part_slice, write_assembly};
-use pelage::io::{CurveBasis, CurvesExport, UsdOptions};
+use pelage::io::{CurveBasis, CurvesExport, CurvesFormat, UsdOptions};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -95,6 +95,18 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         }
         None => (0..parts, output.clone()),
     };
+    // Refuse an output pelage cannot write before growing anything.
+    match CurvesFormat::from_path(&path) {
+        None => bail!(
+            "{}: unknown curves format; pelage writes .usda (or .usd), .hair, .ply, .rib and .pbrt",
+            path.display()
+        ),
+        Some(CurvesFormat::Usdc) => bail!(
+            "{}: pelage writes text USD only (.usda or .usd); see docs/curves-io.md",
+            path.display()
+        ),
+        Some(_) => {}
+    }
     let file = groom.file();
     let basis = match file.output.basis.as_deref() {
         None | Some("catmull-rom") | Some("catmullRom") => CurveBasis::CatmullRom,
@@ -126,13 +138,13 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         bar
     };
     println!(
-        "{}: {} hairs on {} ({} triangles) from {} guides, {} parts; operators: {}",
+        "{}: {} hairs on {} ({} triangles) from {} guides, {}; operators: {}",
         args.file.display(),
         thousands(planned),
         groom.mesh().name(),
         thousands(groom.mesh().triangle_count() as u64),
         thousands(groom.guides().len() as u64),
-        range.len(),
+        parts_text(range.len()),
         match generator.operators().len() {
             0 => "none".to_string(),
             _ => generator
@@ -159,10 +171,10 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let seconds = growing.elapsed().as_secs_f64();
     println!(
-        "{} hairs, {} points in {} parts → {} in {:.2} s ({:.2} M hairs/s; setup {:.2} s)",
+        "{} hairs, {} points in {} → {} in {:.2} s ({:.2} M hairs/s; setup {:.2} s)",
         thousands(summary.hairs),
         thousands(summary.points),
-        range.len(),
+        parts_text(range.len()),
         path.display(),
         seconds,
         summary.hairs as f64 / seconds / 1e6,
@@ -180,6 +192,15 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// "1 part", "3 parts".
+fn parts_text(n: usize) -> String {
+    if n == 1 {
+        "1 part".into()
+    } else {
+        format!("{n} parts")
+    }
 }
 
 /// Hairs the preview draws at most.

@@ -15,7 +15,7 @@ pub enum CurvesFormat {
     /// `.usda` (and `.usd` when writing: text USD; reading sniffs text or
     /// binary).
     Usda,
-    /// `.usdc`: read only (see docs/usd.md).
+    /// `.usdc`: read only (see docs/curves-io.md).
     Usdc,
     /// Cem Yuksel's `.hair`.
     Hair,
@@ -90,7 +90,7 @@ pub fn write_curves<'c>(
     let basis = export.usd.basis;
     match format {
         CurvesFormat::Usdc => Err(fail(
-            "pelage writes text USD only (.usda or .usd); see docs/usd.md".into(),
+            "pelage writes text USD only (.usda or .usd); see docs/curves-io.md".into(),
         )),
         CurvesFormat::Usda => write_atomically(path, |out| {
             let other = std::io::Error::other;

@@ -11,7 +11,7 @@
 //! `displayOpacity` are per point (`vertex`), the root UV (`st`) and the
 //! hair id are per curve (`uniform`), and every prim has an `extent`
 //! padded by half the widest hair, as `UsdGeomCurves::ComputeExtent` does.
-//! docs/usd.md says why pelage writes usda itself rather than usdc.
+//! docs/curves-io.md says why pelage writes usda itself rather than usdc.
 
 use super::text::{put_f32, put_tuple2, put_tuple3, put_u64};
 use crate::Curves;
