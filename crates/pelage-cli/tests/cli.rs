@@ -585,3 +585,52 @@ fn guides_follow_a_comb_map() {
     ]);
     assert!(!out.status.success());
 }
+
+#[test]
+fn grooms_with_more_parts_than_hairs_write_valid_usd() {
+    // 4 hairs in 40 parts: most parts, and likely whole runs, grow nothing.
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("sparse.toml");
+    std::fs::write(
+        &groom,
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 4\nparts = 40\n[guides]\ngenerate = { count = 10, length = 0.05 }\n",
+    )
+    .unwrap();
+    let out_path = dir.path().join("sparse.usda");
+    let out = out_path.to_str().unwrap();
+    let full = pelage(&["groom", groom.to_str().unwrap(), "-q", "-o", out]);
+    assert!(full.status.success(), "{}", stderr(&full));
+    assert!(stdout(&full).contains("4 hairs"), "{}", stdout(&full));
+    for k in 1..=8 {
+        let run = pelage(&[
+            "groom",
+            groom.to_str().unwrap(),
+            "-q",
+            "-o",
+            out,
+            "--part",
+            &format!("{k}/8"),
+        ]);
+        assert!(run.status.success(), "{}", stderr(&run));
+    }
+    let assembled = dir.path().join("farm.usda");
+    for k in 1..=8 {
+        std::fs::rename(
+            dir.path().join(format!("sparse.part-{k}-of-8.usda")),
+            dir.path().join(format!("farm.part-{k}-of-8.usda")),
+        )
+        .unwrap();
+    }
+    let out = pelage(&[
+        "groom",
+        groom.to_str().unwrap(),
+        "--assemble",
+        "-o",
+        assembled.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    if let Some((ok, report)) = usdcheck(&[&out_path, &assembled]) {
+        assert!(ok, "{report}");
+        assert!(report.contains("4 curves"), "{report}");
+    }
+}

@@ -199,7 +199,7 @@ fn parts_text(n: usize) -> String {
     if n == 1 {
         "1 part".into()
     } else {
-        format!("{n} parts")
+        format!("{} parts", thousands(n as u64))
     }
 }
 

@@ -115,9 +115,9 @@ impl Groom {
     }
 
     /// The number of parts: `[roots] parts`, or one per
-    /// [`HAIRS_PER_PART`] hairs.
+    /// [`HAIRS_PER_PART`] hairs; never more than the mesh has triangles.
     pub fn part_count(&self) -> usize {
-        match &self.file.roots.parts {
+        let wanted = match &self.file.roots.parts {
             Some(p) => (*p.get_ref()).max(1) as usize,
             None => self
                 .file
@@ -126,7 +126,8 @@ impl Groom {
                 .get_ref()
                 .div_ceil(HAIRS_PER_PART)
                 .max(1) as usize,
-        }
+        };
+        wanted.min(self.mesh.triangle_count()).max(1)
     }
 
     /// Prepares generation: the root sampler and part layout, the

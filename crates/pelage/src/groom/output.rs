@@ -64,7 +64,9 @@ impl Generator<'_> {
                 let curves = self.part(p);
                 on_part(p, &curves);
                 count(&curves);
-                grown.push((part_name(p), curves));
+                if curves.curve_count() > 0 {
+                    grown.push((part_name(p), curves));
+                }
             }
             write_curves(path, grown.iter().map(|(n, c)| (n.clone(), c)), export)?;
             return Ok(summary);
@@ -102,7 +104,11 @@ impl Generator<'_> {
                 }
             });
             for (p, curves) in receive {
-                usd.write_part(&part_name(p), &curves).map_err(other)?;
+                // A part that grew no hair (more parts than hairs, or a
+                // bald region) is left out: USD has no empty BasisCurves.
+                if curves.curve_count() > 0 {
+                    usd.write_part(&part_name(p), &curves).map_err(other)?;
+                }
                 on_part(p, &curves);
             }
             grower.join().expect("the part grower does not panic");
@@ -151,16 +157,13 @@ pub fn write_assembly(
                 });
             }
         }
-        let bounds = bounds.ok_or_else(|| {
-            fail(
-                file,
-                "no extent found: is this a part file written by pelage groom?".into(),
-            )
-        })?;
+        // A run whose parts all grew nothing has no prims and no extent;
+        // it is still referenced, so the layer lists every run.
         extents.push(bounds);
     }
     let whole = extents
         .iter()
+        .flatten()
         .copied()
         .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
         .unwrap_or((Vec3::ZERO, Vec3::ZERO));
@@ -180,18 +183,22 @@ pub fn write_assembly(
             t(whole.1),
             root = options.root,
         )?;
-        for (k, (file, (lo, hi))) in part_files.iter().zip(&extents).enumerate() {
+        for (k, (file, bounds)) in part_files.iter().zip(&extents).enumerate() {
             // Reference by path relative to the root layer when possible.
             let shown = file
                 .strip_prefix(folder)
                 .map(|p| format!("./{}", p.display()))
                 .unwrap_or_else(|_| file.display().to_string());
+            let hint = match bounds {
+                Some((lo, hi)) => {
+                    format!("\n        float3[] extentsHint = [{}, {}]", t(*lo), t(*hi))
+                }
+                None => String::new(),
+            };
             writeln!(
                 out,
-                "\n    def Xform \"run_{:04}\" (\n        prepend references = @{shown}@\n    )\n    {{\n        float3[] extentsHint = [{}, {}]\n    }}",
+                "\n    def Xform \"run_{:04}\" (\n        prepend references = @{shown}@\n    )\n    {{{hint}\n    }}",
                 k + 1,
-                t(*lo),
-                t(*hi)
             )?;
         }
         writeln!(out, "}}")
