@@ -118,6 +118,12 @@ fn a_part_grown_alone_equals_that_part_of_the_full_run() {
     let total: usize = parts.iter().map(Curves::curve_count).sum();
     assert_eq!(ids.len(), total);
     assert!(total > 3 * 6000 / 2 && total <= 3 * 6000, "{total}");
+    // Each hair carries its root UV (spot has UVs), for USD's `st`.
+    let c = &parts[1];
+    let uvs = c.root_uvs().expect("root UVs on a mesh with UVs");
+    for (uv, root) in uvs.iter().zip(c.roots().unwrap()).step_by(97) {
+        assert_eq!(Some(*uv), root.uv(g.mesh()));
+    }
     // A different seed gives a different groom.
     let other = g.generator(Some(12)).unwrap().part(2);
     assert_ne!(other.points(), parts[2].points());

@@ -544,7 +544,7 @@ impl<'g> Generator<'g> {
                 self.grow_chunk(chunk, first, ws)
             })
             .collect();
-        PartChunk::concat(chunks, self.groom.mesh.has_uvs())
+        self.with_root_uvs(PartChunk::concat(chunks))
     }
 
     /// Whether every root grows exactly one hair (no `strands`, no `cut`):
@@ -632,10 +632,28 @@ impl<'g> Generator<'g> {
                 .with_opacities(opacities)
                 .expect("one opacity a point");
         }
-        curves
-            .with_ids(ids)
-            .and_then(|c| c.with_roots(roots.to_vec()))
-            .expect("one id and root a curve")
+        self.with_root_uvs(
+            curves
+                .with_ids(ids)
+                .and_then(|c| c.with_roots(roots.to_vec()))
+                .expect("one id and root a curve"),
+        )
+    }
+
+    /// Adds each hair's root UV (USD's uniform `st`, which renderers use to
+    /// read skin textures along the hair) when the mesh has UVs.
+    fn with_root_uvs(&self, curves: Curves) -> Curves {
+        let mesh = &self.groom.mesh;
+        if !mesh.has_uvs() {
+            return curves;
+        }
+        let uvs = curves
+            .roots()
+            .expect("grown curves carry their roots")
+            .iter()
+            .map(|r| r.uv(mesh).unwrap_or_default())
+            .collect();
+        curves.with_root_uvs(uvs).expect("one UV a curve")
     }
 
     fn grow_chunk(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) -> PartChunk {
@@ -703,7 +721,7 @@ impl PartChunk {
         }
     }
 
-    fn concat(chunks: Vec<PartChunk>, uvs: bool) -> Curves {
+    fn concat(chunks: Vec<PartChunk>) -> Curves {
         let total_points: usize = chunks.iter().map(|c| c.points.len()).sum();
         let total_curves: usize = chunks.iter().map(|c| c.counts.len()).sum();
         let (has_normals, has_colors, has_opacities) =
@@ -745,7 +763,6 @@ impl PartChunk {
                 .expect("one opacity a point");
         }
         curves = curves.with_ids(ids).expect("one id a curve");
-        let _ = uvs;
         curves.with_roots(roots).expect("one root a curve")
     }
 }
