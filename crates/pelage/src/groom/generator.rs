@@ -115,7 +115,7 @@ impl Groom {
     }
 
     /// The number of parts: `[roots] parts`, or one per
-    /// [`HAIRS_PER_PART`] hairs; never more than the mesh has triangles.
+    /// 100,000 hairs; never more than the mesh has triangles.
     pub fn part_count(&self) -> usize {
         let wanted = match &self.file.roots.parts {
             Some(p) => (*p.get_ref()).max(1) as usize,

@@ -2,7 +2,7 @@
 //! part by part (Sik §4, Stubble's generator; the Furtility talk's chain of
 //! groom operators).
 //!
-//! - [`file`]: the TOML groom file ([`GroomFile`]), every error with file,
+//! - [`mod@file`]: the TOML groom file ([`GroomFile`]), every error with file,
 //!   line and key.
 //! - [`Groom`]: a groom file loaded: its mesh, guides and resolved maps.
 //! - [`Generator`]: everything prepared for generation (root sampler,
