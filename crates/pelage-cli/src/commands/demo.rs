@@ -35,8 +35,7 @@ fn render_preview(
     curves: &Curves,
     path: &std::path::Path,
 ) -> anyhow::Result<String> {
-    use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
-    let ctx = GpuContext::headless()?;
+    use pelage_gpu::{Camera, PreviewScene, PreviewStyle};
     let texture = image::load_from_memory(pelage::assets::SPOT_TEXTURE_PNG)?.to_rgba8();
     let scene = PreviewScene {
         mesh: Some(spot),
@@ -49,24 +48,11 @@ fn render_preview(
         target: glam::Vec3::new(0.0, 0.2, 0.1),
         fov_y_degrees: 36.0,
     };
-    let image = Renderer::new(&ctx).render(
-        &ctx,
-        &scene,
-        &PreviewStyle {
-            // White fur on white would vanish.
-            background: [0.62, 0.66, 0.72],
-            ..PreviewStyle::default()
-        },
-        Some(camera),
-        1280,
-        720,
-    )?;
-    write_atomically(path, |out| {
-        image
-            .write_to(out, image::ImageFormat::Png)
-            .map_err(std::io::Error::other)
-    })?;
-    Ok(ctx.adapter_name())
+    let style = PreviewStyle {
+        background: super::FUR_BACKGROUND,
+        ..PreviewStyle::default()
+    };
+    super::render_png(&scene, &style, Some(camera), (1280, 720), path)
 }
 
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {

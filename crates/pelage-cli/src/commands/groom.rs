@@ -182,7 +182,17 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     );
     if let Some(png) = &args.preview {
         let curves = pelage::io::join(shown.iter())?;
-        match render_preview(groom.mesh(), &curves, png) {
+        let scene = pelage_gpu::PreviewScene {
+            mesh: Some(groom.mesh()),
+            points: &[],
+            curves: Some(&curves),
+            skin_texture: None,
+        };
+        let style = pelage_gpu::PreviewStyle {
+            background: super::FUR_BACKGROUND,
+            ..pelage_gpu::PreviewStyle::default()
+        };
+        match super::render_png(&scene, &style, None, (1280, 720), png) {
             Ok(adapter) => println!(
                 "preview of {} hairs → {} (rendered on {adapter})",
                 thousands(curves.curve_count() as u64),
@@ -205,34 +215,6 @@ fn parts_text(n: usize) -> String {
 
 /// Hairs the preview draws at most.
 const PREVIEW_HAIRS: u64 = 300_000;
-
-/// Draws `curves` on `mesh` (auto-framed) into `path`; returns the
-/// adapter's name.
-fn render_preview(
-    mesh: &pelage::Mesh,
-    curves: &pelage::Curves,
-    path: &Path,
-) -> anyhow::Result<String> {
-    use pelage_gpu::{GpuContext, PreviewScene, PreviewStyle, Renderer};
-    let ctx = GpuContext::headless()?;
-    let scene = PreviewScene {
-        mesh: Some(mesh),
-        points: &[],
-        curves: Some(curves),
-        skin_texture: None,
-    };
-    let style = PreviewStyle {
-        background: [0.62, 0.66, 0.72],
-        ..PreviewStyle::default()
-    };
-    let image = Renderer::new(&ctx).render(&ctx, &scene, &style, None, 1280, 720)?;
-    pelage::io::write_atomically(path, |out| {
-        image
-            .write_to(out, image::ImageFormat::Png)
-            .map_err(std::io::Error::other)
-    })?;
-    Ok(ctx.adapter_name())
-}
 
 /// Finds `OUTPUT.part-K-of-N.usda` for one N and every K, and writes the
 /// root layer.

@@ -11,7 +11,30 @@ pub mod sample;
 
 use anyhow::Context;
 use pelage::Mesh;
+use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
 use std::path::Path;
+
+/// The background of groom previews: white fur on white would vanish.
+pub const FUR_BACKGROUND: [f32; 3] = [0.62, 0.66, 0.72];
+
+/// Draws `scene` headless (`camera`: `None` frames it automatically) and
+/// writes it to `path` as a PNG, atomically; returns the adapter's name.
+pub fn render_png(
+    scene: &PreviewScene,
+    style: &PreviewStyle,
+    camera: Option<Camera>,
+    (width, height): (u32, u32),
+    path: &Path,
+) -> anyhow::Result<String> {
+    let ctx = GpuContext::headless()?;
+    let image = Renderer::new(&ctx).render(&ctx, scene, style, camera, width, height)?;
+    pelage::io::write_atomically(path, |out| {
+        image
+            .write_to(out, image::ImageFormat::Png)
+            .map_err(std::io::Error::other)
+    })?;
+    Ok(ctx.adapter_name())
+}
 
 /// Loads the mesh at `path`, or the embedded Spot when there is none.
 pub fn load_mesh(path: Option<&Path>) -> anyhow::Result<Mesh> {

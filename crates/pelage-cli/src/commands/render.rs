@@ -4,8 +4,8 @@
 use super::load_mesh;
 use anyhow::Context;
 use clap::Args;
-use pelage::io::{CurvesFormat, ply_element_count, read_curves, read_points_ply, write_atomically};
-use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
+use pelage::io::{CurvesFormat, ply_element_count, read_curves, read_points_ply};
+use pelage_gpu::{Camera, PreviewScene, PreviewStyle};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `pelage render`.
@@ -147,14 +147,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         point_radius: args.point_radius,
         ..Default::default()
     };
-    let ctx = GpuContext::headless()?;
-    let renderer = Renderer::new(&ctx);
-    let image = renderer.render(&ctx, &scene, &style, camera, width, height)?;
-    write_atomically(&args.output, |out| {
-        image
-            .write_to(out, image::ImageFormat::Png)
-            .map_err(std::io::Error::other)
-    })?;
+    let adapter = super::render_png(&scene, &style, camera, (width, height), &args.output)?;
     println!(
         "wrote {} ({width}×{height}, {} on {})",
         args.output.display(),
@@ -170,7 +163,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             (Some(m), n, None) => format!("{n} points on {}", m.name()),
             (None, n, None) => format!("{n} points"),
         },
-        ctx.adapter_name()
+        adapter
     );
     Ok(())
 }

@@ -138,11 +138,17 @@ impl Groom {
     }
 
     fn map(&self, value: &MapValue) -> Result<Map, GroomError> {
-        let map = self.source.map(value)?;
-        map.on_mesh(&self.mesh)
-            .map_err(|e| self.source.error_at(value.span(), GroomErrorKind::Map(e)))?;
-        Ok(map)
+        map_on_mesh(&self.source, &self.mesh, value)
     }
+}
+
+/// Resolves a map value and checks it can be read on `mesh` (UVs), both
+/// errors at the value's line.
+fn map_on_mesh(source: &GroomSource, mesh: &Mesh, value: &MapValue) -> Result<Map, GroomError> {
+    let map = source.map(value)?;
+    map.on_mesh(mesh)
+        .map_err(|e| source.error_at(value.span(), GroomErrorKind::Map(e)))?;
+    Ok(map)
 }
 
 fn load_mesh(source: &GroomSource, file: &GroomFile) -> Result<Mesh, GroomError> {
@@ -182,12 +188,7 @@ fn load_guides(
             Ok((guides, Some(report)))
         }
         (None, Some(generate)) => {
-            let map = |v: &MapValue| {
-                let m = source.map(v)?;
-                m.on_mesh(mesh)
-                    .map_err(|e| source.error_at(v.span(), GroomErrorKind::Map(e)))?;
-                Ok::<_, GroomError>(m)
-            };
+            let map = |v: &MapValue| map_on_mesh(source, mesh, v);
             let growth = GuideGrowth {
                 count: generate.count.max(1),
                 density: map(&generate.density)?,
@@ -446,7 +447,7 @@ impl<'g> Generator<'g> {
                     match ws.batch.hairs().first() {
                         Some(hair) => out.extend_from_slice(&hair.points),
                         // Cut away entirely: the centre is its interpolated shape.
-                        None => out.extend_from_slice(&ws.scratch.points[..self.points]),
+                        None => self.resampled(&ws.shape, &mut out),
                     }
                 }
                 out
@@ -492,21 +493,24 @@ impl<'g> Generator<'g> {
         let hair = ws.batch.reset();
         hair.id = id;
         hair.points.clear();
-        if guide_points == self.points {
-            hair.points.extend_from_slice(&ws.shape);
-        } else {
-            resample_uniform(&ws.shape, self.points, &mut hair.points);
-        }
+        self.resampled(&ws.shape, &mut hair.points);
         hair.colors.clear();
         hair.opacities.clear();
-        // The pre-operator shape, for clump centres cut away entirely.
-        ws.scratch.points.clear();
-        ws.scratch.points.extend_from_slice(&hair.points);
         for op in self.base.iter().chain(ops) {
             op.apply(&mut ws.batch, &context, &mut ws.scratch);
             if ws.batch.is_empty() {
                 break;
             }
+        }
+    }
+
+    /// Appends the interpolated `shape` (guide resolution) at the hairs'
+    /// point count.
+    fn resampled(&self, shape: &[Vec3], out: &mut Vec<Vec3>) {
+        if shape.len() == self.points {
+            out.extend_from_slice(shape);
+        } else {
+            resample_uniform(shape, self.points, out);
         }
     }
 
@@ -529,7 +533,8 @@ impl<'g> Generator<'g> {
 
     /// Grows part `p`: its curves with per-point widths, normals (unless
     /// turned off), colours and opacities (when the groom has them), roots,
-    /// root UVs (meshes with UVs) and ids. Identical on any thread count.
+    /// root UVs (meshes with UVs) and ids. Identical on any thread count:
+    /// workers grow fixed chunks of roots, in order.
     pub fn part(&self, p: usize) -> Curves {
         let part = &self.layout.parts()[p];
         let roots = self.part_roots(p);
@@ -544,7 +549,7 @@ impl<'g> Generator<'g> {
                 self.grow_chunk(chunk, first, ws)
             })
             .collect();
-        self.with_root_uvs(PartChunk::concat(chunks))
+        self.concat(chunks)
     }
 
     /// Whether every root grows exactly one hair (no `strands`, no `cut`):
@@ -659,7 +664,7 @@ impl<'g> Generator<'g> {
     fn grow_chunk(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) -> PartChunk {
         let mesh = &self.groom.mesh;
         let n = self.points;
-        let mut out = PartChunk::with_capacity(roots.len(), n, self);
+        let mut out = PartChunk::default();
         let mut tangents = vec![Vec3::ZERO; n];
         let mut frame = vec![Vec3::ZERO; n];
         for (i, root) in roots.iter().enumerate() {
@@ -686,9 +691,52 @@ impl<'g> Generator<'g> {
         }
         out
     }
+
+    /// One part's curves from its workers' chunks, in order, with the
+    /// attributes this groom has.
+    fn concat(&self, chunks: Vec<PartChunk>) -> Curves {
+        let mut all = PartChunk::default();
+        let mut offsets = vec![0u32];
+        for c in chunks {
+            all.points.extend_from_slice(&c.points);
+            all.widths.extend_from_slice(&c.widths);
+            all.normals.extend_from_slice(&c.normals);
+            all.colors.extend_from_slice(&c.colors);
+            all.opacities.extend_from_slice(&c.opacities);
+            for n in c.counts {
+                offsets.push(offsets.last().expect("starts at 0") + n);
+            }
+            all.ids.extend_from_slice(&c.ids);
+            all.roots.extend_from_slice(&c.roots);
+        }
+        // The generator builds consistent arrays; a failure here is a bug.
+        let mut curves =
+            Curves::new(all.points, all.widths, offsets).expect("consistent part arrays");
+        if self.normals {
+            curves = curves
+                .with_normals(all.normals)
+                .expect("one normal a point");
+        }
+        if self.colors {
+            curves = curves.with_colors(all.colors).expect("one colour a point");
+        }
+        if self.opacities {
+            curves = curves
+                .with_opacities(all.opacities)
+                .expect("one opacity a point");
+        }
+        self.with_root_uvs(
+            curves
+                .with_ids(all.ids)
+                .and_then(|c| c.with_roots(all.roots))
+                .expect("one id and root a curve"),
+        )
+    }
 }
 
-/// Hairs grown by one worker, in order.
+/// Hairs grown by one worker, in order (per-point arrays stay empty for
+/// attributes the groom does not have).
+#[derive(Default)]
 struct PartChunk {
     points: Vec<Vec3>,
     widths: Vec<f32>,
@@ -698,73 +746,6 @@ struct PartChunk {
     counts: Vec<u32>,
     ids: Vec<u64>,
     roots: Vec<SurfacePoint>,
-    has_normals: bool,
-    has_colors: bool,
-    has_opacities: bool,
-}
-
-impl PartChunk {
-    fn with_capacity(hairs: usize, n: usize, g: &Generator) -> Self {
-        let per_point = |on: bool| if on { hairs * n } else { 0 };
-        Self {
-            points: Vec::with_capacity(hairs * n),
-            widths: Vec::with_capacity(hairs * n),
-            normals: Vec::with_capacity(per_point(g.normals)),
-            colors: Vec::with_capacity(per_point(g.colors)),
-            opacities: Vec::with_capacity(per_point(g.opacities)),
-            counts: Vec::with_capacity(hairs),
-            ids: Vec::with_capacity(hairs),
-            roots: Vec::with_capacity(hairs),
-            has_normals: g.normals,
-            has_colors: g.colors,
-            has_opacities: g.opacities,
-        }
-    }
-
-    fn concat(chunks: Vec<PartChunk>) -> Curves {
-        let total_points: usize = chunks.iter().map(|c| c.points.len()).sum();
-        let total_curves: usize = chunks.iter().map(|c| c.counts.len()).sum();
-        let (has_normals, has_colors, has_opacities) =
-            chunks.first().map_or((false, false, false), |c| {
-                (c.has_normals, c.has_colors, c.has_opacities)
-            });
-        let mut points = Vec::with_capacity(total_points);
-        let mut widths = Vec::with_capacity(total_points);
-        let mut normals = Vec::with_capacity(if has_normals { total_points } else { 0 });
-        let mut colors = Vec::with_capacity(if has_colors { total_points } else { 0 });
-        let mut opacities = Vec::with_capacity(if has_opacities { total_points } else { 0 });
-        let mut offsets = Vec::with_capacity(total_curves + 1);
-        offsets.push(0u32);
-        let mut ids = Vec::with_capacity(total_curves);
-        let mut roots = Vec::with_capacity(total_curves);
-        for c in chunks {
-            points.extend_from_slice(&c.points);
-            widths.extend_from_slice(&c.widths);
-            normals.extend_from_slice(&c.normals);
-            colors.extend_from_slice(&c.colors);
-            opacities.extend_from_slice(&c.opacities);
-            for n in c.counts {
-                offsets.push(offsets.last().expect("starts at 0") + n);
-            }
-            ids.extend_from_slice(&c.ids);
-            roots.extend_from_slice(&c.roots);
-        }
-        // The generator builds consistent arrays; a failure here is a bug.
-        let mut curves = Curves::new(points, widths, offsets).expect("consistent part arrays");
-        if has_normals {
-            curves = curves.with_normals(normals).expect("one normal a point");
-        }
-        if has_colors {
-            curves = curves.with_colors(colors).expect("one colour a point");
-        }
-        if has_opacities {
-            curves = curves
-                .with_opacities(opacities)
-                .expect("one opacity a point");
-        }
-        curves = curves.with_ids(ids).expect("one id a curve");
-        curves.with_roots(roots).expect("one root a curve")
-    }
 }
 
 /// `n` points evenly spaced in the parameter of the polyline `shape`

@@ -80,37 +80,9 @@ impl NoiseMap {
 }
 
 impl NoiseMap {
-    /// One octave of 3D Perlin noise (Perlin 2002: quintic fade, the twelve
-    /// edge-direction gradients), in about [−1, 1]; the groom's noise
-    /// operator displaces hair points with it.
-    pub fn perlin3(&self, p: glam::Vec3) -> f32 {
-        let cell = p.floor();
-        let f = p - cell;
-        let [xi, yi, zi] = [cell.x, cell.y, cell.z].map(|c| (c as i64 & 255) as usize);
-        let perm = &self.permutation;
-        let hash = |x: usize, y: usize, z: usize| perm[perm[perm[x] as usize + y] as usize + z];
-        let fade = |t: f32| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
-        let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
-        let g = |dx: usize, dy: usize, dz: usize| {
-            gradient3(
-                hash(xi + dx, yi + dy, zi + dz),
-                f.x - dx as f32,
-                f.y - dy as f32,
-                f.z - dz as f32,
-            )
-        };
-        let lerp = |a: f32, b: f32, t: f32| a + t * (b - a);
-        let x00 = lerp(g(0, 0, 0), g(1, 0, 0), u);
-        let x10 = lerp(g(0, 1, 0), g(1, 1, 0), u);
-        let x01 = lerp(g(0, 0, 1), g(1, 0, 1), u);
-        let x11 = lerp(g(0, 1, 1), g(1, 1, 1), u);
-        lerp(lerp(x00, x10, v), lerp(x01, x11, v), w)
-    }
-}
-
-impl NoiseMap {
-    /// Three independent octaves of 3D Perlin noise at `p`, one a
-    /// component: the lattice cell and fade weights are shared, each
+    /// Three independent octaves of 3D Perlin noise (Perlin 2002: quintic
+    /// fade, the twelve edge-direction gradients) at `p`, one a component —
+    /// the groom's noise operator displaces hair points with it: the lattice cell and fade weights are shared, each
     /// component hashes its corners with its own salt. A smooth random
     /// vector field, each component in about [−1, 1].
     pub fn perlin3_vector(&self, p: glam::Vec3) -> glam::Vec3 {

@@ -33,9 +33,9 @@ const PAPER_SECONDS: f64 = 3.2;
 /// interpolation only (the issue's figure).
 const BLENDER_SECONDS_PER_MILLION: f64 = 1.58;
 
-/// The benchmark groom: spot ×2, 1,000 guides, noise + clump, 16 points,
-/// normals and widths.
-fn groom_text(hairs: u64, method: &str) -> String {
+/// What both benchmark grooms share: spot ×2, a noise density, 1,000
+/// grown guides of 8 points.
+fn groom_head(hairs: u64) -> String {
     format!(
         r#"[mesh]
 path = "spot"
@@ -48,7 +48,15 @@ density = "noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4"
 [guides]
 points = 8
 generate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}
+"#
+    )
+}
 
+/// The Stubble figure: `method` interpolation, clump + noise, 16 points,
+/// normals and widths.
+fn groom_text(hairs: u64, method: &str) -> String {
+    format!(
+        r#"{head}
 [interpolation]
 method = "{method}"
 k = 4
@@ -63,6 +71,7 @@ noise = {{ amplitude = 0.004, frequency = 30 }}
 points = 16
 width = {{ root = 0.0015, tip = 0.0002 }}
 "#,
+        head = groom_head(hairs),
         clumps = (hairs / 100).max(1)
     )
 }
@@ -71,19 +80,8 @@ width = {{ root = 0.0015, tip = 0.0002 }}
 /// operators, no normals.
 fn blender_case_text(hairs: u64) -> String {
     format!(
-        r#"[mesh]
-path = "spot"
-subdivide = 2
-[roots]
-count = {hairs}
-density = "noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4"
-[guides]
-points = 8
-generate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}
-[finish]
-points = 8
-normals = false
-"#
+        "{}\n[finish]\npoints = 8\nnormals = false\n",
+        groom_head(hairs)
     )
 }
 
