@@ -19,6 +19,9 @@
 //! - [`groom`]: the groom generator: groom files (TOML), operators
 //!   (noise, frizz, clump, curl, cut, length, strands, width, colour),
 //!   parts, deterministic generation (Sik §4).
+//! - [`shell`]: shell fur — shell textures (Banisch), the wetness mask and
+//!   the curl / clump / Kajiya-Kay reference math (Silva) that the GPU
+//!   shaders mirror, and shell scene files.
 //! - [`io`]: curves and points in and out (USD, .hair, PLY, RIB, pbrt),
 //!   every writer atomic (temporary file, then rename).
 //! - [`assets`]: the embedded demo mesh (Spot), so every command works with
@@ -37,6 +40,7 @@ pub mod io;
 pub mod map;
 pub mod mesh;
 pub mod sample;
+pub mod shell;
 
 pub use curves::Curves;
 pub use map::{Map, MapError};

@@ -597,6 +597,12 @@ impl GroomSource {
 
     /// Parses the text.
     pub fn parse(&self) -> Result<GroomFile, GroomError> {
+        self.parse_as()
+    }
+
+    /// Parses the text as any TOML file pelage reads (groom files, shell
+    /// scenes), with errors at their line and key.
+    pub fn parse_as<T: serde::de::DeserializeOwned>(&self) -> Result<T, GroomError> {
         toml::from_str(&self.text).map_err(|e| {
             let message = e.message().to_string();
             match e.span() {

@@ -152,14 +152,24 @@ fn map_on_mesh(source: &GroomSource, mesh: &Mesh, value: &MapValue) -> Result<Ma
 }
 
 fn load_mesh(source: &GroomSource, file: &GroomFile) -> Result<Mesh, GroomError> {
-    let path = &file.mesh.path;
+    load_mesh_section(source, &file.mesh)
+}
+
+/// The mesh a `[mesh]` section names (`"spot"`: the embedded one),
+/// subdivided as asked; a mesh that cannot be loaded is reported at its
+/// line.
+pub(crate) fn load_mesh_section(
+    source: &GroomSource,
+    section: &super::file::MeshSection,
+) -> Result<Mesh, GroomError> {
+    let path = &section.path;
     let mesh = if path.get_ref() == "spot" {
         crate::assets::spot()
     } else {
         Mesh::load(source.folder().join(path.get_ref()))
             .map_err(|e| source.error_at(path.span(), GroomErrorKind::Mesh(e)))?
     };
-    Ok(match file.mesh.subdivide {
+    Ok(match section.subdivide {
         0 => mesh,
         n => mesh.subdivided(n),
     })

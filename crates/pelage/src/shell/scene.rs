@@ -1,0 +1,576 @@
+//! Shell scene files (TOML, docs/shells-format.md): what `pelage shells`
+//! draws — the mesh and its fur colour, the shell layers and their texture,
+//! curl (Silva Eq. 4), clumping (Eq. 5), shading (Eq. 6 or Banisch's
+//! stages), droplets over time with drying, light and camera.
+//!
+//! Errors share the groom files' type: `FILE:LINE:COL: KEY: what`.
+
+use super::math::{ClumpParams, CurlParams, KajiyaKay, ShadingMode};
+use super::textures::{ShellTextureParams, TextureStyle};
+use super::wetness::{
+    Droplet, DropletStyle, WetnessMask, droplets_from_image, droplets_on_mesh, mask_coordinates,
+};
+use crate::Mesh;
+use crate::groom::file::MeshSection;
+use crate::groom::{GroomError, GroomErrorKind, GroomSource};
+use glam::{Vec2, Vec3};
+use serde::Deserialize;
+use std::f32::consts::TAU;
+use std::path::Path;
+use toml::Spanned;
+
+/// The file as written.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    mesh: Option<MeshSection>,
+    color: Option<Spanned<String>>,
+    #[serde(default)]
+    fur: FurSection,
+    #[serde(default)]
+    texture: TextureSection,
+    #[serde(default)]
+    curl: CurlSection,
+    #[serde(default)]
+    clump: ClumpSection,
+    #[serde(default)]
+    shading: ShadingSection,
+    #[serde(default)]
+    wetness: WetnessSection,
+    #[serde(default)]
+    droplets: Vec<DropletsSection>,
+    light: Option<[f32; 3]>,
+    camera: Option<CameraSection>,
+    #[serde(default)]
+    animation: AnimationSection,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct FurSection {
+    layers: Option<Spanned<u32>>,
+    length: Option<Spanned<f32>>,
+    tiles: Option<f32>,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct TextureSection {
+    style: Option<Spanned<String>>,
+    resolution: Option<Spanned<u32>>,
+    density: Option<f32>,
+    thickness: Option<f32>,
+    length_variance: Option<f32>,
+    lean: Option<f32>,
+    bend: Option<f32>,
+    undercoat_ratio: Option<f32>,
+    undercoat_length: Option<f32>,
+    seed: Option<u64>,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct CurlSection {
+    radius: Option<f32>,
+    turns: Option<f32>,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct ClumpSection {
+    w: Option<f32>,
+    strength: Option<f32>,
+    enabled: Option<bool>,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct ShadingSection {
+    mode: Option<Spanned<String>>,
+    specular: Option<[f32; 3]>,
+    exponent: Option<f32>,
+    shadow: Option<f32>,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct WetnessSection {
+    resolution: Option<Spanned<u32>>,
+    drying_rate: Option<f32>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DropletsSection {
+    /// Seconds into the sequence when they fall.
+    #[serde(default)]
+    time: f32,
+    /// One droplet at a mesh UV.
+    at: Option<[f32; 2]>,
+    /// Random droplets over the surface.
+    count: Option<usize>,
+    /// Droplets along the bright pixels of an image (mask coordinates).
+    image: Option<Spanned<String>>,
+    /// Grid spacing for `image`.
+    spacing: Option<f32>,
+    /// Radius, or `[min, max]`.
+    radius: Option<RadiusText>,
+    wetness: Option<f32>,
+    seed: Option<u64>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(untagged)]
+enum RadiusText {
+    One(f32),
+    Range([f32; 2]),
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraSection {
+    eye: [f32; 3],
+    target: [f32; 3],
+    fov: Option<f32>,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct AnimationSection {
+    frames: Option<u32>,
+    fps: Option<f32>,
+}
+
+/// The shell layers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FurSettings {
+    /// Number of layers N.
+    pub layers: u32,
+    /// Shell length `L0` in world units.
+    pub length: f32,
+    /// How many times the shell texture repeats across the UV square.
+    pub tiles: f32,
+}
+
+/// Shading parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadingSettings {
+    /// Which stage of shading.
+    pub mode: ShadingMode,
+    /// Kajiya-Kay's specular colour, exponent and `K_shadow`.
+    pub kajiya_kay: KajiyaKay,
+}
+
+/// A camera placed by hand.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneCamera {
+    /// Where the camera is.
+    pub eye: Vec3,
+    /// What it looks at.
+    pub target: Vec3,
+    /// Vertical field of view, degrees.
+    pub fov_y_degrees: f32,
+}
+
+/// A droplet and when it falls.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimedDroplet {
+    /// Seconds into the sequence.
+    pub time: f32,
+    /// The droplet.
+    pub droplet: Droplet,
+}
+
+/// A shell scene, loaded and ready to draw.
+#[derive(Debug)]
+pub struct ShellScene {
+    /// The skin.
+    pub mesh: Mesh,
+    /// The fur colour texture (sRGB), read at the mesh's UVs.
+    pub color: image::RgbaImage,
+    /// The layers.
+    pub fur: FurSettings,
+    /// The shell texture.
+    pub texture: ShellTextureParams,
+    /// Curl (world units).
+    pub curl: CurlParams,
+    /// Clumping; `None` when off.
+    pub clump: Option<ClumpParams>,
+    /// Shading.
+    pub shading: ShadingSettings,
+    /// Direction towards the light, if fixed (else a key light beside the
+    /// camera).
+    pub light: Option<Vec3>,
+    /// Camera, if placed (else framed automatically).
+    pub camera: Option<SceneCamera>,
+    /// Wetness mask resolution.
+    pub wetness_resolution: u32,
+    /// How fast wetness decays, per second (0: never dries).
+    pub drying_rate: f32,
+    /// Every droplet, in time order.
+    pub droplets: Vec<TimedDroplet>,
+    /// Frames of a sequence (`--frames` overrides).
+    pub frames: u32,
+    /// Frames per second of a sequence.
+    pub fps: f32,
+}
+
+impl ShellScene {
+    /// Reads a scene file.
+    pub fn load(path: &Path) -> Result<Self, GroomError> {
+        Self::from_source(&GroomSource::read(path)?)
+    }
+
+    /// The scene without a file: spot with its texture, curly dry fur.
+    pub fn spot() -> Self {
+        Self::from_source(&GroomSource {
+            path: "<spot>".into(),
+            text: String::new(),
+        })
+        .expect("the default scene is valid")
+    }
+
+    /// Builds a scene from a file's text (relative paths against its folder).
+    pub fn from_source(source: &GroomSource) -> Result<Self, GroomError> {
+        let file: SceneFile = source.parse_as()?;
+        let invalid = |span: std::ops::Range<usize>, message: String| {
+            source.error_at(span, GroomErrorKind::Invalid(message))
+        };
+        let (mesh, default_color) = match &file.mesh {
+            None => (crate::assets::spot(), Some(spot_color())),
+            Some(section) => {
+                let mesh = crate::groom::load_mesh_section(source, section)?;
+                let spot = section.path.get_ref() == "spot";
+                (mesh, spot.then(spot_color))
+            }
+        };
+        if !mesh.has_uvs() {
+            let span = file.mesh.as_ref().map_or(0..0, |m| m.path.span());
+            return Err(invalid(
+                span,
+                format!(
+                    "the mesh {} has no UVs; shell fur reads its textures and wetness mask at the mesh's UVs",
+                    mesh.name()
+                ),
+            ));
+        }
+        let color = match &file.color {
+            Some(path) => {
+                let full = source.folder().join(path.get_ref());
+                image::open(&full)
+                    .map_err(|e| invalid(path.span(), format!("{}: {e}", full.display())))?
+                    .to_rgba8()
+            }
+            None => default_color.unwrap_or_else(|| {
+                image::RgbaImage::from_pixel(1, 1, image::Rgba([150, 110, 70, 255]))
+            }),
+        };
+        let (lo, hi) = mesh.bounds();
+        let diagonal = (hi - lo).length();
+
+        let layers = match &file.fur.layers {
+            Some(n) if !(1..=256).contains(n.get_ref()) => {
+                return Err(invalid(
+                    n.span(),
+                    format!("{} layers: use 1 to 256", n.get_ref()),
+                ));
+            }
+            Some(n) => *n.get_ref(),
+            None => 16,
+        };
+        let length = match &file.fur.length {
+            Some(l) if !(l.get_ref().is_finite() && *l.get_ref() > 0.0) => {
+                return Err(invalid(
+                    l.span(),
+                    format!("{} is not a positive length", l.get_ref()),
+                ));
+            }
+            Some(l) => *l.get_ref(),
+            None => 0.025 * diagonal,
+        };
+        let fur = FurSettings {
+            layers,
+            length,
+            tiles: file.fur.tiles.unwrap_or(8.0).max(1e-3),
+        };
+
+        let t = &file.texture;
+        let defaults = ShellTextureParams::default();
+        let style = match t.style.as_ref().map(|s| (s.get_ref().as_str(), s.span())) {
+            None | Some(("blades", _)) => TextureStyle::Blades,
+            Some(("random-strands", _)) => TextureStyle::RandomStrands,
+            Some((other, span)) => {
+                return Err(invalid(
+                    span,
+                    format!("unknown style `{other}`: use `blades` or `random-strands`"),
+                ));
+            }
+        };
+        let resolution = match &t.resolution {
+            Some(r) if !(8..=4096).contains(r.get_ref()) => {
+                return Err(invalid(
+                    r.span(),
+                    format!("{} texels: use 8 to 4096", r.get_ref()),
+                ));
+            }
+            Some(r) => *r.get_ref(),
+            None => defaults.resolution,
+        };
+        let texture = ShellTextureParams {
+            resolution,
+            layers,
+            density: t.density.unwrap_or(defaults.density),
+            thickness: t.thickness.unwrap_or(defaults.thickness),
+            length_variance: t.length_variance.unwrap_or(defaults.length_variance),
+            lean: t.lean.unwrap_or(defaults.lean),
+            bend: t.bend.unwrap_or(defaults.bend),
+            undercoat_ratio: t.undercoat_ratio.unwrap_or(defaults.undercoat_ratio),
+            undercoat_length: t.undercoat_length.unwrap_or(defaults.undercoat_length),
+            style,
+            seed: t.seed.unwrap_or(defaults.seed),
+        };
+
+        // Curl radius is written as a fraction of the shell length.
+        let curl = CurlParams {
+            radius: file.curl.radius.unwrap_or(0.0) * length,
+            frequency: TAU * file.curl.turns.unwrap_or(2.0),
+        };
+        let clump = (file.clump.enabled != Some(false)).then(|| ClumpParams {
+            w: file.clump.w.unwrap_or(0.6).clamp(0.0, 1.0),
+            strength: file.clump.strength.unwrap_or(4.0).max(0.0),
+        });
+        let mode = match file
+            .shading
+            .mode
+            .as_ref()
+            .map(|m| (m.get_ref().as_str(), m.span()))
+        {
+            None | Some(("kajiya-kay", _)) => ShadingMode::KajiyaKay,
+            Some(("structure", _)) => ShadingMode::Structure,
+            Some(("color", _)) => ShadingMode::Color,
+            Some(("shadow", _)) => ShadingMode::Shadow,
+            Some(("lambert", _)) => ShadingMode::Lambert,
+            Some((other, span)) => {
+                return Err(invalid(
+                    span,
+                    format!(
+                        "unknown shading `{other}`: use structure, color, shadow, lambert or kajiya-kay"
+                    ),
+                ));
+            }
+        };
+        let shading = ShadingSettings {
+            mode,
+            kajiya_kay: KajiyaKay {
+                specular: Vec3::from(file.shading.specular.unwrap_or([0.12, 0.11, 0.1])),
+                exponent: file.shading.exponent.unwrap_or(30.0),
+                k_shadow: file.shading.shadow.unwrap_or(2.0).max(1.0),
+            },
+        };
+        let wetness_resolution = match &file.wetness.resolution {
+            Some(r) if !(8..=4096).contains(r.get_ref()) => {
+                return Err(invalid(
+                    r.span(),
+                    format!("{} texels: use 8 to 4096", r.get_ref()),
+                ));
+            }
+            Some(r) => *r.get_ref(),
+            None => 256,
+        };
+
+        let mut droplets = Vec::new();
+        for (i, d) in file.droplets.iter().enumerate() {
+            let (radius_min, radius_max) = match d.radius {
+                Some(RadiusText::One(r)) => (r, r),
+                Some(RadiusText::Range([a, b])) => (a.min(b), a.max(b)),
+                None => (0.015, 0.03),
+            };
+            let style = DropletStyle {
+                radius_min,
+                radius_max,
+                wetness: d.wetness.unwrap_or(1.0).clamp(0.0, 1.0),
+            };
+            let seed = d.seed.unwrap_or(i as u64 + 1);
+            let drops: Vec<Droplet> = match (d.at, d.count, &d.image) {
+                (Some(uv), None, None) => vec![Droplet {
+                    centre: mask_coordinates(Vec2::from(uv)),
+                    radius: radius_max,
+                    wetness: style.wetness,
+                }],
+                (None, Some(count), None) => {
+                    droplets_on_mesh(&mesh, count, style, seed).map_err(|e| {
+                        invalid(0..0, format!("droplets[{i}]: cannot place droplets: {e}"))
+                    })?
+                }
+                (None, None, Some(path)) => {
+                    let full = source.folder().join(path.get_ref());
+                    let image = image::open(&full)
+                        .map_err(|e| invalid(path.span(), format!("{}: {e}", full.display())))?
+                        .to_luma32f();
+                    let (w, h) = (image.width() as f32, image.height() as f32);
+                    let brightness = |p: Vec2| {
+                        let x = (p.x * w).clamp(0.0, w - 1.0) as u32;
+                        let y = (p.y * h).clamp(0.0, h - 1.0) as u32;
+                        image.get_pixel(x, y).0[0]
+                    };
+                    droplets_from_image(brightness, d.spacing.unwrap_or(radius_max), style, seed)
+                }
+                _ => {
+                    let span = d.image.as_ref().map_or(0..0, |p| p.span());
+                    return Err(invalid(
+                        span,
+                        format!(
+                            "droplets[{i}]: give exactly one of `at = [u, v]`, `count = N` or `image = \"FILE\"`"
+                        ),
+                    ));
+                }
+            };
+            droplets.extend(drops.into_iter().map(|droplet| TimedDroplet {
+                time: d.time.max(0.0),
+                droplet,
+            }));
+        }
+        droplets.sort_by(|a, b| a.time.total_cmp(&b.time));
+
+        Ok(Self {
+            mesh,
+            color,
+            fur,
+            texture,
+            curl,
+            clump,
+            shading,
+            light: file.light.map(|l| Vec3::from(l).normalize_or(Vec3::Y)),
+            camera: file.camera.map(|c| SceneCamera {
+                eye: Vec3::from(c.eye),
+                target: Vec3::from(c.target),
+                fov_y_degrees: c.fov.unwrap_or(30.0),
+            }),
+            wetness_resolution,
+            drying_rate: file.wetness.drying_rate.unwrap_or(0.0).max(0.0),
+            droplets,
+            frames: file.animation.frames.unwrap_or(1).max(1),
+            fps: file.animation.fps.unwrap_or(12.0).max(1e-3),
+        })
+    }
+
+    /// A timeline of the wetness mask: droplets fall at their times, the
+    /// mask dries in between.
+    pub fn wetness_timeline(&self) -> WetnessTimeline<'_> {
+        WetnessTimeline {
+            scene: self,
+            mask: WetnessMask::dry_mask(self.wetness_resolution, self.wetness_resolution),
+            time: 0.0,
+            next: 0,
+        }
+    }
+}
+
+fn spot_color() -> image::RgbaImage {
+    image::load_from_memory(crate::assets::SPOT_TEXTURE_PNG)
+        .expect("the embedded texture is a PNG")
+        .to_rgba8()
+}
+
+/// The wetness mask as time passes (see [`ShellScene::wetness_timeline`]).
+#[derive(Debug)]
+pub struct WetnessTimeline<'s> {
+    scene: &'s ShellScene,
+    mask: WetnessMask,
+    time: f32,
+    next: usize,
+}
+
+impl WetnessTimeline<'_> {
+    /// Moves on to `time` (seconds, not before the current time): the
+    /// droplets due by then fall, each followed by drying until the next.
+    pub fn advance_to(&mut self, time: f32) -> &WetnessMask {
+        let rate = self.scene.drying_rate;
+        while let Some(d) = self.scene.droplets.get(self.next) {
+            if d.time > time {
+                break;
+            }
+            if d.time > self.time {
+                self.mask.dry(d.time - self.time, rate);
+                self.time = d.time;
+            }
+            self.mask.add_droplet(d.droplet);
+            self.next += 1;
+        }
+        if time > self.time {
+            self.mask.dry(time - self.time, rate);
+            self.time = time;
+        }
+        &self.mask
+    }
+
+    /// The mask now.
+    pub fn mask(&self) -> &WetnessMask {
+        &self.mask
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(text: &str) -> Result<ShellScene, GroomError> {
+        ShellScene::from_source(&GroomSource {
+            path: "fur.toml".into(),
+            text: text.into(),
+        })
+    }
+
+    #[test]
+    fn an_empty_file_is_curly_dry_fur_on_spot() {
+        let s = scene("").unwrap();
+        assert_eq!(s.mesh.triangle_count(), 5856);
+        assert_eq!(s.fur.layers, 16);
+        assert!(s.droplets.is_empty());
+        assert_eq!(s.shading.mode, ShadingMode::KajiyaKay);
+        assert_eq!(s.color.width(), 1024);
+    }
+
+    #[test]
+    fn errors_name_the_file_line_and_key() {
+        let e = scene("[fur]\nlayers = 0\n").unwrap_err().to_string();
+        assert!(e.starts_with("fur.toml:2:10: fur.layers: 0 layers"), "{e}");
+        let e = scene("[curl]\nradus = 1\n").unwrap_err().to_string();
+        assert!(
+            e.starts_with("fur.toml:2:1: curl.radus: unknown field"),
+            "{e}"
+        );
+        let e = scene("[shading]\nmode = \"toon\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("fur.toml:2:8") && e.contains("unknown shading `toon`"),
+            "{e}"
+        );
+        let e = scene("[[droplets]]\nimage = \"nope.png\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("fur.toml:2:9: droplets.image: nope.png"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn droplets_fall_on_time_and_dry_between() {
+        let s = scene(
+            "[wetness]\nresolution = 64\ndrying_rate = 1.0\n\
+             [[droplets]]\nat = [0.5, 0.5]\nradius = 0.1\n\
+             [[droplets]]\ntime = 2.0\nat = [0.2, 0.2]\nradius = 0.1\n",
+        )
+        .unwrap();
+        let mut timeline = s.wetness_timeline();
+        let first = Vec2::new(0.5, 0.5);
+        let second = mask_coordinates(Vec2::new(0.2, 0.2));
+        assert_eq!(timeline.advance_to(0.0).at(first).wetness, 1.0);
+        assert_eq!(timeline.mask().at(second).wetness, 0.0);
+        let mask = timeline.advance_to(2.0);
+        assert!((mask.at(first).wetness - (-2.0f32).exp()).abs() < 1e-5);
+        assert_eq!(mask.at(second).wetness, 1.0);
+    }
+}
