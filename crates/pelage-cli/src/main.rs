@@ -33,6 +33,8 @@ enum Command {
     Guides(commands::guides::GuidesArgs),
     /// Convert curves between formats (USD, .hair, PLY, RIB, pbrt).
     Convert(commands::convert::ConvertArgs),
+    /// Draw shell fur (curl, wet clumps, drying) to a PNG or a sequence.
+    Shells(commands::shells::ShellsArgs),
     /// Run the demo on the embedded Spot mesh.
     Demo(commands::demo::DemoArgs),
     /// Measure a capability against its paper's figures.
@@ -48,6 +50,7 @@ fn main() -> ExitCode {
         Command::Convert(args) => commands::convert::run(&args),
         Command::Guides(args) => commands::guides::run(&args),
         Command::Groom(args) => commands::groom::run(&args),
+        Command::Shells(args) => commands::shells::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
     };

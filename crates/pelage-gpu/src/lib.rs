@@ -1,7 +1,7 @@
 //! pelage-gpu: the wgpu renderer. Everything pelage makes can be looked at
-//! through it: the skin mesh, points (hair roots, samples) and, with the
-//! groom issue, curves. It renders headless into an image (CI, render
-//! farms without GPUs, docs) and, with the viewer issue, into a window,
+//! through it: the skin mesh, points (hair roots, samples), curves, and
+//! shell fur ([`ShellRenderer`]). It renders headless into an image (CI,
+//! render farms without GPUs, docs) and, with the viewer issue, into a window,
 //! with the same pipelines. WGSL lives in `src/shaders/`.
 //!
 //! Its own crate because wgpu is the heaviest dependency by far: the
@@ -13,11 +13,16 @@
 mod camera;
 mod context;
 mod renderer;
+mod shells;
 
 pub use camera::Camera;
 pub use context::GpuContext;
 pub use pelage::Curves;
 pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer};
+pub use shells::{
+    ShellFeatures, ShellModel, ShellParams, ShellRenderer, ShellScenePlayer, ShellTarget,
+    ShellView, vertex_tangents,
+};
 /// wgpu itself, so callers (a window, the viewer) build surfaces with the same version.
 pub use wgpu;
 
@@ -44,6 +49,14 @@ pub enum GpuError {
     /// Images are read back only from 8-bit RGBA or BGRA targets.
     #[error("images can be read back from Rgba8/Bgra8 renderers only, not {0}")]
     Format(String),
+    /// Shell fur needs UVs: its textures and wetness mask are read at them.
+    #[error(
+        "the mesh {0} has no UVs; shell fur reads its textures and wetness mask at the mesh's UVs"
+    )]
+    NoUvs(String),
+    /// Inputs that do not fit together.
+    #[error("{0}")]
+    Mismatch(String),
     /// The requested image size is not possible.
     #[error("an image of {width}×{height} pixels cannot be rendered (1 to {max} per side)")]
     Size {
@@ -80,6 +93,8 @@ pub const SHADERS: &[(&str, &str)] = &[
             include_str!("shaders/curves.wgsl")
         ),
     ),
+    // Shell fur has its own uniform block.
+    ("shells.wgsl", include_str!("shaders/shells.wgsl")),
 ];
 
 /// The WGSL source of the named shader (with its prelude).

@@ -8,10 +8,10 @@ use pelage::{Curves, Mesh};
 use wgpu::util::DeviceExt;
 
 /// Multisampling: 4 samples per pixel (every Vulkan device supports 4).
-const SAMPLES: u32 = 4;
+pub(crate) const SAMPLES: u32 = 4;
 /// Stored sRGB-encoded; shaders work in linear light.
-const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// What to draw.
 #[derive(Debug, Clone, Copy, Default)]
@@ -630,7 +630,7 @@ impl Renderer {
     }
 }
 
-fn check_size(ctx: &GpuContext, width: u32, height: u32) -> Result<(), GpuError> {
+pub(crate) fn check_size(ctx: &GpuContext, width: u32, height: u32) -> Result<(), GpuError> {
     let max = ctx.device.limits().max_texture_dimension_2d;
     if width == 0 || height == 0 || width > max || height > max {
         return Err(GpuError::Size { width, height, max });
@@ -640,7 +640,7 @@ fn check_size(ctx: &GpuContext, width: u32, height: u32) -> Result<(), GpuError>
 
 /// Copies `texture` (4 bytes a pixel) into a buffer, submits `encoder` and returns
 /// the pixels.
-fn read_back(
+pub(crate) fn read_back(
     ctx: &GpuContext,
     mut encoder: wgpu::CommandEncoder,
     texture: &wgpu::Texture,

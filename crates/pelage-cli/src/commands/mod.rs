@@ -8,6 +8,7 @@ pub mod guides;
 pub mod info;
 pub mod render;
 pub mod sample;
+pub mod shells;
 
 use anyhow::Context;
 use pelage::Mesh;

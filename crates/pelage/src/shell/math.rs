@@ -127,7 +127,9 @@ pub fn layer_offset(
 }
 
 /// The unit strand tangent `T` at `h` (Eq. 6): the derivative of Eq. 1.
-/// Falls back to the rest direction where the derivative vanishes.
+/// Falls back to the rest direction where the derivative vanishes — as it
+/// does at the tip of a strand at rest: the Bézier through `p_root`, `p0`,
+/// `p0` arrives at `p0` with zero speed.
 pub fn strand_tangent(
     strand: &Strand,
     h: f32,
