@@ -634,3 +634,78 @@ fn grooms_with_more_parts_than_hairs_write_valid_usd() {
         assert!(report.contains("4 curves"), "{report}");
     }
 }
+
+#[test]
+fn shells_reports_a_bad_scene_at_its_line_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("rain.toml");
+    std::fs::write(&scene, "[fur]\nlayers = 16\n\n[clump]\nstrenght = 3\n").unwrap();
+    let png = dir.path().join("rain.png");
+    let out = pelage(&[
+        "shells",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(
+        err.contains("rain.toml:5:1: clump.strenght: unknown field `strenght`"),
+        "{err}"
+    );
+    assert!(!png.exists());
+}
+
+#[test]
+fn shells_sequence_dries_and_writes_frames_and_a_gif() {
+    // Needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_none() {
+        eprintln!("SKIPPED: set PELAGE_REQUIRE_GPU=1 to run render tests through the CLI");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("rain.toml");
+    // Wet at t = 0, drying fast: by frame 2 (t = 2 s, ρ ≈ e^−6) it is dry.
+    std::fs::write(
+        &scene,
+        "[fur]\nlayers = 8\n[texture]\nresolution = 64\n[curl]\nradius = 0.5\n\
+         [wetness]\nresolution = 64\ndrying_rate = 3.0\n\
+         [[droplets]]\ncount = 300\nradius = [0.03, 0.05]\n[animation]\nfps = 1\n",
+    )
+    .unwrap();
+    let frames = dir.path().join("rain");
+    let out = pelage(&[
+        "shells",
+        scene.to_str().unwrap(),
+        "--frames",
+        "3",
+        "-o",
+        frames.to_str().unwrap(),
+        "--size",
+        "160x120",
+        "--mask",
+        "-q",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(frames.join("shells.gif").exists());
+    let frame = |k: u32| {
+        image::open(frames.join(format!("frame-{k:04}.png")))
+            .unwrap()
+            .to_rgba8()
+    };
+    let mask = |k: u32| {
+        image::open(frames.join(format!("frame-{k:04}-mask.png")))
+            .unwrap()
+            .to_rgba8()
+    };
+    // Wet at first (blue in the mask), dry at the end (all black).
+    assert!(mask(0).pixels().any(|p| p.0[2] > 80));
+    assert!(mask(2).pixels().all(|p| p.0[..3] == [0, 0, 0]));
+    // The fur changed as it dried (clumps opened, curls came back).
+    let changed = frame(0)
+        .pixels()
+        .zip(frame(2).pixels())
+        .filter(|(a, b)| (0..3).any(|c| a.0[c].abs_diff(b.0[c]) > 8))
+        .count();
+    assert!(changed > 160 * 120 / 50, "{changed} pixels changed");
+}

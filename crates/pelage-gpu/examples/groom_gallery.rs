@@ -13,41 +13,15 @@
 use glam::{Vec2, Vec3};
 use pelage::Mesh;
 use pelage::groom::Groom;
-use pelage::mesh::Uvs;
 use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
 use std::fmt::Write as _;
 
+#[path = "common/patch.rs"]
+mod patch;
+use patch::patch;
+
 const WIDTH: u32 = 480;
 const HEIGHT: u32 = 360;
-
-/// A flat square of `n × n` quads in the XZ plane, normal +Y, with UVs.
-fn patch(n: usize) -> Mesh {
-    let mut positions = Vec::new();
-    let mut uvs = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
-            positions.push(Vec3::new(u - 0.5, 0.0, 0.5 - v));
-            uvs.push(Vec2::new(u, v));
-        }
-    }
-    let mut triangles = Vec::new();
-    let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    for j in 0..n {
-        for i in 0..n {
-            triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-            triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-        }
-    }
-    Mesh::new(
-        "patch",
-        positions,
-        triangles,
-        None,
-        Some(Uvs::PerVertex(uvs)),
-    )
-    .expect("a valid patch")
-}
 
 /// The base groom on the patch, with `ops` appended.
 fn groom_text(hairs: u32, ops: &str) -> String {

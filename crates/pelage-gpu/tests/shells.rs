@@ -323,7 +323,10 @@ fn wet_clumps_and_kajiya_kay_match_the_reference_pixel_for_pixel() {
     // Rounding in the GPU's texture filtering can flip a fragment at the
     // very edge of a hair (alpha just above or at 0) or of a clump; all
     // but a handful of pixels agree to 2/255.
-    eprintln!("clumps: {:.2} % of pixels differ (worst {worst})", 100.0 * off);
+    eprintln!(
+        "clumps: {:.2} % of pixels differ (worst {worst})",
+        100.0 * off
+    );
     assert!(
         off <= 0.01,
         "{:.2} % of pixels differ (worst {worst})",

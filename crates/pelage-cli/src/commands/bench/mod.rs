@@ -10,6 +10,7 @@ pub mod interp;
 pub mod io;
 pub mod render;
 pub mod sampler;
+pub mod shells;
 
 use clap::{Args, Subcommand};
 use std::time::Instant;
@@ -32,6 +33,8 @@ pub enum BenchWhat {
     Interp(interp::InterpBenchArgs),
     /// The groom generator: the Stubble figure (1.6 M hairs) and peak memory.
     Groom(groom::GroomBenchArgs),
+    /// Shell fur frame time, plain vs curl vs curl + clump (Silva Table 1).
+    Shells(shells::ShellsBenchArgs),
     /// Writing a large groom as usda, part by part: throughput and peak memory.
     Io(io::IoBenchArgs),
 }
@@ -43,6 +46,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Io(a) => io::run(a),
         BenchWhat::Interp(a) => interp::run(a),
         BenchWhat::Groom(a) => groom::run(a),
+        BenchWhat::Shells(a) => shells::run(a),
     }
 }
 
