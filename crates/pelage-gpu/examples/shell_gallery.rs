@@ -222,22 +222,24 @@ fn main() {
     // Fig. 7 on a furry square: straight, wavy, few large curls, many small.
     let square = patch(32);
     let brown = image::RgbaImage::from_pixel(1, 1, image::Rgba([150, 105, 60, 255]));
-    let square_length = 0.12;
+    let square_length = 0.1;
     let square_textures = ShellTextures::generate(&ShellTextureParams {
-        layers: 32,
-        density: 0.02,
-        undercoat_ratio: 2.0,
+        layers: 64,
+        density: 0.012,
+        thickness: 2.2,
+        lean: 0.003,
+        undercoat_ratio: 1.0,
         ..scene.texture
     });
     let side = Some(Camera {
-        eye: Vec3::new(0.0, 0.42, 0.5),
-        target: Vec3::new(0.0, 0.0, 0.05),
-        fov_y_degrees: 30.0,
+        eye: Vec3::new(0.0, 0.62, 0.45),
+        target: Vec3::new(0.0, 0.0, 0.02),
+        fov_y_degrees: 40.0,
     });
     let square_base = ShellParams {
-        layers: 32,
+        layers: 64,
         length: square_length,
-        tiles: 3.0,
+        tiles: 2.5,
         ..base
     };
     let square_panel = |params: ShellParams, mask: &WetnessMask| {
@@ -269,21 +271,21 @@ fn main() {
             ),
             square_panel(
                 ShellParams {
-                    curl: curl(0.15, 1.0),
+                    curl: curl(0.12, 1.0),
                     ..square_base
                 },
                 &dry,
             ),
             square_panel(
                 ShellParams {
-                    curl: curl(0.6, 1.5),
+                    curl: curl(0.35, 1.25),
                     ..square_base
                 },
                 &dry,
             ),
             square_panel(
                 ShellParams {
-                    curl: curl(0.2, 5.0),
+                    curl: curl(0.1, 4.0),
                     ..square_base
                 },
                 &dry,
@@ -291,35 +293,54 @@ fn main() {
         ],
     );
 
-    // Fig. 9: w = 0 and w = 1 on wet square fur, seen from the side.
+    // Fig. 9: w = 0 and w = 1, sparse straight guard hair in big clumps,
+    // seen from above at an angle.
     let mut square_wet = WetnessMask::dry_mask(256, 256);
     let big = DropletStyle {
-        radius_min: 0.06,
-        radius_max: 0.08,
+        radius_min: 0.085,
+        radius_max: 0.09,
         wetness: 1.0,
     };
-    for d in droplets_from_image(|_| 1.0, 0.13, big, 9) {
+    for d in droplets_from_image(|_| 1.0, 0.2, big, 9) {
         square_wet.add_droplet(d);
     }
-    let clump = |w: f32| ClumpParams { w, strength: 5.0 };
+    let sparse = ShellTextures::generate(&ShellTextureParams {
+        layers: 64,
+        density: 0.012,
+        thickness: 1.8,
+        lean: 0.004,
+        undercoat_ratio: 0.0,
+        ..scene.texture
+    });
+    let pale = image::RgbaImage::from_pixel(1, 1, image::Rgba([225, 200, 160, 255]));
+    let low = Some(Camera {
+        eye: Vec3::new(0.0, 0.62, 0.45),
+        target: Vec3::new(0.0, 0.0, 0.02),
+        fov_y_degrees: 40.0,
+    });
+    let clump_panel = |w: f32| {
+        render(
+            &ctx,
+            &Panel {
+                mesh: &square,
+                color: &pale,
+                textures: &sparse,
+                mask: &square_wet,
+                params: ShellParams {
+                    layers: 64,
+                    length: 0.1,
+                    tiles: 4.0,
+                    curl: straight,
+                    clump: ClumpParams { w, strength: 4.0 },
+                    ..base
+                },
+                camera: low,
+            },
+        )
+    };
     sheet(
         &out.join("silva-fig9.png"),
-        &[
-            square_panel(
-                ShellParams {
-                    clump: clump(0.0),
-                    ..square_base
-                },
-                &square_wet,
-            ),
-            square_panel(
-                ShellParams {
-                    clump: clump(1.0),
-                    ..square_base
-                },
-                &square_wet,
-            ),
-        ],
+        &[clump_panel(0.0), clump_panel(1.0)],
     );
 
     // Fig. 11: dry vs wet clumped, with the mask.
