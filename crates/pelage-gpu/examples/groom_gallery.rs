@@ -10,8 +10,9 @@
 //! cargo run --release -p pelage-gpu --example groom_gallery
 //! ```
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use pelage::Mesh;
+use pelage::mesh::Uvs;
 use pelage::groom::Groom;
 use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
 use std::fmt::Write as _;
