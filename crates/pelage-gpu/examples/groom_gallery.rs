@@ -12,8 +12,8 @@
 
 use glam::Vec3;
 use pelage::Mesh;
-use pelage::mesh::Uvs;
 use pelage::groom::Groom;
+use pelage::mesh::Uvs;
 use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
 use std::fmt::Write as _;
 

@@ -221,7 +221,7 @@ impl ShellScene {
         Self::from_source(&GroomSource::read(path)?)
     }
 
-    /// The scene without a file: spot with its texture, curly dry fur.
+    /// The scene without a file: spot with its texture, dry straight fur.
     pub fn spot() -> Self {
         Self::from_source(&GroomSource {
             path: "<spot>".into(),
@@ -522,7 +522,7 @@ mod tests {
     }
 
     #[test]
-    fn an_empty_file_is_curly_dry_fur_on_spot() {
+    fn an_empty_file_is_dry_straight_fur_on_spot() {
         let s = scene("").unwrap();
         assert_eq!(s.mesh.triangle_count(), 5856);
         assert_eq!(s.fur.layers, 16);
@@ -554,6 +554,16 @@ mod tests {
             e.starts_with("fur.toml:2:9: droplets.image: nope.png"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn the_documented_example_parses_key_for_key() {
+        let doc = include_str!("../../../../docs/shells-format.md");
+        let start = doc.find("```toml\n").expect("a toml block") + 8;
+        let end = start + doc[start..].find("```").expect("its end");
+        let file: SceneFile = toml::from_str(&doc[start..end]).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(file.droplets.len(), 3);
+        assert!(file.color.is_some() && file.light.is_some() && file.camera.is_some());
     }
 
     #[test]
