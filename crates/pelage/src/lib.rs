@@ -33,6 +33,7 @@
 
 pub mod assets;
 pub mod curves;
+pub mod dynamics;
 pub mod groom;
 pub mod guides;
 pub mod interp;

@@ -1,0 +1,484 @@
+//! Forces and time stepping for [`MassSpringSystem`] (Banisch & Wüthrich,
+//! "Mass–Spring System", "Shell Layer Displacement"; Silva §3.2.1).
+//!
+//! Forces on a tip: its stick's spring (to the root, rest length `L0`; for
+//! Silva strands a zero-length spring to the rest position `p0`) with
+//! damping along the spring; the prisms' tip-tip springs; Banisch's
+//! restoring force `F = (n − s)(1 − n·s) w` (Eq. 5, `s` the unit stick
+//! direction) so fur never flips into the body; gravity; air drag towards
+//! the wind's velocity (gusts and turbulence in space and time); a brush.
+//!
+//! Two solvers:
+//! - **explicit**: symplectic Euler, `v += h F/m; x += h v`, with substeps;
+//! - **implicit**: backward Euler linearised once (Baraff & Witkin 1998):
+//!   `(M − h ∂F/∂v − h² ∂F/∂x) Δv = h (F + h ∂F/∂x v)`, solved by conjugate
+//!   gradients, matrix-free, with a 3×3 block-Jacobi preconditioner. The
+//!   springs and the drag are implicit; gravity, wind, brush and the
+//!   restoring force are taken at the start of the step.
+//!
+//! After each step the constraints are enforced by projection: every tip
+//! stays above its root's tangent plane, and Silva tips within `L0` of their
+//! root (Eq. 3); the velocity component that broke a constraint is removed.
+//!
+//! Every loop over tips runs on rayon and sums in a fixed order, so a step
+//! gives the same bits on any number of threads.
+
+use super::system::{MassSpringSystem, Topology};
+use crate::map::NoiseMap;
+use glam::{Mat3, Vec3};
+use rayon::prelude::*;
+
+/// Below this many items a loop runs on the calling thread: handing a small
+/// loop to rayon's pool costs more than the loop (a patch of fur stepped
+/// 10⁵ times spent most of its time waking threads).
+const PARALLEL_MIN: usize = 2048;
+
+/// `(0..n).map(f).collect()`, in parallel for large `n`.
+fn map_indexed<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    if n < PARALLEL_MIN {
+        (0..n).map(f).collect()
+    } else {
+        (0..n).into_par_iter().map(f).collect()
+    }
+}
+
+/// `f(i, &mut items[i])` for every item, in parallel for many items.
+fn update_each<T: Send>(items: &mut [T], f: impl Fn(usize, &mut T) + Sync + Send) {
+    if items.len() < PARALLEL_MIN {
+        items.iter_mut().enumerate().for_each(|(i, t)| f(i, t));
+    } else {
+        items.par_iter_mut().enumerate().for_each(|(i, t)| f(i, t));
+    }
+}
+
+/// `d̂d̂ᵀ`.
+fn outer(dir: Vec3) -> Mat3 {
+    Mat3::from_cols(dir * dir.x, dir * dir.y, dir * dir.z)
+}
+
+/// Wind: a base velocity that gusts in time, plus turbulence — a vector
+/// noise field drifting with the wind. Build with [`Wind::new`].
+#[derive(Debug, Clone)]
+pub struct Wind {
+    /// Mean wind velocity (units per second).
+    pub velocity: Vec3,
+    /// Gust amplitude as a fraction of the mean (0: steady).
+    pub gust: f32,
+    /// Gusts per second.
+    pub gust_frequency: f32,
+    /// Turbulence speed (units per second).
+    pub turbulence: f32,
+    /// Turbulence features per unit length.
+    pub scale: f32,
+    noise: NoiseMap,
+}
+
+impl Wind {
+    /// Wind of mean `velocity`, gusting by `gust` (fraction of the mean)
+    /// `gust_frequency` times a second, with turbulence of speed
+    /// `turbulence` and `scale` features per unit length, from `seed`.
+    pub fn new(
+        velocity: Vec3,
+        gust: f32,
+        gust_frequency: f32,
+        turbulence: f32,
+        scale: f32,
+        seed: u64,
+    ) -> Self {
+        Self {
+            velocity,
+            gust,
+            gust_frequency,
+            turbulence,
+            scale,
+            noise: NoiseMap::new(1.0, 1, seed, 0.0, 1.0),
+        }
+    }
+
+    /// The wind's velocity at `p` and time `t`.
+    pub fn at(&self, p: Vec3, t: f32) -> Vec3 {
+        let phase = std::f32::consts::TAU * self.gust_frequency * t;
+        // Two incommensurate sines: gusts that do not repeat every period.
+        let gust = 1.0 + self.gust * (0.6 * phase.sin() + 0.4 * (2.31 * phase + 1.3).sin());
+        let mut v = self.velocity * gust;
+        if self.turbulence != 0.0 {
+            let drift = self.velocity * t + Vec3::new(0.0, 0.37 * t, 0.0);
+            v += self.turbulence * self.noise.perlin3_vector((p - drift) * self.scale);
+        }
+        v
+    }
+}
+
+/// A local push (the viewer's brush): `force` on every tip within `radius`
+/// of `centre`, fading smoothly to zero at the edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Brush {
+    /// Where.
+    pub centre: Vec3,
+    /// How far it reaches.
+    pub radius: f32,
+    /// The force at the centre.
+    pub force: Vec3,
+}
+
+/// Physical parameters.
+#[derive(Debug, Clone)]
+pub struct DynamicsParams {
+    /// Mass of each tip.
+    pub mass: f32,
+    /// Stiffness of each stick's spring (Silva: of the spring to `p0`).
+    pub stiffness: f32,
+    /// Stiffness of the prisms' tip-tip springs.
+    pub lateral_stiffness: f32,
+    /// Damping along every spring.
+    pub damping: f32,
+    /// Air drag: force `drag · (wind − v)`.
+    pub drag: f32,
+    /// `w` of Banisch Eq. 5.
+    pub restoring: f32,
+    /// Gravity (acceleration).
+    pub gravity: Vec3,
+    /// Wind, if any.
+    pub wind: Option<Wind>,
+    /// A brush, if any.
+    pub brush: Option<Brush>,
+}
+
+impl Default for DynamicsParams {
+    fn default() -> Self {
+        Self {
+            mass: 1e-3,
+            stiffness: 2.0,
+            lateral_stiffness: 1.0,
+            damping: 0.02,
+            drag: 2e-3,
+            restoring: 0.02,
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            wind: None,
+            brush: None,
+        }
+    }
+}
+
+/// How to step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Solver {
+    /// Symplectic Euler with this many substeps per step.
+    Explicit {
+        /// Substeps per step (1: plain symplectic Euler).
+        substeps: u32,
+    },
+    /// Linearised backward Euler, at most this many CG iterations.
+    Implicit {
+        /// CG iteration limit.
+        iterations: u32,
+    },
+}
+
+impl Solver {
+    /// The name scene files and the benchmark use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::Explicit { .. } => "explicit",
+            Solver::Implicit { .. } => "implicit",
+        }
+    }
+}
+
+/// `k[(1 − L/l)(I − d̂d̂ᵀ) + d̂d̂ᵀ]`: minus the stiffness matrix of a spring
+/// of rest length `rest` stretched to `d`, with `(1 − L/l)` clamped at 0 so
+/// the matrix stays positive semi-definite (compressed springs do not make
+/// the system indefinite; Choi & Ko's remedy).
+fn spring_stiffness(k: f32, d: Vec3, rest: f32) -> (Mat3, Vec3) {
+    let l = d.length();
+    if l <= 1e-12 {
+        return (Mat3::from_diagonal(Vec3::splat(k)), Vec3::ZERO);
+    }
+    let dir = d / l;
+    let outer = outer(dir);
+    let tangential = (1.0 - rest / l).max(0.0);
+    (k * (tangential * (Mat3::IDENTITY - outer) + outer), dir)
+}
+
+impl MassSpringSystem {
+    /// The force on tip `i` from everything but the tip-tip springs.
+    fn tip_force(&self, i: usize, p: &DynamicsParams, time: f32) -> Vec3 {
+        let (x, v) = (self.tips[i], self.velocities[i]);
+        let root = self.roots[i];
+        let n = self.normals[i];
+        let v_rel = v - self.root_velocities[i];
+        let d = x - root;
+        let l = d.length();
+        let dir = if l > 1e-12 { d / l } else { n };
+        let mut f = match self.topology {
+            Topology::SilvaStrands => -p.stiffness * (x - self.rest_tip(i)) - p.damping * v_rel,
+            _ => {
+                let stretch = -p.stiffness * (l - self.lengths[i]) * dir;
+                // Banisch Eq. 5.
+                let restoring = (n - dir) * (1.0 - n.dot(dir)) * p.restoring;
+                stretch - p.damping * v_rel.dot(dir) * dir + restoring
+            }
+        };
+        f += p.mass * p.gravity;
+        let wind = p.wind.as_ref().map_or(Vec3::ZERO, |w| w.at(x, time));
+        f += p.drag * (wind - v);
+        if let Some(b) = p.brush {
+            let q = x.distance(b.centre) / b.radius.max(1e-9);
+            if q < 1.0 {
+                let fade = 1.0 - q * q;
+                f += b.force * fade * fade;
+            }
+        }
+        f
+    }
+
+    /// The tip at the other end of tip-tip spring `s` from tip `i`.
+    fn other_end(&self, s: u32, i: usize) -> usize {
+        let spring = self.springs[s as usize];
+        if spring.a as usize == i {
+            spring.b as usize
+        } else {
+            spring.a as usize
+        }
+    }
+
+    /// The force on tip `i` from its tip-tip springs.
+    fn lateral_force(&self, i: usize, p: &DynamicsParams) -> Vec3 {
+        let mut f = Vec3::ZERO;
+        for &s in self.tip_springs(i) {
+            let other = self.other_end(s, i);
+            let d = self.tips[i] - self.tips[other];
+            let l = d.length();
+            if l <= 1e-12 {
+                continue;
+            }
+            let dir = d / l;
+            let dv = self.velocities[i] - self.velocities[other];
+            let rest = self.springs[s as usize].rest;
+            f += -p.lateral_stiffness * (l - rest) * dir - p.damping * dv.dot(dir) * dir;
+        }
+        f
+    }
+
+    /// All tip forces at the current state.
+    fn forces(&self, p: &DynamicsParams, time: f32) -> Vec<Vec3> {
+        map_indexed(self.tips.len(), |i| {
+            self.tip_force(i, p, time) + self.lateral_force(i, p)
+        })
+    }
+
+    /// `v += Δv; x += h v`.
+    fn advance(&mut self, h: f32, dv: &[Vec3]) {
+        update_each(&mut self.velocities, |i, v| *v += dv[i]);
+        let velocities = &self.velocities;
+        update_each(&mut self.tips, |i, x| *x += h * velocities[i]);
+    }
+
+    /// Advances the simulation by `dt` seconds; `time` is the time at the
+    /// start of the step (the wind's clock).
+    pub fn step(&mut self, dt: f32, params: &DynamicsParams, solver: Solver, time: f32) {
+        match solver {
+            Solver::Explicit { substeps } => {
+                let n = substeps.max(1);
+                let h = dt / n as f32;
+                for k in 0..n {
+                    let mut dv = self.forces(params, time + k as f32 * h);
+                    let scale = h / params.mass;
+                    update_each(&mut dv, |_, f| *f *= scale);
+                    self.advance(h, &dv);
+                    self.enforce_constraints();
+                }
+            }
+            Solver::Implicit { iterations } => {
+                self.implicit_step(dt, params, iterations, time);
+                self.enforce_constraints();
+            }
+        }
+    }
+
+    /// One linearised backward-Euler step.
+    fn implicit_step(&mut self, h: f32, p: &DynamicsParams, iterations: u32, time: f32) {
+        let n = self.tips.len();
+        let f0 = self.forces(p, time);
+        // Per tip: its stick spring's −∂F/∂x (K) and −∂F/∂v (C) blocks.
+        let stick_blocks: Vec<(Mat3, Mat3)> = map_indexed(n, |i| match self.topology {
+            Topology::SilvaStrands => (
+                Mat3::from_diagonal(Vec3::splat(p.stiffness)),
+                Mat3::from_diagonal(Vec3::splat(p.damping)),
+            ),
+            _ => {
+                let d = self.tips[i] - self.roots[i];
+                let (k, dir) = spring_stiffness(p.stiffness, d, self.lengths[i]);
+                (k, p.damping * outer(dir))
+            }
+        });
+        // Per tip-tip spring: the a-a block of −∂F/∂x and −∂F/∂v (a-b is
+        // its negative).
+        let spring_blocks: Vec<(Mat3, Mat3)> = map_indexed(self.springs.len(), |s| {
+            let spring = self.springs[s];
+            let d = self.tips[spring.a as usize] - self.tips[spring.b as usize];
+            let (k, dir) = spring_stiffness(p.lateral_stiffness, d, spring.rest);
+            (k, p.damping * outer(dir))
+        });
+        // A = M − h ∂F/∂v − h² ∂F/∂x = M + h C + h² K (C, K as stored).
+        let drag = Mat3::from_diagonal(Vec3::splat(p.drag));
+        let diagonal: Vec<Mat3> = map_indexed(n, |i| {
+            let (k, c) = stick_blocks[i];
+            let mut a = Mat3::from_diagonal(Vec3::splat(p.mass)) + h * (c + drag) + h * h * k;
+            for &s in self.tip_springs(i) {
+                let (k, c) = spring_blocks[s as usize];
+                a += h * c + h * h * k;
+            }
+            a
+        });
+        let apply = |x: &[Vec3], out: &mut [Vec3]| {
+            update_each(out, |i, y| {
+                let mut sum = diagonal[i] * x[i];
+                for &s in self.tip_springs(i) {
+                    let (k, c) = spring_blocks[s as usize];
+                    sum -= (h * c + h * h * k) * x[self.other_end(s, i)];
+                }
+                *y = sum;
+            });
+        };
+        // b = h (F0 + h ∂F/∂x v0) = h (F0 − h K v0).
+        let b: Vec<Vec3> = map_indexed(n, |i| {
+            let mut kv = stick_blocks[i].0 * self.velocities[i];
+            for &s in self.tip_springs(i) {
+                let other = self.other_end(s, i);
+                kv += spring_blocks[s as usize].0 * (self.velocities[i] - self.velocities[other]);
+            }
+            h * (f0[i] - h * kv)
+        });
+        let preconditioner: Vec<Mat3> = map_indexed(n, |i| diagonal[i].inverse());
+        let dv = conjugate_gradient(&apply, &b, &preconditioner, iterations.max(1), 1e-6);
+        self.advance(h, &dv);
+    }
+
+    fn tip_springs(&self, i: usize) -> &[u32] {
+        &self.spring_index[self.spring_offsets[i] as usize..self.spring_offsets[i + 1] as usize]
+    }
+
+    /// Projects every tip back into its allowed region: above the root's
+    /// tangent plane, and (Silva strands) within `L0` of the root (Eq. 3);
+    /// the velocity that pointed out of it is removed.
+    fn enforce_constraints(&mut self) {
+        let silva = self.topology == Topology::SilvaStrands;
+        let (roots, normals, lengths, root_velocities) = (
+            &self.roots,
+            &self.normals,
+            &self.lengths,
+            &self.root_velocities,
+        );
+        let velocities = &mut self.velocities;
+        let tips = &mut self.tips;
+        let mut state: Vec<(Vec3, Vec3)> = tips
+            .iter()
+            .copied()
+            .zip(velocities.iter().copied())
+            .collect();
+        update_each(&mut state, |i, (x, v)| {
+            let (root, n) = (roots[i], normals[i]);
+            let height = (*x - root).dot(n);
+            if height < 0.0 {
+                *x -= height * n;
+                let vn = (*v - root_velocities[i]).dot(n);
+                if vn < 0.0 {
+                    *v -= vn * n;
+                }
+            }
+            if silva {
+                let d = *x - root;
+                let l = d.length();
+                if l > lengths[i] {
+                    let dir = d / l;
+                    *x = root + lengths[i] * dir;
+                    let vr = (*v - root_velocities[i]).dot(dir);
+                    if vr > 0.0 {
+                        *v -= vr * dir;
+                    }
+                }
+            }
+        });
+        for (i, (x, v)) in state.into_iter().enumerate() {
+            tips[i] = x;
+            velocities[i] = v;
+        }
+    }
+
+    /// Kinetic energy plus the springs' potential energy plus gravity's
+    /// (relative to the rest tips). Banisch's restoring force is not
+    /// conservative and has no potential; tests of energy set it to 0.
+    pub fn energy(&self, p: &DynamicsParams) -> f64 {
+        let mut e = 0.0f64;
+        for i in 0..self.tips.len() {
+            let x = self.tips[i];
+            e += 0.5 * f64::from(p.mass) * f64::from(self.velocities[i].length_squared());
+            let spring = match self.topology {
+                Topology::SilvaStrands => (x - self.rest_tip(i)).length_squared(),
+                _ => {
+                    let stretch = (x - self.roots[i]).length() - self.lengths[i];
+                    stretch * stretch
+                }
+            };
+            e += 0.5 * f64::from(p.stiffness) * f64::from(spring);
+            e -= f64::from(p.mass) * f64::from(p.gravity.dot(x - self.rest_tip(i)));
+        }
+        for s in &self.springs {
+            let stretch = self.tips[s.a as usize].distance(self.tips[s.b as usize]) - s.rest;
+            e += 0.5 * f64::from(p.lateral_stiffness) * f64::from(stretch * stretch);
+        }
+        e
+    }
+}
+
+/// Preconditioned conjugate gradients on 3-vectors: solves `A x = b` with
+/// `apply(x, out)` computing `A x` and a block-diagonal preconditioner.
+fn conjugate_gradient(
+    apply: &impl Fn(&[Vec3], &mut [Vec3]),
+    b: &[Vec3],
+    preconditioner: &[Mat3],
+    iterations: u32,
+    tolerance: f64,
+) -> Vec<Vec3> {
+    let n = b.len();
+    // Sums in fixed chunks, then the chunks in order: the same bits on any
+    // number of threads.
+    let dot = |a: &[Vec3], b: &[Vec3]| -> f64 {
+        let chunk = |k: usize| -> f64 {
+            let range = k * 4096..((k + 1) * 4096).min(a.len());
+            a[range.clone()]
+                .iter()
+                .zip(&b[range])
+                .map(|(a, b)| f64::from(a.dot(*b)))
+                .sum()
+        };
+        map_indexed(a.len().div_ceil(4096), chunk).iter().sum()
+    };
+    let mut x = vec![Vec3::ZERO; n];
+    let mut r = b.to_vec();
+    let mut z: Vec<Vec3> = map_indexed(n, |i| preconditioner[i] * r[i]);
+    let mut d = z.clone();
+    let mut ad = vec![Vec3::ZERO; n];
+    let mut rz = dot(&r, &z);
+    let threshold = tolerance * tolerance * dot(b, b).max(1e-300);
+    for _ in 0..iterations {
+        if dot(&r, &r) <= threshold {
+            break;
+        }
+        apply(&d, &mut ad);
+        let dad = dot(&d, &ad);
+        if dad <= 0.0 {
+            break;
+        }
+        let alpha = (rz / dad) as f32;
+        update_each(&mut x, |i, x| *x += alpha * d[i]);
+        update_each(&mut r, |i, r| *r -= alpha * ad[i]);
+        update_each(&mut z, |i, z| *z = preconditioner[i] * r[i]);
+        let rz_next = dot(&r, &z);
+        let beta = (rz_next / rz.max(1e-300)) as f32;
+        rz = rz_next;
+        update_each(&mut d, |i, d| *d = z[i] + beta * *d);
+    }
+    x
+}
