@@ -14,7 +14,7 @@ use crate::{Camera, GpuContext, GpuError};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use pelage::Mesh;
-use pelage::shell::math::{ClumpParams, CurlParams, KajiyaKay, ShadingMode};
+use pelage::shell::math::{ClumpParams, Coupling, CurlParams, KajiyaKay, ShadingMode};
 use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
 use wgpu::util::DeviceExt;
 
@@ -51,6 +51,11 @@ pub struct ShellParams {
     pub tiles: f32,
     /// Curl (Eq. 4).
     pub curl: CurlParams,
+    /// How the strands' tips bend the layers (Silva's Bézier, Banisch's
+    /// linear or bent layers).
+    pub coupling: Coupling,
+    /// The whole skin moved by this (an object being shaken).
+    pub offset: Vec3,
     /// Clumping (Eq. 5).
     pub clump: ClumpParams,
     /// Shading stage.
@@ -111,6 +116,7 @@ struct ShellUniforms {
     fur: [f32; 4],
     curl: [f32; 4],
     clump: [f32; 4],
+    motion: [f32; 4],
 }
 
 /// A furry mesh on the GPU: skin vertices with their frames, the shell
@@ -118,6 +124,7 @@ struct ShellUniforms {
 #[derive(Debug)]
 pub struct ShellModel {
     vertices: wgpu::Buffer,
+    tip_offsets: wgpu::Buffer,
     vertex_count: u32,
     wetness: wgpu::Texture,
     wetness_size: (u32, u32),
@@ -200,8 +207,9 @@ pub struct ShellRenderer {
     features: ShellFeatures,
 }
 
-/// Vertex layout: position, normal, mask uv, dP/du, tip offset.
-const VERTEX_FLOATS: usize = 14;
+/// Vertex layout: position, normal, mask uv, dP/du; tip offsets come from
+/// a second buffer, rewritten as the fur moves.
+const VERTEX_FLOATS: usize = 11;
 
 impl ShellRenderer {
     /// Pipelines for offscreen images.
@@ -282,8 +290,9 @@ impl ShellRenderer {
             ("CLUMP", f64::from(u8::from(features.clump))),
         ];
         let vertex_attributes = wgpu::vertex_attr_array![
-            0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x3, 4 => Float32x3
+            0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x3
         ];
+        let tip_attributes = wgpu::vertex_attr_array![4 => Float32x3];
         let pipeline = |vs: &str, fs: &str, layers: bool| {
             let compilation_options = wgpu::PipelineCompilationOptions {
                 constants: &constants,
@@ -296,11 +305,18 @@ impl ShellRenderer {
                     module: &module,
                     entry_point: Some(vs),
                     compilation_options: compilation_options.clone(),
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: (VERTEX_FLOATS * 4) as u64,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &vertex_attributes,
-                    })],
+                    buffers: &[
+                        Some(wgpu::VertexBufferLayout {
+                            array_stride: (VERTEX_FLOATS * 4) as u64,
+                            step_mode: wgpu::VertexStepMode::Vertex,
+                            attributes: &vertex_attributes,
+                        }),
+                        Some(wgpu::VertexBufferLayout {
+                            array_stride: 12,
+                            step_mode: wgpu::VertexStepMode::Vertex,
+                            attributes: &tip_attributes,
+                        }),
+                    ],
                 },
                 primitive: wgpu::PrimitiveState {
                     topology: wgpu::PrimitiveTopology::TriangleList,
@@ -382,14 +398,18 @@ impl ShellRenderer {
                     tangents[v as usize],
                 );
                 let uv = pelage::shell::wetness::mask_coordinates(uvs[k]);
-                vertices.extend_from_slice(&[
-                    p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, u.x, u.y, u.z, 0.0, 0.0, 0.0,
-                ]);
+                vertices
+                    .extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, u.x, u.y, u.z]);
             }
         }
         let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shell skin"),
             contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let tip_offsets = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("shell tip offsets"),
+            contents: bytemuck::cast_slice(&vec![0.0f32; mesh.triangle_count() * 9]),
             usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
         });
         let size = |w, h, layers| wgpu::Extent3d {
@@ -469,6 +489,7 @@ impl ShellRenderer {
         });
         Ok(ShellModel {
             vertices: vertex_buffer,
+            tip_offsets,
             vertex_count: (mesh.triangle_count() * 3) as u32,
             wetness,
             wetness_size: (mask_size, mask_size),
@@ -476,6 +497,28 @@ impl ShellRenderer {
             layers: textures.layers(),
             bounds: mesh.bounds(),
         })
+    }
+
+    /// Moves the strands' tips: one offset `p − p0` per triangle corner
+    /// (`3t + k`), as [`pelage::dynamics::MassSpringSystem::corner_tip_offsets`]
+    /// gives them.
+    pub fn set_tip_offsets(
+        &self,
+        ctx: &GpuContext,
+        model: &ShellModel,
+        offsets: &[Vec3],
+    ) -> Result<(), GpuError> {
+        if offsets.len() != model.vertex_count as usize {
+            return Err(GpuError::Mismatch(format!(
+                "{} tip offsets for a model with {} triangle corners",
+                offsets.len(),
+                model.vertex_count
+            )));
+        }
+        let flat: Vec<f32> = offsets.iter().flat_map(|o| o.to_array()).collect();
+        ctx.queue
+            .write_buffer(&model.tip_offsets, 0, bytemuck::cast_slice(&flat));
+        Ok(())
     }
 
     /// Replaces the model's wetness mask (same size as uploaded).
@@ -595,7 +638,7 @@ impl ShellRenderer {
                 params.curl.radius,
                 params.curl.frequency,
                 params.mode.index() as f32,
-                0.0,
+                params.coupling.index() as f32,
             ],
             clump: [
                 params.clump.w,
@@ -603,6 +646,7 @@ impl ShellRenderer {
                 model.wetness_size.0 as f32,
                 model.wetness_size.1 as f32,
             ],
+            motion: params.offset.extend(params.coupling.exponent()).to_array(),
         };
         let device = &ctx.device;
         let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -645,6 +689,7 @@ impl ShellRenderer {
         pass.set_bind_group(0, &uniforms, &[]);
         pass.set_bind_group(1, &model.textures, &[]);
         pass.set_vertex_buffer(0, model.vertices.slice(..));
+        pass.set_vertex_buffer(1, model.tip_offsets.slice(..));
         pass.set_pipeline(&self.skin_pipeline);
         pass.draw(0..model.vertex_count, 0..1);
         pass.set_pipeline(&self.layer_pipeline);
@@ -699,6 +744,8 @@ impl ShellParams {
                 w: 0.0,
                 strength: 0.0,
             }),
+            coupling: Coupling::Bezier,
+            offset: Vec3::ZERO,
             mode: scene.shading.mode,
             kajiya_kay: scene.shading.kajiya_kay,
             background: [0.62, 0.66, 0.72],

@@ -10,8 +10,8 @@ use glam::{Vec2, Vec3};
 use pelage::Mesh;
 use pelage::mesh::Uvs;
 use pelage::shell::math::{
-    ClumpDecision, ClumpParams, CurlParams, KajiyaKay, ShadingMode, Strand, clump_fragment,
-    layer_height, layer_offset, shade, strand_tangent,
+    ClumpDecision, ClumpParams, Coupling, CurlParams, KajiyaKay, ShadingMode, Strand,
+    clump_fragment, coupled_layer_offset, coupled_strand_tangent, layer_height, shade,
 };
 use pelage::shell::{Droplet, ShellTextureParams, ShellTextures, WetnessMask};
 use pelage_gpu::{GpuContext, ShellFeatures, ShellParams, ShellRenderer, ShellTarget, ShellView};
@@ -124,6 +124,8 @@ struct Case {
     textures: ShellTextures,
     mask: WetnessMask,
     light: Vec3,
+    /// Every corner's tip moved by this (`p − p0`).
+    tip_offset: Vec3,
 }
 
 /// What the shaders should draw, pixel by pixel, from the reference
@@ -167,14 +169,15 @@ fn reference(case: &Case) -> image::RgbaImage {
             // whole layer moves by one offset: the pixel sees the layer
             // point that was under pixel − offset.
             let wet_vertex = case.mask.at(Vec2::ZERO).wetness;
-            let strand = Strand::at_rest(Vec3::ZERO, n, p.length);
-            let offset = layer_offset(&strand, h, wet_vertex, curl, u, v);
+            let mut strand = Strand::at_rest(Vec3::ZERO, n, p.length);
+            strand.tip += case.tip_offset;
+            let offset = coupled_layer_offset(p.coupling, &strand, h, wet_vertex, curl, u, v);
             let uv = pixel - Vec2::new(offset.x, offset.z);
             if !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y) {
                 continue;
             }
             let world = skin + Vec3::new(0.0, offset.y, 0.0);
-            let t_strand = strand_tangent(&strand, h, wet_vertex, curl, u, v);
+            let t_strand = coupled_strand_tangent(p.coupling, &strand, h, wet_vertex, curl, u, v);
             let (mut uv_color, mut uv_geo) = (uv, uv * p.tiles);
             if case.features.clump {
                 let here = case.mask.at(uv);
@@ -222,6 +225,8 @@ fn draw(ctx: &GpuContext, case: &Case) -> image::RgbaImage {
         .upload(ctx, &square(), &color_image(), &case.textures, SIZE)
         .unwrap();
     renderer.set_wetness(ctx, &model, &case.mask).unwrap();
+    let corners = vec![case.tip_offset; 6];
+    renderer.set_tip_offsets(ctx, &model, &corners).unwrap();
     let target = ShellTarget::new(ctx, &renderer, SIZE, SIZE).unwrap();
     renderer
         .render(ctx, &model, &case.params, &view(case.light), &target)
@@ -250,6 +255,8 @@ fn params(layers: u32) -> ShellParams {
             radius: 0.0,
             frequency: 0.0,
         },
+        coupling: Coupling::Bezier,
+        offset: Vec3::ZERO,
         clump: ClumpParams {
             w: 0.5,
             strength: 3.0,
@@ -314,6 +321,7 @@ fn wet_clumps_and_kajiya_kay_match_the_reference_pixel_for_pixel() {
         textures: textures(layers),
         mask,
         light: Vec3::new(0.4, 0.8, 0.3),
+        tip_offset: Vec3::ZERO,
     };
     let (gpu_image, cpu_image) = (draw(ctx, &case), reference(&case));
     let (off, worst) = compare(&gpu_image, &cpu_image);
@@ -372,6 +380,7 @@ fn curl_moves_the_layer_by_the_reference_offset_and_wetness_straightens_it() {
         textures: textures(1),
         mask,
         light: Vec3::Y,
+        tip_offset: Vec3::ZERO,
     };
     let (gpu_image, cpu_image) = (draw(ctx, &case), reference(&case));
     let (off, worst) = compare(&gpu_image, &cpu_image);
@@ -409,4 +418,48 @@ fn meshes_without_uvs_are_refused_by_name() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("no-uv triangle") && e.contains("no UVs"), "{e}");
+}
+
+#[test]
+fn moved_tips_bend_the_layers_as_each_coupling_says() {
+    let Some(ctx) = gpu() else { return };
+    // Sticks L0 = 1/8 tipped 30° towards +x: the tip moves 4 texels
+    // sideways, so at h = 1/2 Silva's Bézier and Banisch's bent layers
+    // (k = 2) move a layer 1 texel and the linear ones 2: all on texel
+    // centres, and all different.
+    let length = 0.125;
+    let s = Vec3::new(0.5, 0.75f32.sqrt(), 0.0);
+    let tip_offset = length * s - length * Vec3::Y;
+    let mut images = Vec::new();
+    for coupling in [
+        Coupling::Bezier,
+        Coupling::Linear,
+        Coupling::Bent { exponent: 2.0 },
+    ] {
+        let mut p = params(2);
+        p.length = length;
+        p.coupling = coupling;
+        p.mode = ShadingMode::Color;
+        let case = Case {
+            features: ShellFeatures::PLAIN,
+            params: p,
+            textures: textures(2),
+            mask: WetnessMask::dry_mask(SIZE, SIZE),
+            light: Vec3::Y,
+            tip_offset,
+        };
+        let (gpu_image, cpu_image) = (draw(ctx, &case), reference(&case));
+        let (off, worst) = compare(&gpu_image, &cpu_image);
+        eprintln!(
+            "{coupling:?}: {:.2} % of pixels differ (worst {worst})",
+            100.0 * off
+        );
+        if off > 0.01 {
+            save_on_failure("shells-coupling", &gpu_image, &cpu_image);
+        }
+        assert!(off <= 0.01, "{coupling:?}: {:.2} % differ", 100.0 * off);
+        images.push(gpu_image);
+    }
+    // Linear differs from the other two (2 texels vs 1 at h = 1/2).
+    assert!(compare(&images[0], &images[1]).0 > 0.05);
 }

@@ -14,10 +14,13 @@ struct Shell {
     specular: vec4<f32>,
     // x: shell length L0, y: layers N, z: texture tiles across UV, w: K_shadow.
     fur: vec4<f32>,
-    // x: K_α, y: ω, z: shading mode (ShadingMode::index), w: unused.
+    // x: K_α, y: ω, z: shading mode (ShadingMode::index), w: coupling
+    // (Coupling::index).
     curl: vec4<f32>,
     // x: w, y: clump strength, zw: wetness mask size in texels.
     clump: vec4<f32>,
+    // xyz: the whole skin moved by this (a shaken object), w: Eq. 4's k.
+    motion: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> shell: Shell;
@@ -56,6 +59,47 @@ fn bend_offset(root: vec3<f32>, rest_tip: vec3<f32>, tip: vec3<f32>, h: f32) -> 
 
 fn bend_tangent(root: vec3<f32>, rest_tip: vec3<f32>, tip: vec3<f32>, h: f32) -> vec3<f32> {
     return 2.0 * (1.0 - h) * (rest_tip - root) + 2.0 * h * (tip - rest_tip);
+}
+
+// Strand::direction's s: the unit stick direction, or the rest direction.
+fn stick_direction(root: vec3<f32>, rest_tip: vec3<f32>, tip: vec3<f32>) -> vec3<f32> {
+    let d = tip - root;
+    if dot(d, d) > 0.0 {
+        return normalize(d);
+    }
+    return normalize(rest_tip - root);
+}
+
+// Strand::coupled_offset.
+fn coupled_offset(mode: u32, k: f32, root: vec3<f32>, rest_tip: vec3<f32>, tip: vec3<f32>, h: f32) -> vec3<f32> {
+    if mode == 0u {
+        return bend_offset(root, rest_tip, tip, h);
+    }
+    let s = stick_direction(root, rest_tip, tip);
+    let length = distance(rest_tip, root);
+    if mode == 1u {
+        return h * length * s;
+    }
+    let n = normalize(rest_tip - root);
+    return length * (h * n + pow(h, k) * (s - n));
+}
+
+// Strand::coupled_tangent.
+fn coupled_tangent(mode: u32, k: f32, root: vec3<f32>, rest_tip: vec3<f32>, tip: vec3<f32>, h: f32) -> vec3<f32> {
+    if mode == 0u {
+        return bend_tangent(root, rest_tip, tip, h);
+    }
+    let s = stick_direction(root, rest_tip, tip);
+    let length = distance(rest_tip, root);
+    if mode == 1u {
+        return length * s;
+    }
+    let n = normalize(rest_tip - root);
+    var slope = 0.0;
+    if h > 0.0 {
+        slope = k * pow(h, k - 1.0);
+    }
+    return length * (n + slope * (s - n));
 }
 
 fn curl_radius(h: f32, wet: f32, k_alpha: f32) -> f32 {
@@ -135,8 +179,8 @@ struct SkinOut {
 @vertex
 fn vs_skin(v: VertexIn) -> SkinOut {
     var out: SkinOut;
-    out.clip = shell.view_proj * vec4<f32>(v.position, 1.0);
-    out.world = v.position;
+    out.world = v.position + shell.motion.xyz;
+    out.clip = shell.view_proj * vec4<f32>(out.world, 1.0);
     out.normal = v.normal;
     out.uv = v.uv;
     return out;
@@ -174,11 +218,12 @@ fn vs_layer(v: VertexIn, @builtin(instance_index) layer: u32) -> LayerOut {
     let n = normalize(v.normal);
     let u = normalize(v.tangent - n * dot(n, v.tangent));
     let w = cross(n, u);
-    let root = v.position;
+    let root = v.position + shell.motion.xyz;
     let rest_tip = root + shell.fur.x * n;
     let tip = rest_tip + v.tip_offset;
-    var offset = bend_offset(root, rest_tip, tip, h);
-    var t = bend_tangent(root, rest_tip, tip, h);
+    let coupling = u32(shell.curl.w);
+    var offset = coupled_offset(coupling, shell.motion.w, root, rest_tip, tip, h);
+    var t = coupled_tangent(coupling, shell.motion.w, root, rest_tip, tip, h);
     if CURL {
         let wet = wetness_at(v.uv).w;
         offset += curl_offset(h, wet, shell.curl.x, shell.curl.y, u, w);

@@ -80,6 +80,92 @@ impl Strand {
     }
 }
 
+/// How a strand's tip moves the layers between root and tip.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Coupling {
+    /// Silva §3.2.1: the quadratic Bézier through `p_root`, `p0`, `p`.
+    #[default]
+    Bezier,
+    /// Banisch Fig. 6a: layers straight along `s = (p − p_root)/|p − p_root|`.
+    Linear,
+    /// Banisch Fig. 6b, Eq. 4: up the normal by the layer height, out
+    /// towards `s` by `h^k (s − n)`: straight at the root, bent towards
+    /// the tip. The paper does not give `k`; 2 by default.
+    Bent {
+        /// `k`.
+        exponent: f32,
+    },
+}
+
+impl Coupling {
+    /// The number the shader reads: 0 Bézier, 1 linear, 2 bent.
+    pub fn index(self) -> u32 {
+        match self {
+            Coupling::Bezier => 0,
+            Coupling::Linear => 1,
+            Coupling::Bent { .. } => 2,
+        }
+    }
+
+    /// `k` for [`Coupling::Bent`], else 1.
+    pub fn exponent(self) -> f32 {
+        match self {
+            Coupling::Bent { exponent } => exponent,
+            _ => 1.0,
+        }
+    }
+}
+
+impl Strand {
+    /// The unit stick direction `s` (Banisch Eq. 3) and the rest length
+    /// `L0`; `s` is the rest direction for a degenerate stick.
+    pub fn direction(&self) -> (Vec3, f32) {
+        let rest = self.rest_tip - self.root;
+        let length = rest.length();
+        let s = (self.tip - self.root)
+            .try_normalize()
+            .unwrap_or_else(|| rest.normalize_or_zero());
+        (s, length)
+    }
+
+    /// Where the layer at `h` moves a skin vertex, under `coupling`.
+    pub fn coupled_offset(&self, coupling: Coupling, h: f32) -> Vec3 {
+        match coupling {
+            Coupling::Bezier => self.bend_offset(h),
+            Coupling::Linear => {
+                let (s, length) = self.direction();
+                h * length * s
+            }
+            Coupling::Bent { exponent } => {
+                let (s, length) = self.direction();
+                let n = (self.rest_tip - self.root).normalize_or_zero();
+                length * (h * n + h.powf(exponent) * (s - n))
+            }
+        }
+    }
+
+    /// `d/dh` of [`coupled_offset`](Self::coupled_offset).
+    pub fn coupled_tangent(&self, coupling: Coupling, h: f32) -> Vec3 {
+        match coupling {
+            Coupling::Bezier => self.bend_tangent(h),
+            Coupling::Linear => {
+                let (s, length) = self.direction();
+                length * s
+            }
+            Coupling::Bent { exponent } => {
+                let (s, length) = self.direction();
+                let n = (self.rest_tip - self.root).normalize_or_zero();
+                let slope = if h > 0.0 {
+                    exponent * h.powf(exponent - 1.0)
+                } else {
+                    0.0
+                };
+                length * (n + slope * (s - n))
+            }
+        }
+    }
+}
+
 /// The curl of Eq. 4.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CurlParams {
@@ -126,6 +212,21 @@ pub fn layer_offset(
     strand.bend_offset(h) + curl_offset(h, wetness, curl, u, v)
 }
 
+/// Eq. 1 with the bending term from `coupling` (Silva's Bézier, or
+/// Banisch's linear or bent layers).
+#[allow(clippy::too_many_arguments)]
+pub fn coupled_layer_offset(
+    coupling: Coupling,
+    strand: &Strand,
+    h: f32,
+    wetness: f32,
+    curl: CurlParams,
+    u: Vec3,
+    v: Vec3,
+) -> Vec3 {
+    strand.coupled_offset(coupling, h) + curl_offset(h, wetness, curl, u, v)
+}
+
 /// The unit strand tangent `T` at `h` (Eq. 6): the derivative of Eq. 1.
 /// Falls back to the rest direction where the derivative vanishes — as it
 /// does at the tip of a strand at rest: the Bézier through `p_root`, `p0`,
@@ -138,7 +239,21 @@ pub fn strand_tangent(
     u: Vec3,
     v: Vec3,
 ) -> Vec3 {
-    let t = strand.bend_tangent(h) + curl_tangent(h, wetness, curl, u, v);
+    coupled_strand_tangent(Coupling::Bezier, strand, h, wetness, curl, u, v)
+}
+
+/// [`strand_tangent`] under `coupling`.
+#[allow(clippy::too_many_arguments)]
+pub fn coupled_strand_tangent(
+    coupling: Coupling,
+    strand: &Strand,
+    h: f32,
+    wetness: f32,
+    curl: CurlParams,
+    u: Vec3,
+    v: Vec3,
+) -> Vec3 {
+    let t = strand.coupled_tangent(coupling, h) + curl_tangent(h, wetness, curl, u, v);
     t.try_normalize()
         .unwrap_or_else(|| (strand.rest_tip - strand.root).normalize_or_zero())
 }
@@ -416,6 +531,38 @@ mod tests {
         assert!(o.abs_diff_eq(expected, 1e-6), "{o} vs {expected}");
         let t = strand_tangent(&s, 0.0, 0.0, NO_CURL, Vec3::X, Vec3::Z);
         assert!(t.abs_diff_eq(Vec3::Y, 1e-6));
+    }
+
+    #[test]
+    fn couplings_end_at_the_tip_and_differ_in_between() {
+        let mut s = Strand::at_rest(Vec3::ZERO, Vec3::Y, 1.0);
+        // Tipped 60° over in x, same length.
+        s.tip = Vec3::new(0.75f32.sqrt(), 0.5, 0.0);
+        let bent = Coupling::Bent { exponent: 2.0 };
+        for c in [Coupling::Bezier, Coupling::Linear, bent] {
+            assert!(s.coupled_offset(c, 1.0).abs_diff_eq(s.tip, 1e-6), "{c:?}");
+            assert_eq!(s.coupled_offset(c, 0.0), Vec3::ZERO);
+            let h = 0.4;
+            let numeric = (s.coupled_offset(c, h + 1e-3) - s.coupled_offset(c, h - 1e-3)) / 2e-3;
+            assert!((numeric - s.coupled_tangent(c, h)).length() < 1e-3, "{c:?}");
+        }
+        // Half way: linear is half the tip; bent is up 0.5 and out a quarter
+        // of (s − n); the Bézier leans a quarter of (p − p0).
+        let half = |c| s.coupled_offset(c, 0.5);
+        assert!(half(Coupling::Linear).abs_diff_eq(0.5 * s.tip, 1e-6));
+        let expected_bent = 0.5 * Vec3::Y + 0.25 * (s.tip - Vec3::Y);
+        assert!(half(bent).abs_diff_eq(expected_bent, 1e-6));
+        assert!((half(Coupling::Bezier).x - 0.25 * s.tip.x).abs() < 1e-6);
+        // At rest every coupling is the straight strand.
+        let rest = Strand::at_rest(Vec3::ZERO, Vec3::Y, 1.0);
+        assert!(
+            rest.coupled_offset(Coupling::Linear, 0.3)
+                .abs_diff_eq(0.3 * Vec3::Y, 1e-6)
+        );
+        assert!(
+            rest.coupled_offset(bent, 0.3)
+                .abs_diff_eq(0.3 * Vec3::Y, 1e-6)
+        );
     }
 
     #[test]

@@ -18,7 +18,7 @@ pub mod scene;
 pub mod textures;
 pub mod wetness;
 
-pub use math::{ClumpParams, CurlParams, KajiyaKay, Strand, WetTexel};
+pub use math::{ClumpParams, Coupling, CurlParams, KajiyaKay, Strand, WetTexel};
 pub use scene::ShellScene;
 pub use textures::{ShellTextureParams, ShellTextures, TextureStyle};
 pub use wetness::{Droplet, DropletStyle, WetnessMask};
