@@ -14,6 +14,7 @@ use crate::{Camera, GpuContext, GpuError};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use pelage::Mesh;
+use pelage::dynamics::MassSpringSystem;
 use pelage::shell::math::{ClumpParams, Coupling, CurlParams, KajiyaKay, ShadingMode};
 use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
 use wgpu::util::DeviceExt;
@@ -767,6 +768,16 @@ pub struct ShellScenePlayer<'s> {
     /// From where; change it between frames.
     pub view: ShellView,
     timeline: pelage::shell::scene::WetnessTimeline<'s>,
+    motion: Option<FurMotion>,
+}
+
+/// The mass-spring system of a scene with `[dynamics]`, and its clock.
+#[derive(Debug)]
+struct FurMotion {
+    system: MassSpringSystem,
+    rest_roots: Vec<Vec3>,
+    rest_normals: Vec<Vec3>,
+    time: f32,
 }
 
 impl<'s> ShellScenePlayer<'s> {
@@ -813,11 +824,45 @@ impl<'s> ShellScenePlayer<'s> {
             params: ShellParams::from_scene(scene),
             view,
             timeline: scene.wetness_timeline(),
+            motion: scene.dynamics.as_ref().map(|d| {
+                let system = MassSpringSystem::new(&scene.mesh, d.topology, scene.fur.length);
+                FurMotion {
+                    rest_roots: system.roots().to_vec(),
+                    rest_normals: system.normals().to_vec(),
+                    system,
+                    time: 0.0,
+                }
+            }),
         })
+    }
+
+    /// Runs the scene's mass-spring system up to `time`, in steps of
+    /// `1 / (fps · steps_per_frame)`, moving the skin as the shake says.
+    fn simulate_to(&mut self, ctx: &GpuContext, time: f32) -> Result<(), GpuError> {
+        let (Some(motion), Some(settings)) = (&mut self.motion, &self.scene.dynamics) else {
+            return Ok(());
+        };
+        let dt = 1.0 / (self.scene.fps * settings.steps_per_frame as f32);
+        let shake = |t: f32| settings.shake.map_or(Vec3::ZERO, |s| s.offset(t));
+        while motion.time + 0.5 * dt < time {
+            let next = motion.time + dt;
+            let offset = shake(next);
+            let roots: Vec<Vec3> = motion.rest_roots.iter().map(|&r| r + offset).collect();
+            motion.system.move_roots(&roots, &motion.rest_normals, dt);
+            motion
+                .system
+                .step(dt, &settings.params, settings.solver, motion.time);
+            motion.time = next;
+        }
+        self.params.coupling = settings.coupling;
+        self.params.offset = shake(motion.time);
+        self.renderer
+            .set_tip_offsets(ctx, &self.model, &motion.system.corner_tip_offsets())
     }
 
     /// The frame at `time` seconds (not before the last one drawn).
     pub fn render_at(&mut self, ctx: &GpuContext, time: f32) -> Result<image::RgbaImage, GpuError> {
+        self.simulate_to(ctx, time)?;
         let mask = self.timeline.advance_to(time);
         self.renderer.set_wetness(ctx, &self.model, mask)?;
         self.renderer

@@ -13,5 +13,5 @@
 pub mod solver;
 pub mod system;
 
-pub use solver::{Brush, DynamicsParams, Solver, Wind};
+pub use solver::{Brush, DynamicsParams, Solver, Wind, WindNow};
 pub use system::{MassSpringSystem, Topology};

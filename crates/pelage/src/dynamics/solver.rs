@@ -97,15 +97,38 @@ impl Wind {
 
     /// The wind's velocity at `p` and time `t`.
     pub fn at(&self, p: Vec3, t: f32) -> Vec3 {
+        self.now(t).at(p)
+    }
+
+    /// The wind at time `t`, ready to be read at many points.
+    pub fn now(&self, t: f32) -> WindNow<'_> {
         let phase = std::f32::consts::TAU * self.gust_frequency * t;
         // Two incommensurate sines: gusts that do not repeat every period.
         let gust = 1.0 + self.gust * (0.6 * phase.sin() + 0.4 * (2.31 * phase + 1.3).sin());
-        let mut v = self.velocity * gust;
-        if self.turbulence != 0.0 {
-            let drift = self.velocity * t + Vec3::new(0.0, 0.37 * t, 0.0);
-            v += self.turbulence * self.noise.perlin3_vector((p - drift) * self.scale);
+        WindNow {
+            wind: self,
+            mean: self.velocity * gust,
+            drift: self.velocity * t + Vec3::new(0.0, 0.37 * t, 0.0),
         }
-        v
+    }
+}
+
+/// [`Wind`] at one moment: the gust computed once for every point.
+#[derive(Debug, Clone, Copy)]
+pub struct WindNow<'w> {
+    wind: &'w Wind,
+    mean: Vec3,
+    drift: Vec3,
+}
+
+impl WindNow<'_> {
+    /// The velocity at `p`.
+    pub fn at(&self, p: Vec3) -> Vec3 {
+        let w = self.wind;
+        if w.turbulence == 0.0 {
+            return self.mean;
+        }
+        self.mean + w.turbulence * w.noise.perlin3_vector((p - self.drift) * w.scale)
     }
 }
 
@@ -202,7 +225,7 @@ fn spring_stiffness(k: f32, d: Vec3, rest: f32) -> (Mat3, Vec3) {
 
 impl MassSpringSystem {
     /// The force on tip `i` from everything but the tip-tip springs.
-    fn tip_force(&self, i: usize, p: &DynamicsParams, time: f32) -> Vec3 {
+    fn tip_force(&self, i: usize, p: &DynamicsParams, wind: Option<WindNow>) -> Vec3 {
         let (x, v) = (self.tips[i], self.velocities[i]);
         let root = self.roots[i];
         let n = self.normals[i];
@@ -220,7 +243,7 @@ impl MassSpringSystem {
             }
         };
         f += p.mass * p.gravity;
-        let wind = p.wind.as_ref().map_or(Vec3::ZERO, |w| w.at(x, time));
+        let wind = wind.map_or(Vec3::ZERO, |w| w.at(x));
         f += p.drag * (wind - v);
         if let Some(b) = p.brush {
             let q = x.distance(b.centre) / b.radius.max(1e-9);
@@ -262,16 +285,36 @@ impl MassSpringSystem {
 
     /// All tip forces at the current state.
     fn forces(&self, p: &DynamicsParams, time: f32) -> Vec<Vec3> {
+        let wind = p.wind.as_ref().map(|w| w.now(time));
         map_indexed(self.tips.len(), |i| {
-            self.tip_force(i, p, time) + self.lateral_force(i, p)
+            self.tip_force(i, p, wind) + self.lateral_force(i, p)
         })
     }
 
-    /// `v += Δv; x += h v`.
-    fn advance(&mut self, h: f32, dv: &[Vec3]) {
-        update_each(&mut self.velocities, |i, v| *v += dv[i]);
-        let velocities = &self.velocities;
-        update_each(&mut self.tips, |i, x| *x += h * velocities[i]);
+    /// Writes the next state of every tip, `next(i) = (x, v)`, double
+    /// buffered: `next` reads the current state only.
+    fn update_state(&mut self, next: impl Fn(&Self, usize) -> (Vec3, Vec3) + Sync + Send) {
+        let mut tips = std::mem::take(&mut self.scratch_tips);
+        let mut velocities = std::mem::take(&mut self.scratch_velocities);
+        tips.resize(self.tips.len(), Vec3::ZERO);
+        velocities.resize(self.tips.len(), Vec3::ZERO);
+        let this = &*self;
+        let write = |(i, (x, v)): (usize, (&mut Vec3, &mut Vec3))| {
+            (*x, *v) = next(this, i);
+        };
+        if tips.len() < PARALLEL_MIN {
+            tips.iter_mut()
+                .zip(velocities.iter_mut())
+                .enumerate()
+                .for_each(write);
+        } else {
+            tips.par_iter_mut()
+                .zip(velocities.par_iter_mut())
+                .enumerate()
+                .for_each(write);
+        }
+        self.scratch_tips = std::mem::replace(&mut self.tips, tips);
+        self.scratch_velocities = std::mem::replace(&mut self.velocities, velocities);
     }
 
     /// Advances the simulation by `dt` seconds; `time` is the time at the
@@ -282,16 +325,18 @@ impl MassSpringSystem {
                 let n = substeps.max(1);
                 let h = dt / n as f32;
                 for k in 0..n {
-                    let mut dv = self.forces(params, time + k as f32 * h);
-                    let scale = h / params.mass;
-                    update_each(&mut dv, |_, f| *f *= scale);
-                    self.advance(h, &dv);
-                    self.enforce_constraints();
+                    let wind = params.wind.as_ref().map(|w| w.now(time + k as f32 * h));
+                    // One fused pass per substep: force, velocity, position,
+                    // constraints.
+                    self.update_state(|this, i| {
+                        let f = this.tip_force(i, params, wind) + this.lateral_force(i, params);
+                        let v = this.velocities[i] + (h / params.mass) * f;
+                        this.constrained(i, this.tips[i] + h * v, v)
+                    });
                 }
             }
             Solver::Implicit { iterations } => {
                 self.implicit_step(dt, params, iterations, time);
-                self.enforce_constraints();
             }
         }
     }
@@ -352,58 +397,44 @@ impl MassSpringSystem {
         });
         let preconditioner: Vec<Mat3> = map_indexed(n, |i| diagonal[i].inverse());
         let dv = conjugate_gradient(&apply, &b, &preconditioner, iterations.max(1), 1e-6);
-        self.advance(h, &dv);
+        self.update_state(|this, i| {
+            let v = this.velocities[i] + dv[i];
+            this.constrained(i, this.tips[i] + h * v, v)
+        });
     }
 
     fn tip_springs(&self, i: usize) -> &[u32] {
         &self.spring_index[self.spring_offsets[i] as usize..self.spring_offsets[i + 1] as usize]
     }
 
-    /// Projects every tip back into its allowed region: above the root's
-    /// tangent plane, and (Silva strands) within `L0` of the root (Eq. 3);
-    /// the velocity that pointed out of it is removed.
-    fn enforce_constraints(&mut self) {
-        let silva = self.topology == Topology::SilvaStrands;
-        let (roots, normals, lengths, root_velocities) = (
-            &self.roots,
-            &self.normals,
-            &self.lengths,
-            &self.root_velocities,
-        );
-        let velocities = &mut self.velocities;
-        let tips = &mut self.tips;
-        let mut state: Vec<(Vec3, Vec3)> = tips
-            .iter()
-            .copied()
-            .zip(velocities.iter().copied())
-            .collect();
-        update_each(&mut state, |i, (x, v)| {
-            let (root, n) = (roots[i], normals[i]);
-            let height = (*x - root).dot(n);
-            if height < 0.0 {
-                *x -= height * n;
-                let vn = (*v - root_velocities[i]).dot(n);
-                if vn < 0.0 {
-                    *v -= vn * n;
-                }
+    /// Tip `i` at `x` moving at `v`, projected back into its allowed
+    /// region: above the root's tangent plane, and (Silva strands) within
+    /// `L0` of the root (Eq. 3); the velocity that pointed out of it is
+    /// removed.
+    fn constrained(&self, i: usize, mut x: Vec3, mut v: Vec3) -> (Vec3, Vec3) {
+        let (root, n) = (self.roots[i], self.normals[i]);
+        let root_velocity = self.root_velocities[i];
+        let height = (x - root).dot(n);
+        if height < 0.0 {
+            x -= height * n;
+            let vn = (v - root_velocity).dot(n);
+            if vn < 0.0 {
+                v -= vn * n;
             }
-            if silva {
-                let d = *x - root;
-                let l = d.length();
-                if l > lengths[i] {
-                    let dir = d / l;
-                    *x = root + lengths[i] * dir;
-                    let vr = (*v - root_velocities[i]).dot(dir);
-                    if vr > 0.0 {
-                        *v -= vr * dir;
-                    }
-                }
-            }
-        });
-        for (i, (x, v)) in state.into_iter().enumerate() {
-            tips[i] = x;
-            velocities[i] = v;
         }
+        if self.topology == Topology::SilvaStrands {
+            let d = x - root;
+            let l = d.length();
+            if l > self.lengths[i] {
+                let dir = d / l;
+                x = root + self.lengths[i] * dir;
+                let vr = (v - root_velocity).dot(dir);
+                if vr > 0.0 {
+                    v -= vr * dir;
+                }
+            }
+        }
+        (x, v)
     }
 
     /// Kinetic energy plus the springs' potential energy plus gravity's

@@ -108,6 +108,9 @@ pub struct MassSpringSystem {
     pub(crate) spring_index: Vec<u32>,
     /// For each triangle corner (3t + k), the stick it follows.
     corner_sticks: Vec<u32>,
+    /// The next state while a step writes it (double buffering).
+    pub(crate) scratch_tips: Vec<Vec3>,
+    pub(crate) scratch_velocities: Vec<Vec3>,
 }
 
 impl MassSpringSystem {
@@ -206,6 +209,8 @@ impl MassSpringSystem {
             spring_offsets: counts,
             spring_index,
             corner_sticks,
+            scratch_tips: Vec::new(),
+            scratch_velocities: Vec::new(),
         }
     }
 

@@ -5,12 +5,13 @@
 //!
 //! Errors share the groom files' type: `FILE:LINE:COL: KEY: what`.
 
-use super::math::{ClumpParams, CurlParams, KajiyaKay, ShadingMode};
+use super::math::{ClumpParams, Coupling, CurlParams, KajiyaKay, ShadingMode};
 use super::textures::{ShellTextureParams, TextureStyle};
 use super::wetness::{
     Droplet, DropletStyle, WetnessMask, droplets_from_image, droplets_on_mesh, mask_coordinates,
 };
 use crate::Mesh;
+use crate::dynamics::{DynamicsParams, Solver, Topology, Wind};
 use crate::groom::file::MeshSection;
 use crate::groom::{GroomError, GroomErrorKind, GroomSource};
 use glam::{Vec2, Vec3};
@@ -43,6 +44,47 @@ struct SceneFile {
     camera: Option<CameraSection>,
     #[serde(default)]
     animation: AnimationSection,
+    dynamics: Option<DynamicsSection>,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct DynamicsSection {
+    topology: Option<Spanned<String>>,
+    solver: Option<Spanned<String>>,
+    substeps: Option<u32>,
+    iterations: Option<u32>,
+    steps_per_frame: Option<u32>,
+    coupling: Option<Spanned<String>>,
+    exponent: Option<f32>,
+    mass: Option<f32>,
+    stiffness: Option<f32>,
+    lateral_stiffness: Option<f32>,
+    damping: Option<f32>,
+    drag: Option<f32>,
+    restoring: Option<f32>,
+    gravity: Option<[f32; 3]>,
+    wind: Option<WindSection>,
+    shake: Option<ShakeSection>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WindSection {
+    velocity: [f32; 3],
+    gust: Option<f32>,
+    gust_frequency: Option<f32>,
+    turbulence: Option<f32>,
+    scale: Option<f32>,
+    seed: Option<u64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ShakeSection {
+    amplitude: [f32; 3],
+    frequency: Option<f32>,
+    duration: Option<f32>,
 }
 
 #[derive(Debug, Clone, Deserialize, Default)]
@@ -172,6 +214,46 @@ pub struct SceneCamera {
     pub fov_y_degrees: f32,
 }
 
+/// The object shaken back and forth, then still: the skin is offset by
+/// `amplitude · sin(2π f t)` for `t < duration`, whole periods only.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shake {
+    /// Largest offset.
+    pub amplitude: Vec3,
+    /// Shakes per second.
+    pub frequency: f32,
+    /// How long it shakes (rounded to whole periods).
+    pub duration: f32,
+}
+
+impl Shake {
+    /// The skin's offset at time `t`.
+    pub fn offset(&self, t: f32) -> Vec3 {
+        let periods = (self.duration * self.frequency).round();
+        if t < 0.0 || t * self.frequency >= periods {
+            return Vec3::ZERO;
+        }
+        self.amplitude * (TAU * self.frequency * t).sin()
+    }
+}
+
+/// Moving fur: the mass-spring system the shells follow.
+#[derive(Debug, Clone)]
+pub struct DynamicsSettings {
+    /// Which masses and springs.
+    pub topology: Topology,
+    /// How to step.
+    pub solver: Solver,
+    /// Steps per frame.
+    pub steps_per_frame: u32,
+    /// How the tips bend the layers.
+    pub coupling: Coupling,
+    /// Masses, springs and forces.
+    pub params: DynamicsParams,
+    /// The object shaken, if at all.
+    pub shake: Option<Shake>,
+}
+
 /// A droplet and when it falls.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TimedDroplet {
@@ -213,6 +295,8 @@ pub struct ShellScene {
     pub frames: u32,
     /// Frames per second of a sequence.
     pub fps: f32,
+    /// Moving fur, if the scene has a `[dynamics]` section.
+    pub dynamics: Option<DynamicsSettings>,
 }
 
 impl ShellScene {
@@ -432,6 +516,96 @@ impl ShellScene {
         }
         droplets.sort_by(|a, b| a.time.total_cmp(&b.time));
 
+        let dynamics = match &file.dynamics {
+            None => None,
+            Some(d) => {
+                let named = |value: &Option<Spanned<String>>, default: &str| {
+                    value.as_ref().map_or((default.to_string(), 0..0), |v| {
+                        (v.get_ref().clone(), v.span())
+                    })
+                };
+                let (name, span) = named(&d.topology, "spring-sticks");
+                let topology = Topology::from_name(&name).ok_or_else(|| {
+                    invalid(
+                        span,
+                        format!(
+                            "unknown topology `{name}`: use spring-sticks, separable-spring-sticks, prisms, separable-prisms or silva-strands"
+                        ),
+                    )
+                })?;
+                let (name, span) = named(&d.solver, "implicit");
+                let solver = match name.as_str() {
+                    "implicit" => Solver::Implicit {
+                        iterations: d.iterations.unwrap_or(30).max(1),
+                    },
+                    "explicit" => Solver::Explicit {
+                        substeps: d.substeps.unwrap_or(4).max(1),
+                    },
+                    other => {
+                        return Err(invalid(
+                            span,
+                            format!("unknown solver `{other}`: use implicit or explicit"),
+                        ));
+                    }
+                };
+                let default_coupling = if topology == Topology::SilvaStrands {
+                    "bezier"
+                } else {
+                    "bent"
+                };
+                let (name, span) = named(&d.coupling, default_coupling);
+                let coupling = match name.as_str() {
+                    "bezier" => Coupling::Bezier,
+                    "linear" => Coupling::Linear,
+                    "bent" => Coupling::Bent {
+                        exponent: d.exponent.unwrap_or(2.0).max(1.0),
+                    },
+                    other => {
+                        return Err(invalid(
+                            span,
+                            format!("unknown coupling `{other}`: use bezier, linear or bent"),
+                        ));
+                    }
+                };
+                let defaults = DynamicsParams::default();
+                let params = DynamicsParams {
+                    mass: d.mass.unwrap_or(defaults.mass).max(1e-9),
+                    stiffness: d.stiffness.unwrap_or(defaults.stiffness).max(0.0),
+                    lateral_stiffness: d
+                        .lateral_stiffness
+                        .unwrap_or(defaults.lateral_stiffness)
+                        .max(0.0),
+                    damping: d.damping.unwrap_or(defaults.damping).max(0.0),
+                    drag: d.drag.unwrap_or(defaults.drag).max(0.0),
+                    restoring: d.restoring.unwrap_or(defaults.restoring).max(0.0),
+                    gravity: d.gravity.map_or(defaults.gravity, Vec3::from),
+                    wind: d.wind.as_ref().map(|w| {
+                        Wind::new(
+                            Vec3::from(w.velocity),
+                            w.gust.unwrap_or(0.5),
+                            w.gust_frequency.unwrap_or(0.5),
+                            w.turbulence.unwrap_or(0.0),
+                            w.scale.unwrap_or(4.0),
+                            w.seed.unwrap_or(1),
+                        )
+                    }),
+                    brush: None,
+                };
+                Some(DynamicsSettings {
+                    topology,
+                    solver,
+                    steps_per_frame: d.steps_per_frame.unwrap_or(2).max(1),
+                    coupling,
+                    params,
+                    shake: d.shake.as_ref().map(|s| Shake {
+                        amplitude: Vec3::from(s.amplitude),
+                        frequency: s.frequency.unwrap_or(3.0).max(1e-3),
+                        duration: s.duration.unwrap_or(1.0).max(0.0),
+                    }),
+                })
+            }
+        };
+
         Ok(Self {
             mesh,
             color,
@@ -451,6 +625,7 @@ impl ShellScene {
             droplets,
             frames: file.animation.frames.unwrap_or(1).max(1),
             fps: file.animation.fps.unwrap_or(12.0).max(1e-3),
+            dynamics,
         })
     }
 

@@ -5,6 +5,7 @@
 //! Machines here are small and noisy: every figure is the median of several
 //! runs, and comparisons are ratios taken within one run.
 
+pub mod dynamics;
 pub mod groom;
 pub mod interp;
 pub mod io;
@@ -33,6 +34,8 @@ pub enum BenchWhat {
     Interp(interp::InterpBenchArgs),
     /// The groom generator: the Stubble figure (1.6 M hairs) and peak memory.
     Groom(groom::GroomBenchArgs),
+    /// Mass-spring fur: ms per step for every topology × solver.
+    Dynamics(dynamics::DynamicsBenchArgs),
     /// Shell fur frame time, plain vs curl vs curl + clump (Silva Table 1).
     Shells(shells::ShellsBenchArgs),
     /// Writing a large groom as usda, part by part: throughput and peak memory.
@@ -47,6 +50,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Interp(a) => interp::run(a),
         BenchWhat::Groom(a) => groom::run(a),
         BenchWhat::Shells(a) => shells::run(a),
+        BenchWhat::Dynamics(a) => dynamics::run(a),
     }
 }
 
