@@ -52,14 +52,7 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         meshes.push(("spot ×4".into(), spot.subdivided(4)));
     }
     let params = DynamicsParams {
-        wind: Some(Wind::new(
-            Vec3::new(3.0, 0.0, 1.0),
-            0.6,
-            0.7,
-            std::env::var("TURB").map_or(2.0, |v| v.parse().unwrap()),
-            4.0,
-            1,
-        )),
+        wind: Some(Wind::new(Vec3::new(3.0, 0.0, 1.0), 0.6, 0.7, 2.0, 4.0, 1)),
         ..Default::default()
     };
     let dt = 1.0 / 60.0;
