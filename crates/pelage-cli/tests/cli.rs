@@ -674,19 +674,7 @@ fn shells_sequence_dries_and_writes_frames_and_a_gif() {
     )
     .unwrap();
     let frames = dir.path().join("rain");
-    let out = pelage(&[
-        "shells",
-        scene.to_str().unwrap(),
-        "--frames",
-        "3",
-        "-o",
-        frames.to_str().unwrap(),
-        "--size",
-        "160x120",
-        "--mask",
-        "-q",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    shells_sequence(&scene, &frames, &["--mask"]);
     assert!(frames.join("shells.gif").exists());
     let frame = |k: u32| {
         image::open(frames.join(format!("frame-{k:04}.png")))
@@ -708,4 +696,58 @@ fn shells_sequence_dries_and_writes_frames_and_a_gif() {
         .filter(|(a, b)| (0..3).any(|c| a.0[c].abs_diff(b.0[c]) > 8))
         .count();
     assert!(changed > 160 * 120 / 50, "{changed} pixels changed");
+}
+
+#[test]
+fn shells_with_dynamics_move_in_the_wind_and_still_fur_does_not() {
+    // Needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_none() {
+        eprintln!("SKIPPED: set PELAGE_REQUIRE_GPU=1 to run render tests through the CLI");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let base =
+        "[fur]\nlayers = 8\nlength = 0.08\n[texture]\nresolution = 64\n[animation]\nfps = 4\n";
+    let run = |name: &str, extra: &str| {
+        let scene = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&scene, format!("{base}{extra}")).unwrap();
+        let frames = dir.path().join(name);
+        shells_sequence(&scene, &frames, &[]);
+        let frame = |k: u32| {
+            image::open(frames.join(format!("frame-{k:04}.png")))
+                .unwrap()
+                .to_rgba8()
+        };
+        frame(0)
+            .pixels()
+            .zip(frame(2).pixels())
+            .filter(|(a, b)| (0..3).any(|c| a.0[c].abs_diff(b.0[c]) > 8))
+            .count()
+    };
+    assert_eq!(run("still", ""), 0, "fur without dynamics does not move");
+    let windy = "[dynamics]\ntopology = \"prisms\"\n[dynamics.wind]\nvelocity = [6, 0, 2]\nturbulence = 3\n";
+    let moved = run("windy", windy);
+    assert!(
+        moved > 160 * 120 / 100,
+        "{moved} pixels changed in the wind"
+    );
+}
+
+/// `pelage shells SCENE --frames 3 -o FRAMES --size 160x120 -q EXTRA…`,
+/// which must succeed.
+fn shells_sequence(scene: &Path, frames: &Path, extra: &[&str]) {
+    let mut args = vec![
+        "shells",
+        scene.to_str().unwrap(),
+        "--frames",
+        "3",
+        "-o",
+        frames.to_str().unwrap(),
+        "--size",
+        "160x120",
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    let out = pelage(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
 }

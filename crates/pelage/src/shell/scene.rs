@@ -742,6 +742,41 @@ mod tests {
     }
 
     #[test]
+    fn dynamics_sections_parse_with_errors_at_their_line() {
+        let s = scene("[dynamics]\ntopology = \"silva-strands\"\nsolver = \"explicit\"\n").unwrap();
+        let d = s.dynamics.unwrap();
+        assert_eq!(d.topology, Topology::SilvaStrands);
+        assert_eq!(
+            d.coupling,
+            Coupling::Bezier,
+            "Silva strands default to the Bézier"
+        );
+        assert_eq!(d.solver, Solver::Explicit { substeps: 4 });
+        let s = scene("[dynamics]\n[dynamics.shake]\namplitude = [0.1, 0, 0]\nfrequency = 2\n")
+            .unwrap();
+        let d = s.dynamics.unwrap();
+        assert_eq!(d.coupling, Coupling::Bent { exponent: 2.0 });
+        let shake = d.shake.unwrap();
+        assert!((shake.offset(0.125).x - 0.1).abs() < 1e-6);
+        assert_eq!(shake.offset(1.0), Vec3::ZERO, "still after its second");
+        let e = scene("[dynamics]\ntopology = \"springs\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("fur.toml:2:12: dynamics.topology: unknown topology `springs`"),
+            "{e}"
+        );
+        let e = scene("[dynamics.wind]\nvelocty = [1, 0, 0]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("fur.toml:2:1") && e.contains("unknown field `velocty`"),
+            "{e}"
+        );
+        assert!(scene("").unwrap().dynamics.is_none());
+    }
+
+    #[test]
     fn droplets_fall_on_time_and_dry_between() {
         let s = scene(
             "[wetness]\nresolution = 64\ndrying_rate = 1.0\n\
