@@ -35,6 +35,9 @@ enum Command {
     Convert(commands::convert::ConvertArgs),
     /// Draw shell fur (curl, wet clumps, drying) to a PNG or a sequence.
     Shells(commands::shells::ShellsArgs),
+    /// Look at shell fur in a window: sliders, drop water, push, shake
+    /// (needs the `viewer` feature).
+    View(commands::view::ViewArgs),
     /// Run the demo on the embedded Spot mesh.
     Demo(commands::demo::DemoArgs),
     /// Measure a capability against its paper's figures.
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Command::Guides(args) => commands::guides::run(&args),
         Command::Groom(args) => commands::groom::run(&args),
         Command::Shells(args) => commands::shells::run(&args),
+        Command::View(args) => commands::view::run(&args),
         Command::Demo(args) => commands::demo::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
     };

@@ -751,3 +751,12 @@ fn shells_sequence(scene: &Path, frames: &Path, extra: &[&str]) {
     let out = pelage(&args);
     assert!(out.status.success(), "{}", stderr(&out));
 }
+
+#[cfg(not(feature = "viewer"))]
+#[test]
+fn view_without_the_viewer_feature_says_how_to_get_it() {
+    let out = pelage(&["view"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--features viewer"), "{stderr}");
+}

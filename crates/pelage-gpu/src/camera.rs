@@ -64,3 +64,154 @@ impl Camera {
         proj * view
     }
 }
+
+/// A camera that orbits a target, as in Blender's and Houdini's viewports:
+/// drag to turn around the target, pan to move the target in the view
+/// plane, zoom to move in. Angles are kept, not the eye, so orbiting never
+/// drifts and the view never rolls.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrbitCamera {
+    /// What the camera turns around.
+    pub target: Vec3,
+    /// Angle around the y axis, radians (0: looking along −z).
+    pub yaw: f32,
+    /// Angle above the horizon, radians, kept inside ±89°.
+    pub pitch: f32,
+    /// Distance from the eye to the target.
+    pub distance: f32,
+    /// Vertical field of view in degrees.
+    pub fov_y_degrees: f32,
+}
+
+const PITCH_LIMIT: f32 = 89.0 * std::f32::consts::PI / 180.0;
+
+impl OrbitCamera {
+    /// The orbit that sees what `camera` sees.
+    pub fn from_camera(camera: Camera) -> Self {
+        let offset = camera.eye - camera.target;
+        let distance = offset.length().max(1e-6);
+        let direction = offset / distance;
+        Self {
+            target: camera.target,
+            yaw: direction.x.atan2(direction.z),
+            pitch: direction
+                .y
+                .clamp(-1.0, 1.0)
+                .asin()
+                .clamp(-PITCH_LIMIT, PITCH_LIMIT),
+            distance,
+            fov_y_degrees: camera.fov_y_degrees,
+        }
+    }
+
+    /// The camera at this orbit.
+    pub fn camera(&self) -> Camera {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        let direction = Vec3::new(sy * cp, sp, cy * cp);
+        Camera {
+            eye: self.target + direction * self.distance,
+            target: self.target,
+            fov_y_degrees: self.fov_y_degrees,
+        }
+    }
+
+    /// Turns by `yaw` and `pitch` radians (positive: the camera moves
+    /// right and up around the target).
+    pub fn orbit(&mut self, yaw: f32, pitch: f32) {
+        self.yaw = (self.yaw + yaw).rem_euclid(std::f32::consts::TAU);
+        self.pitch = (self.pitch + pitch).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+    }
+
+    /// Moves the target (and the eye with it) by `right` and `up`, in
+    /// fractions of the view's height at the target's distance, so a drag
+    /// across the whole window moves the scene with the pointer.
+    pub fn pan(&mut self, right: f32, up: f32) {
+        let camera = self.camera();
+        let forward = (camera.target - camera.eye).normalize();
+        let side = forward.cross(Vec3::Y).normalize_or_zero();
+        let above = side.cross(forward);
+        let height = 2.0 * self.distance * (0.5 * self.fov_y_degrees).to_radians().tan();
+        self.target += (side * right + above * up) * height;
+    }
+
+    /// Moves in (`factor < 1`) or out (`> 1`), never through the target.
+    pub fn zoom(&mut self, factor: f32) {
+        if factor.is_finite() && factor > 0.0 {
+            self.distance = (self.distance * factor).max(1e-5);
+        }
+    }
+
+    /// The ray through a point of the view, in normalised device
+    /// coordinates (x and y in −1..1, y up): origin at the eye and a unit
+    /// direction.
+    pub fn ray(&self, ndc_x: f32, ndc_y: f32, aspect: f32) -> (Vec3, Vec3) {
+        let camera = self.camera();
+        let forward = (camera.target - camera.eye).normalize();
+        let side = forward.cross(Vec3::Y).normalize_or_zero();
+        let above = side.cross(forward);
+        let tan_y = (0.5 * self.fov_y_degrees).to_radians().tan();
+        let direction = forward + side * (ndc_x * tan_y * aspect) + above * (ndc_y * tan_y);
+        (camera.eye, direction.normalize())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_orbit_reproduces_the_camera_it_was_made_from() {
+        let camera = Camera {
+            eye: Vec3::new(1.0, 2.0, 3.0),
+            target: Vec3::new(0.5, 0.0, -1.0),
+            fov_y_degrees: 40.0,
+        };
+        let back = OrbitCamera::from_camera(camera).camera();
+        assert!((back.eye - camera.eye).length() < 1e-5, "{back:?}");
+        assert_eq!(back.target, camera.target);
+    }
+
+    #[test]
+    fn orbiting_keeps_the_distance_and_stops_short_of_the_pole() {
+        let mut orbit = OrbitCamera::from_camera(Camera::framing(-Vec3::ONE, Vec3::ONE, 1.5));
+        let d = orbit.distance;
+        orbit.orbit(1.0, 10.0);
+        let camera = orbit.camera();
+        assert!(((camera.eye - camera.target).length() - d).abs() < 1e-4);
+        assert!(orbit.pitch < 1.56 && camera.eye.y > 0.0);
+        orbit.zoom(0.5);
+        assert!((orbit.distance - 0.5 * d).abs() < 1e-5);
+        orbit.zoom(-1.0);
+        assert!(
+            (orbit.distance - 0.5 * d).abs() < 1e-5,
+            "nonsense factors ignored"
+        );
+    }
+
+    #[test]
+    fn the_ray_through_a_pixel_lands_where_the_projection_puts_it() {
+        let orbit = OrbitCamera::from_camera(Camera::framing(-Vec3::ONE, Vec3::ONE, 1.5));
+        let clip = orbit.camera().clip_from_world(1.5, 2.0);
+        for (x, y) in [(0.0, 0.0), (0.5, -0.3), (-0.9, 0.8)] {
+            let (origin, direction) = orbit.ray(x, y, 1.5);
+            let p = clip.project_point3(origin + direction * orbit.distance);
+            assert!(
+                (p.x - x).abs() < 1e-4 && (p.y - y).abs() < 1e-4,
+                "{p} for {x},{y}"
+            );
+        }
+    }
+
+    #[test]
+    fn panning_a_full_view_height_moves_the_target_by_that_height() {
+        let mut orbit = OrbitCamera::from_camera(Camera::framing(-Vec3::ONE, Vec3::ONE, 1.0));
+        let before = orbit.target;
+        orbit.pan(0.0, 1.0);
+        let height = 2.0 * orbit.distance * (0.5 * orbit.fov_y_degrees).to_radians().tan();
+        assert!(((orbit.target - before).length() - height).abs() < 1e-4);
+        let clip = orbit.camera().clip_from_world(1.0, 2.0);
+        // The old target now sits a full view height below the centre.
+        assert!((clip.project_point3(before).y + 2.0).abs() < 1e-3);
+    }
+}

@@ -10,6 +10,7 @@ pub struct GpuContext {
     /// Its queue.
     pub queue: wgpu::Queue,
     adapter: wgpu::AdapterInfo,
+    raw_adapter: wgpu::Adapter,
 }
 
 impl GpuContext {
@@ -18,11 +19,28 @@ impl GpuContext {
     pub fn headless() -> Result<Self, GpuError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::open(&instance, None)
+    }
+
+    /// Opens the best adapter that can draw into `surface` (a window's),
+    /// made by `instance`; configure the surface with [`Self::device`]
+    /// afterwards. The same environment variables apply.
+    pub fn for_surface(
+        instance: &wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+    ) -> Result<Self, GpuError> {
+        Self::open(instance, Some(surface))
+    }
+
+    fn open(
+        instance: &wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Self, GpuError> {
         let options = wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::from_env()
                 .unwrap_or(wgpu::PowerPreference::HighPerformance),
             force_fallback_adapter: false,
-            compatible_surface: None,
+            compatible_surface: surface,
             ..Default::default()
         };
         let adapter = pollster::block_on(instance.request_adapter(&options))
@@ -44,7 +62,13 @@ impl GpuContext {
             device,
             queue,
             adapter: info,
+            raw_adapter: adapter,
         })
+    }
+
+    /// The adapter, e.g. for a surface's capabilities.
+    pub fn adapter(&self) -> &wgpu::Adapter {
+        &self.raw_adapter
     }
 
     /// The adapter in words: name and backend, e.g. `llvmpipe (LLVM 15.0.6,

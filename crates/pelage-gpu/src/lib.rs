@@ -15,10 +15,10 @@ mod context;
 mod renderer;
 mod shells;
 
-pub use camera::Camera;
+pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
 pub use pelage::Curves;
-pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer};
+pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer, read_texture};
 pub use shells::{
     ShellFeatures, ShellModel, ShellParams, ShellRenderer, ShellScenePlayer, ShellTarget,
     ShellView, vertex_tangents,

@@ -706,3 +706,21 @@ pub(crate) fn read_back(
     image::RgbaImage::from_raw(width, height, pixels)
         .ok_or_else(|| GpuError::Readback("the image size does not match".into()))
 }
+
+/// Finishes `encoder` with a copy of `texture` (8-bit RGBA or BGRA, such as
+/// an offscreen twin of a window's surface) and reads it back as RGBA.
+pub fn read_texture(
+    ctx: &GpuContext,
+    encoder: wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+) -> Result<image::RgbaImage, GpuError> {
+    let size = texture.size();
+    let mut image = read_back(ctx, encoder, texture, size.width, size.height)?;
+    if matches!(
+        texture.format(),
+        wgpu::TextureFormat::Bgra8UnormSrgb | wgpu::TextureFormat::Bgra8Unorm
+    ) {
+        image.pixels_mut().for_each(|p| p.0.swap(0, 2));
+    }
+    Ok(image)
+}

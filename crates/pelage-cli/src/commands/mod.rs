@@ -9,6 +9,7 @@ pub mod info;
 pub mod render;
 pub mod sample;
 pub mod shells;
+pub mod view;
 
 use anyhow::Context;
 use pelage::Mesh;

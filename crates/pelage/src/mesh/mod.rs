@@ -18,6 +18,7 @@ mod gltf;
 mod load;
 mod obj;
 mod ply;
+mod ray;
 mod subdivide;
 mod surface_point;
 mod topology;
@@ -26,6 +27,7 @@ pub use closest::{ClosestPoint, TriangleBvh, closest_on_triangle};
 pub use error::{Location, MeshError, MeshErrorKind};
 pub use load::MeshFormat;
 pub(crate) use ply::scalar as ply_scalar;
+pub use ray::{RayHit, first_hit};
 pub use surface_point::{SurfacePoint, TangentFrame};
 pub use topology::{EdgeList, TopologyReport, VertexAdjacency};
 

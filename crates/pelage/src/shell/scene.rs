@@ -254,6 +254,21 @@ pub struct DynamicsSettings {
     pub shake: Option<Shake>,
 }
 
+impl Default for DynamicsSettings {
+    /// What an empty `[dynamics]` section gives: spring-sticks, implicit
+    /// (30 CG iterations), two steps a frame, bent layers (k = 2).
+    fn default() -> Self {
+        Self {
+            topology: Topology::SpringSticks,
+            solver: Solver::Implicit { iterations: 30 },
+            steps_per_frame: 2,
+            coupling: Coupling::Bent { exponent: 2.0 },
+            params: DynamicsParams::default(),
+            shake: None,
+        }
+    }
+}
+
 /// A droplet and when it falls.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TimedDroplet {
@@ -694,6 +709,17 @@ mod tests {
             path: "fur.toml".into(),
             text: text.into(),
         })
+    }
+
+    #[test]
+    fn an_empty_dynamics_section_is_the_default() {
+        let d = scene("[dynamics]\n").unwrap().dynamics.unwrap();
+        let e = DynamicsSettings::default();
+        assert_eq!(
+            (d.topology, d.solver, d.steps_per_frame, d.coupling, d.shake),
+            (e.topology, e.solver, e.steps_per_frame, e.coupling, e.shake)
+        );
+        assert_eq!(format!("{:?}", d.params), format!("{:?}", e.params));
     }
 
     #[test]

@@ -1,0 +1,202 @@
+//! Scripted viewer sessions (`pelage view … --script ACTIONS.toml`): what a
+//! person would do with the mouse, written down — orbit, drop water at a
+//! point of the window, push the fur, wait, take screenshots — so tests and
+//! demos drive the real window, event loop and renderer.
+//!
+//! ```toml
+//! ui = false                         # hide the control panel (default: shown)
+//!
+//! [[step]]
+//! wait = 10                          # frames
+//! [[step]]
+//! screenshot = "before.png"          # relative to the script's folder
+//! [[step]]
+//! drop = { at = [400, 300], radius = 0.05, wetness = 1.0 }   # window pixels
+//! [[step]]
+//! orbit = [30, -10]                  # degrees: right, up
+//! [[step]]
+//! push = { from = [400, 300], to = [460, 300], frames = 10 } # drag the fur
+//! ```
+
+use pelage::groom::{GroomError, GroomSource};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// A script: steps run in order, one action a step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Script {
+    /// Whether the control panel is drawn (and in screenshots).
+    pub ui: bool,
+    /// The steps.
+    pub steps: Vec<Step>,
+}
+
+/// One thing done.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Step {
+    /// Draw this many frames (the simulation and drying go on).
+    Wait(u32),
+    /// Write what the window shows to a PNG.
+    Screenshot(PathBuf),
+    /// A click with the water tool: a droplet where the ray through this
+    /// pixel meets the skin (Silva Alg. 1).
+    Drop(DropStep),
+    /// Turn the camera around its target, degrees right and up.
+    Orbit([f32; 2]),
+    /// Move the camera in (< 1) or out (> 1).
+    Zoom(f32),
+    /// A drag with the push tool, from one pixel to another over frames.
+    Push(PushStep),
+    /// Shake the object (the scene's shake, or a default one).
+    Shake(bool),
+    /// Close the window.
+    Quit(bool),
+}
+
+/// `drop = { at, radius, wetness }`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DropStep {
+    /// Window pixel (x right, y down).
+    pub at: [f32; 2],
+    /// Droplet radius in mask units (default: the panel's).
+    pub radius: Option<f32>,
+    /// ρ_drop (default: the panel's).
+    pub wetness: Option<f32>,
+}
+
+/// `push = { from, to, frames }`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PushStep {
+    /// Where the drag starts (window pixel).
+    pub from: [f32; 2],
+    /// Where it ends.
+    pub to: [f32; 2],
+    /// Over how many frames (default 10).
+    #[serde(default = "default_push_frames")]
+    pub frames: u32,
+}
+
+fn default_push_frames() -> u32 {
+    10
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScriptFile {
+    #[serde(default = "default_true")]
+    ui: bool,
+    #[serde(default)]
+    step: Vec<Step>,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+impl Script {
+    /// Reads a script; errors name the file, line and key. Screenshot
+    /// paths are made relative to the script's folder.
+    pub fn load(path: &Path) -> Result<Self, GroomError> {
+        Self::parse(&GroomSource::read(path)?)
+    }
+
+    /// Parses a script's text.
+    pub fn parse(source: &GroomSource) -> Result<Self, GroomError> {
+        let file: ScriptFile = source.parse_as()?;
+        let folder = source.folder();
+        let steps = file
+            .step
+            .into_iter()
+            .map(|step| match step {
+                Step::Screenshot(p) if p.is_relative() => Step::Screenshot(folder.join(p)),
+                other => other,
+            })
+            .collect();
+        Ok(Self { ui: file.ui, steps })
+    }
+
+    /// A script that draws `frames` frames, writes `screenshot` and quits:
+    /// `pelage view --screenshot OUT.png` without a script.
+    pub fn screenshot_after(frames: u32, screenshot: PathBuf) -> Self {
+        Self {
+            ui: true,
+            steps: vec![Step::Wait(frames), Step::Screenshot(screenshot)],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Script, GroomError> {
+        Script::parse(&GroomSource {
+            path: "shots/act.toml".into(),
+            text: text.into(),
+        })
+    }
+
+    #[test]
+    fn every_action_reads_back() {
+        let script = parse(
+            r#"
+ui = false
+[[step]]
+wait = 3
+[[step]]
+screenshot = "a.png"
+[[step]]
+drop = { at = [10, 20], radius = 0.1 }
+[[step]]
+orbit = [30, -5]
+[[step]]
+zoom = 0.5
+[[step]]
+push = { from = [1, 2], to = [3, 4] }
+[[step]]
+shake = true
+[[step]]
+quit = true
+"#,
+        )
+        .unwrap();
+        assert!(!script.ui);
+        assert_eq!(
+            script.steps,
+            vec![
+                Step::Wait(3),
+                Step::Screenshot(PathBuf::from("shots/a.png")),
+                Step::Drop(DropStep {
+                    at: [10.0, 20.0],
+                    radius: Some(0.1),
+                    wetness: None
+                }),
+                Step::Orbit([30.0, -5.0]),
+                Step::Zoom(0.5),
+                Step::Push(PushStep {
+                    from: [1.0, 2.0],
+                    to: [3.0, 4.0],
+                    frames: 10
+                }),
+                Step::Shake(true),
+                Step::Quit(true),
+            ]
+        );
+    }
+
+    #[test]
+    fn a_misspelt_action_is_an_error_at_its_line() {
+        let err = parse("[[step]]\nwait = 2\n[[step]]\ndorp = { at = [1, 2] }\n")
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("shots/act.toml:4:"), "{err}");
+        assert!(err.contains("dorp"), "{err}");
+        let err = parse("[[step]]\ndrop = { at = [1, 2], radius = \"big\" }\n")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("shots/act.toml:2:"), "{err}");
+    }
+}
