@@ -284,14 +284,22 @@ impl WindowState {
         self.orbit.ray(ndc_x, ndc_y, self.aspect())
     }
 
-    fn drop_at(&mut self, pixel: Vec2, radius: Option<f32>, wetness: Option<f32>) -> bool {
+    fn drop_at(
+        &mut self,
+        pixel: Vec2,
+        radius: Option<f32>,
+        wetness: Option<f32>,
+        clump: Option<f32>,
+    ) -> bool {
         let (origin, direction) = self.ray(pixel);
         let c = &self.session.controls;
-        let (radius, wetness) = (
+        let (radius, wetness, clump) = (
             radius.unwrap_or(c.drop_radius),
             wetness.unwrap_or(c.drop_wetness),
+            clump.unwrap_or(c.clump_size),
         );
-        self.session.drop_water(origin, direction, radius, wetness)
+        self.session
+            .drop_water(origin, direction, radius, wetness, clump)
     }
 
     /// A push from where the drag started towards where the pointer is.
@@ -323,7 +331,7 @@ impl WindowState {
         if button == MouseButton::Left {
             match tool {
                 Tool::Water if clicked => {
-                    self.drop_at(position, None, None);
+                    self.drop_at(position, None, None, None);
                 }
                 Tool::Push => self.session.release(),
                 Tool::Water => {}
@@ -388,7 +396,7 @@ impl WindowState {
                         break;
                     }
                     Step::Drop(d) => {
-                        if !self.drop_at(Vec2::from(d.at), d.radius, d.wetness) {
+                        if !self.drop_at(Vec2::from(d.at), d.radius, d.wetness, d.clump) {
                             eprintln!("warning: the drop at pixel {:?} missed the mesh", d.at);
                         }
                     }

@@ -11,7 +11,7 @@
 //! [[step]]
 //! screenshot = "before.png"          # relative to the script's folder
 //! [[step]]
-//! drop = { at = [400, 300], radius = 0.05, wetness = 1.0 }   # window pixels
+//! drop = { at = [400, 300], radius = 0.05, clump = 0.012 }   # window pixels; a splash of clumps
 //! [[step]]
 //! orbit = [30, -10]                  # degrees: right, up
 //! [[step]]
@@ -39,8 +39,8 @@ pub enum Step {
     Wait(u32),
     /// Write what the window shows to a PNG.
     Screenshot(PathBuf),
-    /// A click with the water tool: a droplet where the ray through this
-    /// pixel meets the skin (Silva Alg. 1).
+    /// A click with the water tool: a splash of droplets where the ray
+    /// through this pixel meets the skin (Silva Alg. 1).
     Drop(DropStep),
     /// Turn the camera around its target, degrees right and up.
     Orbit([f32; 2]),
@@ -60,8 +60,10 @@ pub enum Step {
 pub struct DropStep {
     /// Window pixel (x right, y down).
     pub at: [f32; 2],
-    /// Droplet radius in mask units (default: the panel's).
+    /// Splash radius in mask units (default: the panel's).
     pub radius: Option<f32>,
+    /// Radius of each droplet, one clump (default: the panel's).
+    pub clump: Option<f32>,
     /// ρ_drop (default: the panel's).
     pub wetness: Option<f32>,
 }
@@ -172,7 +174,8 @@ quit = true
                 Step::Drop(DropStep {
                     at: [10.0, 20.0],
                     radius: Some(0.1),
-                    wetness: None
+                    wetness: None,
+                    clump: None
                 }),
                 Step::Orbit([30.0, -5.0]),
                 Step::Zoom(0.5),

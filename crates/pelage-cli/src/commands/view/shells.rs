@@ -30,8 +30,10 @@ pub enum Tool {
 pub struct ShellControls {
     /// Left-button tool.
     pub tool: Tool,
-    /// Droplet radius, mask units.
+    /// Splash radius, mask units.
     pub drop_radius: f32,
+    /// Radius of each droplet (one clump), mask units.
+    pub clump_size: f32,
     /// ρ_drop.
     pub drop_wetness: f32,
     /// Wetness decay per second.
@@ -90,6 +92,8 @@ pub struct ShellSession {
     /// The scene's wind (direction, gusts, turbulence); the panel sets
     /// its speed.
     base_wind: Wind,
+    /// Splashes so far (each gets its own jitter).
+    splashes: u64,
     /// Milliseconds the last frame's simulation (dynamics + mask) took.
     pub last_simulation_ms: f64,
 }
@@ -132,7 +136,8 @@ impl ShellSession {
         let dynamics = scene.dynamics.clone().unwrap_or_default();
         let controls = ShellControls {
             tool: Tool::Water,
-            drop_radius: 0.04,
+            drop_radius: 0.05,
+            clump_size: 0.012,
             drop_wetness: 1.0,
             drying_rate: scene.drying_rate,
             rain: false,
@@ -181,6 +186,7 @@ impl ShellSession {
             brush: None,
             last_simulation_ms: 0.0,
             base_wind,
+            splashes: 0,
         };
         // The scene's own droplets at time 0 are the starting mask.
         let mut timeline = session.scene.wetness_timeline();
@@ -210,8 +216,18 @@ impl ShellSession {
         OrbitCamera::from_camera(camera)
     }
 
-    /// A droplet where the ray meets the skin; returns whether it hit.
-    pub fn drop_water(&mut self, origin: Vec3, direction: Vec3, radius: f32, wetness: f32) -> bool {
+    /// A splash of water where the ray meets the skin: the disk of
+    /// `radius` (mask units) around the hit filled with droplets of the
+    /// clump size, each one clump (Alg. 1), on a jittered grid. Returns
+    /// whether the ray hit.
+    pub fn drop_water(
+        &mut self,
+        origin: Vec3,
+        direction: Vec3,
+        radius: f32,
+        wetness: f32,
+        clump: f32,
+    ) -> bool {
         let origin = origin - self.params.offset;
         let Some(hit) = pelage::mesh::first_hit(&self.scene.mesh, origin, direction) else {
             return false;
@@ -219,11 +235,10 @@ impl ShellSession {
         let Some(uv) = hit.point.uv(&self.scene.mesh) else {
             return false;
         };
-        self.mask.add_droplet(Droplet {
-            centre: mask_coordinates(uv),
-            radius,
-            wetness,
-        });
+        self.splashes += 1;
+        for drop in splash(mask_coordinates(uv), radius, clump, wetness, self.splashes) {
+            self.mask.add_droplet(drop);
+        }
         self.mask_changed = true;
         true
     }
@@ -464,7 +479,8 @@ impl ShellSession {
             ui.radio_value(&mut c.tool, Tool::Water, "drop water");
             ui.radio_value(&mut c.tool, Tool::Push, "push fur");
         });
-        ui.add(egui::Slider::new(&mut c.drop_radius, 0.005..=0.2).text("drop radius"));
+        ui.add(egui::Slider::new(&mut c.drop_radius, 0.005..=0.25).text("splash radius"));
+        ui.add(egui::Slider::new(&mut c.clump_size, 0.003..=0.05).text("clump size"));
         ui.add(egui::Slider::new(&mut c.drop_wetness, 0.0..=1.0).text("drop wetness ρ"));
         ui.add(egui::Slider::new(&mut c.drying_rate, 0.0..=2.0).text("drying rate /s"));
         ui.horizontal(|ui| {
@@ -544,5 +560,75 @@ impl ShellSession {
         if ui.button("Shake").clicked() {
             self.shake();
         }
+    }
+}
+
+/// Droplets of radius `clump` covering the disk of `radius` around
+/// `centre` (mask units): a grid of spacing 1.2 · clump, each point moved
+/// by up to a quarter of the spacing (a hash of the point and `salt`), so
+/// neighbouring clumps touch without lining up. A splash no wider than a
+/// clump is one droplet.
+fn splash(centre: glam::Vec2, radius: f32, clump: f32, wetness: f32, salt: u64) -> Vec<Droplet> {
+    let clump = clump.max(1e-4);
+    if radius <= clump {
+        return vec![Droplet {
+            centre,
+            radius: radius.max(1e-4),
+            wetness,
+        }];
+    }
+    let spacing = 1.2 * clump;
+    let n = (radius / spacing).ceil() as i32;
+    let mut drops = Vec::new();
+    for j in -n..=n {
+        for i in -n..=n {
+            let mut h =
+                pelage::sample::SampleRng::new(salt, ((j + n) * (2 * n + 1) + i + n) as u64);
+            let jitter = glam::Vec2::new(h.uniform_f32() - 0.5, h.uniform_f32() - 0.5);
+            let offset = (glam::Vec2::new(i as f32, j as f32) + jitter * 0.5) * spacing;
+            if offset.length() <= radius {
+                drops.push(Droplet {
+                    centre: centre + offset,
+                    radius: clump,
+                    wetness,
+                });
+            }
+        }
+    }
+    drops
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec2;
+
+    #[test]
+    fn a_splash_covers_its_disk_with_clump_sized_drops() {
+        let centre = Vec2::new(0.5, 0.5);
+        let drops = splash(centre, 0.1, 0.01, 0.8, 3);
+        // About the disk's area over a grid cell's.
+        let expected = std::f32::consts::PI * 0.01 / (0.012f32 * 0.012);
+        assert!(
+            (drops.len() as f32 - expected).abs() < 0.15 * expected,
+            "{}",
+            drops.len()
+        );
+        assert!(drops.iter().all(|d| d.radius == 0.01 && d.wetness == 0.8));
+        assert!(drops.iter().all(|d| d.centre.distance(centre) <= 0.1));
+        // The inner disk is wet but for small gaps between clumps.
+        let mut mask = WetnessMask::dry_mask(512, 512);
+        drops.iter().for_each(|&d| mask.add_droplet(d));
+        let wet = (0..400)
+            .filter(|&k| {
+                let a = k as f32 * 2.399_963; // golden angle: a sunflower of points
+                let p = centre + 0.09 * (k as f32 / 400.0).sqrt() * Vec2::new(a.cos(), a.sin());
+                mask.at(p).wetness > 0.0
+            })
+            .count();
+        assert!(wet >= 380, "{wet} of 400 points wet");
+        // Small splashes are one drop; the same salt gives the same drops.
+        assert_eq!(splash(centre, 0.005, 0.01, 1.0, 1).len(), 1);
+        assert_eq!(drops, splash(centre, 0.1, 0.01, 0.8, 3));
     }
 }
