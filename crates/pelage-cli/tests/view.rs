@@ -154,3 +154,75 @@ fn a_screenshot_without_a_script_shows_the_panel_and_the_fur() {
     let corner = image.get_pixel(SIZE.0 - 3, 3).0;
     assert!(corner[2] > corner[0], "background is bluish: {corner:?}");
 }
+
+#[test]
+fn a_groom_file_is_grown_and_drawn_with_its_guides_in_orange() {
+    if !has_display() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("fur.toml");
+    std::fs::write(
+        &groom,
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 3000\n\
+         [guides]\ngenerate = { count = 80, length = 0.12, comb = [0, -1, 0] }\n",
+    )
+    .unwrap();
+    let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
+    let script = dir.path().join("look.toml");
+    std::fs::write(
+        &script,
+        "ui = false\n\
+         [[step]]\nshow = { skin = false, hairs = false, guides = true }\n\
+         [[step]]\nwait = 2\n[[step]]\nscreenshot = \"guides.png\"\n\
+         [[step]]\nshow = { guides = false }\n\
+         [[step]]\nwait = 2\n[[step]]\nscreenshot = \"nothing.png\"\n\
+         [[step]]\nshow = { skin = true, hairs = true }\n\
+         [[step]]\nwait = 2\n[[step]]\nscreenshot = \"groom.png\"\n",
+    )
+    .unwrap();
+    let size = format!("{}x{}", SIZE.0, SIZE.1);
+    let out = pelage(&[
+        "view",
+        groom.to_str().unwrap(),
+        "--script",
+        script.to_str().unwrap(),
+        "--size",
+        &size,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let background = read("nothing.png");
+    let differing = |image: &image::RgbImage| {
+        image
+            .pixels()
+            .zip(background.pixels())
+            .filter(|(a, b)| a.0.iter().zip(b.0).any(|(&x, y)| x.abs_diff(y) > 24))
+            .map(|(a, _)| a.0)
+            .collect::<Vec<_>>()
+    };
+    assert!(differing(&background).is_empty());
+    // Guides alone: orange strokes on the blue-grey background (edges are
+    // blended with it, highlights pale, but all are warmer than it).
+    let guides = differing(&read("guides.png"));
+    let orange = guides
+        .iter()
+        .filter(|[r, _, b]| *r > b.saturating_add(10))
+        .count();
+    assert!(
+        guides.len() > 200 && orange * 10 > guides.len() * 8,
+        "{orange} of {} orange",
+        guides.len()
+    );
+    // Skin and hairs cover far more.
+    let groom = differing(&read("groom.png"));
+    assert!(
+        groom.len() > 5 * guides.len(),
+        "{} vs {}",
+        groom.len(),
+        guides.len()
+    );
+}

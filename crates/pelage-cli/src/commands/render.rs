@@ -72,13 +72,13 @@ pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
 
 /// What a file given to `pelage render` holds.
 #[derive(Debug, PartialEq)]
-enum FileKind {
+pub(crate) enum FileKind {
     Mesh,
     Points,
     Curves,
 }
 
-fn file_kind(path: &Path) -> anyhow::Result<FileKind> {
+pub(crate) fn file_kind(path: &Path) -> anyhow::Result<FileKind> {
     let count = |element| {
         ply_element_count(path, element).with_context(|| format!("cannot read {}", path.display()))
     };

@@ -3,6 +3,7 @@
 //! drives the same calls frame by frame, so the scripted run a test makes
 //! is the run a person gets.
 
+use super::curves::{CurvesSession, CurvesSource};
 use super::script::{Script, Step};
 use super::shells::{ShellSession, Tool};
 use anyhow::Context as _;
@@ -42,15 +43,92 @@ pub struct Timings {
     pub screenshots: Vec<PathBuf>,
 }
 
-/// Opens the window on `scene` and runs until it is closed (or the script
-/// ends).
-pub fn run(scene: ShellScene, options: WindowOptions) -> anyhow::Result<Timings> {
+/// The control panel's width in logical pixels (egui adds its margins).
+const PANEL_WIDTH: f32 = 280.0;
+
+/// What the window shows.
+pub enum Content {
+    /// Shell fur.
+    Shells(Box<ShellScene>),
+    /// A groom or curves file.
+    Curves(CurvesSource),
+}
+
+/// A session in the window: shell fur, or a groom.
+enum Session {
+    Shells(Box<ShellSession>),
+    Curves(Box<CurvesSession>),
+}
+
+impl Session {
+    fn initial_orbit(&self, aspect: f32) -> OrbitCamera {
+        match self {
+            Session::Shells(s) => s.initial_orbit(aspect),
+            Session::Curves(c) => c.initial_orbit(aspect),
+        }
+    }
+
+    fn fps(&self) -> f32 {
+        match self {
+            Session::Shells(s) => s.scene().fps.max(1.0),
+            Session::Curves(_) => 24.0,
+        }
+    }
+
+    fn shells(&mut self) -> Option<&mut ShellSession> {
+        match self {
+            Session::Shells(s) => Some(s),
+            Session::Curves(_) => None,
+        }
+    }
+
+    fn update(&mut self, ctx: &GpuContext, dt: f32) -> anyhow::Result<f64> {
+        match self {
+            Session::Shells(s) => {
+                s.apply_controls(ctx)?;
+                s.advance(ctx, dt)?;
+                Ok(s.last_simulation_ms)
+            }
+            Session::Curves(c) => {
+                c.advance();
+                Ok(0.0)
+            }
+        }
+    }
+
+    fn panel(&mut self, ui: &mut egui::Ui) {
+        match self {
+            Session::Shells(s) => s.panel(ui),
+            Session::Curves(c) => c.panel(ui),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn encode(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        orbit: &OrbitCamera,
+        view: &wgpu::TextureView,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<()> {
+        match self {
+            Session::Shells(s) => Ok(s.encode(ctx, encoder, orbit, view, width, height)?),
+            Session::Curves(c) => c.encode(ctx, encoder, orbit, view, width, height),
+        }
+    }
+}
+
+/// Opens the window on `content` and runs until it is closed (or the
+/// script ends).
+pub fn run(content: Content, options: WindowOptions) -> anyhow::Result<Timings> {
     let event_loop = EventLoop::new().context(
         "cannot open a window: no display (set DISPLAY, or run under `xvfb-run` on a machine without one)",
     )?;
     let mut app = App {
         options,
-        scene: Some(scene),
+        content: Some(content),
         state: None,
         error: None,
         timings: Timings::default(),
@@ -66,7 +144,7 @@ pub fn run(scene: ShellScene, options: WindowOptions) -> anyhow::Result<Timings>
 
 struct App {
     options: WindowOptions,
-    scene: Option<ShellScene>,
+    content: Option<Content>,
     state: Option<WindowState>,
     error: Option<anyhow::Error>,
     timings: Timings,
@@ -79,7 +157,7 @@ struct WindowState {
     ctx: GpuContext,
     egui: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
-    session: ShellSession,
+    session: Session,
     orbit: OrbitCamera,
     home: OrbitCamera,
     pointer: Pointer,
@@ -112,10 +190,10 @@ impl ApplicationHandler for App {
         if self.state.is_some() {
             return;
         }
-        let Some(scene) = self.scene.take() else {
+        let Some(content) = self.content.take() else {
             return;
         };
-        match WindowState::open(event_loop, scene, &self.options) {
+        match WindowState::open(event_loop, content, &self.options) {
             Ok(state) => {
                 self.timings.adapter = state.ctx.adapter_name();
                 state.window.request_redraw();
@@ -157,7 +235,11 @@ impl ApplicationHandler for App {
                     }
                     Key::Character("h") => state.show_ui = !state.show_ui,
                     Key::Character("r") => state.orbit = state.home,
-                    Key::Character("s") => state.session.shake(),
+                    Key::Character("s") => {
+                        if let Some(s) = state.session.shells() {
+                            s.shake();
+                        }
+                    }
                     _ => {}
                 }
             }
@@ -184,7 +266,7 @@ impl ApplicationHandler for App {
 impl WindowState {
     fn open(
         event_loop: &ActiveEventLoop,
-        scene: ShellScene,
+        content: Content,
         options: &WindowOptions,
     ) -> anyhow::Result<Self> {
         let (width, height) = options.size;
@@ -227,8 +309,24 @@ impl WindowState {
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         surface.configure(&ctx.device, &config);
-        let session = ShellSession::new(&ctx, scene, format)?;
-        let orbit = session.initial_orbit(config.width as f32 / config.height as f32);
+        let session = match content {
+            Content::Shells(scene) => {
+                Session::Shells(Box::new(ShellSession::new(&ctx, *scene, format)?))
+            }
+            Content::Curves(source) => {
+                Session::Curves(Box::new(CurvesSession::new(&ctx, source, format)?))
+            }
+        };
+        let show_ui = options.script.as_ref().is_none_or(|s| s.ui);
+        // Framed in the part of the window the panel leaves free.
+        let panel = if show_ui {
+            (PANEL_WIDTH * window.scale_factor() as f32).min(0.5 * config.width as f32)
+        } else {
+            0.0
+        };
+        let height = config.height as f32;
+        let mut orbit = session.initial_orbit((config.width as f32 - panel) / height);
+        orbit.pan(-0.5 * panel / height, 0.0);
         let egui_ctx = egui::Context::default();
         let egui = egui_winit::State::new(
             egui_ctx,
@@ -258,7 +356,7 @@ impl WindowState {
             home: orbit,
             pointer: Pointer::default(),
             script,
-            show_ui: options.script.as_ref().is_none_or(|s| s.ui),
+            show_ui,
             last_frame: None,
             screenshot_requests: Vec::new(),
             screenshots_taken: 0,
@@ -292,14 +390,16 @@ impl WindowState {
         clump: Option<f32>,
     ) -> bool {
         let (origin, direction) = self.ray(pixel);
-        let c = &self.session.controls;
+        let Session::Shells(session) = &mut self.session else {
+            return false;
+        };
+        let c = &session.controls;
         let (radius, wetness, clump) = (
             radius.unwrap_or(c.drop_radius),
             wetness.unwrap_or(c.drop_wetness),
             clump.unwrap_or(c.clump_size),
         );
-        self.session
-            .drop_water(origin, direction, radius, wetness, clump)
+        session.drop_water(origin, direction, radius, wetness, clump)
     }
 
     /// A push from where the drag started towards where the pointer is.
@@ -313,7 +413,9 @@ impl WindowState {
         // Up to full strength over a tenth of the window's height.
         let amount = (drag.length() / (0.1 * self.config.height as f32)).min(1.0);
         let along = (side * drag.x - above * drag.y).normalize_or_zero() * amount;
-        self.session.push(origin, direction, along);
+        if let Some(session) = self.session.shells() {
+            session.push(origin, direction, along);
+        }
     }
 
     fn mouse_button(&mut self, button: MouseButton, pressed: bool) {
@@ -325,7 +427,11 @@ impl WindowState {
             return;
         }
         let clicked = p.button == Some(button) && !p.dragged;
-        let (tool, position) = (self.session.controls.tool, p.position);
+        let position = p.position;
+        let tool = match &self.session {
+            Session::Shells(s) => s.controls.tool,
+            Session::Curves(_) => return,
+        };
         p.button = None;
         p.pressed_at = None;
         if button == MouseButton::Left {
@@ -333,7 +439,11 @@ impl WindowState {
                 Tool::Water if clicked => {
                     self.drop_at(position, None, None, None);
                 }
-                Tool::Push => self.session.release(),
+                Tool::Push => {
+                    if let Some(s) = self.session.shells() {
+                        s.release();
+                    }
+                }
                 Tool::Water => {}
             }
         }
@@ -350,7 +460,8 @@ impl WindowState {
         }
         let height = self.config.height.max(1) as f32;
         match self.pointer.button {
-            Some(MouseButton::Left) if self.session.controls.tool == Tool::Push => {
+            Some(MouseButton::Left) if matches!(&self.session, Session::Shells(s) if s.controls.tool == Tool::Push) =>
+            {
                 self.push_at(start, position);
             }
             Some(MouseButton::Right) if !self.pointer.shift => {
@@ -378,7 +489,9 @@ impl WindowState {
             let done = *k > frames;
             self.push_at(push_from, from.lerp(to, t));
             if done {
-                self.session.release();
+                if let Some(s) = self.session.shells() {
+                    s.release();
+                }
                 run.push = None;
             }
         } else if run.wait > 0 {
@@ -409,10 +522,23 @@ impl WindowState {
                         break;
                     }
                     Step::Shake(on) => {
-                        if on {
-                            self.session.shake();
+                        if let (true, Some(s)) = (on, self.session.shells()) {
+                            s.shake();
                         }
                     }
+                    Step::Show(show) => match &mut self.session {
+                        Session::Curves(c) => {
+                            let t = &mut c.controls;
+                            t.skin = show.skin.unwrap_or(t.skin);
+                            t.hairs = show.hairs.unwrap_or(t.hairs);
+                            t.guides = show.guides.unwrap_or(t.guides);
+                            t.roots = show.roots.unwrap_or(t.roots);
+                            t.percent = show.percent.map_or(t.percent, |p| p.clamp(0.1, 100.0));
+                        }
+                        Session::Shells(_) => {
+                            eprintln!("warning: `show` is for groom and curves views; ignored");
+                        }
+                    },
                     Step::Quit(true) => {
                         open = false;
                         break;
@@ -440,7 +566,7 @@ impl WindowState {
         // Scripts advance by the scene's frame time, so their runs repeat
         // exactly; a person gets the wall clock.
         let dt = match self.last_frame {
-            _ if scripted => 1.0 / self.session.scene().fps.max(1.0),
+            _ if scripted => 1.0 / self.session.fps(),
             Some(last) => now.duration_since(last).as_secs_f32(),
             None => 0.0,
         };
@@ -458,6 +584,7 @@ impl WindowState {
         // The panel.
         let input = self.egui.take_egui_input(&self.window);
         let frame_ms = timings.frame_ms.last().copied().unwrap_or(0.0);
+        let simulation_ms = timings.simulation_ms.last().copied().unwrap_or(0.0);
         let show_ui = self.show_ui;
         let session = &mut self.session;
         let mut output = self.egui.egui_ctx().run_ui(input, |ui| {
@@ -465,13 +592,12 @@ impl WindowState {
                 return;
             }
             egui::Panel::left("controls")
-                .default_size(270.0)
+                .default_size(PANEL_WIDTH - 10.0)
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| {
                         ui.label(format!(
-                            "frame {frame_ms:.1} ms ({:.1} fps) · simulation {:.2} ms",
+                            "frame {frame_ms:.1} ms ({:.1} fps) · simulation {simulation_ms:.2} ms",
                             1e3 / frame_ms.max(1e-3),
-                            session.last_simulation_ms
                         ));
                         ui.small("left: tool · right drag: orbit · shift/middle: pan · wheel: zoom · P: screenshot · H: hide · R: reset · S: shake");
                         ui.separator();
@@ -498,9 +624,8 @@ impl WindowState {
         let freed: Vec<egui::TextureId> = textures.free.iter().copied().collect();
         textures.clear();
 
-        self.session.apply_controls(&self.ctx)?;
-        self.session.advance(&self.ctx, dt)?;
-        timings.simulation_ms.push(self.session.last_simulation_ms);
+        let simulation = self.session.update(&self.ctx, dt)?;
+        timings.simulation_ms.push(simulation);
 
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [self.config.width, self.config.height],

@@ -10,6 +10,8 @@
 #[cfg(feature = "viewer")]
 mod app;
 #[cfg(feature = "viewer")]
+mod curves;
+#[cfg(feature = "viewer")]
 pub mod script;
 #[cfg(feature = "viewer")]
 mod shells;
@@ -21,9 +23,14 @@ use std::path::PathBuf;
 /// Arguments of `pelage view`.
 #[derive(Debug, Args)]
 pub struct ViewArgs {
-    /// A shell scene (TOML, docs/shells-format.md) or a mesh with UVs
-    /// (.obj .ply .gltf .glb) to cover in fur. Without it: the embedded Spot.
+    /// A shell scene (TOML, docs/shells-format.md), a mesh with UVs (.obj
+    /// .ply .gltf .glb) to cover in fur, a groom file (TOML,
+    /// docs/groom-format.md) or a curves file (.usda .usdc .usd .hair, PLY
+    /// with edges). Without it: the embedded Spot in fur.
     pub input: Option<PathBuf>,
+    /// The skin under a curves file: a mesh file, or `spot`.
+    #[arg(long)]
+    pub mesh: Option<PathBuf>,
     /// Run the steps of this file (docs/viewer.md), then close.
     #[arg(long)]
     pub script: Option<PathBuf>,
@@ -52,15 +59,33 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
     use pelage::groom::GroomSource;
     use pelage::shell::ShellScene;
 
-    let (scene, title) = match &args.input {
-        None => (ShellScene::spot(), "embedded spot".to_string()),
-        Some(path) => {
-            let is_toml = path
+    let title = args
+        .input
+        .as_deref()
+        .map_or("embedded spot".into(), |p| p.display().to_string());
+    let content = match &args.input {
+        None => app::Content::Shells(Box::new(ShellScene::spot())),
+        Some(path) if is_groom_file(path)? => {
+            app::Content::Curves(curves::CurvesSource::Groom(path.clone()))
+        }
+        Some(path)
+            if path
                 .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-            let scene = if is_toml {
-                ShellScene::load(path)?
-            } else {
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml")) =>
+        {
+            app::Content::Shells(Box::new(ShellScene::load(path)?))
+        }
+        Some(path) => match super::render::file_kind(path)? {
+            super::render::FileKind::Curves => app::Content::Curves(curves::CurvesSource::File {
+                path: path.clone(),
+                mesh: args.mesh.clone(),
+            }),
+            super::render::FileKind::Points => anyhow::bail!(
+                "{} is a point cloud: `pelage view` shows shell scenes, meshes, grooms and curves \
+                 (draw points with `pelage render`)",
+                path.display()
+            ),
+            super::render::FileKind::Mesh => {
                 // A mesh: the default scene on it.
                 let text = format!(
                     "[mesh]\npath = {}\n",
@@ -71,13 +96,12 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
                             .to_string_lossy()
                     )
                 );
-                ShellScene::from_source(&GroomSource {
+                app::Content::Shells(Box::new(ShellScene::from_source(&GroomSource {
                     path: path.clone(),
                     text,
-                })?
-            };
-            (scene, path.display().to_string())
-        }
+                })?))
+            }
+        },
     };
     let mut script = match &args.script {
         Some(path) => Some(script::Script::load(path)?),
@@ -89,14 +113,16 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
             None => script = Some(script::Script::screenshot_after(3, shot.clone())),
         }
     }
-    println!(
-        "{title}: {} layers over {} ({} triangles)",
-        scene.fur.layers,
-        scene.mesh.name(),
-        scene.mesh.triangle_count()
-    );
+    if let app::Content::Shells(scene) = &content {
+        println!(
+            "{title}: {} layers over {} ({} triangles)",
+            scene.fur.layers,
+            scene.mesh.name(),
+            scene.mesh.triangle_count()
+        );
+    }
     let timings = app::run(
-        scene,
+        content,
         app::WindowOptions {
             size: args.size,
             title: format!("pelage view — {title}"),
@@ -117,6 +143,36 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         median(&timings.simulation_ms),
     );
     Ok(())
+}
+
+/// Whether a TOML file is a groom file (it has a groom's tables) rather
+/// than a shell scene.
+#[cfg(feature = "viewer")]
+fn is_groom_file(path: &std::path::Path) -> anyhow::Result<bool> {
+    use anyhow::Context;
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+    {
+        return Ok(false);
+    }
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    // A file that does not parse goes to the shell-scene reader, whose
+    // error names the line.
+    let Ok(table) = text.parse::<toml::Table>() else {
+        return Ok(false);
+    };
+    Ok([
+        "roots",
+        "ops",
+        "guides",
+        "interpolation",
+        "finish",
+        "output",
+    ]
+    .iter()
+    .any(|key| table.contains_key(*key)))
 }
 
 /// A TOML basic string (quotes and backslashes escaped).

@@ -16,6 +16,8 @@
 //! orbit = [30, -10]                  # degrees: right, up
 //! [[step]]
 //! push = { from = [400, 300], to = [460, 300], frames = 10 } # drag the fur
+//! [[step]]
+//! show = { skin = false, guides = true, percent = 10 }       # groom views
 //! ```
 
 use pelage::groom::{GroomError, GroomSource};
@@ -50,6 +52,8 @@ pub enum Step {
     Push(PushStep),
     /// Shake the object (the scene's shake, or a default one).
     Shake(bool),
+    /// What a groom view draws: the panel's toggles.
+    Show(ShowStep),
     /// Close the window.
     Quit(bool),
 }
@@ -79,6 +83,22 @@ pub struct PushStep {
     /// Over how many frames (default 10).
     #[serde(default = "default_push_frames")]
     pub frames: u32,
+}
+
+/// `show = { skin, hairs, guides, roots, percent }`: any of them.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShowStep {
+    /// The mesh.
+    pub skin: Option<bool>,
+    /// The hairs.
+    pub hairs: Option<bool>,
+    /// The guides.
+    pub guides: Option<bool>,
+    /// The roots.
+    pub roots: Option<bool>,
+    /// Percentage of hairs drawn.
+    pub percent: Option<f32>,
 }
 
 fn default_push_frames() -> u32 {

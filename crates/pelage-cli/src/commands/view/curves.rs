@@ -1,0 +1,329 @@
+//! The viewer's groom session: a curves file (USD, .hair, PLY) or a groom
+//! file grown in memory, drawn by the preview renderer with toggles for the
+//! skin, roots, guides and hairs, a slider for how many hairs to draw, and
+//! a reload whenever the file changes on disk — edit a groom file in one
+//! window, see it regrow in the other.
+
+use anyhow::Context as _;
+use glam::Vec3;
+use pelage::groom::Groom;
+use pelage::{Curves, Mesh};
+use pelage_gpu::{Camera, GpuContext, GpuScene, OrbitCamera, PreviewScene, PreviewStyle, Renderer};
+use std::path::{Path, PathBuf};
+use std::time::{Instant, SystemTime};
+
+/// Where the hairs come from.
+#[derive(Debug, Clone)]
+pub enum CurvesSource {
+    /// A curves file, over an optional mesh (`--mesh`, or `spot`).
+    File {
+        /// The curves.
+        path: PathBuf,
+        /// The skin: a mesh file, `spot`, or none.
+        mesh: Option<PathBuf>,
+    },
+    /// A groom file (docs/groom-format.md), grown here.
+    Groom(PathBuf),
+}
+
+impl CurvesSource {
+    fn path(&self) -> &Path {
+        match self {
+            CurvesSource::File { path, .. } | CurvesSource::Groom(path) => path,
+        }
+    }
+}
+
+/// What was loaded.
+struct Loaded {
+    hairs: Curves,
+    guides: Option<Curves>,
+    skin: Skin,
+    texture: Option<image::RgbaImage>,
+    summary: String,
+}
+
+enum Skin {
+    None,
+    Mesh(Box<Mesh>),
+    Groom(Box<Groom>),
+}
+
+impl Skin {
+    fn mesh(&self) -> Option<&Mesh> {
+        match self {
+            Skin::None => None,
+            Skin::Mesh(m) => Some(m),
+            Skin::Groom(g) => Some(g.mesh()),
+        }
+    }
+}
+
+/// Which parts are drawn and how many hairs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurvesControls {
+    /// The mesh.
+    pub skin: bool,
+    /// A dot at each drawn hair's root.
+    pub roots: bool,
+    /// The guide curves (groom files), in orange.
+    pub guides: bool,
+    /// The hairs.
+    pub hairs: bool,
+    /// Percentage of the hairs drawn (every n-th).
+    pub percent: f32,
+    /// Reload when the file changes.
+    pub watch: bool,
+}
+
+/// A groom or curves file being looked at.
+pub struct CurvesSession {
+    source: CurvesSource,
+    loaded: Loaded,
+    renderer: Renderer,
+    scene: Option<GpuScene>,
+    uploaded: Option<CurvesControls>,
+    /// The panel's toggles.
+    pub controls: CurvesControls,
+    modified: Option<SystemTime>,
+    last_check: Instant,
+    /// The last reload's outcome (errors stay on screen, the old groom too).
+    pub status: String,
+}
+
+const GUIDE_COLOR: Vec3 = Vec3::new(1.0, 0.3, 0.0);
+
+impl CurvesSession {
+    /// Loads `source` for drawing into targets of `format`.
+    pub fn new(
+        ctx: &GpuContext,
+        source: CurvesSource,
+        format: pelage_gpu::wgpu::TextureFormat,
+    ) -> anyhow::Result<Self> {
+        let loaded = load(&source)?;
+        let status = loaded.summary.clone();
+        // A million hairs draw slowly in software: start with at most
+        // 200,000 and let the slider bring the rest.
+        let count = loaded.hairs.curve_count().max(1) as f32;
+        Ok(Self {
+            modified: modified(source.path()),
+            source,
+            loaded,
+            renderer: Renderer::for_format(ctx, format),
+            scene: None,
+            uploaded: None,
+            controls: CurvesControls {
+                skin: true,
+                roots: false,
+                guides: true,
+                hairs: true,
+                percent: (100.0 * 200_000.0 / count).min(100.0),
+                watch: true,
+            },
+            last_check: Instant::now(),
+            status,
+        })
+    }
+
+    /// Where the camera starts: framing everything.
+    pub fn initial_orbit(&self, aspect: f32) -> OrbitCamera {
+        let (lo, hi) = self.bounds();
+        OrbitCamera::from_camera(Camera::framing(lo, hi, aspect))
+    }
+
+    fn bounds(&self) -> (Vec3, Vec3) {
+        let mesh = self.loaded.skin.mesh().map(Mesh::bounds);
+        let hairs = self.loaded.hairs.bounds();
+        match (mesh, hairs) {
+            (Some((a, b)), Some((c, d))) => (a.min(c), b.max(d)),
+            (Some(m), None) | (None, Some(m)) => m,
+            (None, None) => (Vec3::splat(-1.0), Vec3::ONE),
+        }
+    }
+
+    /// Reloads when the file changed (checked twice a second).
+    pub fn advance(&mut self) {
+        if !self.controls.watch || self.last_check.elapsed().as_secs_f32() < 0.5 {
+            return;
+        }
+        self.last_check = Instant::now();
+        let now = modified(self.source.path());
+        if now == self.modified {
+            return;
+        }
+        self.modified = now;
+        match load(&self.source) {
+            Ok(loaded) => {
+                self.status = format!("reloaded: {}", loaded.summary);
+                self.loaded = loaded;
+                self.uploaded = None;
+            }
+            Err(err) => self.status = format!("not reloaded: {err:#}"),
+        }
+    }
+
+    fn upload(&mut self, ctx: &GpuContext) -> anyhow::Result<()> {
+        let c = self.controls;
+        let count = self.loaded.hairs.curve_count();
+        let shown = (count as f32 * c.percent / 100.0).round().max(1.0);
+        let stride = (count as f32 / shown).round().max(1.0) as usize;
+        let hairs = self.loaded.hairs.every_nth(stride);
+        // Hairs keep their own colours (or get the preview's brown); guides
+        // stand out in orange. Both carry colours, so they join with them.
+        let mut parts: Vec<Curves> = Vec::new();
+        if c.hairs {
+            let brown = Vec3::from(PreviewStyle::default().hair);
+            parts.push(match hairs.colors() {
+                Some(_) => hairs.clone(),
+                None => painted(hairs.clone(), brown)?,
+            });
+        }
+        if let (true, Some(guides)) = (c.guides, &self.loaded.guides) {
+            // Three hairs wide, so they read among the hairs.
+            let hair_widths = self.loaded.hairs.widths();
+            let mean = hair_widths.iter().sum::<f32>() / hair_widths.len().max(1) as f32;
+            let widths = vec![3.0 * mean.max(1e-5); guides.points().len()];
+            let wide = Curves::new(guides.points().to_vec(), widths, guides.offsets().to_vec())?;
+            parts.push(painted(wide, GUIDE_COLOR)?);
+        }
+        let curves = pelage::io::join(parts.iter())?;
+        let roots: Vec<Vec3> = if c.roots {
+            (0..hairs.curve_count())
+                .map(|i| hairs.points()[hairs.range(i).start])
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let scene = PreviewScene {
+            mesh: self.loaded.skin.mesh().filter(|_| c.skin),
+            points: &roots,
+            curves: (curves.curve_count() > 0).then_some(&curves),
+            skin_texture: self.loaded.texture.as_ref(),
+        };
+        self.scene = Some(self.renderer.upload(ctx, &scene));
+        self.uploaded = Some(c);
+        Ok(())
+    }
+
+    /// Records the groom into `resolve` (`width × height`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut pelage_gpu::wgpu::CommandEncoder,
+        orbit: &OrbitCamera,
+        resolve: &pelage_gpu::wgpu::TextureView,
+        width: u32,
+        height: u32,
+    ) -> anyhow::Result<()> {
+        if self.uploaded != Some(self.controls) {
+            self.upload(ctx)?;
+        }
+        let style = PreviewStyle {
+            background: super::super::FUR_BACKGROUND,
+            ..PreviewStyle::default()
+        };
+        let scene = self.scene.as_ref().expect("uploaded above");
+        self.renderer.encode(
+            ctx,
+            encoder,
+            scene,
+            &style,
+            Some(orbit.camera()),
+            resolve,
+            width,
+            height,
+        )?;
+        Ok(())
+    }
+
+    /// The control panel.
+    pub fn panel(&mut self, ui: &mut egui::Ui) {
+        let c = &mut self.controls;
+        ui.heading("Groom");
+        ui.label(&self.status);
+        ui.checkbox(&mut c.skin, "skin");
+        ui.checkbox(&mut c.hairs, "hairs");
+        ui.add_enabled(
+            self.loaded.guides.is_some(),
+            egui::Checkbox::new(&mut c.guides, "guides (orange)"),
+        );
+        ui.checkbox(&mut c.roots, "roots");
+        let count = self.loaded.hairs.curve_count();
+        ui.add(
+            egui::Slider::new(&mut c.percent, 0.1..=100.0)
+                .logarithmic(true)
+                .suffix(" %")
+                .text(format!("of {count} hairs")),
+        );
+        ui.checkbox(&mut c.watch, "reload when the file changes");
+    }
+}
+
+/// `curves` all in one colour.
+fn painted(curves: Curves, colour: Vec3) -> Result<Curves, pelage::curves::CurvesError> {
+    let n = curves.points().len();
+    curves.with_colors(vec![colour; n])
+}
+
+fn modified(path: &Path) -> Option<SystemTime> {
+    std::fs::metadata(path).and_then(|m| m.modified()).ok()
+}
+
+fn load(source: &CurvesSource) -> anyhow::Result<Loaded> {
+    let spot_texture =
+        || image::load_from_memory(pelage::assets::SPOT_TEXTURE_PNG).map(|i| i.to_rgba8());
+    match source {
+        CurvesSource::File { path, mesh } => {
+            let hairs = pelage::io::read_curves(path).context("cannot load the curves")?;
+            let (skin, texture) = match mesh.as_deref() {
+                None => (Skin::None, None),
+                Some(m) if m == Path::new("spot") => (
+                    Skin::Mesh(Box::new(pelage::assets::spot())),
+                    Some(spot_texture()?),
+                ),
+                Some(m) => (
+                    Skin::Mesh(Box::new(Mesh::load(m).context("cannot load the mesh")?)),
+                    None,
+                ),
+            };
+            let summary = format!("{} hairs from {}", hairs.curve_count(), path.display());
+            Ok(Loaded {
+                hairs,
+                guides: None,
+                skin,
+                texture,
+                summary,
+            })
+        }
+        CurvesSource::Groom(path) => {
+            let started = Instant::now();
+            let groom = Groom::load(path)?;
+            let generator = groom.generator(None)?;
+            let parts: Vec<Curves> = (0..generator.parts().len())
+                .map(|p| generator.part(p))
+                .collect();
+            let hairs = pelage::io::join(parts.iter())?;
+            let guides = groom.guides().curves().clone();
+            drop(generator);
+            let texture = if groom.mesh().name() == pelage::assets::spot().name() {
+                Some(spot_texture()?)
+            } else {
+                None
+            };
+            let summary = format!(
+                "{} hairs from {} guides, grown in {:.2} s",
+                hairs.curve_count(),
+                guides.curve_count(),
+                started.elapsed().as_secs_f64()
+            );
+            Ok(Loaded {
+                hairs,
+                guides: Some(guides),
+                skin: Skin::Groom(Box::new(groom)),
+                texture,
+                summary,
+            })
+        }
+    }
+}
