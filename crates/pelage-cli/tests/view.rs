@@ -34,24 +34,40 @@ fn has_display() -> bool {
 
 const SIZE: (u32, u32) = (480, 360);
 
+/// Writes `input` and `script` into `dir` and views the one with the
+/// other in a `SIZE` window; panics with the output if it fails.
+fn view_scripted(dir: &Path, input: &str, script: &str) -> String {
+    let (input_path, script_path) = (dir.join("input.toml"), dir.join("script.toml"));
+    std::fs::write(&input_path, input).unwrap();
+    std::fs::write(&script_path, script).unwrap();
+    let size = format!("{}x{}", SIZE.0, SIZE.1);
+    let out = pelage(&[
+        "view",
+        input_path.to_str().unwrap(),
+        "--script",
+        script_path.to_str().unwrap(),
+        "--size",
+        &size,
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(!stderr.contains("missed the mesh"), "{stderr}");
+    stdout
+}
+
 #[test]
 fn a_drop_of_water_changes_the_fur_where_it_falls_and_nowhere_else() {
     if !has_display() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    // Curly fur with wet clumps: a wet patch both straightens and clumps.
-    let scene = dir.path().join("curly.toml");
-    std::fs::write(
-        &scene,
-        "[fur]\nlayers = 16\n[curl]\nradius = 0.6\nturns = 2\n[clump]\nw = 0.6\n",
-    )
-    .unwrap();
     let (cx, cy) = (SIZE.0 as f32 / 2.0, SIZE.1 as f32 / 2.0);
-    let script = dir.path().join("drop.toml");
-    std::fs::write(
-        &script,
-        format!(
+    // Curly fur with wet clumps: a wet patch both straightens and clumps.
+    let stdout = view_scripted(
+        dir.path(),
+        "[fur]\nlayers = 16\n[curl]\nradius = 0.6\nturns = 2\n[clump]\nw = 0.6\n",
+        &format!(
             "ui = false\n\
              [[step]]\nwait = 2\n\
              [[step]]\nscreenshot = \"before.png\"\n\
@@ -59,23 +75,9 @@ fn a_drop_of_water_changes_the_fur_where_it_falls_and_nowhere_else() {
              [[step]]\nwait = 2\n\
              [[step]]\nscreenshot = \"after.png\"\n"
         ),
-    )
-    .unwrap();
-    let size = format!("{}x{}", SIZE.0, SIZE.1);
-    let out = pelage(&[
-        "view",
-        scene.to_str().unwrap(),
-        "--script",
-        script.to_str().unwrap(),
-        "--size",
-        &size,
-    ]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stdout}\n{stderr}");
+    );
     assert!(stdout.contains("frame time median"), "{stdout}");
     eprintln!("{stdout}");
-    assert!(!stderr.contains("missed the mesh"), "{stderr}");
 
     let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
     let (before, after) = (read("before.png"), read("after.png"));
@@ -161,17 +163,10 @@ fn a_groom_file_is_grown_and_drawn_with_its_guides_in_orange() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let groom = dir.path().join("fur.toml");
-    std::fs::write(
-        &groom,
+    view_scripted(
+        dir.path(),
         "[mesh]\npath = \"spot\"\n[roots]\ncount = 3000\n\
          [guides]\ngenerate = { count = 80, length = 0.12, comb = [0, -1, 0] }\n",
-    )
-    .unwrap();
-    let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
-    let script = dir.path().join("look.toml");
-    std::fs::write(
-        &script,
         "ui = false\n\
          [[step]]\nshow = { skin = false, hairs = false, guides = true }\n\
          [[step]]\nwait = 2\n[[step]]\nscreenshot = \"guides.png\"\n\
@@ -179,22 +174,8 @@ fn a_groom_file_is_grown_and_drawn_with_its_guides_in_orange() {
          [[step]]\nwait = 2\n[[step]]\nscreenshot = \"nothing.png\"\n\
          [[step]]\nshow = { skin = true, hairs = true }\n\
          [[step]]\nwait = 2\n[[step]]\nscreenshot = \"groom.png\"\n",
-    )
-    .unwrap();
-    let size = format!("{}x{}", SIZE.0, SIZE.1);
-    let out = pelage(&[
-        "view",
-        groom.to_str().unwrap(),
-        "--script",
-        script.to_str().unwrap(),
-        "--size",
-        &size,
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
+    let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
     let background = read("nothing.png");
     let differing = |image: &image::RgbImage| {
         image

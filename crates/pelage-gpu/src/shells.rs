@@ -500,6 +500,23 @@ impl ShellRenderer {
         })
     }
 
+    /// Generates a scene's shell texture and uploads the scene
+    /// ([`Self::upload`] with the scene's mesh, colour and mask size).
+    pub fn upload_scene(
+        &self,
+        ctx: &GpuContext,
+        scene: &ShellScene,
+    ) -> Result<ShellModel, GpuError> {
+        let textures = ShellTextures::generate(&scene.texture);
+        self.upload(
+            ctx,
+            &scene.mesh,
+            &scene.color,
+            &textures,
+            scene.wetness_resolution,
+        )
+    }
+
     /// Moves the strands' tips: one offset `p − p0` per triangle corner
     /// (`3t + k`), as [`pelage::dynamics::MassSpringSystem::corner_tip_offsets`]
     /// gives them.
@@ -795,14 +812,7 @@ impl<'s> ShellScenePlayer<'s> {
             clump: scene.clump.is_some(),
         };
         let renderer = ShellRenderer::new(ctx, features);
-        let textures = ShellTextures::generate(&scene.texture);
-        let model = renderer.upload(
-            ctx,
-            &scene.mesh,
-            &scene.color,
-            &textures,
-            scene.wetness_resolution,
-        )?;
+        let model = renderer.upload_scene(ctx, scene)?;
         let target = ShellTarget::new(ctx, &renderer, width, height)?;
         let camera = scene.camera.map(|c| Camera {
             eye: c.eye,

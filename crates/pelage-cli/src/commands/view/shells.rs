@@ -9,7 +9,7 @@ use pelage::dynamics::{Brush, MassSpringSystem, Solver, Topology, Wind};
 use pelage::shell::math::{ClumpParams, Coupling, ShadingMode};
 use pelage::shell::scene::DynamicsSettings;
 use pelage::shell::wetness::{Droplet, DropletStyle, droplets_on_mesh, mask_coordinates};
-use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
+use pelage::shell::{ShellScene, WetnessMask};
 use pelage_gpu::{
     GpuContext, GpuError, OrbitCamera, ShellFeatures, ShellModel, ShellParams, ShellRenderer,
     ShellTarget, ShellView,
@@ -116,14 +116,7 @@ impl ShellSession {
         // Curl and clumps are always compiled in, so the sliders can turn
         // them on; at zero they cost little (see `pelage bench shells`).
         let renderer = ShellRenderer::for_format(ctx, format, ShellFeatures::ALL);
-        let textures = ShellTextures::generate(&scene.texture);
-        let model = renderer.upload(
-            ctx,
-            &scene.mesh,
-            &scene.color,
-            &textures,
-            scene.wetness_resolution,
-        )?;
+        let model = renderer.upload_scene(ctx, &scene)?;
         let mut params = ShellParams::from_scene(&scene);
         let clump = scene.clump.is_some();
         if !clump {
@@ -388,14 +381,7 @@ impl ShellSession {
         if c.layers != self.model.texture_layers() {
             self.scene.texture.layers = c.layers;
             self.scene.fur.layers = c.layers;
-            let textures = ShellTextures::generate(&self.scene.texture);
-            self.model = self.renderer.upload(
-                ctx,
-                &self.scene.mesh,
-                &self.scene.color,
-                &textures,
-                self.scene.wetness_resolution,
-            )?;
+            self.model = self.renderer.upload_scene(ctx, &self.scene)?;
             self.params.layers = c.layers;
             self.mask_changed = true;
             self.motion = None;
