@@ -83,21 +83,7 @@ fn a_drop_of_water_changes_the_fur_where_it_falls_and_nowhere_else() {
     let (before, after) = (read("before.png"), read("after.png"));
     assert_eq!(before.dimensions(), SIZE);
     assert_eq!(after.dimensions(), SIZE);
-    // Changed: any channel by more than 24 of 255.
-    let mut near = 0;
-    let mut far = 0;
-    let radius = 0.25 * SIZE.1 as f32;
-    for (x, y, a) in before.enumerate_pixels() {
-        let b = after.get_pixel(x, y);
-        let changed = a.0.iter().zip(b.0).any(|(&p, q)| p.abs_diff(q) > 24);
-        if changed {
-            if (x as f32 - cx).hypot(y as f32 - cy) <= radius {
-                near += 1;
-            } else {
-                far += 1;
-            }
-        }
-    }
+    let (near, far) = changed_near_and_far(&before, &after, (cx, cy), 0.25 * SIZE.1 as f32);
     let total = SIZE.0 * SIZE.1;
     eprintln!("changed pixels: {near} near the drop, {far} elsewhere, of {total}");
     assert!(
@@ -109,6 +95,62 @@ fn a_drop_of_water_changes_the_fur_where_it_falls_and_nowhere_else() {
     assert!(
         (far as f32) < 0.005 * total as f32 && far < near / 10,
         "{far} pixels changed away from the drop ({near} near it)"
+    );
+}
+
+/// Pixels that differ by more than 24 of 255 in any channel, near `at`
+/// (within `radius`) and elsewhere.
+fn changed_near_and_far(
+    a: &image::RgbImage,
+    b: &image::RgbImage,
+    at: (f32, f32),
+    radius: f32,
+) -> (usize, usize) {
+    let (mut near, mut far) = (0, 0);
+    for (x, y, p) in a.enumerate_pixels() {
+        let q = b.get_pixel(x, y);
+        if p.0.iter().zip(q.0).any(|(&u, v)| u.abs_diff(v) > 24) {
+            if (x as f32 - at.0).hypot(y as f32 - at.1) <= radius {
+                near += 1;
+            } else {
+                far += 1;
+            }
+        }
+    }
+    (near, far)
+}
+
+#[test]
+fn dragging_with_the_push_tool_moves_the_fur_under_the_pointer() {
+    if !has_display() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (cx, cy) = (SIZE.0 as f32 / 2.0, SIZE.1 as f32 / 2.0);
+    // No gravity and no wind: the fur is at rest until pushed.
+    view_scripted(
+        dir.path(),
+        "[fur]\nlayers = 16\n[dynamics]\ngravity = [0, 0, 0]\n",
+        &format!(
+            "ui = false\n\
+             [[step]]\nwait = 3\n[[step]]\nscreenshot = \"before.png\"\n\
+             [[step]]\npush = {{ from = [{cx}, {cy}], to = [{}, {cy}], frames = 4 }}\n\
+             [[step]]\nscreenshot = \"after.png\"\n",
+            cx + 60.0
+        ),
+    );
+    let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
+    let (near, far) = changed_near_and_far(
+        &read("before.png"),
+        &read("after.png"),
+        (cx + 30.0, cy),
+        0.25 * SIZE.1 as f32,
+    );
+    eprintln!("changed pixels: {near} near the push, {far} elsewhere");
+    assert!(near > 100, "the push must show: {near}");
+    assert!(
+        far < near / 10,
+        "{far} pixels changed away from the push ({near} near it)"
     );
 }
 
