@@ -10,7 +10,12 @@ fn main() {
         ..Default::default()
     };
     let guides = pelage::guides::Guides::grow(&mesh, &growth).unwrap();
+    let t = std::time::Instant::now();
     let _ = mesh.edges();
+    let edges = t.elapsed();
+    let t = std::time::Instant::now();
+    let _ = mesh.edge_graph();
+    eprintln!("mesh edges {edges:?}, edge graph {:?}", t.elapsed());
     let t = std::time::Instant::now();
     let style = StyleMesh::build(&mesh, &guides, &Default::default());
     eprintln!(

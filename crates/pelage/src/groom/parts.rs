@@ -11,7 +11,7 @@
 //! probability at the part boundaries, so the parts' hair ids tile
 //! `0..N` exactly.
 
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, morton};
 use glam::Vec3;
 
 /// One part of the mesh.
@@ -109,34 +109,9 @@ impl PartLayout {
     }
 }
 
-/// 63-bit Morton code of a point of the unit cube (21 bits an axis).
-fn morton(p: Vec3) -> u64 {
-    let scale = ((1u32 << 21) - 1) as f32;
-    let q = |x: f32| spread((x.clamp(0.0, 1.0) * scale) as u64);
-    q(p.x) | (q(p.y) << 1) | (q(p.z) << 2)
-}
-
-/// Spreads the low 21 bits of `x` to every third bit.
-fn spread(mut x: u64) -> u64 {
-    x &= 0x1F_FFFF;
-    x = (x | (x << 32)) & 0x001F_0000_0000_FFFF;
-    x = (x | (x << 16)) & 0x001F_0000_FF00_00FF;
-    x = (x | (x << 8)) & 0x100F_00F0_0F00_F00F;
-    x = (x | (x << 4)) & 0x10C3_0C30_C30C_30C3;
-    x = (x | (x << 2)) & 0x1249_2492_4924_9249;
-    x
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn morton_interleaves_axes() {
-        assert_eq!(spread(0b111), 0b1001001);
-        assert!(morton(Vec3::ZERO) < morton(Vec3::splat(0.5)));
-        assert!(morton(Vec3::splat(0.5)) < morton(Vec3::ONE));
-    }
 
     #[test]
     fn parts_cover_every_triangle_and_tile_the_hair_ids() {

@@ -42,7 +42,7 @@
 
 use super::{GuideWeight, GuideWeights, HairRoot, normalise};
 use crate::guides::Guides;
-use crate::mesh::{EdgeList, Mesh, TriangleBvh, VertexAdjacency, closest_on_triangle};
+use crate::mesh::{EdgeGraph, EdgeList, Mesh, TriangleBvh, closest_on_triangle};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -126,6 +126,7 @@ impl StyleMesh {
             .map(|g| (nearest_corner(g), g as u32))
             .collect();
         let lost = conflicts(&marks, &positions, mesh.positions());
+
         // 2. The colouring, on the mesh itself or, with the split fix, on a
         // copy split under each lost guide (then no guide is lost).
         let mut split_colours: HashMap<u32, Vec<u32>> = HashMap::new();
@@ -135,43 +136,70 @@ impl StyleMesh {
                 split_colours.entry(tri).or_default().push(l.guide);
             }
             let (vertices, triangles) = split_under(mesh, guides, &lost, &positions, &mut marks);
-            let adjacency =
-                VertexAdjacency::from_edges(&EdgeList::build(&triangles), vertices.len());
-            let colours = colour(&vertices, &adjacency, &marks, &[]);
+            let graph = EdgeGraph::new(&vertices, &EdgeList::build(&triangles));
+            let colours = colour(&graph, &marks, &[]);
             (colours, Some(triangles), Vec::new())
         } else {
-            let colours = colour(mesh.positions(), &mesh.vertex_adjacency(), &marks, &lost);
+            let colours = colour(mesh.edge_graph(), &marks, &lost);
             (colours, None, lost)
         };
-        let mesh_triangles = split_triangles.as_deref().unwrap_or(mesh.triangles());
-        // 3. Style edges and triangles from the colouring: only triangles
-        // on cell borders matter; find them in parallel, keep the first of
-        // each guide triple in mesh order.
-        let border: Vec<[u32; 3]> = mesh_triangles
+
+        // Per skin triangle, its corners' colours (what a hair's weights
+        // start from); on the split copy, the border comes from its own.
+        let triangle_colours: Vec<[u32; 3]> = mesh
+            .triangles()
             .par_iter()
             .map(|t| t.map(|v| colours[v as usize]))
-            .filter(|c| !c.contains(&u32::MAX) && (c[0] != c[1] || c[1] != c[2]))
             .collect();
-        let mut triangles = Vec::new();
-        let mut seen_triangles = HashSet::new();
-        let mut edges = HashSet::new();
-        for &c in &border {
-            for (a, b) in [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])] {
-                if a != b {
-                    edges.insert([a.min(b), a.max(b)]);
-                }
-            }
-            if c[0] != c[1] && c[1] != c[2] && c[0] != c[2] {
-                let mut key = c;
+        let split_triangle_colours: Vec<[u32; 3]> = split_triangles
+            .as_deref()
+            .unwrap_or_default()
+            .par_iter()
+            .map(|t| t.map(|v| colours[v as usize]))
+            .collect();
+        let coloured = if split_triangles.is_some() {
+            &split_triangle_colours
+        } else {
+            &triangle_colours
+        };
+        // 3. Style edges and triangles from the colouring: only triangles
+        // on cell borders matter. Sorting, not hashing, dedups them (the
+        // same result, in parallel); a style triangle keeps the corner
+        // order of the first mesh triangle of its guide triple.
+        let border: Vec<u32> = (0..coloured.len() as u32)
+            .into_par_iter()
+            .filter(|&t| {
+                let c = coloured[t as usize];
+                !c.contains(&u32::MAX) && (c[0] != c[1] || c[1] != c[2])
+            })
+            .collect();
+        let mut edges: Vec<[u32; 2]> = border
+            .par_iter()
+            .flat_map_iter(|&t| {
+                let c = coloured[t as usize];
+                [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])]
+                    .into_iter()
+                    .filter(|(a, b)| a != b)
+                    .map(|(a, b)| [a.min(b), a.max(b)])
+            })
+            .collect();
+        edges.par_sort_unstable();
+        edges.dedup();
+        let mut firsts: Vec<([u32; 3], u32)> = border
+            .par_iter()
+            .filter_map(|&t| {
+                let mut key = coloured[t as usize];
                 key.sort_unstable();
-                if seen_triangles.insert(key) {
-                    triangles.push(c);
-                }
-            }
-        }
+                (key[0] != key[1] && key[1] != key[2]).then_some((key, t))
+            })
+            .collect();
+        firsts.par_sort_unstable();
+        firsts.dedup_by_key(|(key, _)| *key);
+        firsts.par_sort_unstable_by_key(|&(_, t)| t);
+        let mut triangles: Vec<[u32; 3]> =
+            firsts.iter().map(|&(_, t)| coloured[t as usize]).collect();
         let real_triangles = triangles.len();
-        let mut edges: Vec<[u32; 2]> = edges.into_iter().collect();
-        edges.sort_unstable();
+
         // Gaps: edges in no triangle become segments, lone guides points.
         let mut covered_edges = HashSet::new();
         let mut touched = vec![false; guides.len()];
@@ -195,6 +223,7 @@ impl StyleMesh {
             }
         }
         let bvh = TriangleBvh::new(&positions, &triangles);
+
         let corners: Vec<[Vec3; 3]> = triangles
             .iter()
             .map(|t| t.map(|g| positions[g as usize]))
@@ -221,11 +250,7 @@ impl StyleMesh {
                 }
             }
         }
-        let triangle_colours = mesh
-            .triangles()
-            .par_iter()
-            .map(|t| t.map(|v| colours[v as usize]))
-            .collect();
+
         Self {
             positions,
             triangles,
@@ -338,19 +363,20 @@ impl StyleMesh {
     }
 }
 
-/// A triangle prepared for barycentric projection (Ericson §3.4): the
-/// coordinates of a point's projection onto the triangle's plane from two
-/// dot products.
+/// A triangle prepared for barycentric projection (Ericson §3.4, with the
+/// solve folded into two "dual" vectors): for a point `p`, with
+/// `r = p − a`, the barycentric coordinates of its projection onto the
+/// plane are `v = r·q₁`, `w = r·q₂`, `u = 1 − v − w`, where
+/// `q₁ = (d₁₁ e₁ − d₀₁ e₂) / D` and `q₂ = (d₀₀ e₂ − d₀₁ e₁) / D`
+/// (`dᵢⱼ = eᵢ·eⱼ`, `D = d₀₀ d₁₁ − d₀₁²`); the squared distance to the plane
+/// is `(r·n̂)²`. Three dot products a candidate.
 #[derive(Debug, Clone, Copy)]
 struct Projection {
     a: Vec3,
-    e1: Vec3,
-    e2: Vec3,
-    d00: f32,
-    d01: f32,
-    d11: f32,
-    /// `1 / (d00 d11 − d01²)`; not finite for degenerate primitives.
-    inverse: f32,
+    q1: Vec3,
+    q2: Vec3,
+    /// Unit normal of the plane.
+    normal: Vec3,
 }
 
 impl Projection {
@@ -358,6 +384,8 @@ impl Projection {
         let (e1, e2) = (b - a, c - a);
         let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
         let denominator = d00 * d11 - d01 * d01;
+        // Degenerate primitives (segments, points, slivers) get NaN duals,
+        // which fail every inside test below.
         let inverse = if denominator > 1e-12 * (d00 * d11).max(f32::MIN_POSITIVE) {
             1.0 / denominator
         } else {
@@ -365,26 +393,24 @@ impl Projection {
         };
         Self {
             a,
-            e1,
-            e2,
-            d00,
-            d01,
-            d11,
-            inverse,
+            q1: (d11 * e1 - d01 * e2) * inverse,
+            q2: (d00 * e2 - d01 * e1) * inverse,
+            normal: e1.cross(e2).normalize_or_zero(),
         }
     }
 
     /// Squared distance to the plane and the barycentric weights, when the
     /// projection of `p` falls inside the triangle.
+    #[inline]
     fn inside(&self, p: Vec3) -> Option<(f32, [f32; 3])> {
-        let v2 = p - self.a;
-        let (d20, d21) = (v2.dot(self.e1), v2.dot(self.e2));
-        let v = (self.d11 * d20 - self.d01 * d21) * self.inverse;
-        let w = (self.d00 * d21 - self.d01 * d20) * self.inverse;
+        let r = p - self.a;
+        let v = r.dot(self.q1);
+        let w = r.dot(self.q2);
         let u = 1.0 - v - w;
         // NaN (degenerate) fails these comparisons.
         if u >= 0.0 && v >= 0.0 && w >= 0.0 {
-            Some(((v2 - v * self.e1 - w * self.e2).length_squared(), [u, v, w]))
+            let h = r.dot(self.normal);
+            Some((h * h, [u, v, w]))
         } else {
             None
         }
@@ -458,47 +484,33 @@ fn conflicts(marks: &[(u32, u32)], roots: &[Vec3], vertices: &[Vec3]) -> Vec<Los
 /// result is the unique smallest label of every vertex, so it does not
 /// depend on the number of threads or the order of work — and the local
 /// searches are kinder to the cache than one global frontier.
-fn colour(
-    vertices: &[Vec3],
-    adjacency: &VertexAdjacency,
-    marks: &[(u32, u32)],
-    lost: &[LostGuide],
-) -> Vec<u32> {
+fn colour(graph: &EdgeGraph, marks: &[(u32, u32)], lost: &[LostGuide]) -> Vec<u32> {
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
     use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
     let lost: HashSet<u32> = lost.iter().map(|l| l.guide).collect();
-    // Edge lengths in adjacency order, so searches read them in order.
-    let lengths: Vec<f32> = (0..vertices.len())
-        .into_par_iter()
-        .flat_map_iter(|v| {
-            let p = vertices[v];
-            adjacency
-                .neighbors(v)
-                .iter()
-                .map(move |&n| (vertices[n as usize] - p).length())
-        })
-        .collect();
     // Label = distance bits (non-negative floats order like their bits)
     // above the guide index: the smallest label is the nearest guide, ties
     // to the lower index.
     let label = |d: f32, g: u32| (u64::from(d.to_bits()) << 32) | u64::from(g);
-    let state: Vec<AtomicU64> = (0..vertices.len())
+    let state: Vec<AtomicU64> = (0..graph.vertex_count())
+        .into_par_iter()
         .map(|_| AtomicU64::new(u64::MAX))
         .collect();
+    // Seeds in graph indices.
     let seeds: Vec<(u32, u32)> = marks
         .iter()
-        .copied()
         .filter(|(_, g)| !lost.contains(g))
+        .map(|&(v, g)| (graph.rank(v), g))
         .collect();
-    for &(v, g) in &seeds {
-        state[v as usize].fetch_min(label(0.0, g), Relaxed);
+    for &(u, g) in &seeds {
+        state[u as usize].fetch_min(label(0.0, g), Relaxed);
     }
     // The searches advance in lockstep, one distance band at a time: a
     // search that ran ahead alone would flood cells its neighbours have not
     // claimed yet. A band of two mean edge lengths keeps the overlap small
     // and the rounds few.
-    let mean_edge = lengths.iter().sum::<f32>() / lengths.len().max(1) as f32;
+    let mean_edge = graph.mean_edge_length();
     let band = if mean_edge > 0.0 {
         2.0 * mean_edge
     } else {
@@ -506,7 +518,7 @@ fn colour(
     };
     let mut frontiers: Vec<BinaryHeap<Reverse<(u32, u32)>>> = seeds
         .iter()
-        .map(|&(v, _)| BinaryHeap::from([Reverse((0u32, v))]))
+        .map(|&(u, _)| BinaryHeap::from([Reverse((0u32, u))]))
         .collect();
     let mut limit = band;
     while frontiers.iter().any(|f| !f.is_empty()) {
@@ -514,24 +526,23 @@ fn colour(
             .par_iter_mut()
             .zip(&seeds)
             .for_each(|(heap, &(_, g))| {
-                while let Some(&Reverse((d_bits, v))) = heap.peek() {
+                while let Some(&Reverse((d_bits, u))) = heap.peek() {
                     let d = f32::from_bits(d_bits);
                     if d >= limit {
                         break;
                     }
                     heap.pop();
-                    if state[v as usize].load(Relaxed) != label(d, g) {
+                    if state[u as usize].load(Relaxed) != label(d, g) {
                         continue;
                     }
-                    let range = adjacency.offsets[v as usize] as usize
-                        ..adjacency.offsets[v as usize + 1] as usize;
-                    for (&n, &length) in adjacency.neighbors[range.clone()]
-                        .iter()
-                        .zip(&lengths[range])
-                    {
+                    let (neighbors, lengths) = graph.edges_of(u);
+                    for (&n, &length) in neighbors.iter().zip(lengths) {
                         let nd = d + length;
                         let key = label(nd, g);
-                        if key < state[n as usize].fetch_min(key, Relaxed) {
+                        // A plain load first: most relaxations lose, and
+                        // an atomic read-modify-write costs far more.
+                        let slot = &state[n as usize];
+                        if key < slot.load(Relaxed) && key < slot.fetch_min(key, Relaxed) {
                             heap.push(Reverse((nd.to_bits(), n)));
                         }
                     }
@@ -539,10 +550,12 @@ fn colour(
             });
         limit += band;
     }
-    state
-        .into_iter()
-        .map(|s| {
-            let s = s.into_inner();
+    // Back to mesh vertex order.
+    graph
+        .ranks()
+        .par_iter()
+        .map(|&u| {
+            let s = state[u as usize].load(Relaxed);
             if s == u64::MAX { u32::MAX } else { s as u32 }
         })
         .collect()

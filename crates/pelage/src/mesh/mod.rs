@@ -5,7 +5,7 @@
 //! (read, or computed area-weighted) and optional UVs (per vertex, or per
 //! corner with their own index buffer, as OBJ stores them). It is immutable
 //! once built, so derived data (triangle areas at construction, the edge list
-//! on first use) is cached without invalidation.
+//! on first use, the edge graph) is cached without invalidation.
 //!
 //! Degenerate triangles (a repeated vertex index, or an area that is zero
 //! relative to the triangle's size) are kept so indices stay as in the file,
@@ -15,6 +15,7 @@
 mod closest;
 mod error;
 mod gltf;
+mod graph;
 mod load;
 mod obj;
 mod ply;
@@ -25,6 +26,8 @@ mod topology;
 
 pub use closest::{ClosestPoint, TriangleBvh, closest_on_triangle};
 pub use error::{Location, MeshError, MeshErrorKind};
+pub use graph::EdgeGraph;
+pub(crate) use graph::morton;
 pub use load::MeshFormat;
 pub(crate) use ply::scalar as ply_scalar;
 pub use ray::{RayHit, first_hit};
@@ -61,6 +64,7 @@ pub struct Mesh {
     areas: Vec<f32>,
     degenerate_count: usize,
     edges: OnceLock<EdgeList>,
+    edge_graph: OnceLock<EdgeGraph>,
 }
 
 impl Clone for Mesh {
@@ -74,6 +78,7 @@ impl Clone for Mesh {
             areas: self.areas.clone(),
             degenerate_count: self.degenerate_count,
             edges: OnceLock::new(),
+            edge_graph: OnceLock::new(),
         }
     }
 }
@@ -160,6 +165,7 @@ impl Mesh {
             areas,
             degenerate_count,
             edges: OnceLock::new(),
+            edge_graph: OnceLock::new(),
         })
     }
 
@@ -261,6 +267,15 @@ impl Mesh {
     /// each; built on first use and cached.
     pub fn edges(&self) -> &EdgeList {
         self.edges.get_or_init(|| EdgeList::build(&self.triangles))
+    }
+
+    /// The mesh as a graph for shortest paths along edges (vertices in a
+    /// locality-preserving order, edge lengths); built on first use and
+    /// cached, so a style mesh rebuilt for new guides on the same mesh
+    /// does not pay for it again.
+    pub fn edge_graph(&self) -> &EdgeGraph {
+        self.edge_graph
+            .get_or_init(|| EdgeGraph::new(&self.positions, self.edges()))
     }
 }
 
