@@ -95,17 +95,28 @@ impl NoiseMap {
         let cell = glam::Vec3::new(floor(p.x), floor(p.y), floor(p.z));
         let f = p - cell;
         let [xi, yi, zi] = [cell.x, cell.y, cell.z].map(|c| (c as i64 & 255) as usize);
-        let perm = &self.permutation;
+        let perm: &[u8; 512] = &self.permutation;
+        // Indices masked to the table: they never exceed it (see below),
+        // and the mask lets the compiler drop every bounds check.
+        let at = |i: usize| perm[i & 511] as usize;
         let fade = |t: f32| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
         let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
         let lerp = |a: glam::Vec3, b: glam::Vec3, t: f32| a + t * (b - a);
+        // Perlin's hash chain perm[perm[perm[x] + y] + z], its first two
+        // links shared by the corners that share them (x ≤ 256, each
+        // table entry ≤ 255, so every index stays below 512).
+        let hx = [at(xi), at(xi + 1)];
+        let hxy = [
+            [at(hx[0] + yi), at(hx[0] + yi + 1)],
+            [at(hx[1] + yi), at(hx[1] + yi + 1)],
+        ];
         let corner = |dx: usize, dy: usize, dz: usize| {
-            let h = perm[perm[perm[xi + dx] as usize + yi + dy] as usize + zi + dz];
+            let h = at(hxy[dx][dy] + zi + dz);
             let (x, y, z) = (f.x - dx as f32, f.y - dy as f32, f.z - dz as f32);
             glam::Vec3::new(
-                gradient3(h, x, y, z),
-                gradient3(perm[h as usize + 101], x, y, z),
-                gradient3(perm[h as usize + 203], x, y, z),
+                gradient3(h as u8, x, y, z),
+                gradient3(at(h + 101) as u8, x, y, z),
+                gradient3(at(h + 203) as u8, x, y, z),
             )
         };
         let x00 = lerp(corner(0, 0, 0), corner(1, 0, 0), u);
