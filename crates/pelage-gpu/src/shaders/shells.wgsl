@@ -126,8 +126,11 @@ fn clump_profile(h: f32, w: f32, layers: u32) -> f32 {
     return max((1.0 - w) * h + w * (1.0 + log(max(h, 1e-6)) / k), 0.0);
 }
 
-fn clump_displacement(h: f32, layers: u32, w: f32, strength: f32, wet: f32, pixel: vec2<f32>, centre: vec2<f32>) -> vec2<f32> {
-    return clump_profile(h, w, layers) * wet * strength * (pixel - centre);
+// clump_displacement, with clump_profile(h, w, layers) given: it is the
+// same for a whole layer, so the vertex shader works it out (two
+// logarithms) and hands it to every fragment of the layer.
+fn clump_displacement(profile: f32, strength: f32, wet: f32, pixel: vec2<f32>, centre: vec2<f32>) -> vec2<f32> {
+    return profile * wet * strength * (pixel - centre);
 }
 
 fn shadow_factor(h: f32, k_shadow: f32) -> f32 {
@@ -209,6 +212,8 @@ struct LayerOut {
     @location(3) normal: vec3<f32>,
     @location(4) u_axis: vec3<f32>,
     @location(5) @interpolate(flat) layer: u32,
+    // clump_profile(h, w, N) of this layer.
+    @location(6) @interpolate(flat) clump_profile: f32,
 };
 
 @vertex
@@ -243,6 +248,10 @@ fn vs_layer(v: VertexIn, @builtin(instance_index) layer: u32) -> LayerOut {
     out.normal = n;
     out.u_axis = u;
     out.layer = layer;
+    out.clump_profile = 0.0;
+    if CLUMP {
+        out.clump_profile = clump_profile(h, shell.clump.x, layers);
+    }
     return out;
 }
 
@@ -256,7 +265,7 @@ fn fs_layer(v: LayerOut) -> @location(0) vec4<f32> {
     if CLUMP {
         let here = wetness_at(v.uv);
         if here.w != 0.0 {
-            let d = clump_displacement(h, layers, shell.clump.x, shell.clump.y, here.w, v.uv, here.xy);
+            let d = clump_displacement(v.clump_profile, shell.clump.y, here.w, v.uv, here.xy);
             if distance(v.uv, here.xy) > here.z {
                 discard;
             }
