@@ -1,6 +1,7 @@
 //! pelage-gpu: the wgpu renderer. Everything pelage makes can be looked at
 //! through it: the skin mesh, points (hair roots, samples), curves, and
-//! shell fur ([`ShellRenderer`]). It renders headless into an image (CI,
+//! shell fur ([`ShellRenderer`]); and it steps moving fur's explicit
+//! mass-spring solver in a compute shader ([`GpuMassSpring`]). It renders headless into an image (CI,
 //! render farms without GPUs, docs) and, with the viewer issue, into a window,
 //! with the same pipelines. WGSL lives in `src/shaders/`.
 //!
@@ -12,11 +13,13 @@
 
 mod camera;
 mod context;
+mod dynamics;
 mod renderer;
 mod shells;
 
 pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
+pub use dynamics::GpuMassSpring;
 pub use pelage::Curves;
 pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer, read_texture};
 pub use shells::{
@@ -95,6 +98,8 @@ pub const SHADERS: &[(&str, &str)] = &[
     ),
     // Shell fur has its own uniform block.
     ("shells.wgsl", include_str!("shaders/shells.wgsl")),
+    // The explicit mass-spring substep (compute).
+    ("dynamics.wgsl", include_str!("shaders/dynamics.wgsl")),
 ];
 
 /// The WGSL source of the named shader (with its prelude).

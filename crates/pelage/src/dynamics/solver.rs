@@ -123,6 +123,22 @@ pub struct WindNow<'w> {
 }
 
 impl WindNow<'_> {
+    /// The gusting mean velocity at this moment.
+    pub fn mean(&self) -> Vec3 {
+        self.mean
+    }
+
+    /// How far the turbulence field has drifted with the wind by now: the
+    /// field is read at `(p − drift) · scale`.
+    pub fn drift(&self) -> Vec3 {
+        self.drift
+    }
+
+    /// The turbulence's noise (its permutation table, for a GPU port).
+    pub fn noise(&self) -> &NoiseMap {
+        &self.wind.noise
+    }
+
     /// The velocity at `p`.
     pub fn at(&self, p: Vec3) -> Vec3 {
         let w = self.wind;

@@ -249,6 +249,37 @@ impl MassSpringSystem {
         &self.normals
     }
 
+    /// Root velocities (the skin's motion, from [`move_roots`](Self::move_roots)).
+    pub fn root_velocities(&self) -> &[Vec3] {
+        &self.root_velocities
+    }
+
+    /// Rest length `L0` of each stick.
+    pub fn lengths(&self) -> &[f32] {
+        &self.lengths
+    }
+
+    /// The tip-tip springs (prisms; empty otherwise).
+    pub fn tip_tip_springs(&self) -> &[TipSpring] {
+        &self.springs
+    }
+
+    /// For each tip `i`, its tip-tip springs are
+    /// `spring_index[spring_offsets[i]..spring_offsets[i + 1]]`, indices
+    /// into [`tip_tip_springs`](Self::tip_tip_springs): `(spring_offsets, spring_index)`.
+    pub fn tip_spring_adjacency(&self) -> (&[u32], &[u32]) {
+        (&self.spring_offsets, &self.spring_index)
+    }
+
+    /// Replaces the tips' state (positions and velocities, one per tip), e.g.
+    /// with a state stepped elsewhere (the GPU).
+    pub fn set_state(&mut self, tips: &[Vec3], velocities: &[Vec3]) {
+        assert_eq!(tips.len(), self.tips.len(), "one position a tip");
+        assert_eq!(velocities.len(), self.tips.len(), "one velocity a tip");
+        self.tips.copy_from_slice(tips);
+        self.velocities.copy_from_slice(velocities);
+    }
+
     /// The rest position `p0` of tip `i`.
     pub fn rest_tip(&self, i: usize) -> Vec3 {
         self.roots[i] + self.lengths[i] * self.normals[i]

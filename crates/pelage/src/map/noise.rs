@@ -42,6 +42,16 @@ impl NoiseMap {
         }
     }
 
+    /// The doubled permutation table the noise hashes lattice points with
+    /// (a GPU port of the noise uploads it).
+    pub fn permutation_table(&self) -> &[u8; 512] {
+        &self.permutation
+    }
+
+    /// Perlin's twelve gradients padded to sixteen, indexed by a hash's low
+    /// four bits, as [`perlin3_vector`](Self::perlin3_vector) uses them.
+    pub const GRADIENTS3: [[f32; 3]; 16] = GRADIENTS3;
+
     /// The map's value at `uv`.
     pub fn eval(&self, uv: Vec2) -> f32 {
         let mut sum = 0.0;

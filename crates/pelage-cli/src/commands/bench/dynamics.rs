@@ -6,6 +6,10 @@
 //! turbulent wind, on all threads. Targets (2 cores): 1 M masses —
 //! implicit ≤ 10 ms a step, explicit ≤ 3 ms. Banisch's baseline: 1,247 to
 //! 6,888 masses at 22–27 fps including rendering (P4 1.7 GHz, 2006).
+//!
+//! Beside the CPU, the explicit step on the GPU adapter present
+//! (`pelage_gpu::GpuMassSpring`; lavapipe without a GPU): steps queued in
+//! one submission, as a real-time loop would, and waited for.
 
 use super::median_seconds;
 use crate::format::thousands;
@@ -27,6 +31,9 @@ pub struct DynamicsBenchArgs {
     /// Steps per median.
     #[arg(long, default_value_t = 5)]
     pub steps: usize,
+    /// Leave out the GPU column.
+    #[arg(long)]
+    pub no_gpu: bool,
 }
 
 struct Row {
@@ -35,6 +42,32 @@ struct Row {
     masses: usize,
     springs: usize,
     ms: [f64; 2],
+    /// The explicit step on the GPU, if one was measured.
+    gpu_ms: Option<f64>,
+}
+
+/// Milliseconds a GPU explicit step: the median over three batches of
+/// `steps` steps, each batch queued in one go and waited for.
+fn gpu_explicit_ms(
+    ctx: &pelage_gpu::GpuContext,
+    system: &MassSpringSystem,
+    params: &DynamicsParams,
+    dt: f32,
+    steps: usize,
+) -> anyhow::Result<f64> {
+    let mut gpu = pelage_gpu::GpuMassSpring::new(ctx, system)?;
+    gpu.step_explicit(ctx, dt, params, 1, 0.0, 1);
+    gpu.wait(ctx)?;
+    let steps = steps.max(1) as u32;
+    let mut batches = Vec::new();
+    for b in 0..3 {
+        let start = std::time::Instant::now();
+        gpu.step_explicit(ctx, dt, params, 1, (1 + b * steps) as f32 * dt, steps);
+        gpu.wait(ctx)?;
+        batches.push(start.elapsed().as_secs_f64() * 1e3 / f64::from(steps));
+    }
+    batches.sort_by(f64::total_cmp);
+    Ok(batches[1])
 }
 
 const SOLVERS: [Solver; 2] = [
@@ -57,12 +90,33 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         ..Default::default()
     };
     let dt = 1.0 / 60.0;
+    let gpu = if args.no_gpu {
+        None
+    } else {
+        match pelage_gpu::GpuContext::headless() {
+            Ok(ctx) => Some(ctx),
+            Err(e) => {
+                eprintln!("no GPU column: {e}");
+                None
+            }
+        }
+    };
     let mut rows = Vec::new();
     for (name, mesh) in &meshes {
         let length = 0.025 * (mesh.bounds().1 - mesh.bounds().0).length();
         for topology in Topology::ALL {
             let mut ms = [0.0; 2];
             let mut counts = (0, 0);
+            let gpu_ms = match &gpu {
+                Some(ctx) => Some(gpu_explicit_ms(
+                    ctx,
+                    &MassSpringSystem::new(mesh, topology, length),
+                    &params,
+                    dt,
+                    args.steps,
+                )?),
+                None => None,
+            };
             for (k, solver) in SOLVERS.into_iter().enumerate() {
                 let mut system = MassSpringSystem::new(mesh, topology, length);
                 counts = (system.mass_count(), system.spring_count());
@@ -79,6 +133,7 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
                 masses: counts.0,
                 springs: counts.1,
                 ms,
+                gpu_ms,
             });
         }
     }
@@ -88,29 +143,39 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         .rev()
         .find(|r| r.topology == Topology::SpringSticks)
         .expect("spring-sticks always run");
+    let json_ms = |ms: Option<f64>| ms.map_or("null".to_string(), |ms| format!("{ms:.4}"));
+    let gpu_name = gpu.as_ref().map(|ctx| ctx.adapter_name());
     if args.json {
         let list: Vec<String> = rows
             .iter()
             .map(|r| {
                 format!(
-                    "{{\"model\":{:?},\"topology\":{:?},\"masses\":{},\"springs\":{},\"explicit_ms\":{:.4},\"implicit_ms\":{:.4}}}",
+                    "{{\"model\":{:?},\"topology\":{:?},\"masses\":{},\"springs\":{},\"explicit_ms\":{:.4},\"implicit_ms\":{:.4},\"gpu_explicit_ms\":{}}}",
                     r.model,
                     r.topology.name(),
                     r.masses,
                     r.springs,
                     r.ms[0],
-                    r.ms[1]
+                    r.ms[1],
+                    json_ms(r.gpu_ms)
                 )
             })
             .collect();
         println!(
-            "{{\"model\":{:?},\"masses\":{},\"explicit_ms\":{:.4},\"implicit_ms\":{:.4},\"explicit_ms_per_million\":{:.4},\"implicit_ms_per_million\":{:.4},\"threads\":{threads},\"rows\":[{}]}}",
+            "{{\"model\":{:?},\"masses\":{},\"explicit_ms\":{:.4},\"implicit_ms\":{:.4},\"explicit_ms_per_million\":{:.4},\"implicit_ms_per_million\":{:.4},\"threads\":{threads},\"gpu_adapter\":{},\"gpu_software\":{},\"gpu_explicit_ms\":{},\"gpu_explicit_ms_per_million\":{},\"rows\":[{}]}}",
             headline.model,
             headline.masses,
             headline.ms[0],
             headline.ms[1],
             headline.ms[0] * 1e6 / headline.masses as f64,
             headline.ms[1] * 1e6 / headline.masses as f64,
+            gpu_name
+                .as_ref()
+                .map_or("null".to_string(), |n| format!("{n:?}")),
+            gpu.as_ref()
+                .map_or("null".to_string(), |ctx| ctx.is_software().to_string()),
+            json_ms(headline.gpu_ms),
+            json_ms(headline.gpu_ms.map(|ms| ms * 1e6 / headline.masses as f64)),
             list.join(",")
         );
         return Ok(());
@@ -120,22 +185,37 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         args.steps.max(1)
     );
     println!(
-        "explicit: symplectic Euler, 1 substep; implicit: backward Euler, 10 CG iterations (prisms) or a direct 3×3 solve per tip (no tip-tip springs)\n"
+        "explicit: symplectic Euler, 1 substep; implicit: backward Euler, 10 CG iterations (prisms) or a direct 3×3 solve per tip (no tip-tip springs)"
     );
+    match &gpu_name {
+        Some(name) => println!(
+            "GPU explicit: the same step as a compute shader on {name}, steps queued {} at a time\n",
+            args.steps.max(1)
+        ),
+        None => println!(),
+    }
     println!(
-        "{:>8}  {:>24}  {:>10}  {:>10}  {:>11}  {:>11}  {:>14}",
-        "model", "topology", "masses", "springs", "explicit", "implicit", "M masses/s (impl.)"
+        "{:>8}  {:>24}  {:>10}  {:>10}  {:>11}  {:>11}  {:>14}  {:>12}",
+        "model",
+        "topology",
+        "masses",
+        "springs",
+        "explicit",
+        "implicit",
+        "M masses/s (impl.)",
+        "GPU explicit"
     );
     for r in &rows {
         println!(
-            "{:>8}  {:>24}  {:>10}  {:>10}  {:>8.2} ms  {:>8.2} ms  {:>14.2}",
+            "{:>8}  {:>24}  {:>10}  {:>10}  {:>8.2} ms  {:>8.2} ms  {:>18.2}  {:>12}",
             r.model,
             r.topology.name(),
             thousands(r.masses as u64),
             thousands(r.springs as u64),
             r.ms[0],
             r.ms[1],
-            r.masses as f64 / r.ms[1] / 1e3
+            r.masses as f64 / r.ms[1] / 1e3,
+            r.gpu_ms.map_or("—".to_string(), |ms| format!("{ms:.2} ms"))
         );
     }
     let per_million = |ms: f64| ms * 1e6 / headline.masses as f64;
@@ -155,6 +235,23 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
             "missed"
         },
     );
+    if let (Some(ms), Some(name)) = (headline.gpu_ms, &gpu_name) {
+        let software = gpu.as_ref().is_some_and(|ctx| ctx.is_software());
+        println!(
+            "explicit on the GPU ({name}{}): {:.1} ms per 1 M masses ({})",
+            if software {
+                ", a software rasteriser on this CPU"
+            } else {
+                ""
+            },
+            per_million(ms),
+            if per_million(ms) <= 3.0 {
+                "met"
+            } else {
+                "missed"
+            }
+        );
+    }
     println!(
         "Banisch & Wüthrich (P4 1.7 GHz, 2006): 1,247–6,888 masses at 22–27 fps including rendering"
     );

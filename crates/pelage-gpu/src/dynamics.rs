@@ -1,0 +1,447 @@
+//! The explicit mass-spring solver on the GPU: the fused substep of
+//! `pelage::dynamics` (force, velocity, position, constraints; Banisch &
+//! Wüthrich, Silva §3.2.1) as a compute shader, one invocation a tip,
+//! double buffered like the CPU pass. `shaders/dynamics.wgsl` mirrors the
+//! Rust function by function; `tests/dynamics.rs` steps both and compares.
+//!
+//! Why it exists: on two CPU cores a step of a million masses takes tens of
+//! milliseconds (docs/benchmarks/dynamics.md) against the 3 ms; a
+//! GPU moves the ~90 bytes a mass a step that bounds the CPU at hundreds of
+//! GB/s. Many steps can be queued in one submission, as a real-time loop
+//! would, and the state read back only when the CPU needs it.
+
+use crate::{GpuContext, GpuError};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use pelage::dynamics::{DynamicsParams, MassSpringSystem, Topology};
+use wgpu::util::DeviceExt;
+
+/// Threads a workgroup (the shader's `@workgroup_size`).
+const WORKGROUP: u32 = 64;
+/// Substeps queued in one submission: one uniform slot each.
+const SLOTS: u32 = 64;
+/// Bytes a uniform slot (the dynamic-offset alignment wgpu guarantees).
+const SLOT_BYTES: u64 = 256;
+
+/// The shader's `Step` block: everything one substep reads besides buffers.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct StepUniform {
+    gravity: [f32; 4],
+    springs: [f32; 4],
+    misc: [f32; 4],
+    wind_mean: [f32; 4],
+    wind_drift: [f32; 4],
+    brush_centre: [f32; 4],
+    brush_force: [f32; 4],
+    counts: [u32; 4],
+}
+
+/// A [`MassSpringSystem`] uploaded to the GPU, stepped there with the
+/// explicit solver. Build with [`new`](Self::new), step with
+/// [`step_explicit`](Self::step_explicit), read with
+/// [`read_state`](Self::read_state).
+#[derive(Debug)]
+pub struct GpuMassSpring {
+    tips: u32,
+    silva: bool,
+    pipeline: wgpu::ComputePipeline,
+    uniforms: wgpu::Buffer,
+    roots: wgpu::Buffer,
+    normals: wgpu::Buffer,
+    root_velocities: wgpu::Buffer,
+    permutation: wgpu::Buffer,
+    permutation_seed: Option<u64>,
+    /// (tips, velocities), twice: substeps read one and write the other.
+    state: [(wgpu::Buffer, wgpu::Buffer); 2],
+    /// `bind_groups[k]` reads `state[k]` and writes `state[1 − k]`.
+    bind_groups: [wgpu::BindGroup; 2],
+    /// Which of `state` holds the current state.
+    current: usize,
+}
+
+fn padded(v: &[Vec3]) -> Vec<[f32; 4]> {
+    v.iter().map(|p| [p.x, p.y, p.z, 0.0]).collect()
+}
+
+/// Each stick's root with its rest length in w, as the shader reads them.
+fn roots_and_lengths(system: &MassSpringSystem) -> Vec<[f32; 4]> {
+    system
+        .roots()
+        .iter()
+        .zip(system.lengths())
+        .map(|(r, &l)| [r.x, r.y, r.z, l])
+        .collect()
+}
+
+impl GpuMassSpring {
+    /// Uploads `system` (its sticks, tip-tip springs and current state).
+    pub fn new(ctx: &GpuContext, system: &MassSpringSystem) -> Result<Self, GpuError> {
+        let device = &ctx.device;
+        let n = system.mass_count();
+        let tips = u32::try_from(n)
+            .map_err(|_| GpuError::Mismatch(format!("{n} masses do not fit a GPU index")))?;
+        let bytes = (n.max(1) * 16) as u64;
+        let limit = device.limits().max_storage_buffer_binding_size;
+        if bytes > limit {
+            return Err(GpuError::Mismatch(format!(
+                "{n} masses need {bytes} bytes a state buffer; the adapter binds at most {limit}"
+            )));
+        }
+        let storage = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
+            // wgpu refuses empty bindings: a system without tip-tip springs
+            // still binds one (unread) element.
+            let contents = if contents.is_empty() {
+                &[0u8; 16][..]
+            } else {
+                contents
+            };
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE | usage,
+            })
+        };
+        let copy_dst = wgpu::BufferUsages::COPY_DST;
+        let roots = storage(
+            "dynamics roots",
+            bytemuck::cast_slice(&roots_and_lengths(system)),
+            copy_dst,
+        );
+        let normals = storage(
+            "dynamics normals",
+            bytemuck::cast_slice(&padded(system.normals())),
+            copy_dst,
+        );
+        let root_velocities = storage(
+            "dynamics root velocities",
+            bytemuck::cast_slice(&padded(system.root_velocities())),
+            copy_dst,
+        );
+        let (offsets, index) = system.tip_spring_adjacency();
+        let springs = system.tip_tip_springs();
+        let ends: Vec<[u32; 2]> = (0..n)
+            .flat_map(|i| {
+                index[offsets[i] as usize..offsets[i + 1] as usize]
+                    .iter()
+                    .map(move |&s| {
+                        let spring = springs[s as usize];
+                        let other = if spring.a as usize == i {
+                            spring.b
+                        } else {
+                            spring.a
+                        };
+                        [other, spring.rest.to_bits()]
+                    })
+            })
+            .collect();
+        let spring_offsets = storage(
+            "dynamics spring offsets",
+            bytemuck::cast_slice(offsets),
+            wgpu::BufferUsages::empty(),
+        );
+        let spring_ends = storage(
+            "dynamics spring ends",
+            bytemuck::cast_slice(&ends),
+            wgpu::BufferUsages::empty(),
+        );
+        let permutation = storage(
+            "dynamics noise permutation",
+            bytemuck::cast_slice(&[0u32; 512]),
+            copy_dst,
+        );
+        let state_usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        let state = [0, 1].map(|_| {
+            (
+                storage(
+                    "dynamics tips",
+                    bytemuck::cast_slice(&padded(system.tips())),
+                    state_usage,
+                ),
+                storage(
+                    "dynamics velocities",
+                    bytemuck::cast_slice(&padded(system.velocities())),
+                    state_usage,
+                ),
+            )
+        });
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("dynamics steps"),
+            size: SLOT_BYTES * u64::from(SLOTS),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+
+        let entry =
+            |binding: u32, ty: wgpu::BufferBindingType, dynamic: bool| wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty,
+                    has_dynamic_offset: dynamic,
+                    min_binding_size: None,
+                },
+                count: None,
+            };
+        let read = wgpu::BufferBindingType::Storage { read_only: true };
+        let write = wgpu::BufferBindingType::Storage { read_only: false };
+        let mut entries = vec![entry(0, wgpu::BufferBindingType::Uniform, true)];
+        entries.extend((1..=8).map(|b| entry(b, read, false)));
+        entries.extend((9..=10).map(|b| entry(b, write, false)));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dynamics"),
+            entries: &entries,
+        });
+        let bind_groups =
+            [0usize, 1].map(|k| {
+                let (tips_in, velocities_in) = &state[k];
+                let (tips_out, velocities_out) = &state[1 - k];
+                let buffers = [
+                    &roots,
+                    &normals,
+                    &root_velocities,
+                    &spring_offsets,
+                    &spring_ends,
+                    &permutation,
+                    tips_in,
+                    velocities_in,
+                    tips_out,
+                    velocities_out,
+                ];
+                let mut entries = vec![wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &uniforms,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<StepUniform>() as u64),
+                    }),
+                }];
+                entries.extend(buffers.iter().enumerate().map(|(b, buffer)| {
+                    wgpu::BindGroupEntry {
+                        binding: b as u32 + 1,
+                        resource: buffer.as_entire_binding(),
+                    }
+                }));
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("dynamics"),
+                    layout: &layout,
+                    entries: &entries,
+                })
+            });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("dynamics.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(crate::shader_source("dynamics.wgsl").into()),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dynamics"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("dynamics explicit substep"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("explicit_substep"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Ok(Self {
+            tips,
+            silva: system.topology() == Topology::SilvaStrands,
+            pipeline,
+            uniforms,
+            roots,
+            normals,
+            root_velocities,
+            permutation,
+            permutation_seed: None,
+            state,
+            bind_groups,
+            current: 0,
+        })
+    }
+
+    /// Number of masses.
+    pub fn mass_count(&self) -> usize {
+        self.tips as usize
+    }
+
+    /// Uploads the skin's current state — roots, rest directions and root
+    /// velocities — after [`MassSpringSystem::move_roots`].
+    pub fn upload_roots(&self, ctx: &GpuContext, system: &MassSpringSystem) {
+        ctx.queue.write_buffer(
+            &self.roots,
+            0,
+            bytemuck::cast_slice(&roots_and_lengths(system)),
+        );
+        ctx.queue.write_buffer(
+            &self.normals,
+            0,
+            bytemuck::cast_slice(&padded(system.normals())),
+        );
+        ctx.queue.write_buffer(
+            &self.root_velocities,
+            0,
+            bytemuck::cast_slice(&padded(system.root_velocities())),
+        );
+    }
+
+    /// Queues `steps` explicit steps of `dt` seconds, `substeps` each,
+    /// starting at `time` (the wind's clock), as the CPU's
+    /// `Solver::Explicit { substeps }` steps. Returns once they are
+    /// submitted; [`wait`](Self::wait) or [`read_state`](Self::read_state)
+    /// for them to finish.
+    pub fn step_explicit(
+        &mut self,
+        ctx: &GpuContext,
+        dt: f32,
+        params: &DynamicsParams,
+        substeps: u32,
+        time: f32,
+        steps: u32,
+    ) {
+        let substeps = substeps.max(1);
+        let h = dt / substeps as f32;
+        if let Some(wind) = &params.wind {
+            let noise = wind.now(time);
+            let seed = noise.noise().seed;
+            if self.permutation_seed != Some(seed) {
+                let table: Vec<u32> = noise
+                    .noise()
+                    .permutation_table()
+                    .iter()
+                    .map(|&p| u32::from(p))
+                    .collect();
+                ctx.queue
+                    .write_buffer(&self.permutation, 0, bytemuck::cast_slice(&table));
+                self.permutation_seed = Some(seed);
+            }
+        }
+        let groups = self.tips.div_ceil(WORKGROUP).max(1);
+        let groups_x = groups.min(65_535);
+        let groups_y = groups.div_ceil(groups_x);
+        let times: Vec<f32> = (0..steps)
+            .flat_map(|s| (0..substeps).map(move |k| time + s as f32 * dt + k as f32 * h))
+            .collect();
+        for chunk in times.chunks(SLOTS as usize) {
+            let mut slots = vec![0u8; chunk.len() * SLOT_BYTES as usize];
+            for (k, &t) in chunk.iter().enumerate() {
+                let uniform = self.uniform(params, h, t);
+                let at = k * SLOT_BYTES as usize;
+                slots[at..at + std::mem::size_of::<StepUniform>()]
+                    .copy_from_slice(bytemuck::bytes_of(&uniform));
+            }
+            ctx.queue.write_buffer(&self.uniforms, 0, &slots);
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("dynamics explicit"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                for k in 0..chunk.len() {
+                    pass.set_bind_group(
+                        0,
+                        &self.bind_groups[self.current],
+                        &[(k as u64 * SLOT_BYTES) as u32],
+                    );
+                    pass.dispatch_workgroups(groups_x, groups_y, 1);
+                    self.current = 1 - self.current;
+                }
+            }
+            ctx.queue.submit([encoder.finish()]);
+        }
+    }
+
+    fn uniform(&self, p: &DynamicsParams, h: f32, time: f32) -> StepUniform {
+        let (mean, drift, turbulence, scale) = match &p.wind {
+            Some(w) => {
+                let now = w.now(time);
+                (now.mean(), now.drift(), w.turbulence, w.scale)
+            }
+            None => (Vec3::ZERO, Vec3::ZERO, 0.0, 0.0),
+        };
+        let (centre, radius, force) = match p.brush {
+            Some(b) => (b.centre, b.radius, b.force),
+            None => (Vec3::ZERO, 0.0, Vec3::ZERO),
+        };
+        let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
+        StepUniform {
+            gravity: v4(p.gravity, h),
+            springs: [p.mass, p.stiffness, p.lateral_stiffness, p.damping],
+            misc: [p.drag, p.restoring, 0.0, 0.0],
+            wind_mean: v4(mean, turbulence),
+            wind_drift: v4(drift, scale),
+            // A zero radius means no brush to the shader; the CPU's brush
+            // of radius 0 pushes nothing either.
+            brush_centre: v4(centre, radius),
+            brush_force: v4(force, 0.0),
+            counts: [self.tips, u32::from(self.silva), 0, 0],
+        }
+    }
+
+    /// Waits for every queued step to finish.
+    pub fn wait(&self, ctx: &GpuContext) -> Result<(), GpuError> {
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Readback(e.to_string()))
+    }
+
+    /// The current tip positions and velocities, read back.
+    pub fn read_state(&self, ctx: &GpuContext) -> Result<(Vec<Vec3>, Vec<Vec3>), GpuError> {
+        let (tips, velocities) = &self.state[self.current];
+        let size = tips.size();
+        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("dynamics readback"),
+            size: 2 * size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(tips, 0, &readback, 0, size);
+        encoder.copy_buffer_to_buffer(velocities, 0, &readback, size, size);
+        ctx.queue.submit([encoder.finish()]);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        readback.map_async(wgpu::MapMode::Read, .., move |result| {
+            let _ = sender.send(result);
+        });
+        self.wait(ctx)?;
+        receiver
+            .recv()
+            .map_err(|e| GpuError::Readback(e.to_string()))?
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let mapped = readback
+            .get_mapped_range(..)
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let values: &[[f32; 4]] = bytemuck::cast_slice(&mapped);
+        let n = self.tips as usize;
+        let to_vec3 = |v: &[f32; 4]| Vec3::new(v[0], v[1], v[2]);
+        let tips = values[..n].iter().map(to_vec3).collect();
+        let velocities = values[size as usize / 16..][..n]
+            .iter()
+            .map(to_vec3)
+            .collect();
+        drop(mapped);
+        readback.unmap();
+        Ok((tips, velocities))
+    }
+
+    /// Copies the GPU's state into `system` (the one this was built from).
+    pub fn download_into(
+        &self,
+        ctx: &GpuContext,
+        system: &mut MassSpringSystem,
+    ) -> Result<(), GpuError> {
+        if system.mass_count() != self.tips as usize {
+            return Err(GpuError::Mismatch(format!(
+                "the system has {} masses; the GPU one {}",
+                system.mass_count(),
+                self.tips
+            )));
+        }
+        let (tips, velocities) = self.read_state(ctx)?;
+        system.set_state(&tips, &velocities);
+        Ok(())
+    }
+}

@@ -1,0 +1,210 @@
+// One explicit substep of a mass-spring system (Banisch & Wüthrich; Silva
+// §3.2.1), one invocation a tip: force, velocity, position, constraints —
+// the fused pass of pelage::dynamics::solver's explicit solver, read from
+// one state buffer and written to the other. Every function mirrors the
+// Rust one named the same; keep them in step (tests/dynamics.rs steps both
+// and compares).
+
+struct Step {
+    // xyz: gravity (acceleration), w: substep h.
+    gravity: vec4<f32>,
+    // x: mass, y: stiffness, z: lateral stiffness, w: damping.
+    springs: vec4<f32>,
+    // x: drag, y: restoring w (Eq. 5).
+    misc: vec4<f32>,
+    // xyz: the wind's gusting mean now, w: turbulence speed (no wind: all 0).
+    wind_mean: vec4<f32>,
+    // xyz: the turbulence's drift now, w: its scale.
+    wind_drift: vec4<f32>,
+    // xyz: brush centre, w: radius (0: no brush).
+    brush_centre: vec4<f32>,
+    // xyz: brush force.
+    brush_force: vec4<f32>,
+    // x: tips, y: 1 for Silva strands (a spring to p0, length limit).
+    counts: vec4<u32>,
+};
+
+@group(0) @binding(0) var<uniform> step: Step;
+// xyz: root, w: rest length L0.
+@group(0) @binding(1) var<storage, read> roots: array<vec4<f32>>;
+// xyz: unit rest direction n.
+@group(0) @binding(2) var<storage, read> normals: array<vec4<f32>>;
+// xyz: root velocity.
+@group(0) @binding(3) var<storage, read> root_velocities: array<vec4<f32>>;
+// Tip i's tip-tip springs are spring_ends[spring_offsets[i] ..
+// spring_offsets[i + 1]]: (other tip, bitcast rest length).
+@group(0) @binding(4) var<storage, read> spring_offsets: array<u32>;
+@group(0) @binding(5) var<storage, read> spring_ends: array<vec2<u32>>;
+// The turbulence's doubled permutation table.
+@group(0) @binding(6) var<storage, read> permutation: array<u32>;
+@group(0) @binding(7) var<storage, read> tips_in: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read> velocities_in: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read_write> tips_out: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read_write> velocities_out: array<vec4<f32>>;
+
+// ---- pelage::map::NoiseMap::perlin3_vector ----
+
+fn perm_at(i: u32) -> u32 {
+    return permutation[i & 511u];
+}
+
+// NoiseMap::GRADIENTS3[hash & 15] · d, written out as Perlin's reference
+// code selects it (the table's sixteen rows exactly): no array indexed at
+// run time, which some compilers copy into every invocation.
+fn gradient3(hash: u32, d: vec3<f32>) -> f32 {
+    let h = hash & 15u;
+    let u = select(d.y, d.x, h < 8u);
+    let v = select(select(d.z, d.x, h == 12u || h == 14u), d.y, h < 4u);
+    return select(-u, u, (h & 1u) == 0u) + select(-v, v, (h & 2u) == 0u);
+}
+
+fn fade(t: vec3<f32>) -> vec3<f32> {
+    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+}
+
+fn corner(hxy: u32, zi: u32, dz: u32, d: vec3<f32>) -> vec3<f32> {
+    let h = perm_at(hxy + zi + dz);
+    return vec3<f32>(
+        gradient3(h, d),
+        gradient3(perm_at(h + 101u), d),
+        gradient3(perm_at(h + 203u), d),
+    );
+}
+
+fn perlin3_vector(p: vec3<f32>) -> vec3<f32> {
+    let cell = floor(p);
+    let f = p - cell;
+    let ci = vec3<u32>(vec3<i32>(cell) & vec3<i32>(255));
+    let t = fade(f);
+    let hx0 = perm_at(ci.x);
+    let hx1 = perm_at(ci.x + 1u);
+    let h00 = perm_at(hx0 + ci.y);
+    let h01 = perm_at(hx0 + ci.y + 1u);
+    let h10 = perm_at(hx1 + ci.y);
+    let h11 = perm_at(hx1 + ci.y + 1u);
+    let x00 = mix(corner(h00, ci.z, 0u, f), corner(h10, ci.z, 0u, f - vec3<f32>(1.0, 0.0, 0.0)), t.x);
+    let x10 = mix(corner(h01, ci.z, 0u, f - vec3<f32>(0.0, 1.0, 0.0)), corner(h11, ci.z, 0u, f - vec3<f32>(1.0, 1.0, 0.0)), t.x);
+    let x01 = mix(corner(h00, ci.z, 1u, f - vec3<f32>(0.0, 0.0, 1.0)), corner(h10, ci.z, 1u, f - vec3<f32>(1.0, 0.0, 1.0)), t.x);
+    let x11 = mix(corner(h01, ci.z, 1u, f - vec3<f32>(0.0, 1.0, 1.0)), corner(h11, ci.z, 1u, f - vec3<f32>(1.0, 1.0, 1.0)), t.x);
+    return mix(mix(x00, x10, t.y), mix(x01, x11, t.y), t.z);
+}
+
+// ---- pelage::dynamics::solver ----
+
+// WindNow::at.
+fn wind_at(p: vec3<f32>) -> vec3<f32> {
+    let turbulence = step.wind_mean.w;
+    if turbulence == 0.0 {
+        return step.wind_mean.xyz;
+    }
+    return step.wind_mean.xyz + turbulence * perlin3_vector((p - step.wind_drift.xyz) * step.wind_drift.w);
+}
+
+// MassSpringSystem::tip_force.
+fn tip_force(i: u32, x: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    let root = roots[i].xyz;
+    let rest_length = roots[i].w;
+    let n = normals[i].xyz;
+    let v_rel = v - root_velocities[i].xyz;
+    let d = x - root;
+    let l = length(d);
+    var dir = n;
+    if l > 1e-12 {
+        dir = d / l;
+    }
+    var f: vec3<f32>;
+    if step.counts.y != 0u {
+        f = -step.springs.y * (x - (root + rest_length * n)) - step.springs.w * v_rel;
+    } else {
+        let stretch = -step.springs.y * (l - rest_length) * dir;
+        // Banisch Eq. 5.
+        let restoring = (n - dir) * (1.0 - dot(n, dir)) * step.misc.y;
+        f = stretch - step.springs.w * dot(v_rel, dir) * dir + restoring;
+    }
+    f += step.springs.x * step.gravity.xyz;
+    f += step.misc.x * (wind_at(x) - v);
+    let radius = step.brush_centre.w;
+    if radius > 0.0 {
+        let q = distance(x, step.brush_centre.xyz) / max(radius, 1e-9);
+        if q < 1.0 {
+            let fade = 1.0 - q * q;
+            f += step.brush_force.xyz * fade * fade;
+        }
+    }
+    return f;
+}
+
+// MassSpringSystem::lateral_force.
+fn lateral_force(i: u32, x: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    var f = vec3<f32>(0.0);
+    for (var s = spring_offsets[i]; s < spring_offsets[i + 1u]; s += 1u) {
+        let end = spring_ends[s];
+        let d = x - tips_in[end.x].xyz;
+        let l = length(d);
+        if l <= 1e-12 {
+            continue;
+        }
+        let dir = d / l;
+        let dv = v - velocities_in[end.x].xyz;
+        let rest = bitcast<f32>(end.y);
+        f += -step.springs.z * (l - rest) * dir - step.springs.w * dot(dv, dir) * dir;
+    }
+    return f;
+}
+
+struct TipState {
+    x: vec3<f32>,
+    v: vec3<f32>,
+};
+
+// MassSpringSystem::constrained.
+fn constrained(i: u32, x_in: vec3<f32>, v_in: vec3<f32>) -> TipState {
+    var x = x_in;
+    var v = v_in;
+    let root = roots[i].xyz;
+    let rest_length = roots[i].w;
+    let n = normals[i].xyz;
+    let root_velocity = root_velocities[i].xyz;
+    let height = dot(x - root, n);
+    if height < 0.0 {
+        x -= height * n;
+        let vn = dot(v - root_velocity, n);
+        if vn < 0.0 {
+            v -= vn * n;
+        }
+    }
+    if step.counts.y != 0u {
+        let d = x - root;
+        let l = length(d);
+        if l > rest_length {
+            let dir = d / l;
+            x = root + rest_length * dir;
+            let vr = dot(v - root_velocity, dir);
+            if vr > 0.0 {
+                v -= vr * dir;
+            }
+        }
+    }
+    return TipState(x, v);
+}
+
+// Millions of tips need more workgroups than one dispatch dimension
+// holds (65,535), so the host spreads them over x and y.
+@compute @workgroup_size(64)
+fn explicit_substep(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let i = id.y * groups.x * 64u + id.x;
+    if i >= step.counts.x {
+        return;
+    }
+    let h = step.gravity.w;
+    let x = tips_in[i].xyz;
+    let v0 = velocities_in[i].xyz;
+    let f = tip_force(i, x, v0) + lateral_force(i, x, v0);
+    let v = v0 + (h / step.springs.x) * f;
+    let next = constrained(i, x + h * v, v);
+    tips_out[i] = vec4<f32>(next.x, 0.0);
+    velocities_out[i] = vec4<f32>(next.v, 0.0);
+}

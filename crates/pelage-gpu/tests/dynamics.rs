@@ -1,0 +1,123 @@
+//! The GPU's explicit mass-spring step against the CPU's
+//! (`pelage::dynamics`): every topology on spot, in gusting turbulent wind
+//! with gravity and a brush, some tips started inside the skin or
+//! overstretched so the constraints act; after 80 substeps (more than one
+//! submission's worth) the two states must agree. Needs an adapter
+//! (lavapipe serves); `PELAGE_REQUIRE_GPU=1` (CI) makes a missing one a
+//! failure.
+
+use glam::Vec3;
+use pelage::dynamics::{Brush, DynamicsParams, MassSpringSystem, Solver, Topology, Wind};
+use pelage_gpu::{GpuContext, GpuMassSpring};
+use std::sync::OnceLock;
+
+fn gpu() -> Option<&'static GpuContext> {
+    static GPU: OnceLock<Option<GpuContext>> = OnceLock::new();
+    GPU.get_or_init(|| match GpuContext::headless() {
+        Ok(ctx) => Some(ctx),
+        Err(e) if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() => {
+            panic!("PELAGE_REQUIRE_GPU is set and there is no adapter: {e}")
+        }
+        Err(e) => {
+            eprintln!("SKIPPED: no GPU adapter ({e})");
+            None
+        }
+    })
+    .as_ref()
+}
+
+#[test]
+fn the_gpu_explicit_step_matches_the_cpu_one() {
+    let Some(ctx) = gpu() else { return };
+    let mesh = pelage::assets::spot();
+    let (lo, hi) = mesh.bounds();
+    let length = 0.03 * (hi - lo).length();
+    let params = DynamicsParams {
+        wind: Some(Wind::new(Vec3::new(3.0, 0.0, 1.0), 0.8, 1.5, 4.0, 3.0, 7)),
+        brush: Some(Brush {
+            centre: mesh.positions()[0],
+            radius: 0.3 * (hi - lo).length(),
+            force: Vec3::new(0.0, 0.0, 0.02),
+        }),
+        ..Default::default()
+    };
+    let (dt, substeps, steps) = (1.0 / 60.0, 2, 40);
+    for topology in Topology::ALL {
+        let mut cpu = MassSpringSystem::new(&mesh, topology, length);
+        // Every seventh tip starts inside the skin, every eleventh stretched
+        // to twice its length: the constraints must bring them back alike.
+        for i in 0..cpu.mass_count() {
+            let (root, n) = (cpu.roots()[i], cpu.normals()[i]);
+            if i % 7 == 0 {
+                cpu.set_tip(i, root - 0.5 * length * n, Vec3::ZERO);
+            } else if i % 11 == 0 {
+                cpu.set_tip(i, root + 2.0 * length * n, -n);
+            }
+        }
+        let start = cpu.tips().to_vec();
+        let mut gpu_system = GpuMassSpring::new(ctx, &cpu).expect("upload");
+        gpu_system.step_explicit(ctx, dt, &params, substeps, 0.0, steps);
+        for k in 0..steps {
+            cpu.step(dt, &params, Solver::Explicit { substeps }, k as f32 * dt);
+        }
+        let (tips, velocities) = gpu_system.read_state(ctx).expect("read back");
+        let moved = start
+            .iter()
+            .zip(cpu.tips())
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max);
+        assert!(
+            moved > 0.2 * length,
+            "{topology:?}: the fur hardly moved ({moved}), the comparison would prove little"
+        );
+        let worst = tips
+            .iter()
+            .zip(cpu.tips())
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max);
+        let worst_velocity = velocities
+            .iter()
+            .zip(cpu.velocities())
+            .map(|(a, b)| a.distance(*b) / (1.0 + b.length()))
+            .fold(0.0f32, f32::max);
+        eprintln!(
+            "{topology:?}: {} masses, moved up to {:.3} L0, GPU − CPU up to {:.2e} L0, velocity {:.2e}",
+            cpu.mass_count(),
+            moved / length,
+            worst / length,
+            worst_velocity
+        );
+        assert!(
+            worst <= 1e-3 * length,
+            "{topology:?}: GPU and CPU tips differ by {} (L0 = {length})",
+            worst
+        );
+        assert!(
+            worst_velocity <= 1e-2,
+            "{topology:?}: GPU and CPU velocities differ by {worst_velocity}"
+        );
+    }
+}
+
+#[test]
+fn the_gpu_state_downloads_into_the_system_it_came_from_only() {
+    let Some(ctx) = gpu() else { return };
+    let mesh = pelage::assets::spot();
+    let params = DynamicsParams {
+        wind: Some(Wind::new(Vec3::new(2.0, 0.0, 0.0), 0.5, 1.0, 1.0, 3.0, 1)),
+        ..Default::default()
+    };
+    let mut system = MassSpringSystem::new(&mesh, Topology::Prisms, 0.05);
+    let rest = system.tips().to_vec();
+    let mut on_gpu = GpuMassSpring::new(ctx, &system).expect("upload");
+    on_gpu.step_explicit(ctx, 1.0 / 60.0, &params, 1, 0.0, 10);
+    on_gpu.download_into(ctx, &mut system).expect("read back");
+    let (tips, _) = on_gpu.read_state(ctx).expect("read back");
+    assert_eq!(system.tips(), &tips[..]);
+    assert_ne!(system.tips(), &rest[..], "ten windy steps moved the fur");
+    let mut other = MassSpringSystem::new(&mesh, Topology::SeparablePrisms, 0.05);
+    let error = on_gpu
+        .download_into(ctx, &mut other)
+        .expect_err("a system of another size is refused");
+    assert!(error.to_string().contains("masses"), "{error}");
+}
