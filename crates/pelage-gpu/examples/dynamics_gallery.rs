@@ -238,6 +238,7 @@ fn main() {
             frequency: 2.0,
             duration: 1.0,
         }),
+        ..Default::default()
     });
     let mut player = ShellScenePlayer::new(&ctx, &scene, WIDTH, HEIGHT).expect("player");
     let frames: Vec<image::RgbaImage> = (0..30)

@@ -10,7 +10,7 @@
 //! GB/s. Many steps can be queued in one submission, as a real-time loop
 //! would, and the state read back only when the CPU needs it.
 
-use crate::{GpuContext, GpuError};
+use crate::{GpuContext, GpuError, ShellModel};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use pelage::dynamics::{DynamicsParams, MassSpringSystem, Topology};
@@ -46,6 +46,11 @@ pub struct GpuMassSpring {
     tips: u32,
     silva: bool,
     pipeline: wgpu::ComputePipeline,
+    /// Writes the shell renderer's per-corner tip offsets.
+    coupling: wgpu::ComputePipeline,
+    coupling_layout: wgpu::BindGroupLayout,
+    corner_sticks: wgpu::Buffer,
+    corners: u32,
     uniforms: wgpu::Buffer,
     roots: wgpu::Buffer,
     normals: wgpu::Buffer,
@@ -58,6 +63,14 @@ pub struct GpuMassSpring {
     bind_groups: [wgpu::BindGroup; 2],
     /// Which of `state` holds the current state.
     current: usize,
+}
+
+/// Workgroups (x, y) covering `n` invocations: past 65,535 along x, the
+/// shaders fold y into the index.
+fn workgroups(n: u32) -> (u32, u32) {
+    let groups = n.div_ceil(WORKGROUP).max(1);
+    let x = groups.min(65_535);
+    (x, groups.div_ceil(x))
 }
 
 fn padded(v: &[Vec3]) -> Vec<[f32; 4]> {
@@ -165,6 +178,11 @@ impl GpuMassSpring {
                 ),
             )
         });
+        let corner_sticks = storage(
+            "dynamics corner sticks",
+            bytemuck::cast_slice(system.corner_sticks()),
+            wgpu::BufferUsages::empty(),
+        );
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("dynamics steps"),
             size: SLOT_BYTES * u64::from(SLOTS),
@@ -245,10 +263,38 @@ impl GpuMassSpring {
             compilation_options: Default::default(),
             cache: None,
         });
+        let coupling_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dynamics coupling"),
+            entries: &[
+                entry(1, read, false),
+                entry(2, read, false),
+                entry(7, read, false),
+                entry(11, read, false),
+                entry(12, write, false),
+            ],
+        });
+        let coupling = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("dynamics corner tip offsets"),
+            layout: Some(
+                &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("dynamics coupling"),
+                    bind_group_layouts: &[Some(&coupling_layout)],
+                    immediate_size: 0,
+                }),
+            ),
+            module: &module,
+            entry_point: Some("corner_tip_offsets"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
         Ok(Self {
             tips,
             silva: system.topology() == Topology::SilvaStrands,
             pipeline,
+            coupling,
+            coupling_layout,
+            corners: system.corner_sticks().len() as u32,
+            corner_sticks,
             uniforms,
             roots,
             normals,
@@ -317,9 +363,7 @@ impl GpuMassSpring {
                 self.permutation_seed = Some(seed);
             }
         }
-        let groups = self.tips.div_ceil(WORKGROUP).max(1);
-        let groups_x = groups.min(65_535);
-        let groups_y = groups.div_ceil(groups_x);
+        let (groups_x, groups_y) = workgroups(self.tips);
         let times: Vec<f32> = (0..steps)
             .flat_map(|s| (0..substeps).map(move |k| time + s as f32 * dt + k as f32 * h))
             .collect();
@@ -378,6 +422,52 @@ impl GpuMassSpring {
             brush_force: v4(force, 0.0),
             counts: [self.tips, u32::from(self.silva), 0, 0],
         }
+    }
+
+    /// Writes each triangle corner's tip offset `p − p0` straight into
+    /// `model`'s vertex buffer — what
+    /// [`ShellRenderer::set_tip_offsets`](crate::ShellRenderer::set_tip_offsets)
+    /// uploads from the CPU — so the renderer draws the GPU's state with no
+    /// read-back. `model` must be of the mesh this system was built on.
+    pub fn write_tip_offsets(&self, ctx: &GpuContext, model: &ShellModel) -> Result<(), GpuError> {
+        if model.vertex_count != self.corners {
+            return Err(GpuError::Mismatch(format!(
+                "the shell model has {} triangle corners; the mass-spring system follows {}",
+                model.vertex_count, self.corners
+            )));
+        }
+        if self.corners == 0 {
+            return Ok(());
+        }
+        let (tips, _) = &self.state[self.current];
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dynamics coupling"),
+            layout: &self.coupling_layout,
+            entries: &[
+                (1, &self.roots),
+                (2, &self.normals),
+                (7, tips),
+                (11, &self.corner_sticks),
+                (12, &model.tip_offsets),
+            ]
+            .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }),
+        });
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("dynamics coupling"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.coupling);
+            pass.set_bind_group(0, &bind_group, &[]);
+            let (x, y) = workgroups(self.corners);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+        ctx.queue.submit([encoder.finish()]);
+        Ok(())
     }
 
     /// Waits for every queued step to finish.

@@ -14,7 +14,7 @@ use crate::{Camera, GpuContext, GpuError};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use pelage::Mesh;
-use pelage::dynamics::MassSpringSystem;
+use pelage::dynamics::{MassSpringSystem, Solver};
 use pelage::shell::math::{ClumpParams, Coupling, CurlParams, KajiyaKay, ShadingMode};
 use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
 use wgpu::util::DeviceExt;
@@ -125,8 +125,9 @@ struct ShellUniforms {
 #[derive(Debug)]
 pub struct ShellModel {
     vertices: wgpu::Buffer,
-    tip_offsets: wgpu::Buffer,
-    vertex_count: u32,
+    /// p − p0 per triangle corner; `GpuMassSpring` writes it in place.
+    pub(crate) tip_offsets: wgpu::Buffer,
+    pub(crate) vertex_count: u32,
     wetness: wgpu::Texture,
     wetness_size: (u32, u32),
     textures: wgpu::BindGroup,
@@ -411,7 +412,9 @@ impl ShellRenderer {
         let tip_offsets = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shell tip offsets"),
             contents: bytemuck::cast_slice(&vec![0.0f32; mesh.triangle_count() * 9]),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::VERTEX
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::STORAGE,
         });
         let size = |w, h, layers| wgpu::Extent3d {
             width: w,
@@ -792,6 +795,9 @@ pub struct ShellScenePlayer<'s> {
 #[derive(Debug)]
 struct FurMotion {
     system: MassSpringSystem,
+    /// The system stepped on the GPU (`gpu = true`); `system` then holds
+    /// only the skin's motion.
+    on_gpu: Option<crate::GpuMassSpring>,
     rest_roots: Vec<Vec3>,
     rest_normals: Vec<Vec3>,
     time: f32,
@@ -826,6 +832,24 @@ impl<'s> ShellScenePlayer<'s> {
             width as f32 / height as f32,
             scene.light,
         );
+        let motion = match &scene.dynamics {
+            None => None,
+            Some(d) => {
+                let system = MassSpringSystem::new(&scene.mesh, d.topology, scene.fur.length);
+                let on_gpu = if d.gpu {
+                    Some(crate::GpuMassSpring::new(ctx, &system)?)
+                } else {
+                    None
+                };
+                Some(FurMotion {
+                    rest_roots: system.roots().to_vec(),
+                    rest_normals: system.normals().to_vec(),
+                    system,
+                    on_gpu,
+                    time: 0.0,
+                })
+            }
+        };
         Ok(Self {
             scene,
             renderer,
@@ -834,15 +858,7 @@ impl<'s> ShellScenePlayer<'s> {
             params: ShellParams::from_scene(scene),
             view,
             timeline: scene.wetness_timeline(),
-            motion: scene.dynamics.as_ref().map(|d| {
-                let system = MassSpringSystem::new(&scene.mesh, d.topology, scene.fur.length);
-                FurMotion {
-                    rest_roots: system.roots().to_vec(),
-                    rest_normals: system.normals().to_vec(),
-                    system,
-                    time: 0.0,
-                }
-            }),
+            motion,
         })
     }
 
@@ -859,15 +875,28 @@ impl<'s> ShellScenePlayer<'s> {
             let offset = shake(next);
             let roots: Vec<Vec3> = motion.rest_roots.iter().map(|&r| r + offset).collect();
             motion.system.move_roots(&roots, &motion.rest_normals, dt);
-            motion
-                .system
-                .step(dt, &settings.params, settings.solver, motion.time);
+            match (&mut motion.on_gpu, settings.solver) {
+                (Some(gpu), Solver::Explicit { substeps }) => {
+                    if settings.shake.is_some() {
+                        gpu.upload_roots(ctx, &motion.system);
+                    }
+                    gpu.step_explicit(ctx, dt, &settings.params, substeps, motion.time, 1);
+                }
+                _ => motion
+                    .system
+                    .step(dt, &settings.params, settings.solver, motion.time),
+            }
             motion.time = next;
         }
         self.params.coupling = settings.coupling;
         self.params.offset = shake(motion.time);
-        self.renderer
-            .set_tip_offsets(ctx, &self.model, &motion.system.corner_tip_offsets())
+        match &motion.on_gpu {
+            Some(gpu) => gpu.write_tip_offsets(ctx, &self.model),
+            None => {
+                self.renderer
+                    .set_tip_offsets(ctx, &self.model, &motion.system.corner_tip_offsets())
+            }
+        }
     }
 
     /// The frame at `time` seconds (not before the last one drawn).

@@ -121,3 +121,46 @@ fn the_gpu_state_downloads_into_the_system_it_came_from_only() {
         .expect_err("a system of another size is refused");
     assert!(error.to_string().contains("masses"), "{error}");
 }
+
+/// A windy shaken scene, animated with the CPU's explicit solver and with
+/// `gpu = true`: the frames must match (the renderer reads the GPU's tips
+/// in place), and the fur must have moved.
+#[test]
+fn a_scene_stepped_on_the_gpu_renders_as_on_the_cpu() {
+    let Some(ctx) = gpu() else { return };
+    let base = "[fur]\nlayers = 8\nlength = 0.08\n[texture]\nresolution = 64\n[animation]\nfps = 8\n\
+        [dynamics]\ntopology = \"prisms\"\nsolver = \"explicit\"\nsubsteps = 8\n\
+        [dynamics.wind]\nvelocity = [6, 0, 2]\nturbulence = 3\n\
+        [dynamics.shake]\namplitude = [0.05, 0, 0]\nfrequency = 4\n";
+    let frames = |gpu: bool| {
+        let text = base.replace("substeps = 8\n", &format!("substeps = 8\ngpu = {gpu}\n"));
+        let scene = pelage::shell::ShellScene::from_source(&pelage::groom::GroomSource {
+            path: "windy.toml".into(),
+            text,
+        })
+        .expect("scene");
+        assert_eq!(scene.dynamics.as_ref().unwrap().gpu, gpu);
+        let mut player = pelage_gpu::ShellScenePlayer::new(ctx, &scene, 160, 120).expect("player");
+        [0.0, 0.5].map(|t| player.render_at(ctx, t).expect("frame"))
+    };
+    let differing = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        a.pixels()
+            .zip(b.pixels())
+            .filter(|(p, q)| (0..3).any(|c| p.0[c].abs_diff(q.0[c]) > 8))
+            .count()
+    };
+    let [cpu_start, cpu_later] = frames(false);
+    let [gpu_start, gpu_later] = frames(true);
+    let moved = differing(&cpu_start, &cpu_later);
+    let apart = differing(&cpu_later, &gpu_later);
+    eprintln!("fur moved in {moved} pixels; GPU and CPU frames differ in {apart}");
+    assert!(
+        moved > 160 * 120 / 100,
+        "the fur hardly moved: {moved} pixels"
+    );
+    assert_eq!(differing(&cpu_start, &gpu_start), 0);
+    assert!(
+        apart <= 160 * 120 / 500,
+        "{apart} pixels differ between GPU and CPU stepping"
+    );
+}

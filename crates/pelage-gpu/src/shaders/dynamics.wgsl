@@ -208,3 +208,27 @@ fn explicit_substep(
     tips_out[i] = vec4<f32>(next.x, 0.0);
     velocities_out[i] = vec4<f32>(next.v, 0.0);
 }
+
+// ---- coupling to the shells: MassSpringSystem::corner_tip_offsets ----
+
+// For each triangle corner, the stick it follows; and the renderer's
+// per-corner tip offsets p − p0 (three floats a corner, its vertex buffer).
+@group(0) @binding(11) var<storage, read> corner_sticks: array<u32>;
+@group(0) @binding(12) var<storage, read_write> corner_offsets: array<f32>;
+
+@compute @workgroup_size(64)
+fn corner_tip_offsets(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let c = id.y * groups.x * 64u + id.x;
+    if c >= arrayLength(&corner_sticks) {
+        return;
+    }
+    let s = corner_sticks[c];
+    let rest_tip = roots[s].xyz + roots[s].w * normals[s].xyz;
+    let offset = tips_in[s].xyz - rest_tip;
+    corner_offsets[3u * c] = offset.x;
+    corner_offsets[3u * c + 1u] = offset.y;
+    corner_offsets[3u * c + 2u] = offset.z;
+}

@@ -54,6 +54,7 @@ struct DynamicsSection {
     solver: Option<Spanned<String>>,
     substeps: Option<u32>,
     iterations: Option<u32>,
+    gpu: Option<Spanned<bool>>,
     steps_per_frame: Option<u32>,
     coupling: Option<Spanned<String>>,
     exponent: Option<f32>,
@@ -252,6 +253,9 @@ pub struct DynamicsSettings {
     pub params: DynamicsParams,
     /// The object shaken, if at all.
     pub shake: Option<Shake>,
+    /// Step on the GPU (explicit solver only): the renderer then reads the
+    /// tips where they are computed, with no copy through the CPU.
+    pub gpu: bool,
 }
 
 impl Default for DynamicsSettings {
@@ -265,6 +269,7 @@ impl Default for DynamicsSettings {
             coupling: Coupling::Bent { exponent: 2.0 },
             params: DynamicsParams::default(),
             shake: None,
+            gpu: false,
         }
     }
 }
@@ -563,6 +568,14 @@ impl ShellScene {
                         ));
                     }
                 };
+                let gpu = d.gpu.as_ref().is_some_and(|g| *g.get_ref());
+                if let (true, Solver::Implicit { .. }) = (gpu, solver) {
+                    let span = d.gpu.as_ref().map_or(0..0, |g| g.span());
+                    return Err(invalid(
+                        span,
+                        "the GPU steps the explicit solver only: set solver = \"explicit\", or gpu = false".to_string(),
+                    ));
+                }
                 let default_coupling = if topology == Topology::SilvaStrands {
                     "bezier"
                 } else {
@@ -617,6 +630,7 @@ impl ShellScene {
                         frequency: s.frequency.unwrap_or(3.0).max(1e-3),
                         duration: s.duration.unwrap_or(1.0).max(0.0),
                     }),
+                    gpu,
                 })
             }
         };
@@ -800,6 +814,16 @@ mod tests {
             "{e}"
         );
         assert!(scene("").unwrap().dynamics.is_none());
+        let d = scene("[dynamics]\nsolver = \"explicit\"\ngpu = true\n")
+            .unwrap()
+            .dynamics
+            .unwrap();
+        assert!(d.gpu);
+        let e = scene("[dynamics]\ngpu = true\n").unwrap_err().to_string();
+        assert!(
+            e.starts_with("fur.toml:2:7: dynamics.gpu: the GPU steps the explicit solver only"),
+            "{e}"
+        );
     }
 
     #[test]
