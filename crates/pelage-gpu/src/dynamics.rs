@@ -334,7 +334,9 @@ impl GpuMassSpring {
 
     /// Queues `steps` explicit steps of `dt` seconds, `substeps` each,
     /// starting at `time` (the wind's clock), as the CPU's
-    /// `Solver::Explicit { substeps }` steps. Returns once they are
+    /// `Solver::Explicit { substeps }` steps (at least 1 here: resolve the
+    /// CPU's automatic 0 with `MassSpringSystem::explicit_substeps`).
+    /// Returns once they are
     /// submitted; [`wait`](Self::wait) or [`read_state`](Self::read_state)
     /// for them to finish.
     pub fn step_explicit(

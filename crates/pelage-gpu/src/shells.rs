@@ -880,6 +880,9 @@ impl<'s> ShellScenePlayer<'s> {
                     if settings.shake.is_some() {
                         gpu.upload_roots(ctx, &motion.system);
                     }
+                    let substeps = motion
+                        .system
+                        .explicit_substeps(dt, &settings.params, substeps);
                     gpu.step_explicit(ctx, dt, &settings.params, substeps, motion.time, 1);
                 }
                 _ => motion

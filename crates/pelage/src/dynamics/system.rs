@@ -106,6 +106,9 @@ pub struct MassSpringSystem {
     /// For each tip, its springs (indices into `springs`), CSR.
     pub(crate) spring_offsets: Vec<u32>,
     pub(crate) spring_index: Vec<u32>,
+    /// The most tip-tip springs any tip has (the explicit solver's
+    /// stability bound reads it).
+    pub(crate) max_tip_springs: u32,
     /// For each triangle corner (3t + k), the stick it follows.
     corner_sticks: Vec<u32>,
     /// The next state while a step writes it (double buffering).
@@ -197,8 +200,10 @@ impl MassSpringSystem {
                 fill[end as usize] += 1;
             }
         }
+        let max_tip_springs = counts.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0);
         Self {
             topology,
+            max_tip_springs,
             root_velocities: vec![Vec3::ZERO; n],
             lengths: vec![length; n],
             velocities: vec![Vec3::ZERO; n],

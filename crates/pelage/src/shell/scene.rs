@@ -559,7 +559,8 @@ impl ShellScene {
                         iterations: d.iterations.unwrap_or(30).max(1),
                     },
                     "explicit" => Solver::Explicit {
-                        substeps: d.substeps.unwrap_or(4).max(1),
+                        // 0: as many as stability needs.
+                        substeps: d.substeps.unwrap_or(0),
                     },
                     other => {
                         return Err(invalid(
@@ -791,7 +792,8 @@ mod tests {
             Coupling::Bezier,
             "Silva strands default to the Bézier"
         );
-        assert_eq!(d.solver, Solver::Explicit { substeps: 4 });
+        // No substeps given: as many as stability needs.
+        assert_eq!(d.solver, Solver::Explicit { substeps: 0 });
         let s = scene("[dynamics]\n[dynamics.shake]\namplitude = [0.1, 0, 0]\nfrequency = 2\n")
             .unwrap();
         let d = s.dynamics.unwrap();

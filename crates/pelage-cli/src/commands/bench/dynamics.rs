@@ -1,6 +1,7 @@
 //! `pelage bench dynamics`: time per step of every mass-spring topology ×
 //! solver (Banisch & Wüthrich's four, Silva's strands; explicit symplectic
-//! Euler with one substep, implicit backward Euler: 10 CG iterations where
+//! Euler with as many substeps as stability needs — one, except for the
+//! prisms — implicit backward Euler: 10 CG iterations where
 //! springs join the tips, a direct 3×3 solve per tip where none do)
 //! on spot, blub and spot ×4 (1.5 M triangles), under gravity and gusting
 //! turbulent wind, on all threads. Targets (2 cores): 1 M masses —
@@ -42,6 +43,8 @@ struct Row {
     masses: usize,
     springs: usize,
     ms: [f64; 2],
+    /// Substeps of the explicit step (the stability bound's).
+    substeps: u32,
     /// The explicit step on the GPU, if one was measured.
     gpu_ms: Option<f64>,
 }
@@ -56,13 +59,21 @@ fn gpu_explicit_ms(
     steps: usize,
 ) -> anyhow::Result<f64> {
     let mut gpu = pelage_gpu::GpuMassSpring::new(ctx, system)?;
-    gpu.step_explicit(ctx, dt, params, 1, 0.0, 1);
+    let substeps = system.stable_substeps(dt, params);
+    gpu.step_explicit(ctx, dt, params, substeps, 0.0, 1);
     gpu.wait(ctx)?;
     let steps = steps.max(1) as u32;
     let mut batches = Vec::new();
     for b in 0..3 {
         let start = std::time::Instant::now();
-        gpu.step_explicit(ctx, dt, params, 1, (1 + b * steps) as f32 * dt, steps);
+        gpu.step_explicit(
+            ctx,
+            dt,
+            params,
+            substeps,
+            (1 + b * steps) as f32 * dt,
+            steps,
+        );
         gpu.wait(ctx)?;
         batches.push(start.elapsed().as_secs_f64() * 1e3 / f64::from(steps));
     }
@@ -71,7 +82,9 @@ fn gpu_explicit_ms(
 }
 
 const SOLVERS: [Solver; 2] = [
-    Solver::Explicit { substeps: 1 },
+    // As many substeps as stability needs: timing a diverging step says
+    // nothing.
+    Solver::Explicit { substeps: 0 },
     Solver::Implicit { iterations: 10 },
 ];
 
@@ -107,6 +120,8 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         for topology in Topology::ALL {
             let mut ms = [0.0; 2];
             let mut counts = (0, 0);
+            let substeps =
+                MassSpringSystem::new(mesh, topology, length).stable_substeps(dt, &params);
             let gpu_ms = match &gpu {
                 Some(ctx) => Some(gpu_explicit_ms(
                     ctx,
@@ -133,6 +148,7 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
                 masses: counts.0,
                 springs: counts.1,
                 ms,
+                substeps,
                 gpu_ms,
             });
         }
@@ -150,12 +166,13 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
             .iter()
             .map(|r| {
                 format!(
-                    "{{\"model\":{:?},\"topology\":{:?},\"masses\":{},\"springs\":{},\"explicit_ms\":{:.4},\"implicit_ms\":{:.4},\"gpu_explicit_ms\":{}}}",
+                    "{{\"model\":{:?},\"topology\":{:?},\"masses\":{},\"springs\":{},\"explicit_ms\":{:.4},\"explicit_substeps\":{},\"implicit_ms\":{:.4},\"gpu_explicit_ms\":{}}}",
                     r.model,
                     r.topology.name(),
                     r.masses,
                     r.springs,
                     r.ms[0],
+                    r.substeps,
                     r.ms[1],
                     json_ms(r.gpu_ms)
                 )
@@ -185,7 +202,7 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         args.steps.max(1)
     );
     println!(
-        "explicit: symplectic Euler, 1 substep; implicit: backward Euler, 10 CG iterations (prisms) or a direct 3×3 solve per tip (no tip-tip springs)"
+        "explicit: symplectic Euler, substeps (sub.) as stability needs; implicit: backward Euler, 10 CG iterations (prisms) or a direct 3×3 solve per tip (no tip-tip springs)"
     );
     match &gpu_name {
         Some(name) => println!(
@@ -195,11 +212,12 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         None => println!(),
     }
     println!(
-        "{:>8}  {:>24}  {:>10}  {:>10}  {:>11}  {:>11}  {:>14}  {:>12}",
+        "{:>8}  {:>24}  {:>10}  {:>10}  {:>4}  {:>11}  {:>11}  {:>14}  {:>12}",
         "model",
         "topology",
         "masses",
         "springs",
+        "sub.",
         "explicit",
         "implicit",
         "M masses/s (impl.)",
@@ -207,11 +225,12 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
     );
     for r in &rows {
         println!(
-            "{:>8}  {:>24}  {:>10}  {:>10}  {:>8.2} ms  {:>8.2} ms  {:>18.2}  {:>12}",
+            "{:>8}  {:>24}  {:>10}  {:>10}  {:>4}  {:>8.2} ms  {:>8.2} ms  {:>18.2}  {:>12}",
             r.model,
             r.topology.name(),
             thousands(r.masses as u64),
             thousands(r.springs as u64),
+            r.substeps,
             r.ms[0],
             r.ms[1],
             r.masses as f64 / r.ms[1] / 1e3,

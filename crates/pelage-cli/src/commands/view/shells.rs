@@ -529,7 +529,8 @@ impl ShellSession {
         });
         d.solver = match (implicit, d.solver) {
             (true, Solver::Explicit { .. }) => Solver::Implicit { iterations: 30 },
-            (false, Solver::Implicit { .. }) => Solver::Explicit { substeps: 4 },
+            // As many substeps as the stiffness slider asks for stability.
+            (false, Solver::Implicit { .. }) => Solver::Explicit { substeps: 0 },
             (_, s) => s,
         };
         ui.add(
