@@ -125,12 +125,20 @@ fn dragging_with_the_push_tool_moves_the_fur_under_the_pointer() {
     if !has_display() {
         return;
     }
+    // Stepped on the CPU (implicit, the default) and on the GPU
+    // (explicit, `gpu = true`): the push must show alike.
+    for solver in ["", "solver = \"explicit\"\ngpu = true\n"] {
+        push_moves_the_fur_under_the_pointer(solver);
+    }
+}
+
+fn push_moves_the_fur_under_the_pointer(solver: &str) {
     let dir = tempfile::tempdir().unwrap();
     let (cx, cy) = (SIZE.0 as f32 / 2.0, SIZE.1 as f32 / 2.0);
     // No gravity and no wind: the fur is at rest until pushed.
     view_scripted(
         dir.path(),
-        "[fur]\nlayers = 16\n[dynamics]\ngravity = [0, 0, 0]\n",
+        &format!("[fur]\nlayers = 16\n[dynamics]\ngravity = [0, 0, 0]\n{solver}"),
         &format!(
             "ui = false\n\
              [[step]]\nwait = 3\n[[step]]\nscreenshot = \"before.png\"\n\
@@ -146,11 +154,11 @@ fn dragging_with_the_push_tool_moves_the_fur_under_the_pointer() {
         (cx + 30.0, cy),
         0.25 * SIZE.1 as f32,
     );
-    eprintln!("changed pixels: {near} near the push, {far} elsewhere");
-    assert!(near > 100, "the push must show: {near}");
+    eprintln!("{solver:?}: changed pixels: {near} near the push, {far} elsewhere");
+    assert!(near > 100, "{solver:?}: the push must show: {near}");
     assert!(
         far < near / 10,
-        "{far} pixels changed away from the push ({near} near it)"
+        "{solver:?}: {far} pixels changed away from the push ({near} near it)"
     );
 }
 

@@ -100,6 +100,10 @@ pub struct ShellSession {
 
 struct Motion {
     system: MassSpringSystem,
+    /// The system stepped on the GPU (explicit solver, "on the GPU"
+    /// ticked); `system` then holds the skin's motion, and the tips only
+    /// once copied back.
+    on_gpu: Option<pelage_gpu::GpuMassSpring>,
     topology: Topology,
     rest_roots: Vec<glam::Vec3>,
     rest_normals: Vec<glam::Vec3>,
@@ -349,27 +353,59 @@ impl ShellSession {
                 rest_roots: system.roots().to_vec(),
                 rest_normals: system.normals().to_vec(),
                 system,
+                on_gpu: None,
                 topology,
                 time: 0.0,
             });
         }
+        let explicit = match settings.solver {
+            Solver::Explicit { substeps } => Some(substeps),
+            Solver::Implicit { .. } => None,
+        };
         let steps = settings.steps_per_frame.max(1);
         let h = dt / steps as f32;
         let motion = self.motion.as_mut().expect("made above");
+        match (settings.gpu && explicit.is_some(), motion.on_gpu.is_some()) {
+            (true, false) => {
+                motion.on_gpu = Some(pelage_gpu::GpuMassSpring::new(ctx, &motion.system)?);
+            }
+            (false, true) => {
+                // Back to the CPU: it carries on from where the GPU got.
+                if let Some(gpu) = motion.on_gpu.take() {
+                    gpu.download_into(ctx, &mut motion.system)?;
+                }
+            }
+            _ => {}
+        }
         if h > 0.0 {
             for _ in 0..steps {
                 let roots: Vec<Vec3> = motion.rest_roots.iter().map(|&r| r + offset).collect();
                 motion.system.move_roots(&roots, &motion.rest_normals, h);
-                motion
-                    .system
-                    .step(h, &settings.params, settings.solver, motion.time);
+                match (&mut motion.on_gpu, explicit) {
+                    (Some(gpu), Some(substeps)) => {
+                        gpu.upload_roots(ctx, &motion.system);
+                        let substeps =
+                            motion
+                                .system
+                                .explicit_substeps(h, &settings.params, substeps);
+                        gpu.step_explicit(ctx, h, &settings.params, substeps, motion.time, 1);
+                    }
+                    _ => motion
+                        .system
+                        .step(h, &settings.params, settings.solver, motion.time),
+                }
                 motion.time += h;
             }
         }
         self.params.coupling = settings.coupling;
         self.params.offset = offset;
-        self.renderer
-            .set_tip_offsets(ctx, &self.model, &motion.system.corner_tip_offsets())
+        match &motion.on_gpu {
+            Some(gpu) => gpu.write_tip_offsets(ctx, &self.model),
+            None => {
+                self.renderer
+                    .set_tip_offsets(ctx, &self.model, &motion.system.corner_tip_offsets())
+            }
+        }
     }
 
     /// Applies the panel's settings that need work (a new shell texture
@@ -533,6 +569,10 @@ impl ShellSession {
             (false, Solver::Implicit { .. }) => Solver::Explicit { substeps: 0 },
             (_, s) => s,
         };
+        if !implicit {
+            ui.checkbox(&mut d.gpu, "on the GPU")
+                .on_hover_text("step the explicit solver in a compute shader; the fur is drawn from the GPU's state");
+        }
         ui.add(
             egui::Slider::new(&mut d.params.stiffness, 0.05..=50.0)
                 .logarithmic(true)
