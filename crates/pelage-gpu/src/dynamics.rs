@@ -13,7 +13,8 @@
 use crate::{GpuContext, GpuError, ShellModel};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use pelage::dynamics::{DynamicsParams, MassSpringSystem, Topology};
+use pelage::dynamics::{DynamicsParams, MassSpringSystem, Solver, Topology};
+use pelage::shell::scene::DynamicsSettings;
 use wgpu::util::DeviceExt;
 
 /// Threads a workgroup (the shader's `@workgroup_size`).
@@ -494,29 +495,17 @@ impl GpuMassSpring {
         encoder.copy_buffer_to_buffer(tips, 0, &readback, 0, size);
         encoder.copy_buffer_to_buffer(velocities, 0, &readback, size, size);
         ctx.queue.submit([encoder.finish()]);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        readback.map_async(wgpu::MapMode::Read, .., move |result| {
-            let _ = sender.send(result);
-        });
-        self.wait(ctx)?;
-        receiver
-            .recv()
-            .map_err(|e| GpuError::Readback(e.to_string()))?
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let mapped = readback
-            .get_mapped_range(..)
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let values: &[[f32; 4]] = bytemuck::cast_slice(&mapped);
-        let n = self.tips as usize;
-        let to_vec3 = |v: &[f32; 4]| Vec3::new(v[0], v[1], v[2]);
-        let tips = values[..n].iter().map(to_vec3).collect();
-        let velocities = values[size as usize / 16..][..n]
-            .iter()
-            .map(to_vec3)
-            .collect();
-        drop(mapped);
-        readback.unmap();
-        Ok((tips, velocities))
+        crate::renderer::map_read(ctx, &readback, |mapped| {
+            let values: &[[f32; 4]] = bytemuck::cast_slice(mapped);
+            let n = self.tips as usize;
+            let to_vec3 = |v: &[f32; 4]| Vec3::new(v[0], v[1], v[2]);
+            let tips = values[..n].iter().map(to_vec3).collect();
+            let velocities = values[size as usize / 16..][..n]
+                .iter()
+                .map(to_vec3)
+                .collect();
+            (tips, velocities)
+        })
     }
 
     /// Copies the GPU's state into `system` (the one this was built from).
@@ -535,5 +524,109 @@ impl GpuMassSpring {
         let (tips, velocities) = self.read_state(ctx)?;
         system.set_state(&tips, &velocities);
         Ok(())
+    }
+}
+
+/// A scene's moving fur as the renderer uses it: the mass-spring system
+/// stepped on the CPU, or on the GPU where the settings say `gpu` and the
+/// solver is explicit; the skin's rest pose it is moved from; its clock.
+/// [`ShellScenePlayer`](crate::ShellScenePlayer) and the viewer step it
+/// frame by frame.
+#[derive(Debug)]
+pub struct FurMotion {
+    /// The CPU's system; while the GPU steps, it holds the skin's motion
+    /// and the tips only as of the last copy.
+    system: MassSpringSystem,
+    on_gpu: Option<GpuMassSpring>,
+    rest_roots: Vec<Vec3>,
+    rest_normals: Vec<Vec3>,
+    /// The skin's offset at the last step, and whether that step moved it
+    /// (root velocities not zero): the GPU's copy of the roots is
+    /// refreshed only while either changes.
+    skin_offset: Vec3,
+    skin_moving: bool,
+    time: f32,
+}
+
+impl FurMotion {
+    /// `topology` over `mesh` with sticks `length` long, at rest at time 0.
+    pub fn new(mesh: &pelage::Mesh, topology: Topology, length: f32) -> Self {
+        let system = MassSpringSystem::new(mesh, topology, length);
+        Self {
+            rest_roots: system.roots().to_vec(),
+            rest_normals: system.normals().to_vec(),
+            system,
+            on_gpu: None,
+            skin_offset: Vec3::ZERO,
+            skin_moving: false,
+            time: 0.0,
+        }
+    }
+
+    /// The topology stepped.
+    pub fn topology(&self) -> Topology {
+        self.system.topology()
+    }
+
+    /// Seconds simulated so far.
+    pub fn time(&self) -> f32 {
+        self.time
+    }
+
+    /// One step of `dt` seconds with the whole skin moved by `skin_offset`
+    /// from rest (its velocity taken from the move, so the tips lag). The
+    /// step runs where `settings` says; a change of place carries the
+    /// state over (back to the CPU: copied down).
+    pub fn step(
+        &mut self,
+        ctx: &GpuContext,
+        dt: f32,
+        skin_offset: Vec3,
+        settings: &DynamicsSettings,
+    ) -> Result<(), GpuError> {
+        let explicit = match settings.solver {
+            Solver::Explicit { substeps } => Some(substeps),
+            Solver::Implicit { .. } => None,
+        };
+        match (settings.gpu && explicit.is_some(), self.on_gpu.take()) {
+            (true, None) => self.on_gpu = Some(GpuMassSpring::new(ctx, &self.system)?),
+            (false, Some(gpu)) => gpu.download_into(ctx, &mut self.system)?,
+            (_, kept) => self.on_gpu = kept,
+        }
+        let roots: Vec<Vec3> = self.rest_roots.iter().map(|&r| r + skin_offset).collect();
+        self.system.move_roots(&roots, &self.rest_normals, dt);
+        let moving = skin_offset != self.skin_offset;
+        match (&mut self.on_gpu, explicit) {
+            (Some(gpu), Some(substeps)) => {
+                if moving || self.skin_moving {
+                    gpu.upload_roots(ctx, &self.system);
+                }
+                let substeps = self
+                    .system
+                    .explicit_substeps(dt, &settings.params, substeps);
+                gpu.step_explicit(ctx, dt, &settings.params, substeps, self.time, 1);
+            }
+            _ => self
+                .system
+                .step(dt, &settings.params, settings.solver, self.time),
+        }
+        self.skin_offset = skin_offset;
+        self.skin_moving = moving;
+        self.time += dt;
+        Ok(())
+    }
+
+    /// Hands the tips to `renderer` for `model`: written in place where the
+    /// GPU steps, uploaded from the CPU otherwise.
+    pub fn show(
+        &self,
+        ctx: &GpuContext,
+        renderer: &crate::ShellRenderer,
+        model: &ShellModel,
+    ) -> Result<(), GpuError> {
+        match &self.on_gpu {
+            Some(gpu) => gpu.write_tip_offsets(ctx, model),
+            None => renderer.set_tip_offsets(ctx, model, &self.system.corner_tip_offsets()),
+        }
     }
 }

@@ -19,7 +19,7 @@ mod shells;
 
 pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
-pub use dynamics::GpuMassSpring;
+pub use dynamics::{FurMotion, GpuMassSpring};
 pub use pelage::Curves;
 pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer, read_texture};
 pub use shells::{

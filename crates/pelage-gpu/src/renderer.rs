@@ -681,30 +681,43 @@ pub(crate) fn read_back(
         },
     );
     ctx.queue.submit([encoder.finish()]);
+    let pixels = map_read(ctx, &readback, |mapped| {
+        let mut pixels = Vec::with_capacity((row * height) as usize);
+        for y in 0..height as usize {
+            let start = y * padded_row as usize;
+            pixels.extend_from_slice(&mapped[start..start + row as usize]);
+        }
+        pixels
+    })?;
+    image::RgbaImage::from_raw(width, height, pixels)
+        .ok_or_else(|| GpuError::Readback("the image size does not match".into()))
+}
 
+/// Maps `buffer` (`MAP_READ`, its copy already submitted), waits for the
+/// GPU, and hands its bytes to `read`.
+pub(crate) fn map_read<T>(
+    ctx: &GpuContext,
+    buffer: &wgpu::Buffer,
+    read: impl FnOnce(&[u8]) -> T,
+) -> Result<T, GpuError> {
     let (sender, receiver) = std::sync::mpsc::channel();
-    readback.map_async(wgpu::MapMode::Read, .., move |result| {
+    buffer.map_async(wgpu::MapMode::Read, .., move |result| {
         let _ = sender.send(result);
     });
-    device
+    ctx.device
         .poll(wgpu::PollType::wait_indefinitely())
         .map_err(|e| GpuError::Readback(e.to_string()))?;
     receiver
         .recv()
         .map_err(|e| GpuError::Readback(e.to_string()))?
         .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let mapped = readback
+    let mapped = buffer
         .get_mapped_range(..)
         .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let mut pixels = Vec::with_capacity((row * height) as usize);
-    for y in 0..height as usize {
-        let start = y * padded_row as usize;
-        pixels.extend_from_slice(&mapped[start..start + row as usize]);
-    }
+    let value = read(&mapped);
     drop(mapped);
-    readback.unmap();
-    image::RgbaImage::from_raw(width, height, pixels)
-        .ok_or_else(|| GpuError::Readback("the image size does not match".into()))
+    buffer.unmap();
+    Ok(value)
 }
 
 /// Finishes `encoder` with a copy of `texture` (8-bit RGBA or BGRA, such as

@@ -10,11 +10,11 @@
 //! compares like with like.
 
 use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES, check_size, read_back};
-use crate::{Camera, GpuContext, GpuError};
+use crate::{Camera, FurMotion, GpuContext, GpuError};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use pelage::Mesh;
-use pelage::dynamics::{MassSpringSystem, Solver};
+
 use pelage::shell::math::{ClumpParams, Coupling, CurlParams, KajiyaKay, ShadingMode};
 use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
 use wgpu::util::DeviceExt;
@@ -791,18 +791,6 @@ pub struct ShellScenePlayer<'s> {
     motion: Option<FurMotion>,
 }
 
-/// The mass-spring system of a scene with `[dynamics]`, and its clock.
-#[derive(Debug)]
-struct FurMotion {
-    system: MassSpringSystem,
-    /// The system stepped on the GPU (`gpu = true`); `system` then holds
-    /// only the skin's motion.
-    on_gpu: Option<crate::GpuMassSpring>,
-    rest_roots: Vec<Vec3>,
-    rest_normals: Vec<Vec3>,
-    time: f32,
-}
-
 impl<'s> ShellScenePlayer<'s> {
     /// Generates the shell texture, uploads the scene and sets up
     /// `width × height` targets. Curl and clumping are computed when the
@@ -832,24 +820,6 @@ impl<'s> ShellScenePlayer<'s> {
             width as f32 / height as f32,
             scene.light,
         );
-        let motion = match &scene.dynamics {
-            None => None,
-            Some(d) => {
-                let system = MassSpringSystem::new(&scene.mesh, d.topology, scene.fur.length);
-                let on_gpu = if d.gpu {
-                    Some(crate::GpuMassSpring::new(ctx, &system)?)
-                } else {
-                    None
-                };
-                Some(FurMotion {
-                    rest_roots: system.roots().to_vec(),
-                    rest_normals: system.normals().to_vec(),
-                    system,
-                    on_gpu,
-                    time: 0.0,
-                })
-            }
-        };
         Ok(Self {
             scene,
             renderer,
@@ -858,7 +828,10 @@ impl<'s> ShellScenePlayer<'s> {
             params: ShellParams::from_scene(scene),
             view,
             timeline: scene.wetness_timeline(),
-            motion,
+            motion: scene
+                .dynamics
+                .as_ref()
+                .map(|d| FurMotion::new(&scene.mesh, d.topology, scene.fur.length)),
         })
     }
 
@@ -870,36 +843,13 @@ impl<'s> ShellScenePlayer<'s> {
         };
         let dt = 1.0 / (self.scene.fps * settings.steps_per_frame as f32);
         let shake = |t: f32| settings.shake.map_or(Vec3::ZERO, |s| s.offset(t));
-        while motion.time + 0.5 * dt < time {
-            let next = motion.time + dt;
-            let offset = shake(next);
-            let roots: Vec<Vec3> = motion.rest_roots.iter().map(|&r| r + offset).collect();
-            motion.system.move_roots(&roots, &motion.rest_normals, dt);
-            match (&mut motion.on_gpu, settings.solver) {
-                (Some(gpu), Solver::Explicit { substeps }) => {
-                    if settings.shake.is_some() {
-                        gpu.upload_roots(ctx, &motion.system);
-                    }
-                    let substeps = motion
-                        .system
-                        .explicit_substeps(dt, &settings.params, substeps);
-                    gpu.step_explicit(ctx, dt, &settings.params, substeps, motion.time, 1);
-                }
-                _ => motion
-                    .system
-                    .step(dt, &settings.params, settings.solver, motion.time),
-            }
-            motion.time = next;
+        while motion.time() + 0.5 * dt < time {
+            let offset = shake(motion.time() + dt);
+            motion.step(ctx, dt, offset, settings)?;
         }
         self.params.coupling = settings.coupling;
-        self.params.offset = shake(motion.time);
-        match &motion.on_gpu {
-            Some(gpu) => gpu.write_tip_offsets(ctx, &self.model),
-            None => {
-                self.renderer
-                    .set_tip_offsets(ctx, &self.model, &motion.system.corner_tip_offsets())
-            }
-        }
+        self.params.offset = shake(motion.time());
+        motion.show(ctx, &self.renderer, &self.model)
     }
 
     /// The frame at `time` seconds (not before the last one drawn).

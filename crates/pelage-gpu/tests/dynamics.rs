@@ -9,22 +9,9 @@
 use glam::Vec3;
 use pelage::dynamics::{Brush, DynamicsParams, MassSpringSystem, Solver, Topology, Wind};
 use pelage_gpu::{GpuContext, GpuMassSpring};
-use std::sync::OnceLock;
+mod common;
 
-fn gpu() -> Option<&'static GpuContext> {
-    static GPU: OnceLock<Option<GpuContext>> = OnceLock::new();
-    GPU.get_or_init(|| match GpuContext::headless() {
-        Ok(ctx) => Some(ctx),
-        Err(e) if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() => {
-            panic!("PELAGE_REQUIRE_GPU is set and there is no adapter: {e}")
-        }
-        Err(e) => {
-            eprintln!("SKIPPED: no GPU adapter ({e})");
-            None
-        }
-    })
-    .as_ref()
-}
+use common::gpu;
 
 #[test]
 fn the_gpu_explicit_step_matches_the_cpu_one() {

@@ -8,21 +8,16 @@ use glam::Vec3;
 use pelage_gpu::{Camera, GpuContext, PreviewScene, PreviewStyle, Renderer};
 use std::sync::OnceLock;
 
+mod common;
+
 fn gpu() -> Option<&'static (GpuContext, Renderer)> {
     static GPU: OnceLock<Option<(GpuContext, Renderer)>> = OnceLock::new();
-    GPU.get_or_init(|| match GpuContext::headless() {
-        Ok(ctx) => {
+    GPU.get_or_init(|| {
+        common::open_headless().map(|ctx| {
             let renderer = Renderer::new(&ctx);
             eprintln!("rendering on {}", ctx.adapter_name());
-            Some((ctx, renderer))
-        }
-        Err(e) if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() => {
-            panic!("PELAGE_REQUIRE_GPU is set and there is no adapter: {e}")
-        }
-        Err(e) => {
-            eprintln!("SKIPPED: no GPU adapter ({e})");
-            None
-        }
+            (ctx, renderer)
+        })
     })
     .as_ref()
 }

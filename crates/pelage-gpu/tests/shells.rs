@@ -15,22 +15,9 @@ use pelage::shell::math::{
 };
 use pelage::shell::{Droplet, ShellTextureParams, ShellTextures, WetnessMask};
 use pelage_gpu::{GpuContext, ShellFeatures, ShellParams, ShellRenderer, ShellTarget, ShellView};
-use std::sync::OnceLock;
+mod common;
 
-fn gpu() -> Option<&'static GpuContext> {
-    static GPU: OnceLock<Option<GpuContext>> = OnceLock::new();
-    GPU.get_or_init(|| match GpuContext::headless() {
-        Ok(ctx) => Some(ctx),
-        Err(e) if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() => {
-            panic!("PELAGE_REQUIRE_GPU is set and there is no adapter: {e}")
-        }
-        Err(e) => {
-            eprintln!("SKIPPED: no GPU adapter ({e})");
-            None
-        }
-    })
-    .as_ref()
-}
+use common::gpu;
 
 /// Pixels, texels and mask texels per side.
 const SIZE: u32 = 64;

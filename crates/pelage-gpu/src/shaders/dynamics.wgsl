@@ -48,7 +48,7 @@ fn perm_at(i: u32) -> u32 {
     return permutation[i & 511u];
 }
 
-// NoiseMap::GRADIENTS3[hash & 15] · d, written out as Perlin's reference
+// pelage::map::noise::GRADIENTS3[hash & 15] · d, written out as Perlin's reference
 // code selects it (the table's sixteen rows exactly): no array indexed at
 // run time, which some compilers copy into every invocation.
 fn gradient3(hash: u32, d: vec3<f32>) -> f32 {

@@ -14,8 +14,9 @@
 //!   `(M − h ∂F/∂v − h² ∂F/∂x) Δv = h (F + h ∂F/∂x v)`, solved by conjugate
 //!   gradients, matrix-free, with a 3×3 block-Jacobi preconditioner — or,
 //!   where no springs join the tips, by a direct 3×3 solve per tip (the
-//!   matrix is then block diagonal). The springs and the drag are implicit; gravity, wind, brush and the
-//!   restoring force are taken at the start of the step.
+//!   matrix is then block diagonal). The springs and the drag are
+//!   implicit; gravity, wind, brush and the restoring force are taken at
+//!   the start of the step.
 //!
 //! After each step the constraints are enforced by projection: every tip
 //! stays above its root's tangent plane, and Silva tips within `L0` of their

@@ -48,10 +48,6 @@ impl NoiseMap {
         &self.permutation
     }
 
-    /// Perlin's twelve gradients padded to sixteen, indexed by a hash's low
-    /// four bits, as [`perlin3_vector`](Self::perlin3_vector) uses them.
-    pub const GRADIENTS3: [[f32; 3]; 16] = GRADIENTS3;
-
     /// The map's value at `uv`.
     pub fn eval(&self, uv: Vec2) -> f32 {
         let mut sum = 0.0;

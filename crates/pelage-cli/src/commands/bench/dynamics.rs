@@ -56,10 +56,10 @@ fn gpu_explicit_ms(
     system: &MassSpringSystem,
     params: &DynamicsParams,
     dt: f32,
+    substeps: u32,
     steps: usize,
 ) -> anyhow::Result<f64> {
     let mut gpu = pelage_gpu::GpuMassSpring::new(ctx, system)?;
-    let substeps = system.stable_substeps(dt, params);
     gpu.step_explicit(ctx, dt, params, substeps, 0.0, 1);
     gpu.wait(ctx)?;
     let steps = steps.max(1) as u32;
@@ -118,23 +118,18 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
     for (name, mesh) in &meshes {
         let length = 0.025 * (mesh.bounds().1 - mesh.bounds().0).length();
         for topology in Topology::ALL {
-            let mut ms = [0.0; 2];
-            let mut counts = (0, 0);
-            let substeps =
-                MassSpringSystem::new(mesh, topology, length).stable_substeps(dt, &params);
+            // Built once; every measurement starts from a copy at rest.
+            let at_rest = MassSpringSystem::new(mesh, topology, length);
+            let substeps = at_rest.stable_substeps(dt, &params);
             let gpu_ms = match &gpu {
                 Some(ctx) => Some(gpu_explicit_ms(
-                    ctx,
-                    &MassSpringSystem::new(mesh, topology, length),
-                    &params,
-                    dt,
-                    args.steps,
+                    ctx, &at_rest, &params, dt, substeps, args.steps,
                 )?),
                 None => None,
             };
+            let mut ms = [0.0; 2];
             for (k, solver) in SOLVERS.into_iter().enumerate() {
-                let mut system = MassSpringSystem::new(mesh, topology, length);
-                counts = (system.mass_count(), system.spring_count());
+                let mut system = at_rest.clone();
                 let mut step = 0;
                 let (seconds, ()) = median_seconds(args.steps.max(1), true, || {
                     system.step(dt, &params, solver, step as f32 * dt);
@@ -145,8 +140,8 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
             rows.push(Row {
                 model: name.clone(),
                 topology,
-                masses: counts.0,
-                springs: counts.1,
+                masses: at_rest.mass_count(),
+                springs: at_rest.spring_count(),
                 ms,
                 substeps,
                 gpu_ms,

@@ -5,14 +5,14 @@
 //! changes all of it live.
 
 use glam::Vec3;
-use pelage::dynamics::{Brush, MassSpringSystem, Solver, Topology, Wind};
+use pelage::dynamics::{Brush, Solver, Topology, Wind};
 use pelage::shell::math::{ClumpParams, Coupling, ShadingMode};
 use pelage::shell::scene::DynamicsSettings;
 use pelage::shell::wetness::{Droplet, DropletStyle, droplets_on_mesh, mask_coordinates};
 use pelage::shell::{ShellScene, WetnessMask};
 use pelage_gpu::{
-    GpuContext, GpuError, OrbitCamera, ShellFeatures, ShellModel, ShellParams, ShellRenderer,
-    ShellTarget, ShellView,
+    FurMotion, GpuContext, GpuError, OrbitCamera, ShellFeatures, ShellModel, ShellParams,
+    ShellRenderer, ShellTarget, ShellView,
 };
 use std::time::Instant;
 
@@ -82,7 +82,7 @@ pub struct ShellSession {
     mask_changed: bool,
     /// The dynamics settings the panel edits (the scene's, or defaults).
     pub dynamics: DynamicsSettings,
-    motion: Option<Motion>,
+    motion: Option<FurMotion>,
     rain: Vec<Droplet>,
     rain_next: usize,
     rain_owed: f32,
@@ -96,18 +96,6 @@ pub struct ShellSession {
     splashes: u64,
     /// Milliseconds the last frame's simulation (dynamics + mask) took.
     pub last_simulation_ms: f64,
-}
-
-struct Motion {
-    system: MassSpringSystem,
-    /// The system stepped on the GPU (explicit solver, "on the GPU"
-    /// ticked); `system` then holds the skin's motion, and the tips only
-    /// once copied back.
-    on_gpu: Option<pelage_gpu::GpuMassSpring>,
-    topology: Topology,
-    rest_roots: Vec<glam::Vec3>,
-    rest_normals: Vec<glam::Vec3>,
-    time: f32,
 }
 
 impl ShellSession {
@@ -347,65 +335,24 @@ impl ShellSession {
         });
         settings.params.brush = self.brush;
         let topology = settings.topology;
-        if self.motion.as_ref().is_none_or(|m| m.topology != topology) {
-            let system = MassSpringSystem::new(&self.scene.mesh, topology, self.scene.fur.length);
-            self.motion = Some(Motion {
-                rest_roots: system.roots().to_vec(),
-                rest_normals: system.normals().to_vec(),
-                system,
-                on_gpu: None,
+        let motion = match &mut self.motion {
+            Some(m) if m.topology() == topology => m,
+            slot => slot.insert(FurMotion::new(
+                &self.scene.mesh,
                 topology,
-                time: 0.0,
-            });
-        }
-        let explicit = match settings.solver {
-            Solver::Explicit { substeps } => Some(substeps),
-            Solver::Implicit { .. } => None,
+                self.scene.fur.length,
+            )),
         };
         let steps = settings.steps_per_frame.max(1);
         let h = dt / steps as f32;
-        let motion = self.motion.as_mut().expect("made above");
-        match (settings.gpu && explicit.is_some(), motion.on_gpu.is_some()) {
-            (true, false) => {
-                motion.on_gpu = Some(pelage_gpu::GpuMassSpring::new(ctx, &motion.system)?);
-            }
-            (false, true) => {
-                // Back to the CPU: it carries on from where the GPU got.
-                if let Some(gpu) = motion.on_gpu.take() {
-                    gpu.download_into(ctx, &mut motion.system)?;
-                }
-            }
-            _ => {}
-        }
         if h > 0.0 {
             for _ in 0..steps {
-                let roots: Vec<Vec3> = motion.rest_roots.iter().map(|&r| r + offset).collect();
-                motion.system.move_roots(&roots, &motion.rest_normals, h);
-                match (&mut motion.on_gpu, explicit) {
-                    (Some(gpu), Some(substeps)) => {
-                        gpu.upload_roots(ctx, &motion.system);
-                        let substeps =
-                            motion
-                                .system
-                                .explicit_substeps(h, &settings.params, substeps);
-                        gpu.step_explicit(ctx, h, &settings.params, substeps, motion.time, 1);
-                    }
-                    _ => motion
-                        .system
-                        .step(h, &settings.params, settings.solver, motion.time),
-                }
-                motion.time += h;
+                motion.step(ctx, h, offset, settings)?;
             }
         }
         self.params.coupling = settings.coupling;
         self.params.offset = offset;
-        match &motion.on_gpu {
-            Some(gpu) => gpu.write_tip_offsets(ctx, &self.model),
-            None => {
-                self.renderer
-                    .set_tip_offsets(ctx, &self.model, &motion.system.corner_tip_offsets())
-            }
-        }
+        motion.show(ctx, &self.renderer, &self.model)
     }
 
     /// Applies the panel's settings that need work (a new shell texture
