@@ -8,7 +8,7 @@
 
 use glam::Vec3;
 use pelage::dynamics::{Brush, DynamicsParams, MassSpringSystem, Solver, Topology, Wind};
-use pelage_gpu::{GpuContext, GpuMassSpring};
+use pelage_gpu::GpuMassSpring;
 mod common;
 
 use common::gpu;
