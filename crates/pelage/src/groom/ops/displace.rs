@@ -25,7 +25,20 @@ impl VectorNoise {
     /// off it.
     #[inline]
     fn at(&self, p: Vec3) -> Vec3 {
-        self.0.perlin3_vector(p + Vec3::new(0.371, 0.713, 0.137))
+        self.0.perlin3_vector(p + Self::OFF_LATTICE)
+    }
+
+    const OFF_LATTICE: Vec3 = Vec3::new(0.371, 0.713, 0.137);
+
+    /// [`at`](Self::at) each of `points` (at most [`MAX_VECTORS`]), into
+    /// `out`: the same values, the noise read several points at a time.
+    fn at_many(&self, points: &[Vec3], out: &mut [Vec3]) {
+        let mut shifted = [Vec3::ZERO; MAX_VECTORS];
+        let shifted = &mut shifted[..points.len()];
+        for (s, p) in shifted.iter_mut().zip(points) {
+            *s = *p + Self::OFF_LATTICE;
+        }
+        self.0.perlin3_vectors(shifted, out);
     }
 }
 
@@ -82,14 +95,15 @@ impl Noise {
         }
         // Noise vectors at m evenly spaced parameters (positions along the
         // polyline), then each point's displacement between its two.
-        let mut samples = [Vec3::ZERO; MAX_VECTORS];
         let m = m.min(MAX_VECTORS);
-        for (k, sample) in samples.iter_mut().enumerate().take(m) {
+        let mut at = [Vec3::ZERO; MAX_VECTORS];
+        for (k, at) in at.iter_mut().enumerate().take(m) {
             let x = param(k, m) * (n - 1) as f32;
             let j = (x as usize).min(n - 2);
-            let p = hair.points[j].lerp(hair.points[j + 1], x - j as f32);
-            *sample = self.field.at(p * frequency);
+            *at = hair.points[j].lerp(hair.points[j + 1], x - j as f32) * frequency;
         }
+        let mut samples = [Vec3::ZERO; MAX_VECTORS];
+        self.field.at_many(&at[..m], &mut samples[..m]);
         for (j, p) in hair.points.iter_mut().enumerate() {
             let t = param(j, n);
             let a = amplitude * self.ramp.at(t);
