@@ -169,8 +169,22 @@ impl NoiseMap {
                 // SAFETY: the CPU has AVX2 (checked above).
                 unsafe { avx2::perlin3_lanes(&self.permutation32, &self.corner_gradients, p, o) };
             }
-            for (p, o) in chunks.remainder().iter().zip(outs.into_remainder()) {
-                *o = self.perlin3_vector(*p);
+            let (rest, rest_out) = (chunks.remainder(), outs.into_remainder());
+            // A part-filled batch costs a full one, about three single
+            // points: worth it from three points up.
+            if rest.len() >= 3 {
+                let mut p = [glam::Vec3::ZERO; LANES];
+                p[..rest.len()].copy_from_slice(rest);
+                let mut o = [glam::Vec3::ZERO; LANES];
+                // SAFETY: as above.
+                unsafe {
+                    avx2::perlin3_lanes(&self.permutation32, &self.corner_gradients, &p, &mut o)
+                };
+                rest_out.copy_from_slice(&o[..rest.len()]);
+            } else {
+                for (p, o) in rest.iter().zip(rest_out) {
+                    *o = self.perlin3_vector(*p);
+                }
             }
             return;
         }
