@@ -670,12 +670,17 @@ fn conjugate_gradient(
 mod tests {
     use super::*;
 
+    /// The gusting, turbulent wind the tests below step in.
+    fn gusting_wind(turbulence: f32) -> Wind {
+        Wind::new(Vec3::new(3.0, 0.0, 1.0), 0.5, 1.0, turbulence, 4.0, 7)
+    }
+
     /// The wind read a batch at a time (the solvers' way) is the wind read
     /// point by point, to the bit, with and without turbulence.
     #[test]
     fn wind_read_in_batches_equals_point_by_point() {
         for turbulence in [0.0, 2.0] {
-            let wind = Wind::new(Vec3::new(3.0, 0.0, 1.0), 0.5, 1.0, turbulence, 4.0, 7);
+            let wind = gusting_wind(turbulence);
             let now = wind.now(1.37);
             let points: Vec<Vec3> = (0..300)
                 .map(|k| Vec3::new(k as f32 * 0.013 - 2.0, (k as f32).sin(), k as f32 * -0.007))
@@ -698,7 +703,7 @@ mod tests {
     fn automatic_substeps_keep_explicit_steps_stable() {
         let mesh = crate::assets::spot();
         let params = DynamicsParams {
-            wind: Some(Wind::new(Vec3::new(3.0, 0.0, 1.0), 0.5, 1.0, 2.0, 4.0, 7)),
+            wind: Some(gusting_wind(2.0)),
             ..DynamicsParams::default()
         };
         let dt = 1.0 / 24.0;
@@ -736,7 +741,7 @@ mod tests {
     fn unjoined_implicit_step_equals_the_conjugate_gradient_step() {
         let mesh = crate::assets::spot();
         let params = DynamicsParams {
-            wind: Some(Wind::new(Vec3::new(3.0, 0.0, 1.0), 0.5, 1.0, 2.0, 4.0, 7)),
+            wind: Some(gusting_wind(2.0)),
             ..DynamicsParams::default()
         };
         for topology in [Topology::SpringSticks, Topology::SilvaStrands] {
