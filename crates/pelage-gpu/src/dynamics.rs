@@ -1,7 +1,11 @@
-//! The explicit mass-spring solver on the GPU: the fused substep of
-//! `pelage::dynamics` (force, velocity, position, constraints; Banisch &
-//! Wüthrich, Silva §3.2.1) as a compute shader, one invocation a tip,
-//! double buffered like the CPU pass. `shaders/dynamics.wgsl` mirrors the
+//! The mass-spring solvers on the GPU: the explicit solver's fused substep
+//! of `pelage::dynamics` (force, velocity, position, constraints; Banisch &
+//! Wüthrich, Silva §3.2.1) and, where no springs join the tips
+//! (spring-sticks, separable spring-sticks, Silva strands), the implicit
+//! solver's backward-Euler step with its direct 3×3 solve per tip — each a
+//! compute shader, one invocation a tip, double buffered like the CPU pass.
+//! Prisms' implicit step (conjugate gradients over the tip-tip springs)
+//! stays on the CPU. `shaders/dynamics.wgsl` mirrors the
 //! Rust function by function; `tests/dynamics.rs` steps both and compares.
 //!
 //! Why it exists: on two CPU cores a step of a million masses takes tens of
@@ -23,6 +27,13 @@ const WORKGROUP: u32 = 64;
 const SLOTS: u32 = 64;
 /// Bytes a uniform slot (the dynamic-offset alignment wgpu guarantees).
 const SLOT_BYTES: u64 = 256;
+
+/// Which of the shader's steps a dispatch runs.
+#[derive(Debug, Clone, Copy)]
+enum Pass {
+    Explicit,
+    Implicit,
+}
 
 /// The shader's `Step` block: everything one substep reads besides buffers.
 #[repr(C)]
@@ -46,7 +57,10 @@ struct StepUniform {
 pub struct GpuMassSpring {
     tips: u32,
     silva: bool,
-    pipeline: wgpu::ComputePipeline,
+    /// Whether tip-tip springs join the tips (prisms): no implicit step here.
+    joined: bool,
+    explicit: wgpu::ComputePipeline,
+    implicit: wgpu::ComputePipeline,
     /// Writes the shell renderer's per-corner tip offsets.
     coupling: wgpu::ComputePipeline,
     coupling_layout: wgpu::BindGroupLayout,
@@ -256,14 +270,18 @@ impl GpuMassSpring {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("dynamics explicit substep"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("explicit_substep"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = |label: &str, entry_point: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let explicit = pipeline("dynamics explicit substep", "explicit_substep");
+        let implicit = pipeline("dynamics implicit step", "implicit_unjoined_step");
         let coupling_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dynamics coupling"),
             entries: &[
@@ -291,7 +309,9 @@ impl GpuMassSpring {
         Ok(Self {
             tips,
             silva: system.topology() == Topology::SilvaStrands,
-            pipeline,
+            joined: !system.tip_tip_springs().is_empty(),
+            explicit,
+            implicit,
             coupling,
             coupling_layout,
             corners: system.corner_sticks().len() as u32,
@@ -351,8 +371,55 @@ impl GpuMassSpring {
     ) {
         let substeps = substeps.max(1);
         let h = dt / substeps as f32;
+        let times: Vec<f32> = (0..steps)
+            .flat_map(|s| (0..substeps).map(move |k| time + s as f32 * dt + k as f32 * h))
+            .collect();
+        self.queue(ctx, Pass::Explicit, params, h, &times);
+    }
+
+    /// Whether [`step_implicit`](Self::step_implicit) can step this system:
+    /// no tip-tip springs join its tips (spring-sticks, separable
+    /// spring-sticks, Silva strands).
+    pub fn steps_implicit(&self) -> bool {
+        !self.joined
+    }
+
+    /// Queues `steps` implicit (backward-Euler) steps of `dt` seconds from
+    /// `time`, as the CPU's `Solver::Implicit` steps a system whose tips no
+    /// springs join: each tip's 3×3 system solved directly. Prisms (tip-tip
+    /// springs, conjugate gradients) are refused: step them on the CPU.
+    pub fn step_implicit(
+        &mut self,
+        ctx: &GpuContext,
+        dt: f32,
+        params: &DynamicsParams,
+        time: f32,
+        steps: u32,
+    ) -> Result<(), GpuError> {
+        if self.joined {
+            return Err(GpuError::Mismatch(
+                "the GPU's implicit step solves each tip on its own; tip-tip springs (prisms) \
+                 join these tips: use the explicit solver on the GPU, or the CPU"
+                    .into(),
+            ));
+        }
+        let times: Vec<f32> = (0..steps).map(|s| time + s as f32 * dt).collect();
+        self.queue(ctx, Pass::Implicit, params, dt, &times);
+        Ok(())
+    }
+
+    /// Queues one `pass` of `h` seconds for each of `times`, one uniform
+    /// slot each, [`SLOTS`] to a submission.
+    fn queue(
+        &mut self,
+        ctx: &GpuContext,
+        pass_kind: Pass,
+        params: &DynamicsParams,
+        h: f32,
+        times: &[f32],
+    ) {
         if let Some(wind) = &params.wind {
-            let noise = wind.now(time);
+            let noise = wind.now(times.first().copied().unwrap_or(0.0));
             let seed = noise.noise().seed;
             if self.permutation_seed != Some(seed) {
                 let table: Vec<u32> = noise
@@ -367,9 +434,10 @@ impl GpuMassSpring {
             }
         }
         let (groups_x, groups_y) = workgroups(self.tips);
-        let times: Vec<f32> = (0..steps)
-            .flat_map(|s| (0..substeps).map(move |k| time + s as f32 * dt + k as f32 * h))
-            .collect();
+        let pipeline = match pass_kind {
+            Pass::Explicit => &self.explicit,
+            Pass::Implicit => &self.implicit,
+        };
         for chunk in times.chunks(SLOTS as usize) {
             let mut slots = vec![0u8; chunk.len() * SLOT_BYTES as usize];
             for (k, &t) in chunk.iter().enumerate() {
@@ -382,10 +450,10 @@ impl GpuMassSpring {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("dynamics explicit"),
+                    label: Some("dynamics steps"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(pipeline);
                 for k in 0..chunk.len() {
                     pass.set_bind_group(
                         0,
@@ -528,8 +596,8 @@ impl GpuMassSpring {
 }
 
 /// A scene's moving fur as the renderer uses it: the mass-spring system
-/// stepped on the CPU, or on the GPU where the settings say `gpu` and the
-/// solver is explicit; the skin's rest pose it is moved from; its clock.
+/// stepped on the CPU, or on the GPU where the settings say `gpu` (and,
+/// for the implicit solver, no springs join the tips); the skin's rest pose it is moved from; its clock.
 /// [`ShellScenePlayer`](crate::ShellScenePlayer) and the viewer step it
 /// frame by frame.
 #[derive(Debug)]
@@ -588,7 +656,11 @@ impl FurMotion {
             Solver::Explicit { substeps } => Some(substeps),
             Solver::Implicit { .. } => None,
         };
-        match (settings.gpu && explicit.is_some(), self.on_gpu.take()) {
+        // The GPU steps every explicit system and the implicit ones whose
+        // tips no springs join; prisms' implicit step stays on the CPU.
+        let on_gpu =
+            settings.gpu && (explicit.is_some() || self.system.tip_tip_springs().is_empty());
+        match (on_gpu, self.on_gpu.take()) {
             (true, None) => self.on_gpu = Some(GpuMassSpring::new(ctx, &self.system)?),
             (false, Some(gpu)) => gpu.download_into(ctx, &mut self.system)?,
             (_, kept) => self.on_gpu = kept,
@@ -596,17 +668,22 @@ impl FurMotion {
         let roots: Vec<Vec3> = self.rest_roots.iter().map(|&r| r + skin_offset).collect();
         self.system.move_roots(&roots, &self.rest_normals, dt);
         let moving = skin_offset != self.skin_offset;
-        match (&mut self.on_gpu, explicit) {
-            (Some(gpu), Some(substeps)) => {
+        match &mut self.on_gpu {
+            Some(gpu) => {
                 if moving || self.skin_moving {
                     gpu.upload_roots(ctx, &self.system);
                 }
-                let substeps = self
-                    .system
-                    .explicit_substeps(dt, &settings.params, substeps);
-                gpu.step_explicit(ctx, dt, &settings.params, substeps, self.time, 1);
+                match explicit {
+                    Some(substeps) => {
+                        let substeps =
+                            self.system
+                                .explicit_substeps(dt, &settings.params, substeps);
+                        gpu.step_explicit(ctx, dt, &settings.params, substeps, self.time, 1);
+                    }
+                    None => gpu.step_implicit(ctx, dt, &settings.params, self.time, 1)?,
+                }
             }
-            _ => self
+            None => self
                 .system
                 .step(dt, &settings.params, settings.solver, self.time),
         }

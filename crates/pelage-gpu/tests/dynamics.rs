@@ -1,4 +1,5 @@
-//! The GPU's explicit mass-spring step against the CPU's
+//! The GPU's explicit mass-spring step — and its implicit one, where no
+//! springs join the tips — against the CPU's
 //! (`pelage::dynamics`): every topology on spot, in gusting turbulent wind
 //! with gravity and a brush, some tips started inside the skin or
 //! overstretched so the constraints act; after 80 substeps (more than one
@@ -78,6 +79,101 @@ fn the_gpu_explicit_step_matches_the_cpu_one() {
             worst <= 1e-3 * length,
             "{topology:?}: GPU and CPU tips differ by {} (L0 = {length})",
             worst
+        );
+        assert!(
+            worst_velocity <= 1e-2,
+            "{topology:?}: GPU and CPU velocities differ by {worst_velocity}"
+        );
+    }
+}
+
+/// The implicit step (backward Euler, a 3×3 solve per tip) on the GPU
+/// against the CPU's, for the topologies whose tips no springs join, at a
+/// stiffness and step where the explicit solver diverges; prisms are
+/// refused with an error that says what to do.
+#[test]
+fn the_gpu_implicit_step_matches_the_cpu_one() {
+    let Some(ctx) = gpu() else { return };
+    let mesh = pelage::assets::spot();
+    let (lo, hi) = mesh.bounds();
+    let length = 0.03 * (hi - lo).length();
+    let params = DynamicsParams {
+        stiffness: 40.0,
+        wind: Some(Wind::new(Vec3::new(3.0, 0.0, 1.0), 0.8, 1.5, 4.0, 3.0, 7)),
+        brush: Some(Brush {
+            centre: mesh.positions()[0],
+            radius: 0.3 * (hi - lo).length(),
+            force: Vec3::new(0.0, 0.0, 0.02),
+        }),
+        ..Default::default()
+    };
+    let (dt, steps) = (1.0 / 30.0, 40);
+    for topology in Topology::ALL {
+        let mut cpu = MassSpringSystem::new(&mesh, topology, length);
+        let mut gpu_system = GpuMassSpring::new(ctx, &cpu).expect("upload");
+        if topology.joins_tips() {
+            assert!(!gpu_system.steps_implicit());
+            let error = gpu_system
+                .step_implicit(ctx, dt, &params, 0.0, 1)
+                .expect_err("prisms' implicit step is the CPU's");
+            assert!(error.to_string().contains("explicit solver"), "{error}");
+            continue;
+        }
+        assert!(
+            cpu.stable_substeps(dt, &params) > 1,
+            "{topology:?}: one explicit step of this size must be unstable, or the implicit solver proves little"
+        );
+        for i in 0..cpu.mass_count() {
+            let (root, n) = (cpu.roots()[i], cpu.normals()[i]);
+            if i % 7 == 0 {
+                cpu.set_tip(i, root - 0.5 * length * n, Vec3::ZERO);
+            } else if i % 11 == 0 {
+                cpu.set_tip(i, root + 2.0 * length * n, -n);
+            }
+        }
+        let start = cpu.tips().to_vec();
+        let mut gpu_system = GpuMassSpring::new(ctx, &cpu).expect("upload");
+        gpu_system
+            .step_implicit(ctx, dt, &params, 0.0, steps)
+            .expect("no tip-tip springs");
+        for k in 0..steps {
+            cpu.step(
+                dt,
+                &params,
+                Solver::Implicit { iterations: 10 },
+                k as f32 * dt,
+            );
+        }
+        let (tips, velocities) = gpu_system.read_state(ctx).expect("read back");
+        let moved = start
+            .iter()
+            .zip(cpu.tips())
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max);
+        assert!(
+            moved > 0.2 * length,
+            "{topology:?}: the fur hardly moved ({moved})"
+        );
+        let worst = tips
+            .iter()
+            .zip(cpu.tips())
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max);
+        let worst_velocity = velocities
+            .iter()
+            .zip(cpu.velocities())
+            .map(|(a, b)| a.distance(*b) / (1.0 + b.length()))
+            .fold(0.0f32, f32::max);
+        eprintln!(
+            "{topology:?} implicit: {} masses, moved up to {:.3} L0, GPU − CPU up to {:.2e} L0, velocity {:.2e}",
+            cpu.mass_count(),
+            moved / length,
+            worst / length,
+            worst_velocity
+        );
+        assert!(
+            worst <= 1e-3 * length,
+            "{topology:?}: GPU and CPU tips differ by {worst} (L0 = {length})"
         );
         assert!(
             worst_velocity <= 1e-2,

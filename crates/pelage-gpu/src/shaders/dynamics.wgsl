@@ -1,4 +1,5 @@
-// One explicit substep of a mass-spring system (Banisch & Wüthrich; Silva
+// One explicit substep — or, where no springs join the tips, one implicit
+// step — of a mass-spring system (Banisch & Wüthrich; Silva
 // §3.2.1), one invocation a tip: force, velocity, position, constraints —
 // the fused pass of pelage::dynamics::solver's explicit solver, read from
 // one state buffer and written to the other. Every function mirrors the
@@ -204,6 +205,74 @@ fn explicit_substep(
     let v0 = velocities_in[i].xyz;
     let f = tip_force(i, x, v0) + lateral_force(i, x, v0);
     let v = v0 + (h / step.springs.x) * f;
+    let next = constrained(i, x + h * v, v);
+    tips_out[i] = vec4<f32>(next.x, 0.0);
+    velocities_out[i] = vec4<f32>(next.v, 0.0);
+}
+
+// ---- the implicit step where no springs join the tips ----
+
+// pelage::dynamics::solver::outer: d dᵀ.
+fn outer(d: vec3<f32>) -> mat3x3<f32> {
+    return mat3x3<f32>(d * d.x, d * d.y, d * d.z);
+}
+
+// MassSpringSystem::stick_blocks: the stick's −∂F/∂x (k) and −∂F/∂v (c)
+// blocks, with solver::spring_stiffness's clamp (compressed sticks keep
+// the matrix positive semi-definite).
+struct Blocks {
+    k: mat3x3<f32>,
+    c: mat3x3<f32>,
+};
+
+fn stick_blocks(i: u32, x: vec3<f32>) -> Blocks {
+    let identity = mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+    if step.counts.y != 0u {
+        return Blocks(step.springs.y * identity, step.springs.w * identity);
+    }
+    let d = x - roots[i].xyz;
+    let l = length(d);
+    if l <= 1e-12 {
+        return Blocks(step.springs.y * identity, mat3x3<f32>());
+    }
+    let dir = d / l;
+    let o = outer(dir);
+    let tangential = max(1.0 - roots[i].w / l, 0.0);
+    return Blocks(step.springs.y * (tangential * (identity - o) + o), step.springs.w * o);
+}
+
+// glam's Mat3::inverse: the adjugate's rows are cross products of the
+// columns, over the determinant.
+fn inverse3(a: mat3x3<f32>) -> mat3x3<f32> {
+    let r0 = cross(a[1], a[2]);
+    let r1 = cross(a[2], a[0]);
+    let r2 = cross(a[0], a[1]);
+    let inv_det = 1.0 / dot(a[2], r2);
+    return transpose(mat3x3<f32>(r0 * inv_det, r1 * inv_det, r2 * inv_det));
+}
+
+// MassSpringSystem::implicit_step_unjoined: one linearised backward-Euler
+// step, (M + h C + h² K) Δv = h (F − h K v), each tip's 3×3 block solved
+// directly (no tip-tip springs: the matrix is block diagonal).
+@compute @workgroup_size(64)
+fn implicit_unjoined_step(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let i = id.y * groups.x * 64u + id.x;
+    if i >= step.counts.x {
+        return;
+    }
+    let h = step.gravity.w;
+    let x = tips_in[i].xyz;
+    let v0 = velocities_in[i].xyz;
+    let f = tip_force(i, x, v0);
+    let blocks = stick_blocks(i, x);
+    let fixed = step.springs.x + h * step.misc.x;
+    let a = mat3x3<f32>(vec3<f32>(fixed, 0.0, 0.0), vec3<f32>(0.0, fixed, 0.0), vec3<f32>(0.0, 0.0, fixed))
+        + h * blocks.c + (h * h) * blocks.k;
+    let dv = inverse3(a) * (h * (f - h * (blocks.k * v0)));
+    let v = v0 + dv;
     let next = constrained(i, x + h * v, v);
     tips_out[i] = vec4<f32>(next.x, 0.0);
     velocities_out[i] = vec4<f32>(next.v, 0.0);

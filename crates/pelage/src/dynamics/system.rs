@@ -65,6 +65,12 @@ impl Topology {
         Self::ALL.into_iter().find(|t| t.name() == name)
     }
 
+    /// Whether springs join the tips (the prisms): the implicit step then
+    /// solves one system over all of them, not a 3×3 one per tip.
+    pub fn joins_tips(self) -> bool {
+        matches!(self, Topology::Prisms | Topology::SeparablePrisms)
+    }
+
     /// Whether each triangle has sticks of its own.
     pub fn is_per_corner(self) -> bool {
         matches!(

@@ -570,11 +570,15 @@ impl ShellScene {
                     }
                 };
                 let gpu = d.gpu.as_ref().is_some_and(|g| *g.get_ref());
-                if let (true, Solver::Implicit { .. }) = (gpu, solver) {
+                if let (true, Solver::Implicit { .. }, true) = (gpu, solver, topology.joins_tips())
+                {
                     let span = d.gpu.as_ref().map_or(0..0, |g| g.span());
                     return Err(invalid(
                         span,
-                        "the GPU steps the explicit solver only: set solver = \"explicit\", or gpu = false".to_string(),
+                        format!(
+                            "the GPU steps {} with the explicit solver only (their implicit step solves all tips at once, on the CPU): set solver = \"explicit\", or gpu = false",
+                            topology.name()
+                        ),
                     ));
                 }
                 let default_coupling = if topology == Topology::SilvaStrands {
@@ -821,9 +825,22 @@ mod tests {
             .dynamics
             .unwrap();
         assert!(d.gpu);
-        let e = scene("[dynamics]\ngpu = true\n").unwrap_err().to_string();
+        // Spring-sticks (the default) step implicitly on the GPU too;
+        // prisms only explicitly.
         assert!(
-            e.starts_with("fur.toml:2:7: dynamics.gpu: the GPU steps the explicit solver only"),
+            scene("[dynamics]\ngpu = true\n")
+                .unwrap()
+                .dynamics
+                .unwrap()
+                .gpu
+        );
+        let e = scene("[dynamics]\ntopology = \"prisms\"\ngpu = true\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(
+                "fur.toml:3:7: dynamics.gpu: the GPU steps prisms with the explicit solver only"
+            ),
             "{e}"
         );
     }

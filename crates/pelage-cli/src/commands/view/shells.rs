@@ -516,9 +516,15 @@ impl ShellSession {
             (false, Solver::Implicit { .. }) => Solver::Explicit { substeps: 0 },
             (_, s) => s,
         };
-        if !implicit {
-            ui.checkbox(&mut d.gpu, "on the GPU")
-                .on_hover_text("step the explicit solver in a compute shader; the fur is drawn from the GPU's state");
+        if implicit && d.topology.joins_tips() {
+            // FurMotion steps prisms' implicit solve (CG over all tips) on
+            // the CPU whatever the box says.
+            ui.add_enabled(false, egui::Checkbox::new(&mut d.gpu, "on the GPU"))
+                .on_disabled_hover_text("the prisms' implicit step runs on the CPU; choose explicit to step them on the GPU");
+        } else {
+            ui.checkbox(&mut d.gpu, "on the GPU").on_hover_text(
+                "step the solver in a compute shader; the fur is drawn from the GPU's state",
+            );
         }
         ui.add(
             egui::Slider::new(&mut d.params.stiffness, 0.05..=50.0)
