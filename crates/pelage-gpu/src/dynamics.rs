@@ -309,7 +309,7 @@ impl GpuMassSpring {
         Ok(Self {
             tips,
             silva: system.topology() == Topology::SilvaStrands,
-            joined: !system.tip_tip_springs().is_empty(),
+            joined: system.joins_tips(),
             explicit,
             implicit,
             coupling,
@@ -597,7 +597,8 @@ impl GpuMassSpring {
 
 /// A scene's moving fur as the renderer uses it: the mass-spring system
 /// stepped on the CPU, or on the GPU where the settings say `gpu` (and,
-/// for the implicit solver, no springs join the tips); the skin's rest pose it is moved from; its clock.
+/// for the implicit solver, no springs join the tips); the skin's rest
+/// pose it is moved from; its clock.
 /// [`ShellScenePlayer`](crate::ShellScenePlayer) and the viewer step it
 /// frame by frame.
 #[derive(Debug)]
@@ -658,8 +659,7 @@ impl FurMotion {
         };
         // The GPU steps every explicit system and the implicit ones whose
         // tips no springs join; prisms' implicit step stays on the CPU.
-        let on_gpu =
-            settings.gpu && (explicit.is_some() || self.system.tip_tip_springs().is_empty());
+        let on_gpu = settings.gpu && (explicit.is_some() || !self.system.joins_tips());
         match (on_gpu, self.on_gpu.take()) {
             (true, None) => self.on_gpu = Some(GpuMassSpring::new(ctx, &self.system)?),
             (false, Some(gpu)) => gpu.download_into(ctx, &mut self.system)?,

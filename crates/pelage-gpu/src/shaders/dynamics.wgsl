@@ -189,14 +189,24 @@ fn constrained(i: u32, x_in: vec3<f32>, v_in: vec3<f32>) -> TipState {
     return TipState(x, v);
 }
 
-// Millions of tips need more workgroups than one dispatch dimension
-// holds (65,535), so the host spreads them over x and y.
+// The element (tip, or triangle corner) an invocation works on. Millions
+// of them need more workgroups than one dispatch dimension holds
+// (65,535), so the host spreads them over x and y.
+fn flat_index(id: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return id.y * groups.x * 64u + id.x;
+}
+
+fn store(i: u32, next: TipState) {
+    tips_out[i] = vec4<f32>(next.x, 0.0);
+    velocities_out[i] = vec4<f32>(next.v, 0.0);
+}
+
 @compute @workgroup_size(64)
 fn explicit_substep(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let i = id.y * groups.x * 64u + id.x;
+    let i = flat_index(id, groups);
     if i >= step.counts.x {
         return;
     }
@@ -205,9 +215,7 @@ fn explicit_substep(
     let v0 = velocities_in[i].xyz;
     let f = tip_force(i, x, v0) + lateral_force(i, x, v0);
     let v = v0 + (h / step.springs.x) * f;
-    let next = constrained(i, x + h * v, v);
-    tips_out[i] = vec4<f32>(next.x, 0.0);
-    velocities_out[i] = vec4<f32>(next.v, 0.0);
+    store(i, constrained(i, x + h * v, v));
 }
 
 // ---- the implicit step where no springs join the tips ----
@@ -259,7 +267,7 @@ fn implicit_unjoined_step(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let i = id.y * groups.x * 64u + id.x;
+    let i = flat_index(id, groups);
     if i >= step.counts.x {
         return;
     }
@@ -273,9 +281,7 @@ fn implicit_unjoined_step(
         + h * blocks.c + (h * h) * blocks.k;
     let dv = inverse3(a) * (h * (f - h * (blocks.k * v0)));
     let v = v0 + dv;
-    let next = constrained(i, x + h * v, v);
-    tips_out[i] = vec4<f32>(next.x, 0.0);
-    velocities_out[i] = vec4<f32>(next.v, 0.0);
+    store(i, constrained(i, x + h * v, v));
 }
 
 // ---- coupling to the shells: MassSpringSystem::corner_tip_offsets ----
@@ -290,7 +296,7 @@ fn corner_tip_offsets(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let c = id.y * groups.x * 64u + id.x;
+    let c = flat_index(id, groups);
     if c >= arrayLength(&corner_sticks) {
         return;
     }

@@ -478,10 +478,10 @@ impl MassSpringSystem {
 
     /// One linearised backward-Euler step.
     fn implicit_step(&mut self, h: f32, p: &DynamicsParams, iterations: u32, time: f32) {
-        if self.springs.is_empty() {
-            self.implicit_step_unjoined(h, p, time);
-        } else {
+        if self.joins_tips() {
             self.implicit_step_joined(h, p, iterations, time);
+        } else {
+            self.implicit_step_unjoined(h, p, time);
         }
     }
 

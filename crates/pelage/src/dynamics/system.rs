@@ -275,6 +275,14 @@ impl MassSpringSystem {
         &self.springs
     }
 
+    /// Whether springs join the tips: then the implicit step solves one
+    /// system over all of them (conjugate gradients), else a 3×3 one per
+    /// tip — on the CPU or the GPU. [`Topology::joins_tips`] says the same
+    /// before a system is built.
+    pub fn joins_tips(&self) -> bool {
+        !self.springs.is_empty()
+    }
+
     /// For each tip `i`, its tip-tip springs are
     /// `spring_index[spring_offsets[i]..spring_offsets[i + 1]]`, indices
     /// into [`tip_tip_springs`](Self::tip_tip_springs): `(spring_offsets, spring_index)`.
