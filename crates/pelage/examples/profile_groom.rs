@@ -24,7 +24,9 @@ fn main() {
     let t = std::time::Instant::now();
     let mut n = 0;
     for p in 0..generator.parts().len() {
-        n += generator.part(p).curve_count();
+        let part = generator.part(p);
+        n += part.curve_count();
+        generator.recycle(part);
     }
     let s = t.elapsed().as_secs_f64();
     eprintln!("{n} hairs in {s:.3} s: {:.2} M hairs/s", n as f64 / s / 1e6);

@@ -6,8 +6,8 @@
 use glam::Vec3;
 use pelage::guides::{GuideGrowth, Guides};
 use pelage::interp::{
-    GuideWeight, GuideWeights, HairRoot, InterpolationMethod, Interpolator, Shepard, StyleMesh,
-    StyleMeshOptions,
+    GuideWeight, GuideWeights, HairRoot, HairScratch, InterpolationMethod, Interpolator, Shepard,
+    StyleMesh, StyleMeshOptions,
 };
 use pelage::mesh::TriangleBvh;
 use pelage::{Curves, Mesh, SurfacePoint};
@@ -53,7 +53,10 @@ fn a_hair_at_a_guide_root_is_that_guide() {
     }));
     for method in methods {
         let interp = Interpolator::new(&spot, &guides, &method);
-        let (mut scratch, mut hair) = (Vec::new(), vec![Vec3::ZERO; guides.points_per_guide()]);
+        let (mut scratch, mut hair) = (
+            HairScratch::default(),
+            vec![Vec3::ZERO; guides.points_per_guide()],
+        );
         let skip = |i: usize| {
             method == InterpolationMethod::StyleMesh(StyleMeshOptions::default())
                 && lost.contains(&(i as u32))
@@ -115,7 +118,7 @@ fn straight_guides_give_hairs_along_their_own_normal() {
     .unwrap();
     for method in methods() {
         let interp = Interpolator::new(&spot, &guides, &method);
-        let (mut scratch, mut hair) = (Vec::new(), vec![Vec3::ZERO; 8]);
+        let (mut scratch, mut hair) = (HairScratch::default(), vec![Vec3::ZERO; 8]);
         for i in 0..300u32 {
             let root = SurfacePoint::new(i * 13 % spot.triangle_count() as u32, [0.2, 0.5]);
             interp.hair(&spot, root, &mut scratch, &mut hair);
@@ -299,7 +302,7 @@ fn guides_denser_than_the_mesh_are_reported_and_splitting_gives_each_its_vertex(
     let split = StyleMesh::build(&spot, &guides, &StyleMeshOptions { split_shared: true });
     assert!(split.lost().is_empty());
     let interp = Interpolator::with_weights(&spot, &guides, Box::new(split));
-    let (mut scratch, mut hair) = (Vec::new(), vec![Vec3::ZERO; 3]);
+    let (mut scratch, mut hair) = (HairScratch::default(), vec![Vec3::ZERO; 3]);
     for (i, root) in guides.roots().iter().enumerate() {
         interp.hair(&spot, *root, &mut scratch, &mut hair);
         for (a, b) in hair.iter().zip(guides.guide(i)) {

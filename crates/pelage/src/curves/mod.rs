@@ -32,6 +32,30 @@ pub struct Curves {
     ids: Option<Vec<u64>>,
 }
 
+/// Every array of a [`Curves`], taken back by [`Curves::into_arrays`] to
+/// reuse their memory (an attribute the curves lacked is empty).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CurveArrays {
+    /// Positions.
+    pub points: Vec<Vec3>,
+    /// Per-point widths.
+    pub widths: Vec<f32>,
+    /// Curve offsets.
+    pub offsets: Vec<u32>,
+    /// Per-point normals.
+    pub normals: Vec<Vec3>,
+    /// Per-point colours.
+    pub colors: Vec<Vec3>,
+    /// Per-point opacities.
+    pub opacities: Vec<f32>,
+    /// Per-curve roots.
+    pub roots: Vec<SurfacePoint>,
+    /// Per-curve root UVs.
+    pub root_uvs: Vec<Vec2>,
+    /// Per-curve ids.
+    pub ids: Vec<u64>,
+}
+
 /// Curves could not be built from their arrays.
 #[derive(Debug, thiserror::Error, PartialEq)]
 #[non_exhaustive]
@@ -141,6 +165,23 @@ impl Curves {
             offsets,
             ..Self::default()
         })
+    }
+
+    /// The arrays, to reuse their memory for the next curves (the groom
+    /// generator recycles a written part's arrays into the next part: fresh
+    /// memory costs a page fault every 4 KB).
+    pub fn into_arrays(self) -> CurveArrays {
+        CurveArrays {
+            points: self.points,
+            widths: self.widths,
+            offsets: self.offsets,
+            normals: self.normals.unwrap_or_default(),
+            colors: self.colors.unwrap_or_default(),
+            opacities: self.opacities.unwrap_or_default(),
+            roots: self.roots.unwrap_or_default(),
+            root_uvs: self.root_uvs.unwrap_or_default(),
+            ids: self.ids.unwrap_or_default(),
+        }
     }
 
     /// Every `step`-th curve (0, step, 2·step, …) with its points, widths

@@ -10,10 +10,12 @@ use super::ops::{
     RootContext, RootToTip, Scratch, Strands, Width,
 };
 use super::parts::{Part, PartLayout};
-use crate::curves::Curves;
-use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
+use crate::curves::frames::{
+    FrameScratch, catmull_rom_tangents, hair_normals, rotation_minimizing_normals,
+};
+use crate::curves::{CurveArrays, Curves};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
-use crate::interp::{GuideWeight, InterpolationMethod, Interpolator, StyleMeshOptions};
+use crate::interp::{HairScratch, InterpolationMethod, Interpolator, StyleMeshOptions};
 use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
 use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, sample_range};
@@ -256,7 +258,13 @@ pub struct Generator<'g> {
     opacities: bool,
     normals: bool,
     seed: u64,
+    /// Arrays of parts handed back by [`Self::recycle`], for the next parts.
+    spare: std::sync::Mutex<Vec<CurveArrays>>,
 }
+
+/// Parts' arrays kept for reuse: a writer holds one part while the next
+/// grows, so two cover the stream.
+const SPARE_PARTS: usize = 2;
 
 impl std::fmt::Debug for Generator<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -273,10 +281,13 @@ impl std::fmt::Debug for Generator<'_> {
 /// Per-thread buffers.
 #[derive(Default)]
 struct Workspace {
-    weights: Vec<GuideWeight>,
+    interpolation: HairScratch,
     shape: Vec<Vec3>,
     batch: HairBatch,
     scratch: Scratch,
+    /// Each hair's skin normal, the start of its frame.
+    skin_normals: Vec<Vec3>,
+    frames: FrameScratch,
 }
 
 impl<'g> Generator<'g> {
@@ -352,6 +363,7 @@ impl<'g> Generator<'g> {
             opacities: file.finish.opacity.is_some(),
             normals: file.finish.normals,
             seed,
+            spare: std::sync::Mutex::new(Vec::new()),
         };
         for (k, spec) in file.ops.iter().enumerate() {
             let op = generator.operator(k, spec)?;
@@ -487,8 +499,9 @@ impl<'g> Generator<'g> {
         self.points
     }
 
-    /// Hair `id` grown from `root` through `ops` into `ws.batch`.
-    fn grow(&self, root: SurfacePoint, id: u64, ops: &[Operator], ws: &mut Workspace) {
+    /// Hair `id` grown from `root` through `ops` into `ws.batch`; returns
+    /// the skin normal at the root.
+    fn grow(&self, root: SurfacePoint, id: u64, ops: &[Operator], ws: &mut Workspace) -> Vec3 {
         let mesh = &self.groom.mesh;
         let context = RootContext {
             point: root,
@@ -499,7 +512,7 @@ impl<'g> Generator<'g> {
         let guide_points = self.groom.guides.points_per_guide();
         ws.shape.resize(guide_points, Vec3::ZERO);
         self.interpolator
-            .hair(mesh, root, &mut ws.weights, &mut ws.shape);
+            .hair(mesh, root, &mut ws.interpolation, &mut ws.shape);
         let hair = ws.batch.reset();
         hair.id = id;
         hair.points.clear();
@@ -512,6 +525,7 @@ impl<'g> Generator<'g> {
                 break;
             }
         }
+        context.normal
     }
 
     /// Appends the interpolated `shape` (guide resolution) at the hairs'
@@ -562,6 +576,22 @@ impl<'g> Generator<'g> {
         self.concat(chunks)
     }
 
+    /// Hands a grown part back once it is written, so that a later part
+    /// reuses its memory instead of asking the kernel for fresh pages
+    /// (whose first touch faults and zeroes them: a tenth of a groom's
+    /// time). Optional; a part not handed back is simply freed.
+    pub fn recycle(&self, curves: Curves) {
+        let mut spare = self.spare.lock().unwrap_or_else(|e| e.into_inner());
+        if spare.len() < SPARE_PARTS {
+            spare.push(curves.into_arrays());
+        }
+    }
+
+    fn spare_arrays(&self) -> CurveArrays {
+        let mut spare = self.spare.lock().unwrap_or_else(|e| e.into_inner());
+        spare.pop().unwrap_or_default()
+    }
+
     /// Whether every root grows exactly one hair (no `strands`, no `cut`):
     /// then a part's arrays have a known size and workers fill them in
     /// place.
@@ -580,17 +610,19 @@ impl<'g> Generator<'g> {
         let sized = |on: bool| if on { total } else { 0 };
         // Filled on all threads: zeroing a part's ~50 MB on this one was
         // time every other core waited for (Amdahl: at 16 threads it kept
-        // the groom at a third of the cores' worth).
-        let zeros = |len: usize| {
-            let mut v = Vec::with_capacity(len);
-            v.par_extend(rayon::iter::repeat_n(Vec3::ZERO, len));
+        // the groom at a third of the cores' worth). Recycled arrays have
+        // the room already.
+        fn zeros<T: Copy + Send + Default>(mut v: Vec<T>, len: usize) -> Vec<T> {
+            v.clear();
+            v.par_extend(rayon::iter::repeat_n(T::default(), len));
             v
-        };
-        let mut points = zeros(total);
-        let mut widths = vec![0f32; total];
-        let mut normals = zeros(sized(self.normals));
-        let mut colors = zeros(sized(self.colors));
-        let mut opacities = vec![0f32; sized(self.opacities)];
+        }
+        let spare = self.spare_arrays();
+        let mut points = zeros(spare.points, total);
+        let mut widths = zeros(spare.widths, total);
+        let mut normals = zeros(spare.normals, sized(self.normals));
+        let mut colors = zeros(spare.colors, sized(self.colors));
+        let mut opacities = zeros(spare.opacities, sized(self.opacities));
         {
             let mut jobs = Vec::with_capacity(roots.len().div_ceil(CHUNK));
             let (mut p, mut w, mut nr, mut c, mut o) = (
@@ -615,9 +647,10 @@ impl<'g> Generator<'g> {
             jobs.into_par_iter().for_each_init(
                 Workspace::default,
                 |ws, (chunk, first, p, w, nr, c, o)| {
-                    let mut tangents = vec![Vec3::ZERO; n];
+                    ws.skin_normals.clear();
                     for (i, root) in chunk.iter().enumerate() {
-                        self.grow(*root, first + i as u64, &self.ops, ws);
+                        let skin = self.grow(*root, first + i as u64, &self.ops, ws);
+                        ws.skin_normals.push(skin);
                         let hair = &ws.batch.hairs()[0];
                         let range = i * n..(i + 1) * n;
                         p[range.clone()].copy_from_slice(&hair.points);
@@ -626,23 +659,21 @@ impl<'g> Generator<'g> {
                             c[range.clone()].copy_from_slice(&hair.colors);
                         }
                         if self.opacities {
-                            o[range.clone()].copy_from_slice(&hair.opacities);
+                            o[range].copy_from_slice(&hair.opacities);
                         }
-                        if self.normals {
-                            catmull_rom_tangents(&hair.points, &mut tangents);
-                            rotation_minimizing_normals(
-                                &hair.points,
-                                &tangents,
-                                root.normal(&self.groom.mesh),
-                                &mut nr[range],
-                            );
-                        }
+                    }
+                    if self.normals {
+                        hair_normals(p, n, &ws.skin_normals, nr, &mut ws.frames);
                     }
                 },
             );
         }
-        let offsets = (0..=roots.len() as u32).map(|i| i * n as u32).collect();
-        let ids = (first_hair..first_hair + roots.len() as u64).collect();
+        let mut offsets = spare.offsets;
+        offsets.clear();
+        offsets.extend((0..=roots.len() as u32).map(|i| i * n as u32));
+        let mut ids = spare.ids;
+        ids.clear();
+        ids.extend(first_hair..first_hair + roots.len() as u64);
         let mut curves = Curves::new(points, widths, offsets).expect("consistent part arrays");
         if self.normals {
             curves = curves.with_normals(normals).expect("one normal a point");

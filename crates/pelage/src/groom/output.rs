@@ -110,6 +110,7 @@ impl Generator<'_> {
                     usd.write_part(&part_name(p), &curves).map_err(other)?;
                 }
                 on_part(p, &curves);
+                self.recycle(curves);
             }
             grower.join().expect("the part grower does not panic");
             Ok::<(), std::io::Error>(())

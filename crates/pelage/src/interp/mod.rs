@@ -18,15 +18,17 @@
 //! (Frames built from UV tangents would flip across UV seams; the minimal
 //! rotation between two normals has no seams.)
 
+mod nearest;
 mod shepard;
 mod style_mesh;
 
+pub use nearest::{NearestPoints, Neighbour, NeighbourCache};
 pub use shepard::Shepard;
 pub use style_mesh::{LostGuide, StyleMesh, StyleMeshOptions};
 
 use crate::guides::Guides;
 use crate::mesh::{Mesh, SurfacePoint};
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3};
 
 /// One guide's share of a hair.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,6 +73,24 @@ pub trait GuideWeights: Send + Sync {
     /// Replaces `out` with the guides and weights of a hair rooted at
     /// `root`. Weights are non-negative and sum to 1.
     fn weights(&self, root: HairRoot, out: &mut Vec<GuideWeight>);
+
+    /// [`Self::weights`] for one of a run of nearby roots (a part's hairs,
+    /// sorted by triangle): `near` keeps what earlier roots found, which
+    /// Shepard uses to skip most kd-tree searches. The same result as
+    /// [`Self::weights`] whatever `near` holds.
+    fn weights_near(&self, root: HairRoot, near: &mut NeighbourCache, out: &mut Vec<GuideWeight>) {
+        let _ = near;
+        self.weights(root, out);
+    }
+}
+
+/// What shaping a run of hairs reuses from one hair to the next.
+#[derive(Debug, Default)]
+pub struct HairScratch {
+    /// The last hair's guide weights.
+    pub weights: Vec<GuideWeight>,
+    /// Guides near the last roots.
+    pub near: NeighbourCache,
 }
 
 /// An interpolation method by name, as groom files spell it.
@@ -161,33 +181,59 @@ impl<'g> Interpolator<'g> {
     }
 
     /// Shapes the hair rooted at `root` into `out` (`points_per_guide`
-    /// points, `out[0]` the root), using `scratch` for the weights.
+    /// points, `out[0]` the root). `scratch` is best kept for a run of
+    /// nearby roots (it speeds the guide search, never changes a result).
     pub fn hair(
         &self,
         mesh: &Mesh,
         root: SurfacePoint,
-        scratch: &mut Vec<GuideWeight>,
+        scratch: &mut HairScratch,
         out: &mut [Vec3],
     ) {
         let hair_root = HairRoot::on(mesh, root);
-        self.weights.weights(hair_root, scratch);
-        self.shape(scratch, hair_root.position, root.normal(mesh), out);
+        self.weights
+            .weights_near(hair_root, &mut scratch.near, &mut scratch.weights);
+        self.shape(&scratch.weights, hair_root.position, root.normal(mesh), out);
     }
 
     /// Shapes a hair at `position` with surface normal `normal` from given
     /// weights.
     pub fn shape(&self, weights: &[GuideWeight], position: Vec3, normal: Vec3, out: &mut [Vec3]) {
         let n = self.guides.points_per_guide();
-        out.iter_mut().for_each(|p| *p = Vec3::ZERO);
+        out.iter_mut().for_each(|p| *p = position);
         for w in weights {
             let g = w.guide as usize;
-            let turn = Quat::from_rotation_arc(self.normals[g], normal);
+            // The weight folded into the rotation: one matrix-vector
+            // product a point.
+            let turn = w.weight * rotation_between(self.normals[g], normal);
             for (o, offset) in out.iter_mut().zip(&self.offsets[g * n..(g + 1) * n]) {
-                *o += w.weight * (turn * *offset);
+                *o += turn * *offset;
             }
         }
-        out.iter_mut().for_each(|p| *p += position);
     }
+}
+
+/// The smallest rotation taking unit vector `from` to unit vector `to`, as
+/// a matrix: Rodrigues' formula without trigonometry,
+/// `R = I + [v]× + [v]×² / (1 + c)` with `v = from × to`, `c = from · to`.
+/// Equal vectors give the identity exactly (so a hair at a guide's root is
+/// that guide to the bit); nearly opposite ones, where `1 + c` vanishes,
+/// fall back to glam's half-turn about a perpendicular axis.
+fn rotation_between(from: Vec3, to: Vec3) -> Mat3 {
+    let v = from.cross(to);
+    let c = from.dot(to);
+    let one_plus_c = 1.0 + c;
+    if one_plus_c < 1e-4 {
+        return Mat3::from_quat(Quat::from_rotation_arc(from, to));
+    }
+    let h = one_plus_c.recip();
+    let (hx, hy, hz) = (h * v.x, h * v.y, h * v.z);
+    let (xy, xz, yz) = (hx * v.y, hx * v.z, hy * v.z);
+    Mat3::from_cols(
+        Vec3::new(1.0 - hy * v.y - hz * v.z, xy + v.z, xz - v.y),
+        Vec3::new(xy - v.z, 1.0 - hx * v.x - hz * v.z, yz + v.x),
+        Vec3::new(xz + v.y, yz - v.x, 1.0 - hx * v.x - hy * v.y),
+    )
 }
 
 /// Normalises weights to sum 1 (they must be non-negative, not all zero).

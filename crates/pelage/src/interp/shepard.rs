@@ -3,17 +3,18 @@
 //! `1 / d^p` (Shepard 1968), normalised to sum 1. A hair exactly at a guide
 //! root takes that guide alone; with a radius, guides farther away are
 //! ignored, and a hair with none inside takes its nearest guide alone.
+//! A run of nearby roots is answered from a candidate list instead of the
+//! tree ([`super::NearestPoints`]), with the same result.
 
+use super::nearest::{NearestPoints, Neighbour, NeighbourCache};
 use super::{GuideWeight, GuideWeights, HairRoot, normalise};
 use crate::guides::Guides;
 use crate::mesh::Mesh;
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
-use std::num::NonZeroUsize;
 
 /// Inverse-distance weights over the k nearest guide roots.
 pub struct Shepard {
-    tree: Option<ImmutableKdTree<f32, 3>>,
-    k: NonZeroUsize,
+    roots: NearestPoints,
+    k: usize,
     power: f32,
     radius_squared: f32,
 }
@@ -21,48 +22,57 @@ pub struct Shepard {
 impl Shepard {
     /// A kd-tree over the guides' root positions.
     pub fn new(mesh: &Mesh, guides: &Guides, k: usize, power: f32, radius: Option<f32>) -> Self {
-        let roots: Vec<[f32; 3]> = guides
-            .roots()
-            .iter()
-            .map(|r| r.position(mesh).to_array())
-            .collect();
+        let roots = guides.roots().iter().map(|r| r.position(mesh)).collect();
         Self {
-            tree: (!roots.is_empty())
-                .then(|| ImmutableKdTree::new_from_slice(&roots).expect("finite guide roots")),
-            k: NonZeroUsize::new(k.clamp(1, roots.len().max(1))).expect("at least 1"),
+            roots: NearestPoints::new(roots),
+            k: k.max(1),
             power,
             radius_squared: radius.map_or(f32::INFINITY, |r| r * r),
         }
     }
 }
 
-impl GuideWeights for Shepard {
-    fn weights(&self, root: HairRoot, out: &mut Vec<GuideWeight>) {
+impl Shepard {
+    /// Weights from the nearest guides, nearest first.
+    fn weigh(&self, nearest: &[Neighbour], out: &mut Vec<GuideWeight>) {
         out.clear();
-        let Some(tree) = &self.tree else { return };
-        let nearest = tree
-            .query(&root.position.to_array())
-            .nearest_n::<SquaredEuclidean<f32>>(self.k)
-            .execute();
         for (i, hit) in nearest.iter().enumerate() {
-            let guide = hit.item;
+            let guide = hit.index;
+            let distance = hit.distance_squared;
             // At a guide's root: that guide alone (1/0 would swamp the rest).
-            if hit.distance <= 1e-14 {
+            if distance <= 1e-14 {
                 out.clear();
                 out.push(GuideWeight { guide, weight: 1.0 });
                 return;
             }
-            if hit.distance > self.radius_squared && i > 0 {
+            if distance > self.radius_squared && i > 0 {
                 break;
             }
             // The usual power 2 needs no powf.
             let weight = if self.power == 2.0 {
-                hit.distance.recip()
+                distance.recip()
             } else {
-                hit.distance.powf(-0.5 * self.power)
+                distance.powf(-0.5 * self.power)
             };
             out.push(GuideWeight { guide, weight });
         }
         normalise(out);
+    }
+}
+
+impl GuideWeights for Shepard {
+    fn weights(&self, root: HairRoot, out: &mut Vec<GuideWeight>) {
+        let mut nearest = Vec::with_capacity(self.k);
+        self.roots.nearest(root.position, self.k, &mut nearest);
+        self.weigh(&nearest, out);
+    }
+
+    fn weights_near(&self, root: HairRoot, near: &mut NeighbourCache, out: &mut Vec<GuideWeight>) {
+        // The found list lives in the cache too, so a hair allocates nothing.
+        let mut found = std::mem::take(&mut near.found);
+        self.roots
+            .nearest_cached(root.position, self.k, near, &mut found);
+        self.weigh(&found, out);
+        near.found = found;
     }
 }

@@ -6,16 +6,15 @@
 
 use super::{Hair, RootContext, param};
 use crate::groom::file::Ramp;
+use crate::interp::{NearestPoints, NeighbourCache};
 use crate::map::Map;
 use glam::Vec3;
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 /// The centre hairs of one clump level: roots in a kd-tree, shapes with
 /// the hairs' point count.
 #[derive(Debug)]
 pub struct ClumpCentres {
-    tree: Option<ImmutableKdTree<f32, 3>>,
-    roots: Vec<Vec3>,
+    roots: NearestPoints,
     shapes: Vec<Vec3>,
     points: usize,
 }
@@ -25,11 +24,8 @@ impl ClumpCentres {
     /// `shapes[i * points..(i + 1) * points]`.
     pub fn new(roots: Vec<Vec3>, shapes: Vec<Vec3>, points: usize) -> Self {
         assert_eq!(roots.len() * points, shapes.len());
-        let positions: Vec<[f32; 3]> = roots.iter().map(|r| r.to_array()).collect();
         Self {
-            tree: (!positions.is_empty())
-                .then(|| ImmutableKdTree::new_from_slice(&positions).expect("finite roots")),
-            roots,
+            roots: NearestPoints::new(roots),
             shapes,
             points,
         }
@@ -37,22 +33,30 @@ impl ClumpCentres {
 
     /// Number of centres.
     pub fn len(&self) -> usize {
-        self.roots.len()
+        self.roots.points().len()
     }
 
     /// Whether there are none.
     pub fn is_empty(&self) -> bool {
-        self.roots.is_empty()
+        self.roots.points().is_empty()
     }
 
-    /// The centre nearest `position` and its distance.
+    /// The centre nearest `position` and its distance (ties: the lower
+    /// index).
     pub fn nearest(&self, position: Vec3) -> Option<(usize, f32)> {
-        let tree = self.tree.as_ref()?;
-        let hit = tree
-            .query(&position.to_array())
-            .nearest_one::<SquaredEuclidean<f32>>()
-            .execute();
-        Some((hit.item as usize, hit.distance.sqrt()))
+        self.nearest_near(position, &mut NeighbourCache::default())
+    }
+
+    /// [`Self::nearest`] for one of a run of nearby positions, `near`
+    /// kept between them (faster, same result).
+    pub fn nearest_near(&self, position: Vec3, near: &mut NeighbourCache) -> Option<(usize, f32)> {
+        let mut found = std::mem::take(&mut near.found);
+        self.roots.nearest_cached(position, 1, near, &mut found);
+        let hit = found
+            .first()
+            .map(|n| (n.index as usize, n.distance_squared.sqrt()));
+        near.found = found;
+        hit
     }
 
     /// Centre `i`'s points.
@@ -62,7 +66,7 @@ impl ClumpCentres {
 
     /// Every centre's root.
     pub fn roots(&self) -> &[Vec3] {
-        &self.roots
+        self.roots.points()
     }
 }
 
@@ -94,8 +98,8 @@ impl Clump {
         &self.centres
     }
 
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext) {
-        let Some((centre, distance)) = self.centres.nearest(root.position) else {
+    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, near: &mut NeighbourCache) {
+        let Some((centre, distance)) = self.centres.nearest_near(root.position, near) else {
             return;
         };
         let mut w = self.rate.eval(root.uv);
@@ -136,7 +140,7 @@ mod tests {
     fn full_rate_brings_the_tip_to_the_centre_and_keeps_the_root() {
         let op = Clump::new(centre_at(0.1), Map::Constant(1.0), Ramp::default(), None);
         let mut hair = straight(1, 8, 1.0);
-        op.apply(&mut hair, &root());
+        op.apply(&mut hair, &root(), &mut NeighbourCache::default());
         assert_eq!(hair.points[0], Vec3::ZERO);
         assert!((hair.points[7] - Vec3::new(0.1, 0.0, 1.0)).length() < 1e-6);
         assert!(
@@ -154,7 +158,7 @@ mod tests {
             Some(Map::Constant(0.05)),
         );
         let mut hair = straight(1, 8, 1.0);
-        op.apply(&mut hair, &root());
+        op.apply(&mut hair, &root(), &mut NeighbourCache::default());
         assert_eq!(hair, straight(1, 8, 1.0), "beyond the clump's size");
         let mut shapes = centre_at(0.1).shapes;
         shapes.extend(centre_at(-0.3).shapes);

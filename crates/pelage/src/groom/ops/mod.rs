@@ -147,6 +147,8 @@ pub struct Scratch {
     pub(crate) points: Vec<Vec3>,
     pub(crate) floats: Vec<f32>,
     pub(crate) bases: HairBatch,
+    /// Clump centres near the last roots.
+    pub(crate) near: crate::interp::NeighbourCache,
 }
 
 impl Scratch {
@@ -204,7 +206,7 @@ impl Operator {
                     match self {
                         Operator::Noise(op) => op.apply(hair, root),
                         Operator::Frizz(op) => op.apply(hair, root),
-                        Operator::Clump(op) => op.apply(hair, root),
+                        Operator::Clump(op) => op.apply(hair, root, &mut scratch.near),
                         Operator::Curl(op) => op.apply(hair, root, scratch),
                         Operator::Length(op) => op.apply(hair, root),
                         Operator::Width(op) => op.apply(hair, root),

@@ -1,0 +1,361 @@
+//! The k nearest of a fixed set of points (guide roots for Shepard, clump
+//! centres for `clump`), for queries that arrive in spatially coherent
+//! order: the generator grows a part's hairs sorted by triangle, so each
+//! root is close to the one before.
+//!
+//! A kd-tree answers any query, but most hairs are answered from a short
+//! list of candidates kept for the last neighbourhood ([`NeighbourCache`]).
+//! The list is exact, not a heuristic. It is filled at a point `q` whose
+//! k-th nearest point is `d_k(q)` away, and serves queries `p` within
+//! `R = d_k(q) / 2` of `q`: `q`'s k nearest are within `d_k(q) + R` of
+//! `p`, so `d_k(p) ≤ d_k(q) + R`, and every point `p` could choose lies
+//! within `d_k(q) + 2R` of `q` — those are the candidates.
+//!
+//! Results are ordered by (squared distance, index), computed here from
+//! the points, so they are the same whichever earlier query filled the
+//! list: a hair's neighbours never depend on the thread or the order that
+//! grew it (DESIGN.md, "Deterministic by hair id"), ties included.
+
+use glam::Vec3;
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use std::num::NonZeroUsize;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Candidates a list may hold before it serves only the point it was
+/// filled at (a few large triangles under many guides would otherwise
+/// brute-force hundreds of points a hair).
+const MOST_CANDIDATES: usize = 64;
+
+/// Slack on squared radii handed to the kd-tree, so that its rounding of a
+/// distance and ours can never leave a point out.
+const RADIUS_SLACK: f32 = 1.001;
+
+/// One of the nearest points: its index and squared distance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Neighbour {
+    /// Index into the point set.
+    pub index: u32,
+    /// Squared distance to the query.
+    pub distance_squared: f32,
+}
+
+/// A fixed set of points with a kd-tree over them.
+#[derive(Debug)]
+pub struct NearestPoints {
+    tree: Option<ImmutableKdTree<f32, 3>>,
+    points: Vec<Vec3>,
+    /// Tells this set's list apart in a shared [`NeighbourCache`].
+    id: u64,
+}
+
+/// Candidate lists kept between queries, one per point set and k. Keep one
+/// per worker and pass it to every query of a run of nearby points.
+#[derive(Debug, Default)]
+pub struct NeighbourCache {
+    lists: Vec<CandidateList>,
+    /// A result buffer for callers that keep nothing else per worker.
+    pub(crate) found: Vec<Neighbour>,
+}
+
+#[derive(Debug)]
+struct CandidateList {
+    set: u64,
+    k: usize,
+    centre: Vec3,
+    reach_squared: f32,
+    /// Candidate indices and their coordinates, copied as three columns so
+    /// a query computes all distances in one vectorised pass.
+    candidates: Vec<u32>,
+    xs: Vec<f32>,
+    ys: Vec<f32>,
+    zs: Vec<f32>,
+    /// This query's candidates as [`key`]s, and the k smallest.
+    keys: Vec<u64>,
+    best: Vec<u64>,
+}
+
+impl NearestPoints {
+    /// A set over `points` (finite).
+    pub fn new(points: Vec<Vec3>) -> Self {
+        static NEXT_ID: AtomicU64 = AtomicU64::new(0);
+        let array: Vec<[f32; 3]> = points.iter().map(|p| p.to_array()).collect();
+        Self {
+            tree: (!array.is_empty())
+                .then(|| ImmutableKdTree::new_from_slice(&array).expect("finite points")),
+            points,
+            id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
+        }
+    }
+
+    /// The points.
+    pub fn points(&self) -> &[Vec3] {
+        &self.points
+    }
+
+    /// Replaces `out` with the `k` points nearest `p` (fewer if the set is
+    /// smaller), nearest first, ties by index.
+    pub fn nearest(&self, p: Vec3, k: usize, out: &mut Vec<Neighbour>) {
+        out.clear();
+        let Some(kth) = self.kth_distance_squared(p, k) else {
+            return;
+        };
+        let mut best = vec![u64::MAX; k];
+        self.visit_within(p, kth * RADIUS_SLACK, |i| {
+            keep_smallest(
+                &mut best,
+                key((self.points[i as usize] - p).length_squared(), i),
+            );
+        });
+        out.extend(neighbours(&best));
+    }
+
+    /// [`Self::nearest`], answered from `cache`'s candidates when `p` is
+    /// near the point they were gathered for. The same result as
+    /// [`Self::nearest`] whatever the cache holds.
+    pub fn nearest_cached(
+        &self,
+        p: Vec3,
+        k: usize,
+        cache: &mut NeighbourCache,
+        out: &mut Vec<Neighbour>,
+    ) {
+        out.clear();
+        let k = k.min(self.points.len());
+        if k == 0 {
+            return;
+        }
+        let list = match cache
+            .lists
+            .iter()
+            .position(|l| l.set == self.id && l.k == k)
+        {
+            Some(i) => &mut cache.lists[i],
+            None => {
+                cache.lists.push(CandidateList {
+                    set: self.id,
+                    k,
+                    centre: p,
+                    reach_squared: -1.0,
+                    candidates: Vec::new(),
+                    xs: Vec::new(),
+                    ys: Vec::new(),
+                    zs: Vec::new(),
+                    keys: Vec::new(),
+                    best: Vec::new(),
+                });
+                cache.lists.last_mut().expect("just pushed")
+            }
+        };
+        if (p - list.centre).length_squared() > list.reach_squared {
+            self.refill(list, p, k);
+        }
+        // The same arithmetic as `(q - p).length_squared()`, so cached and
+        // uncached answers agree to the bit.
+        let (xs, ys, zs) = (&list.xs, &list.ys, &list.zs);
+        list.keys.clear();
+        list.keys
+            .extend(
+                xs.iter()
+                    .zip(ys)
+                    .zip(zs)
+                    .zip(&list.candidates)
+                    .map(|(((&x, &y), &z), &i)| {
+                        let (dx, dy, dz) = (x - p.x, y - p.y, z - p.z);
+                        key(dx * dx + dy * dy + dz * dz, i)
+                    }),
+            );
+        list.best.clear();
+        list.best.resize(k, u64::MAX);
+        for &candidate in &list.keys {
+            keep_smallest(&mut list.best, candidate);
+        }
+        out.extend(neighbours(&list.best));
+    }
+
+    /// Gathers the candidates for queries near `p` (module docs).
+    fn refill(&self, list: &mut CandidateList, p: Vec3, k: usize) {
+        list.centre = p;
+        list.candidates.clear();
+        list.xs.clear();
+        list.ys.clear();
+        list.zs.clear();
+        let Some(kth) = self.kth_distance_squared(p, k) else {
+            list.reach_squared = -1.0;
+            return;
+        };
+        // R = a·d_k, candidates within (1 + 2a)·d_k. A single nearest point
+        // has few candidates even at a = 1 and would otherwise be
+        // refilled every few hairs; for larger k the list grows fast.
+        let a: f32 = if k == 1 { 1.0 } else { 0.5 };
+        list.reach_squared = a * a * kth;
+        let reach = (1.0 + 2.0 * a) * (1.0 + 2.0 * a) * kth * RADIUS_SLACK;
+        let candidates = &mut list.candidates;
+        self.visit_within(p, reach, |i| candidates.push(i));
+        if list.candidates.len() > MOST_CANDIDATES {
+            // Too crowded to brute-force: serve `p` alone.
+            list.reach_squared = 0.0;
+            list.candidates.clear();
+            let candidates = &mut list.candidates;
+            self.visit_within(p, kth * RADIUS_SLACK, |i| candidates.push(i));
+        }
+        for &i in &list.candidates {
+            let q = self.points[i as usize];
+            list.xs.push(q.x);
+            list.ys.push(q.y);
+            list.zs.push(q.z);
+        }
+    }
+
+    /// The kd-tree's squared distance from `p` to its `k`-th nearest point.
+    fn kth_distance_squared(&self, p: Vec3, k: usize) -> Option<f32> {
+        let tree = self.tree.as_ref()?;
+        let k = NonZeroUsize::new(k.min(self.points.len()))?;
+        let hits = tree
+            .query(&p.to_array())
+            .nearest_n::<SquaredEuclidean<f32>>(k)
+            .execute();
+        hits.last().map(|h| h.distance)
+    }
+
+    fn visit_within(&self, p: Vec3, radius_squared: f32, mut visit: impl FnMut(u32)) {
+        if let Some(tree) = &self.tree {
+            tree.query(&p.to_array())
+                .within::<SquaredEuclidean<f32>>(radius_squared)
+                .unsorted()
+                .visit(|hit| visit(hit.item));
+        }
+    }
+}
+
+/// A point's place in the order "nearer first, equally near the lower
+/// index first" as one integer: squared distances are never negative, and
+/// the bits of non-negative floats order as their values do.
+#[inline(always)]
+fn key(distance_squared: f32, index: u32) -> u64 {
+    (u64::from(distance_squared.to_bits()) << 32) | u64::from(index)
+}
+
+/// Merges `key` into `best` (ascending): one compare-exchange per slot and
+/// no branch, where inserting into a sorted list mispredicts at every
+/// candidate.
+#[inline(always)]
+fn keep_smallest(best: &mut [u64], key: u64) {
+    let mut carried = key;
+    for slot in best {
+        let (low, high) = ((*slot).min(carried), (*slot).max(carried));
+        *slot = low;
+        carried = high;
+    }
+}
+
+/// The neighbours a sorted `best` list holds (unused slots are `MAX`).
+fn neighbours(best: &[u64]) -> impl Iterator<Item = Neighbour> + '_ {
+    best.iter()
+        .take_while(|&&k| k != u64::MAX)
+        .map(|&k| Neighbour {
+            index: k as u32,
+            distance_squared: f32::from_bits((k >> 32) as u32),
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sample::mix64;
+
+    fn scattered(n: usize, seed: u64) -> Vec<Vec3> {
+        let unit = |h: u64| (h >> 40) as f32 / (1u64 << 24) as f32;
+        (0..n as u64)
+            .map(|i| {
+                let h = mix64(seed ^ mix64(i));
+                Vec3::new(unit(h), unit(mix64(h)), 0.1 * unit(mix64(h ^ 7)))
+            })
+            .collect()
+    }
+
+    fn brute_force(points: &[Vec3], p: Vec3, k: usize) -> Vec<u32> {
+        let mut all: Vec<(f32, u32)> = points
+            .iter()
+            .enumerate()
+            .map(|(i, q)| ((*q - p).length_squared(), i as u32))
+            .collect();
+        all.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        all.iter().take(k).map(|a| a.1).collect()
+    }
+
+    #[test]
+    fn cached_queries_along_a_path_match_brute_force() {
+        let points = scattered(500, 1);
+        let set = NearestPoints::new(points.clone());
+        let mut cache = NeighbourCache::default();
+        let mut out = Vec::new();
+        for k in [1, 4, 9] {
+            // A wandering path of small steps (as sorted hair roots are),
+            // with jumps now and then.
+            let mut p = Vec3::new(0.5, 0.5, 0.05);
+            for step in 0..3000u64 {
+                let h = mix64(step ^ (k as u64) << 32);
+                let jump = if step % 500 == 0 { 0.4 } else { 0.004 };
+                let d = Vec3::new(
+                    (h & 0xffff) as f32 / 65536.0 - 0.5,
+                    (h >> 16 & 0xffff) as f32 / 65536.0 - 0.5,
+                    0.0,
+                );
+                p = (p + d * jump).clamp(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.1));
+                set.nearest_cached(p, k, &mut cache, &mut out);
+                let got: Vec<u32> = out.iter().map(|n| n.index).collect();
+                assert_eq!(got, brute_force(&points, p, k), "k {k} step {step}");
+                set.nearest(p, k, &mut out);
+                let uncached: Vec<u32> = out.iter().map(|n| n.index).collect();
+                assert_eq!(uncached, got);
+            }
+        }
+    }
+
+    #[test]
+    fn ties_go_to_the_lower_index_whatever_filled_the_cache() {
+        // A square grid: the centre of a cell is equally far from its four
+        // corners; with k = 2 the two lowest indices win, from any cache.
+        let points: Vec<Vec3> = (0..100)
+            .map(|i| Vec3::new((i % 10) as f32, (i / 10) as f32, 0.0))
+            .collect();
+        let set = NearestPoints::new(points.clone());
+        let centre = Vec3::new(4.5, 4.5, 0.0);
+        let mut expected = Vec::new();
+        set.nearest(centre, 2, &mut expected);
+        assert_eq!(
+            expected.iter().map(|n| n.index).collect::<Vec<_>>(),
+            [44, 45]
+        );
+        for start in [Vec3::new(4.4, 4.6, 0.0), Vec3::new(4.6, 4.4, 0.0), centre] {
+            let mut cache = NeighbourCache::default();
+            let mut out = Vec::new();
+            set.nearest_cached(start, 2, &mut cache, &mut out);
+            set.nearest_cached(centre, 2, &mut cache, &mut out);
+            assert_eq!(out, expected, "cache filled at {start}");
+        }
+    }
+
+    #[test]
+    fn crowded_neighbourhoods_and_small_sets_are_still_exact() {
+        // Many points piled near one spot and k larger than the set.
+        let mut points = vec![Vec3::ZERO; 200];
+        for (i, p) in points.iter_mut().enumerate() {
+            *p = Vec3::new(1e-3 * (i % 7) as f32, 1e-3 * (i / 7) as f32, 0.0);
+        }
+        let set = NearestPoints::new(points.clone());
+        let mut cache = NeighbourCache::default();
+        let mut out = Vec::new();
+        for i in 0..50 {
+            let p = Vec3::new(0.002 + 1e-4 * i as f32, 0.01, 0.0);
+            set.nearest_cached(p, 3, &mut cache, &mut out);
+            let got: Vec<u32> = out.iter().map(|n| n.index).collect();
+            assert_eq!(got, brute_force(&points, p, 3));
+        }
+        let small = NearestPoints::new(vec![Vec3::X, Vec3::Y]);
+        small.nearest_cached(Vec3::ZERO, 5, &mut cache, &mut out);
+        assert_eq!(out.len(), 2);
+        NearestPoints::new(Vec::new()).nearest_cached(Vec3::ZERO, 3, &mut cache, &mut out);
+        assert!(out.is_empty());
+    }
+}
