@@ -15,7 +15,7 @@ use crate::curves::frames::{
 };
 use crate::curves::{CurveArrays, Curves};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
-use crate::interp::{HairScratch, InterpolationMethod, Interpolator, StyleMeshOptions};
+use crate::interp::{HairRoot, HairScratch, InterpolationMethod, Interpolator, StyleMeshOptions};
 use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
 use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, sample_range};
@@ -511,8 +511,16 @@ impl<'g> Generator<'g> {
         };
         let guide_points = self.groom.guides.points_per_guide();
         ws.shape.resize(guide_points, Vec3::ZERO);
-        self.interpolator
-            .hair(mesh, root, &mut ws.interpolation, &mut ws.shape);
+        let hair_root = HairRoot {
+            position: context.position,
+            triangle: Some(root.tri),
+        };
+        self.interpolator.hair_at(
+            hair_root,
+            context.normal,
+            &mut ws.interpolation,
+            &mut ws.shape,
+        );
         let hair = ws.batch.reset();
         hair.id = id;
         hair.points.clear();
@@ -704,7 +712,7 @@ impl<'g> Generator<'g> {
         let uvs = curves
             .roots()
             .expect("grown curves carry their roots")
-            .iter()
+            .par_iter()
             .map(|r| r.uv(mesh).unwrap_or_default())
             .collect();
         curves.with_root_uvs(uvs).expect("one UV a curve")

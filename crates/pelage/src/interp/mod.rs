@@ -190,10 +190,21 @@ impl<'g> Interpolator<'g> {
         scratch: &mut HairScratch,
         out: &mut [Vec3],
     ) {
-        let hair_root = HairRoot::on(mesh, root);
+        self.hair_at(HairRoot::on(mesh, root), root.normal(mesh), scratch, out);
+    }
+
+    /// [`Self::hair`] for a root whose position (with its triangle) and
+    /// skin normal the caller has at hand already.
+    pub fn hair_at(
+        &self,
+        root: HairRoot,
+        normal: Vec3,
+        scratch: &mut HairScratch,
+        out: &mut [Vec3],
+    ) {
         self.weights
-            .weights_near(hair_root, &mut scratch.near, &mut scratch.weights);
-        self.shape(&scratch.weights, hair_root.position, root.normal(mesh), out);
+            .weights_near(root, &mut scratch.near, &mut scratch.weights);
+        self.shape(&scratch.weights, root.position, normal, out);
     }
 
     /// Shapes a hair at `position` with surface normal `normal` from given

@@ -7,9 +7,11 @@
 //! list of candidates kept for the last neighbourhood ([`NeighbourCache`]).
 //! The list is exact, not a heuristic. It is filled at a point `q` whose
 //! k-th nearest point is `d_k(q)` away, and serves queries `p` within
-//! `R = d_k(q) / 2` of `q`: `q`'s k nearest are within `d_k(q) + R` of
-//! `p`, so `d_k(p) ≤ d_k(q) + R`, and every point `p` could choose lies
-//! within `d_k(q) + 2R` of `q` — those are the candidates.
+//! `R = a·d_k(q)` of `q` (`a` = 1/2; 1 when k = 1): `q`'s k nearest are
+//! within `d_k(q) + R` of `p`, so `d_k(p) ≤ d_k(q) + R`, and every point
+//! `p` could choose lies within `d_k(q) + 2R` of `q` — those are the
+//! candidates. A query then costs a dozen or two distances instead of a
+//! tree search.
 //!
 //! Results are ordered by (squared distance, index), computed here from
 //! the points, so they are the same whichever earlier query filled the
