@@ -719,14 +719,12 @@ impl<'g> Generator<'g> {
     }
 
     fn grow_chunk(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) -> PartChunk {
-        let mesh = &self.groom.mesh;
         let n = self.points;
         let mut out = PartChunk::default();
         let mut tangents = vec![Vec3::ZERO; n];
         let mut frame = vec![Vec3::ZERO; n];
         for (i, root) in roots.iter().enumerate() {
-            self.grow(*root, first_id + i as u64, &self.ops, ws);
-            let normal = root.normal(mesh);
+            let normal = self.grow(*root, first_id + i as u64, &self.ops, ws);
             for hair in ws.batch.hairs() {
                 out.points.extend_from_slice(&hair.points);
                 out.widths.extend_from_slice(&hair.widths);

@@ -55,8 +55,6 @@ pub struct NearestPoints {
 #[derive(Debug, Default)]
 pub struct NeighbourCache {
     lists: Vec<CandidateList>,
-    /// A result buffer for callers that keep nothing else per worker.
-    pub(crate) found: Vec<Neighbour>,
 }
 
 #[derive(Debug)]
@@ -112,19 +110,18 @@ impl NearestPoints {
     }
 
     /// [`Self::nearest`], answered from `cache`'s candidates when `p` is
-    /// near the point they were gathered for. The same result as
-    /// [`Self::nearest`] whatever the cache holds.
-    pub fn nearest_cached(
+    /// near the point they were gathered for, and read from the cache (no
+    /// buffer of the caller's). The same result as [`Self::nearest`]
+    /// whatever the cache holds.
+    pub fn nearest_cached<'c>(
         &self,
         p: Vec3,
         k: usize,
-        cache: &mut NeighbourCache,
-        out: &mut Vec<Neighbour>,
-    ) {
-        out.clear();
+        cache: &'c mut NeighbourCache,
+    ) -> impl Iterator<Item = Neighbour> + 'c {
         let k = k.min(self.points.len());
         if k == 0 {
-            return;
+            return neighbours(&[]);
         }
         let list = match cache
             .lists
@@ -171,7 +168,7 @@ impl NearestPoints {
         for &candidate in &list.keys {
             keep_smallest(&mut list.best, candidate);
         }
-        out.extend(neighbours(&list.best));
+        neighbours(&list.best)
     }
 
     /// Gathers the candidates for queries near `p` (module docs).
@@ -304,8 +301,10 @@ mod tests {
                     0.0,
                 );
                 p = (p + d * jump).clamp(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.1));
-                set.nearest_cached(p, k, &mut cache, &mut out);
-                let got: Vec<u32> = out.iter().map(|n| n.index).collect();
+                let got: Vec<u32> = set
+                    .nearest_cached(p, k, &mut cache)
+                    .map(|n| n.index)
+                    .collect();
                 assert_eq!(got, brute_force(&points, p, k), "k {k} step {step}");
                 set.nearest(p, k, &mut out);
                 let uncached: Vec<u32> = out.iter().map(|n| n.index).collect();
@@ -331,9 +330,8 @@ mod tests {
         );
         for start in [Vec3::new(4.4, 4.6, 0.0), Vec3::new(4.6, 4.4, 0.0), centre] {
             let mut cache = NeighbourCache::default();
-            let mut out = Vec::new();
-            set.nearest_cached(start, 2, &mut cache, &mut out);
-            set.nearest_cached(centre, 2, &mut cache, &mut out);
+            let _ = set.nearest_cached(start, 2, &mut cache).count();
+            let out: Vec<Neighbour> = set.nearest_cached(centre, 2, &mut cache).collect();
             assert_eq!(out, expected, "cache filled at {start}");
         }
     }
@@ -347,17 +345,17 @@ mod tests {
         }
         let set = NearestPoints::new(points.clone());
         let mut cache = NeighbourCache::default();
-        let mut out = Vec::new();
         for i in 0..50 {
             let p = Vec3::new(0.002 + 1e-4 * i as f32, 0.01, 0.0);
-            set.nearest_cached(p, 3, &mut cache, &mut out);
-            let got: Vec<u32> = out.iter().map(|n| n.index).collect();
+            let got: Vec<u32> = set
+                .nearest_cached(p, 3, &mut cache)
+                .map(|n| n.index)
+                .collect();
             assert_eq!(got, brute_force(&points, p, 3));
         }
         let small = NearestPoints::new(vec![Vec3::X, Vec3::Y]);
-        small.nearest_cached(Vec3::ZERO, 5, &mut cache, &mut out);
-        assert_eq!(out.len(), 2);
-        NearestPoints::new(Vec::new()).nearest_cached(Vec3::ZERO, 3, &mut cache, &mut out);
-        assert!(out.is_empty());
+        assert_eq!(small.nearest_cached(Vec3::ZERO, 5, &mut cache).count(), 2);
+        let empty = NearestPoints::new(Vec::new());
+        assert_eq!(empty.nearest_cached(Vec3::ZERO, 3, &mut cache).count(), 0);
     }
 }

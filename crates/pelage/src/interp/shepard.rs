@@ -34,9 +34,9 @@ impl Shepard {
 
 impl Shepard {
     /// Weights from the nearest guides, nearest first.
-    fn weigh(&self, nearest: &[Neighbour], out: &mut Vec<GuideWeight>) {
+    fn weigh(&self, nearest: impl IntoIterator<Item = Neighbour>, out: &mut Vec<GuideWeight>) {
         out.clear();
-        for (i, hit) in nearest.iter().enumerate() {
+        for (i, hit) in nearest.into_iter().enumerate() {
             let guide = hit.index;
             let distance = hit.distance_squared;
             // At a guide's root: that guide alone (1/0 would swamp the rest).
@@ -64,15 +64,10 @@ impl GuideWeights for Shepard {
     fn weights(&self, root: HairRoot, out: &mut Vec<GuideWeight>) {
         let mut nearest = Vec::with_capacity(self.k);
         self.roots.nearest(root.position, self.k, &mut nearest);
-        self.weigh(&nearest, out);
+        self.weigh(nearest, out);
     }
 
     fn weights_near(&self, root: HairRoot, near: &mut NeighbourCache, out: &mut Vec<GuideWeight>) {
-        // The found list lives in the cache too, so a hair allocates nothing.
-        let mut found = std::mem::take(&mut near.found);
-        self.roots
-            .nearest_cached(root.position, self.k, near, &mut found);
-        self.weigh(&found, out);
-        near.found = found;
+        self.weigh(self.roots.nearest_cached(root.position, self.k, near), out);
     }
 }

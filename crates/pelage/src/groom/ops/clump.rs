@@ -50,13 +50,10 @@ impl ClumpCentres {
     /// [`Self::nearest`] for one of a run of nearby positions, `near`
     /// kept between them (faster, same result).
     pub fn nearest_near(&self, position: Vec3, near: &mut NeighbourCache) -> Option<(usize, f32)> {
-        let mut found = std::mem::take(&mut near.found);
-        self.roots.nearest_cached(position, 1, near, &mut found);
-        let hit = found
-            .first()
-            .map(|n| (n.index as usize, n.distance_squared.sqrt()));
-        near.found = found;
-        hit
+        self.roots
+            .nearest_cached(position, 1, near)
+            .next()
+            .map(|n| (n.index as usize, n.distance_squared.sqrt()))
     }
 
     /// Centre `i`'s points.
