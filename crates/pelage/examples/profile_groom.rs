@@ -23,11 +23,26 @@ fn main() {
     eprintln!("prepare {:?}", t.elapsed());
     let t = std::time::Instant::now();
     let mut n = 0;
+    // A checksum of every point, width and normal, to tell whether a change
+    // altered the output (CHECKSUM=1; it costs a pass over the arrays).
+    let checksum = std::env::var("CHECKSUM").as_deref() == Ok("1");
+    let mut sum = 0u64;
     for p in 0..generator.parts().len() {
         let part = generator.part(p);
         n += part.curve_count();
+        if checksum {
+            let vectors = part.points().iter().chain(part.normals().unwrap_or(&[]));
+            let bits = vectors
+                .flat_map(|v| v.to_array())
+                .chain(part.widths().iter().copied())
+                .map(f32::to_bits);
+            sum = bits.fold(sum, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
+        }
         generator.recycle(part);
     }
     let s = t.elapsed().as_secs_f64();
     eprintln!("{n} hairs in {s:.3} s: {:.2} M hairs/s", n as f64 / s / 1e6);
+    if checksum {
+        eprintln!("checksum {sum:016x}");
+    }
 }

@@ -6,8 +6,8 @@ use super::file::{
     ColorSpec, GroomError, GroomErrorKind, GroomFile, GroomSource, MapValue, OpSpec, RootToTipSpec,
 };
 use super::ops::{
-    Clump, ClumpCentres, Color, Curl, Cut, Frizz, HairBatch, Length, Noise, Opacity, Operator,
-    RootContext, RootToTip, Scratch, Strands, Width,
+    Clump, ClumpCentres, Color, Curl, Cut, Frizz, Hair, HairBatch, Length, Noise, Opacity,
+    Operator, RootContext, RootToTip, Scratch, Strands, Width,
 };
 use super::parts::{Part, PartLayout};
 use crate::curves::frames::{
@@ -254,6 +254,8 @@ pub struct Generator<'g> {
     ops: Vec<Operator>,
     base: Vec<Operator>,
     points: usize,
+    /// From the guides' points to the hairs'.
+    resampling: Resampling,
     colors: bool,
     opacities: bool,
     normals: bool,
@@ -288,7 +290,15 @@ struct Workspace {
     /// Each hair's skin normal, the start of its frame.
     skin_normals: Vec<Vec3>,
     frames: FrameScratch,
+    /// A group of hairs grown side by side ([`Generator::grow_group`]) and
+    /// their roots.
+    group: Vec<Hair>,
+    contexts: Vec<RootContext>,
 }
+
+/// Hairs grown side by side through the operators when each root grows one
+/// hair: enough to fill the noise's eight SIMD lanes several times over.
+const GROUP: usize = 8;
 
 impl<'g> Generator<'g> {
     fn new(groom: &'g Groom, seed: Option<u64>) -> Result<Self, GroomError> {
@@ -359,6 +369,7 @@ impl<'g> Generator<'g> {
             ops: Vec::with_capacity(file.ops.len()),
             base,
             points,
+            resampling: Resampling::new(groom.guides.points_per_guide(), points),
             colors: file.finish.color.is_some(),
             opacities: file.finish.opacity.is_some(),
             normals: file.finish.normals,
@@ -502,31 +513,9 @@ impl<'g> Generator<'g> {
     /// Hair `id` grown from `root` through `ops` into `ws.batch`; returns
     /// the skin normal at the root.
     fn grow(&self, root: SurfacePoint, id: u64, ops: &[Operator], ws: &mut Workspace) -> Vec3 {
-        let mesh = &self.groom.mesh;
-        let context = RootContext {
-            point: root,
-            position: root.position(mesh),
-            normal: root.normal(mesh),
-            uv: root.uv(mesh).unwrap_or(Vec2::ZERO),
-        };
-        let guide_points = self.groom.guides.points_per_guide();
-        ws.shape.resize(guide_points, Vec3::ZERO);
-        let hair_root = HairRoot {
-            position: context.position,
-            triangle: Some(root.tri),
-        };
-        self.interpolator.hair_at(
-            hair_root,
-            context.normal,
-            &mut ws.interpolation,
-            &mut ws.shape,
-        );
+        let context = self.root_context(root);
         let hair = ws.batch.reset();
-        hair.id = id;
-        hair.points.clear();
-        self.resampled(&ws.shape, &mut hair.points);
-        hair.colors.clear();
-        hair.opacities.clear();
+        self.interpolated(&context, id, &mut ws.interpolation, &mut ws.shape, hair);
         for op in self.base.iter().chain(ops) {
             op.apply(&mut ws.batch, &context, &mut ws.scratch);
             if ws.batch.is_empty() {
@@ -536,14 +525,67 @@ impl<'g> Generator<'g> {
         context.normal
     }
 
+    /// Hairs `first_id…` grown from `roots` (at most [`GROUP`]) through
+    /// every operator side by side, into `ws.group` with their roots in
+    /// `ws.contexts`: hair for hair what [`Self::grow`] makes, for grooms
+    /// whose operators keep one hair a root.
+    fn grow_group(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) {
+        if ws.group.len() < roots.len() {
+            ws.group.resize_with(roots.len(), Hair::default);
+        }
+        ws.contexts.clear();
+        for (i, root) in roots.iter().enumerate() {
+            let context = self.root_context(*root);
+            let hair = &mut ws.group[i];
+            let id = first_id + i as u64;
+            self.interpolated(&context, id, &mut ws.interpolation, &mut ws.shape, hair);
+            ws.contexts.push(context);
+        }
+        let hairs = &mut ws.group[..roots.len()];
+        for op in self.base.iter().chain(&self.ops) {
+            op.apply_each(hairs, &ws.contexts, &mut ws.scratch);
+        }
+    }
+
+    /// Where a hair grows: its root's position, skin normal and UV.
+    fn root_context(&self, root: SurfacePoint) -> RootContext {
+        let mesh = &self.groom.mesh;
+        RootContext {
+            point: root,
+            position: root.position(mesh),
+            normal: root.normal(mesh),
+            uv: root.uv(mesh).unwrap_or(Vec2::ZERO),
+        }
+    }
+
+    /// Starts `hair` as hair `id`: the guides' shape interpolated at its
+    /// root, at the hairs' point count, no colours or opacities yet.
+    fn interpolated(
+        &self,
+        context: &RootContext,
+        id: u64,
+        scratch: &mut HairScratch,
+        shape: &mut Vec<Vec3>,
+        hair: &mut Hair,
+    ) {
+        shape.resize(self.groom.guides.points_per_guide(), Vec3::ZERO);
+        let hair_root = HairRoot {
+            position: context.position,
+            triangle: Some(context.point.tri),
+        };
+        self.interpolator
+            .hair_at(hair_root, context.normal, scratch, shape);
+        hair.id = id;
+        hair.points.clear();
+        self.resampled(shape, &mut hair.points);
+        hair.colors.clear();
+        hair.opacities.clear();
+    }
+
     /// Appends the interpolated `shape` (guide resolution) at the hairs'
     /// point count.
     fn resampled(&self, shape: &[Vec3], out: &mut Vec<Vec3>) {
-        if shape.len() == self.points {
-            out.extend_from_slice(shape);
-        } else {
-            resample_uniform(shape, self.points, out);
-        }
+        self.resampling.apply(shape, out);
     }
 
     /// Roots of part `p`: sampled in the part's triangles with the part's
@@ -604,10 +646,7 @@ impl<'g> Generator<'g> {
     /// then a part's arrays have a known size and workers fill them in
     /// place.
     fn one_hair_per_root(&self) -> bool {
-        !self
-            .ops
-            .iter()
-            .any(|op| matches!(op, Operator::Strands(_) | Operator::Cut(_)))
+        self.ops.iter().all(Operator::keeps_one_hair_a_root)
     }
 
     /// [`Self::part`] when each root grows one hair: the arrays are
@@ -616,21 +655,25 @@ impl<'g> Generator<'g> {
         let n = self.points;
         let total = roots.len() * n;
         let sized = |on: bool| if on { total } else { 0 };
-        // Filled on all threads: zeroing a part's ~50 MB on this one was
-        // time every other core waited for (Amdahl: at 16 threads it kept
-        // the groom at a third of the cores' worth). Recycled arrays have
-        // the room already.
-        fn zeros<T: Copy + Send + Default>(mut v: Vec<T>, len: usize) -> Vec<T> {
-            v.clear();
-            v.par_extend(rayon::iter::repeat_n(T::default(), len));
+        // Every element is overwritten by the workers below, so a recycled
+        // array keeps its old values and only grows where this part is
+        // larger: parts are nearly equal in size, so most of the time
+        // nothing is filled at all. The growth is filled on all threads:
+        // zeroing a part's ~50 MB on this one was time every other core
+        // waited for (Amdahl: at 16 threads it kept the groom at a third of
+        // the cores' worth).
+        fn sized_to<T: Copy + Send + Default>(mut v: Vec<T>, len: usize) -> Vec<T> {
+            v.truncate(len);
+            let more = len - v.len();
+            v.par_extend(rayon::iter::repeat_n(T::default(), more));
             v
         }
         let spare = self.spare_arrays();
-        let mut points = zeros(spare.points, total);
-        let mut widths = zeros(spare.widths, total);
-        let mut normals = zeros(spare.normals, sized(self.normals));
-        let mut colors = zeros(spare.colors, sized(self.colors));
-        let mut opacities = zeros(spare.opacities, sized(self.opacities));
+        let mut points = sized_to(spare.points, total);
+        let mut widths = sized_to(spare.widths, total);
+        let mut normals = sized_to(spare.normals, sized(self.normals));
+        let mut colors = sized_to(spare.colors, sized(self.colors));
+        let mut opacities = sized_to(spare.opacities, sized(self.opacities));
         {
             let mut jobs = Vec::with_capacity(roots.len().div_ceil(CHUNK));
             let (mut p, mut w, mut nr, mut c, mut o) = (
@@ -656,18 +699,21 @@ impl<'g> Generator<'g> {
                 Workspace::default,
                 |ws, (chunk, first, p, w, nr, c, o)| {
                     ws.skin_normals.clear();
-                    for (i, root) in chunk.iter().enumerate() {
-                        let skin = self.grow(*root, first + i as u64, &self.ops, ws);
-                        ws.skin_normals.push(skin);
-                        let hair = &ws.batch.hairs()[0];
-                        let range = i * n..(i + 1) * n;
-                        p[range.clone()].copy_from_slice(&hair.points);
-                        w[range.clone()].copy_from_slice(&hair.widths);
-                        if self.colors {
-                            c[range.clone()].copy_from_slice(&hair.colors);
-                        }
-                        if self.opacities {
-                            o[range].copy_from_slice(&hair.opacities);
+                    for (g, group) in chunk.chunks(GROUP).enumerate() {
+                        let first_in_group = g * GROUP;
+                        self.grow_group(group, first + first_in_group as u64, ws);
+                        for (k, (hair, root)) in ws.group.iter().zip(&ws.contexts).enumerate() {
+                            let i = first_in_group + k;
+                            ws.skin_normals.push(root.normal);
+                            let range = i * n..(i + 1) * n;
+                            p[range.clone()].copy_from_slice(&hair.points);
+                            w[range.clone()].copy_from_slice(&hair.widths);
+                            if self.colors {
+                                c[range.clone()].copy_from_slice(&hair.colors);
+                            }
+                            if self.opacities {
+                                o[range].copy_from_slice(&hair.opacities);
+                            }
                         }
                     }
                     if self.normals {
@@ -803,22 +849,51 @@ struct PartChunk {
     roots: Vec<SurfacePoint>,
 }
 
-/// `n` points evenly spaced in the parameter of the polyline `shape`
-/// (linear interpolation between its points).
-fn resample_uniform(shape: &[Vec3], n: usize, out: &mut Vec<Vec3>) {
-    let m = shape.len();
-    if m < 2 {
-        out.extend(std::iter::repeat_n(
-            shape.first().copied().unwrap_or_default(),
-            n,
-        ));
-        return;
+/// `n` points evenly spaced in the parameter of a polyline of `m` points
+/// (linear interpolation between its points): for each output point, the
+/// segment it falls in and how far along, worked out once for the groom.
+#[derive(Debug, Clone)]
+struct Resampling {
+    from: usize,
+    to: usize,
+    /// Point `k`: `shape[j].lerp(shape[j + 1], f)`, as `(j, f)`.
+    between: Vec<(u32, f32)>,
+}
+
+impl Resampling {
+    fn new(from: usize, to: usize) -> Self {
+        let between = if from >= 2 && from != to {
+            (0..to)
+                .map(|k| {
+                    let x = k as f32 / (to - 1) as f32 * (from - 1) as f32;
+                    let j = (x as usize).min(from - 2);
+                    (j as u32, x - j as f32)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Self { from, to, between }
     }
-    out.extend((0..n).map(|k| {
-        let x = k as f32 / (n - 1) as f32 * (m - 1) as f32;
-        let j = (x as usize).min(m - 2);
-        shape[j].lerp(shape[j + 1], x - j as f32)
-    }));
+
+    /// Appends `shape` (of `from` points) resampled to `to` points.
+    fn apply(&self, shape: &[Vec3], out: &mut Vec<Vec3>) {
+        debug_assert_eq!(shape.len(), self.from);
+        if self.from == self.to {
+            out.extend_from_slice(shape);
+        } else if self.from < 2 {
+            out.extend(std::iter::repeat_n(
+                shape.first().copied().unwrap_or_default(),
+                self.to,
+            ));
+        } else {
+            out.extend(
+                self.between
+                    .iter()
+                    .map(|&(j, f)| shape[j as usize].lerp(shape[j as usize + 1], f)),
+            );
+        }
+    }
 }
 
 fn root_to_tip(groom: &Groom, s: &RootToTipSpec) -> Result<RootToTip, GroomError> {

@@ -30,15 +30,10 @@ impl VectorNoise {
 
     const OFF_LATTICE: Vec3 = Vec3::new(0.371, 0.713, 0.137);
 
-    /// [`at`](Self::at) each of `points` (at most [`MAX_VECTORS`]), into
-    /// `out`: the same values, the noise read several points at a time.
-    fn at_many(&self, points: &[Vec3], out: &mut [Vec3]) {
-        let mut shifted = [Vec3::ZERO; MAX_VECTORS];
-        let shifted = &mut shifted[..points.len()];
-        for (s, p) in shifted.iter_mut().zip(points) {
-            *s = *p + Self::OFF_LATTICE;
-        }
-        self.0.perlin3_vectors(shifted, out);
+    /// Where [`at`](Self::at) reads the noise for `p`.
+    #[inline]
+    fn shifted(p: Vec3) -> Vec3 {
+        p + Self::OFF_LATTICE
     }
 }
 
@@ -72,47 +67,147 @@ impl Noise {
         }
     }
 
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext) {
-        let amplitude = self.amplitude.eval(root.uv);
-        if amplitude == 0.0 {
-            return;
+    /// Displaces one hair.
+    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, scratch: &mut NoiseScratch) {
+        self.apply_each(
+            std::slice::from_mut(hair),
+            std::slice::from_ref(root),
+            scratch,
+        );
+    }
+
+    /// Displaces each of `hairs` (`hairs[i]` grown from `roots[i]`): the
+    /// same values as one at a time, with the noise vectors of all of them
+    /// read in one go, so the eight-lane noise runs full (a hair's handful
+    /// of vectors leaves lanes idle).
+    pub(super) fn apply_each(
+        &self,
+        hairs: &mut [Hair],
+        roots: &[RootContext],
+        scratch: &mut NoiseScratch,
+    ) {
+        let NoiseScratch {
+            at,
+            samples,
+            hairs: per_hair,
+            along,
+        } = scratch;
+        at.clear();
+        per_hair.clear();
+        for (hair, root) in hairs.iter().zip(roots) {
+            let amplitude = self.amplitude.eval(root.uv);
+            let n = hair.points.len();
+            if amplitude == 0.0 || n == 0 {
+                per_hair.push((0.0, 0));
+                continue;
+            }
+            let frequency = self.frequency.eval(root.uv);
+            let m = self.vectors_along(n);
+            per_hair.push((amplitude, m));
+            if m == n {
+                at.extend(
+                    hair.points
+                        .iter()
+                        .map(|p| VectorNoise::shifted(*p * frequency)),
+                );
+            } else {
+                // Noise vectors at m evenly spaced parameters (positions
+                // along the polyline).
+                at.extend((0..m).map(|k| {
+                    let x = param(k, m) * (n - 1) as f32;
+                    let j = (x as usize).min(n - 2);
+                    let p = hair.points[j].lerp(hair.points[j + 1], x - j as f32);
+                    VectorNoise::shifted(p * frequency)
+                }));
+            }
         }
-        let frequency = self.frequency.eval(root.uv);
-        let n = hair.points.len();
-        let m = if self.vectors == 0 || self.vectors >= n {
-            n
-        } else {
-            self.vectors.max(2)
-        };
-        if m == n {
-            for (j, p) in hair.points.iter_mut().enumerate() {
-                let a = amplitude * self.ramp.at(param(j, n));
-                if a != 0.0 {
-                    *p += a * self.field.at(*p * frequency);
+        samples.resize(at.len(), Vec3::ZERO);
+        self.field.0.perlin3_vectors(at, samples);
+        let mut next = 0;
+        for (hair, &(amplitude, m)) in hairs.iter_mut().zip(per_hair.iter()) {
+            if m == 0 {
+                continue;
+            }
+            let samples = &samples[next..next + m];
+            next += m;
+            let n = hair.points.len();
+            along.fit(&self.ramp, n, m);
+            if m == n {
+                for ((p, s), ramp) in hair.points.iter_mut().zip(samples).zip(&along.ramp) {
+                    let a = amplitude * ramp;
+                    if a != 0.0 {
+                        *p += a * *s;
+                    }
+                }
+            } else {
+                // Each point's displacement between its two vectors.
+                for ((p, &(k, f)), ramp) in
+                    hair.points.iter_mut().zip(&along.between).zip(&along.ramp)
+                {
+                    let a = amplitude * ramp;
+                    if a != 0.0 {
+                        let k = k as usize;
+                        *p += a * samples[k].lerp(samples[k + 1], f);
+                    }
                 }
             }
+        }
+    }
+
+    /// How many noise vectors a hair of `n` points samples.
+    fn vectors_along(&self, n: usize) -> usize {
+        if self.vectors == 0 || self.vectors >= n {
+            n
+        } else {
+            self.vectors.clamp(2, MAX_VECTORS)
+        }
+    }
+}
+
+/// Buffers of [`Noise::apply_each`], reused.
+#[derive(Debug, Default)]
+pub struct NoiseScratch {
+    /// Where the noise is read (scaled and shifted), every hair's in turn.
+    at: Vec<Vec3>,
+    /// The noise vectors read there.
+    samples: Vec<Vec3>,
+    /// Each hair's amplitude and number of vectors (0: not displaced).
+    hairs: Vec<(f32, usize)>,
+    along: AlongHair,
+}
+
+/// Per-point values along a hair of `n` points with `m` noise vectors,
+/// kept while `n`, `m` and the ramp stay the same (they do for a whole
+/// groom unless hairs are cut).
+#[derive(Debug, Default)]
+struct AlongHair {
+    key: Option<(usize, usize, Ramp)>,
+    /// `ramp(t_j)`.
+    ramp: Vec<f32>,
+    /// For `m < n`: the vector before point `j` and the fraction toward
+    /// the next.
+    between: Vec<(u32, f32)>,
+}
+
+impl AlongHair {
+    fn fit(&mut self, ramp: &Ramp, n: usize, m: usize) {
+        if let Some((kn, km, kr)) = &self.key
+            && (*kn, *km) == (n, m)
+            && kr == ramp
+        {
             return;
         }
-        // Noise vectors at m evenly spaced parameters (positions along the
-        // polyline), then each point's displacement between its two.
-        let m = m.min(MAX_VECTORS);
-        let mut at = [Vec3::ZERO; MAX_VECTORS];
-        for (k, at) in at.iter_mut().enumerate().take(m) {
-            let x = param(k, m) * (n - 1) as f32;
-            let j = (x as usize).min(n - 2);
-            *at = hair.points[j].lerp(hair.points[j + 1], x - j as f32) * frequency;
-        }
-        let mut samples = [Vec3::ZERO; MAX_VECTORS];
-        self.field.at_many(&at[..m], &mut samples[..m]);
-        for (j, p) in hair.points.iter_mut().enumerate() {
-            let t = param(j, n);
-            let a = amplitude * self.ramp.at(t);
-            if a != 0.0 {
-                let x = t * (m - 1) as f32;
+        self.ramp.clear();
+        self.ramp.extend((0..n).map(|j| ramp.at(param(j, n))));
+        self.between.clear();
+        if m < n {
+            self.between.extend((0..n).map(|j| {
+                let x = param(j, n) * (m - 1) as f32;
                 let k = (x as usize).min(m - 2);
-                *p += a * samples[k].lerp(samples[k + 1], x - k as f32);
-            }
+                (k as u32, x - k as f32)
+            }));
         }
+        self.key = Some((n, m, ramp.clone()));
     }
 }
 
@@ -224,7 +319,7 @@ mod tests {
             0,
         );
         let mut a = straight(1, 16, 1.0);
-        op.apply(&mut a, &root());
+        op.apply(&mut a, &root(), &mut NoiseScratch::default());
         assert_eq!(a.points[0], Vec3::ZERO, "a linear ramp leaves the root");
         let moved = (a.points[15] - Vec3::Z).length();
         assert!(moved > 1e-3 && moved <= 0.1 * 3f32.sqrt() * 1.01, "{moved}");
@@ -232,9 +327,60 @@ mod tests {
         // noise is a field in space, not per hair.
         let mut b = straight(2, 16, 1.0);
         b.points.iter_mut().for_each(|p| *p += Vec3::X * 1e-3);
-        op.apply(&mut b, &root());
+        op.apply(&mut b, &root(), &mut NoiseScratch::default());
         let db = b.points[15] - Vec3::Z - Vec3::X * 1e-3;
         assert!((db - (a.points[15] - Vec3::Z)).length() < 0.1 * 0.05);
+    }
+
+    #[test]
+    fn noise_on_many_hairs_at_once_matches_one_at_a_time_to_the_bit() {
+        // Hairs of several point counts (one too short to interpolate
+        // between vectors), bent so no two read the same noise; vectors
+        // sampled every point, a few a hair, and none (amplitude 0).
+        let hairs: Vec<Hair> = [16usize, 1, 2, 3, 16, 9, 16, 16, 16, 4, 16]
+            .iter()
+            .enumerate()
+            .map(|(i, &n)| {
+                let mut hair = straight(i as u64, n, 1.0 + 0.1 * i as f32);
+                for (j, p) in hair.points.iter_mut().enumerate() {
+                    *p += Vec3::new(0.3 * i as f32, (j as f32 * 0.7).sin() * 0.1, 0.0);
+                }
+                hair
+            })
+            .collect();
+        let roots = vec![root(); hairs.len()];
+        for (vectors, amplitude) in [(5, 0.1), (0, 0.1), (2, 0.05), (5, 0.0)] {
+            let op = Noise::new(
+                Map::Constant(amplitude),
+                Map::Constant(4.0),
+                Ramp::Smooth,
+                7,
+                vectors,
+            );
+            let mut together = hairs.clone();
+            op.apply_each(&mut together, &roots, &mut NoiseScratch::default());
+            let mut scratch = NoiseScratch::default();
+            for (i, (hair, root)) in hairs.iter().zip(&roots).enumerate() {
+                let mut alone = hair.clone();
+                op.apply(&mut alone, root, &mut scratch);
+                let bits = |h: &Hair| -> Vec<[u32; 3]> {
+                    h.points
+                        .iter()
+                        .map(|p| p.to_array().map(f32::to_bits))
+                        .collect()
+                };
+                assert_eq!(
+                    bits(&alone),
+                    bits(&together[i]),
+                    "vectors {vectors} hair {i}"
+                );
+            }
+            if amplitude == 0.0 {
+                assert_eq!(together, hairs, "amplitude 0 moves nothing");
+            } else {
+                assert_ne!(together[0], hairs[0], "the noise moves hairs");
+            }
+        }
     }
 
     #[test]

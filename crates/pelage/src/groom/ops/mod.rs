@@ -20,7 +20,7 @@ mod strands;
 mod trim;
 
 pub use clump::{Clump, ClumpCentres};
-pub use displace::{Curl, Frizz, Noise};
+pub use displace::{Curl, Frizz, Noise, NoiseScratch};
 pub use look::{Color, Opacity, Width};
 pub use strands::Strands;
 pub use trim::{Cut, Length};
@@ -149,6 +149,7 @@ pub struct Scratch {
     pub(crate) bases: HairBatch,
     /// Clump centres near the last roots.
     pub(crate) near: crate::interp::NeighbourCache,
+    pub(crate) noise: NoiseScratch,
 }
 
 impl Scratch {
@@ -203,18 +204,52 @@ impl Operator {
             Operator::Cut(op) => op.apply(batch, root, scratch),
             _ => {
                 for hair in batch.hairs_mut() {
-                    match self {
-                        Operator::Noise(op) => op.apply(hair, root),
-                        Operator::Frizz(op) => op.apply(hair, root),
-                        Operator::Clump(op) => op.apply(hair, root, &mut scratch.near),
-                        Operator::Curl(op) => op.apply(hair, root, scratch),
-                        Operator::Length(op) => op.apply(hair, root),
-                        Operator::Width(op) => op.apply(hair, root),
-                        Operator::Color(op) => op.apply(hair, root),
-                        Operator::Opacity(op) => op.apply(hair, root),
-                        Operator::Strands(_) | Operator::Cut(_) => unreachable!(),
-                    }
+                    self.apply_to_hair(hair, root, scratch);
                 }
+            }
+        }
+    }
+
+    /// Applies the operator to hairs grown one a root (`hairs[i]` from
+    /// `roots[i]`): the same result as [`Self::apply`] root by root, with
+    /// the work of some operators (noise) shared across the hairs.
+    ///
+    /// # Panics
+    /// For operators that change the number of hairs ([`Self::keeps_one_hair_a_root`]).
+    pub fn apply_each(&self, hairs: &mut [Hair], roots: &[RootContext], scratch: &mut Scratch) {
+        assert_eq!(hairs.len(), roots.len(), "one root a hair");
+        match self {
+            Operator::Noise(op) => op.apply_each(hairs, roots, &mut scratch.noise),
+            Operator::Strands(_) | Operator::Cut(_) => {
+                panic!("{} changes the number of hairs a root grows", self.name())
+            }
+            _ => {
+                for (hair, root) in hairs.iter_mut().zip(roots) {
+                    self.apply_to_hair(hair, root, scratch);
+                }
+            }
+        }
+    }
+
+    /// Whether every root still grows exactly one hair after this operator
+    /// (all but `strands` and `cut`, which may remove a hair).
+    pub fn keeps_one_hair_a_root(&self) -> bool {
+        !matches!(self, Operator::Strands(_) | Operator::Cut(_))
+    }
+
+    /// An operator that works hair by hair, on one hair.
+    fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
+        match self {
+            Operator::Noise(op) => op.apply(hair, root, &mut scratch.noise),
+            Operator::Frizz(op) => op.apply(hair, root),
+            Operator::Clump(op) => op.apply(hair, root, &mut scratch.near),
+            Operator::Curl(op) => op.apply(hair, root, scratch),
+            Operator::Length(op) => op.apply(hair, root),
+            Operator::Width(op) => op.apply(hair, root),
+            Operator::Color(op) => op.apply(hair, root),
+            Operator::Opacity(op) => op.apply(hair, root),
+            Operator::Strands(_) | Operator::Cut(_) => {
+                unreachable!("strands and cut work on the whole batch")
             }
         }
     }
