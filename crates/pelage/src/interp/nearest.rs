@@ -69,7 +69,10 @@ struct CandidateList {
     xs: Vec<f32>,
     ys: Vec<f32>,
     zs: Vec<f32>,
-    /// This query's candidates as [`key`]s, and the k smallest.
+    /// This query's squared distances to the candidates, the candidates
+    /// that can be among its k nearest as [`key`]s, and the k smallest
+    /// (kept for the next query).
+    distances: Vec<f32>,
     keys: Vec<u64>,
     best: Vec<u64>,
 }
@@ -139,6 +142,7 @@ impl NearestPoints {
                     xs: Vec::new(),
                     ys: Vec::new(),
                     zs: Vec::new(),
+                    distances: Vec::new(),
                     keys: Vec::new(),
                     best: Vec::new(),
                 });
@@ -150,22 +154,46 @@ impl NearestPoints {
         }
         // The same arithmetic as `(q - p).length_squared()`, so cached and
         // uncached answers agree to the bit.
+        let distance_squared = |x: f32, y: f32, z: f32| {
+            let (dx, dy, dz) = (x - p.x, y - p.y, z - p.z);
+            dx * dx + dy * dy + dz * dz
+        };
+        // The last query's answer is mostly this one's too: its k points,
+        // measured from `p`, bound the k-th distance, and only candidates
+        // within that bound can be among the k nearest. Filtering first
+        // leaves a handful to sort in instead of the whole list.
+        let mut bound = 0.0f32;
+        for &previous in &list.best {
+            if previous == u64::MAX {
+                bound = f32::INFINITY;
+                break;
+            }
+            let q = self.points[previous as u32 as usize];
+            bound = bound.max(distance_squared(q.x, q.y, q.z));
+        }
+        if list.best.len() != k {
+            bound = f32::INFINITY;
+        }
         let (xs, ys, zs) = (&list.xs, &list.ys, &list.zs);
+        list.distances.clear();
+        list.distances.extend(
+            xs.iter()
+                .zip(ys)
+                .zip(zs)
+                .map(|((&x, &y), &z)| distance_squared(x, y, z)),
+        );
+        // Kept without branching on the distance (which candidates pass
+        // changes from hair to hair, so a branch would mispredict).
         list.keys.clear();
-        list.keys
-            .extend(
-                xs.iter()
-                    .zip(ys)
-                    .zip(zs)
-                    .zip(&list.candidates)
-                    .map(|(((&x, &y), &z), &i)| {
-                        let (dx, dy, dz) = (x - p.x, y - p.y, z - p.z);
-                        key(dx * dx + dy * dy + dz * dz, i)
-                    }),
-            );
+        list.keys.resize(list.candidates.len(), 0);
+        let mut kept = 0;
+        for (&d, &i) in list.distances.iter().zip(&list.candidates) {
+            list.keys[kept] = key(d, i);
+            kept += usize::from(d <= bound);
+        }
         list.best.clear();
         list.best.resize(k, u64::MAX);
-        for &candidate in &list.keys {
+        for &candidate in &list.keys[..kept] {
             keep_smallest(&mut list.best, candidate);
         }
         neighbours(&list.best)
