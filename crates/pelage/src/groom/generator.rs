@@ -22,6 +22,8 @@ use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, sample_range};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Hairs per part when the groom file does not say.
 pub const HAIRS_PER_PART: u64 = 100_000;
@@ -261,7 +263,11 @@ pub struct Generator<'g> {
     normals: bool,
     seed: u64,
     /// Arrays of parts handed back by [`Self::recycle`], for the next parts.
-    spare: std::sync::Mutex<Vec<CurveArrays>>,
+    spare: Mutex<Vec<CurveArrays>>,
+    /// The part asked for last (`usize::MAX`: none yet), and the roots of
+    /// the one after it, sampled ahead.
+    last_part: AtomicUsize,
+    prefetched: Mutex<Option<(usize, Vec<SurfacePoint>)>>,
 }
 
 /// Parts' arrays kept for reuse: a writer holds one part while the next
@@ -374,7 +380,9 @@ impl<'g> Generator<'g> {
             opacities: file.finish.opacity.is_some(),
             normals: file.finish.normals,
             seed,
-            spare: std::sync::Mutex::new(Vec::new()),
+            spare: Mutex::new(Vec::new()),
+            last_part: AtomicUsize::new(usize::MAX),
+            prefetched: Mutex::new(None),
         };
         for (k, spec) in file.ops.iter().enumerate() {
             let op = generator.operator(k, spec)?;
@@ -610,10 +618,38 @@ impl<'g> Generator<'g> {
     /// root UVs (meshes with UVs) and ids. Identical on any thread count:
     /// workers grow fixed chunks of roots, in order.
     pub fn part(&self, p: usize) -> Curves {
+        let roots = self
+            .take_prefetched(p)
+            .unwrap_or_else(|| self.part_roots(p));
+        // Parts asked for in order (a whole groom, a farm task's range):
+        // the next part's roots are sampled and sorted beside this part's
+        // growth, on threads that would otherwise wait for its last chunks.
+        let previous = self.last_part.swap(p, Ordering::Relaxed);
+        let prefetch = p + 1 < self.layout.len() && (p == 0 || previous == p - 1);
+        let (curves, next) = rayon::join(
+            || self.grow_part(p, &roots),
+            || prefetch.then(|| self.part_roots(p + 1)),
+        );
+        if let Some(next) = next {
+            *self.prefetched.lock().unwrap_or_else(|e| e.into_inner()) = Some((p + 1, next));
+        }
+        curves
+    }
+
+    /// The roots of part `p` if they were sampled ahead.
+    fn take_prefetched(&self, p: usize) -> Option<Vec<SurfacePoint>> {
+        let mut prefetched = self.prefetched.lock().unwrap_or_else(|e| e.into_inner());
+        match prefetched.take() {
+            Some((q, roots)) if q == p => Some(roots),
+            _ => None,
+        }
+    }
+
+    /// Part `p` grown from its `roots`.
+    fn grow_part(&self, p: usize, roots: &[SurfacePoint]) -> Curves {
         let part = &self.layout.parts()[p];
-        let roots = self.part_roots(p);
         if self.one_hair_per_root() {
-            return self.part_in_place(&roots, part.first_hair);
+            return self.part_in_place(roots, part.first_hair);
         }
         let chunks: Vec<PartChunk> = roots
             .par_chunks(CHUNK)
