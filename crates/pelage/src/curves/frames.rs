@@ -93,7 +93,7 @@ pub fn rotation_minimizing_normals(
 /// Hairs framed at once by [`hair_normals`]. One hair's double reflection
 /// is a chain of dependent steps that leaves the CPU idle between them;
 /// eight hairs side by side, lane by lane, fill that time and compile to
-/// SIMD (two SSE registers a value).
+/// SIMD (one AVX register a value, or two SSE registers without AVX).
 const LANES: usize = 8;
 
 type Lanes = [f32; LANES];

@@ -627,7 +627,7 @@ impl<'g> Generator<'g> {
         let previous = self.last_part.swap(p, Ordering::Relaxed);
         let prefetch = p + 1 < self.layout.len() && (p == 0 || previous == p - 1);
         let (curves, next) = rayon::join(
-            || self.grow_part(p, &roots),
+            || self.grow_part(p, roots),
             || prefetch.then(|| self.part_roots(p + 1)),
         );
         if let Some(next) = next {
@@ -646,7 +646,7 @@ impl<'g> Generator<'g> {
     }
 
     /// Part `p` grown from its `roots`.
-    fn grow_part(&self, p: usize, roots: &[SurfacePoint]) -> Curves {
+    fn grow_part(&self, p: usize, roots: Vec<SurfacePoint>) -> Curves {
         let part = &self.layout.parts()[p];
         if self.one_hair_per_root() {
             return self.part_in_place(roots, part.first_hair);
@@ -686,8 +686,9 @@ impl<'g> Generator<'g> {
     }
 
     /// [`Self::part`] when each root grows one hair: the arrays are
-    /// allocated once and each worker writes its chunk's slices.
-    fn part_in_place(&self, roots: &[SurfacePoint], first_hair: u64) -> Curves {
+    /// allocated once and each worker writes its chunk's slices; `roots`
+    /// become the curves' roots.
+    fn part_in_place(&self, roots: Vec<SurfacePoint>, first_hair: u64) -> Curves {
         let n = self.points;
         let total = roots.len() * n;
         let sized = |on: bool| if on { total } else { 0 };
@@ -779,7 +780,7 @@ impl<'g> Generator<'g> {
         self.with_root_uvs(
             curves
                 .with_ids(ids)
-                .and_then(|c| c.with_roots(roots.to_vec()))
+                .and_then(|c| c.with_roots(roots))
                 .expect("one id and root a curve"),
         )
     }

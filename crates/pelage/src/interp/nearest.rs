@@ -162,18 +162,18 @@ impl NearestPoints {
         // measured from `p`, bound the k-th distance, and only candidates
         // within that bound can be among the k nearest. Filtering first
         // leaves a handful to sort in instead of the whole list.
-        let mut bound = 0.0f32;
-        for &previous in &list.best {
-            if previous == u64::MAX {
-                bound = f32::INFINITY;
-                break;
-            }
-            let q = self.points[previous as u32 as usize];
-            bound = bound.max(distance_squared(q.x, q.y, q.z));
-        }
-        if list.best.len() != k {
-            bound = f32::INFINITY;
-        }
+        let answered = list.best.len() == k && !list.best.contains(&u64::MAX);
+        let bound = if answered {
+            list.best
+                .iter()
+                .map(|&previous| {
+                    let q = self.points[previous as u32 as usize];
+                    distance_squared(q.x, q.y, q.z)
+                })
+                .fold(0.0, f32::max)
+        } else {
+            f32::INFINITY
+        };
         let (xs, ys, zs) = (&list.xs, &list.ys, &list.zs);
         list.distances.clear();
         list.distances.extend(
