@@ -1,7 +1,8 @@
 //! Profiling harness for the groom generator (`perf record` it): the
 //! `pelage bench groom` groom (spot ×2, 1,000 guides, clump + noise, 16
 //! points, normals, widths), HAIRS hairs (default 400,000) grown in memory.
-//! OPS=none drops the operators, to see interpolation alone.
+//! OPS=none drops the operators, to see interpolation alone; NORMALS=0
+//! drops the per-point normals.
 use pelage::groom::Groom;
 
 fn main() {
@@ -14,8 +15,9 @@ fn main() {
     } else {
         "[[ops]]\nclump = { count = 4000, rate = 0.6 }\n[[ops]]\nnoise = { amplitude = 0.004, frequency = 30 }\n"
     };
+    let normals = std::env::var("NORMALS").as_deref() != Ok("0");
     let text = format!(
-        "[mesh]\npath = \"spot\"\nsubdivide = 2\n[roots]\ncount = {hairs}\ndensity = \"noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4\"\n[guides]\npoints = 8\ngenerate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}\n{ops}[finish]\npoints = 16\n"
+        "[mesh]\npath = \"spot\"\nsubdivide = 2\n[roots]\ncount = {hairs}\ndensity = \"noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4\"\n[guides]\npoints = 8\ngenerate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}\n{ops}[finish]\npoints = 16\nnormals = {normals}\n"
     );
     let groom = Groom::from_text("<profile>", text).unwrap();
     let t = std::time::Instant::now();

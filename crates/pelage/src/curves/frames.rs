@@ -147,24 +147,11 @@ pub fn hair_normals(
     scratch: &mut FrameScratch,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx") {
+    if n >= 2 && std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: the CPU has AVX (checked just above).
-        unsafe { hair_normals_avx(points, n, first, out, scratch) };
+        unsafe { avx::hair_normals(points, n, first, out, scratch) };
         return;
     }
-    hair_normals_in_lanes(points, n, first, out, scratch);
-}
-
-/// [`hair_normals_in_lanes`] compiled for AVX.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-fn hair_normals_avx(
-    points: &[Vec3],
-    n: usize,
-    first: &[Vec3],
-    out: &mut [Vec3],
-    scratch: &mut FrameScratch,
-) {
     hair_normals_in_lanes(points, n, first, out, scratch);
 }
 
@@ -204,24 +191,10 @@ fn hair_normals_in_lanes(
         // Spare lanes repeat the group's last hair and are not written out.
         let hair = |l: usize| group + l.min(count - 1);
         let (p, t) = (&mut scratch.points[..], &mut scratch.tangents[..]);
-        for (i, lane) in p.iter_mut().enumerate() {
-            for l in 0..LANES {
-                lane.set(l, points[hair(l) * n + i]);
-            }
-        }
+        gather(points, n, hair, p);
         lane_tangents(p, t);
-        let mut r = LaneVec::default();
+        let mut r = start_vectors(&t[0], |l| first[hair(l)]);
         let mut normal = LaneVec::default();
-        for l in 0..LANES {
-            // The start is per hair and rarely degenerate: scalar.
-            let t0 = t[0].at(l);
-            let f = first[hair(l)];
-            let mut start = (f - t0 * t0.dot(f)).normalize_or_zero();
-            if start == Vec3::ZERO {
-                start = t0.any_orthonormal_vector();
-            }
-            r.set(l, start);
-        }
         store(out, n, 0, count, group, &r);
         for i in 0..n - 1 {
             let mut degenerate = [false; LANES];
@@ -276,6 +249,14 @@ fn lane_tangents(p: &[LaneVec], t: &mut [LaneVec]) {
             (t[i].x[l], t[i].y[l], t[i].z[l]) = (scaled(dx), scaled(dy), scaled(dz));
         }
     }
+    fill_zero_tangents(t);
+}
+
+/// [`catmull_rom_tangents`]' fallback, lane by lane: zero tangents
+/// (repeated points) take the one before, else the one after.
+#[inline(always)]
+fn fill_zero_tangents(t: &mut [LaneVec]) {
+    let n = t.len();
     let zero = |v: &LaneVec, l: usize| v.x[l] == 0.0 && v.y[l] == 0.0 && v.z[l] == 0.0;
     for i in 1..n {
         for l in 0..LANES {
@@ -295,11 +276,225 @@ fn lane_tangents(p: &[LaneVec], t: &mut [LaneVec]) {
     }
 }
 
+/// Point `i` of the hairs `hair(l)` into lane `l` of `p[i]`.
+#[inline(always)]
+fn gather(points: &[Vec3], n: usize, hair: impl Fn(usize) -> usize, p: &mut [LaneVec]) {
+    for (i, lane) in p.iter_mut().enumerate() {
+        for l in 0..LANES {
+            lane.set(l, points[hair(l) * n + i]);
+        }
+    }
+}
+
+/// The frames' first vectors: lane `l`'s `first(l)` made perpendicular to
+/// its tangent `t0` (as [`rotation_minimizing_normals`] starts). Per hair
+/// and rarely degenerate, so scalar.
+#[inline(always)]
+fn start_vectors(t0: &LaneVec, first: impl Fn(usize) -> Vec3) -> LaneVec {
+    let mut r = LaneVec::default();
+    for l in 0..LANES {
+        let (t0, f) = (t0.at(l), first(l));
+        let mut start = (f - t0 * t0.dot(f)).normalize_or_zero();
+        if start == Vec3::ZERO {
+            start = t0.any_orthonormal_vector();
+        }
+        r.set(l, start);
+    }
+    r
+}
+
 /// Writes point `i`'s lanes to the group's real hairs.
 #[inline(always)]
 fn store(out: &mut [Vec3], n: usize, i: usize, count: usize, group: usize, v: &LaneVec) {
     for l in 0..count {
         out[(group + l) * n + i] = v.at(l);
+    }
+}
+
+/// [`hair_normals`] in AVX registers: the arithmetic of
+/// [`hair_normals_in_lanes`] operation for operation (no fused
+/// multiply-add, the same order), so the bits agree; the rare cases (a zero
+/// tangent, a degenerate step) are found with a lane mask and handed to the
+/// scalar rules. Written with intrinsics because the compiler kept the
+/// portable version's lanes on the stack between steps and branched lane
+/// by lane on the rare cases.
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::{FrameScratch, LANES, LaneVec, fill_zero_tangents, gather, start_vectors, store};
+    use glam::Vec3;
+    use std::arch::x86_64::*;
+
+    /// Three coordinates in three registers.
+    #[derive(Clone, Copy)]
+    struct V {
+        x: __m256,
+        y: __m256,
+        z: __m256,
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn load(v: &LaneVec) -> V {
+        // SAFETY: each field is eight f32s.
+        unsafe {
+            V {
+                x: _mm256_loadu_ps(v.x.as_ptr()),
+                y: _mm256_loadu_ps(v.y.as_ptr()),
+                z: _mm256_loadu_ps(v.z.as_ptr()),
+            }
+        }
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn save(v: V, out: &mut LaneVec) {
+        // SAFETY: each field is eight f32s.
+        unsafe {
+            _mm256_storeu_ps(out.x.as_mut_ptr(), v.x);
+            _mm256_storeu_ps(out.y.as_mut_ptr(), v.y);
+            _mm256_storeu_ps(out.z.as_mut_ptr(), v.z);
+        }
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn sub(a: V, b: V) -> V {
+        V {
+            x: _mm256_sub_ps(a.x, b.x),
+            y: _mm256_sub_ps(a.y, b.y),
+            z: _mm256_sub_ps(a.z, b.z),
+        }
+    }
+
+    /// `a − s·b`, per lane.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn sub_scaled(a: V, s: __m256, b: V) -> V {
+        V {
+            x: _mm256_sub_ps(a.x, _mm256_mul_ps(s, b.x)),
+            y: _mm256_sub_ps(a.y, _mm256_mul_ps(s, b.y)),
+            z: _mm256_sub_ps(a.z, _mm256_mul_ps(s, b.z)),
+        }
+    }
+
+    /// `(ax·bx + ay·by) + az·bz`, glam's order.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn dot(a: V, b: V) -> __m256 {
+        let xy = _mm256_add_ps(_mm256_mul_ps(a.x, b.x), _mm256_mul_ps(a.y, b.y));
+        _mm256_add_ps(xy, _mm256_mul_ps(a.z, b.z))
+    }
+
+    /// `if c > 1e-20 { 2 / c } else { 0 }`.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn reflection_scale(c: __m256) -> __m256 {
+        let usable = _mm256_cmp_ps::<_CMP_GT_OQ>(c, _mm256_set1_ps(1e-20));
+        _mm256_and_ps(usable, _mm256_div_ps(_mm256_set1_ps(2.0), c))
+    }
+
+    /// [`super::lane_tangents`]: `Vec3::normalize_or_zero` of each chord,
+    /// then the fallback for zero ones when a lane has any.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn tangents(p: &[LaneVec], t: &mut [LaneVec]) {
+        let n = p.len();
+        let zero = _mm256_setzero_ps();
+        let (one, infinity) = (_mm256_set1_ps(1.0), _mm256_set1_ps(f32::INFINITY));
+        let mut any_zero = 0;
+        for i in 0..n {
+            let d = sub(load(&p[(i + 1).min(n - 1)]), load(&p[i.saturating_sub(1)]));
+            let rcp = _mm256_div_ps(one, _mm256_sqrt_ps(dot(d, d)));
+            // Finite and positive; NaN fails both.
+            let ok = _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_GT_OQ>(rcp, zero),
+                _mm256_cmp_ps::<_CMP_LT_OQ>(rcp, infinity),
+            );
+            let scaled = |c: __m256| _mm256_and_ps(ok, _mm256_mul_ps(c, rcp));
+            let tangent = V {
+                x: scaled(d.x),
+                y: scaled(d.y),
+                z: scaled(d.z),
+            };
+            save(tangent, &mut t[i]);
+            let is_zero = |c: __m256| _mm256_cmp_ps::<_CMP_EQ_OQ>(c, zero);
+            let all_zero = _mm256_and_ps(
+                _mm256_and_ps(is_zero(tangent.x), is_zero(tangent.y)),
+                is_zero(tangent.z),
+            );
+            any_zero |= _mm256_movemask_ps(all_zero);
+        }
+        if any_zero != 0 {
+            fill_zero_tangents(t);
+        }
+    }
+
+    /// See [`super::hair_normals`]; `n ≥ 2`.
+    #[target_feature(enable = "avx")]
+    pub(super) fn hair_normals(
+        points: &[Vec3],
+        n: usize,
+        first: &[Vec3],
+        out: &mut [Vec3],
+        scratch: &mut FrameScratch,
+    ) {
+        let hairs = first.len();
+        assert!(n >= 2);
+        assert_eq!(points.len(), hairs * n);
+        assert_eq!(out.len(), hairs * n);
+        scratch.points.resize(n, LaneVec::default());
+        scratch.tangents.resize(n, LaneVec::default());
+        let mut normal = LaneVec::default();
+        let mut carried = LaneVec::default();
+        for group in (0..hairs).step_by(LANES) {
+            let count = (hairs - group).min(LANES);
+            // Spare lanes repeat the group's last hair and are not written out.
+            let hair = |l: usize| group + l.min(count - 1);
+            let (p, t) = (&mut scratch.points[..], &mut scratch.tangents[..]);
+            gather(points, n, hair, p);
+            tangents(p, t);
+            let start = start_vectors(&t[0], |l| first[hair(l)]);
+            store(out, n, 0, count, group, &start);
+            let mut r = load(&start);
+            let mut a = load(&p[0]);
+            let mut ta = load(&t[0]);
+            for i in 0..n - 1 {
+                let (b, tb) = (load(&p[i + 1]), load(&t[i + 1]));
+                let v1 = sub(b, a);
+                let k1 = reflection_scale(dot(v1, v1));
+                let t_l = sub_scaled(ta, _mm256_mul_ps(k1, dot(v1, ta)), v1);
+                let v2 = sub(tb, t_l);
+                let k2 = reflection_scale(dot(v2, v2));
+                let r_l = sub_scaled(r, _mm256_mul_ps(k1, dot(v1, r)), v1);
+                let f = sub_scaled(r_l, _mm256_mul_ps(k2, dot(v2, r_l)), v2);
+                // `f − tb·s` is `f − s·tb` to the bit (products commute).
+                let q = sub_scaled(f, dot(tb, f), tb);
+                let q2 = dot(q, q);
+                let inverse = _mm256_div_ps(_mm256_set1_ps(1.0), _mm256_sqrt_ps(q2));
+                let usable = _mm256_cmp_ps::<_CMP_GT_OQ>(q2, _mm256_set1_ps(1e-12));
+                r = f;
+                save(
+                    V {
+                        x: _mm256_mul_ps(q.x, inverse),
+                        y: _mm256_mul_ps(q.y, inverse),
+                        z: _mm256_mul_ps(q.z, inverse),
+                    },
+                    &mut normal,
+                );
+                let degenerate = _mm256_movemask_ps(usable) ^ 0xff;
+                if degenerate != 0 {
+                    save(r, &mut carried);
+                    for l in (0..LANES).filter(|l| degenerate & (1 << l) != 0) {
+                        let restart = t[i + 1].at(l).any_orthonormal_vector();
+                        carried.set(l, restart);
+                        normal.set(l, restart);
+                    }
+                    r = load(&carried);
+                }
+                store(out, n, i + 1, count, group, &normal);
+                (a, ta) = (b, tb);
+            }
+        }
     }
 }
 
@@ -392,17 +587,20 @@ mod tests {
                     Vec3::new(1.0, 0.2 * h as f32, 0.0)
                 });
             }
+            // The dispatching entry (AVX intrinsics where the CPU has
+            // them) and the portable lanes, both against the scalar path.
             let mut lanes = vec![Vec3::NAN; points.len()];
-            hair_normals(&points, n, &first, &mut lanes, &mut FrameScratch::default());
+            let mut portable = vec![Vec3::NAN; points.len()];
+            let scratch = &mut FrameScratch::default();
+            hair_normals(&points, n, &first, &mut lanes, scratch);
+            hair_normals_in_lanes(&points, n, &first, &mut portable, scratch);
             for (h, start) in first.iter().enumerate() {
                 let range = h * n..(h + 1) * n;
                 let (_, one) = frames(&points[range.clone()], *start);
-                for (a, b) in one.iter().zip(&lanes[range]) {
-                    assert_eq!(
-                        a.to_array().map(f32::to_bits),
-                        b.to_array().map(f32::to_bits),
-                        "n {n} hair {h}"
-                    );
+                for ((a, b), c) in one.iter().zip(&lanes[range.clone()]).zip(&portable[range]) {
+                    let bits = |v: &Vec3| v.to_array().map(f32::to_bits);
+                    assert_eq!(bits(a), bits(b), "n {n} hair {h}");
+                    assert_eq!(bits(a), bits(c), "n {n} hair {h}, portable lanes");
                 }
             }
         }
