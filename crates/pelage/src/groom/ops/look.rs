@@ -3,7 +3,7 @@
 //! attributes at hair root and tip and we interpolate them to every hair
 //! vertex. Again we add some noise to hair color").
 
-use super::{Hair, RootContext, RootToTip, jittered, param};
+use super::{Hair, RampTables, RootContext, RootToTip, jittered};
 use crate::groom::file::Ramp;
 use crate::map::Map;
 use crate::sample::SampleRng;
@@ -17,13 +17,23 @@ fn root_to_tip(
     hair_id: u64,
     root: &RootContext,
     out: &mut Vec<f32>,
-    n: usize,
+    ramp: &[f32],
 ) {
-    let mut rng = SampleRng::new(spec.seed ^ salt, hair_id);
-    let factor = jittered(spec.jitter.eval(root.uv), &mut rng);
+    let factor = varied(spec.jitter.eval(root.uv), spec.seed ^ salt, hair_id);
     let (a, b) = (spec.root.eval(root.uv), spec.tip.eval(root.uv));
     out.clear();
-    out.extend((0..n).map(|j| factor * (a + spec.ramp.at(param(j, n)) * (b - a))));
+    out.extend(ramp.iter().map(|&r| factor * (a + r * (b - a))));
+}
+
+/// The per-hair factor `1 ± jitter`; the random stream is only set up
+/// when there is jitter (most grooms have none, and every hair pays for
+/// the hashing).
+fn varied(jitter: f32, seed: u64, hair_id: u64) -> f32 {
+    if jitter == 0.0 {
+        1.0
+    } else {
+        jittered(jitter, &mut SampleRng::new(seed, hair_id))
+    }
 }
 
 /// `width`: `(root + ramp(t)(tip − root)) · (1 ± jitter)` per hair;
@@ -32,9 +42,9 @@ fn root_to_tip(
 pub struct Width(pub RootToTip);
 
 impl Width {
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext) {
-        let n = hair.points.len();
-        root_to_tip(&self.0, 0x3D_7714, hair.id, root, &mut hair.widths, n);
+    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
+        let ramp = ramps.along(&self.0.ramp, hair.points.len());
+        root_to_tip(&self.0, 0x3D_7714, hair.id, root, &mut hair.widths, ramp);
         hair.widths.iter_mut().for_each(|w| *w = w.max(0.0));
     }
 }
@@ -44,9 +54,16 @@ impl Width {
 pub struct Opacity(pub RootToTip);
 
 impl Opacity {
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext) {
-        let n = hair.points.len();
-        root_to_tip(&self.0, 0x00BA_C17E, hair.id, root, &mut hair.opacities, n);
+    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
+        let ramp = ramps.along(&self.0.ramp, hair.points.len());
+        root_to_tip(
+            &self.0,
+            0x00BA_C17E,
+            hair.id,
+            root,
+            &mut hair.opacities,
+            ramp,
+        );
         hair.opacities
             .iter_mut()
             .for_each(|o| *o = o.clamp(0.0, 1.0));
@@ -70,15 +87,15 @@ pub struct Color {
 }
 
 impl Color {
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext) {
-        let mut rng = SampleRng::new(self.seed ^ 0xC0_10E, hair.id);
-        let factor = jittered(self.jitter.eval(root.uv), &mut rng);
+    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
+        let factor = varied(self.jitter.eval(root.uv), self.seed ^ 0xC0_10E, hair.id);
         let rgb = |m: &[Map; 3]| Vec3::from(m.each_ref().map(|c| c.eval(root.uv)));
         let (a, b) = (rgb(&self.root), rgb(&self.tip));
-        let n = hair.points.len();
+        let ramp = ramps.along(&self.ramp, hair.points.len());
         hair.colors.clear();
         hair.colors.extend(
-            (0..n).map(|j| (factor * a.lerp(b, self.ramp.at(param(j, n)))).max(Vec3::ZERO)),
+            ramp.iter()
+                .map(|&r| (factor * a.lerp(b, r)).max(Vec3::ZERO)),
         );
     }
 }
@@ -101,7 +118,7 @@ mod tests {
     #[test]
     fn width_runs_root_to_tip() {
         let mut hair = straight(1, 5, 1.0);
-        Width(spec(0.01, 0.002, 0.0)).apply(&mut hair, &root());
+        Width(spec(0.01, 0.002, 0.0)).apply(&mut hair, &root(), &mut RampTables::default());
         assert_eq!(hair.widths[0], 0.01);
         assert!((hair.widths[4] - 0.002).abs() < 1e-9);
         assert!((hair.widths[2] - 0.006).abs() < 1e-9);
@@ -112,7 +129,7 @@ mod tests {
         let roots: Vec<f32> = (0..100)
             .map(|id| {
                 let mut h = straight(id, 5, 1.0);
-                Opacity(spec(0.5, 0.5, 0.5)).apply(&mut h, &root());
+                Opacity(spec(0.5, 0.5, 0.5)).apply(&mut h, &root(), &mut RampTables::default());
                 h.opacities[0]
             })
             .collect();
@@ -131,7 +148,7 @@ mod tests {
             jitter: Map::Constant(0.0),
             seed: 0,
         }
-        .apply(&mut hair, &root());
+        .apply(&mut hair, &root(), &mut RampTables::default());
         assert_eq!(hair.colors.len(), 3);
         assert!((hair.colors[1] - Vec3::new(0.6, 0.5, 0.4)).length() < 1e-6);
     }

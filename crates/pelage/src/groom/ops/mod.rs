@@ -150,6 +150,43 @@ pub struct Scratch {
     /// Clump centres near the last roots.
     pub(crate) near: crate::interp::NeighbourCache,
     pub(crate) noise: NoiseScratch,
+    /// Root-to-tip profiles at the hairs' point counts.
+    pub(crate) ramps: RampTables,
+}
+
+/// `ramp(t_j)` for the points `j` of an `n`-point hair, kept per (ramp,
+/// `n`): a groom's hairs mostly share one point count, so the appearance
+/// operators read their profile from a table instead of evaluating it (and
+/// dividing for `t_j`) at every point of every hair.
+#[derive(Debug, Default)]
+pub struct RampTables {
+    tables: Vec<(Ramp, usize, Vec<f32>)>,
+}
+
+/// Tables kept at most: one for each of a few operators and point counts;
+/// past that the oldest makes room.
+const RAMP_TABLES: usize = 8;
+
+impl RampTables {
+    /// `ramp.at(param(j, n))` for `j` in `0..n`.
+    pub fn along(&mut self, ramp: &Ramp, n: usize) -> &[f32] {
+        let found = self
+            .tables
+            .iter()
+            .position(|(r, m, _)| *m == n && r == ramp);
+        let i = match found {
+            Some(i) => i,
+            None => {
+                if self.tables.len() == RAMP_TABLES {
+                    self.tables.remove(0);
+                }
+                let values = (0..n).map(|j| ramp.at(param(j, n))).collect();
+                self.tables.push((ramp.clone(), n, values));
+                self.tables.len() - 1
+            }
+        };
+        &self.tables[i].2
+    }
 }
 
 impl Scratch {
@@ -245,9 +282,9 @@ impl Operator {
             Operator::Clump(op) => op.apply(hair, root, &mut scratch.near),
             Operator::Curl(op) => op.apply(hair, root, scratch),
             Operator::Length(op) => op.apply(hair, root),
-            Operator::Width(op) => op.apply(hair, root),
-            Operator::Color(op) => op.apply(hair, root),
-            Operator::Opacity(op) => op.apply(hair, root),
+            Operator::Width(op) => op.apply(hair, root, &mut scratch.ramps),
+            Operator::Color(op) => op.apply(hair, root, &mut scratch.ramps),
+            Operator::Opacity(op) => op.apply(hair, root, &mut scratch.ramps),
             Operator::Strands(_) | Operator::Cut(_) => {
                 unreachable!("strands and cut work on the whole batch")
             }
