@@ -608,9 +608,8 @@ impl<'g> Generator<'g> {
             return Vec::new();
         };
         let stream = mix64(self.seed ^ mix64(0x9A27 + p as u64));
-        let mut roots = sample_range(&sampler, stream, 0..part.hair_count);
-        roots.par_sort_unstable_by_key(|r| (r.tri, r.bary[0].to_bits(), r.bary[1].to_bits()));
-        roots
+        let roots = sample_range(&sampler, stream, 0..part.hair_count);
+        sorted_by_triangle(roots)
     }
 
     /// Grows part `p`: its curves with per-point widths, normals (unless
@@ -954,4 +953,73 @@ fn color_spec(groom: &Groom, s: &ColorSpec) -> Result<Color, GroomError> {
         jitter: groom.map(&s.jitter)?,
         seed: s.seed,
     })
+}
+
+/// `roots` ordered by (triangle, first barycentric, second barycentric),
+/// the order [`Generator::part_roots`] grows hairs in: the same order as
+/// a comparison sort by that key, found faster. A counting sort by
+/// triangle moves each root once; each triangle's few roots (a dozen or
+/// two) are then sorted among themselves. A comparison sort of the whole
+/// part took a tenth of a groom's time on one core.
+fn sorted_by_triangle(roots: Vec<SurfacePoint>) -> Vec<SurfacePoint> {
+    let (Some(lo), Some(hi)) = (
+        roots.iter().map(|r| r.tri).min(),
+        roots.iter().map(|r| r.tri).max(),
+    ) else {
+        return roots;
+    };
+    // starts[t − lo] .. starts[t − lo + 1]: where triangle t's roots go.
+    let mut starts = vec![0u32; (hi - lo) as usize + 2];
+    for r in &roots {
+        starts[(r.tri - lo) as usize + 1] += 1;
+    }
+    for t in 1..starts.len() {
+        starts[t] += starts[t - 1];
+    }
+    let mut next = starts.clone();
+    let mut sorted = vec![SurfacePoint::default(); roots.len()];
+    for r in &roots {
+        let slot = &mut next[(r.tri - lo) as usize];
+        sorted[*slot as usize] = *r;
+        *slot += 1;
+    }
+    for range in starts.windows(2) {
+        let triangle = &mut sorted[range[0] as usize..range[1] as usize];
+        if triangle.len() > 1 {
+            triangle.sort_unstable_by_key(|r| (r.bary[0].to_bits(), r.bary[1].to_bits()));
+        }
+    }
+    sorted
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn roots_sorted_by_triangle_match_a_comparison_sort() {
+        // Random roots over a few hundred triangles, with repeated
+        // triangles and first barycentrics (ties broken by the second),
+        // exact duplicates, and a negative zero.
+        let mut roots: Vec<SurfacePoint> = (0..5000u64)
+            .map(|i| {
+                let h = mix64(i);
+                let unit = |h: u64| (h >> 40) as f32 / (1u64 << 24) as f32;
+                let b0 = if i % 7 == 0 { 0.25 } else { unit(h) };
+                SurfacePoint::new((h % 300) as u32 * 77, [b0, unit(mix64(h))])
+            })
+            .collect();
+        roots.extend_from_slice(&roots[..50].to_vec());
+        roots.push(SurfacePoint::new(3, [-0.0, 0.5]));
+        roots.push(SurfacePoint::new(3, [0.0, 0.5]));
+        let mut expected = roots.clone();
+        expected.sort_unstable_by_key(|r| (r.tri, r.bary[0].to_bits(), r.bary[1].to_bits()));
+        let got = sorted_by_triangle(roots);
+        let bits = |r: &SurfacePoint| (r.tri, r.bary.map(f32::to_bits));
+        assert_eq!(
+            got.iter().map(bits).collect::<Vec<_>>(),
+            expected.iter().map(bits).collect::<Vec<_>>()
+        );
+        assert!(sorted_by_triangle(Vec::new()).is_empty());
+    }
 }
