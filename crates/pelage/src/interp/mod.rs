@@ -28,7 +28,7 @@ pub use style_mesh::{LostGuide, StyleMesh, StyleMeshOptions};
 
 use crate::guides::Guides;
 use crate::mesh::{Mesh, SurfacePoint};
-use glam::{Mat3, Quat, Vec3};
+use glam::{Mat3, Quat, Vec3, Vec3A};
 
 /// One guide's share of a hair.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -132,7 +132,10 @@ pub struct Interpolator<'g> {
     /// Each guide's offsets from its root.
     offsets: Vec<Vec3>,
     /// Each guide's root normal.
-    normals: Vec<Vec3>,
+    /// Each guide's skin normal, padded to 16 bytes: read as one load
+    /// (a 12-byte `Vec3` went through the stack in two pieces and stalled
+    /// the load that reassembled it).
+    normals: Vec<Vec3A>,
     weights: Box<dyn GuideWeights + 'g>,
 }
 
@@ -161,7 +164,11 @@ impl<'g> Interpolator<'g> {
             let g = guides.guide(i);
             offsets.extend(g.iter().map(|p| *p - g[0]));
         }
-        let normals = guides.roots().iter().map(|r| r.normal(mesh)).collect();
+        let normals = guides
+            .roots()
+            .iter()
+            .map(|r| Vec3A::from(r.normal(mesh)))
+            .collect();
         Self {
             guides,
             offsets,
@@ -216,7 +223,7 @@ impl<'g> Interpolator<'g> {
             let g = w.guide as usize;
             // The weight folded into the rotation: one matrix-vector
             // product a point.
-            let turn = w.weight * rotation_between(self.normals[g], normal);
+            let turn = w.weight * rotation_between(Vec3::from(self.normals[g]), normal);
             for (o, offset) in out.iter_mut().zip(&self.offsets[g * n..(g + 1) * n]) {
                 *o += turn * *offset;
             }
