@@ -4,7 +4,7 @@
 //! second `clump` clumps the first level's clumps (multi-level clumping by
 //! stacking). Each hair follows the centre whose root is nearest its own.
 
-use super::{Hair, RootContext, param};
+use super::{Hair, RampTables, RootContext};
 use crate::groom::file::Ramp;
 use crate::interp::{NearestPoints, NeighbourCache};
 use crate::map::Map;
@@ -95,7 +95,13 @@ impl Clump {
         &self.centres
     }
 
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, near: &mut NeighbourCache) {
+    pub(super) fn apply(
+        &self,
+        hair: &mut Hair,
+        root: &RootContext,
+        near: &mut NeighbourCache,
+        ramps: &mut RampTables,
+    ) {
         let Some((centre, distance)) = self.centres.nearest_near(root.position, near) else {
             return;
         };
@@ -112,9 +118,9 @@ impl Clump {
         if w == 0.0 || shape.len() != hair.points.len() {
             return;
         }
-        let n = hair.points.len();
-        for (j, (p, c)) in hair.points.iter_mut().zip(shape).enumerate() {
-            *p += w * self.ramp.at(param(j, n)) * (*c - *p);
+        let ramp = ramps.along(&self.ramp, hair.points.len());
+        for ((p, c), r) in hair.points.iter_mut().zip(shape).zip(ramp) {
+            *p += w * r * (*c - *p);
         }
     }
 }
@@ -137,7 +143,12 @@ mod tests {
     fn full_rate_brings_the_tip_to_the_centre_and_keeps_the_root() {
         let op = Clump::new(centre_at(0.1), Map::Constant(1.0), Ramp::default(), None);
         let mut hair = straight(1, 8, 1.0);
-        op.apply(&mut hair, &root(), &mut NeighbourCache::default());
+        op.apply(
+            &mut hair,
+            &root(),
+            &mut NeighbourCache::default(),
+            &mut RampTables::default(),
+        );
         assert_eq!(hair.points[0], Vec3::ZERO);
         assert!((hair.points[7] - Vec3::new(0.1, 0.0, 1.0)).length() < 1e-6);
         assert!(
@@ -155,7 +166,12 @@ mod tests {
             Some(Map::Constant(0.05)),
         );
         let mut hair = straight(1, 8, 1.0);
-        op.apply(&mut hair, &root(), &mut NeighbourCache::default());
+        op.apply(
+            &mut hair,
+            &root(),
+            &mut NeighbourCache::default(),
+            &mut RampTables::default(),
+        );
         assert_eq!(hair, straight(1, 8, 1.0), "beyond the clump's size");
         let mut shapes = centre_at(0.1).shapes;
         shapes.extend(centre_at(-0.3).shapes);

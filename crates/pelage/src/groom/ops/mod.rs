@@ -279,7 +279,7 @@ impl Operator {
         match self {
             Operator::Noise(op) => op.apply(hair, root, &mut scratch.noise),
             Operator::Frizz(op) => op.apply(hair, root),
-            Operator::Clump(op) => op.apply(hair, root, &mut scratch.near),
+            Operator::Clump(op) => op.apply(hair, root, &mut scratch.near, &mut scratch.ramps),
             Operator::Curl(op) => op.apply(hair, root, scratch),
             Operator::Length(op) => op.apply(hair, root),
             Operator::Width(op) => op.apply(hair, root, &mut scratch.ramps),
