@@ -1009,7 +1009,7 @@ mod tests {
                 SurfacePoint::new((h % 300) as u32 * 77, [b0, unit(mix64(h))])
             })
             .collect();
-        roots.extend_from_slice(&roots[..50].to_vec());
+        roots.extend_from_within(..50);
         roots.push(SurfacePoint::new(3, [-0.0, 0.5]));
         roots.push(SurfacePoint::new(3, [0.0, 0.5]));
         let mut expected = roots.clone();
