@@ -155,10 +155,11 @@ pub fn hair_normals(
     hair_normals_in_lanes(points, n, first, out, scratch);
 }
 
-/// The body of [`hair_normals`], inlined into each instruction-set version.
+/// [`hair_normals`] in portable lanes: what runs without AVX (and for
+/// one-point hairs), and what the AVX version matches operation for
+/// operation.
 // Loops over lane indices are the form the compiler vectorises.
 #[allow(clippy::needless_range_loop)]
-#[inline(always)]
 fn hair_normals_in_lanes(
     points: &[Vec3],
     n: usize,
