@@ -137,8 +137,11 @@ fn dot(ax: f32, ay: f32, az: f32, bx: f32, by: f32, bz: f32) -> f32 {
 /// [`rotation_minimizing_normals`] hair by hair, computed [`LANES`] hairs at
 /// a time.
 ///
-/// On x86-64 CPUs with AVX the lanes run eight wide instead of SSE's four
-/// (the same operations, no fused multiply-adds, so the same bits).
+/// On x86-64 CPUs with AVX the lanes are AVX registers (module `avx`; the same
+/// operations, no fused multiply-adds, so the same bits).
+///
+/// # Panics
+/// If `points` and `out` do not hold `first.len()` hairs of `n` points.
 pub fn hair_normals(
     points: &[Vec3],
     n: usize,
@@ -146,6 +149,8 @@ pub fn hair_normals(
     out: &mut [Vec3],
     scratch: &mut FrameScratch,
 ) {
+    assert_eq!(points.len(), first.len() * n);
+    assert_eq!(out.len(), first.len() * n);
     #[cfg(target_arch = "x86_64")]
     if n >= 2 && std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: the CPU has AVX (checked just above).
@@ -168,8 +173,6 @@ fn hair_normals_in_lanes(
     scratch: &mut FrameScratch,
 ) {
     let hairs = first.len();
-    assert_eq!(points.len(), hairs * n);
-    assert_eq!(out.len(), hairs * n);
     if n < 2 {
         // No segment to follow: the single-point rule of the scalar path.
         let mut tangent = [Vec3::ZERO; 1];
@@ -430,7 +433,7 @@ mod avx {
         }
     }
 
-    /// See [`super::hair_normals`]; `n ≥ 2`.
+    /// See [`super::hair_normals`], which checks the lengths; `n ≥ 2`.
     #[target_feature(enable = "avx")]
     pub(super) fn hair_normals(
         points: &[Vec3],
@@ -440,9 +443,6 @@ mod avx {
         scratch: &mut FrameScratch,
     ) {
         let hairs = first.len();
-        assert!(n >= 2);
-        assert_eq!(points.len(), hairs * n);
-        assert_eq!(out.len(), hairs * n);
         scratch.points.resize(n, LaneVec::default());
         scratch.tangents.resize(n, LaneVec::default());
         let mut normal = LaneVec::default();

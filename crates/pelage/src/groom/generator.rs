@@ -7,7 +7,7 @@ use super::file::{
 };
 use super::ops::{
     Clump, ClumpCentres, Color, Curl, Cut, Frizz, Hair, HairBatch, Length, Noise, Opacity,
-    Operator, RootContext, RootToTip, Scratch, Strands, Width,
+    Operator, Resampling, RootContext, RootToTip, Scratch, Strands, Width,
 };
 use super::parts::{Part, PartLayout};
 use crate::curves::frames::{
@@ -883,53 +883,6 @@ struct PartChunk {
     counts: Vec<u32>,
     ids: Vec<u64>,
     roots: Vec<SurfacePoint>,
-}
-
-/// `n` points evenly spaced in the parameter of a polyline of `m` points
-/// (linear interpolation between its points): for each output point, the
-/// segment it falls in and how far along, worked out once for the groom.
-#[derive(Debug, Clone)]
-struct Resampling {
-    from: usize,
-    to: usize,
-    /// Point `k`: `shape[j].lerp(shape[j + 1], f)`, as `(j, f)`.
-    between: Vec<(u32, f32)>,
-}
-
-impl Resampling {
-    fn new(from: usize, to: usize) -> Self {
-        let between = if from >= 2 && from != to {
-            (0..to)
-                .map(|k| {
-                    let x = k as f32 / (to - 1) as f32 * (from - 1) as f32;
-                    let j = (x as usize).min(from - 2);
-                    (j as u32, x - j as f32)
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
-        Self { from, to, between }
-    }
-
-    /// Appends `shape` (of `from` points) resampled to `to` points.
-    fn apply(&self, shape: &[Vec3], out: &mut Vec<Vec3>) {
-        debug_assert_eq!(shape.len(), self.from);
-        if self.from == self.to {
-            out.extend_from_slice(shape);
-        } else if self.from < 2 {
-            out.extend(std::iter::repeat_n(
-                shape.first().copied().unwrap_or_default(),
-                self.to,
-            ));
-        } else {
-            out.extend(
-                self.between
-                    .iter()
-                    .map(|&(j, f)| shape[j as usize].lerp(shape[j as usize + 1], f)),
-            );
-        }
-    }
 }
 
 fn root_to_tip(groom: &Groom, s: &RootToTipSpec) -> Result<RootToTip, GroomError> {

@@ -3,7 +3,7 @@
 //! `frizz` (per-hair random high-frequency wiggle) and `curl` (a helix
 //! around the hair's path, the shape of Silva et al. Eq. 4).
 
-use super::{Hair, RootContext, Scratch, param};
+use super::{Hair, RampTables, Resampling, RootContext, Scratch, param};
 use crate::groom::file::Ramp;
 use crate::map::{Map, NoiseMap};
 use crate::sample::SampleRng;
@@ -68,11 +68,18 @@ impl Noise {
     }
 
     /// Displaces one hair.
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, scratch: &mut NoiseScratch) {
+    pub(super) fn apply(
+        &self,
+        hair: &mut Hair,
+        root: &RootContext,
+        scratch: &mut NoiseScratch,
+        ramps: &mut RampTables,
+    ) {
         self.apply_each(
             std::slice::from_mut(hair),
             std::slice::from_ref(root),
             scratch,
+            ramps,
         );
     }
 
@@ -85,12 +92,13 @@ impl Noise {
         hairs: &mut [Hair],
         roots: &[RootContext],
         scratch: &mut NoiseScratch,
+        ramps: &mut RampTables,
     ) {
         let NoiseScratch {
             at,
             samples,
             hairs: per_hair,
-            along,
+            spacing,
         } = scratch;
         at.clear();
         per_hair.clear();
@@ -113,11 +121,10 @@ impl Noise {
             } else {
                 // Noise vectors at m evenly spaced parameters (positions
                 // along the polyline).
-                at.extend((0..m).map(|k| {
-                    let x = param(k, m) * (n - 1) as f32;
-                    let j = (x as usize).min(n - 2);
-                    let p = hair.points[j].lerp(hair.points[j + 1], x - j as f32);
-                    VectorNoise::shifted(p * frequency)
+                let points = &hair.points;
+                at.extend(spacing.fit(n, m).0.between().iter().map(|&(j, f)| {
+                    let j = j as usize;
+                    VectorNoise::shifted(points[j].lerp(points[j + 1], f) * frequency)
                 }));
             }
         }
@@ -131,9 +138,9 @@ impl Noise {
             let samples = &samples[next..next + m];
             next += m;
             let n = hair.points.len();
-            along.fit(&self.ramp, n, m);
+            let ramp = ramps.along(&self.ramp, n);
             if m == n {
-                for ((p, s), ramp) in hair.points.iter_mut().zip(samples).zip(&along.ramp) {
+                for ((p, s), ramp) in hair.points.iter_mut().zip(samples).zip(ramp) {
                     let a = amplitude * ramp;
                     if a != 0.0 {
                         *p += a * *s;
@@ -141,9 +148,8 @@ impl Noise {
                 }
             } else {
                 // Each point's displacement between its two vectors.
-                for ((p, &(k, f)), ramp) in
-                    hair.points.iter_mut().zip(&along.between).zip(&along.ramp)
-                {
+                let between = spacing.fit(n, m).1.between();
+                for ((p, &(k, f)), ramp) in hair.points.iter_mut().zip(between).zip(ramp) {
                     let a = amplitude * ramp;
                     if a != 0.0 {
                         let k = k as usize;
@@ -173,41 +179,25 @@ pub struct NoiseScratch {
     samples: Vec<Vec3>,
     /// Each hair's amplitude and number of vectors (0: not displaced).
     hairs: Vec<(f32, usize)>,
-    along: AlongHair,
+    spacing: VectorSpacing,
 }
 
-/// Per-point values along a hair of `n` points with `m` noise vectors,
-/// kept while `n`, `m` and the ramp stay the same (they do for a whole
-/// groom unless hairs are cut).
+/// Where a hair of `n` points reads its `m < n` noise vectors, and where
+/// each point lies between them: the two resamplings, kept while `n` and
+/// `m` stay the same (for a whole groom unless hairs are cut).
 #[derive(Debug, Default)]
-struct AlongHair {
-    key: Option<(usize, usize, Ramp)>,
-    /// `ramp(t_j)`.
-    ramp: Vec<f32>,
-    /// For `m < n`: the vector before point `j` and the fraction toward
-    /// the next.
-    between: Vec<(u32, f32)>,
+struct VectorSpacing {
+    fitted: Option<(usize, usize, Resampling, Resampling)>,
 }
 
-impl AlongHair {
-    fn fit(&mut self, ramp: &Ramp, n: usize, m: usize) {
-        if let Some((kn, km, kr)) = &self.key
-            && (*kn, *km) == (n, m)
-            && kr == ramp
-        {
-            return;
+impl VectorSpacing {
+    /// (points → vectors, vectors → points) for `n` points, `m` vectors.
+    fn fit(&mut self, n: usize, m: usize) -> (&Resampling, &Resampling) {
+        if !matches!(&self.fitted, Some((kn, km, ..)) if (*kn, *km) == (n, m)) {
+            self.fitted = Some((n, m, Resampling::new(n, m), Resampling::new(m, n)));
         }
-        self.ramp.clear();
-        self.ramp.extend((0..n).map(|j| ramp.at(param(j, n))));
-        self.between.clear();
-        if m < n {
-            self.between.extend((0..n).map(|j| {
-                let x = param(j, n) * (m - 1) as f32;
-                let k = (x as usize).min(m - 2);
-                (k as u32, x - k as f32)
-            }));
-        }
-        self.key = Some((n, m, ramp.clone()));
+        let (_, _, to_vectors, to_points) = self.fitted.as_ref().expect("just fitted");
+        (to_vectors, to_points)
     }
 }
 
@@ -319,7 +309,12 @@ mod tests {
             0,
         );
         let mut a = straight(1, 16, 1.0);
-        op.apply(&mut a, &root(), &mut NoiseScratch::default());
+        op.apply(
+            &mut a,
+            &root(),
+            &mut NoiseScratch::default(),
+            &mut RampTables::default(),
+        );
         assert_eq!(a.points[0], Vec3::ZERO, "a linear ramp leaves the root");
         let moved = (a.points[15] - Vec3::Z).length();
         assert!(moved > 1e-3 && moved <= 0.1 * 3f32.sqrt() * 1.01, "{moved}");
@@ -327,7 +322,12 @@ mod tests {
         // noise is a field in space, not per hair.
         let mut b = straight(2, 16, 1.0);
         b.points.iter_mut().for_each(|p| *p += Vec3::X * 1e-3);
-        op.apply(&mut b, &root(), &mut NoiseScratch::default());
+        op.apply(
+            &mut b,
+            &root(),
+            &mut NoiseScratch::default(),
+            &mut RampTables::default(),
+        );
         let db = b.points[15] - Vec3::Z - Vec3::X * 1e-3;
         assert!((db - (a.points[15] - Vec3::Z)).length() < 0.1 * 0.05);
     }
@@ -358,11 +358,16 @@ mod tests {
                 vectors,
             );
             let mut together = hairs.clone();
-            op.apply_each(&mut together, &roots, &mut NoiseScratch::default());
-            let mut scratch = NoiseScratch::default();
+            op.apply_each(
+                &mut together,
+                &roots,
+                &mut NoiseScratch::default(),
+                &mut RampTables::default(),
+            );
+            let (mut scratch, mut ramps) = (NoiseScratch::default(), RampTables::default());
             for (i, (hair, root)) in hairs.iter().zip(&roots).enumerate() {
                 let mut alone = hair.clone();
-                op.apply(&mut alone, root, &mut scratch);
+                op.apply(&mut alone, root, &mut scratch, &mut ramps);
                 let bits = |h: &Hair| -> Vec<[u32; 3]> {
                     h.points
                         .iter()

@@ -155,9 +155,10 @@ pub struct Scratch {
 }
 
 /// `ramp(t_j)` for the points `j` of an `n`-point hair, kept per (ramp,
-/// `n`): a groom's hairs mostly share one point count, so the appearance
-/// operators read their profile from a table instead of evaluating it (and
-/// dividing for `t_j`) at every point of every hair.
+/// `n`): a groom's hairs mostly share one point count, so `noise`,
+/// `clump`, `width`, `color` and `opacity` read their profile from a table
+/// instead of evaluating it (and dividing for `t_j`) at every point of
+/// every hair.
 #[derive(Debug, Default)]
 pub struct RampTables {
     tables: Vec<(Ramp, usize, Vec<f32>)>,
@@ -256,7 +257,9 @@ impl Operator {
     pub fn apply_each(&self, hairs: &mut [Hair], roots: &[RootContext], scratch: &mut Scratch) {
         assert_eq!(hairs.len(), roots.len(), "one root a hair");
         match self {
-            Operator::Noise(op) => op.apply_each(hairs, roots, &mut scratch.noise),
+            Operator::Noise(op) => {
+                op.apply_each(hairs, roots, &mut scratch.noise, &mut scratch.ramps)
+            }
             Operator::Strands(_) | Operator::Cut(_) => {
                 panic!("{} changes the number of hairs a root grows", self.name())
             }
@@ -277,7 +280,7 @@ impl Operator {
     /// An operator that works hair by hair, on one hair.
     fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
         match self {
-            Operator::Noise(op) => op.apply(hair, root, &mut scratch.noise),
+            Operator::Noise(op) => op.apply(hair, root, &mut scratch.noise, &mut scratch.ramps),
             Operator::Frizz(op) => op.apply(hair, root),
             Operator::Clump(op) => op.apply(hair, root, &mut scratch.near, &mut scratch.ramps),
             Operator::Curl(op) => op.apply(hair, root, scratch),
@@ -315,6 +318,60 @@ pub(crate) fn param(j: usize, n: usize) -> f32 {
         j as f32 / (n - 1) as f32
     } else {
         0.0
+    }
+}
+
+/// `to` points evenly spaced in the parameter of a polyline of `from`
+/// points (linear interpolation between its points): for each output
+/// point, the segment it falls in and how far along, worked out once and
+/// reused for every hair of those point counts.
+#[derive(Debug, Clone)]
+pub(crate) struct Resampling {
+    from: usize,
+    to: usize,
+    /// Point `k`: `shape[j].lerp(shape[j + 1], f)`, as `(j, f)`.
+    between: Vec<(u32, f32)>,
+}
+
+impl Resampling {
+    pub(crate) fn new(from: usize, to: usize) -> Self {
+        let between = if from >= 2 && from != to {
+            (0..to)
+                .map(|k| {
+                    let x = k as f32 / (to - 1) as f32 * (from - 1) as f32;
+                    let j = (x as usize).min(from - 2);
+                    (j as u32, x - j as f32)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Self { from, to, between }
+    }
+
+    /// For each output point (when `from ≥ 2` and `from ≠ to`): the
+    /// segment it falls in and how far along, `(j, f)`.
+    pub(crate) fn between(&self) -> &[(u32, f32)] {
+        &self.between
+    }
+
+    /// Appends `shape` (of `from` points) resampled to `to` points.
+    pub(crate) fn apply(&self, shape: &[Vec3], out: &mut Vec<Vec3>) {
+        debug_assert_eq!(shape.len(), self.from);
+        if self.from == self.to {
+            out.extend_from_slice(shape);
+        } else if self.from < 2 {
+            out.extend(std::iter::repeat_n(
+                shape.first().copied().unwrap_or_default(),
+                self.to,
+            ));
+        } else {
+            out.extend(
+                self.between
+                    .iter()
+                    .map(|&(j, f)| shape[j as usize].lerp(shape[j as usize + 1], f)),
+            );
+        }
     }
 }
 
