@@ -45,6 +45,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    quiet_vulkan_device_select();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
@@ -65,5 +66,26 @@ fn main() -> ExitCode {
             eprintln!("error: {err:#}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// Mesa's `VK_LAYER_MESA_device_select` (an implicit Vulkan layer, there
+/// whenever Mesa's drivers are) connects to Wayland while the GPUs are
+/// listed, to put the display's GPU first. Without a usable
+/// `XDG_RUNTIME_DIR` (ssh, `su`, containers, CI) libwayland then prints
+/// "error: XDG_RUNTIME_DIR is invalid or not set in the environment." twice
+/// on a render that succeeds, which reads as pelage failing. With no such
+/// directory there is no Wayland display for the layer to find, so its own
+/// off switch (`NODEVICE_SELECT=1`) loses nothing: wgpu still chooses the
+/// adapter (`WGPU_ADAPTER_NAME`, `WGPU_POWER_PREF`). A value the user set
+/// is left alone.
+fn quiet_vulkan_device_select() {
+    // libwayland's own test: unset, or not an absolute path.
+    let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR");
+    let usable = runtime_dir.is_some_and(|d| d.to_string_lossy().starts_with('/'));
+    if cfg!(target_os = "linux") && !usable && std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: the first thing `main` does; no other thread exists yet
+        // to read the environment while it changes.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
     }
 }
