@@ -126,6 +126,7 @@ impl LaneVec {
 pub struct FrameScratch {
     points: Vec<LaneVec>,
     tangents: Vec<LaneVec>,
+    normals: Vec<LaneVec>,
 }
 
 /// `a · b` in glam's order, so the lanes round as [`Vec3::dot`] does.
@@ -319,7 +320,7 @@ fn store(out: &mut [Vec3], n: usize, i: usize, count: usize, group: usize, v: &L
 /// by lane on the rare cases.
 #[cfg(target_arch = "x86_64")]
 mod avx {
-    use super::{FrameScratch, LANES, LaneVec, fill_zero_tangents, gather, start_vectors, store};
+    use super::{FrameScratch, LANES, LaneVec, fill_zero_tangents, start_vectors};
     use glam::Vec3;
     use std::arch::x86_64::*;
 
@@ -428,6 +429,87 @@ mod avx {
         }
     }
 
+    /// Point `index` of `points` as (x, y, z, junk).
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn point4(points: &[Vec3], index: usize) -> __m128 {
+        if index + 1 < points.len() {
+            // SAFETY: the point and the next one's x (the junk) are in
+            // `points`: four floats from the point's first.
+            unsafe { _mm_loadu_ps(points.as_ptr().add(index).cast::<f32>()) }
+        } else {
+            let p = points[index];
+            _mm_set_ps(0.0, p.z, p.y, p.x)
+        }
+    }
+
+    /// [`super::gather`] in registers: eight (x, y, z, junk) loads and a
+    /// 4×4 transpose a point instead of 24 single-float moves.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn gather(points: &[Vec3], n: usize, hair: impl Fn(usize) -> usize, p: &mut [LaneVec]) {
+        for (i, lane) in p.iter_mut().enumerate() {
+            let at = |l: usize| point4(points, hair(l) * n + i);
+            // Lanes l and l + 4 share a register, low and high half.
+            let pair =
+                |l: usize| _mm256_insertf128_ps::<1>(_mm256_castps128_ps256(at(l)), at(l + 4));
+            let (m0, m1, m2, m3) = (pair(0), pair(1), pair(2), pair(3));
+            let (xy01, xy23) = (_mm256_unpacklo_ps(m0, m1), _mm256_unpacklo_ps(m2, m3));
+            let (zw01, zw23) = (_mm256_unpackhi_ps(m0, m1), _mm256_unpackhi_ps(m2, m3));
+            save(
+                V {
+                    x: _mm256_shuffle_ps::<0x44>(xy01, xy23),
+                    y: _mm256_shuffle_ps::<0xEE>(xy01, xy23),
+                    z: _mm256_shuffle_ps::<0x44>(zw01, zw23),
+                },
+                lane,
+            );
+        }
+    }
+
+    /// The group's normals (`normals[i]` point `i` of each lane) out to
+    /// its `count` real hairs: the transpose of [`gather`], each point
+    /// written as four floats. The fourth lands on the next point's x,
+    /// which the next, later store overwrites; a hair's last point,
+    /// whose next float is another hair's, is written as three.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    fn scatter(out: &mut [Vec3], n: usize, count: usize, group: usize, normals: &[LaneVec]) {
+        let zero = _mm256_setzero_ps();
+        for (i, v) in normals.iter().enumerate() {
+            let v = load(v);
+            let (xy01, xy23) = (_mm256_unpacklo_ps(v.x, v.y), _mm256_unpackhi_ps(v.x, v.y));
+            let (zw01, zw23) = (_mm256_unpacklo_ps(v.z, zero), _mm256_unpackhi_ps(v.z, zero));
+            // Lane l in the low half of rows[l % 4] for l < 4, the high
+            // half for l ≥ 4.
+            let rows = [
+                _mm256_shuffle_ps::<0x44>(xy01, zw01),
+                _mm256_shuffle_ps::<0xEE>(xy01, zw01),
+                _mm256_shuffle_ps::<0x44>(xy23, zw23),
+                _mm256_shuffle_ps::<0xEE>(xy23, zw23),
+            ];
+            for l in 0..count {
+                let row = rows[l % 4];
+                let point = if l < 4 {
+                    _mm256_castps256_ps128(row)
+                } else {
+                    _mm256_extractf128_ps::<1>(row)
+                };
+                let index = (group + l) * n + i;
+                if i + 1 < n {
+                    // SAFETY: point `index` and the next one's x are in
+                    // `out` (the next point belongs to the same hair).
+                    unsafe { _mm_storeu_ps(out.as_mut_ptr().add(index).cast::<f32>(), point) };
+                } else {
+                    let mut xyzw = [0.0; 4];
+                    // SAFETY: writes the four floats of `xyzw`.
+                    unsafe { _mm_storeu_ps(xyzw.as_mut_ptr(), point) };
+                    out[index] = Vec3::new(xyzw[0], xyzw[1], xyzw[2]);
+                }
+            }
+        }
+    }
+
     /// See [`super::hair_normals`], which checks the lengths; `n ≥ 2`.
     #[target_feature(enable = "avx")]
     pub(super) fn hair_normals(
@@ -440,17 +522,17 @@ mod avx {
         let hairs = first.len();
         scratch.points.resize(n, LaneVec::default());
         scratch.tangents.resize(n, LaneVec::default());
-        let mut carried = LaneVec::default();
+        scratch.normals.resize(n, LaneVec::default());
         for group in (0..hairs).step_by(LANES) {
             let count = (hairs - group).min(LANES);
             // Spare lanes repeat the group's last hair and are not written out.
             let hair = |l: usize| group + l.min(count - 1);
             let (p, t) = (&mut scratch.points[..], &mut scratch.tangents[..]);
+            let normals = &mut scratch.normals[..];
             gather(points, n, hair, p);
             tangents(p, t);
-            let start = start_vectors(&t[0], |l| first[hair(l)]);
-            store(out, n, 0, count, group, &start);
-            let mut r = load(&start);
+            normals[0] = start_vectors(&t[0], |l| first[hair(l)]);
+            let mut r = load(&normals[0]);
             let mut a = load(&p[0]);
             let mut ta = load(&t[0]);
             for i in 0..n - 1 {
@@ -466,17 +548,17 @@ mod avx {
                 let q = sub_scaled(f, dot(tb, f), tb);
                 let usable = _mm256_cmp_ps::<_CMP_GT_OQ>(dot(q, q), _mm256_set1_ps(1e-12));
                 r = f;
-                save(r, &mut carried);
+                save(r, &mut normals[i + 1]);
                 let degenerate = _mm256_movemask_ps(usable) ^ 0xff;
                 if degenerate != 0 {
                     for l in (0..LANES).filter(|l| degenerate & (1 << l) != 0) {
-                        carried.set(l, t[i + 1].at(l).any_orthonormal_vector());
+                        normals[i + 1].set(l, t[i + 1].at(l).any_orthonormal_vector());
                     }
-                    r = load(&carried);
+                    r = load(&normals[i + 1]);
                 }
-                store(out, n, i + 1, count, group, &carried);
                 (a, ta) = (b, tb);
             }
+            scatter(out, n, count, group, normals);
         }
     }
 }
