@@ -232,7 +232,7 @@ impl Frizz {
         }
     }
 
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext) {
+    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
         let mut rng = SampleRng::new(self.seed ^ 0xF122_F122, hair.id);
         if rng.uniform_f32() >= self.fraction.eval(root.uv) {
             return;
@@ -242,9 +242,10 @@ impl Frizz {
         let [a, b] = rng.uniform_f32_pair();
         let phase = Vec3::new(a, b, rng.uniform_f32()) * 256.0;
         let n = hair.points.len();
-        for (j, p) in hair.points.iter_mut().enumerate() {
+        let ramp = ramps.along(&self.ramp, n);
+        for (j, (p, r)) in hair.points.iter_mut().zip(ramp).enumerate() {
             let t = param(j, n);
-            *p += amplitude * self.ramp.at(t) * self.field.at(phase + Vec3::X * (frequency * t));
+            *p += amplitude * r * self.field.at(phase + Vec3::X * (frequency * t));
         }
     }
 }
@@ -283,9 +284,10 @@ impl Curl {
         let phase = TAU * SampleRng::new(self.seed ^ 0xC0_11, hair.id).uniform_f32();
         let n = hair.points.len();
         scratch.frame_along(&hair.points, root.normal);
-        for (j, p) in hair.points.iter_mut().enumerate() {
+        let ramp = scratch.ramps.along(&self.ramp, n);
+        for (j, (p, r)) in hair.points.iter_mut().zip(ramp).enumerate() {
             let t = param(j, n);
-            let alpha = radius * self.ramp.at(t);
+            let alpha = radius * r;
             let (s, c) = (TAU * turns * t + phase).sin_cos();
             let r = scratch.frame[j];
             let b = scratch.tangents[j].cross(r);
@@ -397,12 +399,13 @@ mod tests {
             Ramp::default(),
             0,
         );
+        let ramps = &mut RampTables::default();
         let (mut a, mut b) = (straight(1, 16, 1.0), straight(2, 16, 1.0));
-        op.apply(&mut a, &root());
-        op.apply(&mut b, &root());
+        op.apply(&mut a, &root(), ramps);
+        op.apply(&mut b, &root(), ramps);
         assert!((a.points[15] - b.points[15]).length() > 1e-3, "per hair");
         let mut again = straight(1, 16, 1.0);
-        op.apply(&mut again, &root());
+        op.apply(&mut again, &root(), ramps);
         assert_eq!(again, a, "same id, same frizz");
         let none = Frizz::new(
             Map::Constant(0.05),
@@ -412,7 +415,7 @@ mod tests {
             0,
         );
         let mut c = straight(3, 16, 1.0);
-        none.apply(&mut c, &root());
+        none.apply(&mut c, &root(), ramps);
         assert_eq!(c, straight(3, 16, 1.0), "fraction 0 frizzes nothing");
     }
 

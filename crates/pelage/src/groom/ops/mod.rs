@@ -281,7 +281,7 @@ impl Operator {
     fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
         match self {
             Operator::Noise(op) => op.apply(hair, root, &mut scratch.noise, &mut scratch.ramps),
-            Operator::Frizz(op) => op.apply(hair, root),
+            Operator::Frizz(op) => op.apply(hair, root, &mut scratch.ramps),
             Operator::Clump(op) => op.apply(hair, root, &mut scratch.near, &mut scratch.ramps),
             Operator::Curl(op) => op.apply(hair, root, scratch),
             Operator::Length(op) => op.apply(hair, root),
