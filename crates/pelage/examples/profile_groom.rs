@@ -1,6 +1,7 @@
 //! Profiling harness for the groom generator (`perf record` it): the
-//! `pelage bench groom` groom (spot ×2, 1,000 guides, clump + noise, 16
-//! points, normals, widths), HAIRS hairs (default 400,000) grown in memory.
+//! `pelage bench groom` groom (spot ×2, 1,000 guides, Shepard k = 4, a
+//! clump centre every 100 hairs, noise, 16 points, normals, widths), HAIRS
+//! hairs (default 400,000) grown in memory.
 //! OPS=none drops the operators, to see interpolation alone; NORMALS=0
 //! drops the per-point normals.
 use pelage::groom::Groom;
@@ -10,14 +11,18 @@ fn main() {
         .ok()
         .and_then(|h| h.parse().ok())
         .unwrap_or(400_000);
+    // As `pelage bench groom`: a clump centre for every 100 hairs.
     let ops = if std::env::var("OPS").as_deref() == Ok("none") {
-        ""
+        String::new()
     } else {
-        "[[ops]]\nclump = { count = 4000, rate = 0.6 }\n[[ops]]\nnoise = { amplitude = 0.004, frequency = 30 }\n"
+        format!(
+            "[[ops]]\nclump = {{ count = {}, rate = 0.6 }}\n[[ops]]\nnoise = {{ amplitude = 0.004, frequency = 30 }}\n",
+            (hairs / 100).max(1)
+        )
     };
     let normals = std::env::var("NORMALS").as_deref() != Ok("0");
     let text = format!(
-        "[mesh]\npath = \"spot\"\nsubdivide = 2\n[roots]\ncount = {hairs}\ndensity = \"noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4\"\n[guides]\npoints = 8\ngenerate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}\n{ops}[finish]\npoints = 16\nnormals = {normals}\n"
+        "[mesh]\npath = \"spot\"\nsubdivide = 2\n[roots]\ncount = {hairs}\ndensity = \"noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4\"\n[guides]\npoints = 8\ngenerate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}\n[interpolation]\nmethod = \"shepard\"\nk = 4\n{ops}[finish]\npoints = 16\nnormals = {normals}\nwidth = {{ root = 0.0015, tip = 0.0002 }}\n"
     );
     let groom = Groom::from_text("<profile>", text).unwrap();
     let t = std::time::Instant::now();
