@@ -15,7 +15,9 @@ use crate::curves::frames::{
 };
 use crate::curves::{CurveArrays, Curves};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
-use crate::interp::{HairRoot, HairScratch, InterpolationMethod, Interpolator, StyleMeshOptions};
+use crate::interp::{
+    HairRoot, HairScratch, InterpolationMethod, Interpolator, QueryRegion, StyleMeshOptions,
+};
 use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
 use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, sample_range};
@@ -563,6 +565,7 @@ impl<'g> Generator<'g> {
             position: root.position(mesh),
             normal: root.normal(mesh),
             uv: root.uv(mesh).unwrap_or(Vec2::ZERO),
+            skin_triangle: QueryRegion::around_triangle(mesh.triangle_positions(root.tri as usize)),
         }
     }
 

@@ -22,7 +22,7 @@ mod nearest;
 mod shepard;
 mod style_mesh;
 
-pub use nearest::{NearestPoints, Neighbour, NeighbourCache};
+pub use nearest::{NearestPoints, Neighbour, NeighbourCache, QueryRegion};
 pub use shepard::Shepard;
 pub use style_mesh::{LostGuide, StyleMesh, StyleMeshOptions};
 

@@ -13,6 +13,13 @@
 //! candidates. A query then costs a dozen or two distances instead of a
 //! tree search.
 //!
+//! The argument holds for any `R`, which gives callers a second way to
+//! keep lists: a [`QueryRegion`], a ball known to hold the query (the skin
+//! triangle under a hair's root). A list is then filled at the ball's
+//! centre with `R` at least its radius, and serves every query in the
+//! ball, however the roots in it are ordered: clump centres (k = 1, a
+//! small `d_1`) needed a fill every six hairs without it.
+//!
 //! Results are ordered by (squared distance, index), computed here from
 //! the points, so they are the same whichever earlier query filled the
 //! list: a hair's neighbours never depend on the thread or the order that
@@ -39,6 +46,34 @@ pub struct Neighbour {
     pub index: u32,
     /// Squared distance to the query.
     pub distance_squared: f32,
+}
+
+/// A ball that holds a query point and, likely, the next few (see the
+/// module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QueryRegion {
+    /// Its centre.
+    pub centre: Vec3,
+    /// Its radius.
+    pub radius: f32,
+}
+
+impl QueryRegion {
+    /// The ball around a triangle from its centroid, through its farthest
+    /// corner, a little larger so that rounding cannot leave a point of
+    /// the triangle outside.
+    pub fn around_triangle(corners: [Vec3; 3]) -> Self {
+        let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+        let farthest = corners
+            .iter()
+            .map(|c| (*c - centre).length_squared())
+            .fold(0.0, f32::max)
+            .sqrt();
+        Self {
+            centre,
+            radius: farthest * (1.0 + 1e-5) + 1e-9,
+        }
+    }
 }
 
 /// A fixed set of points with a kd-tree over them.
@@ -122,6 +157,20 @@ impl NearestPoints {
         k: usize,
         cache: &'c mut NeighbourCache,
     ) -> impl Iterator<Item = Neighbour> + 'c {
+        self.nearest_cached_in(p, k, cache, None)
+    }
+
+    /// [`Self::nearest_cached`] for a `p` inside `region` (a ball that
+    /// likely holds the next queries too): a list filled here serves the
+    /// whole ball. The same result as [`Self::nearest`]; a `p` outside its
+    /// region is answered, only without the region's help.
+    pub fn nearest_cached_in<'c>(
+        &self,
+        p: Vec3,
+        k: usize,
+        cache: &'c mut NeighbourCache,
+        region: Option<QueryRegion>,
+    ) -> impl Iterator<Item = Neighbour> + 'c {
         let k = k.min(self.points.len());
         if k == 0 {
             return neighbours(&[]);
@@ -150,7 +199,7 @@ impl NearestPoints {
             }
         };
         if (p - list.centre).length_squared() > list.reach_squared {
-            self.refill(list, p, k);
+            self.refill(list, p, k, region);
         }
         // The same arithmetic as `(q - p).length_squared()`, so cached and
         // uncached answers agree to the bit.
@@ -199,29 +248,48 @@ impl NearestPoints {
         neighbours(&list.best)
     }
 
-    /// Gathers the candidates for queries near `p` (module docs).
-    fn refill(&self, list: &mut CandidateList, p: Vec3, k: usize) {
-        list.centre = p;
+    /// Gathers the candidates for queries near `p`, or in `region` when it
+    /// holds `p` (module docs).
+    fn refill(&self, list: &mut CandidateList, p: Vec3, k: usize, region: Option<QueryRegion>) {
         list.candidates.clear();
         list.xs.clear();
         list.ys.clear();
         list.zs.clear();
-        let Some(kth) = self.kth_distance_squared(p, k) else {
+        // The list's centre q and the least reach R: the region's centre
+        // and radius, so that R covers all of it (it holds p).
+        let (q, least_reach) = match region {
+            Some(r) if (p - r.centre).length_squared() <= r.radius * r.radius => {
+                (r.centre, r.radius)
+            }
+            _ => (p, 0.0),
+        };
+        list.centre = q;
+        let Some(kth) = self.kth_distance_squared(q, k) else {
             list.reach_squared = -1.0;
             return;
         };
-        // R = a·d_k, candidates within (1 + 2a)·d_k. A single nearest point
-        // has few candidates even at a = 1 and would otherwise be
-        // refilled every few hairs; for larger k the list grows fast.
+        // R = a·d_k (at least the region's radius), candidates within
+        // d_k + 2R. A single nearest point has few candidates even at
+        // a = 1 and would otherwise be refilled every few hairs; for
+        // larger k the list grows fast.
         let a: f32 = if k == 1 { 1.0 } else { 0.5 };
-        list.reach_squared = a * a * kth;
-        let reach = (1.0 + 2.0 * a) * (1.0 + 2.0 * a) * kth * RADIUS_SLACK;
+        let d_k = kth.sqrt();
+        let reach = (a * d_k).max(least_reach);
+        list.reach_squared = reach * reach;
+        let within = d_k + 2.0 * reach;
         let candidates = &mut list.candidates;
-        self.visit_within(p, reach, |i| candidates.push(i));
+        self.visit_within(q, within * within * RADIUS_SLACK, |i| candidates.push(i));
         if list.candidates.len() > MOST_CANDIDATES {
             // Too crowded to brute-force: serve `p` alone.
+            list.centre = p;
             list.reach_squared = 0.0;
             list.candidates.clear();
+            let kth = if q == p {
+                kth
+            } else {
+                self.kth_distance_squared(p, k)
+                    .expect("the set is not empty")
+            };
             let candidates = &mut list.candidates;
             self.visit_within(p, kth * RADIUS_SLACK, |i| candidates.push(i));
         }
@@ -337,6 +405,48 @@ mod tests {
                 set.nearest(p, k, &mut out);
                 let uncached: Vec<u32> = out.iter().map(|n| n.index).collect();
                 assert_eq!(uncached, got);
+            }
+        }
+    }
+
+    #[test]
+    fn queries_in_triangle_regions_match_brute_force() {
+        // Roots on small triangles, several a triangle in any order, as
+        // the generator asks; now and then a point outside its region (a
+        // caller's mistake must cost speed, never a wrong answer).
+        let points = scattered(2000, 3);
+        let set = NearestPoints::new(points.clone());
+        let mut cache = NeighbourCache::default();
+        for k in [1, 4] {
+            for t in 0..400u64 {
+                let h = mix64(t ^ (k as u64) << 40);
+                let unit = |s: u64| (mix64(h ^ s) >> 40) as f32 / (1u64 << 24) as f32;
+                let a = Vec3::new(unit(1), unit(2), 0.1 * unit(3));
+                let size = 0.001 + 0.02 * unit(4);
+                let corners = [a, a + Vec3::X * size, a + Vec3::new(0.3, 1.0, 0.2) * size];
+                let region = QueryRegion::around_triangle(corners);
+                for r in 0..12u64 {
+                    let (u, v) = (unit(10 + r), unit(30 + r));
+                    let (u, v) = if u + v > 1.0 {
+                        (1.0 - u, 1.0 - v)
+                    } else {
+                        (u, v)
+                    };
+                    let mut p =
+                        corners[0] + u * (corners[1] - corners[0]) + v * (corners[2] - corners[0]);
+                    if r == 11 {
+                        p += Vec3::X * 0.05;
+                    }
+                    let got: Vec<u32> = set
+                        .nearest_cached_in(p, k, &mut cache, Some(region))
+                        .map(|n| n.index)
+                        .collect();
+                    assert_eq!(
+                        got,
+                        brute_force(&points, p, k),
+                        "k {k} triangle {t} root {r}"
+                    );
+                }
             }
         }
     }

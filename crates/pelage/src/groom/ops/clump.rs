@@ -6,7 +6,7 @@
 
 use super::{Hair, RampTables, RootContext};
 use crate::groom::file::Ramp;
-use crate::interp::{NearestPoints, NeighbourCache};
+use crate::interp::{NearestPoints, NeighbourCache, QueryRegion};
 use crate::map::Map;
 use glam::Vec3;
 
@@ -44,14 +44,20 @@ impl ClumpCentres {
     /// The centre nearest `position` and its distance (ties: the lower
     /// index).
     pub fn nearest(&self, position: Vec3) -> Option<(usize, f32)> {
-        self.nearest_near(position, &mut NeighbourCache::default())
+        self.nearest_near(position, &mut NeighbourCache::default(), None)
     }
 
     /// [`Self::nearest`] for one of a run of nearby positions, `near`
-    /// kept between them (faster, same result).
-    pub fn nearest_near(&self, position: Vec3, near: &mut NeighbourCache) -> Option<(usize, f32)> {
+    /// kept between them, `region` a ball around `position` that likely
+    /// holds the next ones too (faster, same result).
+    pub fn nearest_near(
+        &self,
+        position: Vec3,
+        near: &mut NeighbourCache,
+        region: Option<QueryRegion>,
+    ) -> Option<(usize, f32)> {
         self.roots
-            .nearest_cached(position, 1, near)
+            .nearest_cached_in(position, 1, near, region)
             .next()
             .map(|n| (n.index as usize, n.distance_squared.sqrt()))
     }
@@ -102,7 +108,10 @@ impl Clump {
         near: &mut NeighbourCache,
         ramps: &mut RampTables,
     ) {
-        let Some((centre, distance)) = self.centres.nearest_near(root.position, near) else {
+        let Some((centre, distance)) =
+            self.centres
+                .nearest_near(root.position, near, Some(root.skin_triangle))
+        else {
             return;
         };
         let mut w = self.rate.eval(root.uv);

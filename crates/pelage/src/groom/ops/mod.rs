@@ -27,6 +27,7 @@ pub use trim::{Cut, Length};
 
 use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
 use crate::groom::file::Ramp;
+use crate::interp::QueryRegion;
 use crate::map::Map;
 use crate::mesh::SurfacePoint;
 use crate::sample::SampleRng;
@@ -137,6 +138,9 @@ pub struct RootContext {
     /// The UV maps are read at (zero on meshes without UVs, where only
     /// constant maps are allowed).
     pub uv: Vec2,
+    /// A ball around the root's skin triangle: nearest-point searches
+    /// keep one candidate list for all the roots in it.
+    pub skin_triangle: QueryRegion,
 }
 
 /// Buffers operators share, reused hair after hair.
@@ -422,6 +426,10 @@ pub(crate) mod test_hairs {
             position: Vec3::ZERO,
             normal: Vec3::Z,
             uv: Vec2::new(0.5, 0.5),
+            skin_triangle: QueryRegion {
+                centre: Vec3::ZERO,
+                radius: 0.0,
+            },
         }
     }
 
