@@ -297,8 +297,12 @@ mod avx2 {
         let lerp = |a: __m256, b: __m256, t: __m256| {
             _mm256_add_ps(a, _mm256_mul_ps(t, _mm256_sub_ps(b, a)))
         };
-        // Each corner's dot products, one a component.
-        let corner: [[__m256; 3]; 8] = std::array::from_fn(|c| {
+        // Each corner's dot products, one a component. A loop in this
+        // function's body, not a closure handed to `array::from_fn`: the
+        // compiler sometimes kept that closure out of line, reloading the
+        // tables and spilling its results at every corner.
+        let mut corner = [[_mm256_setzero_ps(); 3]; 8];
+        for (c, dots) in corner.iter_mut().enumerate() {
             let (dx, dy, dz) = (c & 1, (c >> 1) & 1, c >> 2);
             let rows = gradients_at(add(_mm256_add_epi32(hxy[dx][dy], zi), dz as i32));
             let x = _mm256_sub_ps(fx, _mm256_set1_ps(dx as f32));
@@ -309,16 +313,16 @@ mod avx2 {
                 _mm256_srli_epi32::<4>(rows),
                 _mm256_srli_epi32::<8>(rows),
             ];
-            component_rows.map(|hc| {
-                _mm256_add_ps(
+            for (dot, hc) in dots.iter_mut().zip(component_rows) {
+                *dot = _mm256_add_ps(
                     _mm256_add_ps(
                         _mm256_mul_ps(gradient(&tables[0], hc), x),
                         _mm256_mul_ps(gradient(&tables[1], hc), y),
                     ),
                     _mm256_mul_ps(gradient(&tables[2], hc), z),
-                )
-            })
-        });
+                );
+            }
+        }
         for component in 0..3 {
             let k: [__m256; 8] = std::array::from_fn(|c| corner[c][component]);
             let x00 = lerp(k[0], k[1], u);
