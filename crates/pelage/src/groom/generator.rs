@@ -262,6 +262,9 @@ pub struct Generator<'g> {
     resampling: Resampling,
     colors: bool,
     opacities: bool,
+    /// Whether a `clump` searches for centres: only then do roots carry
+    /// the ball around their triangle.
+    clumps: bool,
     normals: bool,
     seed: u64,
     /// Arrays of parts handed back by [`Self::recycle`], for the next parts.
@@ -380,6 +383,7 @@ impl<'g> Generator<'g> {
             resampling: Resampling::new(groom.guides.points_per_guide(), points),
             colors: file.finish.color.is_some(),
             opacities: file.finish.opacity.is_some(),
+            clumps: false,
             normals: file.finish.normals,
             seed,
             spare: Mutex::new(Vec::new()),
@@ -390,6 +394,7 @@ impl<'g> Generator<'g> {
             let op = generator.operator(k, spec)?;
             generator.colors |= matches!(op, Operator::Color(_));
             generator.opacities |= matches!(op, Operator::Opacity(_));
+            generator.clumps |= matches!(op, Operator::Clump(_));
             generator.ops.push(op);
         }
         Ok(generator)
@@ -565,7 +570,9 @@ impl<'g> Generator<'g> {
             position: root.position(mesh),
             normal: root.normal(mesh),
             uv: root.uv(mesh).unwrap_or(Vec2::ZERO),
-            skin_triangle: QueryRegion::around_triangle(mesh.triangle_positions(root.tri as usize)),
+            skin_triangle: self
+                .clumps
+                .then(|| QueryRegion::around_triangle(mesh.triangle_positions(root.tri as usize))),
         }
     }
 

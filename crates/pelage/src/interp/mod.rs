@@ -131,8 +131,7 @@ pub struct Interpolator<'g> {
     guides: &'g Guides,
     /// Each guide's offsets from its root.
     offsets: Vec<Vec3>,
-    /// Each guide's root normal.
-    /// Each guide's skin normal, padded to 16 bytes: read as one load
+    /// Each guide's skin normal at its root, padded to 16 bytes: read as one load
     /// (a 12-byte `Vec3` went through the stack in two pieces and stalled
     /// the load that reassembled it).
     normals: Vec<Vec3A>,

@@ -110,7 +110,7 @@ impl Clump {
     ) {
         let Some((centre, distance)) =
             self.centres
-                .nearest_near(root.position, near, Some(root.skin_triangle))
+                .nearest_near(root.position, near, root.skin_triangle)
         else {
             return;
         };

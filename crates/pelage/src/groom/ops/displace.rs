@@ -243,9 +243,9 @@ impl Frizz {
         let phase = Vec3::new(a, b, rng.uniform_f32()) * 256.0;
         let n = hair.points.len();
         let ramp = ramps.along(&self.ramp, n);
-        for (j, (p, r)) in hair.points.iter_mut().zip(ramp).enumerate() {
+        for (j, (p, profile)) in hair.points.iter_mut().zip(ramp).enumerate() {
             let t = param(j, n);
-            *p += amplitude * r * self.field.at(phase + Vec3::X * (frequency * t));
+            *p += amplitude * profile * self.field.at(phase + Vec3::X * (frequency * t));
         }
     }
 }
@@ -285,9 +285,9 @@ impl Curl {
         let n = hair.points.len();
         scratch.frame_along(&hair.points, root.normal);
         let ramp = scratch.ramps.along(&self.ramp, n);
-        for (j, (p, r)) in hair.points.iter_mut().zip(ramp).enumerate() {
+        for (j, (p, profile)) in hair.points.iter_mut().zip(ramp).enumerate() {
             let t = param(j, n);
-            let alpha = radius * r;
+            let alpha = radius * profile;
             let (s, c) = (TAU * turns * t + phase).sin_cos();
             let r = scratch.frame[j];
             let b = scratch.tangents[j].cross(r);

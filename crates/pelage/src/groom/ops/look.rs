@@ -17,8 +17,10 @@ fn root_to_tip(
     hair_id: u64,
     root: &RootContext,
     out: &mut Vec<f32>,
-    ramp: &[f32],
+    n: usize,
+    ramps: &mut RampTables,
 ) {
+    let ramp = ramps.along(&spec.ramp, n);
     let factor = varied(spec.jitter.eval(root.uv), spec.seed ^ salt, hair_id);
     let (a, b) = (spec.root.eval(root.uv), spec.tip.eval(root.uv));
     out.clear();
@@ -43,8 +45,16 @@ pub struct Width(pub RootToTip);
 
 impl Width {
     pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
-        let ramp = ramps.along(&self.0.ramp, hair.points.len());
-        root_to_tip(&self.0, 0x3D_7714, hair.id, root, &mut hair.widths, ramp);
+        let n = hair.points.len();
+        root_to_tip(
+            &self.0,
+            0x3D_7714,
+            hair.id,
+            root,
+            &mut hair.widths,
+            n,
+            ramps,
+        );
         hair.widths.iter_mut().for_each(|w| *w = w.max(0.0));
     }
 }
@@ -55,14 +65,15 @@ pub struct Opacity(pub RootToTip);
 
 impl Opacity {
     pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
-        let ramp = ramps.along(&self.0.ramp, hair.points.len());
+        let n = hair.points.len();
         root_to_tip(
             &self.0,
             0x00BA_C17E,
             hair.id,
             root,
             &mut hair.opacities,
-            ramp,
+            n,
+            ramps,
         );
         hair.opacities
             .iter_mut()

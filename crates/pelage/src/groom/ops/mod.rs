@@ -138,9 +138,10 @@ pub struct RootContext {
     /// The UV maps are read at (zero on meshes without UVs, where only
     /// constant maps are allowed).
     pub uv: Vec2,
-    /// A ball around the root's skin triangle: nearest-point searches
-    /// keep one candidate list for all the roots in it.
-    pub skin_triangle: QueryRegion,
+    /// A ball around the root's skin triangle, when an operator searches
+    /// for nearest points (`clump`): one candidate list serves all the
+    /// roots in it.
+    pub skin_triangle: Option<QueryRegion>,
 }
 
 /// Buffers operators share, reused hair after hair.
@@ -426,10 +427,7 @@ pub(crate) mod test_hairs {
             position: Vec3::ZERO,
             normal: Vec3::Z,
             uv: Vec2::new(0.5, 0.5),
-            skin_triangle: QueryRegion {
-                centre: Vec3::ZERO,
-                radius: 0.0,
-            },
+            skin_triangle: None,
         }
     }
 
