@@ -207,6 +207,21 @@ impl NearestPoints {
             let (dx, dy, dz) = (x - p.x, y - p.y, z - p.z);
             dx * dx + dy * dy + dz * dz
         };
+        if k == 1 {
+            // The least key of all: one pass, no bound to filter by (it
+            // would cost more than it saves for a single point).
+            let least = list
+                .xs
+                .iter()
+                .zip(&list.ys)
+                .zip(&list.zs)
+                .zip(&list.candidates)
+                .map(|(((&x, &y), &z), &i)| key(distance_squared(x, y, z), i))
+                .fold(u64::MAX, u64::min);
+            list.best.clear();
+            list.best.push(least);
+            return neighbours(&list.best);
+        }
         // The last query's answer is mostly this one's too: its k points,
         // measured from `p`, bound the k-th distance, and only candidates
         // within that bound can be among the k nearest. Filtering first
