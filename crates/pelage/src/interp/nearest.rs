@@ -98,16 +98,14 @@ struct CandidateList {
     k: usize,
     centre: Vec3,
     reach_squared: f32,
-    /// Candidate indices and their coordinates, copied as three columns so
-    /// a query computes all distances in one vectorised pass.
+    /// Candidate indices and their coordinates, copied as three columns.
     candidates: Vec<u32>,
     xs: Vec<f32>,
     ys: Vec<f32>,
     zs: Vec<f32>,
-    /// This query's squared distances to the candidates, the candidates
-    /// that can be among its k nearest as [`key`]s, and the k smallest
+    /// The last query's candidates that could be among its k nearest, as
+    /// [`key`]s (valid up to the count kept), and its k smallest keys
     /// (kept for the next query).
-    distances: Vec<f32>,
     keys: Vec<u64>,
     best: Vec<u64>,
 }
@@ -191,7 +189,6 @@ impl NearestPoints {
                     xs: Vec::new(),
                     ys: Vec::new(),
                     zs: Vec::new(),
-                    distances: Vec::new(),
                     keys: Vec::new(),
                     best: Vec::new(),
                 });
@@ -238,20 +235,21 @@ impl NearestPoints {
         } else {
             f32::INFINITY
         };
-        let (xs, ys, zs) = (&list.xs, &list.ys, &list.zs);
-        list.distances.clear();
-        list.distances.extend(
-            xs.iter()
-                .zip(ys)
-                .zip(zs)
-                .map(|((&x, &y), &z)| distance_squared(x, y, z)),
-        );
         // Kept without branching on the distance (which candidates pass
-        // changes from hair to hair, so a branch would mispredict).
-        list.keys.clear();
-        list.keys.resize(list.candidates.len(), 0);
+        // changes from hair to hair, so a branch would mispredict). The
+        // key buffer only grows, so it is not cleared for every query.
+        if list.keys.len() < list.candidates.len() {
+            list.keys.resize(list.candidates.len(), 0);
+        }
         let mut kept = 0;
-        for (&d, &i) in list.distances.iter().zip(&list.candidates) {
+        for (((&x, &y), &z), &i) in list
+            .xs
+            .iter()
+            .zip(&list.ys)
+            .zip(&list.zs)
+            .zip(&list.candidates)
+        {
+            let d = distance_squared(x, y, z);
             list.keys[kept] = key(d, i);
             kept += usize::from(d <= bound);
         }
