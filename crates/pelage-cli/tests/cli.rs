@@ -474,6 +474,42 @@ fn groom_file_errors_name_the_line_and_key() {
     assert!(err.contains("unknown field `rtae`"), "{err}");
 }
 
+#[test]
+fn a_groom_that_overflows_is_an_error_at_its_operator_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("huge.toml");
+    // Two noises of 3e38: the second takes the hairs past f32's range.
+    std::fs::write(
+        &groom,
+        SMALL_GROOM
+            .replace(
+                "clump = { count = 100, rate = 0.5 }",
+                "noise = { amplitude = 3e38, frequency = 30 }",
+            )
+            .replace(
+                "noise = { amplitude = 0.002, frequency = 20 }",
+                "noise = { amplitude = 3e38, frequency = 30 }",
+            ),
+    )
+    .unwrap();
+    let output = dir.path().join("huge.usda");
+    let out = pelage(&[
+        "groom",
+        groom.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(err.contains("huge.toml:12:1: ops[1].noise: hair "), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "only the groom file"
+    );
+}
+
 /// Runs usdcheck on `files`; `None` (after printing SKIPPED) where it is
 /// not available and not required (PELAGE_REQUIRE_USDCHECK makes it
 /// required, as in CI).

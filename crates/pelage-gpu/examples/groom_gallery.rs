@@ -122,9 +122,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::fs::write(&path, groom_text(hairs, ops))?;
         let groom = Groom::load(&path)?;
         let generator = groom.generator(None)?;
-        let parts: Vec<_> = (0..generator.parts().len())
+        let parts = (0..generator.parts().len())
             .map(|p| generator.part(p))
-            .collect();
+            .collect::<Result<Vec<_>, _>>()?;
         let curves = pelage::io::join(parts.iter())?;
         let scene = PreviewScene {
             mesh: Some(groom.mesh()),

@@ -74,7 +74,7 @@ fn output_is_identical_on_one_and_two_threads() {
         in_pool(threads, || {
             let generator = g.generator(None).unwrap();
             (0..generator.parts().len())
-                .map(|p| generator.part(p))
+                .map(|p| generator.part(p).unwrap())
                 .collect::<Vec<Curves>>()
         })
     };
@@ -105,10 +105,10 @@ fn output_is_identical_on_one_and_two_threads() {
 fn a_part_grown_alone_equals_that_part_of_the_full_run() {
     let g = groom(EVERY_OPERATOR);
     let full = g.generator(None).unwrap();
-    let parts: Vec<Curves> = (0..3).map(|p| full.part(p)).collect();
+    let parts: Vec<Curves> = (0..3).map(|p| full.part(p).unwrap()).collect();
     // A fresh generator (another process, another machine) asked for the
     // last part only.
-    let alone = g.generator(None).unwrap().part(2);
+    let alone = g.generator(None).unwrap().part(2).unwrap();
     assert_eq!(alone, parts[2]);
     // Hair ids are unique over the whole groom and strands multiply them.
     let ids: HashSet<u64> = parts
@@ -125,7 +125,7 @@ fn a_part_grown_alone_equals_that_part_of_the_full_run() {
         assert_eq!(Some(*uv), root.uv(g.mesh()));
     }
     // A different seed gives a different groom.
-    let other = g.generator(Some(12)).unwrap().part(2);
+    let other = g.generator(Some(12)).unwrap().part(2).unwrap();
     assert_ne!(other.points(), parts[2].points());
 }
 
@@ -144,7 +144,7 @@ fn roots_follow_the_density_across_parts() {
     let mut hairs = 0;
     for p in 0..generator.parts().len() {
         let part = &generator.parts()[p];
-        let curves = generator.part(p);
+        let curves = generator.part(p).unwrap();
         assert_eq!(curves.curve_count() as u64, part.hair_count);
         for root in curves.roots().unwrap() {
             assert!(
@@ -175,7 +175,7 @@ fn clumped_tips_meet_at_their_centres() {
     let g = groom(
         "[mesh]\npath = \"spot\"\n[roots]\ncount = 5000\n[guides]\ngenerate = { count = 80, length = 0.05 }\n[[ops]]\nclump = { count = 25, rate = 1.0 }\n",
     );
-    let curves = g.generator(None).unwrap().part(0);
+    let curves = g.generator(None).unwrap().part(0).unwrap();
     let tips: HashSet<[u32; 3]> = (0..curves.curve_count())
         .map(|i| {
             let tip = curves.points()[curves.range(i).end - 1];
@@ -193,7 +193,7 @@ fn clumped_tips_meet_at_their_centres() {
 #[test]
 fn normals_are_unit_and_perpendicular_to_the_hair() {
     let g = groom(EVERY_OPERATOR);
-    let curves = g.generator(None).unwrap().part(1);
+    let curves = g.generator(None).unwrap().part(1).unwrap();
     let normals = curves.normals().unwrap();
     for i in 0..curves.curve_count() {
         let r = curves.range(i);
@@ -247,4 +247,43 @@ fn errors_name_the_file_line_and_key() {
         zero.starts_with("fur/test.toml:8:21: ops[0].strands.count:"),
         "{zero}"
     );
+}
+
+/// A groom whose second operator takes hairs past the float range (each
+/// noise alone stays finite; the second doubles it), grown `parts` at a
+/// time, with `last` as a third operator.
+fn overflowing(last: &str) -> String {
+    format!(
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 300\nparts = 2\n[guides]\ngenerate = {{ count = 20, length = 0.05 }}\n\
+         [[ops]]\nnoise = {{ amplitude = 3e38, frequency = 30 }}\n\
+         [[ops]]\nnoise = {{ amplitude = 3e38, frequency = 30 }}\n\
+         [[ops]]\n{last}\n"
+    )
+}
+
+#[test]
+fn a_hair_grown_past_the_float_range_is_an_error_at_the_operator_not_a_panic() {
+    // One hair a root (grown in place) and strands (grown hair by hair).
+    for last in [
+        "width = { root = 0.001, tip = 0.0001 }",
+        "strands = { count = 2, tip_spread = 0.01 }",
+    ] {
+        let g = Groom::from_text("fur/huge.toml", overflowing(last)).unwrap();
+        let generator = g.generator(None).unwrap();
+        let message = generator.part(0).unwrap_err().to_string();
+        // Line 10 holds the second `[[ops]]`.
+        assert!(
+            message.starts_with("fur/huge.toml:10:1: ops[1].noise: hair "),
+            "{message}"
+        );
+        assert!(message.contains("no longer finite"), "{message}");
+        // The same for the whole file written: an error, and no file.
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("huge.usda");
+        let export = pelage::io::CurvesExport::default();
+        let written = generator.write(&out, 0..2, &export, |_, _| {});
+        let message = written.unwrap_err().to_string();
+        assert!(message.starts_with("fur/huge.toml:10:1: "), "{message}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
 }

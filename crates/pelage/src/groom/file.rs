@@ -625,16 +625,40 @@ impl GroomSource {
             return GroomError::new(self.path.clone(), None, None, kind);
         }
         let start = span.start.min(self.text.len());
-        let before = &self.text[..start];
-        let line = before.matches('\n').count() + 1;
-        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-        let column = before[line_start..].chars().count() + 1;
+        let line_start = self.text[..start].rfind('\n').map_or(0, |i| i + 1);
         GroomError::new(
             self.path.clone(),
-            Some((line, column)),
+            self.line_of(span),
             key_at(&self.text, line_start, start),
             kind,
         )
+    }
+
+    /// Line and column (1-based) of a span of the text; `None` for a
+    /// default value (the empty span at 0).
+    pub fn line_of(&self, span: std::ops::Range<usize>) -> Option<(usize, usize)> {
+        if span == (0..0) {
+            return None;
+        }
+        let start = span.start.min(self.text.len());
+        let before = &self.text[..start];
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        Some((
+            before.matches('\n').count() + 1,
+            before[line_start..].chars().count() + 1,
+        ))
+    }
+
+    /// Line and column of operator `k`'s table: its `[[ops]]` header.
+    pub fn line_of_op(&self, k: usize) -> Option<(usize, usize)> {
+        let line = self
+            .text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| l.trim_start().starts_with("[[ops]]"))
+            .nth(k)?
+            .0;
+        Some((line + 1, 1))
     }
 
     /// Resolves a map value, reporting a bad spec or unreadable image at its
@@ -810,6 +834,9 @@ pub enum GroomErrorKind {
     /// Roots could not be sampled.
     #[error("{0}")]
     Sample(crate::sample::SampleError),
+    /// A hair grew values that are not finite numbers.
+    #[error("{0}")]
+    NotFinite(String),
 }
 
 #[cfg(test)]

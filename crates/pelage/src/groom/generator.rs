@@ -13,7 +13,7 @@ use super::parts::{Part, PartLayout};
 use crate::curves::frames::{
     FrameScratch, catmull_rom_tangents, hair_normals, rotation_minimizing_normals,
 };
-use crate::curves::{CurveArrays, Curves};
+use crate::curves::{CurveArrays, Curves, Values, floats_finite, vectors_finite};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{
     HairRoot, HairScratch, InterpolationMethod, Interpolator, QueryRegion, StyleMeshOptions,
@@ -626,7 +626,13 @@ impl<'g> Generator<'g> {
     /// turned off), colours and opacities (when the groom has them), roots,
     /// root UVs (meshes with UVs) and ids. Identical on any thread count:
     /// workers grow fixed chunks of roots, in order.
-    pub fn part(&self, p: usize) -> Curves {
+    ///
+    /// # Errors
+    /// When a hair's positions, widths, normals, colours or opacities are
+    /// not finite (an operator's parameters took it past `f32`'s range):
+    /// the error names the operator in the groom file, from growing that
+    /// hair again one operator at a time.
+    pub fn part(&self, p: usize) -> Result<Curves, GroomError> {
         let roots = self
             .take_prefetched(p)
             .unwrap_or_else(|| self.part_roots(p));
@@ -655,7 +661,7 @@ impl<'g> Generator<'g> {
     }
 
     /// Part `p` grown from its `roots`.
-    fn grow_part(&self, p: usize, roots: Vec<SurfacePoint>) -> Curves {
+    fn grow_part(&self, p: usize, roots: Vec<SurfacePoint>) -> Result<Curves, GroomError> {
         let part = &self.layout.parts()[p];
         if self.one_hair_per_root() {
             return self.part_in_place(roots, part.first_hair);
@@ -668,7 +674,16 @@ impl<'g> Generator<'g> {
                 self.grow_chunk(chunk, first, ws)
             })
             .collect();
-        self.concat(chunks)
+        // The first root, in the part's order, that grew a value that is
+        // not a finite number.
+        let bad = chunks
+            .iter()
+            .enumerate()
+            .find_map(|(c, chunk)| chunk.first_non_finite.map(|i| c * CHUNK + i));
+        if let Some(i) = bad {
+            return Err(self.non_finite_error(roots[i], part.first_hair + i as u64));
+        }
+        Ok(self.concat(chunks))
     }
 
     /// Hands a grown part back once it is written, so that a later part
@@ -697,7 +712,11 @@ impl<'g> Generator<'g> {
     /// [`Self::part`] when each root grows one hair: the arrays are
     /// allocated once and each worker writes its chunk's slices; `roots`
     /// become the curves' roots.
-    fn part_in_place(&self, roots: Vec<SurfacePoint>, first_hair: u64) -> Curves {
+    fn part_in_place(
+        &self,
+        roots: Vec<SurfacePoint>,
+        first_hair: u64,
+    ) -> Result<Curves, GroomError> {
         let n = self.points;
         let total = roots.len() * n;
         let sized = |on: bool| if on { total } else { 0 };
@@ -720,7 +739,7 @@ impl<'g> Generator<'g> {
         let mut normals = sized_to(spare.normals, sized(self.normals));
         let mut colors = sized_to(spare.colors, sized(self.colors));
         let mut opacities = sized_to(spare.opacities, sized(self.opacities));
-        {
+        let bad = {
             let mut jobs = Vec::with_capacity(roots.len().div_ceil(CHUNK));
             let (mut p, mut w, mut nr, mut c, mut o) = (
                 &mut points[..],
@@ -739,34 +758,45 @@ impl<'g> Generator<'g> {
                 let (o0, o1) = std::mem::take(&mut o).split_at_mut(take(self.opacities));
                 (p, w, nr, c, o) = (p1, w1, n1, c1, o1);
                 let first = first_hair + (k * CHUNK) as u64;
-                jobs.push((chunk, first, p0, w0, n0, c0, o0));
+                jobs.push((k, chunk, first, p0, w0, n0, c0, o0));
             }
-            jobs.into_par_iter().for_each_init(
-                Workspace::default,
-                |ws, (chunk, first, p, w, nr, c, o)| {
-                    ws.skin_normals.clear();
-                    for (g, group) in chunk.chunks(GROUP).enumerate() {
-                        let first_in_group = g * GROUP;
-                        self.grow_group(group, first + first_in_group as u64, ws);
-                        for (k, (hair, root)) in ws.group.iter().zip(&ws.contexts).enumerate() {
-                            let i = first_in_group + k;
-                            ws.skin_normals.push(root.normal);
-                            let range = i * n..(i + 1) * n;
-                            p[range.clone()].copy_from_slice(&hair.points);
-                            w[range.clone()].copy_from_slice(&hair.widths);
-                            if self.colors {
-                                c[range.clone()].copy_from_slice(&hair.colors);
-                            }
-                            if self.opacities {
-                                o[range].copy_from_slice(&hair.opacities);
+            // Each job answers with its first hair whose values are not all
+            // finite, if any (checked while they are still in cache).
+            let bad: Vec<Option<usize>> = jobs
+                .into_par_iter()
+                .map_init(
+                    Workspace::default,
+                    |ws, (job, chunk, first, p, w, nr, c, o)| {
+                        ws.skin_normals.clear();
+                        for (g, group) in chunk.chunks(GROUP).enumerate() {
+                            let first_in_group = g * GROUP;
+                            self.grow_group(group, first + first_in_group as u64, ws);
+                            for (k, (hair, root)) in ws.group.iter().zip(&ws.contexts).enumerate() {
+                                let i = first_in_group + k;
+                                ws.skin_normals.push(root.normal);
+                                let range = i * n..(i + 1) * n;
+                                p[range.clone()].copy_from_slice(&hair.points);
+                                w[range.clone()].copy_from_slice(&hair.widths);
+                                if self.colors {
+                                    c[range.clone()].copy_from_slice(&hair.colors);
+                                }
+                                if self.opacities {
+                                    o[range].copy_from_slice(&hair.opacities);
+                                }
                             }
                         }
-                    }
-                    if self.normals {
-                        hair_normals(p, n, &ws.skin_normals, nr, &mut ws.frames);
-                    }
-                },
-            );
+                        if self.normals {
+                            hair_normals(p, n, &ws.skin_normals, nr, &mut ws.frames);
+                        }
+                        self.first_non_finite_hair(n, p, w, nr, c, o)
+                            .map(|i| job * CHUNK + i)
+                    },
+                )
+                .collect();
+            bad.into_iter().flatten().next()
+        };
+        if let Some(i) = bad {
+            return Err(self.non_finite_error(roots[i], first_hair + i as u64));
         }
         let mut offsets = spare.offsets;
         offsets.clear();
@@ -774,23 +804,151 @@ impl<'g> Generator<'g> {
         let mut ids = spare.ids;
         ids.clear();
         ids.extend(first_hair..first_hair + roots.len() as u64);
-        let mut curves = Curves::new(points, widths, offsets).expect("consistent part arrays");
+        // Every hair was found finite above.
+        let checked = Values::Checked;
+        let mut curves =
+            Curves::build(points, widths, offsets, checked).expect("consistent part arrays");
         if self.normals {
-            curves = curves.with_normals(normals).expect("one normal a point");
+            curves = curves
+                .with_normals_as(normals, checked)
+                .expect("one normal a point");
         }
         if self.colors {
-            curves = curves.with_colors(colors).expect("one colour a point");
+            curves = curves
+                .with_colors_as(colors, checked)
+                .expect("one colour a point");
         }
         if self.opacities {
             curves = curves
-                .with_opacities(opacities)
+                .with_opacities_as(opacities, checked)
                 .expect("one opacity a point");
         }
-        self.with_root_uvs(
+        Ok(self.with_root_uvs(
             curves
                 .with_ids(ids)
                 .and_then(|c| c.with_roots(roots))
                 .expect("one id and root a curve"),
+        ))
+    }
+
+    /// The first of a chunk's hairs (`n` points each, the chunk's slices
+    /// of a part's arrays) with a value that is not finite.
+    fn first_non_finite_hair(
+        &self,
+        n: usize,
+        points: &[Vec3],
+        widths: &[f32],
+        normals: &[Vec3],
+        colors: &[Vec3],
+        opacities: &[f32],
+    ) -> Option<usize> {
+        let finite = |i: usize| {
+            let range = |on: bool| if on { i * n..(i + 1) * n } else { 0..0 };
+            vectors_finite(&points[range(true)])
+                && floats_finite(&widths[range(true)])
+                && vectors_finite(&normals[range(self.normals)])
+                && vectors_finite(&colors[range(self.colors)])
+                && floats_finite(&opacities[range(self.opacities)])
+        };
+        let all = vectors_finite(points)
+            && floats_finite(widths)
+            && vectors_finite(normals)
+            && vectors_finite(colors)
+            && floats_finite(opacities);
+        if all {
+            return None;
+        }
+        (0..points.len() / n.max(1)).find(|&i| !finite(i))
+    }
+
+    /// Hair `id`, grown from `root`, has a value that is not finite: grows
+    /// it again one operator at a time to say which operator (its place in
+    /// the groom file) took it there, and what went.
+    fn non_finite_error(&self, root: SurfacePoint, id: u64) -> GroomError {
+        let mut ws = Workspace::default();
+        let context = self.root_context(root);
+        let hair = ws.batch.reset();
+        self.interpolated(&context, id, &mut ws.interpolation, &mut ws.shape, hair);
+        let place = |k: usize| -> (Option<(usize, usize)>, String) {
+            let file = &self.groom.file;
+            let finish = |name: &str, spec: Option<&RootToTipSpec>| {
+                let span = spec.map_or(0..0, |s| s.root.span());
+                (self.groom.source.line_of(span), format!("finish.{name}"))
+            };
+            match k.checked_sub(self.base.len()) {
+                Some(op) => (
+                    self.groom.source.line_of_op(op),
+                    format!("ops[{op}].{}", self.ops[op].name()),
+                ),
+                None => match &self.base[k] {
+                    Operator::Width(_) => finish("width", Some(&file.finish.width)),
+                    Operator::Opacity(_) => finish("opacity", file.finish.opacity.as_ref()),
+                    _ => (
+                        self.groom.source.line_of(
+                            file.finish
+                                .color
+                                .as_ref()
+                                .map_or(0..0, |c| c.root[0].span()),
+                        ),
+                        "finish.color".to_string(),
+                    ),
+                },
+            }
+        };
+        let error = |line, key, what: String| {
+            GroomError::new(
+                self.groom.source.path.clone(),
+                line,
+                Some(key),
+                GroomErrorKind::NotFinite(what),
+            )
+        };
+        for (k, op) in self.base.iter().chain(&self.ops).enumerate() {
+            op.apply(&mut ws.batch, &context, &mut ws.scratch);
+            let bad = ws.batch.hairs().iter().find_map(|h| {
+                [
+                    (!vectors_finite(&h.points)).then_some("positions"),
+                    (!floats_finite(&h.widths)).then_some("widths"),
+                    (!vectors_finite(&h.colors)).then_some("colours"),
+                    (!floats_finite(&h.opacities)).then_some("opacities"),
+                ]
+                .into_iter()
+                .flatten()
+                .next()
+            });
+            if let Some(what) = bad {
+                let (line, key) = place(k);
+                return error(
+                    line,
+                    key,
+                    format!(
+                        "hair {id}'s {what} are no longer finite numbers after this operator: \
+                         its values take the hair past the range of 32-bit floats (about \
+                         ±3.4e38); make them smaller"
+                    ),
+                );
+            }
+            if ws.batch.is_empty() {
+                break;
+            }
+        }
+        // The values are finite, the normals are not: differences of
+        // points near the float range overflow.
+        let farthest = ws
+            .batch
+            .hairs()
+            .iter()
+            .flat_map(|h| h.points.iter())
+            .map(|p| p.abs().max_element())
+            .fold(0.0f32, f32::max);
+        error(
+            self.groom.source.line_of(0..0),
+            "finish.normals".to_string(),
+            format!(
+                "hair {id}'s normals are not finite numbers: its points reach {farthest:e}, \
+                 too far for their differences to fit in 32-bit floats; make the \
+                 operators' values smaller (or set normals = false)"
+            ),
         )
     }
 
@@ -817,6 +975,15 @@ impl<'g> Generator<'g> {
         let mut frame = vec![Vec3::ZERO; n];
         for (i, root) in roots.iter().enumerate() {
             let normal = self.grow(*root, first_id + i as u64, &self.ops, ws);
+            let finite = ws.batch.hairs().iter().all(|h| {
+                vectors_finite(&h.points)
+                    && floats_finite(&h.widths)
+                    && vectors_finite(&h.colors)
+                    && floats_finite(&h.opacities)
+            });
+            if !finite && out.first_non_finite.is_none() {
+                out.first_non_finite = Some(i);
+            }
             for hair in ws.batch.hairs() {
                 out.points.extend_from_slice(&hair.points);
                 out.widths.extend_from_slice(&hair.widths);
@@ -829,6 +996,9 @@ impl<'g> Generator<'g> {
                 if self.normals {
                     catmull_rom_tangents(&hair.points, &mut tangents);
                     rotation_minimizing_normals(&hair.points, &tangents, normal, &mut frame);
+                    if !vectors_finite(&frame) && out.first_non_finite.is_none() {
+                        out.first_non_finite = Some(i);
+                    }
                     out.normals.extend_from_slice(&frame);
                 }
                 out.counts.push(hair.points.len() as u32);
@@ -856,20 +1026,24 @@ impl<'g> Generator<'g> {
             all.ids.extend_from_slice(&c.ids);
             all.roots.extend_from_slice(&c.roots);
         }
-        // The generator builds consistent arrays; a failure here is a bug.
-        let mut curves =
-            Curves::new(all.points, all.widths, offsets).expect("consistent part arrays");
+        // The generator builds consistent arrays (a failure here is a bug),
+        // and every hair was found finite as it grew.
+        let checked = Values::Checked;
+        let mut curves = Curves::build(all.points, all.widths, offsets, checked)
+            .expect("consistent part arrays");
         if self.normals {
             curves = curves
-                .with_normals(all.normals)
+                .with_normals_as(all.normals, checked)
                 .expect("one normal a point");
         }
         if self.colors {
-            curves = curves.with_colors(all.colors).expect("one colour a point");
+            curves = curves
+                .with_colors_as(all.colors, checked)
+                .expect("one colour a point");
         }
         if self.opacities {
             curves = curves
-                .with_opacities(all.opacities)
+                .with_opacities_as(all.opacities, checked)
                 .expect("one opacity a point");
         }
         self.with_root_uvs(
@@ -893,6 +1067,9 @@ struct PartChunk {
     counts: Vec<u32>,
     ids: Vec<u64>,
     roots: Vec<SurfacePoint>,
+    /// The first of the chunk's roots that grew a value that is not
+    /// finite.
+    first_non_finite: Option<usize>,
 }
 
 fn root_to_tip(groom: &Groom, s: &RootToTipSpec) -> Result<RootToTip, GroomError> {

@@ -28,5 +28,5 @@ pub mod parts;
 pub use file::{GroomError, GroomErrorKind, GroomFile, GroomSource, Ramp};
 pub(crate) use generator::load_mesh_section;
 pub use generator::{Generator, Groom, GroomSummary};
-pub use output::{part_file, part_name, part_slice, write_assembly};
+pub use output::{GroomWriteError, part_file, part_name, part_slice, write_assembly};
 pub use parts::{Part, PartLayout};

@@ -2,6 +2,7 @@
 //! "Streaming"), and a farm's per-part files are tied together by a small
 //! root USD layer ([`write_assembly`]).
 
+use super::file::GroomError;
 use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
@@ -46,13 +47,17 @@ impl Generator<'_> {
     /// so memory holds about two parts whatever the groom's size. Other
     /// formats need every curve at once and join the parts first.
     /// `on_part(p, curves)` is called as each part is done.
+    ///
+    /// # Errors
+    /// A hair that grew values that are not finite (the file is then not
+    /// written), or a file that cannot be written.
     pub fn write(
         &self,
         path: &Path,
         parts: Range<usize>,
         export: &CurvesExport,
         mut on_part: impl FnMut(usize, &Curves) + Send,
-    ) -> Result<GroomSummary, WriteError> {
+    ) -> Result<GroomSummary, GroomWriteError> {
         let mut summary = GroomSummary::default();
         let mut count = |c: &Curves| {
             summary.hairs += c.curve_count() as u64;
@@ -61,7 +66,7 @@ impl Generator<'_> {
         if CurvesFormat::from_path(path) != Some(CurvesFormat::Usda) {
             let mut grown = Vec::new();
             for p in parts {
-                let curves = self.part(p);
+                let curves = self.part(p)?;
                 on_part(p, &curves);
                 count(&curves);
                 if curves.curve_count() > 0 {
@@ -76,12 +81,27 @@ impl Generator<'_> {
                 on_part(p, c);
                 count(c);
             })
+        })
+        .map_err(|e| {
+            // A part that could not grow comes back wrapped as an I/O
+            // error (see `write_usd`); the half-written file is gone.
+            if e.error
+                .get_ref()
+                .is_some_and(|inner| inner.is::<GroomError>())
+            {
+                let inner = e.error.into_inner().expect("checked above");
+                GroomWriteError::Groom(*inner.downcast::<GroomError>().expect("checked above"))
+            } else {
+                GroomWriteError::Write(e)
+            }
         })?;
         Ok(summary)
     }
 
     /// Grows `parts` and streams them as USD text to `out`, one part
-    /// written while the next grows (memory: about two parts).
+    /// written while the next grows (memory: about two parts). A part that
+    /// cannot grow ([`Generator::part`]) stops the stream with an I/O error
+    /// of kind `Other` wrapping its [`GroomError`].
     pub fn write_usd(
         &self,
         out: impl Write,
@@ -95,15 +115,19 @@ impl Generator<'_> {
             usd.write_mesh("skin", mesh).map_err(other)?;
         }
         std::thread::scope(|scope| {
-            let (send, receive) = std::sync::mpsc::sync_channel::<(usize, Curves)>(1);
+            type Grown = (usize, Result<Curves, GroomError>);
+            let (send, receive) = std::sync::mpsc::sync_channel::<Grown>(1);
             let grower = scope.spawn(move || {
                 for p in parts {
-                    if send.send((p, self.part(p))).is_err() {
-                        break; // the writer failed and hung up
+                    let part = self.part(p);
+                    let failed = part.is_err();
+                    if send.send((p, part)).is_err() || failed {
+                        break; // the writer failed and hung up, or we did
                     }
                 }
             });
             for (p, curves) in receive {
+                let curves = curves.map_err(std::io::Error::other)?;
                 // A part that grew no hair (more parts than hairs, or a
                 // bald region) is left out: USD has no empty BasisCurves.
                 if curves.curve_count() > 0 {
@@ -118,6 +142,17 @@ impl Generator<'_> {
         usd.finish().map_err(other)?;
         Ok(())
     }
+}
+
+/// A groom could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum GroomWriteError {
+    /// A hair could not be grown (the error names the groom file's line).
+    #[error(transparent)]
+    Groom(#[from] GroomError),
+    /// The output could not be written.
+    #[error(transparent)]
+    Write(#[from] WriteError),
 }
 
 /// Writes a root USD layer at `path` that references every part file (each

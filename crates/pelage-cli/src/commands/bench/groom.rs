@@ -91,7 +91,7 @@ fn grow_all(groom: &Groom) -> anyhow::Result<(u64, u64)> {
     let generator = groom.generator(None)?;
     let (mut hairs, mut points) = (0u64, 0u64);
     for p in 0..generator.parts().len() {
-        let c = generator.part(p);
+        let c = generator.part(p)?;
         hairs += c.curve_count() as u64;
         points += c.points().len() as u64;
         generator.recycle(c);

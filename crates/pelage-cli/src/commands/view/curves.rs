@@ -300,9 +300,9 @@ fn load(source: &CurvesSource) -> anyhow::Result<Loaded> {
             let started = Instant::now();
             let groom = Groom::load(path)?;
             let generator = groom.generator(None)?;
-            let parts: Vec<Curves> = (0..generator.parts().len())
+            let parts = (0..generator.parts().len())
                 .map(|p| generator.part(p))
-                .collect();
+                .collect::<Result<Vec<Curves>, _>>()?;
             let hairs = pelage::io::join(parts.iter())?;
             let guides = groom.guides().curves().clone();
             drop(generator);
