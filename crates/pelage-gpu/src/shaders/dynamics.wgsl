@@ -49,9 +49,9 @@ fn perm_at(i: u32) -> u32 {
     return permutation[i & 511u];
 }
 
-// pelage::map::noise::GRADIENTS3[hash & 15] · d, written out as Perlin's reference
-// code selects it (the table's sixteen rows exactly): no array indexed at
-// run time, which some compilers copy into every invocation.
+// pelage::map::noise::gradient3: Perlin's reference `grad`, selects and sign
+// flips picking one of his sixteen gradient rows: no array indexed at run
+// time, which some compilers copy into every invocation.
 fn gradient3(hash: u32, d: vec3<f32>) -> f32 {
     let h = hash & 15u;
     let u = select(d.y, d.x, h < 8u);

@@ -13,7 +13,7 @@ use super::parts::{Part, PartLayout};
 use crate::curves::frames::{
     FrameScratch, catmull_rom_tangents, hair_normals, rotation_minimizing_normals,
 };
-use crate::curves::{CurveArrays, Curves, Values, floats_finite, vectors_finite};
+use crate::curves::{CurveArrays, Curves, Values, vectors_finite};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{
     HairRoot, HairScratch, InterpolationMethod, Interpolator, QueryRegion, StyleMeshOptions,
@@ -761,18 +761,22 @@ impl<'g> Generator<'g> {
                 jobs.push((k, chunk, first, p0, w0, n0, c0, o0));
             }
             // Each job answers with its first hair whose values are not all
-            // finite, if any (checked while they are still in cache).
+            // finite, if any (checked as it is copied, while in cache).
             let bad: Vec<Option<usize>> = jobs
                 .into_par_iter()
                 .map_init(
                     Workspace::default,
                     |ws, (job, chunk, first, p, w, nr, c, o)| {
                         ws.skin_normals.clear();
+                        let mut bad = None;
                         for (g, group) in chunk.chunks(GROUP).enumerate() {
                             let first_in_group = g * GROUP;
                             self.grow_group(group, first + first_in_group as u64, ws);
                             for (k, (hair, root)) in ws.group.iter().zip(&ws.contexts).enumerate() {
                                 let i = first_in_group + k;
+                                if bad.is_none() && hair.non_finite().is_some() {
+                                    bad = Some(i);
+                                }
                                 ws.skin_normals.push(root.normal);
                                 let range = i * n..(i + 1) * n;
                                 p[range.clone()].copy_from_slice(&hair.points);
@@ -787,9 +791,12 @@ impl<'g> Generator<'g> {
                         }
                         if self.normals {
                             hair_normals(p, n, &ws.skin_normals, nr, &mut ws.frames);
+                            if !vectors_finite(nr) {
+                                let normals_bad = nr.chunks(n).position(|h| !vectors_finite(h));
+                                bad = bad.into_iter().chain(normals_bad).min();
+                            }
                         }
-                        self.first_non_finite_hair(n, p, w, nr, c, o)
-                            .map(|i| job * CHUNK + i)
+                        bad.map(|i| job * CHUNK + i)
                     },
                 )
                 .collect();
@@ -831,36 +838,6 @@ impl<'g> Generator<'g> {
         ))
     }
 
-    /// The first of a chunk's hairs (`n` points each, the chunk's slices
-    /// of a part's arrays) with a value that is not finite.
-    fn first_non_finite_hair(
-        &self,
-        n: usize,
-        points: &[Vec3],
-        widths: &[f32],
-        normals: &[Vec3],
-        colors: &[Vec3],
-        opacities: &[f32],
-    ) -> Option<usize> {
-        let finite = |i: usize| {
-            let range = |on: bool| if on { i * n..(i + 1) * n } else { 0..0 };
-            vectors_finite(&points[range(true)])
-                && floats_finite(&widths[range(true)])
-                && vectors_finite(&normals[range(self.normals)])
-                && vectors_finite(&colors[range(self.colors)])
-                && floats_finite(&opacities[range(self.opacities)])
-        };
-        let all = vectors_finite(points)
-            && floats_finite(widths)
-            && vectors_finite(normals)
-            && vectors_finite(colors)
-            && floats_finite(opacities);
-        if all {
-            return None;
-        }
-        (0..points.len() / n.max(1)).find(|&i| !finite(i))
-    }
-
     /// Hair `id`, grown from `root`, has a value that is not finite: grows
     /// it again one operator at a time to say which operator (its place in
     /// the groom file) took it there, and what went.
@@ -869,31 +846,27 @@ impl<'g> Generator<'g> {
         let context = self.root_context(root);
         let hair = ws.batch.reset();
         self.interpolated(&context, id, &mut ws.interpolation, &mut ws.shape, hair);
+        // Where operator `k` of the chain (the finishing ones first) is
+        // written in the groom file, and its key.
         let place = |k: usize| -> (Option<(usize, usize)>, String) {
-            let file = &self.groom.file;
-            let finish = |name: &str, spec: Option<&RootToTipSpec>| {
-                let span = spec.map_or(0..0, |s| s.root.span());
-                (self.groom.source.line_of(span), format!("finish.{name}"))
-            };
-            match k.checked_sub(self.base.len()) {
-                Some(op) => (
-                    self.groom.source.line_of_op(op),
-                    format!("ops[{op}].{}", self.ops[op].name()),
-                ),
-                None => match &self.base[k] {
-                    Operator::Width(_) => finish("width", Some(&file.finish.width)),
-                    Operator::Opacity(_) => finish("opacity", file.finish.opacity.as_ref()),
-                    _ => (
-                        self.groom.source.line_of(
-                            file.finish
-                                .color
-                                .as_ref()
-                                .map_or(0..0, |c| c.root[0].span()),
-                        ),
-                        "finish.color".to_string(),
-                    ),
-                },
+            let source = &self.groom.source;
+            let finish = &self.groom.file.finish;
+            if let Some(op) = k.checked_sub(self.base.len()) {
+                let key = format!("ops[{op}].{}", self.ops[op].name());
+                return (source.line_of_op(op), key);
             }
+            let (name, span) = match &self.base[k] {
+                Operator::Width(_) => ("width", finish.width.root.span()),
+                Operator::Opacity(_) => (
+                    "opacity",
+                    finish.opacity.as_ref().map_or(0..0, |o| o.root.span()),
+                ),
+                _ => (
+                    "color",
+                    finish.color.as_ref().map_or(0..0, |c| c.root[0].span()),
+                ),
+            };
+            (source.line_of(span), format!("finish.{name}"))
         };
         let error = |line, key, what: String| {
             GroomError::new(
@@ -905,18 +878,7 @@ impl<'g> Generator<'g> {
         };
         for (k, op) in self.base.iter().chain(&self.ops).enumerate() {
             op.apply(&mut ws.batch, &context, &mut ws.scratch);
-            let bad = ws.batch.hairs().iter().find_map(|h| {
-                [
-                    (!vectors_finite(&h.points)).then_some("positions"),
-                    (!floats_finite(&h.widths)).then_some("widths"),
-                    (!vectors_finite(&h.colors)).then_some("colours"),
-                    (!floats_finite(&h.opacities)).then_some("opacities"),
-                ]
-                .into_iter()
-                .flatten()
-                .next()
-            });
-            if let Some(what) = bad {
+            if let Some(what) = ws.batch.hairs().iter().find_map(Hair::non_finite) {
                 let (line, key) = place(k);
                 return error(
                     line,
@@ -942,7 +904,7 @@ impl<'g> Generator<'g> {
             .map(|p| p.abs().max_element())
             .fold(0.0f32, f32::max);
         error(
-            self.groom.source.line_of(0..0),
+            None,
             "finish.normals".to_string(),
             format!(
                 "hair {id}'s normals are not finite numbers: its points reach {farthest:e}, \
@@ -975,12 +937,7 @@ impl<'g> Generator<'g> {
         let mut frame = vec![Vec3::ZERO; n];
         for (i, root) in roots.iter().enumerate() {
             let normal = self.grow(*root, first_id + i as u64, &self.ops, ws);
-            let finite = ws.batch.hairs().iter().all(|h| {
-                vectors_finite(&h.points)
-                    && floats_finite(&h.widths)
-                    && vectors_finite(&h.colors)
-                    && floats_finite(&h.opacities)
-            });
+            let finite = ws.batch.hairs().iter().all(|h| h.non_finite().is_none());
             if !finite && out.first_non_finite.is_none() {
                 out.first_non_finite = Some(i);
             }

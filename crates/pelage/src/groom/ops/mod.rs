@@ -26,6 +26,7 @@ pub use strands::Strands;
 pub use trim::{Cut, Length};
 
 use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
+use crate::curves::{floats_finite, vectors_finite};
 use crate::groom::file::Ramp;
 use crate::interp::QueryRegion;
 use crate::map::Map;
@@ -49,6 +50,22 @@ pub struct Hair {
 }
 
 impl Hair {
+    /// The first of its attributes holding a value that is not finite
+    /// (`"positions"`, `"widths"`, `"colours"`, `"opacities"`), if any.
+    pub fn non_finite(&self) -> Option<&'static str> {
+        if !vectors_finite(&self.points) {
+            Some("positions")
+        } else if !floats_finite(&self.widths) {
+            Some("widths")
+        } else if !vectors_finite(&self.colors) {
+            Some("colours")
+        } else if !floats_finite(&self.opacities) {
+            Some("opacities")
+        } else {
+            None
+        }
+    }
+
     /// Copies `other` into `self`, reusing `self`'s buffers.
     pub fn copy_from(&mut self, other: &Hair) {
         self.id = other.id;
