@@ -231,9 +231,11 @@ fn errors_name_the_file_line_and_key() {
         "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\ngenerate = { count = 5, length = 0.1 }\n[interpolation]\nmethod = \"shepherd\"\n",
     );
     assert!(
-        method.starts_with(
-            "fur/test.toml:8:10: interpolation.method: unknown interpolation method \"shepherd\""
-        ),
+        method.starts_with("fur/test.toml:8:10: interpolation.method: unknown variant `shepherd`"),
+        "{method}"
+    );
+    assert!(
+        method.contains("`shepard`") && method.contains("`style-mesh`"),
         "{method}"
     );
 

@@ -52,7 +52,7 @@ fn a_hair_at_a_guide_root_is_that_guide() {
         split_shared: true,
     }));
     for method in methods {
-        let interp = Interpolator::new(&spot, &guides, &method);
+        let interp = Interpolator::new(&spot, guides.clone(), &method);
         let (mut scratch, mut hair) = (
             HairScratch::default(),
             vec![Vec3::ZERO; guides.points_per_guide()],
@@ -117,7 +117,7 @@ fn straight_guides_give_hairs_along_their_own_normal() {
     )
     .unwrap();
     for method in methods() {
-        let interp = Interpolator::new(&spot, &guides, &method);
+        let interp = Interpolator::new(&spot, guides.clone(), &method);
         let (mut scratch, mut hair) = (HairScratch::default(), vec![Vec3::ZERO; 8]);
         for i in 0..300u32 {
             let root = SurfacePoint::new(i * 13 % spot.triangle_count() as u32, [0.2, 0.5]);
@@ -210,12 +210,12 @@ fn on_a_thin_plate_the_style_mesh_keeps_each_side_to_its_guides_and_shepard_does
     let shepard = Shepard::new(&plate, &guides, 8, 2.0, None);
     let interp_style = Interpolator::new(
         &plate,
-        &guides,
+        guides.clone(),
         &InterpolationMethod::StyleMesh(StyleMeshOptions::default()),
     );
     let interp_shepard = Interpolator::new(
         &plate,
-        &guides,
+        guides.clone(),
         &InterpolationMethod::Shepard {
             k: 8,
             power: 2.0,
@@ -301,7 +301,7 @@ fn guides_denser_than_the_mesh_are_reported_and_splitting_gives_each_its_vertex(
 
     let split = StyleMesh::build(&spot, &guides, &StyleMeshOptions { split_shared: true });
     assert!(split.lost().is_empty());
-    let interp = Interpolator::with_weights(&spot, &guides, Box::new(split));
+    let interp = Interpolator::with_weights(&spot, guides.clone(), Box::new(split));
     let (mut scratch, mut hair) = (HairScratch::default(), vec![Vec3::ZERO; 3]);
     for (i, root) in guides.roots().iter().enumerate() {
         interp.hair(&spot, *root, &mut scratch, &mut hair);

@@ -248,7 +248,7 @@ fn counts_per_texel(mesh: &Mesh, points: &[SurfacePoint], probabilities: &[f64])
     counts
 }
 
-fn subdivision(mesh: &Mesh, map: &Map) -> DensitySampler<'static> {
+fn subdivision(mesh: &Mesh, map: &Map) -> DensitySampler {
     let options = DensitySamplerOptions {
         selector: Selector::CdfGrid { grid_percent: 100 },
         ..Default::default()
@@ -256,7 +256,7 @@ fn subdivision(mesh: &Mesh, map: &Map) -> DensitySampler<'static> {
     DensitySampler::new(leak_mesh(mesh), map, options).unwrap()
 }
 
-fn alias(mesh: &Mesh, map: &Map) -> DensitySampler<'static> {
+fn alias(mesh: &Mesh, map: &Map) -> DensitySampler {
     let options = DensitySamplerOptions {
         selector: Selector::Alias,
         ..Default::default()

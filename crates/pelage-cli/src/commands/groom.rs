@@ -7,7 +7,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use pelage::groom::{Groom, part_file, part_slice, write_assembly};
-use pelage::io::{CurveBasis, CurvesExport, CurvesFormat, UsdOptions};
+use pelage::io::{CurvesExport, CurvesFormat, UsdOptions};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -108,14 +108,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         Some(_) => {}
     }
     let file = groom.file();
-    let basis = match file.output.basis.as_deref() {
-        None | Some("catmull-rom") | Some("catmullRom") => CurveBasis::CatmullRom,
-        Some("linear") => CurveBasis::Linear,
-        Some(other) => bail!(
-            "{}: output.basis {other:?}: the bases are \"catmull-rom\" and \"linear\"",
-            args.file.display()
-        ),
-    };
+    let basis = file.output.basis;
     let export = CurvesExport {
         usd: UsdOptions {
             basis,

@@ -10,11 +10,11 @@
 //! the groom file's folder, and a map that cannot be read is reported at
 //! its line too.
 
-use crate::map::{Map, MapError};
+pub use super::ramp::Ramp;
+use crate::io::CurveBasis;
 use serde::Deserialize;
 use serde::de::{self, Deserializer, Visitor};
 use std::fmt;
-use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 /// A map as written in a groom file: a number or a map spec string
@@ -52,99 +52,6 @@ impl<'de> Deserialize<'de> for MapText {
             }
         }
         deserializer.deserialize_any(MapVisitor)
-    }
-}
-
-/// A root-to-tip profile `ramp(t)`, `t` from 0 at the root to 1 at the tip:
-/// a number `p` for `t^p` (1: linear, 0: constant 1), a name (`linear`,
-/// `constant`, `smooth` = smoothstep, `tip` = t², `root` = 1 − t), or a list
-/// of values evenly spaced from root to tip, interpolated linearly.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Ramp {
-    /// `t^p`.
-    Power(f32),
-    /// Smoothstep `3t² − 2t³`.
-    Smooth,
-    /// `1 − t`: strongest at the root.
-    Root,
-    /// Piecewise linear through evenly spaced values.
-    Values(Vec<f32>),
-}
-
-impl Default for Ramp {
-    fn default() -> Self {
-        Ramp::Power(1.0)
-    }
-}
-
-impl Ramp {
-    /// The profile's value at `t` ∈ [0, 1].
-    #[inline]
-    pub fn at(&self, t: f32) -> f32 {
-        match self {
-            Ramp::Power(p) if *p == 1.0 => t,
-            Ramp::Power(p) if *p == 0.0 => 1.0,
-            Ramp::Power(p) => t.max(0.0).powf(*p),
-            Ramp::Smooth => t * t * (3.0 - 2.0 * t),
-            Ramp::Root => 1.0 - t,
-            Ramp::Values(v) => match v.len() {
-                0 => 1.0,
-                1 => v[0],
-                n => {
-                    let x = t.clamp(0.0, 1.0) * (n - 1) as f32;
-                    let i = (x as usize).min(n - 2);
-                    v[i] + (x - i as f32) * (v[i + 1] - v[i])
-                }
-            },
-        }
-    }
-}
-
-impl<'de> Deserialize<'de> for Ramp {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        struct RampVisitor;
-        impl<'de> Visitor<'de> for RampVisitor {
-            type Value = Ramp;
-            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a ramp: an exponent (1 = linear), \"linear\", \"constant\", \"smooth\", \"tip\", \"root\", or a list of values from root to tip")
-            }
-            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Ramp, E> {
-                if v.is_finite() && v >= 0.0 {
-                    Ok(Ramp::Power(v as f32))
-                } else {
-                    Err(E::custom(format!(
-                        "a ramp exponent must be 0 or more, not {v}"
-                    )))
-                }
-            }
-            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Ramp, E> {
-                self.visit_f64(v as f64)
-            }
-            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Ramp, E> {
-                self.visit_f64(v as f64)
-            }
-            fn visit_str<E: de::Error>(self, v: &str) -> Result<Ramp, E> {
-                match v {
-                    "linear" => Ok(Ramp::Power(1.0)),
-                    "constant" => Ok(Ramp::Power(0.0)),
-                    "smooth" => Ok(Ramp::Smooth),
-                    "tip" => Ok(Ramp::Power(2.0)),
-                    "root" => Ok(Ramp::Root),
-                    _ => Err(E::invalid_value(de::Unexpected::Str(v), &self)),
-                }
-            }
-            fn visit_seq<A: de::SeqAccess<'de>>(self, mut seq: A) -> Result<Ramp, A::Error> {
-                let mut values = Vec::new();
-                while let Some(v) = seq.next_element::<f32>()? {
-                    values.push(v);
-                }
-                if values.is_empty() {
-                    return Err(de::Error::custom("a ramp list needs at least one value"));
-                }
-                Ok(Ramp::Values(values))
-            }
-        }
-        deserializer.deserialize_any(RampVisitor)
     }
 }
 
@@ -269,8 +176,8 @@ pub struct GenerateSection {
 #[serde(deny_unknown_fields)]
 pub struct InterpolationSection {
     /// `shepard` or `style-mesh`.
-    #[serde(default = "default_method")]
-    pub method: Spanned<String>,
+    #[serde(default)]
+    pub method: InterpolationKind,
     /// Shepard: guides per hair.
     #[serde(default = "default_k")]
     pub k: usize,
@@ -284,8 +191,16 @@ pub struct InterpolationSection {
     pub split_shared: bool,
 }
 
-fn default_method() -> Spanned<String> {
-    Spanned::new(0..0, "shepard".to_string())
+/// `[interpolation] method`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum InterpolationKind {
+    /// Shepard's inverse-distance weights over the k nearest guides.
+    #[default]
+    Shepard,
+    /// Furtility's style mesh.
+    #[serde(alias = "style_mesh")]
+    StyleMesh,
 }
 fn default_k() -> usize {
     4
@@ -297,7 +212,7 @@ fn default_power() -> f32 {
 impl Default for InterpolationSection {
     fn default() -> Self {
         Self {
-            method: default_method(),
+            method: InterpolationKind::default(),
             k: default_k(),
             power: default_power(),
             radius: None,
@@ -566,282 +481,14 @@ pub struct OutputSection {
     #[serde(default)]
     pub with_mesh: bool,
     /// `catmull-rom` (default) or `linear`.
-    pub basis: Option<String>,
-}
-
-/// A groom file and where it came from, for error messages and relative
-/// paths.
-#[derive(Debug, Clone)]
-pub struct GroomSource {
-    /// The file (or a name such as `<demo>`).
-    pub path: PathBuf,
-    /// Its text.
-    pub text: String,
-}
-
-impl GroomSource {
-    /// Reads a groom file.
-    pub fn read(path: &Path) -> Result<Self, GroomError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| GroomError::new(path.to_path_buf(), None, None, GroomErrorKind::Io(e)))?;
-        Ok(Self {
-            path: path.to_path_buf(),
-            text,
-        })
-    }
-
-    /// The folder relative paths are resolved against.
-    pub fn folder(&self) -> &Path {
-        self.path.parent().unwrap_or(Path::new(""))
-    }
-
-    /// Parses the text.
-    pub fn parse(&self) -> Result<GroomFile, GroomError> {
-        self.parse_as()
-    }
-
-    /// Parses the text as any TOML file pelage reads (groom files, shell
-    /// scenes), with errors at their line and key.
-    pub fn parse_as<T: serde::de::DeserializeOwned>(&self) -> Result<T, GroomError> {
-        toml::from_str(&self.text).map_err(|e| {
-            let message = e.message().to_string();
-            match e.span() {
-                Some(span) => self.error_at(span, GroomErrorKind::Syntax(message)),
-                None => GroomError::new(
-                    self.path.clone(),
-                    None,
-                    None,
-                    GroomErrorKind::Syntax(message),
-                ),
-            }
-        })
-    }
-
-    /// An error at a span of the text: its line and column, and the key
-    /// written there (with its table).
-    pub fn error_at(&self, span: std::ops::Range<usize>, kind: GroomErrorKind) -> GroomError {
-        if span == (0..0) {
-            // A default value: no place in the file.
-            return GroomError::new(self.path.clone(), None, None, kind);
-        }
-        let start = span.start.min(self.text.len());
-        let line_start = self.text[..start].rfind('\n').map_or(0, |i| i + 1);
-        GroomError::new(
-            self.path.clone(),
-            self.line_of(span),
-            key_at(&self.text, line_start, start),
-            kind,
-        )
-    }
-
-    /// Line and column (1-based) of a span of the text; `None` for a
-    /// default value (the empty span at 0).
-    pub fn line_of(&self, span: std::ops::Range<usize>) -> Option<(usize, usize)> {
-        if span == (0..0) {
-            return None;
-        }
-        let start = span.start.min(self.text.len());
-        let before = &self.text[..start];
-        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-        Some((
-            before.matches('\n').count() + 1,
-            before[line_start..].chars().count() + 1,
-        ))
-    }
-
-    /// Line and column of operator `k`'s table: its `[[ops]]` header.
-    pub fn line_of_op(&self, k: usize) -> Option<(usize, usize)> {
-        let line = self
-            .text
-            .lines()
-            .enumerate()
-            .filter(|(_, l)| l.trim_start().starts_with("[[ops]]"))
-            .nth(k)?
-            .0;
-        Some((line + 1, 1))
-    }
-
-    /// Resolves a map value, reporting a bad spec or unreadable image at its
-    /// line.
-    pub fn map(&self, value: &MapValue) -> Result<Map, GroomError> {
-        match value.get_ref() {
-            MapText::Number(n) if n.is_finite() => Ok(Map::Constant(*n)),
-            MapText::Number(n) => Err(self.error_at(
-                value.span(),
-                GroomErrorKind::Invalid(format!("{n} is not a finite number")),
-            )),
-            MapText::Spec(spec) => Map::parse_with_base(spec, Some(self.folder()))
-                .map_err(|e| self.error_at(value.span(), GroomErrorKind::Map(e))),
-        }
-    }
-}
-
-/// The dotted key at `offset` on the line starting at `line_start`, with
-/// its table: `roots.count`, `ops[2].clump.rate`.
-fn key_at(text: &str, line_start: usize, offset: usize) -> Option<String> {
-    let line_end = text[line_start..]
-        .find('\n')
-        .map_or(text.len(), |i| line_start + i);
-    let line = &text[line_start..line_end];
-    let in_line = offset - line_start;
-    let trimmed = line.trim_start();
-    if trimmed.starts_with('[') {
-        return Some(trimmed.trim().to_string());
-    }
-    // The key is what precedes the last `=` before the offset, or the bare
-    // word at the offset (an unknown key is reported at the key itself).
-    let head = &line[..in_line.min(line.len())];
-    let rest = &line[in_line.min(line.len())..];
-    let word_end = rest
-        .find(|c: char| c == '=' || c == ',' || c == '}' || c.is_whitespace())
-        .unwrap_or(rest.len());
-    let at_key = rest[word_end..].trim_start().starts_with('=') && word_end > 0;
-    // The key owning the inline table that is open at `pos`.
-    let owner_of = |pos: usize| {
-        let brace = line[..pos].rfind('{')?;
-        let before = line[..brace].trim_end().strip_suffix('=')?.trim_end();
-        let start = before.rfind(['{', ',']).map_or(0, |i| i + 1);
-        Some(before[start..].trim().to_string())
-    };
-    let key = match head.rfind('=') {
-        // An unknown key is reported at the key itself.
-        _ if at_key => {
-            let key = rest[..word_end].to_string();
-            match owner_of(head.len()) {
-                Some(owner) => format!("{owner}.{key}"),
-                None => key,
-            }
-        }
-        Some(eq) => {
-            let left = &head[..eq];
-            // Inside an inline table: the key after the last `{` or `,`.
-            let start = left.rfind(['{', ',']).map_or(0, |i| i + 1);
-            let inline_owner = owner_of(start);
-            let key = left[start..].trim().to_string();
-            match inline_owner {
-                Some(owner) if start > 0 => format!("{owner}.{key}"),
-                _ => key,
-            }
-        }
-        None => rest[..word_end].to_string(),
-    };
-    if key.is_empty() {
-        return None;
-    }
-    // The table the line is in: the last header above it.
-    let mut table = None;
-    let mut ops_seen = 0usize;
-    for l in text[..line_start].lines() {
-        let l = l.trim();
-        if l.starts_with("[[ops]]") {
-            ops_seen += 1;
-            table = Some(format!("ops[{}]", ops_seen - 1));
-        } else if let Some(name) = l.strip_prefix('[').and_then(|l| l.split(']').next()) {
-            let name = name.trim_start_matches('[').trim();
-            table = Some(match name.strip_prefix("ops.") {
-                Some(rest) if ops_seen > 0 => format!("ops[{}].{rest}", ops_seen - 1),
-                _ => name.to_string(),
-            });
-        }
-    }
-    Some(match table {
-        Some(t) => format!("{t}.{key}"),
-        None => key,
-    })
-}
-
-/// A groom file could not be read, parsed or set up. Displays as
-/// `FILE:LINE:COLUMN: KEY: what is wrong`.
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct GroomError(Box<GroomErrorDetails>);
-
-/// Where and what a [`GroomError`] is.
-#[derive(Debug)]
-pub struct GroomErrorDetails {
-    /// The groom file.
-    pub path: PathBuf,
-    /// Line and column (1-based), where the problem is in the file.
-    pub line: Option<(usize, usize)>,
-    /// The key there, with its table (`roots.count`).
-    pub key: Option<String>,
-    /// What is wrong.
-    pub kind: GroomErrorKind,
-}
-
-impl GroomError {
-    /// An error in the groom file at `path`.
-    pub fn new(
-        path: PathBuf,
-        line: Option<(usize, usize)>,
-        key: Option<String>,
-        kind: GroomErrorKind,
-    ) -> Self {
-        Self(Box::new(GroomErrorDetails {
-            path,
-            line,
-            key,
-            kind,
-        }))
-    }
-}
-
-impl std::ops::Deref for GroomError {
-    type Target = GroomErrorDetails;
-    fn deref(&self) -> &GroomErrorDetails {
-        &self.0
-    }
-}
-
-impl fmt::Display for GroomErrorDetails {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(f, "{}", self.path.display())?;
-        if let Some((line, column)) = self.line {
-            write!(f, ":{line}:{column}")?;
-        }
-        if let Some(key) = &self.key {
-            write!(f, ": {key}")?;
-        }
-        write!(f, ": {}", self.kind)
-    }
-}
-
-/// What is wrong with a groom.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum GroomErrorKind {
-    /// The file could not be read.
-    #[error("cannot read the groom file: {0}")]
-    Io(std::io::Error),
-    /// Not valid TOML, an unknown key, or a value of the wrong type.
-    #[error("{0}")]
-    Syntax(String),
-    /// A value that parses but cannot be used.
-    #[error("{0}")]
-    Invalid(String),
-    /// A map that cannot be read or used.
-    #[error("{0}")]
-    Map(MapError),
-    /// The mesh could not be loaded.
-    #[error("{0}")]
-    Mesh(crate::mesh::MeshError),
-    /// The guides file could not be read.
-    #[error("{0}")]
-    Guides(crate::io::CurvesReadError),
-    /// Guides could not be grown.
-    #[error("{0}")]
-    GuideGrowth(crate::guides::GuideError),
-    /// Roots could not be sampled.
-    #[error("{0}")]
-    Sample(crate::sample::SampleError),
-    /// A hair grew values that are not finite numbers.
-    #[error("{0}")]
-    NotFinite(String),
+    #[serde(default)]
+    pub basis: CurveBasis,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::groom::{GroomError, GroomSource};
 
     fn parse(text: &str) -> Result<GroomFile, GroomError> {
         GroomSource {
@@ -857,7 +504,7 @@ mod tests {
     fn minimal_file_takes_defaults() {
         let f = parse(MINIMAL).unwrap();
         assert_eq!(*f.roots.count.get_ref(), 1000);
-        assert_eq!(f.interpolation.method.get_ref(), "shepard");
+        assert_eq!(f.interpolation.method, InterpolationKind::Shepard);
         assert_eq!(*f.finish.points.get_ref(), 16);
         assert!(f.ops.is_empty());
     }
@@ -890,6 +537,36 @@ mod tests {
             "{err}"
         );
         assert!(err.contains("a map: a number"), "{err}");
+    }
+
+    #[test]
+    fn bad_enum_values_name_line_key_and_accepted_values() {
+        let err = parse(&format!(
+            "{MINIMAL}[interpolation]\nmethod = \"shepherd\"\n"
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.starts_with("test.toml:8:10: interpolation.method: unknown variant `shepherd`"),
+            "{err}"
+        );
+        assert!(
+            err.contains("`shepard`") && err.contains("`style-mesh`"),
+            "{err}"
+        );
+        let err = parse(&format!("{MINIMAL}[output]\nbasis = \"bspline\"\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("test.toml:8:9: output.basis: "), "{err}");
+        assert!(
+            err.contains("`linear`") && err.contains("`catmull-rom`"),
+            "{err}"
+        );
+        let f = parse(&format!(
+            "{MINIMAL}[interpolation]\nmethod = \"style_mesh\"\n"
+        ))
+        .unwrap();
+        assert_eq!(f.interpolation.method, InterpolationKind::StyleMesh);
     }
 
     #[test]

@@ -2,12 +2,16 @@
 //! part by part (Sik §4, Stubble's generator; the Furtility talk's chain of
 //! groom operators).
 //!
-//! - [`mod@file`]: the TOML groom file ([`GroomFile`]), every error with file,
-//!   line and key.
-//! - [`Groom`]: a groom file loaded: its mesh, guides and resolved maps.
-//! - [`Generator`]: everything prepared for generation (root sampler,
+//! - [`GroomSpec`] (`spec.rs`): the groom as plain Rust values: mesh,
+//!   guides, roots, interpolation, operators, finish. Programs and bindings
+//!   build one directly.
+//! - [`mod@file`], [`Groom`] (`load.rs`): the TOML groom file, one front end
+//!   that produces a `GroomSpec`; every error with file, line and key
+//!   ([`GroomError`], `error.rs`; `source.rs` finds lines and keys).
+//! - [`Generator`]: a spec prepared for generation (root sampler,
 //!   [`PartLayout`], interpolator, operator chain with clump centres);
-//!   [`Generator::part`] grows one part's hairs.
+//!   [`Generator::part`] grows one part's hairs (`grow.rs`; a hair that
+//!   overflows is traced to its operator in `diagnose.rs`).
 //! - [`ops`]: the operators.
 //! - [`parts`]: the part layout; [`Generator::write`] streams parts to a
 //!   file, [`write_assembly`] ties a farm's part files together in USD.
@@ -19,14 +23,29 @@
 //! by (seed, hair id), so the output does not depend on threads, and any
 //! part generated alone equals that part of the full run.
 
+mod diagnose;
+mod error;
 pub mod file;
 mod generator;
+mod grow;
+mod load;
 pub mod ops;
 mod output;
 pub mod parts;
+mod ramp;
+mod source;
+mod spec;
 
-pub use file::{GroomError, GroomErrorKind, GroomFile, GroomSource, Ramp};
-pub(crate) use generator::load_mesh_section;
-pub use generator::{Generator, Groom, GroomSummary};
+pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
+pub use file::{GroomFile, InterpolationKind};
+pub use generator::{Generator, GroomSummary, HAIRS_PER_PART};
+pub use load::Groom;
+pub(crate) use load::load_mesh_section;
 pub use output::{GroomWriteError, part_file, part_name, part_slice, write_assembly};
 pub use parts::{Part, PartLayout};
+pub use ramp::Ramp;
+pub use source::GroomSource;
+pub use spec::{
+    ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, LengthParams,
+    NoiseParams, RootsSpec, StrandsParams,
+};

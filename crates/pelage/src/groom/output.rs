@@ -2,7 +2,7 @@
 //! "Streaming"), and a farm's per-part files are tied together by a small
 //! root USD layer ([`write_assembly`]).
 
-use super::file::GroomError;
+use super::error::GroomError;
 use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
@@ -41,7 +41,7 @@ pub fn part_file(output: &Path, k: usize, n: usize) -> PathBuf {
     output.with_file_name(format!("{stem}.part-{k}-of-{n}.{ext}"))
 }
 
-impl Generator<'_> {
+impl Generator {
     /// Grows `parts` and writes them to `path` (format by extension),
     /// atomically. USD streams: a part is written while the next one grows,
     /// so memory holds about two parts whatever the groom's size. Other

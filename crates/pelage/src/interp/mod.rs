@@ -29,6 +29,7 @@ pub use style_mesh::{LostGuide, StyleMesh, StyleMeshOptions};
 use crate::guides::Guides;
 use crate::mesh::{Mesh, SurfacePoint};
 use glam::{Mat3, Quat, Vec3, Vec3A};
+use std::sync::Arc;
 
 /// One guide's share of a hair.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -127,26 +128,29 @@ impl InterpolationMethod {
 }
 
 /// Guides ready to shape hairs with one method.
-pub struct Interpolator<'g> {
-    guides: &'g Guides,
+pub struct Interpolator {
+    /// Shared, so that an interpolator (and a generator holding one) owns
+    /// what it reads and borrows nothing.
+    guides: Arc<Guides>,
     /// Each guide's offsets from its root.
     offsets: Vec<Vec3>,
     /// Each guide's skin normal at its root, padded to 16 bytes: read as one load
     /// (a 12-byte `Vec3` went through the stack in two pieces and stalled
     /// the load that reassembled it).
     normals: Vec<Vec3A>,
-    weights: Box<dyn GuideWeights + 'g>,
+    weights: Box<dyn GuideWeights>,
 }
 
-impl<'g> Interpolator<'g> {
+impl Interpolator {
     /// Prepares `guides` (bound to `mesh`) for interpolation by `method`.
-    pub fn new(mesh: &Mesh, guides: &'g Guides, method: &InterpolationMethod) -> Self {
+    pub fn new(mesh: &Mesh, guides: impl Into<Arc<Guides>>, method: &InterpolationMethod) -> Self {
+        let guides = guides.into();
         let weights: Box<dyn GuideWeights> = match method {
             InterpolationMethod::Shepard { k, power, radius } => {
-                Box::new(Shepard::new(mesh, guides, *k, *power, *radius))
+                Box::new(Shepard::new(mesh, &guides, *k, *power, *radius))
             }
             InterpolationMethod::StyleMesh(options) => {
-                Box::new(StyleMesh::build(mesh, guides, options))
+                Box::new(StyleMesh::build(mesh, &guides, options))
             }
         };
         Self::with_weights(mesh, guides, weights)
@@ -155,9 +159,10 @@ impl<'g> Interpolator<'g> {
     /// Prepares `guides` with a weighting of your own.
     pub fn with_weights(
         mesh: &Mesh,
-        guides: &'g Guides,
-        weights: Box<dyn GuideWeights + 'g>,
+        guides: impl Into<Arc<Guides>>,
+        weights: Box<dyn GuideWeights>,
     ) -> Self {
+        let guides = guides.into();
         let mut offsets = Vec::with_capacity(guides.curves().points().len());
         for i in 0..guides.len() {
             let g = guides.guide(i);
@@ -178,7 +183,7 @@ impl<'g> Interpolator<'g> {
 
     /// The guides.
     pub fn guides(&self) -> &Guides {
-        self.guides
+        &self.guides
     }
 
     /// The weighting.

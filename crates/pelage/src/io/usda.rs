@@ -21,13 +21,17 @@ use rayon::prelude::*;
 use std::collections::HashSet;
 use std::io::Write;
 
-/// How the points of each curve are interpolated (USD `type` + `basis`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// How the points of each curve are interpolated (USD `type` + `basis`);
+/// `linear` or `catmull-rom` in groom files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum CurveBasis {
     /// Straight segments between the points.
     Linear,
-    /// A cubic Catmull-Rom spline through the points.
+    /// A cubic Catmull-Rom spline through the points (also spelled
+    /// `catmullRom`, as USD does).
     #[default]
+    #[serde(alias = "catmullRom")]
     CatmullRom,
 }
 

@@ -12,6 +12,7 @@ use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
 use glam::Vec2;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// One sub-triangle of the distribution: 12 bytes, as in the paper.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,8 +101,11 @@ fn alias_bin(bits: u64, n: usize) -> usize {
 
 /// Samples points on a mesh with a density given by a [`Map`] (Sik §3).
 #[derive(Debug, Clone)]
-pub struct DensitySampler<'m> {
-    mesh: &'m Mesh,
+pub struct DensitySampler {
+    /// The mesh's triangle areas (shared by the samplers restricted from
+    /// this one): all the sampler needs of the mesh once built, so it
+    /// holds no borrow and a binding or a generator can own it.
+    areas: Arc<[f32]>,
     records: Vec<SubTriangleRecord>,
     /// Records of triangle t are `records[first[t]..first[t + 1]]`.
     first_record: Vec<u32>,
@@ -197,12 +201,12 @@ struct Chunk {
     total: f64,
 }
 
-impl<'m> DensitySampler<'m> {
+impl DensitySampler {
     /// Builds the distribution (the paper's preprocess). Errors name the
     /// mesh: a map that needs UVs on a mesh without them, a negative or NaN
     /// density (with the triangle and UV), a density that is zero everywhere.
     pub fn new(
-        mesh: &'m Mesh,
+        mesh: &Mesh,
         density: &Map,
         options: DensitySamplerOptions,
     ) -> Result<Self, SampleError> {
@@ -212,7 +216,7 @@ impl<'m> DensitySampler<'m> {
             total,
         } = SubTriangleRecords::build(mesh, density, options.max_level)?;
         Ok(Self::from_records(
-            mesh,
+            mesh.triangle_areas().into(),
             records,
             first_record,
             total,
@@ -223,12 +227,12 @@ impl<'m> DensitySampler<'m> {
     /// The same distribution restricted to `triangles` (ascending, no
     /// repeats) and renormalised: where one part of a groom places its
     /// roots. `None` if the density is zero on all of them.
-    pub fn restricted(&self, triangles: &[u32]) -> Option<DensitySampler<'m>> {
+    pub fn restricted(&self, triangles: &[u32]) -> Option<DensitySampler> {
         debug_assert!(triangles.windows(2).all(|w| w[0] < w[1]));
         let mut records = Vec::new();
         let mut first_record = vec![0u32; self.first_record.len()];
         let mut next = triangles.iter().peekable();
-        for t in 0..self.mesh.triangle_count() {
+        for t in 0..self.triangle_count() {
             if next.next_if(|&&k| k as usize == t).is_some() {
                 let range = self.first_record[t] as usize..self.first_record[t + 1] as usize;
                 records.extend_from_slice(&self.records[range]);
@@ -236,12 +240,19 @@ impl<'m> DensitySampler<'m> {
             first_record[t + 1] = records.len() as u32;
         }
         let total: f64 = records.iter().map(|r| f64::from(r.probability)).sum();
-        (total > 0.0)
-            .then(|| Self::from_records(self.mesh, records, first_record, total, self.options))
+        (total > 0.0).then(|| {
+            Self::from_records(
+                self.areas.clone(),
+                records,
+                first_record,
+                total,
+                self.options,
+            )
+        })
     }
 
     fn from_records(
-        mesh: &'m Mesh,
+        areas: Arc<[f32]>,
         records: Vec<SubTriangleRecord>,
         first_record: Vec<u32>,
         total: f64,
@@ -268,7 +279,7 @@ impl<'m> DensitySampler<'m> {
             }
         };
         Self {
-            mesh,
+            areas,
             records,
             first_record,
             total,
@@ -312,13 +323,13 @@ impl<'m> DensitySampler<'m> {
             + self.positions.memory_bytes()
     }
 
-    /// The mesh sampled.
-    pub fn mesh(&self) -> &'m Mesh {
-        self.mesh
+    /// Triangles of the mesh sampled.
+    pub fn triangle_count(&self) -> usize {
+        self.areas.len()
     }
 }
 
-impl DensitySampler<'_> {
+impl DensitySampler {
     /// Fig. 6 steps 2–3: a uniform point in the sub-triangle at
     /// `position` of `triangle` (from 48 bits of `bits`), mapped to the
     /// triangle's barycentrics.
@@ -336,7 +347,7 @@ impl DensitySampler<'_> {
 /// Samples per block of [`DensitySampler::sample_block`]'s pipeline.
 const BLOCK: usize = 64;
 
-impl SurfaceSampler for DensitySampler<'_> {
+impl SurfaceSampler for DensitySampler {
     /// Sample `index`: its first draw selects the sub-triangle, its second
     /// places the point in it.
     #[inline]
@@ -434,7 +445,7 @@ impl SurfaceSampler for DensitySampler<'_> {
     /// point over its area.
     fn pdf(&self, point: SurfacePoint) -> f64 {
         let t = point.tri as usize;
-        let area = f64::from(self.mesh.triangle_areas()[t]);
+        let area = f64::from(self.areas[t]);
         let b = Vec2::from(point.bary);
         let range = self.first_record[t] as usize..self.first_record[t + 1] as usize;
         self.records[range]

@@ -21,6 +21,11 @@ impl Cut {
         Self { at }
     }
 
+    /// The curve parameter map.
+    pub fn at(&self) -> &Map {
+        &self.at
+    }
+
     pub(super) fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
         let at = self.at.eval(root.uv);
         if at >= 1.0 {

@@ -1,0 +1,484 @@
+//! Growing a part's hairs: each root's shape interpolated from the guides,
+//! resampled, passed through the finish and the operators, with per-point
+//! normals from rotation-minimizing frames (Sik §4.2.2; Wang et al. 2008).
+//! Grooms whose roots each grow one hair are grown eight hairs at a time
+//! into arrays sized in advance; `strands` and `cut` take the general path,
+//! chunk by chunk. Both end in one assembly of the part's [`Curves`].
+
+use super::error::GroomError;
+use super::generator::Generator;
+use super::ops::{Hair, HairBatch, Operator, RootContext, Scratch};
+use crate::curves::frames::{
+    FrameScratch, catmull_rom_tangents, hair_normals, rotation_minimizing_normals,
+};
+use crate::curves::{Curves, Values, vectors_finite};
+use crate::interp::{HairRoot, HairScratch, QueryRegion};
+use crate::mesh::SurfacePoint;
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+/// Hairs a worker grows between hand-overs (fixed, so results never depend
+/// on the number of threads).
+const CHUNK: usize = 512;
+
+/// Per-thread buffers.
+#[derive(Default)]
+pub(super) struct Workspace {
+    pub(super) interpolation: HairScratch,
+    pub(super) shape: Vec<Vec3>,
+    pub(super) batch: HairBatch,
+    pub(super) scratch: Scratch,
+    /// Each hair's skin normal, the start of its frame.
+    skin_normals: Vec<Vec3>,
+    frames: FrameScratch,
+    /// A group of hairs grown side by side ([`Generator::grow_group`]) and
+    /// their roots.
+    group: Vec<Hair>,
+    contexts: Vec<RootContext>,
+}
+
+/// Hairs grown side by side through the operators when each root grows one
+/// hair: enough to fill the noise's eight SIMD lanes several times over.
+const GROUP: usize = 8;
+
+impl Generator {
+    /// Hair `id` grown from `root` through `ops` into `ws.batch`; returns
+    /// the skin normal at the root.
+    pub(super) fn grow(
+        &self,
+        root: SurfacePoint,
+        id: u64,
+        ops: &[Operator],
+        ws: &mut Workspace,
+    ) -> Vec3 {
+        let context = self.root_context(root);
+        let hair = ws.batch.reset();
+        self.interpolated(&context, id, &mut ws.interpolation, &mut ws.shape, hair);
+        for op in self.base.iter().chain(ops) {
+            op.apply(&mut ws.batch, &context, &mut ws.scratch);
+            if ws.batch.is_empty() {
+                break;
+            }
+        }
+        context.normal
+    }
+
+    /// Hairs `first_id…` grown from `roots` (at most [`GROUP`]) through
+    /// every operator side by side, into `ws.group` with their roots in
+    /// `ws.contexts`: hair for hair what [`Self::grow`] makes, for grooms
+    /// whose operators keep one hair a root.
+    fn grow_group(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) {
+        if ws.group.len() < roots.len() {
+            ws.group.resize_with(roots.len(), Hair::default);
+        }
+        ws.contexts.clear();
+        for (i, root) in roots.iter().enumerate() {
+            let context = self.root_context(*root);
+            let hair = &mut ws.group[i];
+            let id = first_id + i as u64;
+            self.interpolated(&context, id, &mut ws.interpolation, &mut ws.shape, hair);
+            ws.contexts.push(context);
+        }
+        let hairs = &mut ws.group[..roots.len()];
+        for op in self.base.iter().chain(&self.ops) {
+            op.apply_each(hairs, &ws.contexts, &mut ws.scratch);
+        }
+    }
+
+    /// Where a hair grows: its root's position, skin normal and UV.
+    pub(super) fn root_context(&self, root: SurfacePoint) -> RootContext {
+        let mesh = &self.spec.mesh;
+        RootContext {
+            point: root,
+            position: root.position(mesh),
+            normal: root.normal(mesh),
+            uv: root.uv(mesh).unwrap_or(Vec2::ZERO),
+            skin_triangle: self
+                .clumps
+                .then(|| QueryRegion::around_triangle(mesh.triangle_positions(root.tri as usize))),
+        }
+    }
+
+    /// Starts `hair` as hair `id`: the guides' shape interpolated at its
+    /// root, at the hairs' point count, no colours or opacities yet.
+    pub(super) fn interpolated(
+        &self,
+        context: &RootContext,
+        id: u64,
+        scratch: &mut HairScratch,
+        shape: &mut Vec<Vec3>,
+        hair: &mut Hair,
+    ) {
+        shape.resize(self.spec.guides.points_per_guide(), Vec3::ZERO);
+        let hair_root = HairRoot {
+            position: context.position,
+            triangle: Some(context.point.tri),
+        };
+        self.interpolator
+            .hair_at(hair_root, context.normal, scratch, shape);
+        hair.id = id;
+        hair.points.clear();
+        self.resampled(shape, &mut hair.points);
+        hair.colors.clear();
+        hair.opacities.clear();
+    }
+
+    /// Appends the interpolated `shape` (guide resolution) at the hairs'
+    /// point count.
+    pub(super) fn resampled(&self, shape: &[Vec3], out: &mut Vec<Vec3>) {
+        self.resampling.apply(shape, out);
+    }
+
+    /// Part `p` grown from its `roots`.
+    pub(super) fn grow_part(
+        &self,
+        p: usize,
+        roots: Vec<SurfacePoint>,
+    ) -> Result<Curves, GroomError> {
+        let part = &self.layout.parts()[p];
+        if self.one_hair_per_root() {
+            return self.part_in_place(roots, part.first_hair);
+        }
+        let chunks: Vec<PartChunk> = roots
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map_init(Workspace::default, |ws, (c, chunk)| {
+                let first = part.first_hair + (c * CHUNK) as u64;
+                self.grow_chunk(chunk, first, ws)
+            })
+            .collect();
+        // The first root, in the part's order, that grew a value that is
+        // not a finite number.
+        let bad = chunks
+            .iter()
+            .enumerate()
+            .find_map(|(c, chunk)| chunk.first_non_finite.map(|i| c * CHUNK + i));
+        if let Some(i) = bad {
+            return Err(self.non_finite_error(roots[i], part.first_hair + i as u64));
+        }
+        Ok(self.assemble(concat(chunks)))
+    }
+
+    /// Whether every root grows exactly one hair (no `strands`, no `cut`):
+    /// then a part's arrays have a known size and workers fill them in
+    /// place.
+    fn one_hair_per_root(&self) -> bool {
+        self.ops.iter().all(Operator::keeps_one_hair_a_root)
+    }
+
+    /// [`Self::part`] when each root grows one hair: the arrays are
+    /// allocated once and each worker writes its chunk's slices; `roots`
+    /// become the curves' roots.
+    fn part_in_place(
+        &self,
+        roots: Vec<SurfacePoint>,
+        first_hair: u64,
+    ) -> Result<Curves, GroomError> {
+        let n = self.points;
+        let total = roots.len() * n;
+        let sized = |on: bool| if on { total } else { 0 };
+        // Every element is overwritten by the workers below, so a recycled
+        // array keeps its old values and only grows where this part is
+        // larger: parts are nearly equal in size, so most of the time
+        // nothing is filled at all. The growth is filled on all threads:
+        // zeroing a part's ~50 MB on this one was time every other core
+        // waited for (Amdahl: at 16 threads it kept the groom at a third of
+        // the cores' worth).
+        fn sized_to<T: Copy + Send + Default>(mut v: Vec<T>, len: usize) -> Vec<T> {
+            v.truncate(len);
+            let more = len - v.len();
+            v.par_extend(rayon::iter::repeat_n(T::default(), more));
+            v
+        }
+        let spare = self.spare_arrays();
+        let mut points = sized_to(spare.points, total);
+        let mut widths = sized_to(spare.widths, total);
+        let mut normals = sized_to(spare.normals, sized(self.normals));
+        let mut colors = sized_to(spare.colors, sized(self.colors));
+        let mut opacities = sized_to(spare.opacities, sized(self.opacities));
+        let bad = {
+            let mut jobs = Vec::with_capacity(roots.len().div_ceil(CHUNK));
+            let (mut p, mut w, mut nr, mut c, mut o) = (
+                &mut points[..],
+                &mut widths[..],
+                &mut normals[..],
+                &mut colors[..],
+                &mut opacities[..],
+            );
+            for (k, chunk) in roots.chunks(CHUNK).enumerate() {
+                let len = chunk.len() * n;
+                let take = |on: bool| if on { len } else { 0 };
+                let (p0, p1) = std::mem::take(&mut p).split_at_mut(len);
+                let (w0, w1) = std::mem::take(&mut w).split_at_mut(len);
+                let (n0, n1) = std::mem::take(&mut nr).split_at_mut(take(self.normals));
+                let (c0, c1) = std::mem::take(&mut c).split_at_mut(take(self.colors));
+                let (o0, o1) = std::mem::take(&mut o).split_at_mut(take(self.opacities));
+                (p, w, nr, c, o) = (p1, w1, n1, c1, o1);
+                let first = first_hair + (k * CHUNK) as u64;
+                jobs.push((k, chunk, first, p0, w0, n0, c0, o0));
+            }
+            // Each job answers with its first hair whose values are not all
+            // finite, if any (checked as it is copied, while in cache).
+            let bad: Vec<Option<usize>> = jobs
+                .into_par_iter()
+                .map_init(
+                    Workspace::default,
+                    |ws, (job, chunk, first, p, w, nr, c, o)| {
+                        ws.skin_normals.clear();
+                        let mut bad = None;
+                        for (g, group) in chunk.chunks(GROUP).enumerate() {
+                            let first_in_group = g * GROUP;
+                            self.grow_group(group, first + first_in_group as u64, ws);
+                            for (k, (hair, root)) in ws.group.iter().zip(&ws.contexts).enumerate() {
+                                let i = first_in_group + k;
+                                if bad.is_none() && hair.non_finite().is_some() {
+                                    bad = Some(i);
+                                }
+                                ws.skin_normals.push(root.normal);
+                                let range = i * n..(i + 1) * n;
+                                p[range.clone()].copy_from_slice(&hair.points);
+                                w[range.clone()].copy_from_slice(&hair.widths);
+                                if self.colors {
+                                    c[range.clone()].copy_from_slice(&hair.colors);
+                                }
+                                if self.opacities {
+                                    o[range].copy_from_slice(&hair.opacities);
+                                }
+                            }
+                        }
+                        if self.normals {
+                            hair_normals(p, n, &ws.skin_normals, nr, &mut ws.frames);
+                            if !vectors_finite(nr) {
+                                let normals_bad = nr.chunks(n).position(|h| !vectors_finite(h));
+                                bad = bad.into_iter().chain(normals_bad).min();
+                            }
+                        }
+                        bad.map(|i| job * CHUNK + i)
+                    },
+                )
+                .collect();
+            bad.into_iter().flatten().next()
+        };
+        if let Some(i) = bad {
+            return Err(self.non_finite_error(roots[i], first_hair + i as u64));
+        }
+        let mut offsets = spare.offsets;
+        offsets.clear();
+        offsets.extend((0..=roots.len() as u32).map(|i| i * n as u32));
+        let mut ids = spare.ids;
+        ids.clear();
+        ids.extend(first_hair..first_hair + roots.len() as u64);
+        Ok(self.assemble(PartArrays {
+            points,
+            widths,
+            normals,
+            colors,
+            opacities,
+            offsets,
+            ids,
+            roots,
+        }))
+    }
+
+    /// Adds each hair's root UV (USD's uniform `st`, which renderers use to
+    /// read skin textures along the hair) when the mesh has UVs.
+    fn with_root_uvs(&self, curves: Curves) -> Curves {
+        let mesh = &self.spec.mesh;
+        if !mesh.has_uvs() {
+            return curves;
+        }
+        let uvs = curves
+            .roots()
+            .expect("grown curves carry their roots")
+            .par_iter()
+            .map(|r| r.uv(mesh).unwrap_or_default())
+            .collect();
+        curves.with_root_uvs(uvs).expect("one UV a curve")
+    }
+
+    fn grow_chunk(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) -> PartChunk {
+        let n = self.points;
+        let mut out = PartChunk::default();
+        let mut tangents = vec![Vec3::ZERO; n];
+        let mut frame = vec![Vec3::ZERO; n];
+        for (i, root) in roots.iter().enumerate() {
+            let normal = self.grow(*root, first_id + i as u64, &self.ops, ws);
+            let finite = ws.batch.hairs().iter().all(|h| h.non_finite().is_none());
+            if !finite && out.first_non_finite.is_none() {
+                out.first_non_finite = Some(i);
+            }
+            for hair in ws.batch.hairs() {
+                let a = &mut out.arrays;
+                a.points.extend_from_slice(&hair.points);
+                a.widths.extend_from_slice(&hair.widths);
+                if self.colors {
+                    a.colors.extend_from_slice(&hair.colors);
+                }
+                if self.opacities {
+                    a.opacities.extend_from_slice(&hair.opacities);
+                }
+                if self.normals {
+                    catmull_rom_tangents(&hair.points, &mut tangents);
+                    rotation_minimizing_normals(&hair.points, &tangents, normal, &mut frame);
+                    if !vectors_finite(&frame) && out.first_non_finite.is_none() {
+                        out.first_non_finite = Some(i);
+                    }
+                    a.normals.extend_from_slice(&frame);
+                }
+                out.counts.push(hair.points.len() as u32);
+                a.ids.push(hair.id);
+                a.roots.push(*root);
+            }
+        }
+        out
+    }
+
+    /// A part's curves from its arrays, with the attributes this groom
+    /// has and each hair's root UV. Every hair was found finite as it grew,
+    /// so `Curves` does not scan the values again.
+    fn assemble(&self, a: PartArrays) -> Curves {
+        // The generator builds consistent arrays: a failure here is a bug.
+        let checked = Values::Checked;
+        let mut curves =
+            Curves::build(a.points, a.widths, a.offsets, checked).expect("consistent part arrays");
+        if self.normals {
+            curves = curves
+                .with_normals_as(a.normals, checked)
+                .expect("one normal a point");
+        }
+        if self.colors {
+            curves = curves
+                .with_colors_as(a.colors, checked)
+                .expect("one colour a point");
+        }
+        if self.opacities {
+            curves = curves
+                .with_opacities_as(a.opacities, checked)
+                .expect("one opacity a point");
+        }
+        self.with_root_uvs(
+            curves
+                .with_ids(a.ids)
+                .and_then(|c| c.with_roots(a.roots))
+                .expect("one id and root a curve"),
+        )
+    }
+}
+
+/// A part's arrays before they become [`Curves`] (per-point arrays stay
+/// empty for attributes the groom does not have).
+#[derive(Default)]
+struct PartArrays {
+    points: Vec<Vec3>,
+    widths: Vec<f32>,
+    normals: Vec<Vec3>,
+    colors: Vec<Vec3>,
+    opacities: Vec<f32>,
+    offsets: Vec<u32>,
+    ids: Vec<u64>,
+    roots: Vec<SurfacePoint>,
+}
+
+/// Hairs grown by one worker, in order: their arrays with a count of
+/// points a hair (offsets come when the chunks are joined).
+#[derive(Default)]
+struct PartChunk {
+    arrays: PartArrays,
+    counts: Vec<u32>,
+    /// The first of the chunk's roots that grew a value that is not
+    /// finite.
+    first_non_finite: Option<usize>,
+}
+
+/// The chunks of a part, in order, as one part's arrays.
+fn concat(chunks: Vec<PartChunk>) -> PartArrays {
+    let mut all = PartArrays {
+        offsets: vec![0u32],
+        ..Default::default()
+    };
+    for c in chunks {
+        let a = c.arrays;
+        all.points.extend_from_slice(&a.points);
+        all.widths.extend_from_slice(&a.widths);
+        all.normals.extend_from_slice(&a.normals);
+        all.colors.extend_from_slice(&a.colors);
+        all.opacities.extend_from_slice(&a.opacities);
+        for n in c.counts {
+            all.offsets
+                .push(all.offsets.last().expect("starts at 0") + n);
+        }
+        all.ids.extend_from_slice(&a.ids);
+        all.roots.extend_from_slice(&a.roots);
+    }
+    all
+}
+
+/// `roots` ordered by (triangle, first barycentric, second barycentric),
+/// the order [`Generator::part_roots`] grows hairs in: the same order as
+/// a comparison sort by that key, found faster. A counting sort by
+/// triangle moves each root once; each triangle's few roots (a dozen or
+/// two) are then sorted among themselves. A comparison sort of the whole
+/// part took a tenth of a groom's time on one core.
+pub(super) fn sorted_by_triangle(roots: Vec<SurfacePoint>) -> Vec<SurfacePoint> {
+    let (Some(lo), Some(hi)) = (
+        roots.iter().map(|r| r.tri).min(),
+        roots.iter().map(|r| r.tri).max(),
+    ) else {
+        return roots;
+    };
+    // starts[t − lo] .. starts[t − lo + 1]: where triangle t's roots go.
+    let mut starts = vec![0u32; (hi - lo) as usize + 2];
+    for r in &roots {
+        starts[(r.tri - lo) as usize + 1] += 1;
+    }
+    for t in 1..starts.len() {
+        starts[t] += starts[t - 1];
+    }
+    let mut next = starts.clone();
+    let mut sorted = vec![SurfacePoint::default(); roots.len()];
+    for r in &roots {
+        let slot = &mut next[(r.tri - lo) as usize];
+        sorted[*slot as usize] = *r;
+        *slot += 1;
+    }
+    for range in starts.windows(2) {
+        let triangle = &mut sorted[range[0] as usize..range[1] as usize];
+        if triangle.len() > 1 {
+            triangle.sort_unstable_by_key(|r| (r.bary[0].to_bits(), r.bary[1].to_bits()));
+        }
+    }
+    sorted
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sample::mix64;
+
+    #[test]
+    fn roots_sorted_by_triangle_match_a_comparison_sort() {
+        // Random roots over a few hundred triangles, with repeated
+        // triangles and first barycentrics (ties broken by the second),
+        // exact duplicates, and a negative zero.
+        let mut roots: Vec<SurfacePoint> = (0..5000u64)
+            .map(|i| {
+                let h = mix64(i);
+                let unit = |h: u64| (h >> 40) as f32 / (1u64 << 24) as f32;
+                let b0 = if i % 7 == 0 { 0.25 } else { unit(h) };
+                SurfacePoint::new((h % 300) as u32 * 77, [b0, unit(mix64(h))])
+            })
+            .collect();
+        roots.extend_from_within(..50);
+        roots.push(SurfacePoint::new(3, [-0.0, 0.5]));
+        roots.push(SurfacePoint::new(3, [0.0, 0.5]));
+        let mut expected = roots.clone();
+        expected.sort_unstable_by_key(|r| (r.tri, r.bary[0].to_bits(), r.bary[1].to_bits()));
+        let got = sorted_by_triangle(roots);
+        let bits = |r: &SurfacePoint| (r.tri, r.bary.map(f32::to_bits));
+        assert_eq!(
+            got.iter().map(bits).collect::<Vec<_>>(),
+            expected.iter().map(bits).collect::<Vec<_>>()
+        );
+        assert!(sorted_by_triangle(Vec::new()).is_empty());
+    }
+}

@@ -1,0 +1,409 @@
+//! Groom files as one front end of [`GroomSpec`]: [`Groom`] reads a file,
+//! loads its mesh and guides, and turns its settings into the values a
+//! [`Generator`] is built from, keeping where each was written so that
+//! errors found later still name the line.
+
+use super::error::{GroomError, GroomErrorKind};
+use super::file::{
+    ColorSpec, GroomFile, InterpolationKind, MapValue, MeshSection, OpSpec, RootToTipSpec,
+};
+use super::generator::Generator;
+use super::ops::{Color, Cut, RootToTip};
+use super::source::GroomSource;
+use super::spec::{
+    ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, LengthParams,
+    NoiseParams, RootsSpec, SpecOrigin, StrandsParams,
+};
+use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
+use crate::interp::{InterpolationMethod, StyleMeshOptions};
+use crate::map::Map;
+use crate::mesh::Mesh;
+use glam::Vec3;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Hairs per part when the groom does not say.
+pub const HAIRS_PER_PART: u64 = 100_000;
+
+/// A groom file loaded: the file, its mesh and guides.
+pub struct Groom {
+    source: GroomSource,
+    file: GroomFile,
+    mesh: Arc<Mesh>,
+    guides: Arc<Guides>,
+    bind_report: Option<BindReport>,
+}
+
+impl std::fmt::Debug for Groom {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Groom")
+            .field("path", &self.source.path)
+            .field("mesh", &self.mesh.name())
+            .field("guides", &self.guides.len())
+            .finish()
+    }
+}
+
+impl Groom {
+    /// Reads, parses and loads the groom file at `path`.
+    pub fn load(path: &Path) -> Result<Self, GroomError> {
+        Self::from_source(GroomSource::read(path)?)
+    }
+
+    /// Loads a groom from its text (`path` names it in errors and is the
+    /// base of relative paths).
+    pub fn from_text(
+        path: impl Into<PathBuf>,
+        text: impl Into<String>,
+    ) -> Result<Self, GroomError> {
+        Self::from_source(GroomSource {
+            path: path.into(),
+            text: text.into(),
+        })
+    }
+
+    /// Parses the source, loads the mesh and the guides.
+    pub fn from_source(source: GroomSource) -> Result<Self, GroomError> {
+        let file = source.parse()?;
+        let mesh = Arc::new(load_mesh_section(&source, &file.mesh)?);
+        let (guides, bind_report) = load_guides(&source, &file, &mesh)?;
+        Ok(Self {
+            source,
+            file,
+            mesh,
+            guides: Arc::new(guides),
+            bind_report,
+        })
+    }
+
+    /// The parsed file.
+    pub fn file(&self) -> &GroomFile {
+        &self.file
+    }
+
+    /// The file's path and text.
+    pub fn source(&self) -> &GroomSource {
+        &self.source
+    }
+
+    /// The mesh hairs grow on.
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    /// The guides, bound to the mesh.
+    pub fn guides(&self) -> &Guides {
+        &self.guides
+    }
+
+    /// When the guides came from a file: what binding them kept and left
+    /// out.
+    pub fn bind_report(&self) -> Option<&BindReport> {
+        self.bind_report.as_ref()
+    }
+
+    /// Where the curves go: `[output] path` relative to the groom file, or
+    /// the groom file's name with `.usda`.
+    pub fn output_path(&self) -> PathBuf {
+        match &self.file.output.path {
+            Some(p) => self.source.folder().join(p),
+            None => self.source.path.with_extension("usda"),
+        }
+    }
+
+    /// The number of parts: `[roots] parts`, or one per 100,000 hairs;
+    /// never more than the mesh has triangles.
+    pub fn part_count(&self) -> usize {
+        part_count(
+            &self.mesh,
+            *self.file.roots.count.get_ref(),
+            self.file.roots.parts.as_ref().map(|p| *p.get_ref()),
+        )
+    }
+
+    /// The groom as values: every map read (and checked against the mesh),
+    /// every operator with its settings. Errors are at their line.
+    pub fn spec(&self) -> Result<GroomSpec, GroomError> {
+        let file = &self.file;
+        let source = &self.source;
+        // Where the settings the generator checks were written.
+        let mut lines = HashMap::new();
+        let mut mark = |key: String, line: Option<(usize, usize)>| {
+            if let Some(line) = line {
+                lines.insert(key, line);
+            }
+        };
+        let map = |v: &MapValue| map_on_mesh(source, &self.mesh, v);
+
+        mark(
+            "roots.count".into(),
+            source.line_of(file.roots.count.span()),
+        );
+        mark(
+            "roots.density".into(),
+            source.line_of(file.roots.density.span()),
+        );
+        mark(
+            "finish.points".into(),
+            source.line_of(file.finish.points.span()),
+        );
+        mark(
+            "finish.width".into(),
+            source.line_of(file.finish.width.root.span()),
+        );
+        if let Some(o) = &file.finish.opacity {
+            mark("finish.opacity".into(), source.line_of(o.root.span()));
+        }
+        if let Some(c) = &file.finish.color {
+            mark("finish.color".into(), source.line_of(c.root[0].span()));
+        }
+        let roots = RootsSpec {
+            count: *file.roots.count.get_ref(),
+            density: map(&file.roots.density)?,
+            seed: file.roots.seed,
+            parts: file.roots.parts.as_ref().map(|p| *p.get_ref()),
+        };
+        let method = &file.interpolation;
+        let interpolation = match method.method {
+            InterpolationKind::Shepard => InterpolationMethod::Shepard {
+                k: method.k.max(1),
+                power: method.power,
+                radius: method.radius,
+            },
+            InterpolationKind::StyleMesh => InterpolationMethod::StyleMesh(StyleMeshOptions {
+                split_shared: method.split_shared,
+            }),
+        };
+        let finish = FinishSpec {
+            points: *file.finish.points.get_ref(),
+            width: root_to_tip(source, &self.mesh, &file.finish.width)?,
+            color: file
+                .finish
+                .color
+                .as_ref()
+                .map(|c| color(source, &self.mesh, c))
+                .transpose()?,
+            opacity: file
+                .finish
+                .opacity
+                .as_ref()
+                .map(|o| root_to_tip(source, &self.mesh, o))
+                .transpose()?,
+            normals: file.finish.normals,
+        };
+        let mut ops = Vec::with_capacity(file.ops.len());
+        for (k, spec) in file.ops.iter().enumerate() {
+            let op = match spec {
+                OpSpec::Noise(s) => GroomOp::Noise(NoiseParams {
+                    amplitude: map(&s.amplitude)?,
+                    frequency: map(&s.frequency)?,
+                    ramp: s.ramp.clone(),
+                    vectors: s.vectors,
+                    seed: s.seed,
+                }),
+                OpSpec::Frizz(s) => GroomOp::Frizz(FrizzParams {
+                    amplitude: map(&s.amplitude)?,
+                    frequency: map(&s.frequency)?,
+                    fraction: map(&s.fraction)?,
+                    ramp: s.ramp.clone(),
+                    seed: s.seed,
+                }),
+                OpSpec::Curl(s) => GroomOp::Curl(CurlParams {
+                    radius: map(&s.radius)?,
+                    turns: map(&s.turns)?,
+                    ramp: s.ramp.clone(),
+                    seed: s.seed,
+                }),
+                OpSpec::Cut(s) => GroomOp::Cut(Cut::new(map(&s.at)?)),
+                OpSpec::Length(s) => GroomOp::Length(LengthParams {
+                    scale: map(&s.scale)?,
+                    jitter: map(&s.jitter)?,
+                    seed: s.seed,
+                }),
+                OpSpec::Strands(s) => {
+                    mark(
+                        format!("ops[{k}].strands.count"),
+                        source.line_of(s.count.span()),
+                    );
+                    GroomOp::Strands(StrandsParams {
+                        count: *s.count.get_ref(),
+                        root_spread: map(&s.root_spread)?,
+                        tip_spread: map(&s.tip_spread)?,
+                        twist: map(&s.twist)?,
+                        seed: s.seed,
+                    })
+                }
+                OpSpec::Width(s) => GroomOp::Width(root_to_tip(source, &self.mesh, s)?),
+                OpSpec::Color(s) => GroomOp::Color(color(source, &self.mesh, s)?),
+                OpSpec::Opacity(s) => GroomOp::Opacity(root_to_tip(source, &self.mesh, s)?),
+                OpSpec::Clump(s) => {
+                    mark(
+                        format!("ops[{k}].clump.count"),
+                        source.line_of(s.count.span()),
+                    );
+                    mark(
+                        format!("ops[{k}].clump.density"),
+                        source.line_of(s.density.span()),
+                    );
+                    GroomOp::Clump(ClumpParams {
+                        count: *s.count.get_ref(),
+                        density: map(&s.density)?,
+                        rate: map(&s.rate)?,
+                        ramp: s.ramp.clone(),
+                        size: s.size.as_ref().map(map).transpose()?,
+                        seed: s.seed,
+                    })
+                }
+            };
+            mark(format!("ops[{k}].{}", op.name()), source.line_of_op(k));
+            ops.push(op);
+        }
+        Ok(GroomSpec {
+            name: source.path.clone(),
+            mesh: self.mesh.clone(),
+            guides: self.guides.clone(),
+            roots,
+            interpolation,
+            ops,
+            finish,
+            origin: Some(Arc::new(SpecOrigin { lines })),
+        })
+    }
+
+    /// Prepares generation from [`Self::spec`]; `seed` overrides the
+    /// file's.
+    pub fn generator(&self, seed: Option<u64>) -> Result<Generator, GroomError> {
+        let mut spec = self.spec()?;
+        if let Some(seed) = seed {
+            spec.roots.seed = seed;
+        }
+        Generator::new(spec)
+    }
+}
+
+/// The number of parts of `count` hairs: `parts` if given, or one per
+/// [`HAIRS_PER_PART`] hairs; at least one, at most one a triangle.
+pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>) -> usize {
+    let wanted = match parts {
+        Some(p) => p.max(1) as usize,
+        None => count.div_ceil(HAIRS_PER_PART).max(1) as usize,
+    };
+    wanted.min(mesh.triangle_count()).max(1)
+}
+
+/// Resolves a map value and checks it can be read on `mesh` (UVs), both
+/// errors at the value's line.
+fn map_on_mesh(source: &GroomSource, mesh: &Mesh, value: &MapValue) -> Result<Map, GroomError> {
+    let map = source.map(value)?;
+    map.on_mesh(mesh)
+        .map_err(|e| source.error_at(value.span(), GroomErrorKind::Map(e)))?;
+    Ok(map)
+}
+
+fn root_to_tip(
+    source: &GroomSource,
+    mesh: &Mesh,
+    s: &RootToTipSpec,
+) -> Result<RootToTip, GroomError> {
+    let map = |v: &MapValue| map_on_mesh(source, mesh, v);
+    Ok(RootToTip {
+        root: map(&s.root)?,
+        tip: map(&s.tip)?,
+        ramp: s.ramp.clone(),
+        jitter: map(&s.jitter)?,
+        seed: s.seed,
+    })
+}
+
+fn color(source: &GroomSource, mesh: &Mesh, s: &ColorSpec) -> Result<Color, GroomError> {
+    let map = |v: &MapValue| map_on_mesh(source, mesh, v);
+    let three = |c: &[MapValue; 3]| -> Result<[Map; 3], GroomError> {
+        Ok([map(&c[0])?, map(&c[1])?, map(&c[2])?])
+    };
+    Ok(Color {
+        root: three(&s.root)?,
+        tip: three(&s.tip)?,
+        ramp: s.ramp.clone(),
+        jitter: map(&s.jitter)?,
+        seed: s.seed,
+    })
+}
+
+/// The mesh a `[mesh]` section names (`"spot"`: the embedded one),
+/// subdivided as asked; a mesh that cannot be loaded is reported at its
+/// line.
+pub(crate) fn load_mesh_section(
+    source: &GroomSource,
+    section: &MeshSection,
+) -> Result<Mesh, GroomError> {
+    let path = &section.path;
+    let mesh = if path.get_ref() == "spot" {
+        crate::assets::spot()
+    } else {
+        Mesh::load(source.folder().join(path.get_ref()))
+            .map_err(|e| source.error_at(path.span(), GroomErrorKind::Mesh(e)))?
+    };
+    Ok(match section.subdivide {
+        0 => mesh,
+        n => mesh.subdivided(n),
+    })
+}
+
+fn load_guides(
+    source: &GroomSource,
+    file: &GroomFile,
+    mesh: &Mesh,
+) -> Result<(Guides, Option<BindReport>), GroomError> {
+    let section = &file.guides;
+    let invalid =
+        |span, message: &str| source.error_at(span, GroomErrorKind::Invalid(message.to_string()));
+    match (&section.file, &section.generate) {
+        (Some(path), None) => {
+            let full = source.folder().join(path.get_ref());
+            let curves = crate::io::read_curves(&full)
+                .map_err(|e| source.error_at(path.span(), GroomErrorKind::Guides(e)))?;
+            let (guides, report) = Guides::bind(mesh, &curves, section.points, section.tolerance);
+            if guides.is_empty() {
+                return Err(invalid(
+                    path.span(),
+                    "no guide is within the tolerance of the mesh; check that the guides belong to this mesh, or raise [guides] tolerance",
+                ));
+            }
+            Ok((guides, Some(report)))
+        }
+        (None, Some(generate)) => {
+            let map = |v: &MapValue| map_on_mesh(source, mesh, v);
+            let growth = GuideGrowth {
+                count: generate.count.max(1),
+                density: map(&generate.density)?,
+                length: map(&generate.length)?,
+                comb: Vec3::from(generate.comb),
+                comb_map: match &generate.comb_map {
+                    Some([u, v]) => Some(CombMap {
+                        u: map(u)?,
+                        v: map(v)?,
+                        strength: generate.comb_strength,
+                    }),
+                    None => None,
+                },
+                gravity: generate.gravity,
+                points: section.points,
+                width: 0.004,
+                seed: generate.seed,
+            };
+            let guides = Guides::grow(mesh, &growth).map_err(|e| {
+                source.error_at(generate.length.span(), GroomErrorKind::GuideGrowth(e))
+            })?;
+            Ok((guides, None))
+        }
+        _ => Err(GroomError::new(
+            source.path.clone(),
+            None,
+            Some("guides".into()),
+            GroomErrorKind::Invalid(
+                "give exactly one of `file = \"guides.usda\"` or a [guides.generate] table".into(),
+            ),
+        )),
+    }
+}

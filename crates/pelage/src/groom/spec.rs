@@ -1,0 +1,475 @@
+//! The groom as plain Rust values: a mesh, guides, where roots grow, how
+//! hairs take the guides' shape, the operator chain and the finish
+//! (Sik §4's generator inputs). [`GroomSpec::generator`] prepares a
+//! [`Generator`] from them; a groom file ([`super::Groom`]) is one front end
+//! that produces a `GroomSpec`, a program (or a binding) is another.
+//!
+//! Everything here is owned or shared (`Arc`), so a spec and the generator
+//! built from it borrow nothing and can be held for as long as a caller
+//! likes.
+//!
+//! ```
+//! use pelage::groom::{GroomOp, GroomSpec, NoiseParams, RootsSpec};
+//! use pelage::guides::{GuideGrowth, Guides};
+//! use pelage::map::Map;
+//! use std::sync::Arc;
+//!
+//! let mesh = Arc::new(pelage::assets::spot());
+//! let growth = GuideGrowth { count: 50, length: Map::Constant(0.05), ..Default::default() };
+//! let guides = Guides::grow(&mesh, &growth).unwrap();
+//! let spec = GroomSpec::new(mesh, guides, RootsSpec::new(2_000))
+//!     .with_op(GroomOp::Noise(NoiseParams::new(Map::Constant(0.002))));
+//! let generator = spec.generator().unwrap();
+//! let curves = generator.part(0).unwrap();
+//! assert_eq!(curves.curve_count(), 2_000);
+//! ```
+
+use super::error::{GroomError, GroomErrorKind};
+use super::generator::Generator;
+use super::ops::{Color, Cut, RootToTip};
+use crate::guides::Guides;
+use crate::interp::InterpolationMethod;
+use crate::map::Map;
+use crate::mesh::Mesh;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+pub use super::ramp::Ramp;
+
+/// A whole groom, as values. Build one with [`GroomSpec::new`] and the
+/// `with_*` methods (or set the public fields), then call
+/// [`GroomSpec::generator`].
+#[derive(Debug, Clone)]
+pub struct GroomSpec {
+    /// The name errors start with: a groom file's path, or `<groom>`.
+    pub name: PathBuf,
+    /// The surface hairs grow on.
+    pub mesh: Arc<Mesh>,
+    /// The guides, bound to `mesh`.
+    pub guides: Arc<Guides>,
+    /// How many hairs, where, and their seed.
+    pub roots: RootsSpec,
+    /// How hairs take their shape from the guides.
+    pub interpolation: InterpolationMethod,
+    /// The operators, applied in order to every hair.
+    pub ops: Vec<GroomOp>,
+    /// Points, widths, colours, opacities and normals.
+    pub finish: FinishSpec,
+    /// Where the settings were written, for a groom read from a file.
+    pub(crate) origin: Option<Arc<SpecOrigin>>,
+}
+
+impl GroomSpec {
+    /// A groom of `roots` on `mesh` shaped by `guides`, with Shepard
+    /// interpolation (k = 4, power 2), no operators and the default finish
+    /// (16 points, widths 0.002 to 0.0002, normals): the defaults of a
+    /// groom file.
+    pub fn new(
+        mesh: impl Into<Arc<Mesh>>,
+        guides: impl Into<Arc<Guides>>,
+        roots: RootsSpec,
+    ) -> Self {
+        Self {
+            name: PathBuf::from("<groom>"),
+            mesh: mesh.into(),
+            guides: guides.into(),
+            roots,
+            interpolation: InterpolationMethod::Shepard {
+                k: 4,
+                power: 2.0,
+                radius: None,
+            },
+            ops: Vec::new(),
+            finish: FinishSpec::default(),
+            origin: None,
+        }
+    }
+
+    /// Sets the interpolation method.
+    pub fn with_interpolation(mut self, method: InterpolationMethod) -> Self {
+        self.interpolation = method;
+        self
+    }
+
+    /// Appends an operator to the chain.
+    pub fn with_op(mut self, op: GroomOp) -> Self {
+        self.ops.push(op);
+        self
+    }
+
+    /// Sets the finish.
+    pub fn with_finish(mut self, finish: FinishSpec) -> Self {
+        self.finish = finish;
+        self
+    }
+
+    /// Sets the name errors start with.
+    pub fn with_name(mut self, name: impl Into<PathBuf>) -> Self {
+        self.name = name.into();
+        self
+    }
+
+    /// Prepares generation: the root sampler and part layout, the
+    /// interpolator (the style mesh is built here), the operator chain and
+    /// its clump centres.
+    ///
+    /// # Errors
+    /// A count of zero, fewer than 2 points a hair, a map that needs UVs on
+    /// a mesh without them, a density that is zero everywhere; the error
+    /// names the setting (`ops[2].clump.count`), and its line when the
+    /// groom came from a file.
+    pub fn generator(self) -> Result<Generator, GroomError> {
+        Generator::new(self)
+    }
+
+    /// An error about the setting `key` (`roots.count`, `ops[1].noise`),
+    /// at its line when the groom came from a file.
+    pub(crate) fn error(&self, key: &str, kind: GroomErrorKind) -> GroomError {
+        let line = self.origin.as_ref().and_then(|o| o.lines.get(key).copied());
+        GroomError::new(self.name.clone(), line, Some(key.to_string()), kind)
+    }
+}
+
+/// Where a groom file wrote the settings the generator checks: setting key
+/// (`roots.count`, `ops[2].clump.density`, `ops[2].clump` for an
+/// operator's `[[ops]]` header) to line and column.
+#[derive(Debug, Default)]
+pub(crate) struct SpecOrigin {
+    pub(crate) lines: HashMap<String, (usize, usize)>,
+}
+
+/// `[roots]`: how many hairs grow where.
+#[derive(Debug, Clone)]
+pub struct RootsSpec {
+    /// Number of hairs (before `strands` multiplies them).
+    pub count: u64,
+    /// Root density over the surface.
+    pub density: Map,
+    /// Seed of every random number in the groom.
+    pub seed: u64,
+    /// Number of parts (`None`: one per 100,000 hairs).
+    pub parts: Option<u32>,
+}
+
+impl RootsSpec {
+    /// `count` hairs, uniform density, seed 1, the default parts.
+    pub fn new(count: u64) -> Self {
+        Self {
+            count,
+            density: Map::Constant(1.0),
+            seed: 1,
+            parts: None,
+        }
+    }
+
+    /// Sets the density map.
+    pub fn with_density(mut self, density: Map) -> Self {
+        self.density = density;
+        self
+    }
+
+    /// Sets the seed.
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Sets the number of parts.
+    pub fn with_parts(mut self, parts: u32) -> Self {
+        self.parts = Some(parts);
+        self
+    }
+}
+
+/// `[finish]`: what every hair ends with.
+#[derive(Debug, Clone)]
+pub struct FinishSpec {
+    /// Points per hair (at least 2).
+    pub points: usize,
+    /// Widths before any `width` operator.
+    pub width: RootToTip,
+    /// Colours (none unless given here or by a `color` operator).
+    pub color: Option<Color>,
+    /// Opacities (none unless given here or by an `opacity` operator).
+    pub opacity: Option<RootToTip>,
+    /// Per-point ribbon normals from rotation-minimizing frames.
+    pub normals: bool,
+}
+
+impl Default for FinishSpec {
+    /// A groom file's defaults: 16 points, widths 0.002 at the root to
+    /// 0.0002 at the tip, linearly, normals on.
+    fn default() -> Self {
+        Self {
+            points: 16,
+            width: RootToTip::new(Map::Constant(0.002), Map::Constant(0.0002)),
+            color: None,
+            opacity: None,
+            normals: true,
+        }
+    }
+}
+
+/// One operator of the chain, with its settings. Seeds are the operator's
+/// own; the generator mixes them with the groom's seed and the operator's
+/// place in the chain, so two operators with the same seed still differ.
+#[derive(Debug, Clone)]
+pub enum GroomOp {
+    /// Perlin displacement ([`super::ops::Noise`]).
+    Noise(NoiseParams),
+    /// Per-hair random high-frequency displacement ([`super::ops::Frizz`]).
+    Frizz(FrizzParams),
+    /// Pull hairs toward clump centre hairs ([`super::ops::Clump`]).
+    Clump(ClumpParams),
+    /// Helix around the hair's path ([`super::ops::Curl`]).
+    Curl(CurlParams),
+    /// Cut at a curve parameter.
+    Cut(Cut),
+    /// Scale the length ([`super::ops::Length`]).
+    Length(LengthParams),
+    /// Each hair becomes a strand of hairs ([`super::ops::Strands`]).
+    Strands(StrandsParams),
+    /// Widths root to tip (seed as given).
+    Width(RootToTip),
+    /// Colours root to tip (seed as given).
+    Color(Color),
+    /// Opacities root to tip (seed as given).
+    Opacity(RootToTip),
+}
+
+impl GroomOp {
+    /// The operator's name in groom files (`noise`, `clump`, …).
+    pub fn name(&self) -> &'static str {
+        match self {
+            GroomOp::Noise(_) => "noise",
+            GroomOp::Frizz(_) => "frizz",
+            GroomOp::Clump(_) => "clump",
+            GroomOp::Curl(_) => "curl",
+            GroomOp::Cut(_) => "cut",
+            GroomOp::Length(_) => "length",
+            GroomOp::Strands(_) => "strands",
+            GroomOp::Width(_) => "width",
+            GroomOp::Color(_) => "color",
+            GroomOp::Opacity(_) => "opacity",
+        }
+    }
+
+    /// Every map the operator reads, with its setting's name.
+    pub fn maps(&self) -> Vec<(&'static str, &Map)> {
+        match self {
+            GroomOp::Noise(s) => vec![("amplitude", &s.amplitude), ("frequency", &s.frequency)],
+            GroomOp::Frizz(s) => vec![
+                ("amplitude", &s.amplitude),
+                ("frequency", &s.frequency),
+                ("fraction", &s.fraction),
+            ],
+            GroomOp::Clump(s) => {
+                let mut maps = vec![("density", &s.density), ("rate", &s.rate)];
+                maps.extend(s.size.as_ref().map(|m| ("size", m)));
+                maps
+            }
+            GroomOp::Curl(s) => vec![("radius", &s.radius), ("turns", &s.turns)],
+            GroomOp::Cut(s) => vec![("at", s.at())],
+            GroomOp::Length(s) => vec![("scale", &s.scale), ("jitter", &s.jitter)],
+            GroomOp::Strands(s) => vec![
+                ("root_spread", &s.root_spread),
+                ("tip_spread", &s.tip_spread),
+                ("twist", &s.twist),
+            ],
+            GroomOp::Width(s) | GroomOp::Opacity(s) => root_to_tip_maps(s),
+            GroomOp::Color(s) => color_maps(s),
+        }
+    }
+}
+
+/// The maps of a root-to-tip setting, by name.
+pub(crate) fn root_to_tip_maps(s: &RootToTip) -> Vec<(&'static str, &Map)> {
+    vec![("root", &s.root), ("tip", &s.tip), ("jitter", &s.jitter)]
+}
+
+/// The maps of a colour setting, by name.
+pub(crate) fn color_maps(s: &Color) -> Vec<(&'static str, &Map)> {
+    let root = s.root.iter().map(|m| ("root", m));
+    let tip = s.tip.iter().map(|m| ("tip", m));
+    root.chain(tip).chain([("jitter", &s.jitter)]).collect()
+}
+
+/// `noise`: see [`super::ops::Noise`].
+#[derive(Debug, Clone)]
+pub struct NoiseParams {
+    /// Largest displacement (world units).
+    pub amplitude: Map,
+    /// Noise cycles per world unit.
+    pub frequency: Map,
+    /// Root-to-tip profile of the amplitude.
+    pub ramp: Ramp,
+    /// Noise vectors sampled along each hair, interpolated between (0: one
+    /// at every point).
+    pub vectors: usize,
+    /// Seed of the noise field.
+    pub seed: u64,
+}
+
+impl NoiseParams {
+    /// Noise of `amplitude`; a groom file's defaults for the rest
+    /// (frequency 10, linear ramp, 5 vectors, seed 0).
+    pub fn new(amplitude: Map) -> Self {
+        Self {
+            amplitude,
+            frequency: Map::Constant(10.0),
+            ramp: Ramp::default(),
+            vectors: 5,
+            seed: 0,
+        }
+    }
+}
+
+/// `frizz`: see [`super::ops::Frizz`].
+#[derive(Debug, Clone)]
+pub struct FrizzParams {
+    /// Largest displacement (world units).
+    pub amplitude: Map,
+    /// Wiggles along one hair.
+    pub frequency: Map,
+    /// Share of hairs that frizz (0 to 1).
+    pub fraction: Map,
+    /// Root-to-tip profile.
+    pub ramp: Ramp,
+    /// Seed.
+    pub seed: u64,
+}
+
+impl FrizzParams {
+    /// Frizz of `amplitude` on every hair; frequency 6, linear ramp, seed 0.
+    pub fn new(amplitude: Map) -> Self {
+        Self {
+            amplitude,
+            frequency: Map::Constant(6.0),
+            fraction: Map::Constant(1.0),
+            ramp: Ramp::default(),
+            seed: 0,
+        }
+    }
+}
+
+/// `clump`: see [`super::ops::Clump`].
+#[derive(Debug, Clone)]
+pub struct ClumpParams {
+    /// Number of clumps over the whole mesh.
+    pub count: u64,
+    /// Density of clump centres.
+    pub density: Map,
+    /// How far hairs move to their centre hair (0 to 1).
+    pub rate: Map,
+    /// Root-to-tip profile of the rate.
+    pub ramp: Ramp,
+    /// Clump radius (`None`: no limit).
+    pub size: Option<Map>,
+    /// Seed of the clump centres.
+    pub seed: u64,
+}
+
+impl ClumpParams {
+    /// `count` clumps, uniform centres, rate 0.8, linear ramp, no size
+    /// limit, seed 0.
+    pub fn new(count: u64) -> Self {
+        Self {
+            count,
+            density: Map::Constant(1.0),
+            rate: Map::Constant(0.8),
+            ramp: Ramp::default(),
+            size: None,
+            seed: 0,
+        }
+    }
+}
+
+/// `curl`: see [`super::ops::Curl`].
+#[derive(Debug, Clone)]
+pub struct CurlParams {
+    /// Helix radius at the tip (world units): Silva's K_α.
+    pub radius: Map,
+    /// Turns along the hair: Silva's ω / 2π.
+    pub turns: Map,
+    /// Root-to-tip profile of the radius.
+    pub ramp: Ramp,
+    /// Seed of each hair's phase.
+    pub seed: u64,
+}
+
+impl CurlParams {
+    /// A curl of `radius` and `turns`, linear ramp, seed 0.
+    pub fn new(radius: Map, turns: Map) -> Self {
+        Self {
+            radius,
+            turns,
+            ramp: Ramp::default(),
+            seed: 0,
+        }
+    }
+}
+
+/// `length`: see [`super::ops::Length`].
+#[derive(Debug, Clone)]
+pub struct LengthParams {
+    /// Length factor.
+    pub scale: Map,
+    /// Per-hair random variation, a fraction (0.2 = ±20 %).
+    pub jitter: Map,
+    /// Seed of the variation.
+    pub seed: u64,
+}
+
+impl LengthParams {
+    /// Lengths times `scale`, no jitter, seed 0.
+    pub fn new(scale: Map) -> Self {
+        Self {
+            scale,
+            jitter: Map::Constant(0.0),
+            seed: 0,
+        }
+    }
+}
+
+/// `strands`: see [`super::ops::Strands`].
+#[derive(Debug, Clone)]
+pub struct StrandsParams {
+    /// Hairs per strand (at least 1).
+    pub count: u32,
+    /// Spread around the base hair at the root (world units).
+    pub root_spread: Map,
+    /// Spread at the tip.
+    pub tip_spread: Map,
+    /// Turns of the strand's hairs around the base hair, root to tip.
+    pub twist: Map,
+    /// Seed.
+    pub seed: u64,
+}
+
+impl StrandsParams {
+    /// Strands of `count` hairs spreading to `tip_spread`; no root spread,
+    /// no twist, seed 0.
+    pub fn new(count: u32, tip_spread: Map) -> Self {
+        Self {
+            count,
+            root_spread: Map::Constant(0.0),
+            tip_spread,
+            twist: Map::Constant(0.0),
+            seed: 0,
+        }
+    }
+}
+
+impl RootToTip {
+    /// From `root` to `tip`, linearly, no jitter, seed 0.
+    pub fn new(root: Map, tip: Map) -> Self {
+        Self {
+            root,
+            tip,
+            ramp: Ramp::default(),
+            jitter: Map::Constant(0.0),
+            seed: 0,
+        }
+    }
+}
