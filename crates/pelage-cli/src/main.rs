@@ -62,11 +62,29 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            // `{:#}` prints the whole cause chain on one line: "a: b: c".
-            eprintln!("error: {err:#}");
+            eprintln!("error: {}", one_line(&err));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes on one line, "a: b: c", each cause left out
+/// when the message so far already says it (pelage's errors name the
+/// error underneath in their message and also give it as their `source`,
+/// for programs that inspect it).
+pub(crate) fn one_line(err: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
 }
 
 /// Mesa's `VK_LAYER_MESA_device_select` (an implicit Vulkan layer, there

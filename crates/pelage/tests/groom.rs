@@ -4,8 +4,15 @@
 
 use glam::Vec3;
 use pelage::Curves;
-use pelage::groom::{Groom, GroomError};
+use pelage::groom::ops::{Color, Cut, RootToTip};
+use pelage::groom::{
+    ClumpParams, CurlParams, FrizzParams, Groom, GroomError, GroomOp, GroomSpec, LengthParams,
+    NoiseParams, Ramp, RootsSpec, StrandsParams,
+};
+use pelage::guides::{GuideGrowth, Guides};
+use pelage::map::{Map, NoiseMap};
 use std::collections::HashSet;
+use std::sync::Arc;
 
 const EVERY_OPERATOR: &str = r#"
 [mesh]
@@ -99,6 +106,101 @@ fn output_is_identical_on_one_and_two_threads() {
         assert_eq!(a.ids(), b.ids());
         assert_eq!(a.offsets(), b.offsets());
     }
+}
+
+/// [`EVERY_OPERATOR`] written as Rust values, with no file.
+fn every_operator_in_code() -> GroomSpec {
+    let mesh = Arc::new(pelage::assets::spot());
+    let noise = |frequency, seed, offset, scale| {
+        // A noise spec's default octaves: 4.
+        Map::Noise(NoiseMap::new(frequency, 4, seed, offset, scale))
+    };
+    let c = Map::Constant;
+    let guides = Guides::grow(
+        &mesh,
+        &GuideGrowth {
+            count: 120,
+            length: c(0.05),
+            comb: Vec3::new(0.0, -1.0, 0.0),
+            gravity: 0.2,
+            points: 6,
+            width: 0.004,
+            seed: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let roots = RootsSpec::new(6000)
+        .with_density(noise(4.0, 3, 0.6, 0.4))
+        .with_seed(11)
+        .with_parts(3);
+    let mut width = RootToTip::new(c(0.001), c(0.0001));
+    width.jitter = c(0.1);
+    let color = Color {
+        root: [c(0.2), c(0.1), c(0.05)],
+        tip: [c(0.8), c(0.7), c(0.5)],
+        ramp: Ramp::default(),
+        jitter: c(0.1),
+        seed: 0,
+    };
+    GroomSpec::new(mesh, guides, roots)
+        .with_op(GroomOp::Clump(ClumpParams {
+            rate: c(0.6),
+            ramp: Ramp::Smooth,
+            ..ClumpParams::new(300)
+        }))
+        .with_op(GroomOp::Clump(ClumpParams {
+            rate: c(0.3),
+            size: Some(c(0.2)),
+            ..ClumpParams::new(40)
+        }))
+        .with_op(GroomOp::Curl(CurlParams::new(c(0.003), c(1.5))))
+        .with_op(GroomOp::Noise(NoiseParams {
+            frequency: noise(2.0, 0, 30.0, 10.0),
+            ..NoiseParams::new(c(0.003))
+        }))
+        .with_op(GroomOp::Frizz(FrizzParams {
+            fraction: c(0.3),
+            ..FrizzParams::new(c(0.002))
+        }))
+        .with_op(GroomOp::Length(LengthParams {
+            jitter: c(0.2),
+            ..LengthParams::new(c(1.0))
+        }))
+        .with_op(GroomOp::Cut(Cut::new(noise(3.0, 0, 0.9, 0.3))))
+        .with_op(GroomOp::Strands(StrandsParams {
+            root_spread: c(0.001),
+            twist: c(0.5),
+            ..StrandsParams::new(3, c(0.004))
+        }))
+        .with_op(GroomOp::Width(width))
+        .with_op(GroomOp::Color(color))
+        .with_op(GroomOp::Opacity(RootToTip::new(c(1.0), c(0.5))))
+}
+
+#[test]
+fn a_groom_built_in_code_equals_the_same_groom_file() {
+    let from_file = groom(EVERY_OPERATOR).generator(None).unwrap();
+    let from_code = every_operator_in_code().generator().unwrap();
+    assert_eq!(from_code.parts(), from_file.parts());
+    for p in 0..3 {
+        let (a, b) = (from_code.part(p).unwrap(), from_file.part(p).unwrap());
+        assert!(a.curve_count() > 1000);
+        assert_eq!(a, b, "part {p}");
+    }
+    // Both paths check the same things: a count of zero, named by key
+    // (and, from a file, by line).
+    let mut zero = every_operator_in_code();
+    zero.roots.count = 0;
+    let err = zero.generator().unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "<groom>: roots.count: the hair count must be at least 1"
+    );
+    let mut no_strand = every_operator_in_code();
+    no_strand.ops[7] = GroomOp::Strands(StrandsParams::new(0, Map::Constant(0.1)));
+    let err = no_strand.generator().unwrap_err().to_string();
+    assert!(err.starts_with("<groom>: ops[7].strands.count: "), "{err}");
 }
 
 #[test]

@@ -158,7 +158,7 @@ impl CurvesSession {
                 self.loaded = loaded;
                 self.uploaded = None;
             }
-            Err(err) => self.status = format!("not reloaded: {err:#}"),
+            Err(err) => self.status = format!("not reloaded: {}", crate::one_line(&err)),
         }
     }
 
