@@ -25,7 +25,7 @@ fn repo(path: &str) -> PathBuf {
 }
 
 fn blub() -> String {
-    repo("../shared/data/meshes/blub_triangulated.obj")
+    repo("tests/data/meshes/blub_triangulated.obj")
         .display()
         .to_string()
 }
@@ -514,7 +514,7 @@ fn a_groom_that_overflows_is_an_error_at_its_operator_and_writes_nothing() {
 /// not available and not required (PELAGE_REQUIRE_USDCHECK makes it
 /// required, as in CI).
 fn usdcheck(files: &[&Path]) -> Option<(bool, String)> {
-    let script = repo("../shared/tools/usdcheck");
+    let script = repo("tools/usdcheck");
     let required = std::env::var_os("PELAGE_REQUIRE_USDCHECK").is_some();
     if !script.exists() {
         assert!(

@@ -159,7 +159,7 @@ fn style_mesh_figure(
     use pelage::guides::{GuideGrowth, Guides};
     use pelage::interp::{StyleMesh, StyleMeshOptions};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/meshes/blub_triangulated.obj");
+        .join("../../tests/data/meshes/blub_triangulated.obj");
     let blub = Mesh::load(&path)?;
     let guides = Guides::grow(
         &blub,

@@ -8,7 +8,7 @@
 //! perf record -g target/release/examples/profile_sampler sample cdf   # the same with CDF + grid
 //! ```
 //!
-//! Run from the repository root (it reads `../shared/data/meshes/`).
+//! It reads blub from the repository's `tests/data/meshes/`.
 
 use pelage::map::{ImageMap, Map, NoiseMap, Wrap};
 use pelage::mesh::SurfacePoint;
@@ -17,8 +17,11 @@ use std::time::Instant;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let blub = pelage::Mesh::load("../shared/data/meshes/blub_triangulated.obj")
-        .expect("run from the repository root, with shared/ beside it")
+    let blub = pelage::Mesh::load(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../tests/data/meshes/blub_triangulated.obj"),
+    )
+        .expect("blub is in tests/data/meshes")
         .subdivided(1);
     let noise = NoiseMap::new(8.0, 4, 1, 0.5, 0.5);
     let size = 1024u32;

@@ -2,7 +2,7 @@
 //! trips through every format, `.hair` byte for byte, malformed files as
 //! errors naming the file and the field or line.
 //!
-//! The usdcheck tests run `../shared/tools/usdcheck` (it installs usd-core
+//! The usdcheck tests run `tools/usdcheck` (it installs usd-core
 //! into a cached venv on first use). Where it is missing or cannot set
 //! itself up they print SKIPPED; with `PELAGE_REQUIRE_USDCHECK=1` (CI) they
 //! fail instead.
@@ -56,7 +56,7 @@ fn small_groom(curves: u32, points: usize) -> Curves {
 /// Runs usdcheck on `files`; `None` (after printing SKIPPED) where it is
 /// not available and not required.
 fn usdcheck(files: &[&Path]) -> Option<(bool, String)> {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/tools/usdcheck");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/usdcheck");
     let required = std::env::var_os("PELAGE_REQUIRE_USDCHECK").is_some();
     if !script.exists() {
         assert!(

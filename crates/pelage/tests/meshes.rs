@@ -1,5 +1,5 @@
 //! Loading and subdividing the real meshes the project uses
-//! (`shared/data/meshes/`, beside the repository) and the small valid files
+//! (`tests/data/meshes/`, with their licences) and the small valid files
 //! in `tests/data/good/`.
 
 use pelage::Mesh;
@@ -7,9 +7,9 @@ use pelage::mesh::Uvs;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-fn shared_mesh(file: &str) -> PathBuf {
+fn test_mesh(file: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/meshes")
+        .join("../../tests/data/meshes")
         .join(file)
 }
 
@@ -21,7 +21,7 @@ fn good(file: &str) -> PathBuf {
 
 #[test]
 fn blub_loads_as_its_licence_file_describes() {
-    let blub = Mesh::load(shared_mesh("blub_triangulated.obj")).unwrap();
+    let blub = Mesh::load(test_mesh("blub_triangulated.obj")).unwrap();
     assert_eq!(blub.triangle_count(), 14_208);
     assert_eq!(blub.vertex_count(), 7_106);
     assert!(blub.has_uvs());
@@ -102,7 +102,7 @@ fn check_subdivision(mesh: &Mesh, levels: u32) {
 
 #[test]
 fn subdivided_blub_keeps_area_and_uvs() {
-    let blub = Mesh::load(shared_mesh("blub_triangulated.obj")).unwrap();
+    let blub = Mesh::load(test_mesh("blub_triangulated.obj")).unwrap();
     check_subdivision(&blub, 1);
     assert_eq!(blub.subdivided(1).triangle_count(), 56_832);
 }

@@ -97,8 +97,8 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
     let spot = pelage::assets::spot();
     let mut meshes: Vec<(String, Mesh)> = vec![("spot".into(), spot.subdivided(0))];
     if !args.quick {
-        let blub = Path::new("../shared/data/meshes/blub_triangulated.obj");
-        if let Ok(mesh) = Mesh::load(blub) {
+        let blub = super::test_meshes().join("blub_triangulated.obj");
+        if let Ok(mesh) = Mesh::load(&blub) {
             meshes.push(("blub".into(), mesh));
         }
         meshes.push(("spot ×4".into(), spot.subdivided(4)));

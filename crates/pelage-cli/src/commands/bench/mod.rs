@@ -42,6 +42,13 @@ pub enum BenchWhat {
     Io(io::IoBenchArgs),
 }
 
+/// The repository's test meshes (blub), where the benchmarks that go past
+/// the embedded Spot find them: `tests/data/meshes/` of the source tree
+/// this binary was built from.
+pub fn test_meshes() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/meshes")
+}
+
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     match &args.what {
         BenchWhat::Sampler(a) => sampler::run(a),

@@ -31,9 +31,10 @@ pub struct SamplerBenchArgs {
     /// Print one JSON object instead of tables.
     #[arg(long)]
     pub json: bool,
-    /// Folder with blub_triangulated.obj (the shared test meshes).
-    #[arg(long, default_value = "../shared/data/meshes")]
-    pub meshes: PathBuf,
+    /// Folder with blub_triangulated.obj (default: the repository's
+    /// tests/data/meshes).
+    #[arg(long)]
+    pub meshes: Option<PathBuf>,
 }
 
 struct Plan {
@@ -149,7 +150,11 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
         }
     };
     let threads = rayon::current_num_threads();
-    let blub_path = args.meshes.join("blub_triangulated.obj");
+    let blub_path = args
+        .meshes
+        .clone()
+        .unwrap_or_else(super::test_meshes)
+        .join("blub_triangulated.obj");
     let blub = Mesh::load(&blub_path)
         .context("the sampler benchmark needs blub (give the folder with --meshes)")?
         .subdivided(1);

@@ -75,8 +75,8 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
     let (layer_counts, sizes): (&[u32], &[(u32, u32)]) = if args.quick {
         (&[16], &[(800, 600)])
     } else {
-        let blub = Path::new("../shared/data/meshes/blub_triangulated.obj");
-        if let Ok(mesh) = Mesh::load(blub) {
+        let blub = super::test_meshes().join("blub_triangulated.obj");
+        if let Ok(mesh) = Mesh::load(&blub) {
             meshes.insert(1, ("blub".into(), mesh));
         }
         meshes.insert(2, ("spot ×1".into(), spot.subdivided(1)));
