@@ -200,7 +200,7 @@ fn a_scene_stepped_on_the_gpu_renders_as_on_the_cpu() {
         [dynamics.shake]\namplitude = [0.05, 0, 0]\nfrequency = 4\n";
     let frames = |gpu: bool| {
         let text = base.replace("substeps = 8\n", &format!("substeps = 8\ngpu = {gpu}\n"));
-        let scene = pelage::shell::ShellScene::from_source(&pelage::groom::GroomSource {
+        let scene = pelage::shell::ShellScene::from_source(&pelage::settings::SettingsSource {
             path: "windy.toml".into(),
             text,
         })

@@ -21,8 +21,8 @@ fn main() {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../tests/data/meshes/blub_triangulated.obj"),
     )
-        .expect("blub is in tests/data/meshes")
-        .subdivided(1);
+    .expect("blub is in tests/data/meshes")
+    .subdivided(1);
     let noise = NoiseMap::new(8.0, 4, 1, 0.5, 0.5);
     let size = 1024u32;
     let texels: Vec<f32> = (0..size * size)

@@ -41,6 +41,7 @@ pub mod io;
 pub mod map;
 pub mod mesh;
 pub mod sample;
+pub mod settings;
 pub mod shell;
 
 pub use curves::Curves;

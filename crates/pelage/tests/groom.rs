@@ -204,6 +204,29 @@ fn a_groom_built_in_code_equals_the_same_groom_file() {
 }
 
 #[test]
+fn errors_keep_the_error_underneath_as_their_source() {
+    let text = "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\ndensity = \"missing.png:r\"\n[guides]\ngenerate = { count = 5, length = 0.1 }\n";
+    let err = groom(text).generator(None).unwrap_err();
+    assert!(
+        err.to_string()
+            .starts_with("test.toml:5:11: roots.density: "),
+        "{err}"
+    );
+    let mut chain = Vec::new();
+    let mut cause = std::error::Error::source(&err);
+    while let Some(c) = cause {
+        chain.push(c);
+        cause = c.source();
+    }
+    assert!(chain[0].is::<pelage::MapError>(), "{chain:?}");
+    let io = chain.last().unwrap().downcast_ref::<std::io::Error>();
+    assert_eq!(
+        io.map(std::io::Error::kind),
+        Some(std::io::ErrorKind::NotFound)
+    );
+}
+
+#[test]
 fn a_part_grown_alone_equals_that_part_of_the_full_run() {
     let g = groom(EVERY_OPERATOR);
     let full = g.generator(None).unwrap();

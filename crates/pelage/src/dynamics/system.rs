@@ -24,8 +24,10 @@
 use crate::Mesh;
 use glam::Vec3;
 
-/// Which masses and springs (see the module table).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which masses and springs (see the module table); scene files name them
+/// in kebab case (`spring-sticks`, `separable-prisms`, …).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Topology {
     /// One stick per vertex.
     SpringSticks,

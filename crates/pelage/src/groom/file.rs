@@ -104,6 +104,21 @@ pub struct MeshSection {
     pub subdivide: u32,
 }
 
+impl MeshSection {
+    /// The mesh it names (`"spot"`: the embedded one, otherwise a file
+    /// relative to `folder`), subdivided as asked.
+    pub fn load(&self, folder: &std::path::Path) -> Result<crate::Mesh, crate::mesh::MeshError> {
+        let mesh = match self.path.get_ref().as_str() {
+            "spot" => crate::assets::spot(),
+            path => crate::Mesh::load(folder.join(path))?,
+        };
+        Ok(match self.subdivide {
+            0 => mesh,
+            n => mesh.subdivided(n),
+        })
+    }
+}
+
 /// `[roots]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -488,10 +503,11 @@ pub struct OutputSection {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::groom::{GroomError, GroomSource};
+    use crate::groom::GroomError;
+    use crate::settings::SettingsSource;
 
     fn parse(text: &str) -> Result<GroomFile, GroomError> {
-        GroomSource {
+        SettingsSource {
             path: "test.toml".into(),
             text: text.into(),
         }
@@ -599,7 +615,7 @@ mod tests {
 
     #[test]
     fn bad_map_is_reported_at_its_line() {
-        let source = GroomSource {
+        let source = SettingsSource {
             path: "g.toml".into(),
             text: format!("{MINIMAL}[[ops]]\nnoise = {{ amplitude = \"missing.png:r\" }}\n"),
         };

@@ -9,7 +9,6 @@ use super::file::{
 };
 use super::generator::Generator;
 use super::ops::{Color, Cut, RootToTip};
-use super::source::GroomSource;
 use super::spec::{
     ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, LengthParams,
     NoiseParams, RootsSpec, SpecOrigin, StrandsParams,
@@ -18,6 +17,7 @@ use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{InterpolationMethod, StyleMeshOptions};
 use crate::map::Map;
 use crate::mesh::Mesh;
+use crate::settings::SettingsSource;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -28,7 +28,7 @@ pub const HAIRS_PER_PART: u64 = 100_000;
 
 /// A groom file loaded: the file, its mesh and guides.
 pub struct Groom {
-    source: GroomSource,
+    source: SettingsSource,
     file: GroomFile,
     mesh: Arc<Mesh>,
     guides: Arc<Guides>,
@@ -48,7 +48,7 @@ impl std::fmt::Debug for Groom {
 impl Groom {
     /// Reads, parses and loads the groom file at `path`.
     pub fn load(path: &Path) -> Result<Self, GroomError> {
-        Self::from_source(GroomSource::read(path)?)
+        Self::from_source(SettingsSource::read_groom(path)?)
     }
 
     /// Loads a groom from its text (`path` names it in errors and is the
@@ -57,14 +57,14 @@ impl Groom {
         path: impl Into<PathBuf>,
         text: impl Into<String>,
     ) -> Result<Self, GroomError> {
-        Self::from_source(GroomSource {
+        Self::from_source(SettingsSource {
             path: path.into(),
             text: text.into(),
         })
     }
 
     /// Parses the source, loads the mesh and the guides.
-    pub fn from_source(source: GroomSource) -> Result<Self, GroomError> {
+    pub fn from_source(source: SettingsSource) -> Result<Self, GroomError> {
         let file = source.parse()?;
         let mesh = Arc::new(load_mesh_section(&source, &file.mesh)?);
         let (guides, bind_report) = load_guides(&source, &file, &mesh)?;
@@ -83,7 +83,7 @@ impl Groom {
     }
 
     /// The file's path and text.
-    pub fn source(&self) -> &GroomSource {
+    pub fn source(&self) -> &SettingsSource {
         &self.source
     }
 
@@ -294,7 +294,7 @@ pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>) -> usize {
 
 /// Resolves a map value and checks it can be read on `mesh` (UVs), both
 /// errors at the value's line.
-fn map_on_mesh(source: &GroomSource, mesh: &Mesh, value: &MapValue) -> Result<Map, GroomError> {
+fn map_on_mesh(source: &SettingsSource, mesh: &Mesh, value: &MapValue) -> Result<Map, GroomError> {
     let map = source.map(value)?;
     map.on_mesh(mesh)
         .map_err(|e| source.error_at(value.span(), GroomErrorKind::Map(e)))?;
@@ -302,7 +302,7 @@ fn map_on_mesh(source: &GroomSource, mesh: &Mesh, value: &MapValue) -> Result<Ma
 }
 
 fn root_to_tip(
-    source: &GroomSource,
+    source: &SettingsSource,
     mesh: &Mesh,
     s: &RootToTipSpec,
 ) -> Result<RootToTip, GroomError> {
@@ -316,7 +316,7 @@ fn root_to_tip(
     })
 }
 
-fn color(source: &GroomSource, mesh: &Mesh, s: &ColorSpec) -> Result<Color, GroomError> {
+fn color(source: &SettingsSource, mesh: &Mesh, s: &ColorSpec) -> Result<Color, GroomError> {
     let map = |v: &MapValue| map_on_mesh(source, mesh, v);
     let three = |c: &[MapValue; 3]| -> Result<[Map; 3], GroomError> {
         Ok([map(&c[0])?, map(&c[1])?, map(&c[2])?])
@@ -330,28 +330,16 @@ fn color(source: &GroomSource, mesh: &Mesh, s: &ColorSpec) -> Result<Color, Groo
     })
 }
 
-/// The mesh a `[mesh]` section names (`"spot"`: the embedded one),
-/// subdivided as asked; a mesh that cannot be loaded is reported at its
-/// line.
-pub(crate) fn load_mesh_section(
-    source: &GroomSource,
-    section: &MeshSection,
-) -> Result<Mesh, GroomError> {
-    let path = &section.path;
-    let mesh = if path.get_ref() == "spot" {
-        crate::assets::spot()
-    } else {
-        Mesh::load(source.folder().join(path.get_ref()))
-            .map_err(|e| source.error_at(path.span(), GroomErrorKind::Mesh(e)))?
-    };
-    Ok(match section.subdivide {
-        0 => mesh,
-        n => mesh.subdivided(n),
-    })
+/// The mesh a `[mesh]` section names, subdivided as asked; a mesh that
+/// cannot be loaded is reported at its line.
+fn load_mesh_section(source: &SettingsSource, section: &MeshSection) -> Result<Mesh, GroomError> {
+    section
+        .load(source.folder())
+        .map_err(|e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e)))
 }
 
 fn load_guides(
-    source: &GroomSource,
+    source: &SettingsSource,
     file: &GroomFile,
     mesh: &Mesh,
 ) -> Result<(Guides, Option<BindReport>), GroomError> {

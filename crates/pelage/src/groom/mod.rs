@@ -40,11 +40,10 @@ pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
 pub use file::{GroomFile, InterpolationKind};
 pub use generator::{Generator, GroomSummary, HAIRS_PER_PART};
 pub use load::Groom;
-pub(crate) use load::load_mesh_section;
 pub use output::{GroomWriteError, part_file, part_name, part_slice, write_assembly};
 pub use parts::{Part, PartLayout};
 pub use ramp::Ramp;
-pub use source::GroomSource;
+
 pub use spec::{
     ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, LengthParams,
     NoiseParams, RootsSpec, StrandsParams,

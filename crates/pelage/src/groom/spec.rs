@@ -215,6 +215,10 @@ impl Default for FinishSpec {
 /// own; the generator mixes them with the groom's seed and the operator's
 /// place in the chain, so two operators with the same seed still differ.
 #[derive(Debug, Clone)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "a groom holds a handful, built once; boxing would only add noise to building them"
+)]
 pub enum GroomOp {
     /// Perlin displacement ([`super::ops::Noise`]).
     Noise(NoiseParams),

@@ -12,7 +12,7 @@ use std::path::Path;
 pub enum CurvesReadErrorKind {
     /// The file could not be opened or read.
     #[error("cannot read the file: {0}")]
-    Io(std::io::Error),
+    Io(#[source] std::io::Error),
     /// The extension names no format pelage reads curves from.
     #[error(
         "unknown curves format {extension:?}; pelage reads curves from .usda, .usdc, .usd, .hair and .ply"

@@ -34,13 +34,25 @@ pub enum Map {
 
 /// A map could not be read, parsed or used. Displays as `SOURCE: what is
 /// wrong`, where SOURCE is the image file, the spec string or the mesh.
-#[derive(Debug, thiserror::Error)]
-#[error("{source_name}: {kind}")]
+/// Its `source` is the error underneath its kind, if any.
+#[derive(Debug)]
 pub struct MapError {
     /// The image path, the map spec as written, or the mesh name.
     pub source_name: String,
     /// What is wrong.
     pub kind: MapErrorKind,
+}
+
+impl std::fmt::Display for MapError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.source_name, self.kind)
+    }
+}
+
+impl std::error::Error for MapError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        std::error::Error::source(&self.kind)
+    }
 }
 
 /// What is wrong with a map.
@@ -49,7 +61,7 @@ pub struct MapError {
 pub enum MapErrorKind {
     /// The image file could not be opened or read.
     #[error("cannot read the file: {0}")]
-    Io(std::io::Error),
+    Io(#[source] std::io::Error),
     /// The file is not an image pelage can decode.
     #[error("not a readable PNG or EXR image: {0}")]
     Decode(String),

@@ -35,7 +35,7 @@ impl fmt::Display for Location {
 pub enum MeshErrorKind {
     /// The file could not be opened or read.
     #[error("cannot read the file: {0}")]
-    Io(std::io::Error),
+    Io(#[source] std::io::Error),
     /// The extension names no format pelage reads.
     #[error("unknown mesh format {extension:?}; pelage reads .obj, .ply, .gltf and .glb")]
     UnknownFormat {

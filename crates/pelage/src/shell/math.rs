@@ -401,7 +401,8 @@ pub fn kajiya_kay(color: Vec3, t: Vec3, l: Vec3, e: Vec3, h: f32, k: KajiyaKay) 
 
 /// How layer fragments are coloured: the four stages of Banisch Fig. 2,
 /// then Silva's Eq. 6.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum ShadingMode {
     /// The structure alone: grey hair, lighter towards each hair's tip.
     Structure,

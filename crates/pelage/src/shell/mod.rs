@@ -13,11 +13,13 @@
 //! - [`scene`]: shell scene files (TOML): mesh, textures, curl, clumping,
 //!   droplets, light and camera (docs/shells-format.md).
 
+mod error;
 pub mod math;
 pub mod scene;
 pub mod textures;
 pub mod wetness;
 
+pub use error::{SceneError, SceneErrorDetails, SceneErrorKind};
 pub use math::{ClumpParams, Coupling, CurlParams, KajiyaKay, Strand, WetTexel};
 pub use scene::ShellScene;
 pub use textures::{ShellTextureParams, ShellTextures, TextureStyle};

@@ -3,8 +3,11 @@
 //! curl (Silva Eq. 4), clumping (Eq. 5), shading (Eq. 6 or Banisch's
 //! stages), droplets over time with drying, light and camera.
 //!
-//! Errors share the groom files' type: `FILE:LINE:COL: KEY: what`.
+//! Errors are [`SceneError`]s: `FILE:LINE:COL: KEY: what`; names (texture
+//! style, shading, topology, solver, coupling) are serde enums, so an
+//! unknown one lists the accepted names.
 
+use super::error::{SceneError, SceneErrorKind};
 use super::math::{ClumpParams, Coupling, CurlParams, KajiyaKay, ShadingMode};
 use super::textures::{ShellTextureParams, TextureStyle};
 use super::wetness::{
@@ -13,7 +16,7 @@ use super::wetness::{
 use crate::Mesh;
 use crate::dynamics::{DynamicsParams, Solver, Topology, Wind};
 use crate::groom::file::MeshSection;
-use crate::groom::{GroomError, GroomErrorKind, GroomSource};
+use crate::settings::SettingsSource;
 use glam::{Vec2, Vec3};
 use serde::Deserialize;
 use std::f32::consts::TAU;
@@ -50,13 +53,13 @@ struct SceneFile {
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct DynamicsSection {
-    topology: Option<Spanned<String>>,
-    solver: Option<Spanned<String>>,
+    topology: Option<Topology>,
+    solver: Option<SolverName>,
     substeps: Option<u32>,
     iterations: Option<u32>,
     gpu: Option<Spanned<bool>>,
     steps_per_frame: Option<u32>,
-    coupling: Option<Spanned<String>>,
+    coupling: Option<CouplingName>,
     exponent: Option<f32>,
     mass: Option<f32>,
     stiffness: Option<f32>,
@@ -99,7 +102,7 @@ struct FurSection {
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct TextureSection {
-    style: Option<Spanned<String>>,
+    style: Option<TextureStyle>,
     resolution: Option<Spanned<u32>>,
     density: Option<f32>,
     thickness: Option<f32>,
@@ -129,7 +132,7 @@ struct ClumpSection {
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct ShadingSection {
-    mode: Option<Spanned<String>>,
+    mode: Option<ShadingMode>,
     specular: Option<[f32; 3]>,
     exponent: Option<f32>,
     shadow: Option<f32>,
@@ -160,6 +163,23 @@ struct DropletsSection {
     radius: Option<RadiusText>,
     wetness: Option<f32>,
     seed: Option<u64>,
+}
+
+/// `[dynamics] solver`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum SolverName {
+    Implicit,
+    Explicit,
+}
+
+/// `[dynamics] coupling`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum CouplingName {
+    Bezier,
+    Linear,
+    Bent,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]
@@ -321,13 +341,20 @@ pub struct ShellScene {
 
 impl ShellScene {
     /// Reads a scene file.
-    pub fn load(path: &Path) -> Result<Self, GroomError> {
-        Self::from_source(&GroomSource::read(path)?)
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        let source = SettingsSource::read(path).map_err(|e| {
+            SceneError::new(
+                path.to_path_buf(),
+                Default::default(),
+                SceneErrorKind::Io(e),
+            )
+        })?;
+        Self::from_source(&source)
     }
 
     /// The scene without a file: spot with its texture, dry straight fur.
     pub fn spot() -> Self {
-        Self::from_source(&GroomSource {
+        Self::from_source(&SettingsSource {
             path: "<spot>".into(),
             text: String::new(),
         })
@@ -335,15 +362,22 @@ impl ShellScene {
     }
 
     /// Builds a scene from a file's text (relative paths against its folder).
-    pub fn from_source(source: &GroomSource) -> Result<Self, GroomError> {
-        let file: SceneFile = source.parse_as()?;
+    pub fn from_source(source: &SettingsSource) -> Result<Self, SceneError> {
+        let file: SceneFile = source.deserialize().map_err(|(place, message)| {
+            SceneError::new(source.path.clone(), place, SceneErrorKind::Syntax(message))
+        })?;
         let invalid = |span: std::ops::Range<usize>, message: String| {
-            source.error_at(span, GroomErrorKind::Invalid(message))
+            SceneError::at(source, span, SceneErrorKind::Invalid(message))
+        };
+        let image_at = |span: std::ops::Range<usize>, path: std::path::PathBuf| {
+            move |error| SceneError::at(source, span, SceneErrorKind::Image { path, error })
         };
         let (mesh, default_color) = match &file.mesh {
             None => (crate::assets::spot(), Some(spot_color())),
             Some(section) => {
-                let mesh = crate::groom::load_mesh_section(source, section)?;
+                let mesh = section.load(source.folder()).map_err(|e| {
+                    SceneError::at(source, section.path.span(), SceneErrorKind::Mesh(e))
+                })?;
                 let spot = section.path.get_ref() == "spot";
                 (mesh, spot.then(spot_color))
             }
@@ -362,7 +396,7 @@ impl ShellScene {
             Some(path) => {
                 let full = source.folder().join(path.get_ref());
                 image::open(&full)
-                    .map_err(|e| invalid(path.span(), format!("{}: {e}", full.display())))?
+                    .map_err(image_at(path.span(), full.clone()))?
                     .to_rgba8()
             }
             None => default_color.unwrap_or_else(|| {
@@ -400,16 +434,7 @@ impl ShellScene {
 
         let t = &file.texture;
         let defaults = ShellTextureParams::default();
-        let style = match t.style.as_ref().map(|s| (s.get_ref().as_str(), s.span())) {
-            None | Some(("blades", _)) => TextureStyle::Blades,
-            Some(("random-strands", _)) => TextureStyle::RandomStrands,
-            Some((other, span)) => {
-                return Err(invalid(
-                    span,
-                    format!("unknown style `{other}`: use `blades` or `random-strands`"),
-                ));
-            }
-        };
+        let style = t.style.unwrap_or(TextureStyle::Blades);
         let resolution = match &t.resolution {
             Some(r) if !(8..=4096).contains(r.get_ref()) => {
                 return Err(invalid(
@@ -443,26 +468,7 @@ impl ShellScene {
             w: file.clump.w.unwrap_or(0.6).clamp(0.0, 1.0),
             strength: file.clump.strength.unwrap_or(4.0).max(0.0),
         });
-        let mode = match file
-            .shading
-            .mode
-            .as_ref()
-            .map(|m| (m.get_ref().as_str(), m.span()))
-        {
-            None | Some(("kajiya-kay", _)) => ShadingMode::KajiyaKay,
-            Some(("structure", _)) => ShadingMode::Structure,
-            Some(("color", _)) => ShadingMode::Color,
-            Some(("shadow", _)) => ShadingMode::Shadow,
-            Some(("lambert", _)) => ShadingMode::Lambert,
-            Some((other, span)) => {
-                return Err(invalid(
-                    span,
-                    format!(
-                        "unknown shading `{other}`: use structure, color, shadow, lambert or kajiya-kay"
-                    ),
-                ));
-            }
-        };
+        let mode = file.shading.mode.unwrap_or(ShadingMode::KajiyaKay);
         let shading = ShadingSettings {
             mode,
             kajiya_kay: KajiyaKay {
@@ -509,7 +515,7 @@ impl ShellScene {
                 (None, None, Some(path)) => {
                     let full = source.folder().join(path.get_ref());
                     let image = image::open(&full)
-                        .map_err(|e| invalid(path.span(), format!("{}: {e}", full.display())))?
+                        .map_err(image_at(path.span(), full.clone()))?
                         .to_luma32f();
                     let (w, h) = (image.width() as f32, image.height() as f32);
                     let brightness = |p: Vec2| {
@@ -539,35 +545,15 @@ impl ShellScene {
         let dynamics = match &file.dynamics {
             None => None,
             Some(d) => {
-                let named = |value: &Option<Spanned<String>>, default: &str| {
-                    value.as_ref().map_or((default.to_string(), 0..0), |v| {
-                        (v.get_ref().clone(), v.span())
-                    })
-                };
-                let (name, span) = named(&d.topology, "spring-sticks");
-                let topology = Topology::from_name(&name).ok_or_else(|| {
-                    invalid(
-                        span,
-                        format!(
-                            "unknown topology `{name}`: use spring-sticks, separable-spring-sticks, prisms, separable-prisms or silva-strands"
-                        ),
-                    )
-                })?;
-                let (name, span) = named(&d.solver, "implicit");
-                let solver = match name.as_str() {
-                    "implicit" => Solver::Implicit {
+                let topology = d.topology.unwrap_or(Topology::SpringSticks);
+                let solver = match d.solver.unwrap_or(SolverName::Implicit) {
+                    SolverName::Implicit => Solver::Implicit {
                         iterations: d.iterations.unwrap_or(30).max(1),
                     },
-                    "explicit" => Solver::Explicit {
+                    SolverName::Explicit => Solver::Explicit {
                         // 0: as many as stability needs.
                         substeps: d.substeps.unwrap_or(0),
                     },
-                    other => {
-                        return Err(invalid(
-                            span,
-                            format!("unknown solver `{other}`: use implicit or explicit"),
-                        ));
-                    }
                 };
                 let gpu = d.gpu.as_ref().is_some_and(|g| *g.get_ref());
                 if let (true, Solver::Implicit { .. }, true) = (gpu, solver, topology.joins_tips())
@@ -582,23 +568,16 @@ impl ShellScene {
                     ));
                 }
                 let default_coupling = if topology == Topology::SilvaStrands {
-                    "bezier"
+                    CouplingName::Bezier
                 } else {
-                    "bent"
+                    CouplingName::Bent
                 };
-                let (name, span) = named(&d.coupling, default_coupling);
-                let coupling = match name.as_str() {
-                    "bezier" => Coupling::Bezier,
-                    "linear" => Coupling::Linear,
-                    "bent" => Coupling::Bent {
+                let coupling = match d.coupling.unwrap_or(default_coupling) {
+                    CouplingName::Bezier => Coupling::Bezier,
+                    CouplingName::Linear => Coupling::Linear,
+                    CouplingName::Bent => Coupling::Bent {
                         exponent: d.exponent.unwrap_or(2.0).max(1.0),
                     },
-                    other => {
-                        return Err(invalid(
-                            span,
-                            format!("unknown coupling `{other}`: use bezier, linear or bent"),
-                        ));
-                    }
                 };
                 let defaults = DynamicsParams::default();
                 let params = DynamicsParams {
@@ -723,8 +702,8 @@ impl WetnessTimeline<'_> {
 mod tests {
     use super::*;
 
-    fn scene(text: &str) -> Result<ShellScene, GroomError> {
-        ShellScene::from_source(&GroomSource {
+    fn scene(text: &str) -> Result<ShellScene, SceneError> {
+        ShellScene::from_source(&SettingsSource {
             path: "fur.toml".into(),
             text: text.into(),
         })
@@ -764,9 +743,10 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("fur.toml:2:8") && e.contains("unknown shading `toon`"),
+            e.starts_with("fur.toml:2:8: shading.mode: unknown variant `toon`"),
             "{e}"
         );
+        assert!(e.contains("`lambert`") && e.contains("`kajiya-kay`"), "{e}");
         let e = scene("[[droplets]]\nimage = \"nope.png\"\n")
             .unwrap_err()
             .to_string();
@@ -774,6 +754,48 @@ mod tests {
             e.starts_with("fur.toml:2:9: droplets.image: nope.png"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn every_named_setting_lists_the_accepted_names() {
+        let cases = [
+            (
+                "[texture]\nstyle = \"fuzzy\"\n",
+                "texture.style",
+                "`random-strands`",
+            ),
+            (
+                "[shading]\nmode = \"toon\"\n",
+                "shading.mode",
+                "`structure`",
+            ),
+            (
+                "[dynamics]\ntopology = \"x\"\n",
+                "dynamics.topology",
+                "`silva-strands`",
+            ),
+            (
+                "[dynamics]\nsolver = \"x\"\n",
+                "dynamics.solver",
+                "`implicit`",
+            ),
+            (
+                "[dynamics]\ncoupling = \"x\"\n",
+                "dynamics.coupling",
+                "`bezier`",
+            ),
+        ];
+        for (text, key, accepted) in cases {
+            let e = scene(text).unwrap_err();
+            assert!(matches!(e.kind, SceneErrorKind::Syntax(_)), "{e}");
+            let e = e.to_string();
+            assert!(e.starts_with("fur.toml:2:"), "{e}");
+            assert!(e.contains(&format!(": {key}: unknown variant")), "{e}");
+            assert!(e.contains(accepted), "{e}");
+        }
+        // The error underneath an unreadable image is its source.
+        let e = scene("color = \"missing.png\"\n").unwrap_err();
+        assert!(std::error::Error::source(&e).is_some(), "{e}");
     }
 
     #[test]
@@ -809,9 +831,10 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.starts_with("fur.toml:2:12: dynamics.topology: unknown topology `springs`"),
+            e.starts_with("fur.toml:2:12: dynamics.topology: unknown variant `springs`"),
             "{e}"
         );
+        assert!(e.contains("`separable-prisms`"), "{e}");
         let e = scene("[dynamics.wind]\nvelocty = [1, 0, 0]\n")
             .unwrap_err()
             .to_string();

@@ -24,8 +24,10 @@ use crate::sample::SampleRng;
 use rayon::prelude::*;
 use std::f32::consts::TAU;
 
-/// Which hair fills the volume.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which hair fills the volume (`blades` or `random-strands` in scene
+/// files).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum TextureStyle {
     /// Banisch: exponential blades with length, direction and bending
     /// variation, plus an undercoat.

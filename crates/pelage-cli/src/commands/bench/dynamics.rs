@@ -20,7 +20,6 @@ use clap::Args;
 use glam::Vec3;
 use pelage::Mesh;
 use pelage::dynamics::{DynamicsParams, MassSpringSystem, Solver, Topology, Wind};
-use std::path::Path;
 
 /// Arguments of `pelage bench dynamics`.
 #[derive(Debug, Args)]

@@ -17,7 +17,6 @@ use pelage::Mesh;
 use pelage::shell::wetness::{DropletStyle, droplets_on_mesh};
 use pelage::shell::{ShellScene, ShellTextureParams, ShellTextures, WetnessMask};
 use pelage_gpu::{GpuContext, ShellFeatures, ShellParams, ShellRenderer, ShellTarget, ShellView};
-use std::path::Path;
 
 /// Arguments of `pelage bench shells`.
 #[derive(Debug, Args)]

@@ -56,7 +56,7 @@ pub fn run(_: &ViewArgs) -> anyhow::Result<()> {
 /// Runs `pelage view`.
 #[cfg(feature = "viewer")]
 pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
-    use pelage::groom::GroomSource;
+    use pelage::settings::SettingsSource;
     use pelage::shell::ShellScene;
 
     let title = args
@@ -96,7 +96,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
                             .to_string_lossy()
                     )
                 );
-                app::Content::Shells(Box::new(ShellScene::from_source(&GroomSource {
+                app::Content::Shells(Box::new(ShellScene::from_source(&SettingsSource {
                     path: path.clone(),
                     text,
                 })?))

@@ -20,7 +20,8 @@
 //! show = { skin = false, guides = true, percent = 10 }       # groom views
 //! ```
 
-use pelage::groom::{GroomError, GroomSource};
+use pelage::groom::GroomError;
+use pelage::settings::SettingsSource;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -122,11 +123,11 @@ impl Script {
     /// Reads a script; errors name the file, line and key. Screenshot
     /// paths are made relative to the script's folder.
     pub fn load(path: &Path) -> Result<Self, GroomError> {
-        Self::parse(&GroomSource::read(path)?)
+        Self::parse(&SettingsSource::read_groom(path)?)
     }
 
     /// Parses a script's text.
-    pub fn parse(source: &GroomSource) -> Result<Self, GroomError> {
+    pub fn parse(source: &SettingsSource) -> Result<Self, GroomError> {
         let file: ScriptFile = source.parse_as()?;
         let folder = source.folder();
         let steps = file
@@ -155,7 +156,7 @@ mod tests {
     use super::*;
 
     fn parse(text: &str) -> Result<Script, GroomError> {
-        Script::parse(&GroomSource {
+        Script::parse(&SettingsSource {
             path: "shots/act.toml".into(),
             text: text.into(),
         })
