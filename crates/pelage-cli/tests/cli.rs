@@ -52,21 +52,25 @@ fn info_on_blub_reports_its_counts() {
 
 #[test]
 fn info_on_subdivided_blub_has_four_times_the_triangles_and_the_same_area() {
-    let json = |args: &[&str]| {
+    let json = |args: &[&str]| -> serde_json::Value {
         let out = pelage(args);
         assert!(out.status.success(), "{}", stderr(&out));
-        stdout(&out)
-    };
-    let field = |text: &str, key: &str| -> f64 {
-        let start = text.find(&format!("\"{key}\":")).unwrap() + key.len() + 3;
-        let end = text[start..].find([',', '}']).unwrap() + start;
-        text[start..end].parse().unwrap()
+        serde_json::from_str(&stdout(&out)).expect("one JSON object")
     };
     let base = json(&["info", "--json", &blub()]);
     let fine = json(&["info", "--json", "--subdivide", "1", &blub()]);
+    let field = |v: &serde_json::Value, key: &str| v[key].as_f64().unwrap();
     assert_eq!(field(&fine, "triangles"), 4.0 * field(&base, "triangles"));
     let (a0, a1) = (field(&base, "surface_area"), field(&fine, "surface_area"));
     assert!((a1 - a0).abs() / a0 < 1e-5, "{a0} vs {a1}");
+    assert_eq!(base["uvs"], "per corner");
+    assert_eq!(base["bounds_min"].as_array().map(Vec::len), Some(3));
+    assert!(
+        base["mesh"]
+            .as_str()
+            .unwrap()
+            .ends_with("blub_triangulated.obj")
+    );
 }
 
 #[test]

@@ -14,8 +14,8 @@
 //! GB/s. Many steps can be queued in one submission, as a real-time loop
 //! would, and the state read back only when the CPU needs it.
 
+use crate::layout::gpu_struct;
 use crate::{GpuContext, GpuError, ShellModel};
-use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use pelage::dynamics::{DynamicsParams, MassSpringSystem, Solver, Topology};
 use pelage::shell::scene::DynamicsSettings;
@@ -35,18 +35,39 @@ enum Pass {
     Implicit,
 }
 
-/// The shader's `Step` block: everything one substep reads besides buffers.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct StepUniform {
-    gravity: [f32; 4],
-    springs: [f32; 4],
-    misc: [f32; 4],
-    wind_mean: [f32; 4],
-    wind_drift: [f32; 4],
-    brush_centre: [f32; 4],
-    brush_force: [f32; 4],
-    counts: [u32; 4],
+gpu_struct! {
+    /// The shader's `Step` block: everything one substep reads besides
+    /// buffers.
+    pub(crate) struct StepUniform {
+        /// Acceleration.
+        gravity: [f32; 3],
+        /// The substep.
+        h: f32,
+        mass: f32,
+        stiffness: f32,
+        lateral_stiffness: f32,
+        damping: f32,
+        drag: f32,
+        /// Banisch's restoring w (Eq. 5).
+        restoring: f32,
+        /// The wind's turbulence speed (no wind: 0).
+        turbulence: f32,
+        /// The turbulence's spatial scale.
+        turbulence_scale: f32,
+        /// The wind's gusting mean now.
+        wind_mean: [f32; 3],
+        /// The brush's radius (0: no brush).
+        brush_radius: f32,
+        /// The turbulence's drift now.
+        wind_drift: [f32; 3],
+        /// Tips stepped.
+        tips: u32,
+        brush_centre: [f32; 3],
+        /// 1 for Silva strands (a spring to p0, a length limit).
+        silva_strands: u32,
+        brush_force: [f32; 3],
+        pad0: f32,
+    }
 }
 
 /// A [`MassSpringSystem`] uploaded to the GPU, stepped there with the
@@ -480,18 +501,27 @@ impl GpuMassSpring {
             Some(b) => (b.centre, b.radius, b.force),
             None => (Vec3::ZERO, 0.0, Vec3::ZERO),
         };
-        let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
         StepUniform {
-            gravity: v4(p.gravity, h),
-            springs: [p.mass, p.stiffness, p.lateral_stiffness, p.damping],
-            misc: [p.drag, p.restoring, 0.0, 0.0],
-            wind_mean: v4(mean, turbulence),
-            wind_drift: v4(drift, scale),
+            gravity: p.gravity.to_array(),
+            h,
+            mass: p.mass,
+            stiffness: p.stiffness,
+            lateral_stiffness: p.lateral_stiffness,
+            damping: p.damping,
+            drag: p.drag,
+            restoring: p.restoring,
+            turbulence,
+            turbulence_scale: scale,
+            wind_mean: mean.to_array(),
             // A zero radius means no brush to the shader; the CPU's brush
             // of radius 0 pushes nothing either.
-            brush_centre: v4(centre, radius),
-            brush_force: v4(force, 0.0),
-            counts: [self.tips, u32::from(self.silva), 0, 0],
+            brush_radius: radius,
+            wind_drift: drift.to_array(),
+            tips: self.tips,
+            brush_centre: centre.to_array(),
+            silva_strands: u32::from(self.silva),
+            brush_force: force.to_array(),
+            pad0: 0.0,
         }
     }
 

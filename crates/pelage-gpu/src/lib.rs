@@ -14,6 +14,7 @@
 mod camera;
 mod context;
 mod dynamics;
+mod layout;
 mod renderer;
 mod shells;
 

@@ -1,8 +1,8 @@
 //! The preview renderer: the skin mesh (lit), points (discs) and curves
 //! (Kajiya-Kay ribbons) into an image, multisampled, with depth.
 
+use crate::layout::gpu_struct;
 use crate::{Camera, GpuContext, GpuError};
-use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use pelage::{Curves, Mesh};
 use wgpu::util::DeviceExt;
@@ -73,17 +73,31 @@ impl Default for PreviewStyle {
     }
 }
 
-/// The uniform block both shaders read (`struct Frame` in the WGSL).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct FrameUniforms {
-    view_proj: [[f32; 4]; 4],
-    light_dir: [f32; 4],
-    skin_color: [f32; 4],
-    point_color: [f32; 4],
-    viewport: [f32; 4],
-    eye: [f32; 4],
-    hair_color: [f32; 4],
+gpu_struct! {
+    /// The uniform block every preview shader reads (`struct Frame` in
+    /// `frame.wgsl`).
+    pub(crate) struct FrameUniforms {
+        view_proj: [[f32; 4]; 4],
+        /// The camera's position.
+        eye: [f32; 3],
+        /// Point disc radius in pixels.
+        point_radius: f32,
+        /// Unit direction towards the light.
+        light_dir: [f32; 3],
+        /// How far points are pulled towards the camera, in clip w units.
+        point_depth_pull: f32,
+        skin_color: [f32; 3],
+        /// Focal length in pixels: turns world widths into pixels.
+        focal_length_px: f32,
+        point_color: [f32; 3],
+        /// Kajiya-Kay specular strength of the hair.
+        hair_specular: f32,
+        hair_color: [f32; 3],
+        pad0: f32,
+        /// Viewport size in pixels.
+        viewport_px: [f32; 2],
+        pad1: [f32; 2],
+    }
 }
 
 /// A scene's geometry on the GPU (see [`Renderer::upload`]).
@@ -103,7 +117,10 @@ pub struct GpuScene {
 /// Draws preview scenes into images. Build once, render many times.
 #[derive(Debug)]
 pub struct Renderer {
-    frame_layout: wgpu::BindGroupLayout,
+    /// The frame's uniforms, rewritten (`write_buffer`) for each frame,
+    /// and their bind group, both made once.
+    frame_uniforms: wgpu::Buffer,
+    frame: wgpu::BindGroup,
     texture_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     mesh_pipeline: wgpu::RenderPipeline,
@@ -136,6 +153,20 @@ impl Renderer {
                     min_binding_size: None,
                 },
                 count: None,
+            }],
+        });
+        let frame_uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame"),
+            size: std::mem::size_of::<FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let frame = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &frame_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: frame_uniforms.as_entire_binding(),
             }],
         });
         let texture_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -258,7 +289,8 @@ impl Renderer {
             true,
         );
         Self {
-            frame_layout,
+            frame_uniforms,
+            frame,
             texture_layout,
             sampler,
             mesh_pipeline,
@@ -437,12 +469,8 @@ impl Renderer {
         height: u32,
     ) -> Result<image::RgbaImage, GpuError> {
         check_size(ctx, width, height)?;
-        use wgpu::TextureFormat as F;
-        let bgra = match self.format {
-            F::Rgba8UnormSrgb | F::Rgba8Unorm => false,
-            F::Bgra8UnormSrgb | F::Bgra8Unorm => true,
-            format => return Err(GpuError::Format(format!("{format:?}"))),
-        };
+        // Refused before any drawing: only 8-bit RGBA and BGRA read back.
+        is_bgra(self.format)?;
         let resolved = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("preview image"),
             size: wgpu::Extent3d {
@@ -469,11 +497,7 @@ impl Renderer {
             width,
             height,
         )?;
-        let mut image = read_back(ctx, encoder, &resolved, width, height)?;
-        if bgra {
-            image.pixels_mut().for_each(|p| p.0.swap(0, 2));
-        }
-        Ok(image)
+        read_texture(ctx, encoder, &resolved)
     }
 
     /// Records the drawing of an uploaded scene into `target`, a
@@ -481,7 +505,9 @@ impl Renderer {
     /// `width × height` — an offscreen texture or a window surface's
     /// current texture. The renderer draws into its own multisampled colour
     /// and depth targets and resolves into `target`; submit the encoder
-    /// (and present the surface texture) afterwards.
+    /// (and present the surface texture) afterwards, before encoding the
+    /// next frame: the frame's settings live in one uniform buffer that
+    /// each `encode` rewrites.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -510,47 +536,23 @@ impl Renderer {
         let light = view + 0.9 * Vec3::Y + 0.6 * side;
         let uniforms = FrameUniforms {
             view_proj: clip_from_world.to_cols_array_2d(),
-            light_dir: light.normalize().extend(0.0).to_array(),
-            skin_color: if scene.textured {
-                [1.0; 4]
-            } else {
-                [style.skin[0], style.skin[1], style.skin[2], 1.0]
-            },
-            point_color: [
-                style.point[0],
-                style.point[1],
-                style.point[2],
-                style.point_radius,
-            ],
-            // Points are pulled towards the camera by 0.2 % of clip w; the
-            // focal length in pixels turns world widths into pixels.
-            viewport: [
-                width as f32,
-                height as f32,
-                0.002,
-                0.5 * height as f32 * clip_from_world.y_axis.y,
-            ],
-            eye: camera.eye.extend(1.0).to_array(),
-            hair_color: [
-                style.hair[0],
-                style.hair[1],
-                style.hair[2],
-                style.hair_specular,
-            ],
+            eye: camera.eye.to_array(),
+            point_radius: style.point_radius,
+            light_dir: light.normalize().to_array(),
+            // Points are pulled towards the camera by 0.2 % of clip w.
+            point_depth_pull: 0.002,
+            skin_color: if scene.textured { [1.0; 3] } else { style.skin },
+            focal_length_px: 0.5 * height as f32 * clip_from_world.y_axis.y,
+            point_color: style.point,
+            hair_specular: style.hair_specular,
+            hair_color: style.hair,
+            viewport_px: [width as f32, height as f32],
+            ..Default::default()
         };
-        let uniform_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("frame"),
-            contents: bytemuck::bytes_of(&uniforms),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let frame = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("frame"),
-            layout: &self.frame_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform_buffer.as_entire_binding(),
-            }],
-        });
+        // Written before the encoder's commands run (write_buffer is queued
+        // ahead of the next submission): one frame per submission.
+        ctx.queue
+            .write_buffer(&self.frame_uniforms, 0, bytemuck::bytes_of(&uniforms));
 
         let target_texture =
             |samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
@@ -602,7 +604,7 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_bind_group(0, &frame, &[]);
+            pass.set_bind_group(0, &self.frame, &[]);
             pass.set_bind_group(1, &scene.skin_texture, &[]);
             if let Some((vertex, index, count)) = &scene.mesh {
                 pass.set_pipeline(&self.mesh_pipeline);
@@ -722,18 +724,30 @@ pub(crate) fn map_read<T>(
 
 /// Finishes `encoder` with a copy of `texture` (8-bit RGBA or BGRA, such as
 /// an offscreen twin of a window's surface) and reads it back as RGBA.
+///
+/// Every picture pelage reads back goes through here, so BGRA targets (a
+/// window surface's usual format) come back as RGBA in one place.
 pub fn read_texture(
     ctx: &GpuContext,
     encoder: wgpu::CommandEncoder,
     texture: &wgpu::Texture,
 ) -> Result<image::RgbaImage, GpuError> {
+    let bgra = is_bgra(texture.format())?;
     let size = texture.size();
     let mut image = read_back(ctx, encoder, texture, size.width, size.height)?;
-    if matches!(
-        texture.format(),
-        wgpu::TextureFormat::Bgra8UnormSrgb | wgpu::TextureFormat::Bgra8Unorm
-    ) {
+    if bgra {
         image.pixels_mut().for_each(|p| p.0.swap(0, 2));
     }
     Ok(image)
+}
+
+/// Whether `format` is 8-bit BGRA (false: 8-bit RGBA); an error for any
+/// format pelage cannot read back.
+fn is_bgra(format: wgpu::TextureFormat) -> Result<bool, GpuError> {
+    use wgpu::TextureFormat as F;
+    match format {
+        F::Rgba8UnormSrgb | F::Rgba8Unorm => Ok(false),
+        F::Bgra8UnormSrgb | F::Bgra8Unorm => Ok(true),
+        format => Err(GpuError::Format(format!("{format:?}"))),
+    }
 }

@@ -9,9 +9,9 @@
 //! with curl, with curl and clumps ([`ShellFeatures`]) — so the benchmark
 //! compares like with like.
 
-use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES, check_size, read_back};
+use crate::layout::gpu_struct;
+use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES, check_size};
 use crate::{Camera, FurMotion, GpuContext, GpuError};
-use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use pelage::Mesh;
 
@@ -106,18 +106,41 @@ impl ShellView {
     }
 }
 
-/// The uniform block of `shells.wgsl` (`struct Shell`).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct ShellUniforms {
-    view_proj: [[f32; 4]; 4],
-    eye: [f32; 4],
-    light_dir: [f32; 4],
-    specular: [f32; 4],
-    fur: [f32; 4],
-    curl: [f32; 4],
-    clump: [f32; 4],
-    motion: [f32; 4],
+gpu_struct! {
+    /// The uniform block of `shells.wgsl` (`struct Shell`).
+    pub(crate) struct ShellUniforms {
+        view_proj: [[f32; 4]; 4],
+        eye: [f32; 3],
+        /// L0: the outermost layer's height above the skin.
+        shell_length: f32,
+        /// Unit direction towards the light.
+        light_dir: [f32; 3],
+        /// N: layers drawn.
+        layers: u32,
+        /// Kajiya-Kay's K_s.
+        specular: [f32; 3],
+        /// p_phong.
+        specular_exponent: f32,
+        /// The whole skin moved by this (a shaken object).
+        motion: [f32; 3],
+        /// Eq. 4's k, for the bent coupling.
+        coupling_exponent: f32,
+        /// Shell texture repeats across the UV square.
+        tiles: f32,
+        k_shadow: f32,
+        /// K_α and ω of the curl.
+        curl_radius: f32,
+        curl_frequency: f32,
+        /// [`ShadingMode::index`](pelage::shell::math::ShadingMode::index).
+        shading_mode: u32,
+        /// [`Coupling::index`](pelage::shell::Coupling::index).
+        coupling: u32,
+        clump_w: f32,
+        clump_strength: f32,
+        /// The wetness mask's size in texels.
+        wetness_size: [f32; 2],
+        pad0: [f32; 2],
+    }
 }
 
 /// A furry mesh on the GPU: skin vertices with their frames, the shell
@@ -199,7 +222,10 @@ impl ShellTarget {
 /// Draws shell fur. Build once per feature set, draw many frames.
 #[derive(Debug)]
 pub struct ShellRenderer {
-    uniform_layout: wgpu::BindGroupLayout,
+    /// The frame's [`ShellUniforms`], rewritten (`write_buffer`) for each
+    /// frame, and their bind group, both made once.
+    uniforms: wgpu::Buffer,
+    uniform_group: wgpu::BindGroup,
     texture_layout: wgpu::BindGroupLayout,
     fur_sampler: wgpu::Sampler,
     color_sampler: wgpu::Sampler,
@@ -351,10 +377,25 @@ impl ShellRenderer {
                 cache: None,
             })
         };
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shell uniforms"),
+            size: std::mem::size_of::<ShellUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let uniform_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shell uniforms"),
+            layout: &uniform_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniforms.as_entire_binding(),
+            }],
+        });
         Self {
             skin_pipeline: pipeline("vs_skin", "fs_skin", false),
             layer_pipeline: pipeline("vs_layer", "fs_layer", true),
-            uniform_layout,
+            uniforms,
+            uniform_group,
             texture_layout,
             fur_sampler,
             color_sampler,
@@ -612,20 +653,14 @@ impl ShellRenderer {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let resolved = target.resolved.create_view(&Default::default());
         self.encode(ctx, &mut encoder, model, params, view, target, &resolved)?;
-        let (w, h) = target.size;
-        let mut image = read_back(ctx, encoder, &target.resolved, w, h)?;
-        if matches!(
-            self.format,
-            wgpu::TextureFormat::Bgra8UnormSrgb | wgpu::TextureFormat::Bgra8Unorm
-        ) {
-            image.pixels_mut().for_each(|p| p.0.swap(0, 2));
-        }
-        Ok(image)
+        crate::renderer::read_texture(ctx, encoder, &target.resolved)
     }
 
     /// Records a frame: the skin, then the layers, resolved into
     /// `resolve` (a view of `target`'s size: the target's own resolve
-    /// texture, or a window's surface texture).
+    /// texture, or a window's surface texture). Submit it before encoding
+    /// the next frame: the frame's settings live in one uniform buffer
+    /// that each `encode` rewrites.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -646,43 +681,29 @@ impl ShellRenderer {
         let k = params.kajiya_kay;
         let uniforms = ShellUniforms {
             view_proj: view.clip_from_world.to_cols_array_2d(),
-            eye: view.eye.extend(1.0).to_array(),
-            light_dir: view.light.normalize().extend(0.0).to_array(),
-            specular: [k.specular.x, k.specular.y, k.specular.z, k.exponent],
-            fur: [
-                params.length,
-                params.layers as f32,
-                params.tiles,
-                k.k_shadow,
-            ],
-            curl: [
-                params.curl.radius,
-                params.curl.frequency,
-                params.mode.index() as f32,
-                params.coupling.index() as f32,
-            ],
-            clump: [
-                params.clump.w,
-                params.clump.strength,
-                model.wetness_size.0 as f32,
-                model.wetness_size.1 as f32,
-            ],
-            motion: params.offset.extend(params.coupling.exponent()).to_array(),
+            eye: view.eye.to_array(),
+            shell_length: params.length,
+            light_dir: view.light.normalize().to_array(),
+            layers: params.layers,
+            specular: k.specular.to_array(),
+            specular_exponent: k.exponent,
+            motion: params.offset.to_array(),
+            coupling_exponent: params.coupling.exponent(),
+            tiles: params.tiles,
+            k_shadow: k.k_shadow,
+            curl_radius: params.curl.radius,
+            curl_frequency: params.curl.frequency,
+            shading_mode: params.mode.index(),
+            coupling: params.coupling.index(),
+            clump_w: params.clump.w,
+            clump_strength: params.clump.strength,
+            wetness_size: [model.wetness_size.0 as f32, model.wetness_size.1 as f32],
+            pad0: [0.0; 2],
         };
-        let device = &ctx.device;
-        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("shell uniforms"),
-            contents: bytemuck::bytes_of(&uniforms),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let uniforms = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shell uniforms"),
-            layout: &self.uniform_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: buffer.as_entire_binding(),
-            }],
-        });
+        // Written before the encoder's commands run (write_buffer is queued
+        // ahead of the next submission): one frame per submission.
+        ctx.queue
+            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
         let [r, g, b] = params.background.map(f64::from);
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("shells"),
@@ -707,7 +728,7 @@ impl ShellRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(0, &uniforms, &[]);
+        pass.set_bind_group(0, &self.uniform_group, &[]);
         pass.set_bind_group(1, &model.textures, &[]);
         pass.set_vertex_buffer(0, model.vertices.slice(..));
         pass.set_vertex_buffer(1, model.tip_offsets.slice(..));

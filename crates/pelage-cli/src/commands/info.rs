@@ -126,24 +126,21 @@ impl MeshSummary {
     }
 
     pub fn json(&self) -> String {
-        let uvs = match self.uvs {
-            Some(kind) => format!("\"{kind}\""),
-            None => "null".into(),
-        };
-        format!(
-            "{{\"mesh\":{:?},\"subdivisions\":{},\"vertices\":{},\"triangles\":{},\"bounds_min\":{:?},\"bounds_max\":{:?},\"surface_area\":{},\"uvs\":{uvs},\"degenerate_triangles\":{},\"edges\":{},\"boundary_edges\":{},\"non_manifold_edges\":{},\"isolated_vertices\":{}}}",
-            self.name,
-            self.subdivisions,
-            self.vertices,
-            self.triangles,
-            self.bounds_min,
-            self.bounds_max,
-            self.surface_area,
-            self.degenerate_triangles,
-            self.edges,
-            self.boundary_edges,
-            self.non_manifold_edges,
-            self.isolated_vertices
-        )
+        serde_json::json!({
+            "mesh": self.name,
+            "subdivisions": self.subdivisions,
+            "vertices": self.vertices,
+            "triangles": self.triangles,
+            "bounds_min": self.bounds_min,
+            "bounds_max": self.bounds_max,
+            "surface_area": self.surface_area,
+            "uvs": self.uvs.map(|kind| kind.to_string()),
+            "degenerate_triangles": self.degenerate_triangles,
+            "edges": self.edges,
+            "boundary_edges": self.boundary_edges,
+            "non_manifold_edges": self.non_manifold_edges,
+            "isolated_vertices": self.isolated_vertices,
+        })
+        .to_string()
     }
 }

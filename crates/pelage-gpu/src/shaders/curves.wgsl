@@ -34,7 +34,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32, s: SegmentIn) -> VertexOut {
     let t = ts[vertex];
     let p = mix(s.a.xyz, s.b.xyz, t);
     let width = mix(s.a.w, s.b.w, t);
-    let half_size = 0.5 * frame.viewport.xy;
+    let half_size = 0.5 * frame.viewport_px;
     let ca = frame.view_proj * vec4<f32>(s.a.xyz, 1.0);
     let cb = frame.view_proj * vec4<f32>(s.b.xyz, 1.0);
     let clip = frame.view_proj * vec4<f32>(p, 1.0);
@@ -44,7 +44,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32, s: SegmentIn) -> VertexOut {
     }
     let across = normalize(vec2<f32>(-direction.y, direction.x));
     // World width → pixels at this depth.
-    let width_px = width * frame.viewport.w / clip.w;
+    let width_px = width * frame.focal_length_px / clip.w;
     let drawn_px = max(width_px, 1.0);
     let offset_px = across * sides[vertex] * 0.5 * drawn_px;
     var out: VertexOut;
@@ -59,14 +59,14 @@ fn vs_main(@builtin(vertex_index) vertex: u32, s: SegmentIn) -> VertexOut {
 @fragment
 fn fs_main(v: VertexOut) -> @location(0) vec4<f32> {
     let tangent = normalize(v.tangent);
-    let l = frame.light_dir.xyz;
-    let to_eye = normalize(frame.eye.xyz - v.world);
+    let l = frame.light_dir;
+    let to_eye = normalize(frame.eye - v.world);
     let h = normalize(l + to_eye);
     let cos_tl = dot(tangent, l);
     let cos_th = dot(tangent, h);
     let diffuse = sqrt(max(0.0, 1.0 - cos_tl * cos_tl));
     let specular = pow(sqrt(max(0.0, 1.0 - cos_th * cos_th)), 60.0);
-    let base = mix(frame.hair_color.rgb, v.color.rgb, v.color.a);
-    let color = base * (0.3 + 0.7 * diffuse) + vec3<f32>(frame.hair_color.a * specular);
+    let base = mix(frame.hair_color, v.color.rgb, v.color.a);
+    let color = base * (0.3 + 0.7 * diffuse) + vec3<f32>(frame.hair_specular * specular);
     return vec4<f32>(color, v.coverage);
 }

@@ -6,23 +6,34 @@
 // Rust one named the same; keep them in step (tests/dynamics.rs steps both
 // and compares).
 
+// Mirrors StepUniform in dynamics.rs (a test checks names and offsets).
 struct Step {
-    // xyz: gravity (acceleration), w: substep h.
-    gravity: vec4<f32>,
-    // x: mass, y: stiffness, z: lateral stiffness, w: damping.
-    springs: vec4<f32>,
-    // x: drag, y: restoring w (Eq. 5).
-    misc: vec4<f32>,
-    // xyz: the wind's gusting mean now, w: turbulence speed (no wind: all 0).
-    wind_mean: vec4<f32>,
-    // xyz: the turbulence's drift now, w: its scale.
-    wind_drift: vec4<f32>,
-    // xyz: brush centre, w: radius (0: no brush).
-    brush_centre: vec4<f32>,
-    // xyz: brush force.
-    brush_force: vec4<f32>,
-    // x: tips, y: 1 for Silva strands (a spring to p0, length limit).
-    counts: vec4<u32>,
+    // Acceleration.
+    gravity: vec3<f32>,
+    // The substep.
+    h: f32,
+    mass: f32,
+    stiffness: f32,
+    lateral_stiffness: f32,
+    damping: f32,
+    drag: f32,
+    // Banisch's restoring w (Eq. 5).
+    restoring: f32,
+    // The wind's turbulence speed (no wind: 0).
+    turbulence: f32,
+    turbulence_scale: f32,
+    // The wind's gusting mean now.
+    wind_mean: vec3<f32>,
+    // 0: no brush.
+    brush_radius: f32,
+    // The turbulence's drift now.
+    wind_drift: vec3<f32>,
+    tips: u32,
+    brush_centre: vec3<f32>,
+    // 1 for Silva strands (a spring to p0, a length limit).
+    silva_strands: u32,
+    brush_force: vec3<f32>,
+    pad0: f32,
 };
 
 @group(0) @binding(0) var<uniform> step: Step;
@@ -94,11 +105,11 @@ fn perlin3_vector(p: vec3<f32>) -> vec3<f32> {
 
 // WindNow::at.
 fn wind_at(p: vec3<f32>) -> vec3<f32> {
-    let turbulence = step.wind_mean.w;
+    let turbulence = step.turbulence;
     if turbulence == 0.0 {
-        return step.wind_mean.xyz;
+        return step.wind_mean;
     }
-    return step.wind_mean.xyz + turbulence * perlin3_vector((p - step.wind_drift.xyz) * step.wind_drift.w);
+    return step.wind_mean + turbulence * perlin3_vector((p - step.wind_drift) * step.turbulence_scale);
 }
 
 // MassSpringSystem::tip_force.
@@ -114,22 +125,22 @@ fn tip_force(i: u32, x: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
         dir = d / l;
     }
     var f: vec3<f32>;
-    if step.counts.y != 0u {
-        f = -step.springs.y * (x - (root + rest_length * n)) - step.springs.w * v_rel;
+    if step.silva_strands != 0u {
+        f = -step.stiffness * (x - (root + rest_length * n)) - step.damping * v_rel;
     } else {
-        let stretch = -step.springs.y * (l - rest_length) * dir;
+        let stretch = -step.stiffness * (l - rest_length) * dir;
         // Banisch Eq. 5.
-        let restoring = (n - dir) * (1.0 - dot(n, dir)) * step.misc.y;
-        f = stretch - step.springs.w * dot(v_rel, dir) * dir + restoring;
+        let restoring = (n - dir) * (1.0 - dot(n, dir)) * step.restoring;
+        f = stretch - step.damping * dot(v_rel, dir) * dir + restoring;
     }
-    f += step.springs.x * step.gravity.xyz;
-    f += step.misc.x * (wind_at(x) - v);
-    let radius = step.brush_centre.w;
+    f += step.mass * step.gravity;
+    f += step.drag * (wind_at(x) - v);
+    let radius = step.brush_radius;
     if radius > 0.0 {
-        let q = distance(x, step.brush_centre.xyz) / max(radius, 1e-9);
+        let q = distance(x, step.brush_centre) / max(radius, 1e-9);
         if q < 1.0 {
             let fade = 1.0 - q * q;
-            f += step.brush_force.xyz * fade * fade;
+            f += step.brush_force * fade * fade;
         }
     }
     return f;
@@ -148,7 +159,7 @@ fn lateral_force(i: u32, x: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
         let dir = d / l;
         let dv = v - velocities_in[end.x].xyz;
         let rest = bitcast<f32>(end.y);
-        f += -step.springs.z * (l - rest) * dir - step.springs.w * dot(dv, dir) * dir;
+        f += -step.lateral_stiffness * (l - rest) * dir - step.damping * dot(dv, dir) * dir;
     }
     return f;
 }
@@ -174,7 +185,7 @@ fn constrained(i: u32, x_in: vec3<f32>, v_in: vec3<f32>) -> TipState {
             v -= vn * n;
         }
     }
-    if step.counts.y != 0u {
+    if step.silva_strands != 0u {
         let d = x - root;
         let l = length(d);
         if l > rest_length {
@@ -207,14 +218,14 @@ fn explicit_substep(
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
     let i = flat_index(id, groups);
-    if i >= step.counts.x {
+    if i >= step.tips {
         return;
     }
-    let h = step.gravity.w;
+    let h = step.h;
     let x = tips_in[i].xyz;
     let v0 = velocities_in[i].xyz;
     let f = tip_force(i, x, v0) + lateral_force(i, x, v0);
-    let v = v0 + (h / step.springs.x) * f;
+    let v = v0 + (h / step.mass) * f;
     store(i, constrained(i, x + h * v, v));
 }
 
@@ -235,18 +246,18 @@ struct Blocks {
 
 fn stick_blocks(i: u32, x: vec3<f32>) -> Blocks {
     let identity = mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
-    if step.counts.y != 0u {
-        return Blocks(step.springs.y * identity, step.springs.w * identity);
+    if step.silva_strands != 0u {
+        return Blocks(step.stiffness * identity, step.damping * identity);
     }
     let d = x - roots[i].xyz;
     let l = length(d);
     if l <= 1e-12 {
-        return Blocks(step.springs.y * identity, mat3x3<f32>());
+        return Blocks(step.stiffness * identity, mat3x3<f32>());
     }
     let dir = d / l;
     let o = outer(dir);
     let tangential = max(1.0 - roots[i].w / l, 0.0);
-    return Blocks(step.springs.y * (tangential * (identity - o) + o), step.springs.w * o);
+    return Blocks(step.stiffness * (tangential * (identity - o) + o), step.damping * o);
 }
 
 // glam's Mat3::inverse: the adjugate's rows are cross products of the
@@ -268,15 +279,15 @@ fn implicit_unjoined_step(
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
     let i = flat_index(id, groups);
-    if i >= step.counts.x {
+    if i >= step.tips {
         return;
     }
-    let h = step.gravity.w;
+    let h = step.h;
     let x = tips_in[i].xyz;
     let v0 = velocities_in[i].xyz;
     let f = tip_force(i, x, v0);
     let blocks = stick_blocks(i, x);
-    let fixed = step.springs.x + h * step.misc.x;
+    let fixed = step.mass + h * step.drag;
     let a = mat3x3<f32>(vec3<f32>(fixed, 0.0, 0.0), vec3<f32>(0.0, fixed, 0.0), vec3<f32>(0.0, 0.0, fixed))
         + h * blocks.c + (h * h) * blocks.k;
     let dv = inverse3(a) * (h * (f - h * (blocks.k * v0)));

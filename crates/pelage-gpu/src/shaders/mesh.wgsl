@@ -31,11 +31,11 @@ fn vs_main(v: VertexIn) -> VertexOut {
 @fragment
 fn fs_main(v: VertexOut) -> @location(0) vec4<f32> {
     let n = normalize(v.normal);
-    let l = frame.light_dir.xyz;
+    let l = frame.light_dir;
     let lambert = abs(dot(n, l));
     // Sky-ground ambient: a little brighter where the normal faces up.
     let ambient = mix(0.25, 0.4, 0.5 + 0.5 * n.y);
-    let albedo = frame.skin_color.rgb * textureSample(skin_texture, skin_sampler, v.uv).rgb;
+    let albedo = frame.skin_color * textureSample(skin_texture, skin_sampler, v.uv).rgb;
     let color = albedo * (ambient + 0.65 * lambert);
     return vec4<f32>(color, 1.0);
 }

@@ -18,8 +18,8 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @location(0) center: vec3<f32>) -
     let corner = corners[vertex];
     var clip = frame.view_proj * vec4<f32>(center, 1.0);
     // Radius in pixels → NDC (2 / size per pixel), times w for clip space.
-    let radius = frame.point_color.a;
-    clip = vec4<f32>(clip.xy + corner * radius * 2.0 / frame.viewport.xy * clip.w, clip.z - frame.viewport.z * clip.w, clip.w);
+    let radius = frame.point_radius;
+    clip = vec4<f32>(clip.xy + corner * radius * 2.0 / frame.viewport_px * clip.w, clip.z - frame.point_depth_pull * clip.w, clip.w);
     var out: VertexOut;
     out.clip = clip;
     out.corner = corner;
@@ -30,7 +30,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @location(0) center: vec3<f32>) -
 fn fs_main(v: VertexOut) -> @location(0) vec4<f32> {
     // Coverage falls from 1 to 0 over the disc's last pixel.
     let r = length(v.corner);
-    let radius = frame.point_color.a;
+    let radius = frame.point_radius;
     let coverage = clamp((1.0 - r) * radius + 0.5, 0.0, 1.0);
-    return vec4<f32>(frame.point_color.rgb, coverage);
+    return vec4<f32>(frame.point_color, coverage);
 }

@@ -4,23 +4,41 @@
 // order. Every formula mirrors a function of pelage::shell::math, named
 // the same; keep them in step (tests/shells.rs renders against the Rust).
 
+// Mirrors ShellUniforms in shells.rs (a test checks names and offsets).
 struct Shell {
     view_proj: mat4x4<f32>,
-    // xyz: the camera position.
-    eye: vec4<f32>,
-    // xyz: unit direction towards the light.
-    light_dir: vec4<f32>,
-    // rgb: K_s, a: p_phong.
-    specular: vec4<f32>,
-    // x: shell length L0, y: layers N, z: texture tiles across UV, w: K_shadow.
-    fur: vec4<f32>,
-    // x: K_α, y: ω, z: shading mode (ShadingMode::index), w: coupling
-    // (Coupling::index).
-    curl: vec4<f32>,
-    // x: w, y: clump strength, zw: wetness mask size in texels.
-    clump: vec4<f32>,
-    // xyz: the whole skin moved by this (a shaken object), w: Eq. 4's k.
-    motion: vec4<f32>,
+    // The camera position.
+    eye: vec3<f32>,
+    // L0: the length of the outermost layer above the skin.
+    shell_length: f32,
+    // Unit direction towards the light.
+    light_dir: vec3<f32>,
+    // N: layers drawn.
+    layers: u32,
+    // K_s.
+    specular: vec3<f32>,
+    // p_phong.
+    specular_exponent: f32,
+    // The whole skin moved by this (a shaken object).
+    motion: vec3<f32>,
+    // Eq. 4's k, for the bent coupling.
+    coupling_exponent: f32,
+    // Shell texture repeats across the UV square.
+    tiles: f32,
+    k_shadow: f32,
+    // K_α and ω of the curl.
+    curl_radius: f32,
+    curl_frequency: f32,
+    // ShadingMode::index.
+    shading_mode: u32,
+    // Coupling::index.
+    coupling: u32,
+    // w and the strength of the clump.
+    clump_w: f32,
+    clump_strength: f32,
+    // The wetness mask's size in texels.
+    wetness_size: vec2<f32>,
+    pad0: vec2<f32>,
 };
 
 @group(0) @binding(0) var<uniform> shell: Shell;
@@ -143,20 +161,20 @@ fn kajiya_kay(color: vec3<f32>, t: vec3<f32>, l: vec3<f32>, e: vec3<f32>, h: f32
     let sin_te = length(cross(t, e));
     let diffuse = color * sin_tl;
     let base = max(dot(t, l) * dot(t, e) + sin_tl * sin_te, 0.0);
-    let specular = shell.specular.rgb * pow(base, shell.specular.a);
-    return shadow_factor(h, shell.fur.w) * (diffuse + specular);
+    let specular = shell.specular * pow(base, shell.specular_exponent);
+    return shadow_factor(h, shell.k_shadow) * (diffuse + specular);
 }
 
 fn shade(color: vec3<f32>, along: f32, t: vec3<f32>, n: vec3<f32>, l: vec3<f32>, e: vec3<f32>, h: f32) -> vec3<f32> {
-    let mode = u32(shell.curl.z);
+    let mode = shell.shading_mode;
     if mode == 0u {
         return vec3<f32>(0.5 + 0.5 * along);
     } else if mode == 1u {
         return color;
     } else if mode == 2u {
-        return shadow_factor(h, shell.fur.w) * color;
+        return shadow_factor(h, shell.k_shadow) * color;
     } else if mode == 3u {
-        return shadow_factor(h, shell.fur.w) * color * (0.25 + 0.75 * max(dot(n, l), 0.0));
+        return shadow_factor(h, shell.k_shadow) * color * (0.25 + 0.75 * max(dot(n, l), 0.0));
     }
     return kajiya_kay(color, t, l, e, h);
 }
@@ -165,7 +183,7 @@ fn shade(color: vec3<f32>, along: f32, t: vec3<f32>, n: vec3<f32>, l: vec3<f32>,
 
 // WetnessMask::at: nearest texel, clamped.
 fn wetness_at(p: vec2<f32>) -> vec4<f32> {
-    let size = shell.clump.zw;
+    let size = shell.wetness_size;
     let texel = clamp(floor(p * size), vec2<f32>(0.0), size - 1.0);
     return textureLoad(wetness, vec2<i32>(texel), 0);
 }
@@ -182,7 +200,7 @@ struct SkinOut {
 @vertex
 fn vs_skin(v: VertexIn) -> SkinOut {
     var out: SkinOut;
-    out.world = v.position + shell.motion.xyz;
+    out.world = v.position + shell.motion;
     out.clip = shell.view_proj * vec4<f32>(out.world, 1.0);
     out.normal = v.normal;
     out.uv = v.uv;
@@ -192,14 +210,14 @@ fn vs_skin(v: VertexIn) -> SkinOut {
 @fragment
 fn fs_skin(v: SkinOut) -> @location(0) vec4<f32> {
     let n = normalize(v.normal);
-    let e = normalize(shell.eye.xyz - v.world);
+    let e = normalize(shell.eye - v.world);
     let color = textureSampleLevel(color_texture, color_sampler, v.uv, 0.0).rgb;
     // The skin is the fur at h = 0, the strand leaving along the normal;
     // in the structure view it is the black the hair stands on.
-    if u32(shell.curl.z) == 0u {
+    if shell.shading_mode == 0u {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
-    return vec4<f32>(shade(color, 0.0, n, n, shell.light_dir.xyz, e, 0.0), 1.0);
+    return vec4<f32>(shade(color, 0.0, n, n, shell.light_dir, e, 0.0), 1.0);
 }
 
 // ---- the layers ----
@@ -218,21 +236,21 @@ struct LayerOut {
 
 @vertex
 fn vs_layer(v: VertexIn, @builtin(instance_index) layer: u32) -> LayerOut {
-    let layers = u32(shell.fur.y);
+    let layers = shell.layers;
     let h = layer_height(layer, layers);
     let n = normalize(v.normal);
     let u = normalize(v.tangent - n * dot(n, v.tangent));
     let w = cross(n, u);
-    let root = v.position + shell.motion.xyz;
-    let rest_tip = root + shell.fur.x * n;
+    let root = v.position + shell.motion;
+    let rest_tip = root + shell.shell_length * n;
     let tip = rest_tip + v.tip_offset;
-    let coupling = u32(shell.curl.w);
-    var offset = coupled_offset(coupling, shell.motion.w, root, rest_tip, tip, h);
-    var t = coupled_tangent(coupling, shell.motion.w, root, rest_tip, tip, h);
+    let coupling = shell.coupling;
+    var offset = coupled_offset(coupling, shell.coupling_exponent, root, rest_tip, tip, h);
+    var t = coupled_tangent(coupling, shell.coupling_exponent, root, rest_tip, tip, h);
     if CURL {
         let wet = wetness_at(v.uv).w;
-        offset += curl_offset(h, wet, shell.curl.x, shell.curl.y, u, w);
-        t += curl_tangent(h, wet, shell.curl.x, shell.curl.y, u, w);
+        offset += curl_offset(h, wet, shell.curl_radius, shell.curl_frequency, u, w);
+        t += curl_tangent(h, wet, shell.curl_radius, shell.curl_frequency, u, w);
     }
     // strand_tangent's fallback: with the tip at rest (p = p0) the
     // Bézier arrives at the tip with zero speed, so at h = 1 the
@@ -250,22 +268,22 @@ fn vs_layer(v: VertexIn, @builtin(instance_index) layer: u32) -> LayerOut {
     out.layer = layer;
     out.clump_profile = 0.0;
     if CLUMP {
-        out.clump_profile = clump_profile(h, shell.clump.x, layers);
+        out.clump_profile = clump_profile(h, shell.clump_w, layers);
     }
     return out;
 }
 
 @fragment
 fn fs_layer(v: LayerOut) -> @location(0) vec4<f32> {
-    let layers = u32(shell.fur.y);
+    let layers = shell.layers;
     let h = layer_height(v.layer, layers);
     var uv_color = v.uv;
-    var uv_geo = v.uv * shell.fur.z;
+    var uv_geo = v.uv * shell.tiles;
     // Alg. 2.
     if CLUMP {
         let here = wetness_at(v.uv);
         if here.w != 0.0 {
-            let d = clump_displacement(v.clump_profile, shell.clump.y, here.w, v.uv, here.xy);
+            let d = clump_displacement(v.clump_profile, shell.clump_strength, here.w, v.uv, here.xy);
             if distance(v.uv, here.xy) > here.z {
                 discard;
             }
@@ -273,7 +291,7 @@ fn fs_layer(v: LayerOut) -> @location(0) vec4<f32> {
                 discard;
             }
             uv_color += d;
-            uv_geo += d * shell.fur.z;
+            uv_geo += d * shell.tiles;
         }
     }
     let fur = textureSampleLevel(fur_layers, fur_sampler, uv_geo, v.layer, 0.0);
@@ -287,6 +305,6 @@ fn fs_layer(v: LayerOut) -> @location(0) vec4<f32> {
     let u = normalize(v.u_axis);
     let lean = (2.0 * fur.r - 1.0) * u - (2.0 * fur.g - 1.0) * cross(n, u);
     let t = normalize(normalize(v.tangent) + lean);
-    let e = normalize(shell.eye.xyz - v.world);
-    return vec4<f32>(shade(color, fur.b, t, n, shell.light_dir.xyz, e, h), fur.a);
+    let e = normalize(shell.eye - v.world);
+    return vec4<f32>(shade(color, fur.b, t, n, shell.light_dir, e, h), fur.a);
 }

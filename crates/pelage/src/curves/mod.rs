@@ -19,6 +19,22 @@ use rayon::prelude::*;
 
 /// Curves: points, per-point widths, and an offsets array one longer than
 /// the number of curves, plus optional per-point and per-curve attributes.
+///
+/// ```
+/// use glam::Vec3;
+/// use pelage::Curves;
+///
+/// // Two hairs: 3 points and 2 points; curve i is points[offsets[i]..offsets[i + 1]].
+/// let points = vec![Vec3::ZERO, Vec3::Y * 0.5, Vec3::Y, Vec3::X, Vec3::X + Vec3::Y];
+/// let widths = vec![0.01, 0.005, 0.001, 0.01, 0.001];
+/// let curves = Curves::new(points, widths, vec![0, 3, 5])?
+///     .with_ids(vec![7, 8])?;
+/// assert_eq!(curves.curve_count(), 2);
+/// assert_eq!(curves.offsets(), &[0, 3, 5]);
+/// // Offsets that do not match the points are refused.
+/// assert!(Curves::new(vec![Vec3::ZERO], vec![0.01], vec![0, 2]).is_err());
+/// # Ok::<(), pelage::curves::CurvesError>(())
+/// ```
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Curves {
     points: Vec<Vec3>,

@@ -18,7 +18,7 @@ use crate::guides::Guides;
 use crate::interp::Interpolator;
 use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
-use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, sample_range};
+use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, salts, sample_range};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::Mutex;
@@ -290,7 +290,7 @@ impl Generator {
         let Some(sampler) = self.sampler.restricted(&part.triangles) else {
             return Vec::new();
         };
-        let stream = mix64(self.seed ^ mix64(0x9A27 + p as u64));
+        let stream = mix64(self.seed ^ mix64(salts::PART_ROOTS + p as u64));
         let roots = sample_range(&sampler, stream, 0..part.hair_count);
         sorted_by_triangle(roots)
     }

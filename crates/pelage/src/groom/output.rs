@@ -102,6 +102,24 @@ impl Generator {
     /// written while the next grows (memory: about two parts). A part that
     /// cannot grow ([`Generator::part`]) stops the stream with an I/O error
     /// of kind `Other` wrapping its [`GroomError`].
+    ///
+    /// ```
+    /// use pelage::groom::{GroomSpec, RootsSpec};
+    /// use pelage::guides::{GuideGrowth, Guides};
+    /// use pelage::io::CurvesExport;
+    /// use std::sync::Arc;
+    ///
+    /// let mesh = Arc::new(pelage::assets::spot());
+    /// let guides = Guides::grow(&mesh, &GuideGrowth { count: 20, ..Default::default() })?;
+    /// let generator = GroomSpec::new(mesh, guides, RootsSpec::new(500)).generator()?;
+    /// let mut usda = Vec::new();
+    /// let parts = 0..generator.parts().len();
+    /// generator.write_usd(&mut usda, parts, &CurvesExport::default(), |_, _| {})?;
+    /// let text = String::from_utf8(usda)?;
+    /// assert!(text.starts_with("#usda 1.0"));
+    /// assert!(text.contains("int[] curveVertexCounts"));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn write_usd(
         &self,
         out: impl Write,

@@ -54,6 +54,26 @@ pub enum Uvs {
 
 /// A triangle mesh. Build one with [`Mesh::new`] (validated) or load one
 /// with [`Mesh::load`] / [`Mesh::from_bytes`].
+///
+/// ```
+/// use glam::Vec3;
+/// use pelage::Mesh;
+///
+/// // A unit square from two triangles; normals are computed.
+/// let square = Mesh::new(
+///     "square",
+///     vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+///     vec![[0, 1, 2], [0, 2, 3]],
+///     None,
+///     None,
+/// )?;
+/// assert_eq!(square.triangle_count(), 2);
+/// assert!((square.surface_area() - 1.0).abs() < 1e-6);
+/// // Bad input is an error naming the mesh, never a panic.
+/// let err = Mesh::new("bad", vec![Vec3::ZERO], vec![[0, 1, 2]], None, None).unwrap_err();
+/// assert!(err.to_string().starts_with("bad"), "{err}");
+/// # Ok::<(), pelage::MeshError>(())
+/// ```
 #[derive(Debug)]
 pub struct Mesh {
     name: String,

@@ -100,6 +100,23 @@ fn alias_bin(bits: u64, n: usize) -> usize {
 }
 
 /// Samples points on a mesh with a density given by a [`Map`] (Sik §3).
+///
+/// ```
+/// use pelage::map::Map;
+/// use pelage::sample::{DensitySampler, SurfaceSampler, sample_range};
+///
+/// let spot = pelage::assets::spot();
+/// // Twice as many roots where the texture's red channel is twice as bright.
+/// let density = Map::Image(pelage::assets::spot_texture(pelage::map::Channel::R));
+/// let sampler = DensitySampler::new(&spot, &density, Default::default())?;
+/// // Sample i of a stream is a pure function of (seed, i): any range, on
+/// // any number of threads, gives the same points.
+/// let roots = sample_range(&sampler, 7, 0..1000);
+/// assert_eq!(roots.len(), 1000);
+/// assert_eq!(sample_range(&sampler, 7, 500..1000), roots[500..]);
+/// assert!(roots.iter().all(|r| sampler.pdf(*r) > 0.0));
+/// # Ok::<(), pelage::sample::SampleError>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct DensitySampler {
     /// The mesh's triangle areas (shared by the samplers restricted from

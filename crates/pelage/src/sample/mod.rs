@@ -18,6 +18,7 @@ mod cdf;
 mod density;
 mod rejection;
 mod rng;
+pub mod salts;
 pub mod subtriangle;
 pub mod warp;
 

@@ -13,7 +13,9 @@
 use super::math::WetTexel;
 use crate::Mesh;
 use crate::map::Map;
-use crate::sample::{DensitySampler, DensitySamplerOptions, SampleError, SampleRng, sample_range};
+use crate::sample::{
+    DensitySampler, DensitySamplerOptions, SampleError, SampleRng, salts, sample_range,
+};
 use glam::Vec2;
 
 /// One drop of water: where it hits (mask coordinates), how wide the clump
@@ -247,7 +249,7 @@ pub fn droplets_on_mesh(
         .enumerate()
         .filter_map(|(i, p)| {
             let uv = p.uv(mesh)?;
-            let mut rng = SampleRng::new(seed ^ 0x5EED_D201, i as u64);
+            let mut rng = SampleRng::new(seed ^ salts::DROPLETS, i as u64);
             let radius =
                 style.radius_min + (style.radius_max - style.radius_min) * rng.uniform_f32();
             Some(Droplet {

@@ -162,45 +162,42 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         .rev()
         .find(|r| r.topology == Topology::SpringSticks)
         .expect("spring-sticks always run");
-    let json_ms = |ms: Option<f64>| ms.map_or("null".to_string(), |ms| format!("{ms:.4}"));
     let gpu_name = gpu.as_ref().map(|ctx| ctx.adapter_name());
     if args.json {
-        let list: Vec<String> = rows
+        let list: Vec<serde_json::Value> = rows
             .iter()
             .map(|r| {
-                format!(
-                    "{{\"model\":{:?},\"topology\":{:?},\"masses\":{},\"springs\":{},\"explicit_ms\":{:.4},\"explicit_substeps\":{},\"implicit_ms\":{:.4},\"gpu_explicit_ms\":{},\"gpu_implicit_ms\":{}}}",
-                    r.model,
-                    r.topology.name(),
-                    r.masses,
-                    r.springs,
-                    r.ms[0],
-                    r.substeps,
-                    r.ms[1],
-                    json_ms(r.gpu_ms[0]),
-                    json_ms(r.gpu_ms[1])
-                )
+                serde_json::json!({
+                    "model": r.model,
+                    "topology": r.topology.name(),
+                    "masses": r.masses,
+                    "springs": r.springs,
+                    "explicit_ms": r.ms[0],
+                    "explicit_substeps": r.substeps,
+                    "implicit_ms": r.ms[1],
+                    "gpu_explicit_ms": r.gpu_ms[0],
+                    "gpu_implicit_ms": r.gpu_ms[1],
+                })
             })
             .collect();
-        println!(
-            "{{\"model\":{:?},\"masses\":{},\"explicit_ms\":{:.4},\"implicit_ms\":{:.4},\"explicit_ms_per_million\":{:.4},\"implicit_ms_per_million\":{:.4},\"threads\":{threads},\"gpu_adapter\":{},\"gpu_software\":{},\"gpu_explicit_ms\":{},\"gpu_explicit_ms_per_million\":{},\"gpu_implicit_ms\":{},\"gpu_implicit_ms_per_million\":{},\"rows\":[{}]}}",
-            headline.model,
-            headline.masses,
-            headline.ms[0],
-            headline.ms[1],
-            headline.ms[0] * 1e6 / headline.masses as f64,
-            headline.ms[1] * 1e6 / headline.masses as f64,
-            gpu_name
-                .as_ref()
-                .map_or("null".to_string(), |n| format!("{n:?}")),
-            gpu.as_ref()
-                .map_or("null".to_string(), |ctx| ctx.is_software().to_string()),
-            json_ms(headline.gpu_ms[0]),
-            json_ms(headline.gpu_ms[0].map(|ms| ms * 1e6 / headline.masses as f64)),
-            json_ms(headline.gpu_ms[1]),
-            json_ms(headline.gpu_ms[1].map(|ms| ms * 1e6 / headline.masses as f64)),
-            list.join(",")
-        );
+        let per_million = |ms: f64| ms * 1e6 / headline.masses as f64;
+        let report = serde_json::json!({
+            "model": headline.model,
+            "masses": headline.masses,
+            "explicit_ms": headline.ms[0],
+            "implicit_ms": headline.ms[1],
+            "explicit_ms_per_million": per_million(headline.ms[0]),
+            "implicit_ms_per_million": per_million(headline.ms[1]),
+            "threads": threads,
+            "gpu_adapter": gpu_name,
+            "gpu_software": gpu.as_ref().map(|ctx| ctx.is_software()),
+            "gpu_explicit_ms": headline.gpu_ms[0],
+            "gpu_explicit_ms_per_million": headline.gpu_ms[0].map(per_million),
+            "gpu_implicit_ms": headline.gpu_ms[1],
+            "gpu_implicit_ms_per_million": headline.gpu_ms[1].map(per_million),
+            "rows": list,
+        });
+        println!("{report}");
         return Ok(());
     }
     println!(

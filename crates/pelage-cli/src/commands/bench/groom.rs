@@ -192,10 +192,28 @@ pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
     let per_s = hair_count as f64 / shepard_s;
     let paper_scaled = PAPER_SECONDS * hairs as f64 / 1.6e6;
     if args.json {
-        println!(
-            "{{\"hairs\":{hair_count},\"points_per_hair\":16,\"points\":{point_count},\"triangles\":{triangles},\"threads\":{threads},\"seconds\":{shepard_s:.4},\"hairs_per_s\":{per_s:.0},\"prepare_s\":{prep_s:.4},\"grow_s\":{grow_s:.4},\"style_mesh_seconds\":{style_s:.4},\"style_mesh_prepare_s\":{style_prep_s:.4},\"style_mesh_hairs_per_s\":{:.0},\"paper_seconds\":{paper_scaled:.3},\"interpolation_only_8_points_s_per_million\":{blender_per_million:.4},\"blender_s_per_million\":{BLENDER_SECONDS_PER_MILLION},\"rss_hairs\":{rss_hairs},\"peak_rss_bytes\":{rss},\"rss_usd_bytes\":{usd_bytes},\"rss_seconds\":{rss_s:.3}}}",
-            hair_count as f64 / style_s
-        );
+        let report = serde_json::json!({
+            "hairs": hair_count,
+            "points_per_hair": 16,
+            "points": point_count,
+            "triangles": triangles,
+            "threads": threads,
+            "seconds": shepard_s,
+            "hairs_per_s": per_s.round(),
+            "prepare_s": prep_s,
+            "grow_s": grow_s,
+            "style_mesh_seconds": style_s,
+            "style_mesh_prepare_s": style_prep_s,
+            "style_mesh_hairs_per_s": (hair_count as f64 / style_s).round(),
+            "paper_seconds": paper_scaled,
+            "interpolation_only_8_points_s_per_million": blender_per_million,
+            "blender_s_per_million": BLENDER_SECONDS_PER_MILLION,
+            "rss_hairs": rss_hairs,
+            "peak_rss_bytes": rss,
+            "rss_usd_bytes": usd_bytes,
+            "rss_seconds": rss_s,
+        });
+        println!("{report}");
         return Ok(());
     }
     println!(

@@ -93,10 +93,22 @@ pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
     let (triangles, lost) = (style.triangles().len(), style.lost().len());
     let threads = rayon::current_num_threads();
     if args.json {
-        println!(
-            "{{\"triangles\":{},\"guides\":{guide_count},\"hairs\":{hair_count},\"threads\":{threads},\"style_mesh_build_s\":{warm_s:.4},\"style_mesh_build_cold_s\":{cold_s:.4},\"style_mesh_triangles\":{triangles},\"style_mesh_lost_guides\":{lost},\"style_mesh_ns_per_hair\":{style_sorted_ns:.1},\"style_mesh_random_order_ns_per_hair\":{style_ns:.1},\"style_mesh_bvh_ns_per_hair\":{style_bvh_ns:.1},\"shepard_k4_ns_per_hair\":{shepard4:.1},\"shepard_k8_ns_per_hair\":{shepard8:.1}}}",
-            mesh.triangle_count()
-        );
+        let report = serde_json::json!({
+            "triangles": mesh.triangle_count(),
+            "guides": guide_count,
+            "hairs": hair_count,
+            "threads": threads,
+            "style_mesh_build_s": warm_s,
+            "style_mesh_build_cold_s": cold_s,
+            "style_mesh_triangles": triangles,
+            "style_mesh_lost_guides": lost,
+            "style_mesh_ns_per_hair": style_sorted_ns,
+            "style_mesh_random_order_ns_per_hair": style_ns,
+            "style_mesh_bvh_ns_per_hair": style_bvh_ns,
+            "shepard_k4_ns_per_hair": shepard4,
+            "shepard_k8_ns_per_hair": shepard8,
+        });
+        println!("{report}");
         return Ok(());
     }
     println!(

@@ -146,22 +146,20 @@ pub fn run(args: &IoBenchArgs) -> anyhow::Result<()> {
     let mb = |b: u64| b as f64 / 1e6;
     let large = runs.last().expect("at least one run");
     if args.json {
-        let peak = |r: &Run| {
-            r.peak_rss
-                .map_or("null".to_string(), |p| format!("{:.1}", mb(p)))
-        };
-        println!(
-            "{{\"threads\":{threads},\"hairs\":{},\"points_per_hair\":{},\"part_hairs\":{},\"file_mb\":{:.1},\"write_s\":{:.3},\"mb_per_s\":{:.1},\"peak_rss_mb\":{},\"small_hairs\":{},\"small_peak_rss_mb\":{}}}",
-            large.hairs,
-            args.points,
-            args.part_hairs,
-            mb(large.bytes),
-            large.write.as_secs_f64(),
-            mb(large.bytes) / large.write.as_secs_f64(),
-            peak(large),
-            runs[0].hairs,
-            peak(&runs[0]),
-        );
+        let peak = |r: &Run| r.peak_rss.map(mb);
+        let report = serde_json::json!({
+            "threads": threads,
+            "hairs": large.hairs,
+            "points_per_hair": args.points,
+            "part_hairs": args.part_hairs,
+            "file_mb": mb(large.bytes),
+            "write_s": large.write.as_secs_f64(),
+            "mb_per_s": mb(large.bytes) / large.write.as_secs_f64(),
+            "peak_rss_mb": peak(large),
+            "small_hairs": runs[0].hairs,
+            "small_peak_rss_mb": peak(&runs[0]),
+        });
+        println!("{report}");
         return Ok(());
     }
     println!(

@@ -53,11 +53,10 @@ pub fn run(args: &RenderBenchArgs) -> anyhow::Result<()> {
         &[100_000, 1_000_000]
     };
     let mut rows = Vec::new();
-    let mut json = vec![
-        format!("\"adapter\":{:?}", ctx.adapter_name()),
-        format!("\"software_adapter\":{}", ctx.is_software()),
-        format!("\"skin_ms\":{:.3}", skin_s * 1e3),
-    ];
+    let mut json = serde_json::Map::new();
+    json.insert("adapter".into(), ctx.adapter_name().into());
+    json.insert("software_adapter".into(), ctx.is_software().into());
+    json.insert("skin_ms".into(), (skin_s * 1e3).into());
     for &count in counts {
         let roots = sample_range(&sampler, 5, 0..count);
         let curves = Curves::along_normals(&spot, &roots, 0.05, 8, 0.0015, 0.0003);
@@ -74,10 +73,10 @@ pub fn run(args: &RenderBenchArgs) -> anyhow::Result<()> {
         } else {
             format!("curves_{}k_ms", count / 1000)
         };
-        json.push(format!("\"{key}\":{:.3}", frame_s * 1e3));
+        json.insert(key, (frame_s * 1e3).into());
     }
     if args.json {
-        println!("{{{}}}", json.join(","));
+        println!("{}", serde_json::Value::Object(json));
         return Ok(());
     }
     println!(

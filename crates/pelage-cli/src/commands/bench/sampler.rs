@@ -168,7 +168,7 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
     };
 
     let mut report = String::new();
-    let mut json: Vec<(String, String)> = Vec::new();
+    let mut json = serde_json::Map::new();
     let _ = writeln!(
         report,
         "pelage bench sampler{} — {threads} threads, {} samples per rate, median of {} runs",
@@ -245,16 +245,16 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
         &["", "pelage", "paper", "target"],
         &rows,
     );
-    json.push(("preprocess_s".into(), format!("{pre_s:.6}")));
-    json.push((
+    json.insert("preprocess_s".into(), pre_s.into());
+    json.insert(
         "bytes_per_record".into(),
-        std::mem::size_of::<SubTriangleRecord>().to_string(),
-    ));
-    json.push(("records".into(), sampler.records().len().to_string()));
-    json.push(("memory_bytes".into(), sampler.memory_bytes().to_string()));
-    json.push(("samples_per_s_1t".into(), format!("{rate_1t:.0}")));
-    json.push(("samples_per_s_all_threads".into(), format!("{rate_all:.0}")));
-    json.push(("threads".into(), threads.to_string()));
+        std::mem::size_of::<SubTriangleRecord>().into(),
+    );
+    json.insert("records".into(), sampler.records().len().into());
+    json.insert("memory_bytes".into(), sampler.memory_bytes().into());
+    json.insert("samples_per_s_1t".into(), rate_1t.round().into());
+    json.insert("samples_per_s_all_threads".into(), rate_all.round().into());
+    json.insert("threads".into(), threads.into());
 
     // The selectors alone against a peer, rand_distr's WeightedAliasIndex,
     // on the same weights, in plain loops (no prefetching on either side).
@@ -330,19 +330,16 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
         &["selector", "build", "selections/s", "memory"],
         &rows,
     );
-    json.push((
+    json.insert(
         "alias_select_per_s".into(),
-        format!("{:.0}", selections as f64 / ours_select),
-    ));
-    json.push((
+        (selections as f64 / ours_select).round().into(),
+    );
+    json.insert(
         "rand_distr_alias_select_per_s".into(),
-        format!("{:.0}", selections as f64 / peer_select),
-    ));
-    json.push(("alias_build_s".into(), format!("{ours_build:.6}")));
-    json.push((
-        "rand_distr_alias_build_s".into(),
-        format!("{peer_build:.6}"),
-    ));
+        (selections as f64 / peer_select).round().into(),
+    );
+    json.insert("alias_build_s".into(), ours_build.into());
+    json.insert("rand_distr_alias_build_s".into(), peer_build.into());
     drop(sampler);
 
     // Table 1: grid size, uniform density on blub ×1.
@@ -436,7 +433,7 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
             ],
         });
         if name == "spot ×4" {
-            json.push(("spot4_preprocess_s".into(), format!("{pre:.6}")));
+            json.insert("spot4_preprocess_s".into(), pre.into());
         }
     }
     report += &table(
@@ -550,14 +547,14 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
             ],
         });
         if mean == 0.1 {
-            json.push((
+            json.insert(
                 "rejection_samples_per_s_1t_mean_0_1".into(),
-                format!("{rejection_rate:.0}"),
-            ));
-            json.push((
+                rejection_rate.round().into(),
+            );
+            json.insert(
                 "alias_over_rejection_mean_0_1".into(),
-                format!("{:.2}", alias_rate / rejection_rate),
-            ));
+                (alias_rate / rejection_rate).into(),
+            );
         }
     }
     report += &table(
@@ -574,8 +571,7 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
     );
 
     if args.json {
-        let body: Vec<String> = json.iter().map(|(k, v)| format!("\"{k}\":{v}")).collect();
-        println!("{{{}}}", body.join(","));
+        println!("{}", serde_json::Value::Object(json));
     } else {
         print!("{report}");
     }

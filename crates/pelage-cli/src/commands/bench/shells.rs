@@ -167,25 +167,32 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         .find(|r| r.model == "spot ×2" && r.layers == 16 && r.size == (800, 600))
         .expect("spot ×2 at 16 layers, 800×600 is always measured");
     if args.json {
-        let list: Vec<String> = rows
+        let list: Vec<serde_json::Value> = rows
             .iter()
             .map(|r| {
-                format!(
-                    "{{\"model\":{:?},\"triangles\":{},\"layers\":{},\"width\":{},\"height\":{},\"plain_ms\":{:.3},\"curl_ms\":{:.3},\"curl_clump_ms\":{:.3}}}",
-                    r.model, r.triangles, r.layers, r.size.0, r.size.1, r.ms[0], r.ms[1], r.ms[2]
-                )
+                serde_json::json!({
+                    "model": r.model,
+                    "triangles": r.triangles,
+                    "layers": r.layers,
+                    "width": r.size.0,
+                    "height": r.size.1,
+                    "plain_ms": r.ms[0],
+                    "curl_ms": r.ms[1],
+                    "curl_clump_ms": r.ms[2],
+                })
             })
             .collect();
-        println!(
-            "{{\"adapter\":{:?},\"software_adapter\":{},\"plain_ms\":{:.3},\"curl_ms\":{:.3},\"curl_clump_ms\":{:.3},\"overhead_ratio\":{:.4},\"target_overhead_ratio\":1.15,\"rows\":[{}]}}",
-            ctx.adapter_name(),
-            ctx.is_software(),
-            headline.ms[0],
-            headline.ms[1],
-            headline.ms[2],
-            headline.ms[2] / headline.ms[0],
-            list.join(",")
-        );
+        let report = serde_json::json!({
+            "adapter": ctx.adapter_name(),
+            "software_adapter": ctx.is_software(),
+            "plain_ms": headline.ms[0],
+            "curl_ms": headline.ms[1],
+            "curl_clump_ms": headline.ms[2],
+            "overhead_ratio": headline.ms[2] / headline.ms[0],
+            "target_overhead_ratio": 1.15,
+            "rows": list,
+        });
+        println!("{report}");
         return Ok(());
     }
     println!(

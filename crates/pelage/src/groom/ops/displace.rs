@@ -6,7 +6,7 @@
 use super::{Hair, RampTables, Resampling, RootContext, Scratch, param};
 use crate::groom::file::Ramp;
 use crate::map::{Map, NoiseMap};
-use crate::sample::SampleRng;
+use crate::sample::{SampleRng, salts};
 use glam::Vec3;
 use std::f32::consts::TAU;
 
@@ -223,7 +223,7 @@ impl Frizz {
     /// A frizz operator.
     pub fn new(amplitude: Map, frequency: Map, fraction: Map, ramp: Ramp, seed: u64) -> Self {
         Self {
-            field: VectorNoise::new(seed ^ 0xF122),
+            field: VectorNoise::new(seed ^ salts::FRIZZ_FIELD),
             amplitude,
             frequency,
             fraction,
@@ -233,7 +233,7 @@ impl Frizz {
     }
 
     pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
-        let mut rng = SampleRng::new(self.seed ^ 0xF122_F122, hair.id);
+        let mut rng = SampleRng::new(self.seed ^ salts::FRIZZ_HAIR, hair.id);
         if rng.uniform_f32() >= self.fraction.eval(root.uv) {
             return;
         }
@@ -281,7 +281,7 @@ impl Curl {
             return;
         }
         let turns = self.turns.eval(root.uv);
-        let phase = TAU * SampleRng::new(self.seed ^ 0xC0_11, hair.id).uniform_f32();
+        let phase = TAU * SampleRng::new(self.seed ^ salts::CURL_PHASE, hair.id).uniform_f32();
         let n = hair.points.len();
         scratch.frame_along(&hair.points, root.normal);
         let ramp = scratch.ramps.along(&self.ramp, n);

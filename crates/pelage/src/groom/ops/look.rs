@@ -6,7 +6,7 @@
 use super::{Hair, RampTables, RootContext, RootToTip, jittered};
 use crate::groom::file::Ramp;
 use crate::map::Map;
-use crate::sample::SampleRng;
+use crate::sample::{SampleRng, salts};
 use glam::Vec3;
 
 /// Evaluates a [`RootToTip`] along a hair into `out` (resized to the
@@ -48,7 +48,7 @@ impl Width {
         let n = hair.points.len();
         root_to_tip(
             &self.0,
-            0x3D_7714,
+            salts::WIDTH_JITTER,
             hair.id,
             root,
             &mut hair.widths,
@@ -68,7 +68,7 @@ impl Opacity {
         let n = hair.points.len();
         root_to_tip(
             &self.0,
-            0x00BA_C17E,
+            salts::OPACITY_JITTER,
             hair.id,
             root,
             &mut hair.opacities,
@@ -99,7 +99,11 @@ pub struct Color {
 
 impl Color {
     pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
-        let factor = varied(self.jitter.eval(root.uv), self.seed ^ 0xC0_10E, hair.id);
+        let factor = varied(
+            self.jitter.eval(root.uv),
+            self.seed ^ salts::COLOR_JITTER,
+            hair.id,
+        );
         let rgb = |m: &[Map; 3]| Vec3::from(m.each_ref().map(|c| c.eval(root.uv)));
         let (a, b) = (rgb(&self.root), rgb(&self.tip));
         let ramp = ramps.along(&self.ramp, hair.points.len());

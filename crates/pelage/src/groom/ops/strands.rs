@@ -6,7 +6,7 @@
 
 use super::{HairBatch, RootContext, Scratch};
 use crate::map::Map;
-use crate::sample::SampleRng;
+use crate::sample::{SampleRng, salts};
 use std::f32::consts::TAU;
 
 /// `strands`: hair `k` of the strand of base hair `b` has id
@@ -56,7 +56,8 @@ impl Strands {
             scratch.frame_along(&base.points, root.normal);
             for k in 0..u64::from(self.count) {
                 let id = base.id.wrapping_mul(u64::from(self.count)).wrapping_add(k);
-                let [a, b] = SampleRng::new(self.seed ^ 0x57_2A4D, id).uniform_f32_pair();
+                let [a, b] =
+                    SampleRng::new(self.seed ^ salts::STRAND_SPREAD, id).uniform_f32_pair();
                 let rho = a.sqrt();
                 let hair = batch.push();
                 hair.copy_from(base);

@@ -3,7 +3,7 @@
 
 use super::{HairBatch, RootContext, Scratch, jittered, param};
 use crate::map::Map;
-use crate::sample::SampleRng;
+use crate::sample::{SampleRng, salts};
 
 /// `cut`: each hair ends at curve parameter `at` (0 to 1, read from the
 /// map at its root) and keeps its point count: the kept part is resampled
@@ -87,7 +87,7 @@ impl Length {
     }
 
     pub(super) fn apply(&self, hair: &mut super::Hair, root: &RootContext) {
-        let mut rng = SampleRng::new(self.seed ^ 0x1E_4674, hair.id);
+        let mut rng = SampleRng::new(self.seed ^ salts::LENGTH_JITTER, hair.id);
         let factor =
             (self.scale.eval(root.uv) * jittered(self.jitter.eval(root.uv), &mut rng)).max(0.0);
         let Some(&origin) = hair.points.first() else {
