@@ -2,7 +2,7 @@
 //! through it: the skin mesh, points (hair roots, samples), curves, and
 //! shell fur ([`ShellRenderer`]); and it steps moving fur's explicit
 //! mass-spring solver in a compute shader ([`GpuMassSpring`]). It renders headless into an image (CI,
-//! render farms without GPUs, docs) and, with the viewer issue, into a window,
+//! render farms without GPUs, docs) and, for the viewer, into a window,
 //! with the same pipelines. WGSL lives in `src/shaders/`.
 //!
 //! Its own crate because wgpu is the heaviest dependency by far: the
@@ -15,14 +15,18 @@ mod camera;
 mod context;
 mod dynamics;
 mod layout;
+mod motion;
+mod readback;
 mod renderer;
 mod shells;
 
 pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
-pub use dynamics::{FurMotion, GpuMassSpring};
+pub use dynamics::GpuMassSpring;
+pub use motion::FurMotion;
 pub use pelage::Curves;
-pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer, read_texture};
+pub use readback::read_texture;
+pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer};
 pub use shells::{
     ShellFeatures, ShellModel, ShellParams, ShellRenderer, ShellScenePlayer, ShellTarget,
     ShellView, vertex_tangents,

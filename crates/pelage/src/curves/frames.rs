@@ -9,6 +9,10 @@
 //! that takes the reflected tangent onto the tangent at `i + 1`. It is
 //! exact for circles and fourth-order accurate elsewhere, with no
 //! trigonometry.
+//!
+//! One file, past 600 lines: the scalar, portable-lane and AVX versions of
+//! one algorithm must stay bit-identical, so they sit side by side (about 130
+//! of its lines are tests).
 
 use glam::Vec3;
 

@@ -24,6 +24,9 @@
 //!
 //! Every loop over tips runs on rayon and sums in a fixed order, so a step
 //! gives the same bits on any number of threads.
+//!
+//! One file, past 600 lines: forces, both integrators and the constraints
+//! share the per-tip state layout (about 120 of its lines are tests).
 
 use super::system::{MassSpringSystem, Topology};
 use crate::map::NoiseMap;

@@ -9,6 +9,9 @@
 //! parameter … is also specified by a texture"); maps are resolved against
 //! the groom file's folder, and a map that cannot be read is reported at
 //! its line too.
+//!
+//! One file, past 600 lines: the groom file's schema in one place (about 130
+//! of its lines are tests).
 
 pub use super::ramp::Ramp;
 use crate::io::CurveBasis;

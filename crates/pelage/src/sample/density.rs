@@ -2,6 +2,10 @@
 //! sibling merging (Fig. 5), 12-byte records with shared positions (Fig. 4),
 //! selection by CDF + uniform grid (Fig. 7) or by an alias table, and a
 //! uniform point in the chosen sub-triangle (Fig. 6).
+//!
+//! One file, past 600 lines: the §3 sampler end to end (records, both
+//! selectors, prefetched block sampling, the PDF) reads best as one
+//! algorithm.
 
 use super::alias::{AliasBins, build_alias_bins};
 use super::cdf::CdfGrid;

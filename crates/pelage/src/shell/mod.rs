@@ -16,6 +16,7 @@
 mod error;
 pub mod math;
 pub mod scene;
+mod scene_file;
 pub mod textures;
 pub mod wetness;
 

@@ -6,203 +6,26 @@
 //! Errors are [`SceneError`]s: `FILE:LINE:COL: KEY: what`; names (texture
 //! style, shading, topology, solver, coupling) are serde enums, so an
 //! unknown one lists the accepted names.
+//!
+//! One file, past 600 lines: a section-by-section reading of the scene file
+//! (about 190 of its lines are tests).
 
 use super::error::{SceneError, SceneErrorKind};
 use super::math::{ClumpParams, Coupling, CurlParams, KajiyaKay, ShadingMode};
+use super::scene_file::{
+    CouplingName, DropletsSection, DynamicsSection, FurSection, RadiusText, SceneFile, SolverName,
+    TextureSection,
+};
 use super::textures::{ShellTextureParams, TextureStyle};
 use super::wetness::{
     Droplet, DropletStyle, WetnessMask, droplets_from_image, droplets_on_mesh, mask_coordinates,
 };
 use crate::Mesh;
 use crate::dynamics::{DynamicsParams, Solver, Topology, Wind};
-use crate::groom::file::MeshSection;
 use crate::settings::SettingsSource;
 use glam::{Vec2, Vec3};
-use serde::Deserialize;
 use std::f32::consts::TAU;
 use std::path::Path;
-use toml::Spanned;
-
-/// The file as written.
-#[derive(Debug, Clone, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct SceneFile {
-    mesh: Option<MeshSection>,
-    color: Option<Spanned<String>>,
-    #[serde(default)]
-    fur: FurSection,
-    #[serde(default)]
-    texture: TextureSection,
-    #[serde(default)]
-    curl: CurlSection,
-    #[serde(default)]
-    clump: ClumpSection,
-    #[serde(default)]
-    shading: ShadingSection,
-    #[serde(default)]
-    wetness: WetnessSection,
-    #[serde(default)]
-    droplets: Vec<DropletsSection>,
-    light: Option<[f32; 3]>,
-    camera: Option<CameraSection>,
-    #[serde(default)]
-    animation: AnimationSection,
-    dynamics: Option<DynamicsSection>,
-}
-
-#[derive(Debug, Clone, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct DynamicsSection {
-    topology: Option<Topology>,
-    solver: Option<SolverName>,
-    substeps: Option<u32>,
-    iterations: Option<u32>,
-    gpu: Option<Spanned<bool>>,
-    steps_per_frame: Option<u32>,
-    coupling: Option<CouplingName>,
-    exponent: Option<f32>,
-    mass: Option<f32>,
-    stiffness: Option<f32>,
-    lateral_stiffness: Option<f32>,
-    damping: Option<f32>,
-    drag: Option<f32>,
-    restoring: Option<f32>,
-    gravity: Option<[f32; 3]>,
-    wind: Option<WindSection>,
-    shake: Option<ShakeSection>,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct WindSection {
-    velocity: [f32; 3],
-    gust: Option<f32>,
-    gust_frequency: Option<f32>,
-    turbulence: Option<f32>,
-    scale: Option<f32>,
-    seed: Option<u64>,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ShakeSection {
-    amplitude: [f32; 3],
-    frequency: Option<f32>,
-    duration: Option<f32>,
-}
-
-#[derive(Debug, Clone, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct FurSection {
-    layers: Option<Spanned<u32>>,
-    length: Option<Spanned<f32>>,
-    tiles: Option<f32>,
-}
-
-#[derive(Debug, Clone, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct TextureSection {
-    style: Option<TextureStyle>,
-    resolution: Option<Spanned<u32>>,
-    density: Option<f32>,
-    thickness: Option<f32>,
-    length_variance: Option<f32>,
-    lean: Option<f32>,
-    bend: Option<f32>,
-    undercoat_ratio: Option<f32>,
-    undercoat_length: Option<f32>,
-    seed: Option<u64>,
-}
-
-#[derive(Debug, Clone, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct CurlSection {
-    radius: Option<f32>,
-    turns: Option<f32>,
-}
-
-#[derive(Debug, Clone, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct ClumpSection {
-    w: Option<f32>,
-    strength: Option<f32>,
-    enabled: Option<bool>,
-}
-
-#[derive(Debug, Clone, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct ShadingSection {
-    mode: Option<ShadingMode>,
-    specular: Option<[f32; 3]>,
-    exponent: Option<f32>,
-    shadow: Option<f32>,
-}
-
-#[derive(Debug, Clone, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct WetnessSection {
-    resolution: Option<Spanned<u32>>,
-    drying_rate: Option<f32>,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct DropletsSection {
-    /// Seconds into the sequence when they fall.
-    #[serde(default)]
-    time: f32,
-    /// One droplet at a mesh UV.
-    at: Option<[f32; 2]>,
-    /// Random droplets over the surface.
-    count: Option<usize>,
-    /// Droplets along the bright pixels of an image (mask coordinates).
-    image: Option<Spanned<String>>,
-    /// Grid spacing for `image`.
-    spacing: Option<f32>,
-    /// Radius, or `[min, max]`.
-    radius: Option<RadiusText>,
-    wetness: Option<f32>,
-    seed: Option<u64>,
-}
-
-/// `[dynamics] solver`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum SolverName {
-    Implicit,
-    Explicit,
-}
-
-/// `[dynamics] coupling`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum CouplingName {
-    Bezier,
-    Linear,
-    Bent,
-}
-
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(untagged)]
-enum RadiusText {
-    One(f32),
-    Range([f32; 2]),
-}
-
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CameraSection {
-    eye: [f32; 3],
-    target: [f32; 3],
-    fov: Option<f32>,
-}
-
-#[derive(Debug, Clone, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct AnimationSection {
-    frames: Option<u32>,
-    fps: Option<f32>,
-}
 
 /// The shell layers.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -366,99 +189,11 @@ impl ShellScene {
         let file: SceneFile = source.deserialize().map_err(|(place, message)| {
             SceneError::new(source.path.clone(), place, SceneErrorKind::Syntax(message))
         })?;
-        let invalid = |span: std::ops::Range<usize>, message: String| {
-            SceneError::at(source, span, SceneErrorKind::Invalid(message))
-        };
-        let image_at = |span: std::ops::Range<usize>, path: std::path::PathBuf| {
-            move |error| SceneError::at(source, span, SceneErrorKind::Image { path, error })
-        };
-        let (mesh, default_color) = match &file.mesh {
-            None => (crate::assets::spot(), Some(spot_color())),
-            Some(section) => {
-                let mesh = section.load(source.folder()).map_err(|e| {
-                    SceneError::at(source, section.path.span(), SceneErrorKind::Mesh(e))
-                })?;
-                let spot = section.path.get_ref() == "spot";
-                (mesh, spot.then(spot_color))
-            }
-        };
-        if !mesh.has_uvs() {
-            let span = file.mesh.as_ref().map_or(0..0, |m| m.path.span());
-            return Err(invalid(
-                span,
-                format!(
-                    "the mesh {} has no UVs; shell fur reads its textures and wetness mask at the mesh's UVs",
-                    mesh.name()
-                ),
-            ));
-        }
-        let color = match &file.color {
-            Some(path) => {
-                let full = source.folder().join(path.get_ref());
-                image::open(&full)
-                    .map_err(image_at(path.span(), full.clone()))?
-                    .to_rgba8()
-            }
-            None => default_color.unwrap_or_else(|| {
-                image::RgbaImage::from_pixel(1, 1, image::Rgba([150, 110, 70, 255]))
-            }),
-        };
+        let (mesh, color) = mesh_and_color(source, &file)?;
         let (lo, hi) = mesh.bounds();
-        let diagonal = (hi - lo).length();
-
-        let layers = match &file.fur.layers {
-            Some(n) if !(1..=256).contains(n.get_ref()) => {
-                return Err(invalid(
-                    n.span(),
-                    format!("{} layers: use 1 to 256", n.get_ref()),
-                ));
-            }
-            Some(n) => *n.get_ref(),
-            None => 16,
-        };
-        let length = match &file.fur.length {
-            Some(l) if !(l.get_ref().is_finite() && *l.get_ref() > 0.0) => {
-                return Err(invalid(
-                    l.span(),
-                    format!("{} is not a positive length", l.get_ref()),
-                ));
-            }
-            Some(l) => *l.get_ref(),
-            None => 0.025 * diagonal,
-        };
-        let fur = FurSettings {
-            layers,
-            length,
-            tiles: file.fur.tiles.unwrap_or(8.0).max(1e-3),
-        };
-
-        let t = &file.texture;
-        let defaults = ShellTextureParams::default();
-        let style = t.style.unwrap_or(TextureStyle::Blades);
-        let resolution = match &t.resolution {
-            Some(r) if !(8..=4096).contains(r.get_ref()) => {
-                return Err(invalid(
-                    r.span(),
-                    format!("{} texels: use 8 to 4096", r.get_ref()),
-                ));
-            }
-            Some(r) => *r.get_ref(),
-            None => defaults.resolution,
-        };
-        let texture = ShellTextureParams {
-            resolution,
-            layers,
-            density: t.density.unwrap_or(defaults.density),
-            thickness: t.thickness.unwrap_or(defaults.thickness),
-            length_variance: t.length_variance.unwrap_or(defaults.length_variance),
-            lean: t.lean.unwrap_or(defaults.lean),
-            bend: t.bend.unwrap_or(defaults.bend),
-            undercoat_ratio: t.undercoat_ratio.unwrap_or(defaults.undercoat_ratio),
-            undercoat_length: t.undercoat_length.unwrap_or(defaults.undercoat_length),
-            style,
-            seed: t.seed.unwrap_or(defaults.seed),
-        };
-
+        let fur = fur_settings(source, &file.fur, (hi - lo).length())?;
+        let length = fur.length;
+        let texture = texture_params(source, &file.texture, fur.layers)?;
         // Curl radius is written as a fraction of the shell length.
         let curl = CurlParams {
             radius: file.curl.radius.unwrap_or(0.0) * length,
@@ -480,6 +215,7 @@ impl ShellScene {
         let wetness_resolution = match &file.wetness.resolution {
             Some(r) if !(8..=4096).contains(r.get_ref()) => {
                 return Err(invalid(
+                    source,
                     r.span(),
                     format!("{} texels: use 8 to 4096", r.get_ref()),
                 ));
@@ -488,137 +224,12 @@ impl ShellScene {
             None => 256,
         };
 
-        let mut droplets = Vec::new();
-        for (i, d) in file.droplets.iter().enumerate() {
-            let (radius_min, radius_max) = match d.radius {
-                Some(RadiusText::One(r)) => (r, r),
-                Some(RadiusText::Range([a, b])) => (a.min(b), a.max(b)),
-                None => (0.015, 0.03),
-            };
-            let style = DropletStyle {
-                radius_min,
-                radius_max,
-                wetness: d.wetness.unwrap_or(1.0).clamp(0.0, 1.0),
-            };
-            let seed = d.seed.unwrap_or(i as u64 + 1);
-            let drops: Vec<Droplet> = match (d.at, d.count, &d.image) {
-                (Some(uv), None, None) => vec![Droplet {
-                    centre: mask_coordinates(Vec2::from(uv)),
-                    radius: radius_max,
-                    wetness: style.wetness,
-                }],
-                (None, Some(count), None) => {
-                    droplets_on_mesh(&mesh, count, style, seed).map_err(|e| {
-                        invalid(0..0, format!("droplets[{i}]: cannot place droplets: {e}"))
-                    })?
-                }
-                (None, None, Some(path)) => {
-                    let full = source.folder().join(path.get_ref());
-                    let image = image::open(&full)
-                        .map_err(image_at(path.span(), full.clone()))?
-                        .to_luma32f();
-                    let (w, h) = (image.width() as f32, image.height() as f32);
-                    let brightness = |p: Vec2| {
-                        let x = (p.x * w).clamp(0.0, w - 1.0) as u32;
-                        let y = (p.y * h).clamp(0.0, h - 1.0) as u32;
-                        image.get_pixel(x, y).0[0]
-                    };
-                    droplets_from_image(brightness, d.spacing.unwrap_or(radius_max), style, seed)
-                }
-                _ => {
-                    let span = d.image.as_ref().map_or(0..0, |p| p.span());
-                    return Err(invalid(
-                        span,
-                        format!(
-                            "droplets[{i}]: give exactly one of `at = [u, v]`, `count = N` or `image = \"FILE\"`"
-                        ),
-                    ));
-                }
-            };
-            droplets.extend(drops.into_iter().map(|droplet| TimedDroplet {
-                time: d.time.max(0.0),
-                droplet,
-            }));
-        }
-        droplets.sort_by(|a, b| a.time.total_cmp(&b.time));
-
-        let dynamics = match &file.dynamics {
-            None => None,
-            Some(d) => {
-                let topology = d.topology.unwrap_or(Topology::SpringSticks);
-                let solver = match d.solver.unwrap_or(SolverName::Implicit) {
-                    SolverName::Implicit => Solver::Implicit {
-                        iterations: d.iterations.unwrap_or(30).max(1),
-                    },
-                    SolverName::Explicit => Solver::Explicit {
-                        // 0: as many as stability needs.
-                        substeps: d.substeps.unwrap_or(0),
-                    },
-                };
-                let gpu = d.gpu.as_ref().is_some_and(|g| *g.get_ref());
-                if let (true, Solver::Implicit { .. }, true) = (gpu, solver, topology.joins_tips())
-                {
-                    let span = d.gpu.as_ref().map_or(0..0, |g| g.span());
-                    return Err(invalid(
-                        span,
-                        format!(
-                            "the GPU steps {} with the explicit solver only (their implicit step solves all tips at once, on the CPU): set solver = \"explicit\", or gpu = false",
-                            topology.name()
-                        ),
-                    ));
-                }
-                let default_coupling = if topology == Topology::SilvaStrands {
-                    CouplingName::Bezier
-                } else {
-                    CouplingName::Bent
-                };
-                let coupling = match d.coupling.unwrap_or(default_coupling) {
-                    CouplingName::Bezier => Coupling::Bezier,
-                    CouplingName::Linear => Coupling::Linear,
-                    CouplingName::Bent => Coupling::Bent {
-                        exponent: d.exponent.unwrap_or(2.0).max(1.0),
-                    },
-                };
-                let defaults = DynamicsParams::default();
-                let params = DynamicsParams {
-                    mass: d.mass.unwrap_or(defaults.mass).max(1e-9),
-                    stiffness: d.stiffness.unwrap_or(defaults.stiffness).max(0.0),
-                    lateral_stiffness: d
-                        .lateral_stiffness
-                        .unwrap_or(defaults.lateral_stiffness)
-                        .max(0.0),
-                    damping: d.damping.unwrap_or(defaults.damping).max(0.0),
-                    drag: d.drag.unwrap_or(defaults.drag).max(0.0),
-                    restoring: d.restoring.unwrap_or(defaults.restoring).max(0.0),
-                    gravity: d.gravity.map_or(defaults.gravity, Vec3::from),
-                    wind: d.wind.as_ref().map(|w| {
-                        Wind::new(
-                            Vec3::from(w.velocity),
-                            w.gust.unwrap_or(0.5),
-                            w.gust_frequency.unwrap_or(0.5),
-                            w.turbulence.unwrap_or(0.0),
-                            w.scale.unwrap_or(4.0),
-                            w.seed.unwrap_or(1),
-                        )
-                    }),
-                    brush: None,
-                };
-                Some(DynamicsSettings {
-                    topology,
-                    solver,
-                    steps_per_frame: d.steps_per_frame.unwrap_or(2).max(1),
-                    coupling,
-                    params,
-                    shake: d.shake.as_ref().map(|s| Shake {
-                        amplitude: Vec3::from(s.amplitude),
-                        frequency: s.frequency.unwrap_or(3.0).max(1e-3),
-                        duration: s.duration.unwrap_or(1.0).max(0.0),
-                    }),
-                    gpu,
-                })
-            }
-        };
-
+        let droplets = droplets(source, &file.droplets, &mesh)?;
+        let dynamics = file
+            .dynamics
+            .as_ref()
+            .map(|d| dynamics_settings(source, d))
+            .transpose()?;
         Ok(Self {
             mesh,
             color,
@@ -652,6 +263,281 @@ impl ShellScene {
             next: 0,
         }
     }
+}
+
+/// An error at a span of the scene file: a value that cannot be used.
+fn invalid(source: &SettingsSource, span: std::ops::Range<usize>, message: String) -> SceneError {
+    SceneError::at(source, span, SceneErrorKind::Invalid(message))
+}
+
+/// An image at `path` (written at `span`) that cannot be read.
+fn unreadable_image(
+    source: &SettingsSource,
+    span: std::ops::Range<usize>,
+    path: std::path::PathBuf,
+) -> impl FnOnce(image::ImageError) -> SceneError + '_ {
+    move |error| SceneError::at(source, span, SceneErrorKind::Image { path, error })
+}
+
+/// `[mesh]` (Spot by default) and `color`: the skin, which must have UVs,
+/// and the fur colour texture.
+fn mesh_and_color(
+    source: &SettingsSource,
+    file: &SceneFile,
+) -> Result<(Mesh, image::RgbaImage), SceneError> {
+    let (mesh, default_color) = match &file.mesh {
+        None => (crate::assets::spot(), Some(spot_color())),
+        Some(section) => {
+            let mesh = section.load(source.folder()).map_err(|e| {
+                SceneError::at(source, section.path.span(), SceneErrorKind::Mesh(e))
+            })?;
+            let spot = section.path.get_ref() == "spot";
+            (mesh, spot.then(spot_color))
+        }
+    };
+    if !mesh.has_uvs() {
+        let span = file.mesh.as_ref().map_or(0..0, |m| m.path.span());
+        return Err(invalid(
+            source,
+            span,
+            format!(
+                "the mesh {} has no UVs; shell fur reads its textures and wetness mask at the mesh's UVs",
+                mesh.name()
+            ),
+        ));
+    }
+    let color = match &file.color {
+        Some(path) => {
+            let full = source.folder().join(path.get_ref());
+            image::open(&full)
+                .map_err(unreadable_image(source, path.span(), full.clone()))?
+                .to_rgba8()
+        }
+        None => default_color.unwrap_or_else(|| {
+            image::RgbaImage::from_pixel(1, 1, image::Rgba([150, 110, 70, 255]))
+        }),
+    };
+    Ok((mesh, color))
+}
+
+/// `[fur]`: layers (1 to 256) and length (by default 2.5 % of the mesh's
+/// diagonal).
+fn fur_settings(
+    source: &SettingsSource,
+    fur: &FurSection,
+    diagonal: f32,
+) -> Result<FurSettings, SceneError> {
+    let layers = match &fur.layers {
+        Some(n) if !(1..=256).contains(n.get_ref()) => {
+            return Err(invalid(
+                source,
+                n.span(),
+                format!("{} layers: use 1 to 256", n.get_ref()),
+            ));
+        }
+        Some(n) => *n.get_ref(),
+        None => 16,
+    };
+    let length = match &fur.length {
+        Some(l) if !(l.get_ref().is_finite() && *l.get_ref() > 0.0) => {
+            return Err(invalid(
+                source,
+                l.span(),
+                format!("{} is not a positive length", l.get_ref()),
+            ));
+        }
+        Some(l) => *l.get_ref(),
+        None => 0.025 * diagonal,
+    };
+    let fur = FurSettings {
+        layers,
+        length,
+        tiles: fur.tiles.unwrap_or(8.0).max(1e-3),
+    };
+
+    Ok(fur)
+}
+
+/// `[texture]`: the shell texture's blades and undercoat.
+fn texture_params(
+    source: &SettingsSource,
+    t: &TextureSection,
+    layers: u32,
+) -> Result<ShellTextureParams, SceneError> {
+    let defaults = ShellTextureParams::default();
+    let style = t.style.unwrap_or(TextureStyle::Blades);
+    let resolution = match &t.resolution {
+        Some(r) if !(8..=4096).contains(r.get_ref()) => {
+            return Err(invalid(
+                source,
+                r.span(),
+                format!("{} texels: use 8 to 4096", r.get_ref()),
+            ));
+        }
+        Some(r) => *r.get_ref(),
+        None => defaults.resolution,
+    };
+    let texture = ShellTextureParams {
+        resolution,
+        layers,
+        density: t.density.unwrap_or(defaults.density),
+        thickness: t.thickness.unwrap_or(defaults.thickness),
+        length_variance: t.length_variance.unwrap_or(defaults.length_variance),
+        lean: t.lean.unwrap_or(defaults.lean),
+        bend: t.bend.unwrap_or(defaults.bend),
+        undercoat_ratio: t.undercoat_ratio.unwrap_or(defaults.undercoat_ratio),
+        undercoat_length: t.undercoat_length.unwrap_or(defaults.undercoat_length),
+        style,
+        seed: t.seed.unwrap_or(defaults.seed),
+    };
+
+    Ok(texture)
+}
+
+/// `[[droplets]]`: every droplet, in time order.
+fn droplets(
+    source: &SettingsSource,
+    sections: &[DropletsSection],
+    mesh: &Mesh,
+) -> Result<Vec<TimedDroplet>, SceneError> {
+    let mut droplets = Vec::new();
+    for (i, d) in sections.iter().enumerate() {
+        let (radius_min, radius_max) = match d.radius {
+            Some(RadiusText::One(r)) => (r, r),
+            Some(RadiusText::Range([a, b])) => (a.min(b), a.max(b)),
+            None => (0.015, 0.03),
+        };
+        let style = DropletStyle {
+            radius_min,
+            radius_max,
+            wetness: d.wetness.unwrap_or(1.0).clamp(0.0, 1.0),
+        };
+        let seed = d.seed.unwrap_or(i as u64 + 1);
+        let drops: Vec<Droplet> = match (d.at, d.count, &d.image) {
+            (Some(uv), None, None) => vec![Droplet {
+                centre: mask_coordinates(Vec2::from(uv)),
+                radius: radius_max,
+                wetness: style.wetness,
+            }],
+            (None, Some(count), None) => {
+                droplets_on_mesh(mesh, count, style, seed).map_err(|e| {
+                    invalid(
+                        source,
+                        0..0,
+                        format!("droplets[{i}]: cannot place droplets: {e}"),
+                    )
+                })?
+            }
+            (None, None, Some(path)) => {
+                let full = source.folder().join(path.get_ref());
+                let image = image::open(&full)
+                    .map_err(unreadable_image(source, path.span(), full.clone()))?
+                    .to_luma32f();
+                let (w, h) = (image.width() as f32, image.height() as f32);
+                let brightness = |p: Vec2| {
+                    let x = (p.x * w).clamp(0.0, w - 1.0) as u32;
+                    let y = (p.y * h).clamp(0.0, h - 1.0) as u32;
+                    image.get_pixel(x, y).0[0]
+                };
+                droplets_from_image(brightness, d.spacing.unwrap_or(radius_max), style, seed)
+            }
+            _ => {
+                let span = d.image.as_ref().map_or(0..0, |p| p.span());
+                return Err(invalid(
+                    source,
+                    span,
+                    format!(
+                        "droplets[{i}]: give exactly one of `at = [u, v]`, `count = N` or `image = \"FILE\"`"
+                    ),
+                ));
+            }
+        };
+        droplets.extend(drops.into_iter().map(|droplet| TimedDroplet {
+            time: d.time.max(0.0),
+            droplet,
+        }));
+    }
+    droplets.sort_by(|a, b| a.time.total_cmp(&b.time));
+
+    Ok(droplets)
+}
+
+/// `[dynamics]`: the mass-spring system the shells follow.
+fn dynamics_settings(
+    source: &SettingsSource,
+    d: &DynamicsSection,
+) -> Result<DynamicsSettings, SceneError> {
+    let topology = d.topology.unwrap_or(Topology::SpringSticks);
+    let solver = match d.solver.unwrap_or(SolverName::Implicit) {
+        SolverName::Implicit => Solver::Implicit {
+            iterations: d.iterations.unwrap_or(30).max(1),
+        },
+        SolverName::Explicit => Solver::Explicit {
+            // 0: as many as stability needs.
+            substeps: d.substeps.unwrap_or(0),
+        },
+    };
+    let gpu = d.gpu.as_ref().is_some_and(|g| *g.get_ref());
+    if let (true, Solver::Implicit { .. }, true) = (gpu, solver, topology.joins_tips()) {
+        let span = d.gpu.as_ref().map_or(0..0, |g| g.span());
+        return Err(invalid(
+            source,
+            span,
+            format!(
+                "the GPU steps {} with the explicit solver only (their implicit step solves all tips at once, on the CPU): set solver = \"explicit\", or gpu = false",
+                topology.name()
+            ),
+        ));
+    }
+    let default_coupling = if topology == Topology::SilvaStrands {
+        CouplingName::Bezier
+    } else {
+        CouplingName::Bent
+    };
+    let coupling = match d.coupling.unwrap_or(default_coupling) {
+        CouplingName::Bezier => Coupling::Bezier,
+        CouplingName::Linear => Coupling::Linear,
+        CouplingName::Bent => Coupling::Bent {
+            exponent: d.exponent.unwrap_or(2.0).max(1.0),
+        },
+    };
+    let defaults = DynamicsParams::default();
+    let params = DynamicsParams {
+        mass: d.mass.unwrap_or(defaults.mass).max(1e-9),
+        stiffness: d.stiffness.unwrap_or(defaults.stiffness).max(0.0),
+        lateral_stiffness: d
+            .lateral_stiffness
+            .unwrap_or(defaults.lateral_stiffness)
+            .max(0.0),
+        damping: d.damping.unwrap_or(defaults.damping).max(0.0),
+        drag: d.drag.unwrap_or(defaults.drag).max(0.0),
+        restoring: d.restoring.unwrap_or(defaults.restoring).max(0.0),
+        gravity: d.gravity.map_or(defaults.gravity, Vec3::from),
+        wind: d.wind.as_ref().map(|w| {
+            Wind::new(
+                Vec3::from(w.velocity),
+                w.gust.unwrap_or(0.5),
+                w.gust_frequency.unwrap_or(0.5),
+                w.turbulence.unwrap_or(0.0),
+                w.scale.unwrap_or(4.0),
+                w.seed.unwrap_or(1),
+            )
+        }),
+        brush: None,
+    };
+    Ok(DynamicsSettings {
+        topology,
+        solver,
+        steps_per_frame: d.steps_per_frame.unwrap_or(2).max(1),
+        coupling,
+        params,
+        shake: d.shake.as_ref().map(|s| Shake {
+            amplitude: Vec3::from(s.amplitude),
+            frequency: s.frequency.unwrap_or(3.0).max(1e-3),
+            duration: s.duration.unwrap_or(1.0).max(0.0),
+        }),
+        gpu,
+    })
 }
 
 fn spot_color() -> image::RgbaImage {

@@ -1,6 +1,5 @@
 //! `pelage bench io`: writing a large groom as usda, part by part — the
-//! export issue's streaming target (2 M hairs × 16 points with bounded
-//! memory). Hairs are straight strands on Spot with widths, normals, root
+//! streaming target (2 M hairs × 16 points with bounded memory). Hairs are straight strands on Spot with widths, normals, root
 //! UVs and ids (what the groom generator writes), generated one part at a
 //! time as the generator will; only the writing is timed.
 //!

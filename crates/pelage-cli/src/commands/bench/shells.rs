@@ -7,7 +7,7 @@
 //! mask with 400 droplets (about a third of the fur wet).
 //!
 //! The paper's figures (GeForce 8800 GTS, 2010, 256² textures, its method
-//! i.e. with curl and clumps) are printed beside ours for scale; the issue's
+//! i.e. with curl and clumps) are printed beside ours for scale; the
 //! target is on the ratio measured here: curl + clump ≤ 1.15 × plain.
 
 use super::median_seconds;

@@ -2,6 +2,9 @@
 //! Mouse and keys move the camera and drive the session's tools; a script
 //! drives the same calls frame by frame, so the scripted run a test makes
 //! is the run a person gets.
+//!
+//! One file, past 600 lines: one winit application (event loop, surface,
+//! egui, input) whose handlers share its state.
 
 use super::curves::{CurvesSession, CurvesSource};
 use super::script::{Script, Step};

@@ -1,0 +1,120 @@
+//! [`FurMotion`]: a shell scene's moving fur, stepped on the CPU or the
+//! GPU, as the scene player and the viewer use it.
+
+use crate::{GpuContext, GpuError, GpuMassSpring, ShellModel};
+use glam::Vec3;
+use pelage::dynamics::{MassSpringSystem, Solver, Topology};
+use pelage::shell::scene::DynamicsSettings;
+
+/// A scene's moving fur as the renderer uses it: the mass-spring system
+/// stepped on the CPU, or on the GPU where the settings say `gpu` (and,
+/// for the implicit solver, no springs join the tips); the skin's rest
+/// pose it is moved from; its clock.
+/// [`ShellScenePlayer`](crate::ShellScenePlayer) and the viewer step it
+/// frame by frame.
+#[derive(Debug)]
+pub struct FurMotion {
+    /// The CPU's system; while the GPU steps, it holds the skin's motion
+    /// and the tips only as of the last copy.
+    system: MassSpringSystem,
+    on_gpu: Option<GpuMassSpring>,
+    rest_roots: Vec<Vec3>,
+    rest_normals: Vec<Vec3>,
+    /// The skin's offset at the last step, and whether that step moved it
+    /// (root velocities not zero): the GPU's copy of the roots is
+    /// refreshed only while either changes.
+    skin_offset: Vec3,
+    skin_moving: bool,
+    time: f32,
+}
+
+impl FurMotion {
+    /// `topology` over `mesh` with sticks `length` long, at rest at time 0.
+    pub fn new(mesh: &pelage::Mesh, topology: Topology, length: f32) -> Self {
+        let system = MassSpringSystem::new(mesh, topology, length);
+        Self {
+            rest_roots: system.roots().to_vec(),
+            rest_normals: system.normals().to_vec(),
+            system,
+            on_gpu: None,
+            skin_offset: Vec3::ZERO,
+            skin_moving: false,
+            time: 0.0,
+        }
+    }
+
+    /// The topology stepped.
+    pub fn topology(&self) -> Topology {
+        self.system.topology()
+    }
+
+    /// Seconds simulated so far.
+    pub fn time(&self) -> f32 {
+        self.time
+    }
+
+    /// One step of `dt` seconds with the whole skin moved by `skin_offset`
+    /// from rest (its velocity taken from the move, so the tips lag). The
+    /// step runs where `settings` says; a change of place carries the
+    /// state over (back to the CPU: copied down).
+    pub fn step(
+        &mut self,
+        ctx: &GpuContext,
+        dt: f32,
+        skin_offset: Vec3,
+        settings: &DynamicsSettings,
+    ) -> Result<(), GpuError> {
+        let explicit = match settings.solver {
+            Solver::Explicit { substeps } => Some(substeps),
+            Solver::Implicit { .. } => None,
+        };
+        // The GPU steps every explicit system and the implicit ones whose
+        // tips no springs join; prisms' implicit step stays on the CPU.
+        let on_gpu = settings.gpu && (explicit.is_some() || !self.system.joins_tips());
+        match (on_gpu, self.on_gpu.take()) {
+            (true, None) => self.on_gpu = Some(GpuMassSpring::new(ctx, &self.system)?),
+            (false, Some(gpu)) => gpu.download_into(ctx, &mut self.system)?,
+            (_, kept) => self.on_gpu = kept,
+        }
+        let roots: Vec<Vec3> = self.rest_roots.iter().map(|&r| r + skin_offset).collect();
+        self.system.move_roots(&roots, &self.rest_normals, dt);
+        let moving = skin_offset != self.skin_offset;
+        match &mut self.on_gpu {
+            Some(gpu) => {
+                if moving || self.skin_moving {
+                    gpu.upload_roots(ctx, &self.system);
+                }
+                match explicit {
+                    Some(substeps) => {
+                        let substeps =
+                            self.system
+                                .explicit_substeps(dt, &settings.params, substeps);
+                        gpu.step_explicit(ctx, dt, &settings.params, substeps, self.time, 1);
+                    }
+                    None => gpu.step_implicit(ctx, dt, &settings.params, self.time, 1)?,
+                }
+            }
+            None => self
+                .system
+                .step(dt, &settings.params, settings.solver, self.time),
+        }
+        self.skin_offset = skin_offset;
+        self.skin_moving = moving;
+        self.time += dt;
+        Ok(())
+    }
+
+    /// Hands the tips to `renderer` for `model`: written in place where the
+    /// GPU steps, uploaded from the CPU otherwise.
+    pub fn show(
+        &self,
+        ctx: &GpuContext,
+        renderer: &crate::ShellRenderer,
+        model: &ShellModel,
+    ) -> Result<(), GpuError> {
+        match &self.on_gpu {
+            Some(gpu) => gpu.write_tip_offsets(ctx, model),
+            None => renderer.set_tip_offsets(ctx, model, &self.system.corner_tip_offsets()),
+        }
+    }
+}
