@@ -1,4 +1,5 @@
-//! Structs shared with WGSL, declared once with [`gpu_struct!`]: a
+//! Structs shared with WGSL, declared once with [`gpu_struct!`], and the
+//! [`UniformRing`] that holds a uniform block on the GPU. A `gpu_struct` is a
 //! `#[repr(C)]` Pod struct with named fields, and `FIELDS`, each field's
 //! name and byte offset. A test reflects every WGSL struct with naga and
 //! checks its size, member names and offsets against these, so a field
@@ -37,6 +38,97 @@ macro_rules! gpu_struct {
 }
 
 pub(crate) use gpu_struct;
+
+/// A uniform block's buffer, made once and rewritten each frame with
+/// `write_buffer`: a ring of slots bound at a dynamic offset, each frame
+/// its own slot. Writes wait in the queue until the next submission, so
+/// frames recorded on several threads before their submissions (renderers
+/// are shared, `&self`) each keep their own values; a slot is reused only
+/// after [`UniformRing::SLOTS`] frames.
+#[derive(Debug)]
+pub(crate) struct UniformRing<T> {
+    buffer: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    next: std::sync::atomic::AtomicUsize,
+    block: std::marker::PhantomData<T>,
+}
+
+impl<T: bytemuck::Pod> UniformRing<T> {
+    /// Slots in the ring.
+    pub(crate) const SLOTS: u64 = 64;
+    /// Bytes a slot: the largest uniform offset alignment wgpu allows.
+    const SLOT_BYTES: u64 = 256;
+
+    /// The bind group layout of a ring bound at `binding` 0, seen by
+    /// `visibility`.
+    pub(crate) fn layout(
+        device: &wgpu::Device,
+        label: &str,
+        visibility: wgpu::ShaderStages,
+    ) -> wgpu::BindGroupLayout {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: std::num::NonZeroU64::new(Self::size()),
+                },
+                count: None,
+            }],
+        })
+    }
+
+    /// The ring, bound by a group of `layout` (from [`Self::layout`]).
+    pub(crate) fn new(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout) -> Self {
+        const { assert!(std::mem::size_of::<T>() as u64 <= Self::SLOT_BYTES) };
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: Self::SLOTS * Self::SLOT_BYTES,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &buffer,
+                    offset: 0,
+                    size: std::num::NonZeroU64::new(Self::size()),
+                }),
+            }],
+        });
+        Self {
+            buffer,
+            group,
+            next: Default::default(),
+            block: std::marker::PhantomData,
+        }
+    }
+
+    fn size() -> u64 {
+        std::mem::size_of::<T>() as u64
+    }
+
+    /// Writes `value` into the next slot; bind [`Self::group`] at the
+    /// returned dynamic offset.
+    pub(crate) fn write(&self, queue: &wgpu::Queue, value: &T) -> u32 {
+        let slot =
+            self.next.fetch_add(1, std::sync::atomic::Ordering::Relaxed) as u64 % Self::SLOTS;
+        let offset = slot * Self::SLOT_BYTES;
+        queue.write_buffer(&self.buffer, offset, bytemuck::bytes_of(value));
+        offset as u32
+    }
+
+    /// The bind group (at the offset [`Self::write`] returned).
+    pub(crate) fn group(&self) -> &wgpu::BindGroup {
+        &self.group
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -4,7 +4,7 @@
 //! One file, past 600 lines: the three preview pipelines (skin, points,
 //! curves) share one frame uniform and one pass.
 
-use crate::layout::gpu_struct;
+use crate::layout::{UniformRing, gpu_struct};
 use crate::readback::{is_bgra, read_texture};
 use crate::{Camera, GpuContext, GpuError};
 use glam::Vec3;
@@ -121,10 +121,8 @@ pub struct GpuScene {
 /// Draws preview scenes into images. Build once, render many times.
 #[derive(Debug)]
 pub struct Renderer {
-    /// The frame's uniforms, rewritten (`write_buffer`) for each frame,
-    /// and their bind group, both made once.
-    frame_uniforms: wgpu::Buffer,
-    frame: wgpu::BindGroup,
+    /// The frame's uniforms, made once, rewritten for each frame.
+    frame: UniformRing<FrameUniforms>,
     texture_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     mesh_pipeline: wgpu::RenderPipeline,
@@ -146,33 +144,12 @@ impl Renderer {
     /// linear colour.
     pub fn for_format(ctx: &GpuContext, format: wgpu::TextureFormat) -> Self {
         let device = &ctx.device;
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("frame"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
-        });
-        let frame_uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("frame"),
-            size: std::mem::size_of::<FrameUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let frame = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("frame"),
-            layout: &frame_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: frame_uniforms.as_entire_binding(),
-            }],
-        });
+        let frame_layout = UniformRing::<FrameUniforms>::layout(
+            device,
+            "frame",
+            wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+        );
+        let frame = UniformRing::new(device, "frame", &frame_layout);
         let texture_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("skin texture"),
             entries: &[
@@ -293,7 +270,6 @@ impl Renderer {
             true,
         );
         Self {
-            frame_uniforms,
             frame,
             texture_layout,
             sampler,
@@ -509,9 +485,7 @@ impl Renderer {
     /// `width × height` — an offscreen texture or a window surface's
     /// current texture. The renderer draws into its own multisampled colour
     /// and depth targets and resolves into `target`; submit the encoder
-    /// (and present the surface texture) afterwards, before encoding the
-    /// next frame: the frame's settings live in one uniform buffer that
-    /// each `encode` rewrites.
+    /// (and present the surface texture) afterwards.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -553,10 +527,7 @@ impl Renderer {
             viewport_px: [width as f32, height as f32],
             ..Default::default()
         };
-        // Written before the encoder's commands run (write_buffer is queued
-        // ahead of the next submission): one frame per submission.
-        ctx.queue
-            .write_buffer(&self.frame_uniforms, 0, bytemuck::bytes_of(&uniforms));
+        let frame_offset = self.frame.write(&ctx.queue, &uniforms);
 
         let target_texture =
             |samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
@@ -608,7 +579,7 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_bind_group(0, &self.frame, &[]);
+            pass.set_bind_group(0, self.frame.group(), &[frame_offset]);
             pass.set_bind_group(1, &scene.skin_texture, &[]);
             if let Some((vertex, index, count)) = &scene.mesh {
                 pass.set_pipeline(&self.mesh_pipeline);

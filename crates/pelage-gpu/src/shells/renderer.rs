@@ -2,6 +2,7 @@
 //! the frame they record: the skin once with depth write, then the N
 //! layers in one instanced draw.
 
+use crate::layout::UniformRing;
 use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES};
 use crate::{GpuContext, GpuError};
 
@@ -11,10 +12,8 @@ use super::{ShellFeatures, ShellParams, ShellUniforms, ShellView};
 /// Draws shell fur. Build once per feature set, draw many frames.
 #[derive(Debug)]
 pub struct ShellRenderer {
-    /// The frame's [`ShellUniforms`], rewritten (`write_buffer`) for each
-    /// frame, and their bind group, both made once.
-    pub(super) uniforms: wgpu::Buffer,
-    pub(super) uniform_group: wgpu::BindGroup,
+    /// The frame's [`ShellUniforms`], made once, rewritten for each frame.
+    pub(super) uniforms: UniformRing<ShellUniforms>,
     pub(super) texture_layout: wgpu::BindGroupLayout,
     pub(super) fur_sampler: wgpu::Sampler,
     pub(super) color_sampler: wgpu::Sampler,
@@ -41,19 +40,11 @@ impl ShellRenderer {
         features: ShellFeatures,
     ) -> Self {
         let device = &ctx.device;
-        let uniform_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shell uniforms"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
-        });
+        let uniform_layout = UniformRing::<ShellUniforms>::layout(
+            device,
+            "shell uniforms",
+            wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+        );
         let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let texture_entry = |binding, dimension, filterable| wgpu::BindGroupLayoutEntry {
             binding,
@@ -166,25 +157,11 @@ impl ShellRenderer {
                 cache: None,
             })
         };
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("shell uniforms"),
-            size: std::mem::size_of::<ShellUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let uniform_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shell uniforms"),
-            layout: &uniform_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniforms.as_entire_binding(),
-            }],
-        });
+        let uniforms = UniformRing::new(device, "shell uniforms", &uniform_layout);
         Self {
             skin_pipeline: pipeline("vs_skin", "fs_skin", false),
             layer_pipeline: pipeline("vs_layer", "fs_layer", true),
             uniforms,
-            uniform_group,
             texture_layout,
             fur_sampler,
             color_sampler,
@@ -242,9 +219,7 @@ impl ShellRenderer {
 
     /// Records a frame: the skin, then the layers, resolved into
     /// `resolve` (a view of `target`'s size: the target's own resolve
-    /// texture, or a window's surface texture). Submit it before encoding
-    /// the next frame: the frame's settings live in one uniform buffer
-    /// that each `encode` rewrites.
+    /// texture, or a window's surface texture).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -284,10 +259,7 @@ impl ShellRenderer {
             wetness_size: [model.wetness_size.0 as f32, model.wetness_size.1 as f32],
             pad0: [0.0; 2],
         };
-        // Written before the encoder's commands run (write_buffer is queued
-        // ahead of the next submission): one frame per submission.
-        ctx.queue
-            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        let uniform_offset = self.uniforms.write(&ctx.queue, &uniforms);
         let [r, g, b] = params.background.map(f64::from);
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("shells"),
@@ -312,7 +284,7 @@ impl ShellRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(0, &self.uniform_group, &[]);
+        pass.set_bind_group(0, self.uniforms.group(), &[uniform_offset]);
         pass.set_bind_group(1, &model.textures, &[]);
         pass.set_vertex_buffer(0, model.vertices.slice(..));
         pass.set_vertex_buffer(1, model.tip_offsets.slice(..));
