@@ -155,9 +155,10 @@ const LANES: usize = 8;
 impl NoiseMap {
     /// [`perlin3_vector`](Self::perlin3_vector) at every point of `points`,
     /// into `out` (of the same length): bit for bit the same values
-    /// (tested), about 2.3× faster a point (on a first-generation Zen) on x86-64 CPUs with AVX2, where
-    /// eight points go through the noise together in SIMD lanes (the
-    /// permutation table read by gathers). Elsewhere, one point at a time.
+    /// (tested), faster on x86-64 CPUs with AVX2, where eight points go
+    /// through the noise together in SIMD lanes (the permutation table read
+    /// by gathers; docs/benchmarks/groom.md has the figures). Elsewhere, one
+    /// point at a time.
     pub fn perlin3_vectors(&self, points: &[glam::Vec3], out: &mut [glam::Vec3]) {
         assert_eq!(points.len(), out.len(), "one output a point");
         #[cfg(target_arch = "x86_64")]

@@ -22,16 +22,102 @@ pub struct GroomBenchArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Measure a peer in the same run: `blender` grows Blender's own case
+    /// (Distribute Points on Faces + Interpolate Curves) with Blender as a
+    /// Python module (bpy, set up in a cached venv by tools/bpy-python).
+    #[arg(long, value_enum)]
+    pub peer: Option<Peer>,
     /// Internal: stream this many hairs to USD and print the peak RSS.
     #[arg(long, hide = true)]
     pub rss_child: Option<u64>,
 }
 
+/// A program measured beside pelage.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Peer {
+    /// Blender's geometry nodes, through bpy.
+    Blender,
+}
+
 /// The paper's time for 1.6 M hairs on two cores (Sik §4.2.2).
 const PAPER_SECONDS: f64 = 3.2;
-/// Blender 5 on this machine: 1 M hairs × 8 points, distribution +
-/// interpolation only (the figure).
-const BLENDER_SECONDS_PER_MILLION: f64 = 1.58;
+
+/// Blender's case measured by Blender itself, in this run.
+#[derive(Debug)]
+struct BlenderRun {
+    seconds: f64,
+    hairs: u64,
+    points: u64,
+    version: String,
+}
+
+/// Runs Blender's own hair case (`blender_hair.py`: Distribute Points on
+/// Faces + Interpolate Curves, k = 4 neighbours) on `groom`'s mesh and
+/// guides for `hairs` hairs, with bpy from tools/bpy-python. An error says
+/// why it was not measured.
+fn measure_blender(groom: &Groom, hairs: u64, runs: usize) -> anyhow::Result<BlenderRun> {
+    let python = super::tools_dir().join("bpy-python");
+    anyhow::ensure!(python.exists(), "{} not found", python.display());
+    let dir = std::env::temp_dir().join(format!("pelage-blender-peer-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let result = (|| {
+        let mesh = groom.mesh();
+        let floats = |v: &[glam::Vec3]| -> Vec<u8> {
+            v.iter()
+                .flat_map(|p| p.to_array())
+                .flat_map(f32::to_le_bytes)
+                .collect()
+        };
+        std::fs::write(dir.join("positions.f32"), floats(mesh.positions()))?;
+        let triangles: Vec<u8> = mesh
+            .triangles()
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
+        std::fs::write(dir.join("triangles.u32"), triangles)?;
+        let guides = groom.guides();
+        std::fs::write(dir.join("guides.f32"), floats(guides.curves().points()))?;
+        let case = serde_json::json!({
+            "hairs": hairs,
+            "area": mesh.surface_area(),
+            "guides": guides.len(),
+            "points_per_guide": guides.points_per_guide(),
+            "neighbours": 4,
+            "runs": runs,
+        });
+        std::fs::write(dir.join("case.json"), case.to_string())?;
+        let script = dir.join("blender_hair.py");
+        std::fs::write(&script, include_str!("blender_hair.py"))?;
+        let out = std::process::Command::new(&python)
+            .arg(&script)
+            .arg(&dir)
+            .output()?;
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        match out.status.code() {
+            Some(0) => {}
+            Some(2) => anyhow::bail!("bpy could not be set up: {}", stderr.trim()),
+            _ => anyhow::bail!("Blender's case failed: {}", stderr.trim()),
+        }
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let line = stdout
+            .lines()
+            .rev()
+            .find(|l| l.starts_with('{'))
+            .unwrap_or("");
+        let report: serde_json::Value = serde_json::from_str(line)
+            .with_context(|| format!("unexpected output from Blender's case: {stdout:?}"))?;
+        let number = |key: &str| report[key].as_f64().context("a number in Blender's report");
+        Ok(BlenderRun {
+            seconds: number("seconds")?,
+            hairs: number("hairs")? as u64,
+            points: number("points")? as u64,
+            version: report["blender"].as_str().unwrap_or("?").to_string(),
+        })
+    })();
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}
 
 /// What both benchmark grooms share: spot ×2, a noise density, 1,000
 /// grown guides of 8 points.
@@ -161,6 +247,13 @@ pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
     let (blender_s, blender_counted) = median_seconds(runs, false, || grow_all(&blender));
     blender_counted?;
     let blender_per_million = blender_s * 1e6 / blender_hairs as f64;
+    let peer = match args.peer {
+        Some(Peer::Blender) => {
+            eprintln!("measuring Blender's case with bpy (tools/bpy-python)…");
+            measure_blender(&blender, blender_hairs, runs).map_err(|e| format!("{e:#}"))
+        }
+        None => Err("run with --peer blender".to_string()),
+    };
     let (style_prep_s, _) = median_seconds(1, false, || style.generator(None).map(|_| ()));
     let (style_s, style_counted) = median_seconds(runs, false, || grow_all(&style));
     style_counted?;
@@ -207,7 +300,17 @@ pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
             "style_mesh_hairs_per_s": (hair_count as f64 / style_s).round(),
             "paper_seconds": paper_scaled,
             "interpolation_only_8_points_s_per_million": blender_per_million,
-            "blender_s_per_million": BLENDER_SECONDS_PER_MILLION,
+            "blender": match &peer {
+                Ok(b) => serde_json::json!({
+                    "version": b.version,
+                    "seconds": b.seconds,
+                    "hairs": b.hairs,
+                    "points": b.points,
+                    "s_per_million": b.seconds * 1e6 / b.hairs.max(1) as f64,
+                    "pelage_speedup": b.seconds / blender_s * blender_hairs as f64 / b.hairs.max(1) as f64,
+                }),
+                Err(why) => serde_json::json!({ "not_measured": why }),
+            },
             "rss_hairs": rss_hairs,
             "peak_rss_bytes": rss,
             "rss_usd_bytes": usd_bytes,
@@ -263,14 +366,27 @@ pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
         format!("{} × 8 points, no operators", thousands(blender_hairs)),
         blender_s,
         blender_hairs as f64 / blender_s / 1e6,
-        format!("{BLENDER_SECONDS_PER_MILLION} s / M")
+        ""
     );
-    println!(
-        "{:<40} {:>10} {:>12}",
-        "  (peer: Blender 5 on this machine)",
-        format!("{BLENDER_SECONDS_PER_MILLION:.2} / M"),
-        format!("{:.2}", 1.0 / BLENDER_SECONDS_PER_MILLION),
-    );
+    match &peer {
+        Ok(b) => {
+            // Per hair, in case Blender's random distribution made a few
+            // more or fewer hairs than asked.
+            let ratio = b.seconds / blender_s * blender_hairs as f64 / b.hairs.max(1) as f64;
+            println!(
+                "{:<40} {:>10.3} {:>12.2} {:>14}",
+                format!(
+                    "  peer: Blender {} ({} hairs)",
+                    b.version,
+                    thousands(b.hairs)
+                ),
+                b.seconds,
+                b.hairs as f64 / b.seconds / 1e6,
+                format!("pelage {ratio:.1}× faster"),
+            );
+        }
+        Err(why) => println!("{:<40} not measured: {why}", "  peer: Blender"),
+    }
     println!(
         "\ntarget: ≥ 5 M hairs/s (1.6 M in ≤ 0.32 s). Paper: 1.6 M hairs in 3.2 s on 2 cores (0.5 M hairs/s)."
     );

@@ -49,6 +49,12 @@ pub fn test_meshes() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/meshes")
 }
 
+/// The repository's tools/ (tools/bpy-python), beside the source tree this
+/// binary was built from.
+pub fn tools_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools")
+}
+
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     match &args.what {
         BenchWhat::Sampler(a) => sampler::run(a),
