@@ -9,7 +9,9 @@
 //! WGSL's layout rules are met by construction here: every `[f32; 3]`
 //! (a `vec3<f32>`, 16-byte aligned in WGSL) starts at a multiple of 16 and
 //! is followed by a 4-byte scalar; structs are padded by named `pad`
-//! members to a multiple of 16 bytes.
+//! members to a multiple of 16 bytes. Vertex and instance structs
+//! ([`gpu_vertex!`]) are checked the same way against the shader's
+//! `@location` inputs: names, locations and formats.
 
 /// Declares a struct shared with a WGSL struct of the same fields (see the
 /// module docs).
@@ -38,6 +40,81 @@ macro_rules! gpu_struct {
 }
 
 pub(crate) use gpu_struct;
+
+/// A vertex (or instance) attribute's Rust type, and the format wgpu reads
+/// it as.
+pub(crate) trait VertexField {
+    const FORMAT: wgpu::VertexFormat;
+}
+
+impl VertexField for [f32; 2] {
+    const FORMAT: wgpu::VertexFormat = wgpu::VertexFormat::Float32x2;
+}
+impl VertexField for [f32; 3] {
+    const FORMAT: wgpu::VertexFormat = wgpu::VertexFormat::Float32x3;
+}
+impl VertexField for [f32; 4] {
+    const FORMAT: wgpu::VertexFormat = wgpu::VertexFormat::Float32x4;
+}
+
+/// Declares a vertex (or instance) struct whose fields are the shader's
+/// `@location(first..)` inputs in order, with `ATTRIBUTES` (each field's
+/// format, offset and location) for its `wgpu::VertexBufferLayout`, and
+/// `NAMES`; the layout test compares both with the WGSL input struct.
+macro_rules! gpu_vertex {
+    (
+        $(#[$meta:meta])*
+        $vis:vis struct $name:ident at location $first:literal {
+            $( $(#[$field_meta:meta])* $field:ident : $ty:ty ),* $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        #[repr(C)]
+        #[derive(Debug, Clone, Copy, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+        $vis struct $name {
+            $( $(#[$field_meta])* pub $field: $ty ),*
+        }
+
+        impl $name {
+            /// The fields' names, in location order.
+            #[allow(dead_code, reason = "read by the layout test")]
+            pub const NAMES: &'static [&'static str] = &[$(stringify!($field)),*];
+
+            /// Each field's format, offset and shader location.
+            pub const ATTRIBUTES: &'static [wgpu::VertexAttribute] = &{
+                let formats = [$(<$ty as $crate::layout::VertexField>::FORMAT),*];
+                let offsets = [$(std::mem::offset_of!($name, $field) as u64),*];
+                let mut attributes = [wgpu::VertexAttribute {
+                    format: wgpu::VertexFormat::Float32,
+                    offset: 0,
+                    shader_location: 0,
+                }; [$(stringify!($field)),*].len()];
+                let mut i = 0;
+                while i < attributes.len() {
+                    attributes[i] = wgpu::VertexAttribute {
+                        format: formats[i],
+                        offset: offsets[i],
+                        shader_location: $first + i as u32,
+                    };
+                    i += 1;
+                }
+                attributes
+            };
+
+            /// The buffer layout of an array of these, stepped per vertex
+            /// or per instance.
+            pub fn layout(step_mode: wgpu::VertexStepMode) -> wgpu::VertexBufferLayout<'static> {
+                wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<$name>() as u64,
+                    step_mode,
+                    attributes: Self::ATTRIBUTES,
+                }
+            }
+        }
+    };
+}
+
+pub(crate) use gpu_vertex;
 
 /// A uniform block's buffer, made once and rewritten each frame with
 /// `write_buffer`: a ring of slots bound at a dynamic offset, each frame
@@ -175,6 +252,90 @@ mod tests {
         check("shells.wgsl", "Shell", shell, ShellUniforms::FIELDS);
         let step = std::mem::size_of::<StepUniform>();
         check("dynamics.wgsl", "Step", step, StepUniform::FIELDS);
+    }
+
+    /// The `@location` members of the WGSL struct `name`: name, location
+    /// and type (`f32x3`).
+    fn reflect_inputs(wgsl: &str, name: &str) -> Vec<(String, u32, String)> {
+        let module = naga::front::wgsl::parse_str(wgsl).expect("the shader parses");
+        let (_, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no struct {name} in the shader"));
+        let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+            panic!("{name} is not a struct");
+        };
+        members
+            .iter()
+            .map(|m| {
+                let Some(naga::Binding::Location { location, .. }) = m.binding else {
+                    panic!("{name}.{:?} is not a @location input", m.name);
+                };
+                let ty = match &module.types[m.ty].inner {
+                    naga::TypeInner::Vector { size, .. } => format!("f32x{}", *size as u8),
+                    naga::TypeInner::Scalar(_) => "f32".to_string(),
+                    other => panic!("{other:?}"),
+                };
+                (m.name.clone().unwrap_or_default(), location, ty)
+            })
+            .collect()
+    }
+
+    /// The same triples for Rust vertex structs, in order.
+    fn inputs(parts: &[(&[&str], &[wgpu::VertexAttribute])]) -> Vec<(String, u32, String)> {
+        parts
+            .iter()
+            .flat_map(|(names, attributes)| names.iter().zip(attributes.iter()))
+            .map(|(n, a)| {
+                let ty = match a.format {
+                    wgpu::VertexFormat::Float32 => "f32",
+                    wgpu::VertexFormat::Float32x2 => "f32x2",
+                    wgpu::VertexFormat::Float32x3 => "f32x3",
+                    wgpu::VertexFormat::Float32x4 => "f32x4",
+                    other => panic!("{other:?}"),
+                };
+                (n.to_string(), a.shader_location, ty.to_string())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn rust_vertex_structs_match_their_wgsl_inputs() {
+        use crate::renderer::{MeshVertex, PointInstance, SegmentInstance};
+        use crate::shells::{ShellVertex, TipOffset};
+        let cases: [(&str, &str, Vec<(String, u32, String)>); 4] = [
+            (
+                "mesh.wgsl",
+                "VertexIn",
+                inputs(&[(MeshVertex::NAMES, MeshVertex::ATTRIBUTES)]),
+            ),
+            (
+                "points.wgsl",
+                "PointIn",
+                inputs(&[(PointInstance::NAMES, PointInstance::ATTRIBUTES)]),
+            ),
+            (
+                "curves.wgsl",
+                "SegmentIn",
+                inputs(&[(SegmentInstance::NAMES, SegmentInstance::ATTRIBUTES)]),
+            ),
+            (
+                "shells.wgsl",
+                "VertexIn",
+                inputs(&[
+                    (ShellVertex::NAMES, ShellVertex::ATTRIBUTES),
+                    (TipOffset::NAMES, TipOffset::ATTRIBUTES),
+                ]),
+            ),
+        ];
+        for (shader, name, rust) in cases {
+            let wgsl = reflect_inputs(crate::shader_source(shader), name);
+            assert_eq!(
+                rust, wgsl,
+                "{shader}: {name}: Rust (left) and WGSL (right) differ"
+            );
+        }
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! One file, past 600 lines: the three preview pipelines (skin, points,
 //! curves) share one frame uniform and one pass.
 
-use crate::layout::{UniformRing, gpu_struct};
+use crate::layout::{UniformRing, gpu_struct, gpu_vertex};
 use crate::readback::{is_bgra, read_texture};
 use crate::{Camera, GpuContext, GpuError};
 use glam::Vec3;
@@ -74,6 +74,38 @@ impl Default for PreviewStyle {
             hair: [0.35, 0.17, 0.07],
             hair_specular: 0.12,
         }
+    }
+}
+
+gpu_vertex! {
+    /// A skin vertex (`VertexIn` of `mesh.wgsl`).
+    pub(crate) struct MeshVertex at location 0 {
+        position: [f32; 3],
+        normal: [f32; 3],
+        /// Zero on untextured meshes.
+        uv: [f32; 2],
+    }
+}
+
+gpu_vertex! {
+    /// A point disc's centre (`PointIn` of `points.wgsl`), one an instance.
+    pub(crate) struct PointInstance at location 0 {
+        center: [f32; 3],
+    }
+}
+
+gpu_vertex! {
+    /// A curve segment (`SegmentIn` of `curves.wgsl`), one an instance.
+    pub(crate) struct SegmentInstance at location 0 {
+        /// xyz: the first point, w: its width.
+        a: [f32; 4],
+        /// xyz: the second point, w: its width.
+        b: [f32; 4],
+        /// rgb: the first point's colour; a: 1 where the curves have
+        /// colours, 0 to use the style's hair colour.
+        color_a: [f32; 4],
+        /// The second point's colour.
+        color_b: [f32; 4],
     }
 }
 
@@ -239,34 +271,19 @@ impl Renderer {
         };
         let mesh_pipeline = pipeline(
             &mesh_shader,
-            &[Some(wgpu::VertexBufferLayout {
-                array_stride: 32,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
-            })],
+            &[Some(MeshVertex::layout(wgpu::VertexStepMode::Vertex))],
             false,
         );
         let points_pipeline = pipeline(
             &points_shader,
-            &[Some(wgpu::VertexBufferLayout {
-                array_stride: 12,
-                step_mode: wgpu::VertexStepMode::Instance,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-            })],
+            &[Some(PointInstance::layout(wgpu::VertexStepMode::Instance))],
             true,
         );
         let curves_pipeline = pipeline(
             &curves_shader,
-            &[Some(wgpu::VertexBufferLayout {
-                array_stride: 64,
-                step_mode: wgpu::VertexStepMode::Instance,
-                attributes: &wgpu::vertex_attr_array![
-                    0 => Float32x4,
-                    1 => Float32x4,
-                    2 => Float32x4,
-                    3 => Float32x4
-                ],
-            })],
+            &[Some(SegmentInstance::layout(
+                wgpu::VertexStepMode::Instance,
+            ))],
             true,
         );
         Self {
@@ -308,23 +325,28 @@ impl Renderer {
         // their UVs may be per corner; untextured ones stay indexed.
         let textured = scene.skin_texture.is_some() && scene.mesh.is_some_and(Mesh::has_uvs);
         let mesh_buffers = scene.mesh.map(|mesh| {
-            let mut vertices: Vec<f32> = Vec::new();
+            let mut vertices: Vec<MeshVertex> = Vec::new();
             let indices: Option<Vec<u32>> = if textured {
-                vertices.reserve(mesh.triangle_count() * 24);
+                vertices.reserve(mesh.triangle_count() * 3);
                 for t in 0..mesh.triangle_count() {
                     let uvs = mesh.triangle_uvs(t).expect("textured meshes have UVs");
                     for (k, &v) in mesh.triangles()[t].iter().enumerate() {
-                        let (p, n) = (mesh.positions()[v as usize], mesh.normals()[v as usize]);
-                        vertices
-                            .extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, uvs[k].x, uvs[k].y]);
+                        vertices.push(MeshVertex {
+                            position: mesh.positions()[v as usize].to_array(),
+                            normal: mesh.normals()[v as usize].to_array(),
+                            uv: uvs[k].to_array(),
+                        });
                     }
                 }
                 None
             } else {
-                vertices.reserve(mesh.vertex_count() * 8);
-                for (p, n) in mesh.positions().iter().zip(mesh.normals()) {
-                    vertices.extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, 0.0, 0.0]);
-                }
+                vertices.extend(mesh.positions().iter().zip(mesh.normals()).map(|(p, n)| {
+                    MeshVertex {
+                        position: p.to_array(),
+                        normal: n.to_array(),
+                        uv: [0.0; 2],
+                    }
+                }));
                 Some(mesh.triangles().iter().flatten().copied().collect())
             };
             let vertex = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -381,10 +403,16 @@ impl Renderer {
             ],
         });
         let point_buffer = (!scene.points.is_empty()).then(|| {
-            let flat: Vec<f32> = scene.points.iter().flat_map(|p| p.to_array()).collect();
+            let centres: Vec<PointInstance> = scene
+                .points
+                .iter()
+                .map(|p| PointInstance {
+                    center: p.to_array(),
+                })
+                .collect();
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("points"),
-                contents: bytemuck::cast_slice(&flat),
+                contents: bytemuck::cast_slice(&centres),
                 usage: wgpu::BufferUsages::VERTEX,
             })
         });
@@ -400,23 +428,16 @@ impl Renderer {
                     Some(c) => [c[k].x, c[k].y, c[k].z, 1.0],
                     None => [0.0; 4],
                 };
-                let mut segments: Vec<f32> = Vec::with_capacity(curves.segment_count() * 16);
+                let mut segments = Vec::with_capacity(curves.segment_count());
                 for i in 0..curves.curve_count() {
                     let range = curves.range(i);
                     for k in range.start..range.end.saturating_sub(1) {
-                        let (a, b) = (points[k], points[k + 1]);
-                        segments.extend_from_slice(&[
-                            a.x,
-                            a.y,
-                            a.z,
-                            widths[k],
-                            b.x,
-                            b.y,
-                            b.z,
-                            widths[k + 1],
-                        ]);
-                        segments.extend_from_slice(&color(k));
-                        segments.extend_from_slice(&color(k + 1));
+                        segments.push(SegmentInstance {
+                            a: points[k].extend(widths[k]).to_array(),
+                            b: points[k + 1].extend(widths[k + 1]).to_array(),
+                            color_a: color(k),
+                            color_b: color(k + 1),
+                        });
                     }
                 }
                 let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -424,7 +445,7 @@ impl Renderer {
                     contents: bytemuck::cast_slice(&segments),
                     usage: wgpu::BufferUsages::VERTEX,
                 });
-                (buffer, (segments.len() / 16) as u32)
+                (buffer, segments.len() as u32)
             });
 
         GpuScene {

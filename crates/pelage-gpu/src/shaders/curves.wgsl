@@ -6,6 +6,8 @@
 // diffuse sin(T, L), specular sin(T, H)^p — preview shading, not the shell
 // fur's Eq. 6.
 
+// Mirrors SegmentInstance in renderer.rs (a test checks names and
+// locations).
 struct SegmentIn {
     // xyz: first point, w: its width.
     @location(0) a: vec4<f32>,

@@ -6,6 +6,7 @@
 @group(1) @binding(0) var skin_texture: texture_2d<f32>;
 @group(1) @binding(1) var skin_sampler: sampler;
 
+// Mirrors MeshVertex in renderer.rs (a test checks names and locations).
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,

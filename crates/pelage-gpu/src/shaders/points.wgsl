@@ -8,8 +8,14 @@ struct VertexOut {
     @location(0) corner: vec2<f32>,
 };
 
+// Mirrors PointInstance in renderer.rs (a test checks names and locations).
+struct PointIn {
+    @location(0) center: vec3<f32>,
+};
+
 @vertex
-fn vs_main(@builtin(vertex_index) vertex: u32, @location(0) center: vec3<f32>) -> VertexOut {
+fn vs_main(@builtin(vertex_index) vertex: u32, point: PointIn) -> VertexOut {
+    let center = point.center;
     // Two triangles: (0,1,2) (2,1,3) over corners (−1,−1) (1,−1) (−1,1) (1,1).
     var corners = array<vec2<f32>, 6>(
         vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(-1.0, 1.0),

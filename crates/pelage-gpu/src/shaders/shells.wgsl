@@ -52,6 +52,8 @@ struct Shell {
 override CURL: bool = true;
 override CLUMP: bool = true;
 
+// Mirrors ShellVertex (locations 0-3) and TipOffset (4) in shells/mod.rs
+// (a test checks names and locations).
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,

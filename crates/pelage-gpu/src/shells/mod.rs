@@ -24,7 +24,7 @@ pub use player::ShellScenePlayer;
 pub use renderer::ShellRenderer;
 
 use crate::Camera;
-use crate::layout::gpu_struct;
+use crate::layout::{gpu_struct, gpu_vertex};
 use glam::{Mat4, Vec3};
 
 use pelage::shell::ShellScene;
@@ -114,6 +114,27 @@ impl ShellView {
             eye: camera.eye,
             light: light.unwrap_or((view + 0.9 * Vec3::Y + 0.6 * side).normalize()),
         }
+    }
+}
+
+gpu_vertex! {
+    /// A skin vertex, one a triangle corner (`VertexIn` of `shells.wgsl`,
+    /// locations 0 to 3).
+    pub(crate) struct ShellVertex at location 0 {
+        position: [f32; 3],
+        normal: [f32; 3],
+        /// Mask (image) coordinates: (u, 1 − v).
+        uv: [f32; 2],
+        /// dP/du, the texture's x direction on the surface.
+        tangent: [f32; 3],
+    }
+}
+
+gpu_vertex! {
+    /// `p − p0`: how far a corner's strand tip has moved (0 at rest), from
+    /// a second buffer rewritten as the fur moves (location 4).
+    pub(crate) struct TipOffset at location 4 {
+        tip_offset: [f32; 3],
     }
 }
 

@@ -9,7 +9,7 @@ use glam::Vec3;
 use pelage::Mesh;
 
 use super::ShellRenderer;
-use super::renderer::VERTEX_FLOATS;
+use super::{ShellVertex, TipOffset};
 use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
 use wgpu::util::DeviceExt;
 
@@ -107,7 +107,7 @@ impl ShellRenderer {
         }
         let device = &ctx.device;
         let tangents = vertex_tangents(mesh);
-        let mut vertices: Vec<f32> = Vec::with_capacity(mesh.triangle_count() * 3 * VERTEX_FLOATS);
+        let mut vertices = Vec::with_capacity(mesh.triangle_count() * 3);
         for t in 0..mesh.triangle_count() {
             let uvs = mesh.triangle_uvs(t).expect("checked: the mesh has UVs");
             for (k, &v) in mesh.triangles()[t].iter().enumerate() {
@@ -117,8 +117,12 @@ impl ShellRenderer {
                     tangents[v as usize],
                 );
                 let uv = pelage::shell::wetness::mask_coordinates(uvs[k]);
-                vertices
-                    .extend_from_slice(&[p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, u.x, u.y, u.z]);
+                vertices.push(ShellVertex {
+                    position: p.to_array(),
+                    normal: n.to_array(),
+                    uv: uv.to_array(),
+                    tangent: u.to_array(),
+                });
             }
         }
         let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -128,7 +132,7 @@ impl ShellRenderer {
         });
         let tip_offsets = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shell tip offsets"),
-            contents: bytemuck::cast_slice(&vec![0.0f32; mesh.triangle_count() * 9]),
+            contents: bytemuck::cast_slice(&vec![TipOffset::default(); mesh.triangle_count() * 3]),
             usage: wgpu::BufferUsages::VERTEX
                 | wgpu::BufferUsages::COPY_DST
                 | wgpu::BufferUsages::STORAGE,
@@ -253,9 +257,14 @@ impl ShellRenderer {
                 model.vertex_count
             )));
         }
-        let flat: Vec<f32> = offsets.iter().flat_map(|o| o.to_array()).collect();
+        let tips: Vec<TipOffset> = offsets
+            .iter()
+            .map(|o| TipOffset {
+                tip_offset: o.to_array(),
+            })
+            .collect();
         ctx.queue
-            .write_buffer(&model.tip_offsets, 0, bytemuck::cast_slice(&flat));
+            .write_buffer(&model.tip_offsets, 0, bytemuck::cast_slice(&tips));
         Ok(())
     }
 

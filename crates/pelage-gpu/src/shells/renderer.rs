@@ -7,7 +7,7 @@ use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES};
 use crate::{GpuContext, GpuError};
 
 use super::model::{ShellModel, ShellTarget};
-use super::{ShellFeatures, ShellParams, ShellUniforms, ShellView};
+use super::{ShellFeatures, ShellParams, ShellUniforms, ShellVertex, ShellView, TipOffset};
 
 /// Draws shell fur. Build once per feature set, draw many frames.
 #[derive(Debug)]
@@ -22,10 +22,6 @@ pub struct ShellRenderer {
     pub(super) format: wgpu::TextureFormat,
     pub(super) features: ShellFeatures,
 }
-
-/// Vertex layout: position, normal, mask uv, dP/du; tip offsets come from
-/// a second buffer, rewritten as the fur moves.
-pub(super) const VERTEX_FLOATS: usize = 11;
 
 impl ShellRenderer {
     /// Pipelines for offscreen images.
@@ -97,10 +93,6 @@ impl ShellRenderer {
             ("CURL", f64::from(u8::from(features.curl))),
             ("CLUMP", f64::from(u8::from(features.clump))),
         ];
-        let vertex_attributes = wgpu::vertex_attr_array![
-            0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x3
-        ];
-        let tip_attributes = wgpu::vertex_attr_array![4 => Float32x3];
         let pipeline = |vs: &str, fs: &str, layers: bool| {
             let compilation_options = wgpu::PipelineCompilationOptions {
                 constants: &constants,
@@ -114,16 +106,8 @@ impl ShellRenderer {
                     entry_point: Some(vs),
                     compilation_options: compilation_options.clone(),
                     buffers: &[
-                        Some(wgpu::VertexBufferLayout {
-                            array_stride: (VERTEX_FLOATS * 4) as u64,
-                            step_mode: wgpu::VertexStepMode::Vertex,
-                            attributes: &vertex_attributes,
-                        }),
-                        Some(wgpu::VertexBufferLayout {
-                            array_stride: 12,
-                            step_mode: wgpu::VertexStepMode::Vertex,
-                            attributes: &tip_attributes,
-                        }),
+                        Some(ShellVertex::layout(wgpu::VertexStepMode::Vertex)),
+                        Some(TipOffset::layout(wgpu::VertexStepMode::Vertex)),
                     ],
                 },
                 primitive: wgpu::PrimitiveState {
