@@ -254,9 +254,11 @@ mod tests {
         check("dynamics.wgsl", "Step", step, StepUniform::FIELDS);
     }
 
-    /// The `@location` members of the WGSL struct `name`: name, location
-    /// and type (`f32x3`).
-    fn reflect_inputs(wgsl: &str, name: &str) -> Vec<(String, u32, String)> {
+    /// A vertex input: name, location and type (`f32x3`).
+    type Input = (String, u32, String);
+
+    /// The `@location` members of the WGSL struct `name`.
+    fn reflect_inputs(wgsl: &str, name: &str) -> Vec<Input> {
         let module = naga::front::wgsl::parse_str(wgsl).expect("the shader parses");
         let (_, ty) = module
             .types
@@ -283,7 +285,7 @@ mod tests {
     }
 
     /// The same triples for Rust vertex structs, in order.
-    fn inputs(parts: &[(&[&str], &[wgpu::VertexAttribute])]) -> Vec<(String, u32, String)> {
+    fn inputs(parts: &[(&[&str], &[wgpu::VertexAttribute])]) -> Vec<Input> {
         parts
             .iter()
             .flat_map(|(names, attributes)| names.iter().zip(attributes.iter()))
@@ -304,7 +306,7 @@ mod tests {
     fn rust_vertex_structs_match_their_wgsl_inputs() {
         use crate::renderer::{MeshVertex, PointInstance, SegmentInstance};
         use crate::shells::{ShellVertex, TipOffset};
-        let cases: [(&str, &str, Vec<(String, u32, String)>); 4] = [
+        let cases: [(&str, &str, Vec<Input>); 4] = [
             (
                 "mesh.wgsl",
                 "VertexIn",
