@@ -212,17 +212,8 @@ impl ShellScene {
                 k_shadow: file.shading.shadow.unwrap_or(2.0).max(1.0),
             },
         };
-        let wetness_resolution = match &file.wetness.resolution {
-            Some(r) if !(8..=4096).contains(r.get_ref()) => {
-                return Err(invalid(
-                    source,
-                    r.span(),
-                    format!("{} texels: use 8 to 4096", r.get_ref()),
-                ));
-            }
-            Some(r) => *r.get_ref(),
-            None => 256,
-        };
+        let wetness_resolution =
+            count_in(source, &file.wetness.resolution, 8..=4096, "texels", 256)?;
 
         let droplets = droplets(source, &file.droplets, &mesh)?;
         let dynamics = file
@@ -268,6 +259,31 @@ impl ShellScene {
 /// An error at a span of the scene file: a value that cannot be used.
 fn invalid(source: &SettingsSource, span: std::ops::Range<usize>, message: String) -> SceneError {
     SceneError::at(source, span, SceneErrorKind::Invalid(message))
+}
+
+/// A count that must lie in `range`: `default` when not given, an error
+/// at its place when outside ("0 layers: use 1 to 256").
+fn count_in(
+    source: &SettingsSource,
+    value: &Option<toml::Spanned<u32>>,
+    range: std::ops::RangeInclusive<u32>,
+    unit: &str,
+    default: u32,
+) -> Result<u32, SceneError> {
+    match value {
+        None => Ok(default),
+        Some(v) if range.contains(v.get_ref()) => Ok(*v.get_ref()),
+        Some(v) => Err(invalid(
+            source,
+            v.span(),
+            format!(
+                "{} {unit}: use {} to {}",
+                v.get_ref(),
+                range.start(),
+                range.end()
+            ),
+        )),
+    }
 }
 
 /// An image at `path` (written at `span`) that cannot be read.
@@ -327,17 +343,7 @@ fn fur_settings(
     fur: &FurSection,
     diagonal: f32,
 ) -> Result<FurSettings, SceneError> {
-    let layers = match &fur.layers {
-        Some(n) if !(1..=256).contains(n.get_ref()) => {
-            return Err(invalid(
-                source,
-                n.span(),
-                format!("{} layers: use 1 to 256", n.get_ref()),
-            ));
-        }
-        Some(n) => *n.get_ref(),
-        None => 16,
-    };
+    let layers = count_in(source, &fur.layers, 1..=256, "layers", 16)?;
     let length = match &fur.length {
         Some(l) if !(l.get_ref().is_finite() && *l.get_ref() > 0.0) => {
             return Err(invalid(
@@ -366,17 +372,13 @@ fn texture_params(
 ) -> Result<ShellTextureParams, SceneError> {
     let defaults = ShellTextureParams::default();
     let style = t.style.unwrap_or(TextureStyle::Blades);
-    let resolution = match &t.resolution {
-        Some(r) if !(8..=4096).contains(r.get_ref()) => {
-            return Err(invalid(
-                source,
-                r.span(),
-                format!("{} texels: use 8 to 4096", r.get_ref()),
-            ));
-        }
-        Some(r) => *r.get_ref(),
-        None => defaults.resolution,
-    };
+    let resolution = count_in(
+        source,
+        &t.resolution,
+        8..=4096,
+        "texels",
+        defaults.resolution,
+    )?;
     let texture = ShellTextureParams {
         resolution,
         layers,
