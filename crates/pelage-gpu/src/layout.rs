@@ -58,9 +58,10 @@ impl VertexField for [f32; 4] {
 }
 
 /// Declares a vertex (or instance) struct whose fields are the shader's
-/// `@location(first..)` inputs in order, with `ATTRIBUTES` (each field's
-/// format, offset and location) for its `wgpu::VertexBufferLayout`, and
-/// `NAMES`; the layout test compares both with the WGSL input struct.
+/// `@location(first..)` inputs in order: a [`gpu_struct!`], plus
+/// `ATTRIBUTES` (each field's format, offset and location) for its
+/// `wgpu::VertexBufferLayout`. The layout test compares the fields' names
+/// and the attributes with the WGSL input struct.
 macro_rules! gpu_vertex {
     (
         $(#[$meta:meta])*
@@ -68,22 +69,17 @@ macro_rules! gpu_vertex {
             $( $(#[$field_meta:meta])* $field:ident : $ty:ty ),* $(,)?
         }
     ) => {
-        $(#[$meta])*
-        #[repr(C)]
-        #[derive(Debug, Clone, Copy, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-        $vis struct $name {
-            $( $(#[$field_meta])* pub $field: $ty ),*
+        $crate::layout::gpu_struct! {
+            $(#[$meta])*
+            $vis struct $name {
+                $( $(#[$field_meta])* $field: $ty ),*
+            }
         }
 
         impl $name {
-            /// The fields' names, in location order.
-            #[allow(dead_code, reason = "read by the layout test")]
-            pub const NAMES: &'static [&'static str] = &[$(stringify!($field)),*];
-
             /// Each field's format, offset and shader location.
             pub const ATTRIBUTES: &'static [wgpu::VertexAttribute] = &{
                 let formats = [$(<$ty as $crate::layout::VertexField>::FORMAT),*];
-                let offsets = [$(std::mem::offset_of!($name, $field) as u64),*];
                 let mut attributes = [wgpu::VertexAttribute {
                     format: wgpu::VertexFormat::Float32,
                     offset: 0,
@@ -93,7 +89,7 @@ macro_rules! gpu_vertex {
                 while i < attributes.len() {
                     attributes[i] = wgpu::VertexAttribute {
                         format: formats[i],
-                        offset: offsets[i],
+                        offset: Self::FIELDS[i].1 as u64,
                         shader_location: $first + i as u32,
                     };
                     i += 1;
@@ -285,11 +281,14 @@ mod tests {
     }
 
     /// The same triples for Rust vertex structs, in order.
-    fn inputs(parts: &[(&[&str], &[wgpu::VertexAttribute])]) -> Vec<Input> {
+    /// A vertex struct's `FIELDS` and `ATTRIBUTES`.
+    type VertexParts<'a> = (&'a [(&'a str, usize)], &'a [wgpu::VertexAttribute]);
+
+    fn inputs(parts: &[VertexParts]) -> Vec<Input> {
         parts
             .iter()
-            .flat_map(|(names, attributes)| names.iter().zip(attributes.iter()))
-            .map(|(n, a)| {
+            .flat_map(|(fields, attributes)| fields.iter().zip(attributes.iter()))
+            .map(|((n, _), a)| {
                 let ty = match a.format {
                     wgpu::VertexFormat::Float32 => "f32",
                     wgpu::VertexFormat::Float32x2 => "f32x2",
@@ -310,24 +309,24 @@ mod tests {
             (
                 "mesh.wgsl",
                 "VertexIn",
-                inputs(&[(MeshVertex::NAMES, MeshVertex::ATTRIBUTES)]),
+                inputs(&[(MeshVertex::FIELDS, MeshVertex::ATTRIBUTES)]),
             ),
             (
                 "points.wgsl",
                 "PointIn",
-                inputs(&[(PointInstance::NAMES, PointInstance::ATTRIBUTES)]),
+                inputs(&[(PointInstance::FIELDS, PointInstance::ATTRIBUTES)]),
             ),
             (
                 "curves.wgsl",
                 "SegmentIn",
-                inputs(&[(SegmentInstance::NAMES, SegmentInstance::ATTRIBUTES)]),
+                inputs(&[(SegmentInstance::FIELDS, SegmentInstance::ATTRIBUTES)]),
             ),
             (
                 "shells.wgsl",
                 "VertexIn",
                 inputs(&[
-                    (ShellVertex::NAMES, ShellVertex::ATTRIBUTES),
-                    (TipOffset::NAMES, TipOffset::ATTRIBUTES),
+                    (ShellVertex::FIELDS, ShellVertex::ATTRIBUTES),
+                    (TipOffset::FIELDS, TipOffset::ATTRIBUTES),
                 ]),
             ),
         ];

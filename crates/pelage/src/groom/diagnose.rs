@@ -26,8 +26,7 @@ impl Generator {
                 None => format!("finish.{}", self.base[k].name()),
             }
         };
-        let error =
-            |key: String, what: String| self.spec.error(&key, GroomErrorKind::NotFinite(what));
+        let error = |key: String, what: String| self.error(&key, GroomErrorKind::NotFinite(what));
         for (k, op) in self.base.iter().chain(&self.ops).enumerate() {
             op.apply(&mut ws.batch, &context, &mut ws.scratch);
             if let Some(what) = ws.batch.hairs().iter().find_map(Hair::non_finite) {

@@ -12,7 +12,9 @@ use super::ops::{
     Clump, ClumpCentres, Curl, Frizz, Length, Noise, Opacity, Operator, Resampling, Strands, Width,
 };
 use super::parts::{Part, PartLayout};
-use super::spec::{ClumpParams, GroomOp, GroomSpec, color_maps, root_to_tip_maps};
+use super::spec::{
+    ClumpParams, GroomOp, GroomSpec, SpecOrigin, color_maps, root_to_tip_maps, setting_error,
+};
 use crate::curves::{CurveArrays, Curves};
 use crate::guides::Guides;
 use crate::interp::Interpolator;
@@ -21,8 +23,9 @@ use crate::mesh::{Mesh, SurfacePoint};
 use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, salts, sample_range};
 use glam::Vec3;
 use rayon::prelude::*;
-use std::sync::Mutex;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 pub use super::load::HAIRS_PER_PART;
 
@@ -38,9 +41,11 @@ pub struct GroomSummary {
 /// A groom prepared for generation. Shared by every thread; [`Self::part`]
 /// may be called in any order, any number of times.
 pub struct Generator {
-    /// The groom's mesh, guides, name and origin (its operators and
-    /// finish are built into `ops` and `base`).
-    pub(super) spec: GroomSpec,
+    pub(super) mesh: Arc<Mesh>,
+    pub(super) guides: Arc<Guides>,
+    /// The groom's name and where its settings were written, for errors.
+    name: PathBuf,
+    origin: Option<Arc<SpecOrigin>>,
     pub(super) sampler: DensitySampler,
     pub(super) layout: PartLayout,
     pub(super) interpolator: Interpolator,
@@ -83,7 +88,7 @@ impl std::fmt::Debug for Generator {
 
 impl Generator {
     /// Prepares `spec` for growing; see [`GroomSpec::generator`].
-    pub fn new(mut spec: GroomSpec) -> Result<Self, GroomError> {
+    pub fn new(spec: GroomSpec) -> Result<Self, GroomError> {
         let count = spec.roots.count;
         if count == 0 {
             return Err(spec.error(
@@ -109,16 +114,27 @@ impl Generator {
             part_count(mesh, count, spec.roots.parts),
         );
         let interpolator = Interpolator::new(mesh, spec.guides.clone(), &spec.interpolation);
-        let finish = std::mem::take(&mut spec.finish);
+        let GroomSpec {
+            name,
+            mesh,
+            guides,
+            roots,
+            ops,
+            finish,
+            origin,
+            ..
+        } = spec;
         let (colors, opacities) = (finish.color.is_some(), finish.opacity.is_some());
         let mut base = vec![Operator::Width(Width(finish.width))];
         base.extend(finish.color.map(Operator::Color));
         base.extend(finish.opacity.map(|o| Operator::Opacity(Opacity(o))));
-        let ops = std::mem::take(&mut spec.ops);
         let mut generator = Self {
-            resampling: Resampling::new(spec.guides.points_per_guide(), points),
-            seed: spec.roots.seed,
-            spec,
+            resampling: Resampling::new(guides.points_per_guide(), points),
+            seed: roots.seed,
+            mesh,
+            guides,
+            name,
+            origin,
             sampler,
             layout,
             interpolator,
@@ -150,7 +166,7 @@ impl Generator {
         // its position in the chain and its own seed.
         let op_seed = |s: u64| mix64(self.seed ^ mix64((k as u64 + 1) << 32 ^ s));
         let invalid = |key: &str, message: &str| {
-            self.spec.error(
+            self.error(
                 &format!("ops[{k}].{key}"),
                 GroomErrorKind::Invalid(message.into()),
             )
@@ -205,17 +221,14 @@ impl Generator {
                     size,
                     seed,
                 } = s;
-                let sampler = DensitySampler::new(
-                    &self.spec.mesh,
-                    &density,
-                    DensitySamplerOptions::default(),
-                )
-                .map_err(|e| {
-                    self.spec.error(
-                        &format!("ops[{k}].clump.density"),
-                        GroomErrorKind::Sample(e),
-                    )
-                })?;
+                let sampler =
+                    DensitySampler::new(&self.mesh, &density, DensitySamplerOptions::default())
+                        .map_err(|e| {
+                            self.error(
+                                &format!("ops[{k}].clump.density"),
+                                GroomErrorKind::Sample(e),
+                            )
+                        })?;
                 let roots = sample_range(&sampler, op_seed(seed), 0..count);
                 let centres = self.clump_centres(k, &roots);
                 Operator::Clump(Clump::new(centres, rate, ramp, size))
@@ -227,7 +240,7 @@ impl Generator {
     /// through the operators before it. Centre ids live apart from hair ids
     /// (top bits set), so their random numbers are their own.
     fn clump_centres(&self, k: usize, roots: &[SurfacePoint]) -> ClumpCentres {
-        let mesh = &self.spec.mesh;
+        let mesh = &self.mesh;
         let shapes: Vec<Vec<Vec3>> = roots
             .par_chunks(256)
             .enumerate()
@@ -249,14 +262,20 @@ impl Generator {
         ClumpCentres::new(positions, shapes.concat(), self.points)
     }
 
+    /// An error about the setting `key`, at its line when the groom came
+    /// from a file.
+    pub(super) fn error(&self, key: &str, kind: GroomErrorKind) -> GroomError {
+        setting_error(&self.name, self.origin.as_deref(), key, kind)
+    }
+
     /// The mesh hairs grow on.
     pub fn mesh(&self) -> &Mesh {
-        &self.spec.mesh
+        &self.mesh
     }
 
     /// The guides.
     pub fn guides(&self) -> &Guides {
-        &self.spec.guides
+        &self.guides
     }
 
     /// The seed every random number of the groom derives from.

@@ -87,7 +87,7 @@ impl Generator {
 
     /// Where a hair grows: its root's position, skin normal and UV.
     pub(super) fn root_context(&self, root: SurfacePoint) -> RootContext {
-        let mesh = &self.spec.mesh;
+        let mesh = &self.mesh;
         RootContext {
             point: root,
             position: root.position(mesh),
@@ -109,7 +109,7 @@ impl Generator {
         shape: &mut Vec<Vec3>,
         hair: &mut Hair,
     ) {
-        shape.resize(self.spec.guides.points_per_guide(), Vec3::ZERO);
+        shape.resize(self.guides.points_per_guide(), Vec3::ZERO);
         let hair_root = HairRoot {
             position: context.position,
             triangle: Some(context.point.tri),
@@ -283,7 +283,7 @@ impl Generator {
     /// Adds each hair's root UV (USD's uniform `st`, which renderers use to
     /// read skin textures along the hair) when the mesh has UVs.
     fn with_root_uvs(&self, curves: Curves) -> Curves {
-        let mesh = &self.spec.mesh;
+        let mesh = &self.mesh;
         if !mesh.has_uvs() {
             return curves;
         }

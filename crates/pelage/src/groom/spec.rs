@@ -35,7 +35,7 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-pub use super::ramp::Ramp;
+use super::ramp::Ramp;
 
 /// A whole groom, as values. Build one with [`GroomSpec::new`] and the
 /// `with_*` methods (or set the public fields), then call
@@ -126,9 +126,20 @@ impl GroomSpec {
     /// An error about the setting `key` (`roots.count`, `ops[1].noise`),
     /// at its line when the groom came from a file.
     pub(crate) fn error(&self, key: &str, kind: GroomErrorKind) -> GroomError {
-        let line = self.origin.as_ref().and_then(|o| o.lines.get(key).copied());
-        GroomError::new(self.name.clone(), line, Some(key.to_string()), kind)
+        setting_error(&self.name, self.origin.as_deref(), key, kind)
     }
+}
+
+/// An error about the setting `key` of the groom `name`, at its line when
+/// `origin` (the groom file) says where it was written.
+pub(crate) fn setting_error(
+    name: &std::path::Path,
+    origin: Option<&SpecOrigin>,
+    key: &str,
+    kind: GroomErrorKind,
+) -> GroomError {
+    let line = origin.and_then(|o| o.lines.get(key).copied());
+    GroomError::new(name.to_path_buf(), line, Some(key.to_string()), kind)
 }
 
 /// Where a groom file wrote the settings the generator checks: setting key
