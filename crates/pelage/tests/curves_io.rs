@@ -9,8 +9,8 @@
 
 use glam::Vec3;
 use pelage::io::{
-    CurveBasis, CurvesExport, CurvesFormat, HairFile, UsdOptions, UsdWrap, UsdaWriter, read_curves,
-    read_usd_curves, write_curves,
+    CurveBasis, CurvesExport, CurvesFormat, HairFile, UsdOptions, UsdWrap, UsdaWriter, UsdcWriter,
+    read_curves, read_usd_curves, write_curves,
 };
 use pelage::{Curves, SurfacePoint};
 use std::path::{Path, PathBuf};
@@ -120,9 +120,11 @@ fn usd_files_pass_pixars_validators_and_inconsistent_ones_fail() {
             ..UsdOptions::default()
         };
         for mesh in [false, true] {
-            let path = dir.path().join(format!("{label}_mesh{}.usda", mesh as u8));
-            write_usd(&path, &parts, &options, mesh);
-            files.push(path);
+            for ext in ["usda", "usdc"] {
+                let path = dir.path().join(format!("{label}_mesh{}.{ext}", mesh as u8));
+                write_usd(&path, &parts, &options, mesh);
+                files.push(path);
+            }
         }
     }
     let refs: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
@@ -170,6 +172,141 @@ fn usd_written_then_read_back_gives_the_same_curves() {
         assert!((*a - *b).abs().max_element() <= 1e-6, "{a} vs {b}");
     }
     assert_eq!(back.widths(), joined.widths());
+}
+
+#[test]
+fn usdc_holds_the_usda_layer_and_round_trips_every_attribute_to_the_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = small_groom(60, 6);
+    let second = small_groom(9, 4).with_ids(vec![1 << 40; 9]).unwrap();
+    let parts = [("part_0", &groom), ("part_1", &second)];
+    let (usda, usdc) = (dir.path().join("g.usda"), dir.path().join("g.usdc"));
+    write_usd(&usda, &parts, &UsdOptions::default(), true);
+    write_usd(&usdc, &parts, &UsdOptions::default(), true);
+    assert!(std::fs::read(&usdc).unwrap().starts_with(b"PXR-USDC"));
+
+    // What pelage reads back: every attribute, the same from both files.
+    let joined = pelage::io::join([&groom, &second]).unwrap();
+    let from_usdc = read_curves(&usdc).unwrap();
+    assert!(from_usdc.normals().is_some() && from_usdc.colors().is_some());
+    assert!(from_usdc.opacities().is_some() && from_usdc.root_uvs().is_some());
+    assert_eq!(from_usdc.ids(), joined.ids());
+    assert_eq!(from_usdc, read_curves(&usda).unwrap());
+    assert_eq!(from_usdc.points(), joined.points());
+
+    // usdc → usda → usdc: the same values, and the same bytes.
+    let (back_a, back_c) = (dir.path().join("b.usda"), dir.path().join("b.usdc"));
+    let again = dir.path().join("c.usdc");
+    let one = [("p".to_string(), &from_usdc)];
+    write_curves(
+        &back_c,
+        one.iter().map(|(n, c)| (n.clone(), *c)),
+        &CurvesExport::default(),
+    )
+    .unwrap();
+    write_curves(
+        &back_a,
+        one.iter().map(|(n, c)| (n.clone(), *c)),
+        &CurvesExport::default(),
+    )
+    .unwrap();
+    let through_text = read_curves(&back_a).unwrap();
+    assert_eq!(through_text, from_usdc);
+    let two = [("p".to_string(), &through_text)];
+    write_curves(
+        &again,
+        two.iter().map(|(n, c)| (n.clone(), *c)),
+        &CurvesExport::default(),
+    )
+    .unwrap();
+    assert!(std::fs::read(&back_c).unwrap() == std::fs::read(&again).unwrap());
+
+    // Pixar's library sees one layer in the text and the binary file.
+    let Some((ok, text)) = usdcheck(&[Path::new("--same"), &usda, &usdc]) else {
+        return;
+    };
+    assert!(ok, "{text}");
+}
+
+#[test]
+fn animated_usdc_holds_each_frame_and_the_stage_time_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("moving.usdc");
+    let frames: Vec<(f64, Curves)> = (0..4)
+        .map(|f| {
+            let c = small_groom(12, 5);
+            let shifted: Vec<Vec3> = c.points().iter().map(|p| *p + Vec3::X * f as f32).collect();
+            let moved = Curves::new(shifted, c.widths().to_vec(), c.offsets().to_vec()).unwrap();
+            (
+                10.0 + f as f64,
+                moved.with_normals(c.normals().unwrap().to_vec()).unwrap(),
+            )
+        })
+        .collect();
+    pelage::io::write_atomically(&path, |out| {
+        let mut usd =
+            UsdcWriter::new(out, &UsdOptions::default()).map_err(std::io::Error::other)?;
+        // Frame-major, as an animation grows: every part at each time.
+        for (time, curves) in &frames {
+            for part in ["a", "b"] {
+                usd.write_part_at(part, *time, curves)
+                    .map_err(std::io::Error::other)?;
+            }
+        }
+        usd.finish().map_err(std::io::Error::other)?;
+        Ok(())
+    })
+    .unwrap();
+    // A frame with other curves is refused, naming the part and time.
+    let mut usd =
+        UsdcWriter::new(std::io::Cursor::new(Vec::new()), &UsdOptions::default()).unwrap();
+    usd.write_part_at("a", 1.0, &frames[0].1).unwrap();
+    let err = usd
+        .write_part_at("a", 2.0, &small_groom(3, 5))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("part \"a\" at time 2: 3 curves"), "{err}");
+
+    let Some((ok, text)) = usdcheck(&[&path]) else {
+        return;
+    };
+    assert!(ok, "{text}");
+    assert!(
+        text.contains("2 BasisCurves prims, 24 curves, 120 points, 4 frames"),
+        "{text}"
+    );
+    // Pixar's library reads each frame's own points.
+    let values = usd_values(&path, &["/groom/a.points@10[7]", "/groom/b.points@13[7]"]);
+    assert_eq!(values[0], frames[0].1.points()[7].to_array());
+    assert_eq!(values[1], frames[3].1.points()[7].to_array());
+    let (ok, text) = usdcheck(&[Path::new("--values"), &path]).unwrap();
+    assert!(
+        ok && text.contains("stage 10 to 13 at 24 per second"),
+        "{text}"
+    );
+}
+
+/// The array elements `PATH@TIME[INDEX]` as Pixar's library reads them
+/// (`usdcheck --values`), as `f32` triples.
+fn usd_values(file: &Path, specs: &[&str]) -> Vec<[f32; 3]> {
+    let mut args: Vec<&Path> = vec![Path::new("--values"), file];
+    args.extend(specs.iter().map(Path::new));
+    let (ok, text) = usdcheck(&args).expect("usdcheck ran before");
+    assert!(ok, "{text}");
+    specs
+        .iter()
+        .map(|spec| {
+            let line = text
+                .lines()
+                .find_map(|l| l.strip_prefix(&format!("{spec} = ")))
+                .unwrap_or_else(|| panic!("no {spec} in:\n{text}"));
+            let v: Vec<f32> = line
+                .split(' ')
+                .map(|x| x.parse::<f64>().unwrap() as f32)
+                .collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
 }
 
 #[test]
@@ -444,14 +581,11 @@ fn rib_and_pbrt_are_written_for_every_curve() {
         CurvesFormat::from_path(Path::new("x.USDA")),
         Some(CurvesFormat::Usda)
     );
-    let err = write_curves(
-        Path::new("x.usdc"),
-        [("p".to_string(), &groom)],
-        &CurvesExport::default(),
-    )
-    .unwrap_err()
-    .to_string();
-    assert!(err.contains("text USD only"), "{err}");
+    // `.usd` is binary, as in Pixar's tools.
+    assert_eq!(
+        CurvesFormat::from_path(Path::new("x.usd")),
+        Some(CurvesFormat::Usdc)
+    );
 }
 
 #[test]

@@ -1,6 +1,6 @@
 //! `pelage convert IN OUT`: curves from one format to another, formats by
-//! extension (reads .usda/.usdc/.usd/.hair/.ply; writes .usda/.usd/.hair/
-//! .ply/.rib/.pbrt).
+//! extension (reads .usda/.usdc/.usd/.hair/.ply; writes .usdc/.usd/.usda/
+//! .hair/.ply/.rib/.pbrt).
 
 use super::load_mesh;
 use anyhow::Context;
@@ -15,7 +15,8 @@ use std::path::PathBuf;
 pub struct ConvertArgs {
     /// Curves to read: .usda, .usdc, .usd, .hair or .ply (vertex + edge).
     pub input: PathBuf,
-    /// Where to write: .usda (or .usd), .hair, .ply, .rib or .pbrt.
+    /// Where to write: .usdc (or .usd: binary USD), .usda (text USD),
+    /// .hair, .ply, .rib or .pbrt.
     pub output: PathBuf,
     /// How the points are interpolated (USD, RIB, pbrt).
     #[arg(long, value_enum, default_value_t = BasisArg::CatmullRom)]

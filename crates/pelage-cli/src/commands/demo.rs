@@ -1,7 +1,7 @@
 //! `pelage demo`: the groom generator on the embedded Spot mesh, with no
 //! files needed. It writes a groom file (`demo.toml`, with Spot's texture
 //! beside it for the hair colour) into the output folder, grows it —
-//! 400 guides, 200,000 hairs, clump + curl + noise — into `groom.usda`
+//! 400 guides, 200,000 hairs, clump + curl + noise — into `groom.usdc`
 //! (with the skin), and renders `preview.png` (skipped with a message
 //! where no GPU adapter exists). The groom file is the user's to edit and
 //! rerun with `pelage groom`.

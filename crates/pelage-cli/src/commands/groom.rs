@@ -16,8 +16,9 @@ use std::time::Instant;
 pub struct GroomArgs {
     /// The groom file (TOML; see docs/groom-format.md).
     pub file: PathBuf,
-    /// Output (.usda default; .hair, .ply, .rib, .pbrt). Default: the
-    /// file's `[output] path`, or the groom file's name with .usda.
+    /// Output (.usdc or .usd: binary USD; .usda: text USD; .hair, .ply,
+    /// .rib, .pbrt). Default: the file's `[output] path`, or the groom
+    /// file's name with .usdc.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Grow only run K of N (1-based): a contiguous share of the parts,
@@ -25,7 +26,8 @@ pub struct GroomArgs {
     #[arg(long, value_name = "K/N", value_parser = parse_part)]
     pub part: Option<(usize, usize)>,
     /// Instead of growing: write OUTPUT as a USD layer referencing every
-    /// part file `OUTPUT.part-K-of-N.usda` beside it, with extents.
+    /// part file `OUTPUT.part-K-of-N.EXT` beside it, with extents (the
+    /// layer is text: name OUTPUT .usda).
     #[arg(long, conflicts_with = "part")]
     pub assemble: bool,
     /// Worker threads (default: all cores). The output is identical for
@@ -96,16 +98,11 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         None => (0..parts, output.clone()),
     };
     // Refuse an output pelage cannot write before growing anything.
-    match CurvesFormat::from_path(&path) {
-        None => bail!(
-            "{}: unknown curves format; pelage writes .usda (or .usd), .hair, .ply, .rib and .pbrt",
+    if CurvesFormat::from_path(&path).is_none() {
+        bail!(
+            "{}: unknown curves format; pelage writes .usdc (or .usd), .usda, .hair, .ply, .rib and .pbrt",
             path.display()
-        ),
-        Some(CurvesFormat::Usdc) => bail!(
-            "{}: pelage writes text USD only (.usda or .usd); see docs/curves-io.md",
-            path.display()
-        ),
-        Some(_) => {}
+        );
     }
     let file = groom.file();
     let basis = file.output.basis;

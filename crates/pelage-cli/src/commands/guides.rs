@@ -56,7 +56,7 @@ pub struct GuidesArgs {
     /// With --from: the farthest a root may be from the surface.
     #[arg(long, default_value_t = 1e-3)]
     pub tolerance: f32,
-    /// Output: .usda, .hair, .ply, .rib or .pbrt.
+    /// Output: .usdc (or .usd), .usda, .hair, .ply, .rib or .pbrt.
     #[arg(short, long)]
     pub output: PathBuf,
 }

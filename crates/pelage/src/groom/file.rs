@@ -493,7 +493,7 @@ impl Default for FinishSection {
 #[serde(deny_unknown_fields)]
 pub struct OutputSection {
     /// Output file relative to the groom file (default: the groom file's
-    /// name with `.usda`).
+    /// name with `.usdc`: binary USD).
     pub path: Option<String>,
     /// Also write the skin mesh (USD only).
     #[serde(default)]

@@ -104,11 +104,11 @@ impl Groom {
     }
 
     /// Where the curves go: `[output] path` relative to the groom file, or
-    /// the groom file's name with `.usda`.
+    /// the groom file's name with `.usdc`.
     pub fn output_path(&self) -> PathBuf {
         match &self.file.output.path {
             Some(p) => self.source.folder().join(p),
-            None => self.source.path.with_extension("usda"),
+            None => self.source.path.with_extension("usdc"),
         }
     }
 

@@ -6,11 +6,11 @@ use super::error::GroomError;
 use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
-    CurvesExport, CurvesFormat, UpAxis, UsdOptions, UsdaWriter, WriteError, write_atomically,
-    write_curves,
+    CurvesExport, CurvesFormat, UpAxis, UsdOptions, UsdPrimWriter, UsdaWriter, UsdcWriter,
+    WriteError, write_atomically, write_curves,
 };
 use glam::Vec3;
-use std::io::{BufRead, Write};
+use std::io::{BufRead, Seek, Write};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -63,7 +63,8 @@ impl Generator {
             summary.hairs += c.curve_count() as u64;
             summary.points += c.points().len() as u64;
         };
-        if CurvesFormat::from_path(path) != Some(CurvesFormat::Usda) {
+        let format = CurvesFormat::from_path(path);
+        if !matches!(format, Some(CurvesFormat::Usda | CurvesFormat::Usdc)) {
             let mut grown = Vec::new();
             for p in parts {
                 let curves = self.part(p)?;
@@ -77,10 +78,15 @@ impl Generator {
             return Ok(summary);
         }
         write_atomically(path, |out| {
-            self.write_usd(out, parts, export, |p, c| {
+            let on_part = |p, c: &Curves| {
                 on_part(p, c);
                 count(c);
-            })
+            };
+            if format == Some(CurvesFormat::Usdc) {
+                self.write_usdc(out, parts, export, on_part)
+            } else {
+                self.write_usd(out, parts, export, on_part)
+            }
         })
         .map_err(|e| {
             // A part that could not grow comes back wrapped as an I/O
@@ -125,10 +131,40 @@ impl Generator {
         out: impl Write,
         parts: Range<usize>,
         export: &CurvesExport,
+        on_part: impl FnMut(usize, &Curves) + Send,
+    ) -> std::io::Result<()> {
+        let mut usd = UsdaWriter::new(out, &export.usd).map_err(std::io::Error::other)?;
+        self.stream_parts(&mut usd, parts, export, on_part)?;
+        usd.finish().map_err(std::io::Error::other)?;
+        Ok(())
+    }
+
+    /// [`write_usd`](Self::write_usd) as binary USD (usdc): the same
+    /// layer, the same streaming; the output must be seekable (the header
+    /// is written last).
+    pub fn write_usdc(
+        &self,
+        out: impl Write + Seek,
+        parts: Range<usize>,
+        export: &CurvesExport,
+        on_part: impl FnMut(usize, &Curves) + Send,
+    ) -> std::io::Result<()> {
+        let mut usd = UsdcWriter::new(out, &export.usd).map_err(std::io::Error::other)?;
+        self.stream_parts(&mut usd, parts, export, on_part)?;
+        usd.finish().map_err(std::io::Error::other)?;
+        Ok(())
+    }
+
+    /// Writes the skin (if exported), then grows `parts` on a second
+    /// thread and writes each as it arrives.
+    fn stream_parts(
+        &self,
+        usd: &mut impl UsdPrimWriter,
+        parts: Range<usize>,
+        export: &CurvesExport,
         mut on_part: impl FnMut(usize, &Curves) + Send,
     ) -> std::io::Result<()> {
         let other = std::io::Error::other;
-        let mut usd = UsdaWriter::new(out, &export.usd).map_err(other)?;
         if let Some(mesh) = export.mesh {
             usd.write_mesh("skin", mesh).map_err(other)?;
         }
@@ -156,9 +192,7 @@ impl Generator {
             }
             grower.join().expect("the part grower does not panic");
             Ok::<(), std::io::Error>(())
-        })?;
-        usd.finish().map_err(other)?;
-        Ok(())
+        })
     }
 }
 

@@ -3,8 +3,8 @@
 
 use super::read_error::{CurvesReadError, CurvesReadErrorKind};
 use super::{
-    HairFile, UsdOptions, UsdaWriter, WriteError, read_curves_ply, read_usd_curves,
-    write_atomically, write_curves_ply, write_pbrt, write_rib,
+    HairFile, UsdOptions, UsdPrimWriter, UsdaWriter, UsdcWriter, WriteError, read_curves_ply,
+    read_usd_curves, write_atomically, write_curves_ply, write_pbrt, write_rib,
 };
 use crate::{Curves, Mesh};
 use std::path::Path;
@@ -12,10 +12,10 @@ use std::path::Path;
 /// A curves file format, chosen by extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CurvesFormat {
-    /// `.usda` (and `.usd` when writing: text USD; reading sniffs text or
-    /// binary).
+    /// `.usda`: text USD.
     Usda,
-    /// `.usdc`: read only (see docs/curves-io.md).
+    /// `.usdc`, and `.usd` as in Pixar's tools: binary USD when writing
+    /// (reading sniffs text or binary).
     Usdc,
     /// Cem Yuksel's `.hair`.
     Hair,
@@ -32,8 +32,8 @@ impl CurvesFormat {
     pub fn from_path(path: &Path) -> Option<Self> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
         Some(match ext.as_str() {
-            "usda" | "usd" => Self::Usda,
-            "usdc" => Self::Usdc,
+            "usda" => Self::Usda,
+            "usdc" | "usd" => Self::Usdc,
             "hair" => Self::Hair,
             "ply" => Self::Ply,
             "rib" => Self::Rib,
@@ -83,24 +83,23 @@ pub fn write_curves<'c>(
     };
     let format = CurvesFormat::from_path(path).ok_or_else(|| {
         fail(
-            "unknown curves format; pelage writes .usda (or .usd), .hair, .ply, .rib and .pbrt"
+            "unknown curves format; pelage writes .usdc (or .usd), .usda, .hair, .ply, .rib and .pbrt"
                 .into(),
         )
     })?;
     let basis = export.usd.basis;
     match format {
-        CurvesFormat::Usdc => Err(fail(
-            "pelage writes text USD only (.usda or .usd); see docs/curves-io.md".into(),
-        )),
         CurvesFormat::Usda => write_atomically(path, |out| {
             let other = std::io::Error::other;
             let mut usd = UsdaWriter::new(out, &export.usd).map_err(other)?;
-            if let Some(mesh) = export.mesh {
-                usd.write_mesh("skin", mesh).map_err(other)?;
-            }
-            for (name, curves) in parts {
-                usd.write_part(&name, curves).map_err(other)?;
-            }
+            write_usd_prims(&mut usd, parts, export)?;
+            usd.finish().map_err(other)?;
+            Ok(())
+        }),
+        CurvesFormat::Usdc => write_atomically(path, |out| {
+            let other = std::io::Error::other;
+            let mut usd = UsdcWriter::new(out, &export.usd).map_err(other)?;
+            write_usd_prims(&mut usd, parts, export)?;
             usd.finish().map_err(other)?;
             Ok(())
         }),
@@ -127,6 +126,22 @@ pub fn write_curves<'c>(
     }
 }
 
+/// The skin (if exported) and then every part, as prims of one layer.
+fn write_usd_prims<'c>(
+    usd: &mut impl UsdPrimWriter,
+    parts: impl IntoIterator<Item = (String, &'c Curves)>,
+    export: &CurvesExport,
+) -> std::io::Result<()> {
+    let other = std::io::Error::other;
+    if let Some(mesh) = export.mesh {
+        usd.write_mesh("skin", mesh).map_err(other)?;
+    }
+    for (name, curves) in parts {
+        usd.write_part(&name, curves).map_err(other)?;
+    }
+    Ok(())
+}
+
 /// Concatenates curves, keeping only the attributes every part has.
 pub fn join<'c>(
     parts: impl IntoIterator<Item = &'c Curves>,
@@ -147,6 +162,15 @@ pub fn join<'c>(
     }
     if let Some(opacities) = concat_all(&parts, Curves::opacities) {
         joined = joined.with_opacities(opacities)?;
+    }
+    if let Some(normals) = concat_all(&parts, Curves::normals) {
+        joined = joined.with_normals(normals)?;
+    }
+    if let Some(uvs) = concat_all(&parts, Curves::root_uvs) {
+        joined = joined.with_root_uvs(uvs)?;
+    }
+    if let Some(ids) = concat_all(&parts, Curves::ids) {
+        joined = joined.with_ids(ids)?;
     }
     Ok(joined)
 }

@@ -22,7 +22,9 @@ mod read_error;
 mod render_text;
 mod text;
 mod usd_read;
+mod usd_schema;
 mod usda;
+mod usdc;
 
 pub use atomic::write_atomically;
 pub use curves_file::{CurvesExport, CurvesFormat, join, read_curves, write_curves};
@@ -34,7 +36,9 @@ pub use points_ply::{
 pub use read_error::{CurvesReadError, CurvesReadErrorKind};
 pub use render_text::{bezier_control_points, write_pbrt, write_rib};
 pub use usd_read::{DEFAULT_WIDTH, read_usd_curves};
+pub use usd_schema::UsdPrimWriter;
 pub use usda::{CurveBasis, UpAxis, UsdOptions, UsdWrap, UsdWriteError, UsdaWriter};
+pub use usdc::UsdcWriter;
 
 use std::path::PathBuf;
 

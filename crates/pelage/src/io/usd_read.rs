@@ -47,7 +47,7 @@ pub fn read_usd_curves(path: &Path) -> Result<Curves, CurvesReadError> {
             Kind::Empty(" (no BasisCurves prim)"),
         ));
     }
-    let (mut points, mut widths, mut offsets) = (Vec::new(), Vec::new(), vec![0u32]);
+    let mut parts = Vec::with_capacity(prims.len());
     for prim in &prims {
         let fail = |kind| CurvesReadError::whole(path, kind);
         let at = |what: &str| format!("{}: {what}", prim.as_str());
@@ -97,20 +97,78 @@ pub fn read_usd_curves(path: &Path) -> Result<Curves, CurvesReadError> {
         let transform = world_transform(data, prim).map_err(|m| fail(Kind::Unsupported(at(&m))))?;
         let prim_widths =
             read_widths(data, prim, &counts).map_err(|m| fail(Kind::Inconsistent(at(&m))))?;
-        let base = points.len() as u32;
-        points.extend(
-            prim_points
-                .iter()
-                .map(|&p| transform.transform_point3(p).as_vec3()),
-        );
-        widths.extend(prim_widths);
-        let mut end = base;
-        for c in counts {
-            end += c as u32;
-            offsets.push(end);
-        }
+        let points = prim_points
+            .iter()
+            .map(|&p| transform.transform_point3(p).as_vec3())
+            .collect();
+        let offsets = std::iter::once(0)
+            .chain(counts.iter().scan(0u32, |end, &c| {
+                *end += c as u32;
+                Some(*end)
+            }))
+            .collect();
+        let curves = Curves::new(points, prim_widths, offsets)
+            .map_err(|e| CurvesReadError::whole(path, e.into()))?;
+        let curves = with_primvars(curves, data, prim, transform)
+            .map_err(|e| fail(Kind::Inconsistent(at(&e.to_string()))))?;
+        parts.push(curves);
     }
-    Curves::new(points, widths, offsets).map_err(|e| CurvesReadError::whole(path, e.into()))
+    super::join(&parts).map_err(|e| CurvesReadError::whole(path, e.into()))
+}
+
+/// Adds the attributes pelage writes, where the prim has them with the
+/// interpolation pelage writes them with (others are left out): normals,
+/// `displayColor` and `displayOpacity` per point, `st` and `hair_id` per
+/// curve. Normals are turned with the prim's transform.
+fn with_primvars(
+    mut curves: Curves,
+    data: &dyn AbstractData,
+    prim: &sdf::Path,
+    transform: DMat4,
+) -> Result<Curves, crate::curves::CurvesError> {
+    let per = |name: &str, want: &str| {
+        let interpolation = metadata_token(data, prim, name, "interpolation");
+        (interpolation.as_deref() == Some(want))
+            .then(|| attribute(data, prim, name))
+            .flatten()
+    };
+    if let Some(Value::Vec3fVec(v)) = per("normals", "vertex") {
+        let turn = (transform != DMat4::IDENTITY).then(|| transform.inverse().transpose());
+        let normals = v
+            .iter()
+            .map(|n| {
+                let n = glam::Vec3::new(n.x, n.y, n.z);
+                match turn {
+                    None => n,
+                    Some(m) => m
+                        .transform_vector3(n.as_dvec3())
+                        .as_vec3()
+                        .normalize_or_zero(),
+                }
+            })
+            .collect();
+        curves = curves.with_normals(normals)?;
+    }
+    if let Some(Value::Vec3fVec(v)) = per("primvars:displayColor", "vertex") {
+        let colors = v.iter().map(|c| glam::Vec3::new(c.x, c.y, c.z)).collect();
+        curves = curves.with_colors(colors)?;
+    }
+    if let Some(Value::FloatVec(v)) = per("primvars:displayOpacity", "vertex") {
+        curves = curves.with_opacities(v)?;
+    }
+    if let Some(Value::Vec2fVec(v)) = per("primvars:st", "uniform") {
+        let uvs = v.iter().map(|t| glam::Vec2::new(t.x, t.y)).collect();
+        curves = curves.with_root_uvs(uvs)?;
+    }
+    let ids: Option<Vec<u64>> = match per("primvars:hair_id", "uniform") {
+        Some(Value::IntVec(v)) => v.iter().map(|&i| u64::try_from(i).ok()).collect(),
+        Some(Value::Int64Vec(v)) => v.iter().map(|&i| u64::try_from(i).ok()).collect(),
+        _ => None,
+    };
+    if let Some(ids) = ids {
+        curves = curves.with_ids(ids)?;
+    }
+    Ok(curves)
 }
 
 /// Splits openusd's `PATH:LINE: COL: message` into a line location.

@@ -6,17 +6,15 @@
 //! bounded size, so the text of a groom is never held whole in memory. The
 //! bytes do not depend on the number of threads.
 //!
-//! What each attribute means and how many values it needs follows the
-//! `UsdGeomBasisCurves` schema: `widths`, `normals`, `displayColor` and
-//! `displayOpacity` are per point (`vertex`), the root UV (`st`) and the
-//! hair id are per curve (`uniform`), and every prim has an `extent`
-//! padded by half the widest hair, as `UsdGeomCurves::ComputeExtent` does.
-//! docs/curves-io.md says why pelage writes usda itself rather than usdc.
+//! The attributes themselves come from `usd_schema`, shared with the usdc
+//! writer.
 
 use super::text::{put_f32, put_tuple2, put_tuple3, put_u64};
+use super::usd_schema::{
+    UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name, mesh_attributes,
+};
 use crate::Curves;
-use crate::mesh::{Mesh, Uvs};
-use glam::Vec3;
+use crate::mesh::Mesh;
 use rayon::prelude::*;
 use std::collections::HashSet;
 use std::io::Write;
@@ -71,6 +69,8 @@ pub struct UsdOptions {
     pub meters_per_unit: f64,
     /// Name of the default prim (an `Xform`) holding the parts.
     pub root: String,
+    /// `timeCodesPerSecond` (and `framesPerSecond`) of an animated stage.
+    pub time_codes_per_second: f64,
 }
 
 impl Default for UsdOptions {
@@ -81,6 +81,7 @@ impl Default for UsdOptions {
             up_axis: UpAxis::default(),
             meters_per_unit: 1.0,
             root: "groom".into(),
+            time_codes_per_second: 24.0,
         }
     }
 }
@@ -110,6 +111,25 @@ pub enum UsdWriteError {
     /// Two prims with one name.
     #[error("a prim named {0:?} was already written")]
     DuplicateName(String),
+    /// A setting or value USD cannot hold (a NaN time, a zero scale).
+    #[error("{0}")]
+    BadSetting(String),
+    /// A frame of an animated part whose curves differ from the first
+    /// frame's.
+    #[error(
+        "part {part:?} at time {time}: {} curves and {} points, but its first frame had {} and {} (an animated part keeps its curves)",
+        curves.1, points.1, curves.0, points.0
+    )]
+    FrameMismatch {
+        /// The part.
+        part: String,
+        /// The frame's time.
+        time: f64,
+        /// Curves in the first frame and in this one.
+        curves: (usize, usize),
+        /// Points in the first frame and in this one.
+        points: (usize, usize),
+    },
     /// A curve too short for the basis.
     #[error(
         "part {part:?}: curve {curve} has {points} points; {basis} curves need at least {min} (use linear curves or resample)"
@@ -176,138 +196,28 @@ impl<W: Write> UsdaWriter<W> {
 
     /// Writes one part as a `BasisCurves` prim named `name`.
     pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
-        let min = self.options.min_points_per_curve();
-        if let Some(curve) = (0..curves.curve_count()).find(|&i| curves.range(i).len() < min) {
-            return Err(UsdWriteError::ShortCurve {
-                part: name.to_string(),
-                curve,
-                points: curves.range(curve).len(),
-                min,
-                basis: match (self.options.basis, self.options.wrap) {
-                    (CurveBasis::Linear, _) => "linear",
-                    (CurveBasis::CatmullRom, UsdWrap::Pinned) => "pinned Catmull-Rom",
-                    (CurveBasis::CatmullRom, UsdWrap::Nonperiodic) => "nonperiodic Catmull-Rom",
-                },
-            });
-        }
-        self.claim(name)?;
-        let out = &mut self.out;
-        writeln!(out, "    def BasisCurves \"{name}\"\n    {{")?;
-        match self.options.basis {
-            CurveBasis::Linear => writeln!(out, "        uniform token type = \"linear\"")?,
-            CurveBasis::CatmullRom => {
-                let wrap = match self.options.wrap {
-                    UsdWrap::Pinned => "pinned",
-                    UsdWrap::Nonperiodic => "nonperiodic",
-                };
-                writeln!(
-                    out,
-                    "        uniform token type = \"cubic\"\n        uniform token basis = \"catmullRom\"\n        \
-                     uniform token wrap = \"{wrap}\""
-                )?;
-            }
-        }
-        let counts: Vec<u32> = curves.offsets().windows(2).map(|w| w[1] - w[0]).collect();
-        write_array(out, "int[] curveVertexCounts", &counts, None, |n, s| {
-            put_u64(*n as u64, s)
-        })?;
-        write_array(out, "point3f[] points", curves.points(), None, put_tuple3)?;
-        let (lo, hi) = curve_extent(curves);
-        write_array(out, "float3[] extent", &[lo, hi], None, put_tuple3)?;
-        write_array(
-            out,
-            "float[] widths",
-            curves.widths(),
-            Some("vertex"),
-            |w, s| put_f32(*w, s),
-        )?;
-        if let Some(normals) = curves.normals() {
-            write_array(
-                out,
-                "normal3f[] normals",
-                normals,
-                Some("vertex"),
-                put_tuple3,
-            )?;
-        }
-        if let Some(colors) = curves.colors() {
-            let decl = "color3f[] primvars:displayColor";
-            write_array(out, decl, colors, Some("vertex"), put_tuple3)?;
-        }
-        if let Some(opacities) = curves.opacities() {
-            let decl = "float[] primvars:displayOpacity";
-            write_array(out, decl, opacities, Some("vertex"), |o, s| put_f32(*o, s))?;
-        }
-        if let Some(uvs) = curves.root_uvs() {
-            write_array(
-                out,
-                "texCoord2f[] primvars:st",
-                uvs,
-                Some("uniform"),
-                put_tuple2,
-            )?;
-        }
-        if let Some(ids) = curves.ids() {
-            // int is what Blender and Houdini read; larger ids need int64.
-            let decl = if ids.iter().all(|&id| id <= i32::MAX as u64) {
-                "int[] primvars:hair_id"
-            } else {
-                "int64[] primvars:hair_id"
-            };
-            write_array(out, decl, ids, Some("uniform"), |id, s| put_u64(*id, s))?;
-        }
-        writeln!(out, "    }}")?;
-        Ok(())
+        let attributes = basis_curves_attributes(name, curves, &self.options)?;
+        self.write_prim("BasisCurves", name, &attributes)
     }
 
     /// Writes the skin as a `Mesh` prim named `name` (triangles, vertex
     /// normals, UVs as `st`), so the file opens complete in usdview or
     /// Blender.
     pub fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
+        self.write_prim("Mesh", name, &mesh_attributes(mesh))
+    }
+
+    fn write_prim(
+        &mut self,
+        type_name: &str,
+        name: &str,
+        attributes: &[UsdAttribute],
+    ) -> Result<(), UsdWriteError> {
         self.claim(name)?;
         let out = &mut self.out;
-        writeln!(
-            out,
-            "    def Mesh \"{name}\"\n    {{\n        uniform token subdivisionScheme = \"none\""
-        )?;
-        let (lo, hi) = mesh.bounds();
-        write_array(out, "float3[] extent", &[lo, hi], None, put_tuple3)?;
-        let threes = vec![3u32; mesh.triangle_count()];
-        write_array(out, "int[] faceVertexCounts", &threes, None, |n, s| {
-            put_u64(*n as u64, s)
-        })?;
-        write_array(
-            out,
-            "int[] faceVertexIndices",
-            mesh.triangles(),
-            None,
-            put_u32x3,
-        )?;
-        write_array(out, "point3f[] points", mesh.positions(), None, put_tuple3)?;
-        let normals = mesh.normals();
-        write_array(
-            out,
-            "normal3f[] normals",
-            normals,
-            Some("vertex"),
-            put_tuple3,
-        )?;
-        match mesh.uvs() {
-            None => {}
-            Some(Uvs::PerVertex(uvs)) => {
-                write_array(
-                    out,
-                    "texCoord2f[] primvars:st",
-                    uvs,
-                    Some("vertex"),
-                    put_tuple2,
-                )?;
-            }
-            Some(Uvs::PerCorner { values, indices }) => {
-                let decl = "texCoord2f[] primvars:st";
-                write_array(out, decl, values, Some("faceVarying"), put_tuple2)?;
-                write_array(out, "int[] primvars:st:indices", indices, None, put_u32x3)?;
-            }
+        writeln!(out, "    def {type_name} \"{name}\"\n    {{")?;
+        for attribute in attributes {
+            write_attribute(out, attribute)?;
         }
         writeln!(out, "    }}")?;
         Ok(())
@@ -318,30 +228,6 @@ impl<W: Write> UsdaWriter<W> {
         writeln!(self.out, "}}")?;
         Ok(self.out)
     }
-}
-
-/// USD prim names: an identifier.
-fn check_name(name: &str) -> Result<(), UsdWriteError> {
-    let mut chars = name.chars();
-    let ok = chars
-        .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
-    if ok {
-        Ok(())
-    } else {
-        Err(UsdWriteError::BadName(name.to_string()))
-    }
-}
-
-/// Bounds of the points padded by half the widest width (a hair is a tube
-/// of that diameter around its points).
-fn curve_extent(curves: &Curves) -> (Vec3, Vec3) {
-    let Some((lo, hi)) = curves.bounds() else {
-        return (Vec3::ZERO, Vec3::ZERO);
-    };
-    let pad = curves.widths().iter().fold(0.0f32, |m, &w| m.max(w.abs())) * 0.5;
-    (lo - Vec3::splat(pad), hi + Vec3::splat(pad))
 }
 
 /// Writes `decl = [v, v, …]`, with an `interpolation` metadata block when
@@ -380,11 +266,34 @@ fn write_array<T: Sync>(
     }
 }
 
-fn put_u32x3(t: &[u32; 3], s: &mut Vec<u8>) {
-    for (k, i) in t.iter().enumerate() {
-        if k > 0 {
-            s.extend_from_slice(b", ");
+impl<W: Write> UsdPrimWriter for UsdaWriter<W> {
+    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+        UsdaWriter::write_part(self, name, curves)
+    }
+
+    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
+        UsdaWriter::write_mesh(self, name, mesh)
+    }
+}
+
+/// Writes one attribute line: a token, or an array with its
+/// interpolation.
+fn write_attribute(out: &mut impl Write, attribute: &UsdAttribute) -> std::io::Result<()> {
+    let variability = if attribute.uniform { "uniform " } else { "" };
+    let decl = format!("{variability}{} {}", attribute.type_name, attribute.name);
+    let interpolation = attribute.interpolation;
+    match &attribute.values {
+        UsdValues::Token(token) => writeln!(out, "        {decl} = \"{token}\""),
+        UsdValues::Ints(ints) => write_array(out, &decl, ints, interpolation, |n, s| {
+            put_u64(*n as u64, s)
+        }),
+        UsdValues::Int64s(ints) => {
+            write_array(out, &decl, ints, interpolation, |n, s| put_u64(*n, s))
         }
-        put_u64(*i as u64, s);
+        UsdValues::Floats(floats) => {
+            write_array(out, &decl, floats, interpolation, |v, s| put_f32(*v, s))
+        }
+        UsdValues::Vec2s(values) => write_array(out, &decl, values, interpolation, put_tuple2),
+        UsdValues::Vec3s(values) => write_array(out, &decl, values, interpolation, put_tuple3),
     }
 }

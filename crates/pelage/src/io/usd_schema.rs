@@ -1,0 +1,266 @@
+//! What pelage puts in a USD layer, whatever the encoding: the prims'
+//! attributes (name, value type, variability, interpolation, values) for
+//! `UsdGeomBasisCurves` and `UsdGeomMesh`. The text writer (usda) and the
+//! binary writer (usdc) both walk these lists, so the two files hold the
+//! same layer.
+//!
+//! What each attribute means and how many values it needs follows the
+//! `UsdGeomBasisCurves` schema: `widths`, `normals`, `displayColor` and
+//! `displayOpacity` are per point (`vertex`), the root UV (`st`) and the
+//! hair id are per curve (`uniform`), and every prim has an `extent`
+//! padded by half the widest hair, as `UsdGeomCurves::ComputeExtent` does.
+
+use super::usda::{CurveBasis, UsdOptions, UsdWrap, UsdWriteError};
+use crate::Curves;
+use crate::mesh::{Mesh, Uvs};
+use glam::{Vec2, Vec3};
+use std::borrow::Cow;
+
+/// A USD layer being written prim by prim, as text ([`UsdaWriter`]) or
+/// binary ([`UsdcWriter`]), so code that streams parts works with either.
+///
+/// [`UsdaWriter`]: super::UsdaWriter
+/// [`UsdcWriter`]: super::UsdcWriter
+pub trait UsdPrimWriter {
+    /// Writes one part as a `BasisCurves` prim named `name`.
+    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError>;
+    /// Writes the skin as a `Mesh` prim named `name`.
+    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError>;
+}
+
+/// The values of one attribute.
+pub(crate) enum UsdValues<'a> {
+    /// One token (`uniform token type = "cubic"`).
+    Token(&'static str),
+    /// `int[]`. Stored unsigned: every writer of these keeps them below
+    /// 2³¹ (counts, indices, ids that fit).
+    Ints(Cow<'a, [u32]>),
+    /// `int64[]` (ids that need more than 31 bits).
+    Int64s(&'a [u64]),
+    /// `float[]`.
+    Floats(&'a [f32]),
+    /// `float2[]`-shaped (`texCoord2f[]`).
+    Vec2s(&'a [Vec2]),
+    /// `float3[]`-shaped (`point3f[]`, `normal3f[]`, `color3f[]`,
+    /// `float3[]`).
+    Vec3s(Cow<'a, [Vec3]>),
+}
+
+/// One attribute of a prim.
+pub(crate) struct UsdAttribute<'a> {
+    /// The property name (`points`, `primvars:displayColor`).
+    pub name: &'static str,
+    /// The USD value type name (`point3f[]`, `token`).
+    pub type_name: &'static str,
+    /// `uniform` variability (does not change over time).
+    pub uniform: bool,
+    /// The primvar interpolation (`vertex`, `uniform`, `faceVarying`).
+    pub interpolation: Option<&'static str>,
+    /// The values.
+    pub values: UsdValues<'a>,
+}
+
+impl<'a> UsdAttribute<'a> {
+    fn new(name: &'static str, type_name: &'static str, values: UsdValues<'a>) -> Self {
+        Self {
+            name,
+            type_name,
+            uniform: false,
+            interpolation: None,
+            values,
+        }
+    }
+
+    fn uniform_token(name: &'static str, value: &'static str) -> Self {
+        Self {
+            uniform: true,
+            ..Self::new(name, "token", UsdValues::Token(value))
+        }
+    }
+
+    fn interpolated(mut self, interpolation: &'static str) -> Self {
+        self.interpolation = Some(interpolation);
+        self
+    }
+}
+
+/// The attributes of a part's `BasisCurves` prim, in the order the files
+/// list them. Refuses curves too short for the basis, naming the part.
+pub(crate) fn basis_curves_attributes<'a>(
+    part: &str,
+    curves: &'a Curves,
+    options: &UsdOptions,
+) -> Result<Vec<UsdAttribute<'a>>, UsdWriteError> {
+    check_curve_lengths(part, curves, options)?;
+    let mut attributes = Vec::with_capacity(12);
+    match options.basis {
+        CurveBasis::Linear => attributes.push(UsdAttribute::uniform_token("type", "linear")),
+        CurveBasis::CatmullRom => {
+            attributes.push(UsdAttribute::uniform_token("type", "cubic"));
+            attributes.push(UsdAttribute::uniform_token("basis", "catmullRom"));
+            let wrap = match options.wrap {
+                UsdWrap::Pinned => "pinned",
+                UsdWrap::Nonperiodic => "nonperiodic",
+            };
+            attributes.push(UsdAttribute::uniform_token("wrap", wrap));
+        }
+    }
+    let counts: Vec<u32> = curves.offsets().windows(2).map(|w| w[1] - w[0]).collect();
+    attributes.push(UsdAttribute::new(
+        "curveVertexCounts",
+        "int[]",
+        UsdValues::Ints(Cow::Owned(counts)),
+    ));
+    attributes.push(UsdAttribute::new(
+        "points",
+        "point3f[]",
+        UsdValues::Vec3s(Cow::Borrowed(curves.points())),
+    ));
+    let (lo, hi) = curve_extent(curves);
+    attributes.push(UsdAttribute::new(
+        "extent",
+        "float3[]",
+        UsdValues::Vec3s(Cow::Owned(vec![lo, hi])),
+    ));
+    attributes.push(
+        UsdAttribute::new("widths", "float[]", UsdValues::Floats(curves.widths()))
+            .interpolated("vertex"),
+    );
+    if let Some(normals) = curves.normals() {
+        let values = UsdValues::Vec3s(Cow::Borrowed(normals));
+        attributes.push(UsdAttribute::new("normals", "normal3f[]", values).interpolated("vertex"));
+    }
+    if let Some(colors) = curves.colors() {
+        let values = UsdValues::Vec3s(Cow::Borrowed(colors));
+        attributes.push(
+            UsdAttribute::new("primvars:displayColor", "color3f[]", values).interpolated("vertex"),
+        );
+    }
+    if let Some(opacities) = curves.opacities() {
+        let values = UsdValues::Floats(opacities);
+        attributes.push(
+            UsdAttribute::new("primvars:displayOpacity", "float[]", values).interpolated("vertex"),
+        );
+    }
+    if let Some(uvs) = curves.root_uvs() {
+        let values = UsdValues::Vec2s(uvs);
+        attributes
+            .push(UsdAttribute::new("primvars:st", "texCoord2f[]", values).interpolated("uniform"));
+    }
+    if let Some(ids) = curves.ids() {
+        // int is what Blender and Houdini read; larger ids need int64.
+        let attribute = if ids.iter().all(|&id| id <= i32::MAX as u64) {
+            let narrow = ids.iter().map(|&id| id as u32).collect();
+            UsdAttribute::new(
+                "primvars:hair_id",
+                "int[]",
+                UsdValues::Ints(Cow::Owned(narrow)),
+            )
+        } else {
+            UsdAttribute::new("primvars:hair_id", "int64[]", UsdValues::Int64s(ids))
+        };
+        attributes.push(attribute.interpolated("uniform"));
+    }
+    Ok(attributes)
+}
+
+/// The attributes of the skin's `Mesh` prim: triangles, vertex normals,
+/// UVs as `st` (per vertex, or per corner with their own indices).
+pub(crate) fn mesh_attributes(mesh: &Mesh) -> Vec<UsdAttribute<'_>> {
+    let (lo, hi) = mesh.bounds();
+    let mut attributes = vec![
+        UsdAttribute::uniform_token("subdivisionScheme", "none"),
+        UsdAttribute::new(
+            "extent",
+            "float3[]",
+            UsdValues::Vec3s(Cow::Owned(vec![lo, hi])),
+        ),
+        UsdAttribute::new(
+            "faceVertexCounts",
+            "int[]",
+            UsdValues::Ints(Cow::Owned(vec![3u32; mesh.triangle_count()])),
+        ),
+        UsdAttribute::new(
+            "faceVertexIndices",
+            "int[]",
+            UsdValues::Ints(Cow::Borrowed(mesh.triangles().as_flattened())),
+        ),
+        UsdAttribute::new(
+            "points",
+            "point3f[]",
+            UsdValues::Vec3s(Cow::Borrowed(mesh.positions())),
+        ),
+        UsdAttribute::new(
+            "normals",
+            "normal3f[]",
+            UsdValues::Vec3s(Cow::Borrowed(mesh.normals())),
+        )
+        .interpolated("vertex"),
+    ];
+    match mesh.uvs() {
+        None => {}
+        Some(Uvs::PerVertex(uvs)) => attributes.push(
+            UsdAttribute::new("primvars:st", "texCoord2f[]", UsdValues::Vec2s(uvs))
+                .interpolated("vertex"),
+        ),
+        Some(Uvs::PerCorner { values, indices }) => {
+            attributes.push(
+                UsdAttribute::new("primvars:st", "texCoord2f[]", UsdValues::Vec2s(values))
+                    .interpolated("faceVarying"),
+            );
+            attributes.push(UsdAttribute::new(
+                "primvars:st:indices",
+                "int[]",
+                UsdValues::Ints(Cow::Borrowed(indices.as_flattened())),
+            ));
+        }
+    }
+    attributes
+}
+
+/// Refuses a curve with fewer points than the basis needs.
+fn check_curve_lengths(
+    part: &str,
+    curves: &Curves,
+    options: &UsdOptions,
+) -> Result<(), UsdWriteError> {
+    let min = options.min_points_per_curve();
+    match (0..curves.curve_count()).find(|&i| curves.range(i).len() < min) {
+        None => Ok(()),
+        Some(curve) => Err(UsdWriteError::ShortCurve {
+            part: part.to_string(),
+            curve,
+            points: curves.range(curve).len(),
+            min,
+            basis: match (options.basis, options.wrap) {
+                (CurveBasis::Linear, _) => "linear",
+                (CurveBasis::CatmullRom, UsdWrap::Pinned) => "pinned Catmull-Rom",
+                (CurveBasis::CatmullRom, UsdWrap::Nonperiodic) => "nonperiodic Catmull-Rom",
+            },
+        }),
+    }
+}
+
+/// USD prim names: an identifier.
+pub(crate) fn check_name(name: &str) -> Result<(), UsdWriteError> {
+    let mut chars = name.chars();
+    let ok = chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if ok {
+        Ok(())
+    } else {
+        Err(UsdWriteError::BadName(name.to_string()))
+    }
+}
+
+/// Bounds of the points padded by half the widest width (a hair is a tube
+/// of that diameter around its points).
+pub(crate) fn curve_extent(curves: &Curves) -> (Vec3, Vec3) {
+    let Some((lo, hi)) = curves.bounds() else {
+        return (Vec3::ZERO, Vec3::ZERO);
+    };
+    let pad = curves.widths().iter().fold(0.0f32, |m, &w| m.max(w.abs())) * 0.5;
+    (lo - Vec3::splat(pad), hi + Vec3::splat(pad))
+}

@@ -1,0 +1,455 @@
+//! USD binary (usdc, the crate format) output, streamed: the same layer as
+//! the usda writer — one `BasisCurves` prim per part under a default
+//! `Xform`, optionally the skin as a `Mesh` — with arrays written to the
+//! file as each part arrives. Only the layer's structure (names, paths,
+//! field tables: a few hundred bytes a prim) stays in memory until
+//! [`UsdcWriter::finish`] writes it at the end, as OpenUSD's own writer
+//! does.
+//!
+//! Parts may also be written frame by frame ([`UsdcWriter::write_part_at`]):
+//! `points`, `normals` and `extent` become time samples, everything else
+//! is taken from the first frame; the stage gets `startTimeCode`,
+//! `endTimeCode` and `timeCodesPerSecond`.
+//!
+//! Integer arrays (curve counts, ids, mesh indices) use the crate format's
+//! integer compression; floats are written as they are.
+
+mod crate_file;
+
+use super::usd_schema::{
+    UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name, mesh_attributes,
+};
+use super::{UpAxis, UsdOptions, UsdWriteError};
+use crate::Curves;
+use crate::mesh::Mesh;
+use crate_file::{
+    BOOTSTRAP_SIZE, Counted, MIN_COMPRESSED_ARRAY_SIZE, ROOT_PATH, Spec, SpecType, Structure,
+    VERSION, ValueRep, ValueType, compressed_integers,
+};
+use std::collections::{HashMap, HashSet};
+use std::io::{Seek, SeekFrom, Write};
+
+/// The attributes of an animated part that get a sample per frame.
+const ANIMATED: [&str; 3] = ["points", "normals", "extent"];
+
+/// A part written frame by frame: what later frames must match, and the
+/// samples of its animated attributes.
+struct AnimatedPart {
+    offsets: Vec<u32>,
+    samples: Vec<SampledAttribute>,
+}
+
+/// An animated attribute: its spec's index, its name, and its (time,
+/// value) samples.
+type SampledAttribute = (usize, &'static str, Vec<(f64, ValueRep)>);
+
+/// Streams a usdc file: [`UsdcWriter::new`], then any number of
+/// [`write_part`](Self::write_part), [`write_part_at`](Self::write_part_at)
+/// and [`write_mesh`](Self::write_mesh), then [`finish`](Self::finish).
+pub struct UsdcWriter<W: Write + Seek> {
+    out: Counted<W>,
+    /// Where the file starts in `out` (offsets in it count from 0 there).
+    start: u64,
+    options: UsdOptions,
+    structure: Structure,
+    /// The default prim's path and its children's names, in order.
+    root: u32,
+    children: Vec<u32>,
+    names: HashSet<String>,
+    animated: HashMap<String, AnimatedPart>,
+}
+
+impl<W: Write + Seek> UsdcWriter<W> {
+    /// Reserves the bootstrap header; the rest of the file follows.
+    pub fn new(mut out: W, options: &UsdOptions) -> Result<Self, UsdWriteError> {
+        check_name(&options.root)?;
+        if !options.meters_per_unit.is_finite() || options.meters_per_unit <= 0.0 {
+            return Err(UsdWriteError::BadSetting(format!(
+                "metersPerUnit must be a positive number, not {}",
+                options.meters_per_unit
+            )));
+        }
+        let start = out.stream_position()?;
+        out.write_all(&[0u8; BOOTSTRAP_SIZE])?;
+        let mut structure = Structure::new(&options.root);
+        let root = structure.child_path(ROOT_PATH, &options.root, false);
+        Ok(Self {
+            out: Counted {
+                inner: out,
+                position: BOOTSTRAP_SIZE as u64,
+            },
+            start,
+            options: options.clone(),
+            structure,
+            root,
+            children: Vec::new(),
+            names: HashSet::new(),
+            animated: HashMap::new(),
+        })
+    }
+
+    /// Writes one part as a `BasisCurves` prim named `name`.
+    pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+        let attributes = basis_curves_attributes(name, curves, &self.options)?;
+        self.write_prim("BasisCurves", name, &attributes, false)?;
+        Ok(())
+    }
+
+    /// Writes one frame of an animated part: the first call for `name`
+    /// writes the prim (topology, widths, colours and ids from this frame);
+    /// every call adds samples of `points`, `normals` and `extent` at
+    /// `time` (in time codes). Later frames must have the same curves with
+    /// the same point counts.
+    pub fn write_part_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        curves: &Curves,
+    ) -> Result<(), UsdWriteError> {
+        if !time.is_finite() {
+            return Err(UsdWriteError::BadSetting(format!(
+                "part {name:?}: the time {time} is not a number"
+            )));
+        }
+        let attributes = basis_curves_attributes(name, curves, &self.options)?;
+        if !self.animated.contains_key(name) {
+            let specs = self.write_prim("BasisCurves", name, &attributes, true)?;
+            let samples = specs
+                .into_iter()
+                .map(|(spec, attribute)| (spec, attribute, Vec::new()))
+                .collect();
+            let part = AnimatedPart {
+                offsets: curves.offsets().to_vec(),
+                samples,
+            };
+            self.animated.insert(name.to_string(), part);
+        }
+        let part = &self.animated[name];
+        if part.offsets != curves.offsets() {
+            return Err(UsdWriteError::FrameMismatch {
+                part: name.to_string(),
+                time,
+                curves: (part.offsets.len() - 1, curves.curve_count()),
+                points: (
+                    *part.offsets.last().unwrap_or(&0) as usize,
+                    curves.points().len(),
+                ),
+            });
+        }
+        let mut reps = Vec::new();
+        for attribute in attributes.iter().filter(|a| ANIMATED.contains(&a.name)) {
+            reps.push((attribute.name, self.pack(&attribute.values)?));
+        }
+        let part = self.animated.get_mut(name).expect("inserted above");
+        for (_, attribute, samples) in &mut part.samples {
+            if samples.iter().any(|&(t, _)| t == time) {
+                return Err(UsdWriteError::BadSetting(format!(
+                    "part {name:?}: two frames at time {time}"
+                )));
+            }
+            if let Some(&(_, rep)) = reps.iter().find(|(n, _)| n == attribute) {
+                samples.push((time, rep));
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the skin as a `Mesh` prim named `name` (triangles, vertex
+    /// normals, UVs as `st`).
+    pub fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
+        self.write_prim("Mesh", name, &mesh_attributes(mesh), false)?;
+        Ok(())
+    }
+
+    /// Writes a prim's attribute values and records its specs. With
+    /// `animated`, the attributes named in [`ANIMATED`] get no default
+    /// value; their spec indices are returned for the time samples.
+    fn write_prim(
+        &mut self,
+        type_name: &str,
+        name: &str,
+        attributes: &[UsdAttribute],
+        animated: bool,
+    ) -> Result<Vec<(usize, &'static str)>, UsdWriteError> {
+        check_name(name)?;
+        if !self.names.insert(name.to_string()) {
+            return Err(UsdWriteError::DuplicateName(name.to_string()));
+        }
+        let prim = self.structure.child_path(self.root, name, false);
+        let mut sampled = Vec::new();
+        let mut properties = Vec::with_capacity(attributes.len());
+        for attribute in attributes {
+            let path = self.structure.child_path(prim, attribute.name, true);
+            properties.push(self.structure.token(attribute.name));
+            let s = &mut self.structure;
+            let mut fields = vec![
+                (
+                    s.token("typeName"),
+                    ValueRep::inlined(ValueType::Token, s.token(attribute.type_name)),
+                ),
+                (s.token("custom"), ValueRep::inlined(ValueType::Bool, 0)),
+                (
+                    s.token("variability"),
+                    ValueRep::inlined(ValueType::Variability, attribute.uniform as u32),
+                ),
+            ];
+            if let Some(interpolation) = attribute.interpolation {
+                let value = ValueRep::inlined(ValueType::Token, s.token(interpolation));
+                fields.push((s.token("interpolation"), value));
+            }
+            if animated && ANIMATED.contains(&attribute.name) {
+                sampled.push((self.structure.specs.len(), attribute.name));
+            } else {
+                let value = self.pack(&attribute.values)?;
+                fields.push((self.structure.token("default"), value));
+            }
+            self.structure.specs.push(Spec {
+                path,
+                kind: SpecType::Attribute,
+                fields,
+            });
+        }
+        let properties = self.token_vector(&properties)?;
+        let s = &mut self.structure;
+        let fields = vec![
+            (
+                s.token("specifier"),
+                ValueRep::inlined(ValueType::Specifier, 0),
+            ),
+            (
+                s.token("typeName"),
+                ValueRep::inlined(ValueType::Token, s.token(type_name)),
+            ),
+            (s.token("properties"), properties),
+        ];
+        self.structure.specs.push(Spec {
+            path: prim,
+            kind: SpecType::Prim,
+            fields,
+        });
+        let token = self.structure.token(name);
+        self.children.push(token);
+        Ok(sampled)
+    }
+
+    /// Writes an attribute's values where they are not inlined, and
+    /// returns their representation.
+    fn pack(&mut self, values: &UsdValues) -> Result<ValueRep, UsdWriteError> {
+        Ok(match values {
+            UsdValues::Token(token) => {
+                ValueRep::inlined(ValueType::Token, self.structure.token(token))
+            }
+            UsdValues::Ints(ints) => self.integer_array(
+                ValueType::Int,
+                ints.len(),
+                ints.iter().map(|&v| v as i64),
+                false,
+            )?,
+            UsdValues::Int64s(ints) => self.integer_array(
+                ValueType::Int64,
+                ints.len(),
+                ints.iter().map(|&v| v as i64),
+                true,
+            )?,
+            UsdValues::Floats(floats) => self.plain_array(ValueType::Float, floats)?,
+            UsdValues::Vec2s(v) => self.plain_array(ValueType::Vec2f, v)?,
+            UsdValues::Vec3s(v) => self.plain_array(ValueType::Vec3f, v)?,
+        })
+    }
+
+    /// An array of 4-byte components, as they are: element count, then
+    /// the little-endian values.
+    fn plain_array<T: bytemuck::Pod>(
+        &mut self,
+        ty: ValueType,
+        values: &[T],
+    ) -> std::io::Result<ValueRep> {
+        let len = values.len();
+        if len == 0 {
+            return Ok(ValueRep::array(ty, 0, false));
+        }
+        let at = self.out.position;
+        self.out.write_all(&(len as u64).to_le_bytes())?;
+        write_le_words(&mut self.out, bytemuck::cast_slice(values))?;
+        Ok(ValueRep::array(ty, at, false))
+    }
+
+    /// An integer array: compressed from [`MIN_COMPRESSED_ARRAY_SIZE`]
+    /// values on.
+    fn integer_array(
+        &mut self,
+        ty: ValueType,
+        len: usize,
+        values: impl ExactSizeIterator<Item = i64> + Clone,
+        wide: bool,
+    ) -> std::io::Result<ValueRep> {
+        if len == 0 {
+            return Ok(ValueRep::array(ty, 0, false));
+        }
+        let at = self.out.position;
+        self.out.write_all(&(len as u64).to_le_bytes())?;
+        let compressed = len >= MIN_COMPRESSED_ARRAY_SIZE;
+        if compressed {
+            self.out.write_all(&compressed_integers(values, wide))?;
+        } else {
+            for v in values {
+                let bytes = v.to_le_bytes();
+                self.out.write_all(&bytes[..if wide { 8 } else { 4 }])?;
+            }
+        }
+        Ok(ValueRep::array(ty, at, compressed))
+    }
+
+    /// A list of tokens (`primChildren`, `properties`).
+    fn token_vector(&mut self, tokens: &[u32]) -> std::io::Result<ValueRep> {
+        let at = self.out.position;
+        self.out.write_all(&(tokens.len() as u64).to_le_bytes())?;
+        for t in tokens {
+            self.out.write_all(&t.to_le_bytes())?;
+        }
+        Ok(ValueRep::at(ValueType::TokenVector, at))
+    }
+
+    /// A double, which does not fit in a rep.
+    fn double(&mut self, value: f64) -> std::io::Result<ValueRep> {
+        let at = self.out.position;
+        self.out.write_all(&value.to_le_bytes())?;
+        Ok(ValueRep::at(ValueType::Double, at))
+    }
+
+    /// Time samples: an offset to the times' rep, the rep (a list of
+    /// doubles written just before), an offset to the values, their count
+    /// and their reps. Offsets count from where they are written.
+    fn time_samples(&mut self, samples: &mut [(f64, ValueRep)]) -> std::io::Result<ValueRep> {
+        samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let times_at = self.out.position;
+        self.out.write_all(&(samples.len() as u64).to_le_bytes())?;
+        for (t, _) in samples.iter() {
+            self.out.write_all(&t.to_le_bytes())?;
+        }
+        let at = self.out.position;
+        self.out.write_all(&8i64.to_le_bytes())?;
+        let times = ValueRep::at(ValueType::DoubleVector, times_at);
+        self.out.write_all(&times.0.to_le_bytes())?;
+        self.out.write_all(&8i64.to_le_bytes())?;
+        self.out.write_all(&(samples.len() as u64).to_le_bytes())?;
+        for (_, rep) in samples.iter() {
+            self.out.write_all(&rep.0.to_le_bytes())?;
+        }
+        Ok(ValueRep::at(ValueType::TimeSamples, at))
+    }
+
+    /// Writes the time samples, the stage and default prim specs, the
+    /// structure and the table of contents, then the header; returns the
+    /// output (not flushed), positioned at the end.
+    pub fn finish(mut self) -> Result<W, UsdWriteError> {
+        let mut range: Option<(f64, f64)> = None;
+        let mut animated: Vec<_> = std::mem::take(&mut self.animated).into_values().collect();
+        for part in &mut animated {
+            for (spec, _, samples) in &mut part.samples {
+                if samples.is_empty() {
+                    continue;
+                }
+                let value = self.time_samples(samples)?;
+                let (first, last) = (samples[0].0, samples[samples.len() - 1].0);
+                range = Some(range.map_or((first, last), |(a, b)| (a.min(first), b.max(last))));
+                let token = self.structure.token("timeSamples");
+                self.structure.specs[*spec].fields.push((token, value));
+            }
+        }
+        let children = self.children.clone();
+        let prim_children = self.token_vector(&children)?;
+        let s = &mut self.structure;
+        let root_fields = vec![
+            (
+                s.token("specifier"),
+                ValueRep::inlined(ValueType::Specifier, 0),
+            ),
+            (
+                s.token("typeName"),
+                ValueRep::inlined(ValueType::Token, s.token("Xform")),
+            ),
+            (s.token("primChildren"), prim_children),
+        ];
+        self.structure.specs.push(Spec {
+            path: self.root,
+            kind: SpecType::Prim,
+            fields: root_fields,
+        });
+        let root_token = self.structure.token(&self.options.root.clone());
+        let stage_children = self.token_vector(&[root_token])?;
+        let meters = self.double(self.options.meters_per_unit)?;
+        let up = match self.options.up_axis {
+            UpAxis::Y => "Y",
+            UpAxis::Z => "Z",
+        };
+        let s = &mut self.structure;
+        let doc = s.string(&format!("Written by pelage {}", env!("CARGO_PKG_VERSION")));
+        let mut stage_fields = vec![
+            (
+                s.token("defaultPrim"),
+                ValueRep::inlined(ValueType::Token, root_token),
+            ),
+            (
+                s.token("documentation"),
+                ValueRep::inlined(ValueType::String, doc),
+            ),
+            (s.token("metersPerUnit"), meters),
+            (
+                s.token("upAxis"),
+                ValueRep::inlined(ValueType::Token, s.token(up)),
+            ),
+            (s.token("primChildren"), stage_children),
+        ];
+        if let Some((start, end)) = range {
+            let per_second = self.options.time_codes_per_second;
+            for (key, value) in [
+                ("startTimeCode", start),
+                ("endTimeCode", end),
+                ("timeCodesPerSecond", per_second),
+                ("framesPerSecond", per_second),
+            ] {
+                let rep = self.double(value)?;
+                stage_fields.push((self.structure.token(key), rep));
+            }
+        }
+        self.structure.specs.push(Spec {
+            path: ROOT_PATH,
+            kind: SpecType::PseudoRoot,
+            fields: stage_fields,
+        });
+        let toc = self.structure.write_sections(&mut self.out)?;
+        let (mut out, end) = (self.out.inner, self.out.position);
+        out.seek(SeekFrom::Start(self.start))?;
+        let mut header = [0u8; BOOTSTRAP_SIZE];
+        header[..8].copy_from_slice(b"PXR-USDC");
+        header[8..11].copy_from_slice(&VERSION);
+        header[16..24].copy_from_slice(&toc.to_le_bytes());
+        out.write_all(&header)?;
+        out.seek(SeekFrom::Start(self.start + end))?;
+        Ok(out)
+    }
+}
+
+impl<W: Write + Seek> UsdPrimWriter for UsdcWriter<W> {
+    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+        UsdcWriter::write_part(self, name, curves)
+    }
+
+    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
+        UsdcWriter::write_mesh(self, name, mesh)
+    }
+}
+
+/// Writes 4-byte words little-endian: as they are in memory on
+/// little-endian machines, byte-swapped elsewhere.
+fn write_le_words(out: &mut impl Write, words: &[u32]) -> std::io::Result<()> {
+    if cfg!(target_endian = "little") {
+        return out.write_all(bytemuck::cast_slice(words));
+    }
+    for chunk in words.chunks(1 << 14) {
+        let bytes: Vec<u8> = chunk.iter().flat_map(|w| w.to_le_bytes()).collect();
+        out.write_all(&bytes)?;
+    }
+    Ok(())
+}
