@@ -1,7 +1,11 @@
 //! The `pelage` binary as a user runs it: output, errors, exit codes.
 
-use std::path::{Path, PathBuf};
+#[path = "../../pelage/tests/support/mod.rs"]
+mod support;
+
+use std::path::Path;
 use std::process::{Command, Output};
+use support::{blendercheck, repo, usdcheck};
 
 fn pelage(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_pelage"))
@@ -16,12 +20,6 @@ fn stdout(o: &Output) -> String {
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn repo(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(path)
 }
 
 fn blub() -> String {
@@ -123,18 +121,37 @@ fn demo_runs_on_the_embedded_asset_from_any_folder() {
     let text = stdout(&out);
     assert!(text.contains("embedded spot"));
     assert!(
-        text.contains("200,000 hairs, 2,400,000 points → pelage-demo/groom.usda"),
+        text.contains("200,000 hairs, 2,400,000 points → pelage-demo/groom.usdc"),
         "{text}"
     );
     // The groom file it used is there for the user to edit and rerun.
     let groom = std::fs::read_to_string(dir.path().join("pelage-demo/demo.toml")).unwrap();
     assert!(groom.contains("[[ops]]\nclump"));
     assert!(dir.path().join("pelage-demo/spot.png").exists());
-    let usd = std::fs::read(dir.path().join("pelage-demo/groom.usda")).unwrap();
-    assert!(usd.starts_with(b"#usda 1.0\n"));
-    assert!(usd.len() > 100_000_000, "{} bytes", usd.len());
-    let text = String::from_utf8_lossy(&usd[..4096]);
-    assert!(text.contains("def Mesh \"skin\""), "the skin comes first");
+    let path = dir.path().join("pelage-demo/groom.usdc");
+    let usd = std::fs::read(&path).unwrap();
+    assert!(usd.starts_with(b"PXR-USDC"));
+    // 2.4 M points, widths and colours as 4-byte floats: 48 MB at least.
+    assert!(usd.len() > 48_000_000, "{} bytes", usd.len());
+    drop(usd);
+    // Pixar's library validates it; Blender imports every hair of it.
+    if let Some((ok, report)) = usdcheck(&[&path]) {
+        assert!(ok, "{report}");
+        assert!(report.contains("200000 curves, 2400000 points"), "{report}");
+    }
+    if let Some((ok, report)) = blendercheck(&[&path]) {
+        assert!(ok, "{report}");
+        let curves: u64 = report
+            .lines()
+            .filter_map(|l| l.split_once(": ")?.1.split_once(" curves, "))
+            .map(|(n, _)| n.parse::<u64>().unwrap())
+            .sum();
+        assert_eq!(curves, 200_000, "{report}");
+        assert!(
+            report.contains("mesh skin: 2930 vertices, 5856 faces"),
+            "{report}"
+        );
+    }
     // The preview needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
     if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() {
         let png = image::open(dir.path().join("pelage-demo/preview.png")).expect("a preview PNG");
@@ -512,34 +529,6 @@ fn a_groom_that_overflows_is_an_error_at_its_operator_and_writes_nothing() {
         1,
         "only the groom file"
     );
-}
-
-/// Runs usdcheck on `files`; `None` (after printing SKIPPED) where it is
-/// not available and not required (PELAGE_REQUIRE_USDCHECK makes it
-/// required, as in CI).
-fn usdcheck(files: &[&Path]) -> Option<(bool, String)> {
-    let script = repo("tools/usdcheck");
-    let required = std::env::var_os("PELAGE_REQUIRE_USDCHECK").is_some();
-    if !script.exists() {
-        assert!(
-            !required,
-            "PELAGE_REQUIRE_USDCHECK is set but {} is missing",
-            script.display()
-        );
-        eprintln!("SKIPPED: {} not found", script.display());
-        return None;
-    }
-    let output = Command::new(&script)
-        .args(files)
-        .output()
-        .expect("usdcheck runs");
-    let text = format!("{}{}", stdout(&output), stderr(&output));
-    if output.status.code() == Some(2) {
-        assert!(!required, "usdcheck could not set itself up:\n{text}");
-        eprintln!("SKIPPED: usdcheck could not set itself up:\n{text}");
-        return None;
-    }
-    Some((output.status.success(), text))
 }
 
 #[test]

@@ -7,14 +7,16 @@
 //! itself up they print SKIPPED; with `PELAGE_REQUIRE_USDCHECK=1` (CI) they
 //! fail instead.
 
+mod support;
+
 use glam::Vec3;
 use pelage::io::{
-    CurveBasis, CurvesExport, CurvesFormat, HairFile, UsdOptions, UsdWrap, UsdaWriter, UsdcWriter,
-    read_curves, read_usd_curves, write_curves,
+    AbcWriter, CurveBasis, CurvesExport, CurvesFormat, HairFile, UsdOptions, UsdWrap, UsdaWriter,
+    UsdcWriter, read_curves, read_usd_curves, write_curves,
 };
 use pelage::{Curves, SurfacePoint};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use support::{blendercheck, numbers_after, usdcheck};
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -51,37 +53,6 @@ fn small_groom(curves: u32, points: usize) -> Curves {
     .unwrap()
     .with_roots(roots)
     .unwrap()
-}
-
-/// Runs usdcheck on `files`; `None` (after printing SKIPPED) where it is
-/// not available and not required.
-fn usdcheck(files: &[&Path]) -> Option<(bool, String)> {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/usdcheck");
-    let required = std::env::var_os("PELAGE_REQUIRE_USDCHECK").is_some();
-    if !script.exists() {
-        assert!(
-            !required,
-            "PELAGE_REQUIRE_USDCHECK is set but {} is missing",
-            script.display()
-        );
-        eprintln!("SKIPPED: {} not found", script.display());
-        return None;
-    }
-    let output = Command::new(&script)
-        .args(files)
-        .output()
-        .expect("usdcheck runs");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    if output.status.code() == Some(2) {
-        assert!(!required, "usdcheck could not set itself up:\n{text}");
-        eprintln!("SKIPPED: usdcheck could not set itself up:\n{text}");
-        return None;
-    }
-    Some((output.status.success(), text))
 }
 
 fn write_usd(path: &Path, parts: &[(&str, &Curves)], options: &UsdOptions, mesh: bool) {
@@ -296,17 +267,151 @@ fn usd_values(file: &Path, specs: &[&str]) -> Vec<[f32; 3]> {
     specs
         .iter()
         .map(|spec| {
-            let line = text
-                .lines()
-                .find_map(|l| l.strip_prefix(&format!("{spec} = ")))
-                .unwrap_or_else(|| panic!("no {spec} in:\n{text}"));
-            let v: Vec<f32> = line
-                .split(' ')
-                .map(|x| x.parse::<f64>().unwrap() as f32)
-                .collect();
-            [v[0], v[1], v[2]]
+            let v = numbers_after(&text, &format!("{spec} = "));
+            [v[0] as f32, v[1] as f32, v[2] as f32]
         })
         .collect()
+}
+
+#[test]
+fn alembic_round_trips_what_it_holds_and_blender_imports_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = small_groom(60, 6);
+    let second = small_groom(9, 4).with_ids(vec![1 << 40; 9]).unwrap();
+    let abc = dir.path().join("g.abc");
+    write_usd(
+        &abc,
+        &[("part_0", &groom), ("part_1", &second)],
+        &UsdOptions::default(),
+        false,
+    );
+    assert!(std::fs::read(&abc).unwrap().starts_with(b"Ogawa\xff\0\x01"));
+
+    // Everything but opacity (Alembic grooms have none) comes back exactly.
+    let back = read_curves(&abc).unwrap();
+    let joined = pelage::io::join([&groom, &second]).unwrap();
+    assert_eq!(back.offsets(), joined.offsets());
+    assert_eq!(back.points(), joined.points());
+    assert_eq!(back.widths(), joined.widths());
+    assert_eq!(back.normals(), joined.normals());
+    assert_eq!(back.colors(), joined.colors());
+    assert_eq!(back.root_uvs(), joined.root_uvs());
+    assert_eq!(back.ids(), joined.ids());
+    assert_eq!(back.opacities(), None);
+
+    // abc → usdc → abc: the same values, the same bytes.
+    let one = |c: &Curves| [("p".to_string(), c.clone())];
+    let write = |path: &Path, c: &Curves| {
+        let parts = one(c);
+        write_curves(
+            path,
+            parts.iter().map(|(n, c)| (n.clone(), c)),
+            &CurvesExport::default(),
+        )
+        .unwrap();
+    };
+    let (a1, usdc, a2) = (
+        dir.path().join("1.abc"),
+        dir.path().join("m.usdc"),
+        dir.path().join("2.abc"),
+    );
+    write(&a1, &back);
+    write(&usdc, &back);
+    let through_usd = read_curves(&usdc).unwrap();
+    write(&a2, &through_usd);
+    assert!(std::fs::read(&a1).unwrap() == std::fs::read(&a2).unwrap());
+
+    // The skin is refused rather than silently left out.
+    let spot = pelage::assets::spot();
+    let export = CurvesExport {
+        mesh: Some(&spot),
+        ..Default::default()
+    };
+    let parts = one(&groom);
+    let err = write_curves(
+        &dir.path().join("x.abc"),
+        parts.iter().map(|(n, c)| (n.clone(), c)),
+        &export,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("Alembic files hold curves only"), "{err}");
+
+    // Blender's own importer makes the same curves, widths as radii.
+    let Some((ok, report)) = blendercheck(&[&abc]) else {
+        return;
+    };
+    assert!(ok, "{report}");
+    assert!(
+        report.contains("object part_0: 60 curves, 360 points"),
+        "{report}"
+    );
+    assert!(
+        report.contains("object part_1: 9 curves, 36 points"),
+        "{report}"
+    );
+    let radius = numbers_after(&report, "object part_0: radius[0] = ")[0];
+    assert_eq!(radius as f32, groom.widths()[0] / 2.0, "{report}");
+}
+
+#[test]
+fn animated_alembic_holds_each_frame_for_blender() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("moving.abc");
+    let rest = small_groom(12, 5);
+    let frames: Vec<(f64, Curves)> = (0..4)
+        .map(|f| {
+            let shifted: Vec<Vec3> = rest
+                .points()
+                .iter()
+                .map(|p| *p + Vec3::new(0.5, 0.0, 0.25) * f as f32)
+                .collect();
+            (
+                10.0 + f as f64,
+                Curves::new(shifted, rest.widths().to_vec(), rest.offsets().to_vec()).unwrap(),
+            )
+        })
+        .collect();
+    pelage::io::write_atomically(&path, |out| {
+        let other = std::io::Error::other;
+        let mut abc = AbcWriter::new(out, &UsdOptions::default()).map_err(other)?;
+        for (time, curves) in &frames {
+            abc.write_part_at("a", *time, curves).map_err(other)?;
+        }
+        abc.finish().map_err(other)?;
+        Ok(())
+    })
+    .unwrap();
+    // pelage reads the first frame.
+    assert_eq!(read_curves(&path).unwrap().points(), frames[0].1.points());
+    // Frames out of order are refused.
+    let mut abc = AbcWriter::new(std::io::Cursor::new(Vec::new()), &UsdOptions::default()).unwrap();
+    abc.write_part_at("a", 2.0, &rest).unwrap();
+    let err = abc.write_part_at("a", 1.0, &rest).unwrap_err().to_string();
+    assert!(err.contains("write frames in increasing time"), "{err}");
+
+    let Some((ok, report)) = blendercheck(&[
+        path.as_os_str(),
+        "--point".as_ref(),
+        "7".as_ref(),
+        "--frames".as_ref(),
+        "10,13".as_ref(),
+    ]) else {
+        return;
+    };
+    assert!(ok, "{report}");
+    // Blender turns Alembic's Y up into its Z up: (x, y, z) → (x, −z, y).
+    for (frame, (_, curves)) in [(10, &frames[0]), (13, &frames[3])] {
+        let got = numbers_after(&report, &format!("frame {frame}: a point[7] = "));
+        let p = curves.points()[7];
+        let want = [p.x, -p.z, p.y];
+        for k in 0..3 {
+            assert!(
+                (got[k] as f32 - want[k]).abs() < 1e-6,
+                "frame {frame}: {got:?} vs {want:?}\n{report}"
+            );
+        }
+    }
 }
 
 #[test]
@@ -385,10 +490,10 @@ fn malformed_usd_is_an_error_naming_the_file_and_line() {
         "{err}"
     );
 
-    let err = read_curves(Path::new("guides.abc"))
+    let err = read_curves(Path::new("guides.fbx"))
         .unwrap_err()
         .to_string();
-    assert!(err.contains("unknown curves format \"abc\""), "{err}");
+    assert!(err.contains("unknown curves format \"fbx\""), "{err}");
 }
 
 #[test]

@@ -6,8 +6,8 @@ use super::error::GroomError;
 use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
-    CurvesExport, CurvesFormat, UpAxis, UsdOptions, UsdPrimWriter, UsdaWriter, UsdcWriter,
-    WriteError, write_atomically, write_curves,
+    AbcWriter, CurvesExport, CurvesFormat, UpAxis, UsdOptions, UsdPrimWriter, UsdaWriter,
+    UsdcWriter, WriteError, write_atomically, write_curves,
 };
 use glam::Vec3;
 use std::io::{BufRead, Seek, Write};
@@ -64,7 +64,11 @@ impl Generator {
             summary.points += c.points().len() as u64;
         };
         let format = CurvesFormat::from_path(path);
-        if !matches!(format, Some(CurvesFormat::Usda | CurvesFormat::Usdc)) {
+        let streamed = matches!(
+            format,
+            Some(CurvesFormat::Usda | CurvesFormat::Usdc | CurvesFormat::Abc)
+        );
+        if !streamed {
             let mut grown = Vec::new();
             for p in parts {
                 let curves = self.part(p)?;
@@ -82,10 +86,10 @@ impl Generator {
                 on_part(p, c);
                 count(c);
             };
-            if format == Some(CurvesFormat::Usdc) {
-                self.write_usdc(out, parts, export, on_part)
-            } else {
-                self.write_usd(out, parts, export, on_part)
+            match format {
+                Some(CurvesFormat::Usdc) => self.write_usdc(out, parts, export, on_part),
+                Some(CurvesFormat::Abc) => self.write_abc(out, parts, export, on_part),
+                _ => self.write_usd(out, parts, export, on_part),
             }
         })
         .map_err(|e| {
@@ -152,6 +156,21 @@ impl Generator {
         let mut usd = UsdcWriter::new(out, &export.usd).map_err(std::io::Error::other)?;
         self.stream_parts(&mut usd, parts, export, on_part)?;
         usd.finish().map_err(std::io::Error::other)?;
+        Ok(())
+    }
+
+    /// [`write_usd`](Self::write_usd) as Alembic: one `ICurves` object a
+    /// part; the output must be seekable.
+    pub fn write_abc(
+        &self,
+        out: impl Write + Seek,
+        parts: Range<usize>,
+        export: &CurvesExport,
+        on_part: impl FnMut(usize, &Curves) + Send,
+    ) -> std::io::Result<()> {
+        let mut abc = AbcWriter::new(out, &export.usd).map_err(std::io::Error::other)?;
+        self.stream_parts(&mut abc, parts, export, on_part)?;
+        abc.finish().map_err(std::io::Error::other)?;
         Ok(())
     }
 

@@ -3,8 +3,9 @@
 
 use super::read_error::{CurvesReadError, CurvesReadErrorKind};
 use super::{
-    HairFile, UsdOptions, UsdPrimWriter, UsdaWriter, UsdcWriter, WriteError, read_curves_ply,
-    read_usd_curves, write_atomically, write_curves_ply, write_pbrt, write_rib,
+    AbcWriter, HairFile, UsdOptions, UsdPrimWriter, UsdaWriter, UsdcWriter, WriteError,
+    read_abc_curves, read_curves_ply, read_usd_curves, write_atomically, write_curves_ply,
+    write_pbrt, write_rib,
 };
 use crate::{Curves, Mesh};
 use std::path::Path;
@@ -17,6 +18,8 @@ pub enum CurvesFormat {
     /// `.usdc`, and `.usd` as in Pixar's tools: binary USD when writing
     /// (reading sniffs text or binary).
     Usdc,
+    /// Alembic (Ogawa) `.abc`.
+    Abc,
     /// Cem Yuksel's `.hair`.
     Hair,
     /// `.ply` with vertex and edge elements.
@@ -34,6 +37,7 @@ impl CurvesFormat {
         Some(match ext.as_str() {
             "usda" => Self::Usda,
             "usdc" | "usd" => Self::Usdc,
+            "abc" => Self::Abc,
             "hair" => Self::Hair,
             "ply" => Self::Ply,
             "rib" => Self::Rib,
@@ -43,7 +47,8 @@ impl CurvesFormat {
     }
 }
 
-/// Reads curves from a `.usda`, `.usdc`, `.usd`, `.hair` or `.ply` file.
+/// Reads curves from a `.usda`, `.usdc`, `.usd`, `.abc`, `.hair` or `.ply`
+/// file.
 pub fn read_curves(path: &Path) -> Result<Curves, CurvesReadError> {
     let unknown = || {
         let extension = path
@@ -54,6 +59,7 @@ pub fn read_curves(path: &Path) -> Result<Curves, CurvesReadError> {
     };
     match CurvesFormat::from_path(path).ok_or_else(unknown)? {
         CurvesFormat::Usda | CurvesFormat::Usdc => read_usd_curves(path),
+        CurvesFormat::Abc => read_abc_curves(path),
         CurvesFormat::Hair => HairFile::read(path)?.to_curves(path),
         CurvesFormat::Ply => read_curves_ply(path),
         CurvesFormat::Rib | CurvesFormat::Pbrt => Err(unknown()),
@@ -83,7 +89,7 @@ pub fn write_curves<'c>(
     };
     let format = CurvesFormat::from_path(path).ok_or_else(|| {
         fail(
-            "unknown curves format; pelage writes .usdc (or .usd), .usda, .hair, .ply, .rib and .pbrt"
+            "unknown curves format; pelage writes .usdc (or .usd), .usda, .abc, .hair, .ply, .rib and .pbrt"
                 .into(),
         )
     })?;
@@ -101,6 +107,13 @@ pub fn write_curves<'c>(
             let mut usd = UsdcWriter::new(out, &export.usd).map_err(other)?;
             write_usd_prims(&mut usd, parts, export)?;
             usd.finish().map_err(other)?;
+            Ok(())
+        }),
+        CurvesFormat::Abc => write_atomically(path, |out| {
+            let other = std::io::Error::other;
+            let mut abc = AbcWriter::new(out, &export.usd).map_err(other)?;
+            write_usd_prims(&mut abc, parts, export)?;
+            abc.finish().map_err(other)?;
             Ok(())
         }),
         CurvesFormat::Hair | CurvesFormat::Ply => {
@@ -126,7 +139,8 @@ pub fn write_curves<'c>(
     }
 }
 
-/// The skin (if exported) and then every part, as prims of one layer.
+/// The skin (if exported) and then every part, as prims of one layer (or
+/// objects of one Alembic archive).
 fn write_usd_prims<'c>(
     usd: &mut impl UsdPrimWriter,
     parts: impl IntoIterator<Item = (String, &'c Curves)>,

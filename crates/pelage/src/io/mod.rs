@@ -13,6 +13,7 @@
 //! - [`write_rib`] / [`write_pbrt`]: RenderMan and pbrt-v4 scene text.
 //! - [`PointsPly`]: sampled points with normals, UVs and triangle indices.
 
+mod abc;
 mod atomic;
 mod curves_file;
 mod curves_ply;
@@ -26,6 +27,7 @@ mod usd_schema;
 mod usda;
 mod usdc;
 
+pub use abc::{AbcWriter, read_abc_curves};
 pub use atomic::write_atomically;
 pub use curves_file::{CurvesExport, CurvesFormat, join, read_curves, write_curves};
 pub use curves_ply::{read_curves_ply, write_curves_ply};

@@ -15,7 +15,7 @@ pub enum CurvesReadErrorKind {
     Io(#[source] std::io::Error),
     /// The extension names no format pelage reads curves from.
     #[error(
-        "unknown curves format {extension:?}; pelage reads curves from .usda, .usdc, .usd, .hair and .ply"
+        "unknown curves format {extension:?}; pelage reads curves from .usda, .usdc, .usd, .abc, .hair and .ply"
     )]
     UnknownFormat {
         /// The extension found (may be empty).

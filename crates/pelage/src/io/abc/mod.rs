@@ -1,0 +1,690 @@
+//! Alembic (Ogawa) curves output, streamed: one `ICurves` object per part,
+//! with positions, vertex counts, widths and normals as the `AbcGeom_Curve_v2`
+//! schema names them, and colour, hair id and root UV as arbitrary geometry
+//! parameters under the names Unreal's groom importer reads (`groom_color`,
+//! `groom_id`, `groom_root_uv`), so the file goes straight into a game
+//! engine as well as into Blender, Houdini or Maya.
+//!
+//! Arrays are written to the file as each part arrives; the groups that
+//! list them (a few hundred bytes a part) are written at
+//! [`AbcWriter::finish`]. Parts written frame by frame
+//! ([`AbcWriter::write_part_at`]) get a sample of `P`, `N` and the bounds
+//! per frame on one time sampling (seconds = time code / frames per second).
+//!
+//! The layout follows Alembic's `AbcCoreOgawa` (`AwImpl`, `OwData`,
+//! `CpwData`, `ApwImpl`, `SpwImpl`, `WriteUtil`) and `AbcGeom` (`OCurves`,
+//! `OGeomParam`); the keys of samples are MurmurHash3 digests as Alembic's,
+//! the properties' and children's digests in each object's headers are
+//! pelage's own (readers do not check them).
+
+mod ogawa;
+mod read;
+
+pub use read::read_abc_curves;
+
+use super::usd_schema::{check_name, curve_extent};
+use super::{CurveBasis, UsdOptions, UsdWriteError};
+use crate::Curves;
+use ogawa::{Child, EMPTY_DATA, EMPTY_GROUP, OgawaWriter, murmur3_128};
+use std::collections::HashSet;
+use std::io::{Seek, Write};
+
+/// Alembic's plain old data types (`Alembic::Util::PlainOldDataType`).
+#[derive(Debug, Clone, Copy)]
+#[repr(u8)]
+enum Pod {
+    Uint8 = 1,
+    Int32 = 6,
+    Int64 = 8,
+    Float32 = 10,
+    Float64 = 11,
+}
+
+impl Pod {
+    fn name(self) -> &'static str {
+        match self {
+            Pod::Uint8 => "uint8_t",
+            Pod::Int32 => "int32_t",
+            Pod::Int64 => "int64_t",
+            Pod::Float32 => "float32_t",
+            Pod::Float64 => "float64_t",
+        }
+    }
+}
+
+/// Per-point (`vtx`) or per-curve (`uni`) geometry parameters.
+#[derive(Debug, Clone, Copy)]
+enum Scope {
+    Vertex,
+    Uniform,
+}
+
+#[derive(Debug)]
+enum Kind {
+    Compound(Vec<Property>),
+    Scalar,
+    Array,
+}
+
+/// A property and the samples written so far (data blocks, and for
+/// arrays their element counts).
+#[derive(Debug)]
+struct Property {
+    name: String,
+    metadata: String,
+    kind: Kind,
+    pod: Pod,
+    extent: u8,
+    /// 0: the default sampling (one static sample); 1: the frames.
+    time_sampling: u32,
+    samples: Vec<Sample>,
+}
+
+/// A sample: its data block, and its element count.
+type Sample = (Child, usize);
+
+impl Property {
+    fn compound(name: &str, metadata: &str, children: Vec<Property>) -> Self {
+        Self {
+            name: name.into(),
+            metadata: metadata.into(),
+            kind: Kind::Compound(children),
+            pod: Pod::Uint8,
+            extent: 0,
+            time_sampling: 0,
+            samples: Vec::new(),
+        }
+    }
+
+    fn find(&mut self, path: &[&str]) -> Option<&mut Property> {
+        let Some((first, rest)) = path.split_first() else {
+            return Some(self);
+        };
+        match &mut self.kind {
+            Kind::Compound(children) => children.iter_mut().find(|c| c.name == *first)?.find(rest),
+            _ => None,
+        }
+    }
+}
+
+/// One part's object: its `.geom` compound, and what later frames must
+/// match.
+struct Part {
+    name: String,
+    geom: Property,
+    offsets: Vec<u32>,
+    times: Vec<f64>,
+}
+
+/// Streams an Alembic file: [`AbcWriter::new`], then any number of
+/// [`write_part`](Self::write_part) / [`write_part_at`](Self::write_part_at),
+/// then [`finish`](Self::finish).
+pub struct AbcWriter<W: Write + Seek> {
+    ogawa: OgawaWriter<W>,
+    options: UsdOptions,
+    parts: Vec<Part>,
+    names: HashSet<String>,
+}
+
+/// The curves schema's object and compound metadata.
+const CURVES_OBJECT: &str = "schema=AbcGeom_Curve_v2;schemaBaseType=AbcGeom_GeomBase_v1;schemaObjTitle=AbcGeom_Curve_v2:.geom";
+const CURVES_GEOM: &str = "schema=AbcGeom_Curve_v2;schemaBaseType=AbcGeom_GeomBase_v1";
+/// What Alembic's `ALEMBIC_OGAWA_FILE_VERSION` and library version say.
+const OGAWA_FILE_VERSION: i32 = 0;
+const LIBRARY_VERSION: i32 = 10_800;
+/// Alembic's time per cycle for samples at arbitrary times.
+const ACYCLIC_TIME_PER_CYCLE: f64 = f64::MAX / 32.0;
+
+impl<W: Write + Seek> AbcWriter<W> {
+    /// Starts the file. The curve basis, the root name (unused: Alembic
+    /// objects sit under the archive's top object) and the frames per
+    /// second come from `options`.
+    pub fn new(out: W, options: &UsdOptions) -> Result<Self, UsdWriteError> {
+        if !(options.time_codes_per_second.is_finite() && options.time_codes_per_second > 0.0) {
+            return Err(UsdWriteError::BadSetting(format!(
+                "frames per second must be a positive number, not {}",
+                options.time_codes_per_second
+            )));
+        }
+        Ok(Self {
+            ogawa: OgawaWriter::new(out)?,
+            options: options.clone(),
+            parts: Vec::new(),
+            names: HashSet::new(),
+        })
+    }
+
+    /// Writes one part as an `ICurves` object named `name`.
+    pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+        self.start_part(name, curves, None)
+    }
+
+    /// Writes one frame of an animated part: the first call for `name`
+    /// writes the object (vertex counts, widths, colours, ids from this
+    /// frame); every call adds a sample of `P`, `N` and the bounds at
+    /// `time` (in frames). Frames come in increasing time, with the same
+    /// curves; every animated part has the same frames.
+    pub fn write_part_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        curves: &Curves,
+    ) -> Result<(), UsdWriteError> {
+        if !time.is_finite() {
+            return Err(UsdWriteError::BadSetting(format!(
+                "part {name:?}: the time {time} is not a number"
+            )));
+        }
+        let Some(index) = self.parts.iter().position(|p| p.name == name) else {
+            return self.start_part(name, curves, Some(time));
+        };
+        let part = &self.parts[index];
+        if part.times.is_empty() {
+            return Err(UsdWriteError::DuplicateName(name.to_string()));
+        }
+        if part.offsets != curves.offsets() {
+            return Err(UsdWriteError::FrameMismatch {
+                part: name.to_string(),
+                time,
+                curves: (part.offsets.len() - 1, curves.curve_count()),
+                points: (
+                    *part.offsets.last().unwrap_or(&0) as usize,
+                    curves.points().len(),
+                ),
+            });
+        }
+        let last = *part.times.last().expect("an animated part has a frame");
+        if time <= last {
+            return Err(UsdWriteError::BadSetting(format!(
+                "part {name:?}: frame at {time} after the frame at {last}; write frames in increasing time"
+            )));
+        }
+        let samples = self.animated_samples(curves)?;
+        let part = &mut self.parts[index];
+        for (name, sample) in samples {
+            if let Some(property) = part.geom.find(&[name]) {
+                property.samples.push(sample);
+            }
+        }
+        part.times.push(time);
+        Ok(())
+    }
+
+    /// The samples of the animated properties for one frame, by path
+    /// under `.geom`.
+    fn animated_samples(
+        &mut self,
+        curves: &Curves,
+    ) -> std::io::Result<Vec<(&'static str, Sample)>> {
+        let mut samples = vec![
+            (".selfBnds", self.bounds_sample(curves)?),
+            (
+                "P",
+                self.array_sample(bytemuck::cast_slice(curves.points()), curves.points().len())?,
+            ),
+        ];
+        if let Some(normals) = curves.normals() {
+            let sample = self.array_sample(bytemuck::cast_slice(normals), normals.len())?;
+            samples.push(("N", sample));
+        }
+        Ok(samples)
+    }
+
+    fn bounds_sample(&mut self, curves: &Curves) -> std::io::Result<Sample> {
+        let (lo, hi) = curve_extent(curves);
+        let bounds: Vec<u8> = [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
+            .iter()
+            .flat_map(|&v| f64::from(v).to_le_bytes())
+            .collect();
+        self.array_sample(&bounds, 1)
+    }
+
+    /// A sample's data block: its key (MurmurHash3 of the bytes), then the
+    /// bytes, little-endian; an empty array is an empty block.
+    fn array_sample(&mut self, bytes: &[u8], points: usize) -> std::io::Result<Sample> {
+        if bytes.is_empty() {
+            return Ok((EMPTY_DATA, 0));
+        }
+        let key = murmur3_128(bytes);
+        Ok((self.ogawa.data(&[&key, bytes])?, points))
+    }
+
+    fn start_part(
+        &mut self,
+        name: &str,
+        curves: &Curves,
+        time: Option<f64>,
+    ) -> Result<(), UsdWriteError> {
+        check_name(name)?;
+        if !self.names.insert(name.to_string()) {
+            return Err(UsdWriteError::DuplicateName(name.to_string()));
+        }
+        let min = self.options.min_points_per_curve();
+        if let Some(curve) = (0..curves.curve_count()).find(|&i| curves.range(i).len() < min) {
+            return Err(UsdWriteError::ShortCurve {
+                part: name.to_string(),
+                curve,
+                points: curves.range(curve).len(),
+                min,
+                basis: "Catmull-Rom",
+            });
+        }
+        let frames = time.is_some() as u32;
+        let mut animated = self.animated_samples(curves)?.into_iter();
+        let mut next = || animated.next().map(|(_, s)| vec![s]).unwrap_or_default();
+        let bounds = next();
+        let points = next();
+        let normals = next();
+        let mut properties = vec![
+            property(
+                ".selfBnds",
+                "interpretation=box",
+                Kind::Scalar,
+                Pod::Float64,
+                6,
+                frames,
+                bounds,
+            ),
+            property(
+                "P",
+                "geoScope=vtx;interpretation=vector",
+                Kind::Array,
+                Pod::Float32,
+                3,
+                frames,
+                points,
+            ),
+        ];
+        let counts: Vec<u8> = curves
+            .offsets()
+            .windows(2)
+            .flat_map(|w| ((w[1] - w[0]) as i32).to_le_bytes())
+            .collect();
+        let sample = self.array_sample(&counts, curves.curve_count())?;
+        properties.push(property(
+            "nVertices",
+            "",
+            Kind::Array,
+            Pod::Int32,
+            1,
+            0,
+            vec![sample],
+        ));
+        let basis_and_type = match self.options.basis {
+            // type linear, non-periodic, no basis
+            CurveBasis::Linear => [1u8, 0, 0, 0],
+            // type cubic, non-periodic, Catmull-Rom
+            CurveBasis::CatmullRom => [0u8, 0, 3, 3],
+        };
+        let sample = self.array_sample(&basis_and_type, 1)?;
+        properties.push(property(
+            "curveBasisAndType",
+            "",
+            Kind::Scalar,
+            Pod::Uint8,
+            4,
+            0,
+            vec![sample],
+        ));
+        let widths = bytemuck::cast_slice(curves.widths());
+        let sample = self.array_sample(widths, curves.widths().len())?;
+        properties.push(geom_param(
+            "width",
+            Scope::Vertex,
+            "",
+            Pod::Float32,
+            1,
+            0,
+            vec![sample],
+        ));
+        if !normals.is_empty() {
+            properties.push(geom_param(
+                "N",
+                Scope::Vertex,
+                "normal",
+                Pod::Float32,
+                3,
+                frames,
+                normals,
+            ));
+        }
+        let mut arbitrary = Vec::new();
+        if let Some(colors) = curves.colors() {
+            let sample = self.array_sample(bytemuck::cast_slice(colors), colors.len())?;
+            arbitrary.push(geom_param(
+                "groom_color",
+                Scope::Vertex,
+                "rgb",
+                Pod::Float32,
+                3,
+                0,
+                vec![sample],
+            ));
+        }
+        if let Some(ids) = curves.ids() {
+            let (bytes, pod): (Vec<u8>, Pod) = if ids.iter().all(|&id| id <= i32::MAX as u64) {
+                (
+                    ids.iter()
+                        .flat_map(|&id| (id as i32).to_le_bytes())
+                        .collect(),
+                    Pod::Int32,
+                )
+            } else {
+                (
+                    ids.iter()
+                        .flat_map(|&id| (id as i64).to_le_bytes())
+                        .collect(),
+                    Pod::Int64,
+                )
+            };
+            let sample = self.array_sample(&bytes, ids.len())?;
+            arbitrary.push(geom_param(
+                "groom_id",
+                Scope::Uniform,
+                "",
+                pod,
+                1,
+                0,
+                vec![sample],
+            ));
+        }
+        if let Some(uvs) = curves.root_uvs() {
+            let sample = self.array_sample(bytemuck::cast_slice(uvs), uvs.len())?;
+            arbitrary.push(geom_param(
+                "groom_root_uv",
+                Scope::Uniform,
+                "vector",
+                Pod::Float32,
+                2,
+                0,
+                vec![sample],
+            ));
+        }
+        if !arbitrary.is_empty() {
+            properties.push(Property::compound(".arbGeomParams", "", arbitrary));
+        }
+        self.parts.push(Part {
+            name: name.to_string(),
+            geom: Property::compound(".geom", CURVES_GEOM, properties),
+            offsets: curves.offsets().to_vec(),
+            times: time.into_iter().collect(),
+        });
+        Ok(())
+    }
+
+    /// Writes the groups of every part, the top object, the time
+    /// samplings and the archive's metadata; returns the output (not
+    /// flushed), positioned at its end.
+    pub fn finish(mut self) -> Result<W, UsdWriteError> {
+        let frames = self.frame_times()?;
+        let mut objects = Vec::with_capacity(self.parts.len());
+        let mut headers = Vec::new();
+        for part in std::mem::take(&mut self.parts) {
+            let geom = self.write_compound_group(&part.geom)?;
+            let geom_header = property_header(&part.geom);
+            let header_data = self.ogawa.data(&[&geom_header])?;
+            let properties = self.ogawa.group(&[geom, header_data])?;
+            // No children: the headers block is the two digests alone.
+            let digests = self.ogawa.data(&[&object_digests(&part.geom)])?;
+            objects.push(self.ogawa.group(&[properties, digests])?);
+            headers.extend_from_slice(&(part.name.len() as u32).to_le_bytes());
+            headers.extend_from_slice(part.name.as_bytes());
+            headers.push(0xff);
+            headers.extend_from_slice(&(CURVES_OBJECT.len() as u32).to_le_bytes());
+            headers.extend_from_slice(CURVES_OBJECT.as_bytes());
+        }
+        headers.extend_from_slice(&murmur3_128(&headers));
+        headers.extend_from_slice(&[0u8; 16]);
+        let mut top = vec![EMPTY_GROUP];
+        top.extend_from_slice(&objects);
+        top.push(self.ogawa.data(&[&headers])?);
+        let top = self.ogawa.group(&top)?;
+
+        let mut samplings = Vec::new();
+        // Index 0, the default: one sample a second from time 0.
+        samplings.extend_from_slice(&1u32.to_le_bytes());
+        samplings.extend_from_slice(&1.0f64.to_le_bytes());
+        samplings.extend_from_slice(&1u32.to_le_bytes());
+        samplings.extend_from_slice(&0.0f64.to_le_bytes());
+        if let Some(times) = &frames {
+            let per_second = self.options.time_codes_per_second;
+            let seconds: Vec<f64> = times.iter().map(|t| t / per_second).collect();
+            let step = seconds.get(1).map_or(1.0 / per_second, |s| s - seconds[0]);
+            let uniform = seconds
+                .windows(2)
+                .all(|w| ((w[1] - w[0]) - step).abs() <= 1e-9 * step.abs().max(1.0));
+            samplings.extend_from_slice(&(times.len() as u32).to_le_bytes());
+            if uniform {
+                samplings.extend_from_slice(&step.to_le_bytes());
+                samplings.extend_from_slice(&1u32.to_le_bytes());
+                samplings.extend_from_slice(&seconds[0].to_le_bytes());
+            } else {
+                samplings.extend_from_slice(&ACYCLIC_TIME_PER_CYCLE.to_le_bytes());
+                samplings.extend_from_slice(&(seconds.len() as u32).to_le_bytes());
+                for s in &seconds {
+                    samplings.extend_from_slice(&s.to_le_bytes());
+                }
+            }
+        }
+        let metadata = format!(
+            "_ai_AlembicVersion=Alembic 1.8.0 (written by pelage {v});_ai_Application=pelage {v};_ai_Description=hair curves",
+            v = env!("CARGO_PKG_VERSION")
+        );
+        let root = [
+            self.ogawa.data(&[&OGAWA_FILE_VERSION.to_le_bytes()])?,
+            self.ogawa.data(&[&LIBRARY_VERSION.to_le_bytes()])?,
+            top,
+            self.ogawa.data(&[metadata.as_bytes()])?,
+            self.ogawa.data(&[&samplings])?,
+            // No indexed metadata: every header carries its own.
+            EMPTY_DATA,
+        ];
+        let root = self.ogawa.group(&root)?;
+        Ok(self.ogawa.finish(root)?)
+    }
+
+    /// The frames every animated part shares, if any part is animated.
+    fn frame_times(&self) -> Result<Option<Vec<f64>>, UsdWriteError> {
+        let mut animated = self.parts.iter().filter(|p| !p.times.is_empty());
+        let Some(first) = animated.next() else {
+            return Ok(None);
+        };
+        for other in animated {
+            if other.times != first.times {
+                return Err(UsdWriteError::BadSetting(format!(
+                    "parts {:?} and {:?} have different frames; in Alembic every animated part has the same frames",
+                    first.name, other.name
+                )));
+            }
+        }
+        Ok(Some(first.times.clone()))
+    }
+
+    /// A compound's group: each child's group, then the block of their
+    /// headers.
+    fn write_compound_group(&mut self, compound: &Property) -> std::io::Result<Child> {
+        let Kind::Compound(children) = &compound.kind else {
+            unreachable!("called on compounds")
+        };
+        let mut groups = Vec::with_capacity(children.len() + 1);
+        let mut headers = Vec::new();
+        for child in children {
+            groups.push(match &child.kind {
+                Kind::Compound(_) => self.write_compound_group(child)?,
+                // A scalar's samples; an array's samples each followed by
+                // its dimensions (empty: a 1-D array's length follows
+                // from the block's size).
+                Kind::Scalar => self
+                    .ogawa
+                    .group(&child.samples.iter().map(|s| s.0).collect::<Vec<_>>())?,
+                Kind::Array => self.ogawa.group(
+                    &child
+                        .samples
+                        .iter()
+                        .flat_map(|s| [s.0, EMPTY_DATA])
+                        .collect::<Vec<_>>(),
+                )?,
+            });
+            headers.extend(property_header(child));
+        }
+        if !headers.is_empty() {
+            groups.push(self.ogawa.data(&[&headers])?);
+        }
+        self.ogawa.group(&groups)
+    }
+}
+
+/// A plain (scalar or array) property.
+#[allow(clippy::too_many_arguments)]
+fn property(
+    name: &str,
+    metadata: &str,
+    kind: Kind,
+    pod: Pod,
+    extent: u8,
+    time_sampling: u32,
+    samples: Vec<Sample>,
+) -> Property {
+    Property {
+        name: name.into(),
+        metadata: metadata.into(),
+        kind,
+        pod,
+        extent,
+        time_sampling,
+        samples,
+    }
+}
+
+fn geom_param(
+    name: &str,
+    scope: Scope,
+    interpretation: &str,
+    pod: Pod,
+    extent: u8,
+    time_sampling: u32,
+    samples: Vec<Sample>,
+) -> Property {
+    let scope = match scope {
+        Scope::Vertex => "vtx",
+        Scope::Uniform => "uni",
+    };
+    let interpretation = if interpretation.is_empty() {
+        String::new()
+    } else {
+        format!("interpretation={interpretation};")
+    };
+    Property {
+        name: name.into(),
+        metadata: format!(
+            "arrayExtent=1;geoScope={scope};{interpretation}isGeomParam=true;podExtent={extent};podName={}",
+            pod.name()
+        ),
+        kind: Kind::Array,
+        pod,
+        extent,
+        time_sampling,
+        samples,
+    }
+}
+
+/// A property's header as `WritePropertyInfo` packs it: an info word
+/// (kind, size hint, type, sampling flags, extent, metadata inline), the
+/// sample count and time sampling where needed, the name and the metadata,
+/// sizes in 1, 2 or 4 bytes as the longest of them needs.
+fn property_header(property: &Property) -> Vec<u8> {
+    let samples = property.samples.len() as u32;
+    let longest = [
+        property.metadata.len() as u32,
+        property.name.len() as u32,
+        samples,
+        property.time_sampling,
+    ]
+    .into_iter()
+    .max()
+    .unwrap_or(0);
+    let hint: u32 = match longest {
+        0..=255 => 0,
+        256..=65_535 => 1,
+        _ => 2,
+    };
+    let sized = |v: u32, out: &mut Vec<u8>| {
+        out.extend_from_slice(&v.to_le_bytes()[..[1, 2, 4][hint as usize]]);
+    };
+    let metadata_index: u32 = if property.metadata.is_empty() {
+        0
+    } else {
+        0xff
+    };
+    let mut info = (hint << 2) | (metadata_index << 20);
+    let mut out = Vec::new();
+    if let Kind::Compound(_) = property.kind {
+        out.extend_from_slice(&info.to_le_bytes());
+    } else {
+        let scalar_like = property.samples.iter().all(|s| s.1 == 1);
+        let homogenous = property.samples.windows(2).all(|w| w[0].1 == w[1].1);
+        let kind = match property.kind {
+            Kind::Scalar => 1,
+            _ => 2,
+        };
+        info |= kind | scalar_like as u32;
+        info |= (property.pod as u32) << 4;
+        if property.time_sampling != 0 {
+            info |= 0x100;
+        }
+        // Every sample written differs from the one before: the first
+        // change is sample 1 and the last is the last; one sample is a
+        // constant.
+        if samples <= 1 {
+            info |= 0x800;
+        }
+        if homogenous {
+            info |= 0x400;
+        }
+        info |= (property.extent as u32) << 12;
+        out.extend_from_slice(&info.to_le_bytes());
+        sized(samples, &mut out);
+        if property.time_sampling != 0 {
+            sized(property.time_sampling, &mut out);
+        }
+    }
+    sized(property.name.len() as u32, &mut out);
+    out.extend_from_slice(property.name.as_bytes());
+    if metadata_index == 0xff {
+        sized(property.metadata.len() as u32, &mut out);
+        out.extend_from_slice(property.metadata.as_bytes());
+    }
+    out
+}
+
+/// The digests of an object's properties and children that end its
+/// headers block: pelage's own, from the properties' sample keys.
+fn object_digests(geom: &Property) -> [u8; 32] {
+    fn keys(p: &Property, into: &mut Vec<u8>) {
+        into.extend_from_slice(p.name.as_bytes());
+        for s in &p.samples {
+            into.extend_from_slice(&s.0.to_le_bytes());
+        }
+        if let Kind::Compound(children) = &p.kind {
+            children.iter().for_each(|c| keys(c, into));
+        }
+    }
+    let mut all = Vec::new();
+    keys(geom, &mut all);
+    let mut out = [0u8; 32];
+    out[..16].copy_from_slice(&murmur3_128(&all));
+    out
+}
+
+impl<W: Write + Seek> super::UsdPrimWriter for AbcWriter<W> {
+    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+        AbcWriter::write_part(self, name, curves)
+    }
+
+    /// Alembic files from pelage hold curves only.
+    fn write_mesh(&mut self, _name: &str, _mesh: &crate::Mesh) -> Result<(), UsdWriteError> {
+        Err(UsdWriteError::BadSetting(
+            "pelage's Alembic files hold curves only: leave the skin out ([output] with_mesh = false, no --with-mesh) or write USD".into(),
+        ))
+    }
+}

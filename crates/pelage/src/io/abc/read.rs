@@ -1,0 +1,625 @@
+//! Curves from Alembic (Ogawa): every `ICurves` object of the archive, in
+//! file order, joined — what pelage's writer, Blender and Houdini write.
+//! Positions, vertex counts and widths come from the curves schema;
+//! normals (`N`), and the arbitrary parameters `groom_color`, `groom_id`
+//! and `groom_root_uv`, where present with pelage's layout. Each
+//! property's first sample is read (the first frame of an animation).
+//! Transforms of parent `Xform` objects are not applied: pelage reads
+//! curves in the space they were written in.
+//!
+//! Every offset, count and size in the file is checked against the file
+//! before it is used, so a truncated or hostile file is an error naming
+//! the byte and the structure, never a panic or an allocation of a size
+//! the file claims but does not hold.
+
+use super::super::read_error::{CurvesReadError, CurvesReadErrorKind as Kind};
+use super::super::usd_read::DEFAULT_WIDTH;
+use super::ogawa::{Child, EMPTY_DATA};
+use crate::Curves;
+use crate::mesh::Location;
+use glam::{Vec2, Vec3};
+use std::cell::Cell;
+use std::path::Path;
+
+/// Groups visited at most: a file whose groups share children (or list
+/// an ancestor) could otherwise make the walk exponential or endless.
+const MAX_GROUPS_VISITED: usize = 1 << 20;
+/// Object nesting read at most.
+const MAX_DEPTH: usize = 256;
+
+/// The bytes of an Ogawa file, read with every position checked.
+struct Ogawa<'a> {
+    bytes: &'a [u8],
+    path: &'a Path,
+    visited: Cell<usize>,
+}
+
+impl<'a> Ogawa<'a> {
+    fn fail(&self, at: u64, message: String) -> CurvesReadError {
+        CurvesReadError::new(
+            self.path,
+            Location::Element {
+                kind: "byte",
+                index: at as usize,
+            },
+            Kind::Inconsistent(message),
+        )
+    }
+
+    /// The root group, after checking the header.
+    fn open(bytes: &'a [u8], path: &'a Path) -> Result<(Self, Child), CurvesReadError> {
+        let file = Self {
+            bytes,
+            path,
+            visited: Cell::new(0),
+        };
+        if bytes.len() < 16 || &bytes[..5] != b"Ogawa" {
+            return Err(CurvesReadError::whole(
+                path,
+                Kind::Syntax(
+                    "not an Alembic file: it does not start with 'Ogawa' (HDF5 Alembic files are not read; re-export as Ogawa)"
+                        .into(),
+                ),
+            ));
+        }
+        if bytes[5] != 0xff {
+            return Err(file.fail(
+                5,
+                "the file was not completely written (its writer stopped before closing it)".into(),
+            ));
+        }
+        if bytes[6..8] != [0, 1] {
+            return Err(file.fail(
+                6,
+                format!("Ogawa version {}.{} (pelage reads 0.1)", bytes[6], bytes[7]),
+            ));
+        }
+        let root = u64::from_le_bytes(bytes[8..16].try_into().expect("8 bytes"));
+        Ok((file, root))
+    }
+
+    fn u64_at(&self, at: u64, what: &str) -> Result<u64, CurvesReadError> {
+        let start = usize::try_from(at)
+            .ok()
+            .filter(|&s| s.checked_add(8).is_some_and(|e| e <= self.bytes.len()));
+        match start {
+            Some(s) => Ok(u64::from_le_bytes(
+                self.bytes[s..s + 8].try_into().expect("8 bytes"),
+            )),
+            None => Err(self.fail(
+                at,
+                format!(
+                    "{what} lies past the end of the file ({} bytes)",
+                    self.bytes.len()
+                ),
+            )),
+        }
+    }
+
+    /// A group's children.
+    fn group(&self, child: Child, what: &str) -> Result<Vec<Child>, CurvesReadError> {
+        if child & EMPTY_DATA != 0 {
+            return Err(self.fail(
+                child & !EMPTY_DATA,
+                format!("{what}: a data block where a group belongs"),
+            ));
+        }
+        if child == 0 {
+            return Ok(Vec::new());
+        }
+        let n = self.visited.get() + 1;
+        if n > MAX_GROUPS_VISITED {
+            return Err(self.fail(
+                child,
+                format!(
+                    "{what}: more than {MAX_GROUPS_VISITED} groups (groups that share or loop)"
+                ),
+            ));
+        }
+        self.visited.set(n);
+        let count = self.u64_at(child, what)?;
+        let room = (self.bytes.len() as u64 - child - 8) / 8;
+        if count > room {
+            return Err(self.fail(child, format!("{what}: a group of {count} children, but only {room} fit in the rest of the file")));
+        }
+        (0..count)
+            .map(|i| self.u64_at(child + 8 + 8 * i, what))
+            .collect()
+    }
+
+    /// A data block's bytes.
+    fn data(&self, child: Child, what: &str) -> Result<&'a [u8], CurvesReadError> {
+        if child & EMPTY_DATA == 0 {
+            return Err(self.fail(child, format!("{what}: a group where a data block belongs")));
+        }
+        let at = child & !EMPTY_DATA;
+        if at == 0 {
+            return Ok(&[]);
+        }
+        let size = self.u64_at(at, what)?;
+        let room = self.bytes.len() as u64 - at - 8;
+        if size > room {
+            return Err(self.fail(
+                at,
+                format!("{what}: a block of {size} bytes, but only {room} remain in the file"),
+            ));
+        }
+        Ok(&self.bytes[(at + 8) as usize..(at + 8 + size) as usize])
+    }
+}
+
+/// A reader of little fields in a headers block.
+struct Fields<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Fields<'a> {
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        let end = self.at.checked_add(n)?;
+        let s = self.bytes.get(self.at..end)?;
+        self.at = end;
+        Some(s)
+    }
+
+    fn sized(&mut self, hint: u32) -> Option<u32> {
+        let n = [1, 2, 4][hint.min(2) as usize];
+        let mut b = [0u8; 4];
+        b[..n].copy_from_slice(self.take(n)?);
+        Some(u32::from_le_bytes(b))
+    }
+
+    fn text(&mut self, n: u32) -> Option<String> {
+        Some(String::from_utf8_lossy(self.take(n as usize)?).into_owned())
+    }
+}
+
+/// What a property header says (`ReadPropertyHeaders`).
+struct PropertyHeader {
+    name: String,
+    metadata: String,
+    /// 0 compound, 1 scalar, 2 array.
+    kind: u32,
+    pod: u8,
+    extent: u8,
+}
+
+fn property_headers(block: &[u8], indexed: &[String]) -> Option<Vec<PropertyHeader>> {
+    let mut f = Fields {
+        bytes: block,
+        at: 0,
+    };
+    let mut out = Vec::new();
+    while f.at < block.len() {
+        let info = u32::from_le_bytes(f.take(4)?.try_into().ok()?);
+        let kind = match info & 3 {
+            0 => 0,
+            1 => 1,
+            _ => 2,
+        };
+        let hint = (info >> 2) & 3;
+        let (mut pod, mut extent) = (0, 0);
+        if kind != 0 {
+            pod = ((info >> 4) & 0xf) as u8;
+            extent = ((info >> 12) & 0xff) as u8;
+            f.sized(hint)?; // sample count
+            if info & 0x200 != 0 {
+                f.sized(hint)?; // first changed
+                f.sized(hint)?; // last changed
+            }
+            if info & 0x100 != 0 {
+                f.sized(hint)?; // time sampling
+            }
+        }
+        let name_size = f.sized(hint)?;
+        let name = f.text(name_size)?;
+        let index = ((info >> 20) & 0xff) as usize;
+        let metadata = if index == 0xff {
+            let size = f.sized(hint)?;
+            f.text(size)?
+        } else {
+            indexed.get(index)?.clone()
+        };
+        out.push(PropertyHeader {
+            name,
+            metadata,
+            kind,
+            pod,
+            extent,
+        });
+    }
+    Some(out)
+}
+
+fn object_headers(block: &[u8], indexed: &[String]) -> Option<Vec<(String, String)>> {
+    if block.len() <= 32 {
+        return Some(Vec::new());
+    }
+    let body = &block[..block.len() - 32];
+    let mut f = Fields { bytes: body, at: 0 };
+    let mut out = Vec::new();
+    while f.at < body.len() {
+        let size = f.sized(2)?;
+        let name = f.text(size)?;
+        let index = f.take(1)?[0] as usize;
+        let metadata = if index == 0xff {
+            let size = f.sized(2)?;
+            f.text(size)?
+        } else {
+            indexed.get(index)?.clone()
+        };
+        out.push((name, metadata));
+    }
+    Some(out)
+}
+
+fn metadata_value<'m>(metadata: &'m str, key: &str) -> Option<&'m str> {
+    metadata.split(';').find_map(|kv| {
+        kv.split_once('=')
+            .filter(|(k, _)| *k == key)
+            .map(|(_, v)| v)
+    })
+}
+
+/// A compound property: its headers and each property's group.
+struct Compound {
+    properties: Vec<(PropertyHeader, Child)>,
+}
+
+impl Compound {
+    fn read(
+        file: &Ogawa,
+        group: Child,
+        indexed: &[String],
+        what: &str,
+    ) -> Result<Self, CurvesReadError> {
+        let children = file.group(group, what)?;
+        let Some((&last, groups)) = children.split_last() else {
+            return Ok(Self {
+                properties: Vec::new(),
+            });
+        };
+        let block = file.data(last, &format!("{what}: property headers"))?;
+        let headers = property_headers(block, indexed).ok_or_else(|| {
+            file.fail(
+                last & !EMPTY_DATA,
+                format!("{what}: property headers end in the middle of a header"),
+            )
+        })?;
+        if headers.len() > groups.len() {
+            return Err(file.fail(
+                group,
+                format!(
+                    "{what}: {} property headers for {} properties",
+                    headers.len(),
+                    groups.len()
+                ),
+            ));
+        }
+        Ok(Self {
+            properties: headers.into_iter().zip(groups.iter().copied()).collect(),
+        })
+    }
+
+    fn get(&self, name: &str) -> Option<&(PropertyHeader, Child)> {
+        self.properties.iter().find(|(h, _)| h.name == name)
+    }
+}
+
+/// The first sample of an array or scalar property, as values of `pod`
+/// with `extent` components (4-byte components: float or int32; 8-byte:
+/// int64 or double).
+fn first_sample<'a>(
+    file: &Ogawa<'a>,
+    (header, group): &(PropertyHeader, Child),
+    what: &str,
+) -> Result<&'a [u8], CurvesReadError> {
+    let children = file.group(*group, what)?;
+    let Some(&first) = children.first() else {
+        return Ok(&[]);
+    };
+    let block = file.data(first, what)?;
+    if block.is_empty() {
+        return Ok(block);
+    }
+    if block.len() < 16 {
+        return Err(file.fail(
+            first & !EMPTY_DATA,
+            format!(
+                "{what}: a sample of {} bytes is shorter than its 16-byte key",
+                block.len()
+            ),
+        ));
+    }
+    let bytes = &block[16..];
+    let size = pod_size(header.pod) * header.extent.max(1) as usize;
+    if size == 0 || bytes.len() % size != 0 {
+        return Err(file.fail(
+            first & !EMPTY_DATA,
+            format!(
+                "{what}: {} bytes are not whole values of {size} bytes",
+                bytes.len()
+            ),
+        ));
+    }
+    Ok(bytes)
+}
+
+fn pod_size(pod: u8) -> usize {
+    match pod {
+        0..=2 => 1,
+        3 | 4 | 9 => 2,
+        5 | 6 | 10 => 4,
+        7 | 8 | 11 => 8,
+        _ => 0,
+    }
+}
+
+fn floats(bytes: &[u8]) -> impl Iterator<Item = f32> + '_ {
+    bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes")))
+}
+
+/// Reads every `ICurves` object of an Alembic file into one [`Curves`].
+pub fn read_abc_curves(path: &Path) -> Result<Curves, CurvesReadError> {
+    let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
+    let (file, root) = Ogawa::open(&bytes, path)?;
+    let top = file.group(root, "the archive")?;
+    if top.len() < 6 {
+        return Err(file.fail(
+            root,
+            format!("the archive has {} parts; Alembic has 6", top.len()),
+        ));
+    }
+    let mut indexed = vec![String::new()];
+    let block = file.data(top[5], "the indexed metadata")?;
+    let mut f = Fields {
+        bytes: block,
+        at: 0,
+    };
+    while f.at < block.len() {
+        let text = f.take(1).and_then(|n| f.text(n[0] as u32));
+        indexed.push(text.ok_or_else(|| {
+            file.fail(
+                top[5] & !EMPTY_DATA,
+                "the indexed metadata ends in the middle of an entry".into(),
+            )
+        })?);
+    }
+    let mut found = Vec::new();
+    collect_curves(&file, top[2], "", &indexed, 0, &mut found)?;
+    if found.is_empty() {
+        return Err(CurvesReadError::whole(
+            path,
+            Kind::Empty(" (no ICurves object)"),
+        ));
+    }
+    let mut parts = Vec::with_capacity(found.len());
+    for (name, geom) in found {
+        parts.push(read_curves_object(&file, &name, geom, &indexed)?);
+    }
+    super::super::join(&parts).map_err(|e| CurvesReadError::whole(path, e.into()))
+}
+
+/// Walks the object tree; collects each curves object's path and `.geom`.
+fn collect_curves(
+    file: &Ogawa,
+    object: Child,
+    path: &str,
+    indexed: &[String],
+    depth: usize,
+    found: &mut Vec<(String, Child)>,
+) -> Result<(), CurvesReadError> {
+    let what = if path.is_empty() { "/" } else { path };
+    if depth > MAX_DEPTH {
+        return Err(file.fail(
+            object,
+            format!("{what}: objects nested deeper than {MAX_DEPTH}"),
+        ));
+    }
+    let children = file.group(object, what)?;
+    if children.len() < 2 {
+        return Ok(());
+    }
+    let last = children[children.len() - 1];
+    let block = file.data(last, &format!("{what}: object headers"))?;
+    let headers = object_headers(block, indexed).ok_or_else(|| {
+        file.fail(
+            last & !EMPTY_DATA,
+            format!("{what}: object headers end in the middle of a header"),
+        )
+    })?;
+    if headers.len() + 2 > children.len() {
+        return Err(file.fail(
+            object,
+            format!(
+                "{what}: {} object headers for {} children",
+                headers.len(),
+                children.len() - 2
+            ),
+        ));
+    }
+    for (i, (name, metadata)) in headers.iter().enumerate() {
+        let child_path = format!("{path}/{name}");
+        let group = children[i + 1];
+        if metadata_value(metadata, "schema") == Some("AbcGeom_Curve_v2") {
+            let properties = file.group(group, &child_path)?;
+            let top = Compound::read(
+                file,
+                properties.first().copied().unwrap_or(0),
+                indexed,
+                &child_path,
+            )?;
+            let geom = top.get(".geom").ok_or_else(|| {
+                file.fail(
+                    group,
+                    format!("{child_path}: a curves object without .geom"),
+                )
+            })?;
+            found.push((child_path.clone(), geom.1));
+        }
+        collect_curves(file, group, &child_path, indexed, depth + 1, found)?;
+    }
+    Ok(())
+}
+
+fn read_curves_object(
+    file: &Ogawa,
+    path: &str,
+    geom: Child,
+    indexed: &[String],
+) -> Result<Curves, CurvesReadError> {
+    let what = |p: &str| format!("{path}/.geom/{p}");
+    let fail = |message: String| file.fail(geom, message);
+    let geom = Compound::read(file, geom, indexed, &what(""))?;
+    let property = |name: &str, pod: &[u8], extent: u8| -> Result<Option<&[u8]>, CurvesReadError> {
+        let Some(p) = geom.get(name) else {
+            return Ok(None);
+        };
+        if p.0.kind == 0 {
+            return Err(fail(format!(
+                "{}: an indexed parameter; pelage reads plain arrays",
+                what(name)
+            )));
+        }
+        if !pod.contains(&p.0.pod) || p.0.extent != extent {
+            return Err(fail(format!(
+                "{}: type {} × {}, not what pelage reads",
+                what(name),
+                p.0.pod,
+                p.0.extent
+            )));
+        }
+        first_sample(file, p, &what(name)).map(Some)
+    };
+    let points: Vec<Vec3> = match property("P", &[10], 3)? {
+        Some(b) => floats(b)
+            .collect::<Vec<_>>()
+            .chunks_exact(3)
+            .map(Vec3::from_slice)
+            .collect(),
+        None => return Err(fail(format!("{}: no P", path))),
+    };
+    let counts: Vec<i32> = match property("nVertices", &[6], 1)? {
+        Some(b) => b
+            .chunks_exact(4)
+            .map(|c| i32::from_le_bytes(c.try_into().expect("4 bytes")))
+            .collect(),
+        None => return Err(fail(format!("{}: no nVertices", path))),
+    };
+    if let Some(i) = counts.iter().position(|&c| c < 1) {
+        return Err(fail(format!(
+            "{}: curve {i} has {} points",
+            what("nVertices"),
+            counts[i]
+        )));
+    }
+    let total: u64 = counts.iter().map(|&c| c as u64).sum();
+    if total != points.len() as u64 {
+        return Err(fail(format!(
+            "{}: the curves' vertex counts add up to {total}, but P holds {} points",
+            path,
+            points.len()
+        )));
+    }
+    let offsets: Vec<u32> = std::iter::once(0)
+        .chain(counts.iter().scan(0u32, |end, &c| {
+            *end += c as u32;
+            Some(*end)
+        }))
+        .collect();
+    let scope = |name: &str| {
+        geom.get(name)
+            .and_then(|p| metadata_value(&p.0.metadata, "geoScope").map(str::to_string))
+    };
+    let widths: Vec<f32> = match property("width", &[10], 1)? {
+        None => vec![DEFAULT_WIDTH; points.len()],
+        Some(b) => {
+            let w: Vec<f32> = floats(b).collect();
+            match (scope("width").as_deref(), w.len()) {
+                (_, n) if n == points.len() => w,
+                (Some("uni"), n) if n == counts.len() => counts
+                    .iter()
+                    .zip(&w)
+                    .flat_map(|(&c, &v)| std::iter::repeat_n(v, c as usize))
+                    .collect(),
+                (_, 1) => vec![w[0]; points.len()],
+                (s, n) => {
+                    return Err(fail(format!(
+                        "{}: {n} widths ({}) for {} curves of {} points",
+                        what("width"),
+                        s.unwrap_or("no scope"),
+                        counts.len(),
+                        points.len()
+                    )));
+                }
+            }
+        }
+    };
+    let mut curves =
+        Curves::new(points, widths, offsets).map_err(|e| fail(format!("{path}: {e}")))?;
+    let n = curves.points().len();
+    if let Some(b) = property("N", &[10], 3)?.filter(|b| b.len() == n * 12) {
+        let normals = floats(b)
+            .collect::<Vec<_>>()
+            .chunks_exact(3)
+            .map(Vec3::from_slice)
+            .collect();
+        curves = curves
+            .with_normals(normals)
+            .map_err(|e| fail(format!("{path}: {e}")))?;
+    }
+    if let Some(arbitrary) = geom.get(".arbGeomParams").filter(|p| p.0.kind == 0) {
+        let arb = Compound::read(file, arbitrary.1, indexed, &what(".arbGeomParams"))?;
+        let sample =
+            |name: &str, pods: &[u8], extent: u8| -> Result<Option<(u8, &[u8])>, CurvesReadError> {
+                match arb.get(name) {
+                    Some(p) if p.0.kind != 0 && pods.contains(&p.0.pod) && p.0.extent == extent => {
+                        Ok(Some((p.0.pod, first_sample(file, p, &what(name))?)))
+                    }
+                    _ => Ok(None),
+                }
+            };
+        if let Some((_, b)) = sample("groom_color", &[10], 3)?.filter(|(_, b)| b.len() == n * 12) {
+            let colors = floats(b)
+                .collect::<Vec<_>>()
+                .chunks_exact(3)
+                .map(Vec3::from_slice)
+                .collect();
+            curves = curves
+                .with_colors(colors)
+                .map_err(|e| fail(format!("{path}: {e}")))?;
+        }
+        let curve_count = curves.curve_count();
+        if let Some((pod, b)) = sample("groom_id", &[6, 8], 1)? {
+            let ids: Option<Vec<u64>> = if pod == 6 {
+                b.chunks_exact(4)
+                    .map(|c| u64::try_from(i32::from_le_bytes(c.try_into().expect("4"))).ok())
+                    .collect()
+            } else {
+                b.chunks_exact(8)
+                    .map(|c| u64::try_from(i64::from_le_bytes(c.try_into().expect("8"))).ok())
+                    .collect()
+            };
+            if let Some(ids) = ids.filter(|ids| ids.len() == curve_count) {
+                curves = curves
+                    .with_ids(ids)
+                    .map_err(|e| fail(format!("{path}: {e}")))?;
+            }
+        }
+        if let Some((_, b)) =
+            sample("groom_root_uv", &[10], 2)?.filter(|(_, b)| b.len() == curve_count * 8)
+        {
+            let uvs = floats(b)
+                .collect::<Vec<_>>()
+                .chunks_exact(2)
+                .map(Vec2::from_slice)
+                .collect();
+            curves = curves
+                .with_root_uvs(uvs)
+                .map_err(|e| fail(format!("{path}: {e}")))?;
+        }
+    }
+    Ok(curves)
+}

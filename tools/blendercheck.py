@@ -1,0 +1,63 @@
+"""Import a USD or Alembic file with Blender's own importer and print what it made.
+
+Lines (for tests to read):
+    import S seconds
+    object NAME: C curves, P points, attributes a b c
+    object NAME: radius[0] = R
+    object NAME: color[0] = R G B          (the first colour attribute, if any)
+    mesh NAME: V vertices, F faces
+    frame F: NAME point[I] = X Y Z         (evaluated, with --frames and --point)
+"""
+import argparse
+import sys
+import time
+
+import bpy
+
+parser = argparse.ArgumentParser()
+parser.add_argument("file")
+parser.add_argument("--point", type=int, default=0)
+parser.add_argument("--frames", default="")
+args = parser.parse_args(sys.argv[1:])
+
+bpy.ops.wm.read_factory_settings(use_empty=True)
+start = time.perf_counter()
+try:
+    if args.file.lower().endswith(".abc"):
+        result = bpy.ops.wm.alembic_import(filepath=args.file, as_background_job=False)
+    else:
+        result = bpy.ops.wm.usd_import(filepath=args.file)
+except RuntimeError as e:
+    print(f"{args.file}: Blender cannot import it: {e}")
+    sys.exit(1)
+print(f"import {time.perf_counter() - start:.4f} seconds")
+if "FINISHED" not in result:
+    print(f"{args.file}: Blender's importer returned {result}")
+    sys.exit(1)
+
+for ob in sorted((o for o in bpy.data.objects if o.type == "MESH"), key=lambda o: o.name):
+    print(f"mesh {ob.name}: {len(ob.data.vertices)} vertices, {len(ob.data.polygons)} faces")
+curves = sorted((o for o in bpy.data.objects if o.type == "CURVES"), key=lambda o: o.name)
+if not curves:
+    print(f"{args.file}: Blender made no curves object")
+    sys.exit(1)
+for ob in curves:
+    data = ob.data
+    names = sorted(a.name for a in data.attributes if not a.name.startswith("."))
+    print(f"object {ob.name}: {len(data.curves)} curves, {len(data.points)} points, "
+          f"attributes {' '.join(names)}")
+    if "radius" in data.attributes and len(data.points):
+        print(f"object {ob.name}: radius[0] = {data.attributes['radius'].data[0].value!r}")
+    for a in data.attributes:
+        if a.data_type in ("FLOAT_COLOR", "BYTE_COLOR") and len(a.data):
+            c = a.data[0].color
+            print(f"object {ob.name}: color[0] = {c[0]!r} {c[1]!r} {c[2]!r} ({a.name}, {a.domain})")
+            break
+for frame in [f for f in args.frames.split(",") if f]:
+    bpy.context.scene.frame_set(int(frame))
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    for ob in curves:
+        data = ob.evaluated_get(depsgraph).data
+        if args.point < len(data.points):
+            p = data.points[args.point].position
+            print(f"frame {frame}: {ob.name} point[{args.point}] = {p[0]!r} {p[1]!r} {p[2]!r}")
