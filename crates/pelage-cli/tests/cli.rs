@@ -214,7 +214,7 @@ fn convert_goes_through_every_format_and_keeps_the_curves() {
     let input = repo("crates/pelage/tests/data/good/blender_curves.usdc");
     let original = pelage::io::read_curves(&input).unwrap();
     let mut from = input.display().to_string();
-    for ext in ["hair", "ply", "usda"] {
+    for ext in ["hair", "ply", "usda", "usdc", "abc", "usd"] {
         let to = dir.path().join(format!("c.{ext}")).display().to_string();
         let out = pelage(&["convert", &from, &to]);
         assert!(out.status.success(), "{}", stderr(&out));
@@ -255,7 +255,7 @@ fn convert_goes_through_every_format_and_keeps_the_curves() {
             && text.contains("type = \"linear\"")
     );
 
-    let out = pelage(&["convert", &from, "x.abc"]);
+    let out = pelage(&["convert", &from, "x.fbx"]);
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(
         stderr(&out).matches("unknown curves format").count(),
@@ -456,6 +456,50 @@ fn groom_parts_run_separately_concatenate_to_the_full_run_on_any_thread_count() 
     assert_eq!(layer.matches("extentsHint").count(), 4);
     if let Some((ok, report)) = usdcheck(&[&farm, &full]) {
         assert!(ok, "{report}");
+    }
+
+    // Runs that write binary USD are tied together the same way; the
+    // root layer is text, and says so when named otherwise.
+    let binary = dir.path().join("binary.usdc");
+    for k in 1..=3 {
+        run(&["-o", binary.to_str().unwrap(), "--part", &format!("{k}/3")]);
+    }
+    let root = dir.path().join("binary.usda");
+    let assemble = |to: &Path| {
+        pelage(&[
+            "groom",
+            groom.to_str().unwrap(),
+            "--assemble",
+            "-o",
+            to.to_str().unwrap(),
+        ])
+    };
+    let out = assemble(&binary);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("the assembly layer is text USD: name it .usda"),
+        "{}",
+        stderr(&out)
+    );
+    let out = assemble(&root);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(&root).unwrap();
+    assert!(text.contains("@./binary.part-2-of-3.usdc@"), "{text}");
+    assert_eq!(text.matches("extentsHint").count(), 4, "{text}");
+    let whole = |t: &str| {
+        t.split("extentsHint")
+            .nth(1)
+            .and_then(|r| r.split(']').next())
+            .map(str::to_string)
+    };
+    assert_eq!(
+        whole(&text),
+        whole(&layer),
+        "the same bounds from binary parts"
+    );
+    if let Some((ok, report)) = usdcheck(&[&root]) {
+        assert!(ok, "{report}");
+        assert!(report.contains("3 BasisCurves prims"), "{report}");
     }
 
     // Asking for more runs than parts says what to do.

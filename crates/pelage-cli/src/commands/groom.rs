@@ -246,7 +246,17 @@ fn assemble(output: &Path, options: &UsdOptions) -> anyhow::Result<()> {
             folder.display()
         )
     })?;
-    let files: Vec<PathBuf> = (1..=n).map(|k| part_file(output, k, n)).collect();
+    // A run's file is text or binary USD, whatever the root layer's name.
+    let files: Vec<PathBuf> = (1..=n)
+        .map(|k| {
+            let named = part_file(output, k, n);
+            ["usda", "usdc", "usd"]
+                .iter()
+                .map(|ext| named.with_extension(ext))
+                .find(|f| f.exists())
+                .unwrap_or(named)
+        })
+        .collect();
     if let Some(missing) = files.iter().find(|f| !f.exists()) {
         bail!(
             "{} is missing: run {} of {n} has not finished",

@@ -7,7 +7,7 @@ use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
     AbcWriter, CurvesExport, CurvesFormat, UpAxis, UsdOptions, UsdPrimWriter, UsdaWriter,
-    UsdcWriter, WriteError, write_atomically, write_curves,
+    UsdcWriter, WriteError, read_usd_extent, write_atomically, write_curves,
 };
 use glam::Vec3;
 use std::io::{BufRead, Seek, Write};
@@ -240,8 +240,26 @@ pub fn write_assembly(
         path: file.to_path_buf(),
         error: std::io::Error::other(message),
     };
+    if CurvesFormat::from_path(path) != Some(CurvesFormat::Usda) {
+        return Err(fail(
+            path,
+            "the assembly layer is text USD: name it .usda (its part files may be .usdc)".into(),
+        ));
+    }
     let mut extents = Vec::with_capacity(part_files.len());
     for file in part_files {
+        let binary = std::fs::File::open(file)
+            .and_then(|mut f| {
+                let mut head = [0u8; 8];
+                let n = std::io::Read::read(&mut f, &mut head)?;
+                Ok(head[..n] == *b"PXR-USDC")
+            })
+            .map_err(|e| fail(file, format!("cannot read the part file: {e}")))?;
+        if binary {
+            let bounds = read_usd_extent(file).map_err(|e| fail(file, e.to_string()))?;
+            extents.push(bounds);
+            continue;
+        }
         let reader = std::fs::File::open(file)
             .map(std::io::BufReader::new)
             .map_err(|e| fail(file, format!("cannot read the part file: {e}")))?;

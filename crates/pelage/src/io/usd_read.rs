@@ -21,18 +21,7 @@ pub const DEFAULT_WIDTH: f32 = 0.01;
 /// Reads every `BasisCurves` prim of a usda or usdc file into one
 /// [`Curves`] (points in world space).
 pub fn read_usd_curves(path: &Path) -> Result<Curves, CurvesReadError> {
-    let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
-    let data: Box<dyn AbstractData> = if bytes.starts_with(b"PXR-USDC") {
-        openusd::usdc::read_file(path).map_err(|e| parse_error(path, &e))?
-    } else if bytes.starts_with(b"#usda") {
-        Box::new(openusd::usda::read_file(path).map_err(|e| parse_error(path, &e))?)
-    } else {
-        return Err(CurvesReadError::new(
-            path,
-            Location::Line(1),
-            Kind::Syntax("not a USD file: it starts with neither '#usda' nor 'PXR-USDC'".into()),
-        ));
-    };
+    let data = open_layer(path)?;
     let data = data.as_ref();
     let mut prims: Vec<sdf::Path> = data
         .spec_paths()
@@ -169,6 +158,57 @@ fn with_primvars(
         curves = curves.with_ids(ids)?;
     }
     Ok(curves)
+}
+
+/// The union of the authored `extent` of every `BasisCurves` prim of a
+/// usda or usdc file (`None` when no prim has one), without reading the
+/// curves: what an assembly layer needs from its part files.
+pub fn read_usd_extent(path: &Path) -> Result<Option<(glam::Vec3, glam::Vec3)>, CurvesReadError> {
+    let data = open_layer(path)?;
+    let data = data.as_ref();
+    let mut bounds: Option<(glam::Vec3, glam::Vec3)> = None;
+    for prim in data.spec_paths() {
+        if data.spec_type(&prim) != Some(SpecType::Prim)
+            || token(data, &prim, "typeName").as_deref() != Some("BasisCurves")
+        {
+            continue;
+        }
+        if let Some(Value::Vec3fVec(e)) = attribute(data, &prim, "extent") {
+            if let [lo, hi] = e[..] {
+                let (lo, hi) = (
+                    glam::Vec3::new(lo.x, lo.y, lo.z),
+                    glam::Vec3::new(hi.x, hi.y, hi.z),
+                );
+                bounds = Some(match bounds {
+                    Some((l, h)) => (l.min(lo), h.max(hi)),
+                    None => (lo, hi),
+                });
+            }
+        }
+    }
+    Ok(bounds)
+}
+
+/// Parses a usda or usdc layer (by its first bytes).
+fn open_layer(path: &Path) -> Result<Box<dyn AbstractData>, CurvesReadError> {
+    let mut head = [0u8; 8];
+    let n = std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
+        .map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
+    let head = &head[..n];
+    if head.starts_with(b"PXR-USDC") {
+        Ok(openusd::usdc::read_file(path).map_err(|e| parse_error(path, &e))?)
+    } else if head.starts_with(b"#usda") {
+        Ok(Box::new(
+            openusd::usda::read_file(path).map_err(|e| parse_error(path, &e))?,
+        ))
+    } else {
+        Err(CurvesReadError::new(
+            path,
+            Location::Line(1),
+            Kind::Syntax("not a USD file: it starts with neither '#usda' nor 'PXR-USDC'".into()),
+        ))
+    }
 }
 
 /// Splits openusd's `PATH:LINE: COL: message` into a line location.
