@@ -173,17 +173,17 @@ pub fn read_usd_extent(path: &Path) -> Result<Option<(glam::Vec3, glam::Vec3)>, 
         {
             continue;
         }
-        if let Some(Value::Vec3fVec(e)) = attribute(data, &prim, "extent") {
-            if let [lo, hi] = e[..] {
-                let (lo, hi) = (
-                    glam::Vec3::new(lo.x, lo.y, lo.z),
-                    glam::Vec3::new(hi.x, hi.y, hi.z),
-                );
-                bounds = Some(match bounds {
-                    Some((l, h)) => (l.min(lo), h.max(hi)),
-                    None => (lo, hi),
-                });
-            }
+        if let Some(Value::Vec3fVec(e)) = attribute(data, &prim, "extent")
+            && let [lo, hi] = e[..]
+        {
+            let (lo, hi) = (
+                glam::Vec3::new(lo.x, lo.y, lo.z),
+                glam::Vec3::new(hi.x, hi.y, hi.z),
+            );
+            bounds = Some(match bounds {
+                Some((l, h)) => (l.min(lo), h.max(hi)),
+                None => (lo, hi),
+            });
         }
     }
     Ok(bounds)
