@@ -415,6 +415,74 @@ fn animated_alembic_holds_each_frame_for_blender() {
 }
 
 #[test]
+fn hostile_alembic_files_are_errors_naming_the_byte_and_never_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("good.abc");
+    write_usd(
+        &good,
+        &[("part_0", &small_groom(20, 5))],
+        &UsdOptions::default(),
+        false,
+    );
+    let bytes = std::fs::read(&good).unwrap();
+    let path = dir.path().join("bad.abc");
+    let read = |b: &[u8]| {
+        std::fs::write(&path, b).unwrap();
+        read_curves(&path).map_err(|e| e.to_string())
+    };
+
+    // A root group that claims 2^40 children: refused before any allocation.
+    let root = u64::from_le_bytes(bytes[8..16].try_into().unwrap()) as usize;
+    let mut huge = bytes.clone();
+    huge[root..root + 8].copy_from_slice(&(1u64 << 40).to_le_bytes());
+    let err = read(&huge).unwrap_err();
+    assert!(
+        err.contains(&format!(
+            "bad.abc: byte {root}: the archive: a group of 1099511627776 children, but only"
+        )),
+        "{err}"
+    );
+    // Cut short, or never finished by its writer.
+    let err = read(&bytes[..bytes.len() / 2]).unwrap_err();
+    assert!(err.contains("past the end of the file"), "{err}");
+    let mut unfinished = bytes.clone();
+    unfinished[5] = 0;
+    assert!(
+        read(&unfinished)
+            .unwrap_err()
+            .contains("was not completely written")
+    );
+    assert!(
+        read(b"HDF5 file")
+            .unwrap_err()
+            .contains("not an Alembic file")
+    );
+
+    // Every truncation and many corruptions: an error or curves, never a
+    // panic or an allocation of a size the file only claims.
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    for cut in (0..bytes.len()).step_by(7) {
+        let _ = read(&bytes[..cut]);
+    }
+    for _ in 0..600 {
+        let mut b = bytes.clone();
+        let at = next() as usize % (b.len() - 8);
+        if next() % 2 == 0 {
+            b[at..at + 8].copy_from_slice(&(next() >> (next() % 64)).to_le_bytes());
+        } else {
+            b[at] ^= 1 << (next() % 8);
+        }
+        let _ = read(&b);
+    }
+}
+
+#[test]
 fn usda_bytes_do_not_depend_on_the_number_of_threads() {
     // Large enough for several formatting blocks.
     let groom = small_groom(6000, 16);
