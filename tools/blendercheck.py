@@ -1,7 +1,8 @@
 """Import a USD or Alembic file with Blender's own importer and print what it made.
 
 Lines (for tests to read):
-    import S seconds
+    import S seconds                       (the median of --repeat imports)
+    blender VERSION
     object NAME: C curves, P points, attributes a b c
     object NAME: radius[0] = R
     object NAME: color[0] = R G B          (the first colour attribute, if any)
@@ -18,22 +19,32 @@ parser = argparse.ArgumentParser()
 parser.add_argument("file")
 parser.add_argument("--point", type=int, default=0)
 parser.add_argument("--frames", default="")
+parser.add_argument("--repeat", type=int, default=1,
+                    help="import this many times into an empty scene; print the median time")
 args = parser.parse_args(sys.argv[1:])
 
-bpy.ops.wm.read_factory_settings(use_empty=True)
-start = time.perf_counter()
-try:
-    if args.file.lower().endswith(".abc"):
-        result = bpy.ops.wm.alembic_import(filepath=args.file, as_background_job=False)
-    else:
-        result = bpy.ops.wm.usd_import(filepath=args.file)
-except RuntimeError as e:
-    print(f"{args.file}: Blender cannot import it: {e}")
-    sys.exit(1)
-print(f"import {time.perf_counter() - start:.4f} seconds")
-if "FINISHED" not in result:
-    print(f"{args.file}: Blender's importer returned {result}")
-    sys.exit(1)
+
+def import_once():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    start = time.perf_counter()
+    try:
+        if args.file.lower().endswith(".abc"):
+            result = bpy.ops.wm.alembic_import(filepath=args.file, as_background_job=False)
+        else:
+            result = bpy.ops.wm.usd_import(filepath=args.file)
+    except RuntimeError as e:
+        print(f"{args.file}: Blender cannot import it: {e}")
+        sys.exit(1)
+    seconds = time.perf_counter() - start
+    if "FINISHED" not in result:
+        print(f"{args.file}: Blender's importer returned {result}")
+        sys.exit(1)
+    return seconds
+
+
+times = sorted(import_once() for _ in range(max(1, args.repeat)))
+print(f"import {times[len(times) // 2]:.4f} seconds")
+print(f"blender {bpy.app.version_string}")
 
 for ob in sorted((o for o in bpy.data.objects if o.type == "MESH"), key=lambda o: o.name):
     print(f"mesh {ob.name}: {len(ob.data.vertices)} vertices, {len(ob.data.polygons)} faces")

@@ -509,12 +509,16 @@ impl Curves {
     }
 
     /// Axis-aligned bounds of the points, or `None` without points.
+    /// Blocks are bounded in parallel; min and max are exact, so the
+    /// result does not depend on the threads.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let first = *self.points.first()?;
+        let bound = |(lo, hi): (Vec3, Vec3), p: &Vec3| (lo.min(*p), hi.max(*p));
         Some(
             self.points
-                .iter()
-                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
+                .par_chunks(1 << 16)
+                .map(|block| block.iter().fold((first, first), bound))
+                .reduce(|| (first, first), |(a, b), (c, d)| (a.min(c), b.max(d))),
         )
     }
 }

@@ -38,7 +38,7 @@ pub enum BenchWhat {
     Dynamics(dynamics::DynamicsBenchArgs),
     /// Shell fur frame time, plain vs curl vs curl + clump (Silva Table 1).
     Shells(shells::ShellsBenchArgs),
-    /// Writing a large groom as usda, part by part: throughput and peak memory.
+    /// Writing a large groom as usdc, usda and Alembic: throughput, size, peak memory.
     Io(io::IoBenchArgs),
 }
 

@@ -12,6 +12,7 @@
 //! six structural sections and the table of contents. Values come first so
 //! a writer can stream them and keep only the small structure in memory.
 
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::io::{self, Write};
 
@@ -89,8 +90,8 @@ pub(super) enum SpecType {
     PseudoRoot = 7,
 }
 
-/// `Usd_IntegerCompression`'s coding of a run of integers before LZ4: the
-/// most common difference between neighbours, then a 2-bit code per value
+/// `Usd_IntegerCompression`'s coding of a run of integers before LZ4: a
+/// common difference between neighbours, then a 2-bit code per value
 /// (common, or a difference of ¼, ½ or the full width), then the
 /// differences that are not the common one at their code's width.
 /// `wide` selects 64-bit integers (widths 2/4/8 bytes) over 32-bit ones
@@ -106,16 +107,16 @@ pub(super) fn encode_integers(
         *previous = v;
         Some(delta)
     });
-    let mut tally: HashMap<i64, usize> = HashMap::new();
+    // The common difference: any choice decodes right; the majority (by
+    // Boyer–Moore's vote, one pass, no table) codes best where there is
+    // one, as in curve counts (all equal) and ids (steps of 1).
+    let (mut common, mut votes) = (0i64, 0usize);
     for d in deltas.clone() {
-        *tally.entry(d).or_default() += 1;
+        if votes == 0 {
+            common = d;
+        }
+        votes = if d == common { votes + 1 } else { votes - 1 };
     }
-    // The most frequent difference; the smallest among equals, so the
-    // bytes do not depend on hash order.
-    let common = tally
-        .into_iter()
-        .max_by(|a, b| a.1.cmp(&b.1).then(b.0.cmp(&a.0)))
-        .map_or(0, |(d, _)| d);
     let width = if wide { 8 } else { 4 };
     let mut out = Vec::with_capacity(width + count.div_ceil(4) + count * width / 2);
     if wide {
@@ -171,6 +172,105 @@ pub(super) fn compressed_integers(
     out.extend_from_slice(&(compressed.len() as u64).to_le_bytes());
     out.extend_from_slice(&compressed);
     out
+}
+
+/// Distinct values a float lookup table holds at most: enough for any
+/// ramp along a hair, small enough to stay in cache.
+const MAX_TABLE: usize = 1024;
+
+/// A float array with few distinct values (widths along a hair, the same
+/// ramp on every hair), as OpenUSD's writer compresses them: the code
+/// `t`, a lookup table of the distinct values (bit patterns kept) and
+/// each value's index as compressed integers. `None` when more than a
+/// quarter of the values (or more than [`MAX_TABLE`]) are distinct, where
+/// a table does not pay.
+pub(super) fn float_lookup_table(values: &[f32]) -> Option<Vec<u8>> {
+    let limit = (values.len() / 4).min(MAX_TABLE);
+    // Blocks find their distinct values in parallel; the table lists them
+    // in the order of first appearance, as one pass would, so the bytes
+    // do not depend on the threads.
+    let blocks: Vec<(Vec<u32>, Vec<u32>)> = values
+        .par_chunks(1 << 18)
+        .map(|block| local_table(block, limit))
+        .collect::<Option<_>>()?;
+    let mut table = SmallTable::default();
+    let mut remaps: Vec<Vec<u32>> = Vec::with_capacity(blocks.len());
+    for (distinct, _) in &blocks {
+        let mut remap = Vec::with_capacity(distinct.len());
+        for &bits in distinct {
+            remap.push(table.index(bits));
+            if table.values.len() > limit {
+                return None;
+            }
+        }
+        remaps.push(remap);
+    }
+    let mut indices = Vec::with_capacity(values.len());
+    for ((_, local), remap) in blocks.iter().zip(&remaps) {
+        indices.extend(local.iter().map(|&i| remap[i as usize]));
+    }
+    let mut out = Vec::with_capacity(5 + 4 * table.values.len() + values.len() / 2);
+    out.push(b't');
+    out.extend_from_slice(&(table.values.len() as u32).to_le_bytes());
+    for bits in &table.values {
+        out.extend_from_slice(&bits.to_le_bytes());
+    }
+    out.extend(compressed_integers(
+        indices.iter().map(|&i| i as i64),
+        false,
+    ));
+    Some(out)
+}
+
+/// A block's distinct bit patterns (first appearance first) and each
+/// value's index among them; `None` past `limit` distinct values.
+fn local_table(block: &[f32], limit: usize) -> Option<(Vec<u32>, Vec<u32>)> {
+    let mut table = SmallTable::default();
+    let mut indices = Vec::with_capacity(block.len());
+    for v in block {
+        indices.push(table.index(v.to_bits()));
+        if table.values.len() > limit {
+            return None;
+        }
+    }
+    Some((table.values, indices))
+}
+
+/// Distinct `u32`s in order of appearance, found by open addressing (4
+/// slots per value the table may hold, so a probe ends in a step or two).
+struct SmallTable {
+    values: Vec<u32>,
+    slots: Vec<(u32, u32)>,
+}
+
+impl Default for SmallTable {
+    fn default() -> Self {
+        Self {
+            values: Vec::new(),
+            slots: vec![(0, u32::MAX); 4 * (MAX_TABLE + 1)],
+        }
+    }
+}
+
+impl SmallTable {
+    /// The index of `bits`, added if new. Holds [`MAX_TABLE`] + 1 values;
+    /// callers stop before more.
+    fn index(&mut self, bits: u32) -> u32 {
+        let n = self.slots.len();
+        let mut slot = (bits.wrapping_mul(0x9e37_79b9) >> 16) as usize % n;
+        loop {
+            match self.slots[slot] {
+                (_, u32::MAX) => {
+                    let i = self.values.len() as u32;
+                    self.values.push(bits);
+                    self.slots[slot] = (bits, i);
+                    return i;
+                }
+                (b, i) if b == bits => return i,
+                _ => slot = (slot + 1) % n,
+            }
+        }
+    }
 }
 
 /// A writer that knows how many bytes it has written (the offsets values
@@ -475,6 +575,37 @@ mod tests {
         let wide: Vec<i64> = vec![1, 2, 3, 1 << 40, -(1 << 33), 7, 7, 7];
         let bytes = encode_integers(wide.iter().copied(), true);
         assert_eq!(decode(&bytes, wide.len(), true), wide);
+    }
+
+    #[test]
+    fn few_distinct_floats_become_a_table_and_many_stay_plain() {
+        let ramp: Vec<f32> = (0..64)
+            .map(|i| [0.5, 0.25, -0.0, f32::MIN_POSITIVE][i % 4])
+            .collect();
+        let body = float_lookup_table(&ramp).unwrap();
+        assert_eq!(body[0], b't');
+        assert_eq!(u32::from_le_bytes(body[1..5].try_into().unwrap()), 4);
+        let table: Vec<f32> = body[5..21]
+            .chunks(4)
+            .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        assert_eq!(
+            table[2].to_bits(),
+            (-0.0f32).to_bits(),
+            "bit patterns are kept"
+        );
+        let compressed = u64::from_le_bytes(body[21..29].try_into().unwrap()) as usize;
+        let coded =
+            lz4_flex::block::decompress(&body[30..30 + compressed - 1], 4 + 16 + 64).unwrap();
+        let indices = decode(&coded, 64, false);
+        let back: Vec<f32> = indices.iter().map(|&i| table[i as usize]).collect();
+        assert!(
+            back.iter()
+                .zip(&ramp)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        );
+        let distinct: Vec<f32> = (0..64).map(|i| i as f32 * 0.1).collect();
+        assert!(float_lookup_table(&distinct).is_none());
     }
 
     #[test]

@@ -12,7 +12,8 @@
 //! `endTimeCode` and `timeCodesPerSecond`.
 //!
 //! Integer arrays (curve counts, ids, mesh indices) use the crate format's
-//! integer compression; floats are written as they are.
+//! integer compression, float arrays with few distinct values (widths) its
+//! lookup tables; points, normals and colours are written as they are.
 
 mod crate_file;
 
@@ -24,7 +25,7 @@ use crate::Curves;
 use crate::mesh::Mesh;
 use crate_file::{
     BOOTSTRAP_SIZE, Counted, MIN_COMPRESSED_ARRAY_SIZE, ROOT_PATH, Spec, SpecType, Structure,
-    VERSION, ValueRep, ValueType, compressed_integers,
+    VERSION, ValueRep, ValueType, compressed_integers, float_lookup_table,
 };
 use std::collections::{HashMap, HashSet};
 use std::io::{Seek, SeekFrom, Write};
@@ -251,7 +252,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
                 ints.iter().map(|&v| v as i64),
                 true,
             )?,
-            UsdValues::Floats(floats) => self.plain_array(ValueType::Float, floats)?,
+            UsdValues::Floats(floats) => self.float_array(floats)?,
             UsdValues::Vec2s(v) => self.plain_array(ValueType::Vec2f, v)?,
             UsdValues::Vec3s(v) => self.plain_array(ValueType::Vec3f, v)?,
         })
@@ -268,10 +269,28 @@ impl<W: Write + Seek> UsdcWriter<W> {
         if len == 0 {
             return Ok(ValueRep::array(ty, 0, false));
         }
+        // OpenUSD reads an array in place from the mapped file, without a
+        // copy, when its values are aligned: start the count (and so the
+        // values after it) on 8 bytes.
+        self.align(8)?;
         let at = self.out.position;
         self.out.write_all(&(len as u64).to_le_bytes())?;
         write_le_words(&mut self.out, bytemuck::cast_slice(values))?;
         Ok(ValueRep::array(ty, at, false))
+    }
+
+    /// A float array: as a lookup table where few values are distinct
+    /// (OpenUSD's float compression, format 0.6 on), else as it is.
+    fn float_array(&mut self, values: &[f32]) -> std::io::Result<ValueRep> {
+        if values.len() >= MIN_COMPRESSED_ARRAY_SIZE
+            && let Some(body) = float_lookup_table(values)
+        {
+            let at = self.out.position;
+            self.out.write_all(&(values.len() as u64).to_le_bytes())?;
+            self.out.write_all(&body)?;
+            return Ok(ValueRep::array(ValueType::Float, at, true));
+        }
+        self.plain_array(ValueType::Float, values)
     }
 
     /// An integer array: compressed from [`MIN_COMPRESSED_ARRAY_SIZE`]
@@ -298,6 +317,12 @@ impl<W: Write + Seek> UsdcWriter<W> {
             }
         }
         Ok(ValueRep::array(ty, at, compressed))
+    }
+
+    /// Pads the file with zeros to a multiple of `alignment`.
+    fn align(&mut self, alignment: u64) -> std::io::Result<()> {
+        let pad = self.out.position.next_multiple_of(alignment) - self.out.position;
+        self.out.write_all(&[0u8; 8][..pad as usize])
     }
 
     /// A list of tokens (`primChildren`, `properties`).
