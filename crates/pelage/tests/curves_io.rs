@@ -483,6 +483,72 @@ fn hostile_alembic_files_are_errors_naming_the_byte_and_never_panic() {
 }
 
 #[test]
+fn hostile_usdc_files_are_errors_naming_the_byte_and_never_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("good.usdc");
+    write_usd(
+        &good,
+        &[("part_0", &small_groom(20, 5))],
+        &UsdOptions::default(),
+        true,
+    );
+    let bytes = std::fs::read(&good).unwrap();
+    let path = dir.path().join("bad.usdc");
+    let read = |b: &[u8]| {
+        std::fs::write(&path, b).unwrap();
+        read_curves(&path).map_err(|e| e.to_string())
+    };
+    assert!(read(&bytes).is_ok());
+
+    // A table of contents past the end, a section claiming 2^40 entries.
+    let mut far = bytes.clone();
+    far[16..24].copy_from_slice(&(1u64 << 40).to_le_bytes());
+    let err = read(&far).unwrap_err();
+    assert!(
+        err.contains("bad.usdc: byte 1099511627776: the table of contents: 8 bytes past the end"),
+        "{err}"
+    );
+    let toc = u64::from_le_bytes(bytes[16..24].try_into().unwrap()) as usize;
+    let tokens = u64::from_le_bytes(bytes[toc + 8 + 16..toc + 8 + 24].try_into().unwrap()) as usize;
+    let mut huge = bytes.clone();
+    huge[tokens..tokens + 8].copy_from_slice(&(1u64 << 40).to_le_bytes());
+    let err = read(&huge).unwrap_err();
+    assert!(err.contains("TOKENS:"), "{err}");
+    assert!(read(&bytes[..bytes.len() - 40]).is_err());
+    assert!(
+        read(b"PXR-USDC")
+            .unwrap_err()
+            .contains("past the end of the file")
+    );
+
+    // Every truncation and many corruptions: an error or curves, never a
+    // panic or an allocation of a size the file only claims.
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    for cut in (0..bytes.len()).step_by(97) {
+        let _ = read(&bytes[..cut]);
+    }
+    // Corruptions aimed at the structure at the end as often as at the values.
+    let structure = toc.saturating_sub(2000);
+    for k in 0..600 {
+        let mut b = bytes.clone();
+        let from = if k % 2 == 0 { structure } else { 0 };
+        let at = from + next() as usize % (b.len() - 8 - from);
+        if next() % 2 == 0 {
+            b[at..at + 8].copy_from_slice(&(next() >> (next() % 64)).to_le_bytes());
+        } else {
+            b[at] ^= 1 << (next() % 8);
+        }
+        let _ = read(&b);
+    }
+}
+
+#[test]
 fn usda_bytes_do_not_depend_on_the_number_of_threads() {
     // Large enough for several formatting blocks.
     let groom = small_groom(6000, 16);

@@ -2,7 +2,9 @@
 //! in path order, concatenated, with its ancestors' transforms applied — what
 //! pelage's writer and Blender's USD export write.
 //!
-//! The layer is parsed by the `openusd` crate (pure Rust). Only the file's
+//! Text layers are parsed by the `openusd` crate (pure Rust), binary ones
+//! by pelage's checked crate reader (`usdc::read`) into openusd's layer
+//! type. Only the file's
 //! own layer is read: references, payloads and sublayers are not followed,
 //! and animated points must be exported as one frame. Widths are read as
 //! `vertex` (or `varying` on linear curves), `uniform` or `constant`;
@@ -197,7 +199,7 @@ fn open_layer(path: &Path) -> Result<Box<dyn AbstractData>, CurvesReadError> {
         .map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
     let head = &head[..n];
     if head.starts_with(b"PXR-USDC") {
-        Ok(openusd::usdc::read_file(path).map_err(|e| parse_error(path, &e))?)
+        super::usdc::read_usdc(path)
     } else if head.starts_with(b"#usda") {
         Ok(Box::new(
             openusd::usda::read_file(path).map_err(|e| parse_error(path, &e))?,

@@ -16,6 +16,9 @@
 //! lookup tables; points, normals and colours are written as they are.
 
 mod crate_file;
+mod read;
+
+pub(crate) use read::read_usdc;
 
 use super::usd_schema::{
     UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name, mesh_attributes,
