@@ -188,6 +188,30 @@ fn sample_gives_byte_identical_files_on_one_and_two_threads() {
     assert!(one == two, "the files differ between 1 and 2 threads");
     // Header + 300,000 × (xyz, normal, st, triangle).
     assert!(one.len() > 300_000 * 36);
+
+    // The same points as USD Points prims, binary and text.
+    let usdc = run("2", "roots.usdc");
+    assert!(usdc.starts_with(b"PXR-USDC"));
+    assert!(
+        run("1", "roots.usdc") == usdc,
+        "the usdc differs between 1 and 2 threads"
+    );
+    run("2", "roots.usda");
+    let ply = pelage::io::read_points_ply(&dir.path().join("one.ply")).unwrap();
+    let (usdc, usda) = (dir.path().join("roots.usdc"), dir.path().join("roots.usda"));
+    if let Some((ok, report)) = usdcheck(&[Path::new("--same"), &usda, &usdc]) {
+        assert!(ok, "{report}");
+        let (ok, report) = usdcheck(&[&usdc]).unwrap();
+        assert!(ok, "{report}");
+        let spec = "/groom/points_0000.points@0[12345]";
+        let (ok, values) = usdcheck(&[Path::new("--values"), &usdc, Path::new(spec)]).unwrap();
+        assert!(ok, "{values}");
+        let p = support::numbers_after(&values, &format!("{spec} = "));
+        assert_eq!(
+            [p[0] as f32, p[1] as f32, p[2] as f32],
+            ply[12345].to_array()
+        );
+    }
 }
 
 #[test]

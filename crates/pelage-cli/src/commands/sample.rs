@@ -1,5 +1,6 @@
 //! `pelage sample`: hair-root positions on a mesh from a density map
-//! (Sik §3), written as a PLY point cloud.
+//! (Sik §3), written as a PLY point cloud or as USD `Points` prims (one per
+//! batch of a million points).
 
 use super::load_mesh;
 use crate::format::thousands;
@@ -7,7 +8,7 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use pelage::Map;
-use pelage::io::{PointsPly, write_atomically};
+use pelage::io::{PointsPly, SurfacePoints, UsdOptions, UsdaWriter, UsdcWriter, write_atomically};
 use pelage::mesh::SurfacePoint;
 use pelage::sample::{
     DensitySampler, DensitySamplerOptions, RejectionSampler, Selector, SurfaceSampler, sample_into,
@@ -38,7 +39,7 @@ pub struct SampleArgs {
     /// Grid cells as a percentage of the CDF size, for `--method subdivision`.
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(0..=400))]
     pub grid: u32,
-    /// Output PLY file.
+    /// Output: .ply (a point cloud), .usdc or .usd (binary USD), .usda.
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -52,6 +53,47 @@ pub enum Method {
     Alias,
     /// Rejection sampling (Sik §3.4.1), for comparison.
     Rejection,
+}
+
+/// What `--output`'s extension asks for.
+enum PointsFormat {
+    Ply,
+    Usdc,
+    Usda,
+}
+
+/// A batch's points evaluated on the mesh, for a USD `Points` prim.
+struct SampledBatch {
+    positions: Vec<glam::Vec3>,
+    normals: Vec<glam::Vec3>,
+    uvs: Option<Vec<glam::Vec2>>,
+    triangles: Vec<u32>,
+}
+
+impl SampledBatch {
+    fn of(mesh: &pelage::Mesh, points: &[SurfacePoint]) -> Self {
+        use rayon::prelude::*;
+        Self {
+            positions: points.par_iter().map(|p| p.position(mesh)).collect(),
+            normals: points.par_iter().map(|p| p.normal(mesh)).collect(),
+            uvs: mesh.has_uvs().then(|| {
+                points
+                    .par_iter()
+                    .map(|p| p.uv(mesh).unwrap_or_default())
+                    .collect()
+            }),
+            triangles: points.iter().map(|p| p.tri).collect(),
+        }
+    }
+
+    fn view(&self) -> SurfacePoints<'_> {
+        SurfacePoints {
+            positions: &self.positions,
+            normals: &self.normals,
+            uvs: self.uvs.as_deref(),
+            triangles: &self.triangles,
+        }
+    }
 }
 
 /// Points generated and written per batch (bounded memory, progress).
@@ -91,17 +133,55 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
     } else {
         ProgressBar::hidden()
     };
+    let format = match args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("ply") => PointsFormat::Ply,
+        Some("usdc" | "usd") => PointsFormat::Usdc,
+        Some("usda") => PointsFormat::Usda,
+        _ => anyhow::bail!(
+            "{}: unknown points format; pelage writes sampled points as .ply, .usdc (or .usd) and .usda",
+            args.output.display()
+        ),
+    };
     let sampling = Instant::now();
     write_atomically(&args.output, |out| {
-        let mut ply = PointsPly::new(&mesh, args.count, out)?;
         let mut batch = vec![SurfacePoint::default(); BATCH.min(args.count) as usize];
-        let mut first = 0;
-        while first < args.count {
+        let mut batches = (0..args.count).step_by(BATCH as usize).map(|first| {
             let n = BATCH.min(args.count - first) as usize;
             sample_into(sampler.as_ref(), args.seed, first, &mut batch[..n]);
-            ply.write(&batch[..n])?;
-            first += n as u64;
-            progress.set_position(first);
+            progress.set_position(first + n as u64);
+            batch[..n].to_vec()
+        });
+        let other = std::io::Error::other;
+        let options = UsdOptions::default();
+        match format {
+            PointsFormat::Ply => {
+                let mut ply = PointsPly::new(&mesh, args.count, out)?;
+                batches.try_for_each(|b| ply.write(&b))?;
+            }
+            PointsFormat::Usdc => {
+                let mut usd = UsdcWriter::new(out, &options).map_err(other)?;
+                for (k, b) in batches.enumerate() {
+                    let points = SampledBatch::of(&mesh, &b);
+                    usd.write_points(&format!("points_{k:04}"), &points.view())
+                        .map_err(other)?;
+                }
+                usd.finish().map_err(other)?;
+            }
+            PointsFormat::Usda => {
+                let mut usd = UsdaWriter::new(out, &options).map_err(other)?;
+                for (k, b) in batches.enumerate() {
+                    let points = SampledBatch::of(&mesh, &b);
+                    usd.write_points(&format!("points_{k:04}"), &points.view())
+                        .map_err(other)?;
+                }
+                usd.finish().map_err(other)?;
+            }
         }
         Ok(())
     })?;

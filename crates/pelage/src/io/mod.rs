@@ -38,7 +38,7 @@ pub use points_ply::{
 pub use read_error::{CurvesReadError, CurvesReadErrorKind};
 pub use render_text::{bezier_control_points, write_pbrt, write_rib};
 pub use usd_read::{DEFAULT_WIDTH, read_usd_curves, read_usd_extent};
-pub use usd_schema::UsdPrimWriter;
+pub use usd_schema::{SurfacePoints, UsdPrimWriter};
 pub use usda::{CurveBasis, UpAxis, UsdOptions, UsdWrap, UsdWriteError, UsdaWriter};
 pub use usdc::UsdcWriter;
 

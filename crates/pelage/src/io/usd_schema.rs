@@ -28,6 +28,64 @@ pub trait UsdPrimWriter {
     fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError>;
 }
 
+/// Points sampled on a mesh (`pelage sample`), as a `UsdGeomPoints` prim:
+/// positions, surface normals, the surface UV (`st`) where the mesh has
+/// UVs and the triangle each lies on (`triangle`), all per point.
+pub struct SurfacePoints<'a> {
+    /// Positions.
+    pub positions: &'a [Vec3],
+    /// The surface's normal at each.
+    pub normals: &'a [Vec3],
+    /// The surface's UV at each, if the mesh has UVs.
+    pub uvs: Option<&'a [Vec2]>,
+    /// The triangle each lies on.
+    pub triangles: &'a [u32],
+}
+
+/// The attributes of a `Points` prim of sampled surface points.
+pub(crate) fn points_attributes<'a>(points: &SurfacePoints<'a>) -> Vec<UsdAttribute<'a>> {
+    let bounds = points
+        .positions
+        .iter()
+        .fold(None, |b: Option<(Vec3, Vec3)>, &p| {
+            Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
+        });
+    let (lo, hi) = bounds.unwrap_or((Vec3::ZERO, Vec3::ZERO));
+    let mut attributes = vec![
+        UsdAttribute::new(
+            "points",
+            "point3f[]",
+            UsdValues::Vec3s(Cow::Borrowed(points.positions)),
+        ),
+        UsdAttribute::new(
+            "extent",
+            "float3[]",
+            UsdValues::Vec3s(Cow::Owned(vec![lo, hi])),
+        ),
+        UsdAttribute::new(
+            "normals",
+            "normal3f[]",
+            UsdValues::Vec3s(Cow::Borrowed(points.normals)),
+        )
+        .interpolated("vertex"),
+    ];
+    if let Some(uvs) = points.uvs {
+        attributes.push(
+            UsdAttribute::new("primvars:st", "texCoord2f[]", UsdValues::Vec2s(uvs))
+                .interpolated("vertex"),
+        );
+    }
+    attributes.push(
+        UsdAttribute::new(
+            "primvars:triangle",
+            "int[]",
+            UsdValues::Ints(Cow::Borrowed(points.triangles)),
+        )
+        .interpolated("vertex"),
+    );
+    attributes
+}
+
 /// The values of one attribute.
 pub(crate) enum UsdValues<'a> {
     /// One token (`uniform token type = "cubic"`).

@@ -11,7 +11,8 @@
 
 use super::text::{put_f32, put_tuple2, put_tuple3, put_u64};
 use super::usd_schema::{
-    UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name, mesh_attributes,
+    SurfacePoints, UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name,
+    mesh_attributes, points_attributes,
 };
 use crate::Curves;
 use crate::mesh::Mesh;
@@ -198,6 +199,15 @@ impl<W: Write> UsdaWriter<W> {
     pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
         let attributes = basis_curves_attributes(name, curves, &self.options)?;
         self.write_prim("BasisCurves", name, &attributes)
+    }
+
+    /// Writes sampled surface points as a `Points` prim named `name`.
+    pub fn write_points(
+        &mut self,
+        name: &str,
+        points: &SurfacePoints,
+    ) -> Result<(), UsdWriteError> {
+        self.write_prim("Points", name, &points_attributes(points))
     }
 
     /// Writes the skin as a `Mesh` prim named `name` (triangles, vertex

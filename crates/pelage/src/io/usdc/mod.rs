@@ -21,7 +21,8 @@ mod read;
 pub(crate) use read::read_usdc;
 
 use super::usd_schema::{
-    UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name, mesh_attributes,
+    SurfacePoints, UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name,
+    mesh_attributes, points_attributes,
 };
 use super::{UpAxis, UsdOptions, UsdWriteError};
 use crate::Curves;
@@ -155,6 +156,16 @@ impl<W: Write + Seek> UsdcWriter<W> {
                 samples.push((time, rep));
             }
         }
+        Ok(())
+    }
+
+    /// Writes sampled surface points as a `Points` prim named `name`.
+    pub fn write_points(
+        &mut self,
+        name: &str,
+        points: &SurfacePoints,
+    ) -> Result<(), UsdWriteError> {
+        self.write_prim("Points", name, &points_attributes(points), false)?;
         Ok(())
     }
 
