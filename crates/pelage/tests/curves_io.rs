@@ -255,6 +255,28 @@ fn animated_usdc_holds_each_frame_and_the_stage_time_range() {
         ok && text.contains("stage 10 to 13 at 24 per second"),
         "{text}"
     );
+
+    // And Blender's importer, at the same two frames (USD keeps Y up).
+    let Some((ok, report)) = blendercheck(&[
+        path.as_os_str(),
+        "--point".as_ref(),
+        "7".as_ref(),
+        "--frames".as_ref(),
+        "10,13".as_ref(),
+    ]) else {
+        return;
+    };
+    assert!(ok, "{report}");
+    for (frame, (_, curves)) in [(10, &frames[0]), (13, &frames[3])] {
+        let got = numbers_after(&report, &format!("frame {frame}: a point[7] = "));
+        let want = curves.points()[7];
+        for k in 0..3 {
+            assert!(
+                (got[k] as f32 - want[k]).abs() < 1e-6,
+                "frame {frame}: {got:?} vs {want}\n{report}"
+            );
+        }
+    }
 }
 
 /// The array elements `PATH@TIME[INDEX]` as Pixar's library reads them
