@@ -257,23 +257,32 @@ fn animated_usdc_holds_each_frame_and_the_stage_time_range() {
     );
 
     // And Blender's importer, at the same two frames (USD keeps Y up).
-    let Some((ok, report)) = blendercheck(&[
-        path.as_os_str(),
+    let expected = [frames[0].1.points()[7], frames[3].1.points()[7]];
+    assert_blender_points(&path, 7, [10, 13], expected.map(|p| p.to_array()));
+}
+
+/// Asserts that Blender's importer evaluates point `index` of the object
+/// `a` of `file` at two frames to `want` (skipped where Blender cannot be
+/// set up).
+fn assert_blender_points(file: &Path, index: usize, frames: [i32; 2], want: [[f32; 3]; 2]) {
+    let (index, list) = (index.to_string(), format!("{},{}", frames[0], frames[1]));
+    let args = [
+        file.as_os_str(),
         "--point".as_ref(),
-        "7".as_ref(),
+        index.as_ref(),
         "--frames".as_ref(),
-        "10,13".as_ref(),
-    ]) else {
+        list.as_ref(),
+    ];
+    let Some((ok, report)) = blendercheck(&args) else {
         return;
     };
     assert!(ok, "{report}");
-    for (frame, (_, curves)) in [(10, &frames[0]), (13, &frames[3])] {
-        let got = numbers_after(&report, &format!("frame {frame}: a point[7] = "));
-        let want = curves.points()[7];
+    for (frame, want) in frames.iter().zip(want) {
+        let got = numbers_after(&report, &format!("frame {frame}: a point[{index}] = "));
         for k in 0..3 {
             assert!(
                 (got[k] as f32 - want[k]).abs() < 1e-6,
-                "frame {frame}: {got:?} vs {want}\n{report}"
+                "frame {frame}: {got:?} vs {want:?}\n{report}"
             );
         }
     }
@@ -412,28 +421,9 @@ fn animated_alembic_holds_each_frame_for_blender() {
     let err = abc.write_part_at("a", 1.0, &rest).unwrap_err().to_string();
     assert!(err.contains("write frames in increasing time"), "{err}");
 
-    let Some((ok, report)) = blendercheck(&[
-        path.as_os_str(),
-        "--point".as_ref(),
-        "7".as_ref(),
-        "--frames".as_ref(),
-        "10,13".as_ref(),
-    ]) else {
-        return;
-    };
-    assert!(ok, "{report}");
     // Blender turns Alembic's Y up into its Z up: (x, y, z) → (x, −z, y).
-    for (frame, (_, curves)) in [(10, &frames[0]), (13, &frames[3])] {
-        let got = numbers_after(&report, &format!("frame {frame}: a point[7] = "));
-        let p = curves.points()[7];
-        let want = [p.x, -p.z, p.y];
-        for k in 0..3 {
-            assert!(
-                (got[k] as f32 - want[k]).abs() < 1e-6,
-                "frame {frame}: {got:?} vs {want:?}\n{report}"
-            );
-        }
-    }
+    let expected = [frames[0].1.points()[7], frames[3].1.points()[7]];
+    assert_blender_points(&path, 7, [10, 13], expected.map(|p| [p.x, -p.z, p.y]));
 }
 
 #[test]
@@ -480,27 +470,10 @@ fn hostile_alembic_files_are_errors_naming_the_byte_and_never_panic() {
             .contains("not an Alembic file")
     );
 
-    // Every truncation and many corruptions: an error or curves, never a
-    // panic or an allocation of a size the file only claims.
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        state
-    };
-    for cut in (0..bytes.len()).step_by(7) {
-        let _ = read(&bytes[..cut]);
-    }
-    for _ in 0..600 {
-        let mut b = bytes.clone();
-        let at = next() as usize % (b.len() - 8);
-        if next() % 2 == 0 {
-            b[at..at + 8].copy_from_slice(&(next() >> (next() % 64)).to_le_bytes());
-        } else {
-            b[at] ^= 1 << (next() % 8);
-        }
-        let _ = read(&b);
+    // Every 7th truncation and 600 corruptions: an error or curves, never
+    // a panic or an allocation of a size the file only claims.
+    for damaged in damaged_copies(&bytes, 7, 0, 0x9e37_79b9_7f4a_7c15) {
+        let _ = read(&damaged);
     }
 }
 
@@ -543,31 +516,40 @@ fn hostile_usdc_files_are_errors_naming_the_byte_and_never_panic() {
             .contains("past the end of the file")
     );
 
-    // Every truncation and many corruptions: an error or curves, never a
-    // panic or an allocation of a size the file only claims.
-    let mut state = 0x2545_f491_4f6c_dd1du64;
+    // Every 97th truncation and 600 corruptions, half aimed at the
+    // structure at the end: an error or curves, never a panic or an
+    // allocation of a size the file only claims.
+    for damaged in damaged_copies(&bytes, 97, toc.saturating_sub(2000), 0x2545_f491_4f6c_dd1d) {
+        let _ = read(&damaged);
+    }
+}
+
+/// Damaged copies of `bytes`: cut every `step` bytes, then 600 with 8
+/// bytes overwritten or one bit flipped, every other one after `focus`.
+fn damaged_copies(bytes: &[u8], step: usize, focus: usize, seed: u64) -> Vec<Vec<u8>> {
+    let mut state = seed;
     let mut next = move || {
         state ^= state << 13;
         state ^= state >> 7;
         state ^= state << 17;
         state
     };
-    for cut in (0..bytes.len()).step_by(97) {
-        let _ = read(&bytes[..cut]);
-    }
-    // Corruptions aimed at the structure at the end as often as at the values.
-    let structure = toc.saturating_sub(2000);
+    let mut copies: Vec<Vec<u8>> = (0..bytes.len())
+        .step_by(step)
+        .map(|cut| bytes[..cut].to_vec())
+        .collect();
     for k in 0..600 {
-        let mut b = bytes.clone();
-        let from = if k % 2 == 0 { structure } else { 0 };
+        let mut b = bytes.to_vec();
+        let from = if k % 2 == 0 { focus } else { 0 };
         let at = from + next() as usize % (b.len() - 8 - from);
         if next() % 2 == 0 {
             b[at..at + 8].copy_from_slice(&(next() >> (next() % 64)).to_le_bytes());
         } else {
             b[at] ^= 1 << (next() % 8);
         }
-        let _ = read(&b);
+        copies.push(b);
     }
+    copies
 }
 
 #[test]

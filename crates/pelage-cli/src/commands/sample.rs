@@ -8,7 +8,9 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use pelage::Map;
-use pelage::io::{PointsPly, SurfacePoints, UsdOptions, UsdaWriter, UsdcWriter, write_atomically};
+use pelage::io::{
+    CurvesFormat, PointsPly, SurfacePoints, UsdOptions, write_atomically, write_streamed,
+};
 use pelage::mesh::SurfacePoint;
 use pelage::sample::{
     DensitySampler, DensitySamplerOptions, RejectionSampler, Selector, SurfaceSampler, sample_into,
@@ -58,8 +60,8 @@ pub enum Method {
 /// What `--output`'s extension asks for.
 enum PointsFormat {
     Ply,
-    Usdc,
-    Usda,
+    /// usdc or usda.
+    Usd(CurvesFormat),
 }
 
 /// A batch's points evaluated on the mesh, for a USD `Points` prim.
@@ -141,8 +143,8 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
         .as_deref()
     {
         Some("ply") => PointsFormat::Ply,
-        Some("usdc" | "usd") => PointsFormat::Usdc,
-        Some("usda") => PointsFormat::Usda,
+        Some("usdc" | "usd") => PointsFormat::Usd(CurvesFormat::Usdc),
+        Some("usda") => PointsFormat::Usd(CurvesFormat::Usda),
         _ => anyhow::bail!(
             "{}: unknown points format; pelage writes sampled points as .ply, .usdc (or .usd) and .usda",
             args.output.display()
@@ -157,30 +159,20 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
             progress.set_position(first + n as u64);
             batch[..n].to_vec()
         });
-        let other = std::io::Error::other;
-        let options = UsdOptions::default();
         match format {
             PointsFormat::Ply => {
                 let mut ply = PointsPly::new(&mesh, args.count, out)?;
                 batches.try_for_each(|b| ply.write(&b))?;
             }
-            PointsFormat::Usdc => {
-                let mut usd = UsdcWriter::new(out, &options).map_err(other)?;
-                for (k, b) in batches.enumerate() {
-                    let points = SampledBatch::of(&mesh, &b);
-                    usd.write_points(&format!("points_{k:04}"), &points.view())
-                        .map_err(other)?;
-                }
-                usd.finish().map_err(other)?;
-            }
-            PointsFormat::Usda => {
-                let mut usd = UsdaWriter::new(out, &options).map_err(other)?;
-                for (k, b) in batches.enumerate() {
-                    let points = SampledBatch::of(&mesh, &b);
-                    usd.write_points(&format!("points_{k:04}"), &points.view())
-                        .map_err(other)?;
-                }
-                usd.finish().map_err(other)?;
+            PointsFormat::Usd(format) => {
+                write_streamed(out, format, &UsdOptions::default(), |usd| {
+                    for (k, b) in batches.enumerate() {
+                        let points = SampledBatch::of(&mesh, &b);
+                        usd.write_points(&format!("points_{k:04}"), &points.view())
+                            .map_err(std::io::Error::other)?;
+                    }
+                    Ok(())
+                })?;
             }
         }
         Ok(())

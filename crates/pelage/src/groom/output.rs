@@ -6,11 +6,11 @@ use super::error::GroomError;
 use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
-    AbcWriter, CurvesExport, CurvesFormat, UpAxis, UsdOptions, UsdPrimWriter, UsdaWriter,
-    UsdcWriter, WriteError, read_usd_extent, write_atomically, write_curves,
+    CurvesExport, CurvesFormat, UpAxis, UsdOptions, UsdPrimWriter, UsdaWriter, WriteError,
+    read_usd_extent, write_atomically, write_curves, write_streamed,
 };
 use glam::Vec3;
-use std::io::{BufRead, Seek, Write};
+use std::io::{BufRead, Write};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -86,11 +86,10 @@ impl Generator {
                 on_part(p, c);
                 count(c);
             };
-            match format {
-                Some(CurvesFormat::Usdc) => self.write_usdc(out, parts, export, on_part),
-                Some(CurvesFormat::Abc) => self.write_abc(out, parts, export, on_part),
-                _ => self.write_usd(out, parts, export, on_part),
-            }
+            let format = format.expect("a streamed format");
+            write_streamed(out, format, &export.usd, |layer| {
+                self.stream_parts(layer, parts, export, on_part)
+            })
         })
         .map_err(|e| {
             // A part that could not grow comes back wrapped as an I/O
@@ -143,42 +142,11 @@ impl Generator {
         Ok(())
     }
 
-    /// [`write_usd`](Self::write_usd) as binary USD (usdc): the same
-    /// layer, the same streaming; the output must be seekable (the header
-    /// is written last).
-    pub fn write_usdc(
-        &self,
-        out: impl Write + Seek,
-        parts: Range<usize>,
-        export: &CurvesExport,
-        on_part: impl FnMut(usize, &Curves) + Send,
-    ) -> std::io::Result<()> {
-        let mut usd = UsdcWriter::new(out, &export.usd).map_err(std::io::Error::other)?;
-        self.stream_parts(&mut usd, parts, export, on_part)?;
-        usd.finish().map_err(std::io::Error::other)?;
-        Ok(())
-    }
-
-    /// [`write_usd`](Self::write_usd) as Alembic: one `ICurves` object a
-    /// part; the output must be seekable.
-    pub fn write_abc(
-        &self,
-        out: impl Write + Seek,
-        parts: Range<usize>,
-        export: &CurvesExport,
-        on_part: impl FnMut(usize, &Curves) + Send,
-    ) -> std::io::Result<()> {
-        let mut abc = AbcWriter::new(out, &export.usd).map_err(std::io::Error::other)?;
-        self.stream_parts(&mut abc, parts, export, on_part)?;
-        abc.finish().map_err(std::io::Error::other)?;
-        Ok(())
-    }
-
     /// Writes the skin (if exported), then grows `parts` on a second
     /// thread and writes each as it arrives.
     fn stream_parts(
         &self,
-        usd: &mut impl UsdPrimWriter,
+        usd: &mut dyn UsdPrimWriter,
         parts: Range<usize>,
         export: &CurvesExport,
         mut on_part: impl FnMut(usize, &Curves) + Send,

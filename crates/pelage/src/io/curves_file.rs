@@ -8,6 +8,7 @@ use super::{
     write_pbrt, write_rib,
 };
 use crate::{Curves, Mesh};
+use std::io::{Seek, Write};
 use std::path::Path;
 
 /// A curves file format, chosen by extension.
@@ -95,27 +96,13 @@ pub fn write_curves<'c>(
     })?;
     let basis = export.usd.basis;
     match format {
-        CurvesFormat::Usda => write_atomically(path, |out| {
-            let other = std::io::Error::other;
-            let mut usd = UsdaWriter::new(out, &export.usd).map_err(other)?;
-            write_usd_prims(&mut usd, parts, export)?;
-            usd.finish().map_err(other)?;
-            Ok(())
-        }),
-        CurvesFormat::Usdc => write_atomically(path, |out| {
-            let other = std::io::Error::other;
-            let mut usd = UsdcWriter::new(out, &export.usd).map_err(other)?;
-            write_usd_prims(&mut usd, parts, export)?;
-            usd.finish().map_err(other)?;
-            Ok(())
-        }),
-        CurvesFormat::Abc => write_atomically(path, |out| {
-            let other = std::io::Error::other;
-            let mut abc = AbcWriter::new(out, &export.usd).map_err(other)?;
-            write_usd_prims(&mut abc, parts, export)?;
-            abc.finish().map_err(other)?;
-            Ok(())
-        }),
+        CurvesFormat::Usda | CurvesFormat::Usdc | CurvesFormat::Abc => {
+            write_atomically(path, |out| {
+                write_streamed(out, format, &export.usd, |layer| {
+                    write_usd_prims(layer, parts, export)
+                })
+            })
+        }
         CurvesFormat::Hair | CurvesFormat::Ply => {
             // One array for the whole file: join the parts.
             let joined =
@@ -139,10 +126,46 @@ pub fn write_curves<'c>(
     }
 }
 
+/// Writes a streamed file of `format` (usdc, usda or Alembic) to `out`:
+/// starts it, lets `body` write prims, and finishes it. The other formats
+/// are refused (they are not streamed).
+pub fn write_streamed<W: Write + Seek>(
+    out: W,
+    format: CurvesFormat,
+    options: &UsdOptions,
+    body: impl FnOnce(&mut dyn UsdPrimWriter) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    use std::io::Error;
+    match format {
+        CurvesFormat::Usdc => {
+            let mut usd = UsdcWriter::new(out, options).map_err(Error::other)?;
+            body(&mut usd)?;
+            usd.finish().map_err(Error::other)?;
+        }
+        CurvesFormat::Usda => {
+            let mut usd = UsdaWriter::new(out, options).map_err(Error::other)?;
+            body(&mut usd)?;
+            usd.finish().map_err(Error::other)?;
+        }
+        CurvesFormat::Abc => {
+            let mut abc = AbcWriter::new(out, options).map_err(Error::other)?;
+            body(&mut abc)?;
+            abc.finish().map_err(Error::other)?;
+        }
+        other => {
+            return Err(Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!("{other:?} is not written as a stream of prims"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The skin (if exported) and then every part, as prims of one layer (or
 /// objects of one Alembic archive).
 fn write_usd_prims<'c>(
-    usd: &mut impl UsdPrimWriter,
+    usd: &mut dyn UsdPrimWriter,
     parts: impl IntoIterator<Item = (String, &'c Curves)>,
     export: &CurvesExport,
 ) -> std::io::Result<()> {

@@ -29,7 +29,9 @@ mod usdc;
 
 pub use abc::{AbcWriter, read_abc_curves};
 pub use atomic::write_atomically;
-pub use curves_file::{CurvesExport, CurvesFormat, join, read_curves, write_curves};
+pub use curves_file::{
+    CurvesExport, CurvesFormat, join, read_curves, write_curves, write_streamed,
+};
 pub use curves_ply::{read_curves_ply, write_curves_ply};
 pub use hair::{HairFile, HairWriteError};
 pub use points_ply::{

@@ -26,6 +26,8 @@ pub trait UsdPrimWriter {
     fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError>;
     /// Writes the skin as a `Mesh` prim named `name`.
     fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError>;
+    /// Writes sampled surface points as a `Points` prim named `name`.
+    fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), UsdWriteError>;
 }
 
 /// Points sampled on a mesh (`pelage sample`), as a `UsdGeomPoints` prim:

@@ -149,6 +149,37 @@ pub enum UsdWriteError {
     },
 }
 
+impl UsdWriteError {
+    /// Refuses a frame time that is not a number.
+    pub(crate) fn check_time(part: &str, time: f64) -> Result<(), Self> {
+        if time.is_finite() {
+            return Ok(());
+        }
+        Err(Self::BadSetting(format!(
+            "part {part:?}: the time {time} is not a number"
+        )))
+    }
+
+    /// Refuses a frame of an animated part whose curves differ from its
+    /// first frame's (`first`: that frame's offsets).
+    pub(crate) fn check_frame(
+        part: &str,
+        time: f64,
+        first: &[u32],
+        curves: &Curves,
+    ) -> Result<(), Self> {
+        if first == curves.offsets() {
+            return Ok(());
+        }
+        Err(Self::FrameMismatch {
+            part: part.to_string(),
+            time,
+            curves: (first.len().saturating_sub(1), curves.curve_count()),
+            points: (*first.last().unwrap_or(&0) as usize, curves.points().len()),
+        })
+    }
+}
+
 /// Values per formatted block: large enough to keep two threads busy,
 /// small enough that a window of blocks stays a few tens of megabytes.
 const BLOCK: usize = 1 << 14;
@@ -283,6 +314,10 @@ impl<W: Write> UsdPrimWriter for UsdaWriter<W> {
 
     fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
         UsdaWriter::write_mesh(self, name, mesh)
+    }
+
+    fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), UsdWriteError> {
+        UsdaWriter::write_points(self, name, points)
     }
 }
 

@@ -18,7 +18,7 @@ use crate::format::thousands;
 use anyhow::Context;
 use clap::Args;
 use pelage::io::{
-    AbcWriter, CurvesExport, UsdOptions, UsdPrimWriter, UsdaWriter, UsdcWriter, write_atomically,
+    CurvesExport, CurvesFormat, UsdOptions, UsdPrimWriter, write_atomically, write_streamed,
 };
 use pelage::sample::{DensitySampler, DensitySamplerOptions, sample_range};
 use pelage::{Curves, Map};
@@ -147,24 +147,12 @@ fn write_groom(args: &IoBenchArgs, hairs: u64, format: Format) -> anyhow::Result
             }
             Ok::<(), std::io::Error>(())
         };
-        let options = UsdOptions::default();
-        match format {
-            Format::Usdc => {
-                let mut usd = UsdcWriter::new(out, &options).map_err(E::other)?;
-                stream(&mut usd)?;
-                usd.finish().map_err(E::other)?;
-            }
-            Format::Usda => {
-                let mut usd = UsdaWriter::new(out, &options).map_err(E::other)?;
-                stream(&mut usd)?;
-                usd.finish().map_err(E::other)?;
-            }
-            Format::Abc => {
-                let mut abc = AbcWriter::new(out, &options).map_err(E::other)?;
-                stream(&mut abc)?;
-                abc.finish().map_err(E::other)?;
-            }
-        }
+        let format = match format {
+            Format::Usdc => CurvesFormat::Usdc,
+            Format::Usda => CurvesFormat::Usda,
+            Format::Abc => CurvesFormat::Abc,
+        };
+        write_streamed(out, format, &UsdOptions::default(), |writer| stream(writer))?;
         Ok(())
     })?;
     // Writing includes the final flush, fsync and rename.

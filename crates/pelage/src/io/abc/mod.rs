@@ -170,11 +170,7 @@ impl<W: Write + Seek> AbcWriter<W> {
         time: f64,
         curves: &Curves,
     ) -> Result<(), UsdWriteError> {
-        if !time.is_finite() {
-            return Err(UsdWriteError::BadSetting(format!(
-                "part {name:?}: the time {time} is not a number"
-            )));
-        }
+        UsdWriteError::check_time(name, time)?;
         let Some(index) = self.parts.iter().position(|p| p.name == name) else {
             return self.start_part(name, curves, Some(time));
         };
@@ -182,17 +178,7 @@ impl<W: Write + Seek> AbcWriter<W> {
         if part.times.is_empty() {
             return Err(UsdWriteError::DuplicateName(name.to_string()));
         }
-        if part.offsets != curves.offsets() {
-            return Err(UsdWriteError::FrameMismatch {
-                part: name.to_string(),
-                time,
-                curves: (part.offsets.len() - 1, curves.curve_count()),
-                points: (
-                    *part.offsets.last().unwrap_or(&0) as usize,
-                    curves.points().len(),
-                ),
-            });
-        }
+        UsdWriteError::check_frame(name, time, &part.offsets, curves)?;
         let last = *part.times.last().expect("an animated part has a frame");
         if time <= last {
             return Err(UsdWriteError::BadSetting(format!(
@@ -685,6 +671,17 @@ impl<W: Write + Seek> super::UsdPrimWriter for AbcWriter<W> {
     fn write_mesh(&mut self, _name: &str, _mesh: &crate::Mesh) -> Result<(), UsdWriteError> {
         Err(UsdWriteError::BadSetting(
             "pelage's Alembic files hold curves only: leave the skin out ([output] with_mesh = false, no --with-mesh) or write USD".into(),
+        ))
+    }
+
+    /// Alembic files from pelage hold curves only.
+    fn write_points(
+        &mut self,
+        _name: &str,
+        _points: &super::SurfacePoints,
+    ) -> Result<(), UsdWriteError> {
+        Err(UsdWriteError::BadSetting(
+            "pelage's Alembic files hold curves only: write sampled points as .ply or USD".into(),
         ))
     }
 }

@@ -111,11 +111,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
         time: f64,
         curves: &Curves,
     ) -> Result<(), UsdWriteError> {
-        if !time.is_finite() {
-            return Err(UsdWriteError::BadSetting(format!(
-                "part {name:?}: the time {time} is not a number"
-            )));
-        }
+        UsdWriteError::check_time(name, time)?;
         let attributes = basis_curves_attributes(name, curves, &self.options)?;
         if !self.animated.contains_key(name) {
             let specs = self.write_prim("BasisCurves", name, &attributes, true)?;
@@ -130,17 +126,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
             self.animated.insert(name.to_string(), part);
         }
         let part = &self.animated[name];
-        if part.offsets != curves.offsets() {
-            return Err(UsdWriteError::FrameMismatch {
-                part: name.to_string(),
-                time,
-                curves: (part.offsets.len() - 1, curves.curve_count()),
-                points: (
-                    *part.offsets.last().unwrap_or(&0) as usize,
-                    curves.points().len(),
-                ),
-            });
-        }
+        UsdWriteError::check_frame(name, time, &part.offsets, curves)?;
         let mut reps = Vec::new();
         for attribute in attributes.iter().filter(|a| ANIMATED.contains(&a.name)) {
             reps.push((attribute.name, self.pack(&attribute.values)?));
@@ -477,6 +463,10 @@ impl<W: Write + Seek> UsdPrimWriter for UsdcWriter<W> {
 
     fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
         UsdcWriter::write_mesh(self, name, mesh)
+    }
+
+    fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), UsdWriteError> {
+        UsdcWriter::write_points(self, name, points)
     }
 }
 
