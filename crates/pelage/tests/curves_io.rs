@@ -597,6 +597,28 @@ fn blender_style_usd_is_read_with_its_transforms_from_usda_and_usdc() {
 }
 
 #[test]
+fn blenders_alembic_export_is_read_in_world_space() {
+    // blender_curves.abc is Blender 5.0.1's Alembic export of
+    // blender_curves.usda as Blender imports it: the object keeps its own
+    // transform (rotated a quarter turn about Z, moved by (1, 2, 3)) but
+    // not the root's (10, 0, 0), and the export turns Z up into Y up:
+    // (x, y, z) → (x, z, −y). Its curves sit under an Xform with a matrix.
+    let want = [
+        Vec3::new(1.0, 3.0, -3.0),
+        Vec3::new(1.0, 4.0, -3.0),
+        Vec3::new(1.0, 5.0, -3.0),
+        Vec3::new(0.0, 3.0, -2.0),
+        Vec3::new(0.0, 3.5, -2.5),
+    ];
+    let curves = read_curves(&data("blender_curves.abc")).unwrap();
+    assert_eq!(curves.offsets(), &[0, 3, 5]);
+    for (a, b) in curves.points().iter().zip(want) {
+        assert!((*a - b).length() < 1e-6, "{a} vs {b}");
+    }
+    assert_eq!(curves.widths(), &[0.1, 0.05, 0.01, 0.1, 0.01]);
+}
+
+#[test]
 fn malformed_usd_is_an_error_naming_the_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(data("blender_curves.usda")).unwrap();

@@ -17,7 +17,7 @@ use super::super::usd_read::DEFAULT_WIDTH;
 use super::ogawa::{Child, EMPTY_DATA};
 use crate::Curves;
 use crate::mesh::Location;
-use glam::{Vec2, Vec3};
+use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::cell::Cell;
 use std::path::Path;
 
@@ -388,7 +388,7 @@ pub fn read_abc_curves(path: &Path) -> Result<Curves, CurvesReadError> {
         })?);
     }
     let mut found = Vec::new();
-    collect_curves(&file, top[2], "", &indexed, 0, &mut found)?;
+    collect_curves(&file, top[2], "", &indexed, DMat4::IDENTITY, 0, &mut found)?;
     if found.is_empty() {
         return Err(CurvesReadError::whole(
             path,
@@ -396,20 +396,26 @@ pub fn read_abc_curves(path: &Path) -> Result<Curves, CurvesReadError> {
         ));
     }
     let mut parts = Vec::with_capacity(found.len());
-    for (name, geom) in found {
-        parts.push(read_curves_object(&file, &name, geom, &indexed)?);
+    for (name, geom, world) in found {
+        parts.push(read_curves_object(&file, &name, geom, &indexed, world)?);
     }
     super::super::join(&parts).map_err(|e| CurvesReadError::whole(path, e.into()))
 }
 
-/// Walks the object tree; collects each curves object's path and `.geom`.
+/// A curves object: its path, its `.geom` compound, and the transform of
+/// the `Xform` objects above it.
+type Found = (String, Child, DMat4);
+
+/// Walks the object tree; collects each curves object, with the product
+/// of the transforms above it (`world`).
 fn collect_curves(
     file: &Ogawa,
     object: Child,
     path: &str,
     indexed: &[String],
+    world: DMat4,
     depth: usize,
-    found: &mut Vec<(String, Child)>,
+    found: &mut Vec<Found>,
 ) -> Result<(), CurvesReadError> {
     let what = if path.is_empty() { "/" } else { path };
     if depth > MAX_DEPTH {
@@ -443,25 +449,97 @@ fn collect_curves(
     for (i, (name, metadata)) in headers.iter().enumerate() {
         let child_path = format!("{path}/{name}");
         let group = children[i + 1];
-        if metadata_value(metadata, "schema") == Some("AbcGeom_Curve_v2") {
+        let schema = metadata_value(metadata, "schema");
+        let mut child_world = world;
+        if matches!(schema, Some("AbcGeom_Curve_v2" | "AbcGeom_Xform_v3")) {
             let properties = file.group(group, &child_path)?;
-            let top = Compound::read(
-                file,
-                properties.first().copied().unwrap_or(0),
-                indexed,
-                &child_path,
-            )?;
-            let geom = top.get(".geom").ok_or_else(|| {
-                file.fail(
-                    group,
-                    format!("{child_path}: a curves object without .geom"),
-                )
-            })?;
-            found.push((child_path.clone(), geom.1));
+            let first = properties.first().copied().unwrap_or(0);
+            let top = Compound::read(file, first, indexed, &child_path)?;
+            if schema == Some("AbcGeom_Curve_v2") {
+                let geom = top.get(".geom").ok_or_else(|| {
+                    let message = format!("{child_path}: a curves object without .geom");
+                    file.fail(group, message)
+                })?;
+                found.push((child_path.clone(), geom.1, world));
+            } else if let Some(xform) = top.get(".xform") {
+                let (local, inherits) = read_xform(file, xform.1, indexed, &child_path)?;
+                child_world = if inherits { world * local } else { local };
+            }
         }
-        collect_curves(file, group, &child_path, indexed, depth + 1, found)?;
+        collect_curves(
+            file,
+            group,
+            &child_path,
+            indexed,
+            child_world,
+            depth + 1,
+            found,
+        )?;
     }
     Ok(())
+}
+
+/// An `Xform` object's transform (first sample) and whether it inherits
+/// its parent's: the ops (a byte each: type × 16 + hint) read their
+/// channels from `.vals` in order, and compose first op outermost, as
+/// `XformSample::getMatrix` does (Imath's row vectors read as columns).
+fn read_xform(
+    file: &Ogawa,
+    xform: Child,
+    indexed: &[String],
+    path: &str,
+) -> Result<(DMat4, bool), CurvesReadError> {
+    let what = format!("{path}/.xform");
+    let compound = Compound::read(file, xform, indexed, &what)?;
+    let inherits = match compound.get(".inherits") {
+        Some(p) => first_sample(file, p, &what)?
+            .first()
+            .is_none_or(|&b| b != 0),
+        None => true,
+    };
+    let Some(ops) = compound.get(".ops") else {
+        return Ok((DMat4::IDENTITY, inherits));
+    };
+    let ops = first_sample(file, ops, &format!("{what}/.ops"))?;
+    let vals: Vec<f64> = match compound.get(".vals") {
+        Some(p) if p.0.pod == 11 => first_sample(file, p, &format!("{what}/.vals"))?
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+            .collect(),
+        Some(_) => return Err(file.fail(xform, format!("{what}/.vals: not doubles"))),
+        None => Vec::new(),
+    };
+    let mut channels = vals.iter().copied();
+    let mut take = |n: usize| -> Option<Vec<f64>> {
+        let v: Vec<f64> = channels.by_ref().take(n).collect();
+        (v.len() == n).then_some(v)
+    };
+    let mut local = DMat4::IDENTITY;
+    for (k, &op) in ops.iter().enumerate() {
+        let short = || file.fail(xform, format!("{what}: op {k} has too few values in .vals"));
+        let m = match op >> 4 {
+            0 => DMat4::from_scale(DVec3::from_slice(&take(3).ok_or_else(short)?)),
+            1 => DMat4::from_translation(DVec3::from_slice(&take(3).ok_or_else(short)?)),
+            2 => {
+                let v = take(4).ok_or_else(short)?;
+                let axis = DVec3::new(v[0], v[1], v[2]).normalize_or_zero();
+                DMat4::from_axis_angle(axis, v[3].to_radians())
+            }
+            3 => {
+                let m: [f64; 16] = take(16).ok_or_else(short)?.try_into().expect("16 values");
+                DMat4::from_cols_array(&m)
+            }
+            4 => DMat4::from_rotation_x(take(1).ok_or_else(short)?[0].to_radians()),
+            5 => DMat4::from_rotation_y(take(1).ok_or_else(short)?[0].to_radians()),
+            6 => DMat4::from_rotation_z(take(1).ok_or_else(short)?[0].to_radians()),
+            t => {
+                let message = format!("{what}: op {k} has the unknown type {t}");
+                return Err(file.fail(xform, message));
+            }
+        };
+        local *= m;
+    }
+    Ok((local, inherits))
 }
 
 fn read_curves_object(
@@ -469,6 +547,7 @@ fn read_curves_object(
     path: &str,
     geom: Child,
     indexed: &[String],
+    world: DMat4,
 ) -> Result<Curves, CurvesReadError> {
     let what = |p: &str| format!("{path}/.geom/{p}");
     let fail = |message: String| file.fail(geom, message);
@@ -493,11 +572,18 @@ fn read_curves_object(
         }
         first_sample(file, p, &what(name)).map(Some)
     };
+    // Into world space; normals turn with the inverse transpose.
+    let moved = world != DMat4::IDENTITY;
+    let turn = world.inverse().transpose();
     let points: Vec<Vec3> = match property("P", &[10], 3)? {
         Some(b) => floats(b)
             .collect::<Vec<_>>()
             .chunks_exact(3)
             .map(Vec3::from_slice)
+            .map(|p| match moved {
+                true => world.transform_point3(p.as_dvec3()).as_vec3(),
+                false => p,
+            })
             .collect(),
         None => return Err(fail(format!("{}: no P", path))),
     };
@@ -565,6 +651,13 @@ fn read_curves_object(
             .collect::<Vec<_>>()
             .chunks_exact(3)
             .map(Vec3::from_slice)
+            .map(|n| match moved {
+                true => turn
+                    .transform_vector3(n.as_dvec3())
+                    .as_vec3()
+                    .normalize_or_zero(),
+                false => n,
+            })
             .collect();
         curves = curves
             .with_normals(normals)
