@@ -228,6 +228,12 @@ fn animated_usdc_holds_each_frame_and_the_stage_time_range() {
         Ok(())
     })
     .unwrap();
+    // pelage reads the first frame.
+    let first = read_curves(&path).unwrap();
+    assert_eq!(
+        &first.points()[..frames[0].1.points().len()],
+        frames[0].1.points()
+    );
     // A frame with other curves is refused, naming the part and time.
     let mut usd =
         UsdcWriter::new(std::io::Cursor::new(Vec::new()), &UsdOptions::default()).unwrap();

@@ -4,9 +4,9 @@
 //!
 //! Text layers are parsed by the `openusd` crate (pure Rust), binary ones
 //! by pelage's checked crate reader (`usdc::read`) into openusd's layer
-//! type. Only the file's
-//! own layer is read: references, payloads and sublayers are not followed,
-//! and animated points must be exported as one frame. Widths are read as
+//! type. Only the file's own layer is read: references, payloads and
+//! sublayers are not followed. Animated attributes are read at their first
+//! time sample (the first frame). Widths are read as
 //! `vertex` (or `varying` on linear curves), `uniform` or `constant`;
 //! curves without widths get [`DEFAULT_WIDTH`].
 
@@ -63,11 +63,6 @@ pub fn read_usd_curves(path: &Path) -> Result<Curves, CurvesReadError> {
             Some(_) => {
                 return Err(fail(Kind::Unsupported(at(
                     "points are neither float3[] nor double3[]",
-                ))));
-            }
-            None if has_time_samples(data, prim, "points") => {
-                return Err(fail(Kind::Unsupported(at(
-                    "points are animated (time samples only); export a single frame",
                 ))));
             }
             None => return Err(fail(Kind::Inconsistent(at("no points")))),
@@ -237,17 +232,21 @@ fn parse_error(path: &Path, error: &dyn std::fmt::Display) -> CurvesReadError {
     CurvesReadError::whole(path, Kind::Syntax(text))
 }
 
+/// An attribute's value: its default, or for an animated attribute with
+/// no default its earliest time sample (the first frame).
 fn attribute(data: &dyn AbstractData, prim: &sdf::Path, name: &str) -> Option<Value> {
     let property = prim.append_property(name).ok()?;
-    data.try_field(&property, "default")
-        .ok()
-        .flatten()
-        .map(|v| v.into_owned())
-}
-
-fn has_time_samples(data: &dyn AbstractData, prim: &sdf::Path, name: &str) -> bool {
-    prim.append_property(name)
-        .is_ok_and(|p| data.has_field(&p, "timeSamples"))
+    let field = |f| data.try_field(&property, f).ok().flatten();
+    if let Some(value) = field("default") {
+        return Some(value.into_owned());
+    }
+    match field("timeSamples")?.into_owned() {
+        Value::TimeSamples(samples) => samples
+            .into_iter()
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, v)| v),
+        _ => None,
+    }
 }
 
 fn token(data: &dyn AbstractData, path: &sdf::Path, field: &str) -> Option<String> {

@@ -10,8 +10,8 @@
 //! a truncated, corrupted or hostile file is an error naming the byte and
 //! the structure, never a panic or an allocation of a size the file only
 //! claims. Fields of types pelage does not read (list ops, dictionaries,
-//! …) are left out of the layer; time samples are kept as a marker (pelage
-//! reads single frames of USD).
+//! …) are left out of the layer; of time samples only the earliest is
+//! decoded (pelage reads the first frame of an animation).
 
 use super::crate_file::MIN_COMPRESSED_ARRAY_SIZE;
 use crate::io::read_error::{CurvesReadError, CurvesReadErrorKind as Kind};
@@ -569,8 +569,12 @@ fn read_value(file: &Crate, s: &Structure, rep: u64, what: &str) -> Result<Optio
         return read_array(file, &s.tokens, at, ty, compressed, what);
     }
     Ok(Some(match ty {
-        // Time samples: kept as a marker; pelage reads single frames.
-        46 => Value::TimeSamples(Vec::new()),
+        46 => return first_time_sample(file, s, at, what),
+        48 => {
+            let n = file.u64_at(at, what)?;
+            let n = file.count(at + 8, n, 8, what)?;
+            Value::DoubleVec(doubles(file.take(at + 8, 8 * n, what)?))
+        }
         9 => Value::Double(f64::from_le_bytes(
             file.take(at, 8, what)?.try_into().expect("8"),
         )),
@@ -606,6 +610,59 @@ fn read_value(file: &Crate, s: &Structure, rep: u64, what: &str) -> Result<Optio
         }
         _ => return Ok(None),
     }))
+}
+
+/// The earliest of a field's time samples, as a one-sample list. At `at`:
+/// an offset to the times' rep, the rep, an offset to the values, their
+/// count and their reps; offsets count from where they are written.
+fn first_time_sample(file: &Crate, s: &Structure, at: usize, what: &str) -> Result<Option<Value>> {
+    let jump = |from: usize| -> Result<usize> {
+        let offset = file.u64_at(from, what)? as i64;
+        usize::try_from(from as i64 + offset).map_err(|_| {
+            file.fail(
+                from,
+                format!("{what}: a time-samples offset before the file"),
+            )
+        })
+    };
+    let times_at = jump(at)?;
+    let times_rep = file.u64_at(times_at, what)?;
+    // Times are a list of doubles, not themselves time samples.
+    if (times_rep >> 48) & 0xff == 46 {
+        return Err(file.fail(
+            times_at,
+            format!("{what}: time samples nested in their times"),
+        ));
+    }
+    let times = match read_value(file, s, times_rep, what)? {
+        Some(Value::DoubleVec(t)) => t,
+        _ => {
+            return Err(file.fail(
+                times_at,
+                format!("{what}: the sample times are not doubles"),
+            ));
+        }
+    };
+    let values_at = jump(times_at + 8)?;
+    let n = file.u64_at(values_at, what)?;
+    let n = file.count(values_at + 8, n, 8, what)?;
+    if n != times.len() {
+        return Err(file.fail(
+            values_at,
+            format!("{what}: {n} values for {} times", times.len()),
+        ));
+    }
+    let Some(first) = (0..n).min_by(|&a, &b| times[a].total_cmp(&times[b])) else {
+        return Ok(Some(Value::TimeSamples(Vec::new())));
+    };
+    let rep = file.u64_at(values_at + 8 + 8 * first, what)?;
+    if (rep >> 48) & 0xff == 46 {
+        return Err(file.fail(
+            values_at,
+            format!("{what}: time samples nested in a sample"),
+        ));
+    }
+    Ok(read_value(file, s, rep, what)?.map(|v| Value::TimeSamples(vec![(times[first], v)])))
 }
 
 fn floats(b: &[u8]) -> Vec<f32> {
