@@ -675,6 +675,28 @@ fn usd_writer_refuses_what_usd_cannot_hold() {
         err.contains("curve 0 has 3 points; nonperiodic Catmull-Rom curves need at least 4"),
         "{err}"
     );
+    // A scale or frame rate that is not a positive number, in every format.
+    for (meters_per_unit, time_codes_per_second) in [(f64::NAN, 24.0), (0.0, 24.0), (1.0, -24.0)] {
+        let bad = UsdOptions {
+            meters_per_unit,
+            time_codes_per_second,
+            ..UsdOptions::default()
+        };
+        let export = CurvesExport {
+            usd: bad,
+            mesh: None,
+        };
+        for ext in ["usda", "usdc", "abc"] {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join(format!("x.{ext}"));
+            let parts = [("p".to_string(), &short)];
+            let err = write_curves(&path, parts.iter().map(|(n, c)| (n.clone(), *c)), &export)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("must be a positive number"), "{ext}: {err}");
+            assert!(!path.exists(), "{ext}: a file was left");
+        }
+    }
     let mut usd = UsdaWriter::new(Vec::new(), &UsdOptions::default()).unwrap();
     assert!(usd.write_part("9lives", &short).is_err());
     assert!(usd.write_part("has space", &short).is_err());

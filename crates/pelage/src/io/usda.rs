@@ -88,6 +88,27 @@ impl Default for UsdOptions {
 }
 
 impl UsdOptions {
+    /// Refuses options no file can hold: a root name USD does not accept,
+    /// and a scale or frame rate that is not a positive number (a file
+    /// with `metersPerUnit = NaN` would be written and then misread).
+    pub fn check(&self) -> Result<(), UsdWriteError> {
+        check_name(&self.root)?;
+        for (what, value) in [
+            ("metersPerUnit", self.meters_per_unit),
+            (
+                "timeCodesPerSecond (frames per second)",
+                self.time_codes_per_second,
+            ),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(UsdWriteError::BadSetting(format!(
+                    "{what} must be a positive number, not {value}"
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// The fewest points a curve may have under these options.
     pub fn min_points_per_curve(&self) -> usize {
         match (self.basis, self.wrap) {
@@ -198,7 +219,7 @@ pub struct UsdaWriter<W: Write> {
 impl<W: Write> UsdaWriter<W> {
     /// Writes the stage metadata and opens the default prim.
     pub fn new(mut out: W, options: &UsdOptions) -> Result<Self, UsdWriteError> {
-        check_name(&options.root)?;
+        options.check()?;
         let up = match options.up_axis {
             UpAxis::Y => "Y",
             UpAxis::Z => "Z",

@@ -140,12 +140,7 @@ impl<W: Write + Seek> AbcWriter<W> {
     /// objects sit under the archive's top object) and the frames per
     /// second come from `options`.
     pub fn new(out: W, options: &UsdOptions) -> Result<Self, UsdWriteError> {
-        if !(options.time_codes_per_second.is_finite() && options.time_codes_per_second > 0.0) {
-            return Err(UsdWriteError::BadSetting(format!(
-                "frames per second must be a positive number, not {}",
-                options.time_codes_per_second
-            )));
-        }
+        options.check()?;
         Ok(Self {
             ogawa: OgawaWriter::new(out)?,
             options: options.clone(),

@@ -67,13 +67,7 @@ pub struct UsdcWriter<W: Write + Seek> {
 impl<W: Write + Seek> UsdcWriter<W> {
     /// Reserves the bootstrap header; the rest of the file follows.
     pub fn new(mut out: W, options: &UsdOptions) -> Result<Self, UsdWriteError> {
-        check_name(&options.root)?;
-        if !options.meters_per_unit.is_finite() || options.meters_per_unit <= 0.0 {
-            return Err(UsdWriteError::BadSetting(format!(
-                "metersPerUnit must be a positive number, not {}",
-                options.meters_per_unit
-            )));
-        }
+        options.check()?;
         let start = out.stream_position()?;
         out.write_all(&[0u8; BOOTSTRAP_SIZE])?;
         let mut structure = Structure::new(&options.root);
