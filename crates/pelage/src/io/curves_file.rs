@@ -32,6 +32,19 @@ pub enum CurvesFormat {
 }
 
 impl CurvesFormat {
+    /// The extension files of this format are written with.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Usda => "usda",
+            Self::Usdc => "usdc",
+            Self::Abc => "abc",
+            Self::Hair => "hair",
+            Self::Ply => "ply",
+            Self::Rib => "rib",
+            Self::Pbrt => "pbrt",
+        }
+    }
+
     /// The format a path's extension names, if any.
     pub fn from_path(path: &Path) -> Option<Self> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();

@@ -53,25 +53,10 @@ pub struct IoBenchArgs {
 }
 
 /// The formats measured, in the order of the table.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Format {
-    Usdc,
-    Usda,
-    Abc,
-}
-
-impl Format {
-    fn extension(self) -> &'static str {
-        match self {
-            Format::Usdc => "usdc",
-            Format::Usda => "usda",
-            Format::Abc => "abc",
-        }
-    }
-}
+const FORMATS: [CurvesFormat; 3] = [CurvesFormat::Usdc, CurvesFormat::Usda, CurvesFormat::Abc];
 
 struct Run {
-    format: Format,
+    format: CurvesFormat,
     hairs: u64,
     bytes: u64,
     write: Duration,
@@ -117,7 +102,7 @@ fn part(
         .with_ids((first..first + count).collect())?)
 }
 
-fn write_groom(args: &IoBenchArgs, hairs: u64, format: Format) -> anyhow::Result<Run> {
+fn write_groom(args: &IoBenchArgs, hairs: u64, format: CurvesFormat) -> anyhow::Result<Run> {
     let spot = pelage::assets::spot();
     let sampler =
         DensitySampler::new(&spot, &Map::Constant(1.0), DensitySamplerOptions::default())?;
@@ -146,11 +131,6 @@ fn write_groom(args: &IoBenchArgs, hairs: u64, format: Format) -> anyhow::Result
                 index += 1;
             }
             Ok::<(), std::io::Error>(())
-        };
-        let format = match format {
-            Format::Usdc => CurvesFormat::Usdc,
-            Format::Usda => CurvesFormat::Usda,
-            Format::Abc => CurvesFormat::Abc,
         };
         write_streamed(out, format, &UsdOptions::default(), |writer| stream(writer))?;
         Ok(())
@@ -286,7 +266,7 @@ pub fn run(args: &IoBenchArgs) -> anyhow::Result<()> {
         vec![200_000, args.hairs]
     };
     let mut runs = Vec::new();
-    for format in [Format::Usdc, Format::Usda, Format::Abc] {
+    for format in FORMATS {
         for &hairs in &sizes {
             runs.push(on_threads(threads, || write_groom(args, hairs, format))??);
         }
@@ -296,7 +276,11 @@ pub fn run(args: &IoBenchArgs) -> anyhow::Result<()> {
             .rfind(|r: &&Run| r.format == format)
             .expect("every format ran")
     };
-    let (usdc, usda, abc) = (large(Format::Usdc), large(Format::Usda), large(Format::Abc));
+    let (usdc, usda, abc) = (
+        large(CurvesFormat::Usdc),
+        large(CurvesFormat::Usda),
+        large(CurvesFormat::Abc),
+    );
     let dd = dd_mb_per_s(&args.dir, usdc.bytes);
     let blender = args
         .peer

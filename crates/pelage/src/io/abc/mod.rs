@@ -96,12 +96,10 @@ impl Property {
         }
     }
 
-    fn find(&mut self, path: &[&str]) -> Option<&mut Property> {
-        let Some((first, rest)) = path.split_first() else {
-            return Some(self);
-        };
+    /// The child property named `name`, of a compound.
+    fn child(&mut self, name: &str) -> Option<&mut Property> {
         match &mut self.kind {
-            Kind::Compound(children) => children.iter_mut().find(|c| c.name == *first)?.find(rest),
+            Kind::Compound(children) => children.iter_mut().find(|c| c.name == name),
             _ => None,
         }
     }
@@ -183,7 +181,7 @@ impl<W: Write + Seek> AbcWriter<W> {
         let samples = self.animated_samples(curves)?;
         let part = &mut self.parts[index];
         for (name, sample) in samples {
-            if let Some(property) = part.geom.find(&[name]) {
+            if let Some(property) = part.geom.child(name) {
                 property.samples.push(sample);
             }
         }

@@ -22,7 +22,7 @@ pub(crate) use read::read_usdc;
 
 use super::usd_schema::{
     SurfacePoints, UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name,
-    mesh_attributes, points_attributes,
+    curve_extent, mesh_attributes, points_attributes,
 };
 use super::{UpAxis, UsdOptions, UsdWriteError};
 use crate::Curves;
@@ -35,7 +35,7 @@ use std::collections::{HashMap, HashSet};
 use std::io::{Seek, SeekFrom, Write};
 
 /// The attributes of an animated part that get a sample per frame.
-const ANIMATED: [&str; 3] = ["points", "normals", "extent"];
+const ANIMATED: [&str; 3] = ["points", "extent", "normals"];
 
 /// A part written frame by frame: what later frames must match, and the
 /// samples of its animated attributes.
@@ -106,8 +106,8 @@ impl<W: Write + Seek> UsdcWriter<W> {
         curves: &Curves,
     ) -> Result<(), UsdWriteError> {
         UsdWriteError::check_time(name, time)?;
-        let attributes = basis_curves_attributes(name, curves, &self.options)?;
         if !self.animated.contains_key(name) {
+            let attributes = basis_curves_attributes(name, curves, &self.options)?;
             let specs = self.write_prim("BasisCurves", name, &attributes, true)?;
             let samples = specs
                 .into_iter()
@@ -121,17 +121,28 @@ impl<W: Write + Seek> UsdcWriter<W> {
         }
         let part = &self.animated[name];
         UsdWriteError::check_frame(name, time, &part.offsets, curves)?;
-        let mut reps = Vec::new();
-        for attribute in attributes.iter().filter(|a| ANIMATED.contains(&a.name)) {
-            reps.push((attribute.name, self.pack(&attribute.values)?));
+        let seen = |(_, _, samples): &SampledAttribute| samples.iter().any(|&(t, _)| t == time);
+        if part.samples.iter().any(seen) {
+            return Err(UsdWriteError::BadSetting(format!(
+                "part {name:?}: two frames at time {time}"
+            )));
+        }
+        // Only the animated values: the rest of the prim is the first
+        // frame's, and this frame's curves match it.
+        let (lo, hi) = curve_extent(curves);
+        let extent = [lo, hi];
+        let mut reps = Vec::with_capacity(ANIMATED.len());
+        for (attribute, values) in [
+            ("points", Some(curves.points())),
+            ("extent", Some(&extent[..])),
+            ("normals", curves.normals()),
+        ] {
+            if let Some(values) = values {
+                reps.push((attribute, self.plain_array(ValueType::Vec3f, values)?));
+            }
         }
         let part = self.animated.get_mut(name).expect("inserted above");
         for (_, attribute, samples) in &mut part.samples {
-            if samples.iter().any(|&(t, _)| t == time) {
-                return Err(UsdWriteError::BadSetting(format!(
-                    "part {name:?}: two frames at time {time}"
-                )));
-            }
             if let Some(&(_, rep)) = reps.iter().find(|(n, _)| n == attribute) {
                 samples.push((time, rep));
             }

@@ -25,7 +25,8 @@ use std::path::Path;
 struct Crate<'a> {
     bytes: &'a [u8],
     path: &'a Path,
-    version: (u8, u8),
+    /// The format's minor version (the major is 0).
+    minor: u8,
 }
 
 type Result<T> = std::result::Result<T, CurvesReadError>;
@@ -199,7 +200,7 @@ pub(crate) fn read_usdc(path: &Path) -> Result<Box<dyn AbstractData>> {
     let mut file = Crate {
         bytes: &bytes,
         path,
-        version: (0, 0),
+        minor: 0,
     };
     let head = file.take(0, 24, "the bootstrap header")?;
     if &head[..8] != b"PXR-USDC" {
@@ -208,7 +209,7 @@ pub(crate) fn read_usdc(path: &Path) -> Result<Box<dyn AbstractData>> {
             Kind::Syntax("not a usdc file: it does not start with PXR-USDC".into()),
         ));
     }
-    file.version = (head[8], head[9]);
+    file.minor = head[9];
     if head[8] != 0 || !(4..=12).contains(&head[9]) {
         return Err(file.fail(
             8,
@@ -687,7 +688,7 @@ fn read_array(
     compressed: bool,
     what: &str,
 ) -> Result<Option<Value>> {
-    let (minor, element) = (file.version.1, element_size(ty));
+    let (minor, element) = (file.minor, element_size(ty));
     let Some(element) = element else {
         return Ok(None);
     };
