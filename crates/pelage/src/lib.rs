@@ -31,6 +31,7 @@
 //! names the file (or mesh) and, where there is one, the line or element.
 #![warn(missing_docs)]
 
+pub mod anim;
 pub mod assets;
 pub mod curves;
 pub mod dynamics;

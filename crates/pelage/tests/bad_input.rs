@@ -130,7 +130,7 @@ const CASES: &[(&str, &str, &str)] = &[
     (
         "mesh_unknown_extension.stl",
         ": ",
-        "unknown mesh format \"stl\"; pelage reads .obj, .ply, .gltf and .glb",
+        "unknown mesh format \"stl\"; pelage reads .obj, .ply, .gltf, .glb, .usda, .usdc and .usd",
     ),
 ];
 

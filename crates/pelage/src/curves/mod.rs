@@ -289,6 +289,13 @@ impl Curves {
         }
     }
 
+    /// The points and (if present) normals, to move in place: counts and
+    /// every other attribute stay as they are (the skin binding carries a
+    /// part from pose to pose this way). The caller keeps them finite.
+    pub(crate) fn points_and_normals_mut(&mut self) -> (&mut [Vec3], Option<&mut [Vec3]>) {
+        (&mut self.points, self.normals.as_deref_mut())
+    }
+
     /// Adds per-point normals (the orientation of flat ribbons; USD
     /// `normals`).
     pub fn with_normals(self, normals: Vec<Vec3>) -> Result<Self, CurvesError> {

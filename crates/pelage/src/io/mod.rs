@@ -39,7 +39,10 @@ pub use points_ply::{
 };
 pub use read_error::{CurvesReadError, CurvesReadErrorKind};
 pub use render_text::{bezier_control_points, write_pbrt, write_rib};
-pub use usd_read::{DEFAULT_WIDTH, read_usd_curves, read_usd_extent};
+pub use usd_read::{
+    DEFAULT_WIDTH, UsdCurvesSequence, read_usd_curves, read_usd_curves_at, read_usd_extent,
+};
+pub(crate) use usd_read::{UsdSkin, read_usd_skin};
 pub use usd_schema::{SurfacePoints, UsdPrimWriter};
 pub use usda::{CurveBasis, UpAxis, UsdOptions, UsdWrap, UsdWriteError, UsdaWriter};
 pub use usdc::UsdcWriter;

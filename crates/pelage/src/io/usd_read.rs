@@ -23,8 +23,55 @@ pub const DEFAULT_WIDTH: f32 = 0.01;
 /// Reads every `BasisCurves` prim of a usda or usdc file into one
 /// [`Curves`] (points in world space).
 pub fn read_usd_curves(path: &Path) -> Result<Curves, CurvesReadError> {
-    let data = open_layer(path)?;
-    let data = data.as_ref();
+    read_usd_curves_at(path, None)
+}
+
+/// [`read_usd_curves`] at time code `time`: animated `points` are
+/// interpolated linearly between the samples around it (held before the
+/// first and after the last, as USD does); `None` reads the first sample.
+/// Everything else is read as [`read_usd_curves`] reads it.
+pub fn read_usd_curves_at(path: &Path, time: Option<f64>) -> Result<Curves, CurvesReadError> {
+    let data = open_layer_with(path, time.is_some())?;
+    curves_from_layer(path, data.as_ref(), time)
+}
+
+/// A USD file's curves over time, parsed once with every time sample, for
+/// reading many frames (`pelage render --frames`).
+pub struct UsdCurvesSequence {
+    path: std::path::PathBuf,
+    layer: Box<dyn AbstractData>,
+}
+
+impl UsdCurvesSequence {
+    /// Parses the file at `path`.
+    pub fn open(path: &Path) -> Result<Self, CurvesReadError> {
+        Ok(Self {
+            path: path.to_path_buf(),
+            layer: open_layer_with(path, true)?,
+        })
+    }
+
+    /// The curves at time code `time`, as [`read_usd_curves_at`] reads them.
+    pub fn at(&self, time: f64) -> Result<Curves, CurvesReadError> {
+        curves_from_layer(&self.path, self.layer.as_ref(), Some(time))
+    }
+
+    /// The time codes at which any curves' points are sampled, ascending
+    /// (empty for still curves).
+    pub fn times(&self) -> Vec<f64> {
+        let data = self.layer.as_ref();
+        let mut times: Vec<f64> = curve_prims(data)
+            .iter()
+            .flat_map(|p| sample_times(data, p, "points"))
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+}
+
+/// The layer's `BasisCurves` prims, in path order.
+fn curve_prims(data: &dyn AbstractData) -> Vec<sdf::Path> {
     let mut prims: Vec<sdf::Path> = data
         .spec_paths()
         .into_iter()
@@ -32,6 +79,15 @@ pub fn read_usd_curves(path: &Path) -> Result<Curves, CurvesReadError> {
         .filter(|p| token(data, p, "typeName").as_deref() == Some("BasisCurves"))
         .collect();
     prims.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+    prims
+}
+
+fn curves_from_layer(
+    path: &Path,
+    data: &dyn AbstractData,
+    time: Option<f64>,
+) -> Result<Curves, CurvesReadError> {
+    let prims = curve_prims(data);
     if prims.is_empty() {
         return Err(CurvesReadError::whole(
             path,
@@ -51,7 +107,11 @@ pub fn read_usd_curves(path: &Path) -> Result<Curves, CurvesReadError> {
             }
             None => return Err(fail(Kind::Inconsistent(at("no curveVertexCounts")))),
         };
-        let prim_points = match attribute(data, prim, "points") {
+        let points_value = match time {
+            Some(t) => attribute_at(data, prim, "points", t),
+            None => attribute(data, prim, "points"),
+        };
+        let prim_points = match points_value {
             Some(Value::Vec3fVec(v)) => v
                 .iter()
                 .map(|p| DVec3::new(p.x.into(), p.y.into(), p.z.into()))
@@ -186,15 +246,24 @@ pub fn read_usd_extent(path: &Path) -> Result<Option<(glam::Vec3, glam::Vec3)>, 
     Ok(bounds)
 }
 
-/// Parses a usda or usdc layer (by its first bytes).
+/// Parses a usda or usdc layer (by its first bytes), with only the first
+/// time sample of animated values (binary layers).
 fn open_layer(path: &Path) -> Result<Box<dyn AbstractData>, CurvesReadError> {
+    open_layer_with(path, false)
+}
+
+/// Parses a usda or usdc layer; `all_samples`: keep every time sample.
+fn open_layer_with(
+    path: &Path,
+    all_samples: bool,
+) -> Result<Box<dyn AbstractData>, CurvesReadError> {
     let mut head = [0u8; 8];
     let n = std::fs::File::open(path)
         .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
         .map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
     let head = &head[..n];
     if head.starts_with(b"PXR-USDC") {
-        super::usdc::read_usdc(path)
+        super::usdc::read_usdc(path, all_samples)
     } else if head.starts_with(b"#usda") {
         Ok(Box::new(
             openusd::usda::read_file(path).map_err(|e| parse_error(path, &e))?,
@@ -247,6 +316,302 @@ fn attribute(data: &dyn AbstractData, prim: &sdf::Path, name: &str) -> Option<Va
             .map(|(_, v)| v),
         _ => None,
     }
+}
+
+/// An attribute's value at time code `time`: its time samples
+/// interpolated (linearly for float vector arrays of equal length, held
+/// otherwise), or its default when it has no samples.
+fn attribute_at(data: &dyn AbstractData, prim: &sdf::Path, name: &str, time: f64) -> Option<Value> {
+    let property = prim.append_property(name).ok()?;
+    let field = |f| data.try_field(&property, f).ok().flatten();
+    let mut samples = match field("timeSamples").map(|v| v.into_owned()) {
+        Some(Value::TimeSamples(samples)) if !samples.is_empty() => samples,
+        _ => return field("default").map(|v| v.into_owned()),
+    };
+    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let after = samples.partition_point(|(t, _)| *t <= time);
+    if after == 0 {
+        return Some(samples.swap_remove(0).1);
+    }
+    if after == samples.len() {
+        return samples.pop().map(|(_, v)| v);
+    }
+    let (t1, v1) = samples.swap_remove(after);
+    let (t0, v0) = samples.swap_remove(after - 1);
+    let s = if t1 > t0 {
+        (time - t0) / (t1 - t0)
+    } else {
+        0.0
+    };
+    Some(match (v0, v1) {
+        (Value::Vec3fVec(a), Value::Vec3fVec(b)) if a.len() == b.len() => Value::Vec3fVec(
+            a.iter()
+                .zip(&b)
+                .map(|(p, q)| {
+                    let s = s as f32;
+                    openusd::gf::Vec3f {
+                        x: p.x + s * (q.x - p.x),
+                        y: p.y + s * (q.y - p.y),
+                        z: p.z + s * (q.z - p.z),
+                    }
+                })
+                .collect(),
+        ),
+        (Value::Vec3dVec(a), Value::Vec3dVec(b)) if a.len() == b.len() => Value::Vec3dVec(
+            a.iter()
+                .zip(&b)
+                .map(|(p, q)| openusd::gf::Vec3d {
+                    x: p.x + s * (q.x - p.x),
+                    y: p.y + s * (q.y - p.y),
+                    z: p.z + s * (q.z - p.z),
+                })
+                .collect(),
+        ),
+        (v0, _) => v0,
+    })
+}
+
+/// The time codes at which an attribute is sampled (empty when it has
+/// none).
+fn sample_times(data: &dyn AbstractData, prim: &sdf::Path, name: &str) -> Vec<f64> {
+    let Ok(property) = prim.append_property(name) else {
+        return Vec::new();
+    };
+    match data
+        .try_field(&property, "timeSamples")
+        .ok()
+        .flatten()
+        .as_deref()
+    {
+        Some(Value::TimeSamples(samples)) => samples.iter().map(|(t, _)| *t).collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// Every `Mesh` prim of a USD layer, merged (in path order, in world
+/// space), with its animation: [`read_usd_skin`].
+pub(crate) struct UsdSkin {
+    /// Positions at the first sample (or the default).
+    pub positions: Vec<glam::Vec3>,
+    /// Faces fan-triangulated.
+    pub triangles: Vec<[u32; 3]>,
+    /// `primvars:st` (or the first `texCoord2f[]` primvar), per face
+    /// corner or per vertex.
+    pub uvs: Option<crate::mesh::Uvs>,
+    /// Each time code at which some prim's points are sampled, ascending.
+    pub times: Vec<f64>,
+    /// Per prim: its points' samples (time, world-space points), or one
+    /// sample at time 0 for a prim that does not move.
+    prims: Vec<Vec<(f64, Vec<glam::Vec3>)>>,
+}
+
+impl UsdSkin {
+    /// The merged vertex positions at time code `time`: each prim's
+    /// samples interpolated linearly (held before the first and after the
+    /// last).
+    pub fn positions_at(&self, time: f64) -> Result<Vec<glam::Vec3>, String> {
+        let mut out = Vec::with_capacity(self.positions.len());
+        for samples in &self.prims {
+            let after = samples.partition_point(|(t, _)| *t <= time);
+            let points: Vec<glam::Vec3> = match after {
+                0 => samples[0].1.clone(),
+                n if n == samples.len() => samples[n - 1].1.clone(),
+                n => {
+                    let ((t0, a), (t1, b)) = (&samples[n - 1], &samples[n]);
+                    if a.len() != b.len() {
+                        return Err(format!(
+                            "the points change count between times {t0} and {t1}: the topology must not change over time"
+                        ));
+                    }
+                    let s = ((time - t0) / (t1 - t0)) as f32;
+                    a.iter().zip(b).map(|(p, q)| p.lerp(*q, s)).collect()
+                }
+            };
+            out.extend(points);
+        }
+        if out.len() != self.positions.len() {
+            return Err(format!(
+                "at time {time} the meshes have {} points, not {}: the topology must not change over time",
+                out.len(),
+                self.positions.len()
+            ));
+        }
+        Ok(out)
+    }
+}
+
+fn vec3_array(value: Option<Value>) -> Result<Vec<DVec3>, String> {
+    match value {
+        Some(Value::Vec3fVec(v)) => Ok(v
+            .iter()
+            .map(|p| DVec3::new(p.x.into(), p.y.into(), p.z.into()))
+            .collect()),
+        Some(Value::Vec3dVec(v)) => Ok(v.iter().map(|p| DVec3::new(p.x, p.y, p.z)).collect()),
+        Some(_) => Err("points are neither float3[] nor double3[]".into()),
+        None => Err("no points".into()),
+    }
+}
+
+/// Reads the `Mesh` prims of a usda or usdc file as one skin, keeping
+/// every time sample of their points.
+pub(crate) fn read_usd_skin(path: &Path) -> Result<UsdSkin, CurvesReadError> {
+    let layer = open_layer_with(path, true)?;
+    let data = layer.as_ref();
+    let mut prim_paths: Vec<sdf::Path> = data
+        .spec_paths()
+        .into_iter()
+        .filter(|p| data.spec_type(p) == Some(SpecType::Prim))
+        .filter(|p| token(data, p, "typeName").as_deref() == Some("Mesh"))
+        .collect();
+    prim_paths.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+    if prim_paths.is_empty() {
+        return Err(CurvesReadError::whole(
+            path,
+            Kind::Syntax("the file has no Mesh prim".into()),
+        ));
+    }
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let (mut uv_values, mut uv_triangles) = (Vec::new(), Vec::new());
+    let mut uv_kinds = Vec::new();
+    let mut times = Vec::new();
+    let mut prims = Vec::new();
+    for prim in prim_paths {
+        let fail = |m: String| {
+            CurvesReadError::whole(path, Kind::Inconsistent(format!("{}: {m}", prim.as_str())))
+        };
+        let transform = world_transform(data, &prim).map_err(fail)?;
+        let world = |points: Vec<DVec3>| -> Vec<glam::Vec3> {
+            points
+                .iter()
+                .map(|&p| transform.transform_point3(p).as_vec3())
+                .collect()
+        };
+        let mut prim_times = sample_times(data, &prim, "points");
+        prim_times.sort_by(f64::total_cmp);
+        prim_times.dedup();
+        let mut samples = Vec::with_capacity(prim_times.len().max(1));
+        for &t in &prim_times {
+            let points = vec3_array(attribute_at(data, &prim, "points", t)).map_err(fail)?;
+            samples.push((t, world(points)));
+        }
+        if samples.is_empty() {
+            let points = vec3_array(attribute(data, &prim, "points")).map_err(fail)?;
+            samples.push((0.0, world(points)));
+        }
+        times.extend(prim_times);
+        let points = samples[0].1.clone();
+        let ints = |name: &str| match attribute(data, &prim, name) {
+            Some(Value::IntVec(v)) => Ok(v),
+            Some(_) => Err(fail(format!("{name} is not int[]"))),
+            None => Err(fail(format!("no {name}"))),
+        };
+        let counts = ints("faceVertexCounts")?;
+        let indices = ints("faceVertexIndices")?;
+        let base = positions.len() as u32;
+        let mut corner = 0usize;
+        let corner_base = uv_values.len() as u32;
+        let mut prim_triangles = Vec::new();
+        let mut prim_corners = Vec::new();
+        for (f, &c) in counts.iter().enumerate() {
+            if c < 3 {
+                return Err(fail(format!("face {f} has {c} vertices")));
+            }
+            let c = c as usize;
+            let face = indices
+                .get(corner..corner + c)
+                .ok_or_else(|| fail(format!("faceVertexIndices end inside face {f}")))?;
+            for (k, &i) in face.iter().enumerate() {
+                if i < 0 || i as usize >= points.len() {
+                    return Err(fail(format!(
+                        "face {f} corner {k} names point {i} of {}",
+                        points.len()
+                    )));
+                }
+            }
+            for k in 1..c - 1 {
+                prim_triangles.push([face[0], face[k], face[k + 1]].map(|i| base + i as u32));
+                prim_corners.push([corner, corner + k, corner + k + 1]);
+            }
+            corner += c;
+        }
+        if corner != indices.len() {
+            return Err(fail(format!(
+                "faceVertexCounts add up to {corner} but there are {} indices",
+                indices.len()
+            )));
+        }
+        // UVs: faceVarying (optionally indexed) or vertex.
+        let st = ["primvars:st", "primvars:UVMap", "primvars:uv"]
+            .into_iter()
+            .find_map(|name| {
+                let value = attribute(data, &prim, name)?;
+                let values: Vec<glam::Vec2> = match value {
+                    Value::Vec2fVec(v) => v.iter().map(|t| glam::Vec2::new(t.x, t.y)).collect(),
+                    _ => return None,
+                };
+                let interpolation = metadata_token(data, &prim, name, "interpolation");
+                let indices = match attribute(data, &prim, &format!("{name}:indices")) {
+                    Some(Value::IntVec(v)) => Some(v),
+                    _ => None,
+                };
+                Some((values, interpolation, indices))
+            });
+        let kind = match st {
+            Some((values, interpolation, st_indices)) => {
+                let lookup = |k: usize| -> Option<u32> {
+                    let i = match &st_indices {
+                        Some(ix) => usize::try_from(*ix.get(k)?).ok()?,
+                        None => k,
+                    };
+                    (i < values.len()).then_some(i as u32)
+                };
+                match interpolation.as_deref() {
+                    Some("faceVarying") => {
+                        for corners in &prim_corners {
+                            let tri = corners.map(lookup).map(|i| i.map(|i| corner_base + i));
+                            let [Some(a), Some(b), Some(c)] = tri else {
+                                return Err(fail("primvars:st has too few values".into()));
+                            };
+                            uv_triangles.push([a, b, c]);
+                        }
+                        uv_values.extend(values);
+                        "corner"
+                    }
+                    Some("vertex") | Some("varying") if values.len() == points.len() => {
+                        let start = uv_values.len() as u32;
+                        for t in &prim_triangles {
+                            uv_triangles.push(t.map(|i| i - base + start));
+                        }
+                        uv_values.extend(values);
+                        "vertex"
+                    }
+                    _ => "none",
+                }
+            }
+            None => "none",
+        };
+        uv_kinds.push(kind);
+        positions.extend_from_slice(&points);
+        triangles.extend(prim_triangles);
+        prims.push(samples);
+    }
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    let uvs = uv_kinds
+        .iter()
+        .all(|k| *k != "none")
+        .then_some(crate::mesh::Uvs::PerCorner {
+            values: uv_values,
+            indices: uv_triangles,
+        });
+    Ok(UsdSkin {
+        positions,
+        triangles,
+        uvs,
+        times,
+        prims,
+    })
 }
 
 fn token(data: &dyn AbstractData, path: &sdf::Path, field: &str) -> Option<String> {

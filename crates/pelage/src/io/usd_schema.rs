@@ -28,6 +28,29 @@ pub trait UsdPrimWriter {
     fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError>;
     /// Writes sampled surface points as a `Points` prim named `name`.
     fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), UsdWriteError>;
+    /// Writes one frame of an animated part (time code `time`): the first
+    /// call for `name` writes the prim, later ones add time samples of
+    /// points, normals and extent. Writers without time samples refuse.
+    fn write_part_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        curves: &Curves,
+    ) -> Result<(), UsdWriteError> {
+        let _ = (name, time, curves);
+        Err(UsdWriteError::BadSetting(
+            "this format has no time samples; write animated grooms to .usdc or .abc".into(),
+        ))
+    }
+    /// Writes one frame of an animated skin (time code `time`), as
+    /// [`Self::write_part_at`] does for curves. Writers without animated
+    /// meshes refuse.
+    fn write_mesh_at(&mut self, name: &str, time: f64, mesh: &Mesh) -> Result<(), UsdWriteError> {
+        let _ = (name, time, mesh);
+        Err(UsdWriteError::BadSetting(
+            "this format cannot write an animated skin; write it to .usdc".into(),
+        ))
+    }
 }
 
 /// Points sampled on a mesh (`pelage sample`), as a `UsdGeomPoints` prim:

@@ -37,7 +37,9 @@ pub enum MeshErrorKind {
     #[error("cannot read the file: {0}")]
     Io(#[source] std::io::Error),
     /// The extension names no format pelage reads.
-    #[error("unknown mesh format {extension:?}; pelage reads .obj, .ply, .gltf and .glb")]
+    #[error(
+        "unknown mesh format {extension:?}; pelage reads .obj, .ply, .gltf, .glb, .usda, .usdc and .usd"
+    )]
     UnknownFormat {
         /// The extension found (may be empty).
         extension: String,

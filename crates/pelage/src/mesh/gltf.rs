@@ -16,6 +16,37 @@ use std::path::Path;
 /// Reads a glTF or GLB from bytes; `base` is the folder external buffers
 /// are resolved against (None for self-contained files).
 pub(super) fn parse(name: &str, bytes: &[u8], base: Option<&Path>) -> Result<Mesh, MeshError> {
+    parse_with_sources(name, bytes, base).map(|parsed| parsed.mesh)
+}
+
+/// A glTF read as one mesh, with what skinning it again needs: the
+/// document, its buffers, and where each welded vertex came from.
+pub(crate) struct ParsedGltf {
+    pub mesh: Mesh,
+    pub document: gltf::Document,
+    pub buffers: Vec<gltf::buffer::Data>,
+    /// Per welded vertex: the node that instanced its mesh, the primitive
+    /// and the vertex's index in it (its first occurrence).
+    pub sources: Vec<VertexSource>,
+}
+
+/// Where a welded vertex of a glTF mesh came from.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct VertexSource {
+    /// The node instancing the mesh (`None` for meshes of a file with no
+    /// scene).
+    pub node: Option<usize>,
+    pub mesh: usize,
+    pub primitive: usize,
+    pub vertex: u32,
+}
+
+/// [`parse`], keeping the document and the vertices' sources.
+pub(crate) fn parse_with_sources(
+    name: &str,
+    bytes: &[u8],
+    base: Option<&Path>,
+) -> Result<ParsedGltf, MeshError> {
     let whole = |msg: String| MeshError::whole(name, MeshErrorKind::Syntax(msg));
     let gltf = gltf::Gltf::from_slice(bytes)
         .map_err(|e| whole(format!("not a readable glTF file: {e}")))?;
@@ -23,24 +54,33 @@ pub(super) fn parse(name: &str, bytes: &[u8], base: Option<&Path>) -> Result<Mes
         .map_err(|e| whole(format!("cannot load the glTF's buffers: {e}")))?;
     let doc = &gltf.document;
 
-    // (mesh, world_from_mesh) pairs to merge.
-    let mut instances: Vec<(gltf::Mesh, Mat4)> = Vec::new();
+    // (mesh, world_from_mesh, node) to merge.
+    let mut instances: Vec<(gltf::Mesh, Mat4, Option<usize>)> = Vec::new();
     let scenes: Vec<gltf::Scene> = match doc.default_scene() {
         Some(s) => vec![s],
         None => doc.scenes().collect(),
     };
     if scenes.is_empty() {
-        instances.extend(doc.meshes().map(|m| (m, Mat4::IDENTITY)));
+        instances.extend(doc.meshes().map(|m| (m, Mat4::IDENTITY, None)));
     }
+    // A node reached twice on one path is a cycle (a malformed file that
+    // would otherwise be walked forever); the depth bounds the walk.
+    let node_count = doc.nodes().len();
     for scene in scenes {
-        let mut stack: Vec<(gltf::Node, Mat4)> =
-            scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
-        while let Some((node, parent)) = stack.pop() {
+        let mut stack: Vec<(gltf::Node, Mat4, usize)> =
+            scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+        while let Some((node, parent, depth)) = stack.pop() {
+            if depth > node_count {
+                return Err(whole(format!(
+                    "node {} is its own ancestor: the node hierarchy has a cycle",
+                    node.index()
+                )));
+            }
             let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
             if let Some(mesh) = node.mesh() {
-                instances.push((mesh, world));
+                instances.push((mesh, world, Some(node.index())));
             }
-            stack.extend(node.children().map(|c| (c, world)));
+            stack.extend(node.children().map(|c| (c, world, depth + 1)));
         }
     }
 
@@ -52,8 +92,9 @@ pub(super) fn parse(name: &str, bytes: &[u8], base: Option<&Path>) -> Result<Mes
     let mut uv_triangles: Vec<[u32; 3]> = Vec::new();
     let mut all_have_normals = true;
     let mut uv_presence: Option<bool> = None;
+    let mut sources: Vec<VertexSource> = Vec::new();
 
-    for (mesh, world) in instances {
+    for (mesh, world, node) in instances {
         let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
         for primitive in mesh.primitives() {
             let what = format!("mesh {} primitive {}", mesh.index(), primitive.index());
@@ -128,6 +169,12 @@ pub(super) fn parse(name: &str, bytes: &[u8], base: Option<&Path>) -> Result<Mes
                 if id == next {
                     positions.push(p);
                     normal_sums.push(Vec3::ZERO);
+                    sources.push(VertexSource {
+                        node,
+                        mesh: mesh.index(),
+                        primitive: primitive.index(),
+                        vertex: k as u32,
+                    });
                 }
                 if let Some(n) = &normals {
                     normal_sums[id as usize] += (normal_matrix * n[k]).normalize_or_zero();
@@ -170,13 +217,22 @@ pub(super) fn parse(name: &str, bytes: &[u8], base: Option<&Path>) -> Result<Mes
         values: uv_values,
         indices: uv_triangles,
     });
-    Mesh::new(name, positions, triangles, normals, uvs)
+    let mesh = Mesh::new(name, positions, triangles, normals, uvs)?;
+    Ok(ParsedGltf {
+        mesh,
+        document: gltf.document,
+        buffers,
+        sources,
+    })
 }
 
 /// The gltf crate's readers index buffers without bounds checks of their
 /// own; this checks that the accessor's bytes lie inside its view and the
 /// view inside its buffer, so a malformed file is an error, not a panic.
-fn check_accessor(accessor: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Result<(), String> {
+pub(crate) fn check_accessor(
+    accessor: &gltf::Accessor,
+    buffers: &[gltf::buffer::Data],
+) -> Result<(), String> {
     let Some(view) = accessor.view() else {
         return Err(format!(
             "accessor {} has no buffer view (sparse accessors are not supported)",

@@ -12,6 +12,9 @@ pub enum MeshFormat {
     Ply,
     /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
     Gltf,
+    /// USD, text or binary (`.usda`, `.usdc`, `.usd`): every `Mesh` prim,
+    /// at its first time sample.
+    Usd,
 }
 
 impl MeshFormat {
@@ -22,6 +25,7 @@ impl MeshFormat {
             "obj" => Some(Self::Obj),
             "ply" => Some(Self::Ply),
             "gltf" | "glb" => Some(Self::Gltf),
+            "usda" | "usdc" | "usd" => Some(Self::Usd),
             _ => None,
         }
     }
@@ -40,6 +44,9 @@ impl Mesh {
                 .unwrap_or_default();
             MeshError::whole(&name, MeshErrorKind::UnknownFormat { extension })
         })?;
+        if format == MeshFormat::Usd {
+            return read_usd_mesh(path);
+        }
         let bytes =
             std::fs::read(path).map_err(|e| MeshError::whole(&name, MeshErrorKind::Io(e)))?;
         match format {
@@ -56,6 +63,31 @@ impl Mesh {
             MeshFormat::Obj => super::obj::parse(name, bytes),
             MeshFormat::Ply => super::ply::parse(name, bytes),
             MeshFormat::Gltf => super::gltf::parse(name, bytes, None),
+            MeshFormat::Usd => Err(MeshError::whole(
+                name,
+                MeshErrorKind::Unsupported("USD meshes are read from files; use Mesh::load".into()),
+            )),
         }
     }
+}
+
+/// A USD file's `Mesh` prims as one mesh, at their first time sample.
+fn read_usd_mesh(path: &Path) -> Result<Mesh, MeshError> {
+    let skin = crate::io::read_usd_skin(path).map_err(|e| usd_error(&e))?;
+    Mesh::new(
+        path.display().to_string(),
+        skin.positions,
+        skin.triangles,
+        None,
+        skin.uvs,
+    )
+}
+
+/// A USD reader's error as a mesh error (same file, same place).
+pub(crate) fn usd_error(e: &crate::io::CurvesReadError) -> MeshError {
+    MeshError::new(
+        e.source_name(),
+        e.location().clone(),
+        MeshErrorKind::Syntax(e.kind().to_string()),
+    )
 }

@@ -14,9 +14,9 @@
 
 mod closest;
 mod error;
-mod gltf;
+pub(crate) mod gltf;
 mod graph;
-mod load;
+pub(crate) mod load;
 mod obj;
 mod ply;
 mod ray;

@@ -677,4 +677,13 @@ impl<W: Write + Seek> super::UsdPrimWriter for AbcWriter<W> {
             "pelage's Alembic files hold curves only: write sampled points as .ply or USD".into(),
         ))
     }
+
+    fn write_part_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        curves: &Curves,
+    ) -> Result<(), UsdWriteError> {
+        AbcWriter::write_part_at(self, name, time, curves)
+    }
 }

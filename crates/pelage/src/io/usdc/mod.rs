@@ -121,6 +121,56 @@ impl<W: Write + Seek> UsdcWriter<W> {
         }
         let part = &self.animated[name];
         UsdWriteError::check_frame(name, time, &part.offsets, curves)?;
+        let (lo, hi) = curve_extent(curves);
+        self.add_samples(name, time, curves.points(), [lo, hi], curves.normals())
+    }
+
+    /// Writes one frame of an animated skin: the first call for `name`
+    /// writes the `Mesh` prim (topology and UVs from this frame); every
+    /// call adds samples of `points`, `normals` and `extent` at `time`.
+    /// Later frames must have as many vertices and triangles.
+    pub fn write_mesh_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        mesh: &Mesh,
+    ) -> Result<(), UsdWriteError> {
+        UsdWriteError::check_time(name, time)?;
+        let shape = vec![mesh.vertex_count() as u32, mesh.triangle_count() as u32];
+        if !self.animated.contains_key(name) {
+            let specs = self.write_prim("Mesh", name, &mesh_attributes(mesh), true)?;
+            let samples = specs
+                .into_iter()
+                .map(|(spec, attribute)| (spec, attribute, Vec::new()))
+                .collect();
+            let part = AnimatedPart {
+                offsets: shape.clone(),
+                samples,
+            };
+            self.animated.insert(name.to_string(), part);
+        }
+        let first = &self.animated[name].offsets;
+        if *first != shape {
+            return Err(UsdWriteError::BadSetting(format!(
+                "mesh {name:?} at time {time}: {} vertices and {} triangles where the first frame had {} and {}",
+                shape[0], shape[1], first[0], first[1]
+            )));
+        }
+        let (lo, hi) = mesh.bounds();
+        self.add_samples(name, time, mesh.positions(), [lo, hi], Some(mesh.normals()))
+    }
+
+    /// Adds a frame's points, extent and normals to the animated prim
+    /// `name` (already written).
+    fn add_samples(
+        &mut self,
+        name: &str,
+        time: f64,
+        points: &[glam::Vec3],
+        extent: [glam::Vec3; 2],
+        normals: Option<&[glam::Vec3]>,
+    ) -> Result<(), UsdWriteError> {
+        let part = &self.animated[name];
         let seen = |(_, _, samples): &SampledAttribute| samples.iter().any(|&(t, _)| t == time);
         if part.samples.iter().any(seen) {
             return Err(UsdWriteError::BadSetting(format!(
@@ -128,20 +178,18 @@ impl<W: Write + Seek> UsdcWriter<W> {
             )));
         }
         // Only the animated values: the rest of the prim is the first
-        // frame's, and this frame's curves match it.
-        let (lo, hi) = curve_extent(curves);
-        let extent = [lo, hi];
+        // frame's, and this frame matches it.
         let mut reps = Vec::with_capacity(ANIMATED.len());
         for (attribute, values) in [
-            ("points", Some(curves.points())),
+            ("points", Some(points)),
             ("extent", Some(&extent[..])),
-            ("normals", curves.normals()),
+            ("normals", normals),
         ] {
             if let Some(values) = values {
                 reps.push((attribute, self.plain_array(ValueType::Vec3f, values)?));
             }
         }
-        let part = self.animated.get_mut(name).expect("inserted above");
+        let part = self.animated.get_mut(name).expect("written before");
         for (_, attribute, samples) in &mut part.samples {
             if let Some(&(_, rep)) = reps.iter().find(|(n, _)| n == attribute) {
                 samples.push((time, rep));
@@ -472,6 +520,19 @@ impl<W: Write + Seek> UsdPrimWriter for UsdcWriter<W> {
 
     fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), UsdWriteError> {
         UsdcWriter::write_points(self, name, points)
+    }
+
+    fn write_part_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        curves: &Curves,
+    ) -> Result<(), UsdWriteError> {
+        UsdcWriter::write_part_at(self, name, time, curves)
+    }
+
+    fn write_mesh_at(&mut self, name: &str, time: f64, mesh: &Mesh) -> Result<(), UsdWriteError> {
+        UsdcWriter::write_mesh_at(self, name, time, mesh)
     }
 }
 

@@ -27,6 +27,8 @@ struct Crate<'a> {
     path: &'a Path,
     /// The format's minor version (the major is 0).
     minor: u8,
+    /// Whether time-sampled values keep every sample or only the first.
+    all_samples: bool,
 }
 
 type Result<T> = std::result::Result<T, CurvesReadError>;
@@ -195,12 +197,13 @@ struct Structure {
 }
 
 /// Reads a usdc file into openusd's in-memory layer.
-pub(crate) fn read_usdc(path: &Path) -> Result<Box<dyn AbstractData>> {
+pub(crate) fn read_usdc(path: &Path, all_samples: bool) -> Result<Box<dyn AbstractData>> {
     let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
     let mut file = Crate {
         bytes: &bytes,
         path,
         minor: 0,
+        all_samples,
     };
     let head = file.take(0, 24, "the bootstrap header")?;
     if &head[..8] != b"PXR-USDC" {
@@ -570,7 +573,7 @@ fn read_value(file: &Crate, s: &Structure, rep: u64, what: &str) -> Result<Optio
         return read_array(file, &s.tokens, at, ty, compressed, what);
     }
     Ok(Some(match ty {
-        46 => return first_time_sample(file, s, at, what),
+        46 => return time_samples(file, s, at, what),
         48 => {
             let n = file.u64_at(at, what)?;
             let n = file.count(at + 8, n, 8, what)?;
@@ -613,10 +616,12 @@ fn read_value(file: &Crate, s: &Structure, rep: u64, what: &str) -> Result<Optio
     }))
 }
 
-/// The earliest of a field's time samples, as a one-sample list. At `at`:
-/// an offset to the times' rep, the rep, an offset to the values, their
-/// count and their reps; offsets count from where they are written.
-fn first_time_sample(file: &Crate, s: &Structure, at: usize, what: &str) -> Result<Option<Value>> {
+/// A field's time samples: all of them when the file is read with
+/// `all_samples`, otherwise the earliest as a one-sample list (what the
+/// curve readers use, decoding one array instead of a frame each). At
+/// `at`: an offset to the times' rep, the rep, an offset to the values,
+/// their count and their reps; offsets count from where they are written.
+fn time_samples(file: &Crate, s: &Structure, at: usize, what: &str) -> Result<Option<Value>> {
     let jump = |from: usize| -> Result<usize> {
         let offset = file.u64_at(from, what)? as i64;
         usize::try_from(from as i64 + offset).map_err(|_| {
@@ -653,17 +658,27 @@ fn first_time_sample(file: &Crate, s: &Structure, at: usize, what: &str) -> Resu
             format!("{what}: {n} values for {} times", times.len()),
         ));
     }
+    let sample = |k: usize| -> Result<Option<(f64, Value)>> {
+        let rep = file.u64_at(values_at + 8 + 8 * k, what)?;
+        if (rep >> 48) & 0xff == 46 {
+            return Err(file.fail(
+                values_at,
+                format!("{what}: time samples nested in a sample"),
+            ));
+        }
+        Ok(read_value(file, s, rep, what)?.map(|v| (times[k], v)))
+    };
+    if file.all_samples {
+        let mut samples = Vec::with_capacity(n);
+        for k in 0..n {
+            samples.extend(sample(k)?);
+        }
+        return Ok(Some(Value::TimeSamples(samples)));
+    }
     let Some(first) = (0..n).min_by(|&a, &b| times[a].total_cmp(&times[b])) else {
         return Ok(Some(Value::TimeSamples(Vec::new())));
     };
-    let rep = file.u64_at(values_at + 8 + 8 * first, what)?;
-    if (rep >> 48) & 0xff == 46 {
-        return Err(file.fail(
-            values_at,
-            format!("{what}: time samples nested in a sample"),
-        ));
-    }
-    Ok(read_value(file, s, rep, what)?.map(|v| Value::TimeSamples(vec![(times[first], v)])))
+    Ok(sample(first)?.map(|v| Value::TimeSamples(vec![v])))
 }
 
 fn floats(b: &[u8]) -> Vec<f32> {
