@@ -93,6 +93,50 @@ pub struct GroomFile {
     /// Where the curves go.
     #[serde(default)]
     pub output: OutputSection,
+    /// Frames of an animated skin (absent: a still groom).
+    pub animation: Option<AnimationSection>,
+}
+
+/// `[animation]`: the groom follows an animated skin (the `[mesh]` path:
+/// a USD mesh with time-sampled points, a glTF/GLB with animations, or an
+/// OBJ/PLY sequence such as `"skin.####.obj"`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnimationSection {
+    /// The frames written: `"1-24"`, `"1-48x2"`, `"1,5,9"`.
+    pub frames: Spanned<String>,
+    /// Frames per second (the output's `timeCodesPerSecond`; glTF clips
+    /// are played at this rate, frame 1 at their time 0).
+    #[serde(default = "default_fps")]
+    pub fps: f64,
+    /// The frame whose skin the roots are sampled on and the guides bound
+    /// to (default: the first frame).
+    pub rest_frame: Option<f64>,
+    /// `deform` (grow once, carry with the skin) or `regrow` (regrow every
+    /// frame from time-sampled guides).
+    #[serde(default)]
+    pub mode: AnimationModeName,
+    /// The glTF animation to play, by name (default: the file's first).
+    pub clip: Option<String>,
+    /// Shutter offsets in frames, e.g. `[-0.25, 0.25]`: every frame is
+    /// also written at these sub-frame times (motion blur).
+    #[serde(default)]
+    pub motion_blur: Vec<f64>,
+}
+
+fn default_fps() -> f64 {
+    24.0
+}
+
+/// `[animation] mode`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AnimationModeName {
+    /// Grow once at rest; carry every frame.
+    #[default]
+    Deform,
+    /// Regrow every frame from animated guides.
+    Regrow,
 }
 
 /// `[mesh]`.

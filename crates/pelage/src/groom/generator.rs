@@ -46,8 +46,8 @@ pub struct Generator {
     /// The groom's name and where its settings were written, for errors.
     name: PathBuf,
     origin: Option<Arc<SpecOrigin>>,
-    pub(super) sampler: DensitySampler,
-    pub(super) layout: PartLayout,
+    pub(super) sampler: Arc<DensitySampler>,
+    pub(super) layout: Arc<PartLayout>,
     pub(super) interpolator: Interpolator,
     pub(super) ops: Vec<Operator>,
     /// The finish's width, colour and opacity, before the operators.
@@ -89,6 +89,19 @@ impl std::fmt::Debug for Generator {
 impl Generator {
     /// Prepares `spec` for growing; see [`GroomSpec::generator`].
     pub fn new(spec: GroomSpec) -> Result<Self, GroomError> {
+        Self::build(spec, None)
+    }
+
+    /// A generator for `spec`, which must be this generator's spec with
+    /// other guide shapes (the same guides, roots and everything else):
+    /// the root sampler, part layout and guide weights are shared, only
+    /// the shapes and what the operators grew from them (clump centres)
+    /// are new. Animated grooms regrow each frame this way.
+    pub fn reshaped(&self, spec: GroomSpec) -> Result<Self, GroomError> {
+        Self::build(spec, Some(self))
+    }
+
+    fn build(spec: GroomSpec, shared: Option<&Generator>) -> Result<Self, GroomError> {
         let count = spec.roots.count;
         if count == 0 {
             return Err(spec.error(
@@ -103,17 +116,40 @@ impl Generator {
                 GroomErrorKind::Invalid("hairs need at least 2 points".into()),
             ));
         }
-        check_maps_on_mesh(&spec)?;
-        let mesh = &spec.mesh;
-        let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
-            .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
-        let layout = PartLayout::new(
-            mesh,
-            |t| sampler.triangle_probability(t),
-            count,
-            part_count(mesh, count, spec.roots.parts),
-        );
-        let interpolator = Interpolator::new(mesh, spec.guides.clone(), &spec.interpolation);
+        let (sampler, layout, interpolator) = match shared {
+            Some(g) => {
+                if g.guides.len() != spec.guides.len() {
+                    return Err(spec.error(
+                        "guides",
+                        GroomErrorKind::Invalid(format!(
+                            "{} guides where the groom has {}",
+                            spec.guides.len(),
+                            g.guides.len()
+                        )),
+                    ));
+                }
+                (
+                    g.sampler.clone(),
+                    g.layout.clone(),
+                    g.interpolator.reshaped(&spec.mesh, spec.guides.clone()),
+                )
+            }
+            None => {
+                check_maps_on_mesh(&spec)?;
+                let mesh = &spec.mesh;
+                let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
+                    .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
+                let layout = PartLayout::new(
+                    mesh,
+                    |t| sampler.triangle_probability(t),
+                    count,
+                    part_count(mesh, count, spec.roots.parts),
+                );
+                let interpolator =
+                    Interpolator::new(mesh, spec.guides.clone(), &spec.interpolation);
+                (Arc::new(sampler), Arc::new(layout), interpolator)
+            }
+        };
         let GroomSpec {
             name,
             mesh,

@@ -3,9 +3,11 @@
 //! [`Generator`] is built from, keeping where each was written so that
 //! errors found later still name the line.
 
+use super::animate::{AnimatedGroom, AnimationMode, AnimationSpec, GuideMotion};
 use super::error::{GroomError, GroomErrorKind};
 use super::file::{
-    ColorSpec, GroomFile, InterpolationKind, MapValue, MeshSection, OpSpec, RootToTipSpec,
+    AnimationModeName, ColorSpec, GroomFile, InterpolationKind, MapValue, MeshSection, OpSpec,
+    RootToTipSpec,
 };
 use super::generator::Generator;
 use super::ops::{Color, Cut, RootToTip};
@@ -13,6 +15,7 @@ use super::spec::{
     ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, LengthParams,
     NoiseParams, RootsSpec, SpecOrigin, StrandsParams,
 };
+use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{InterpolationMethod, StyleMeshOptions};
 use crate::map::Map;
@@ -26,13 +29,24 @@ use std::sync::Arc;
 /// Hairs per part when the groom does not say.
 pub const HAIRS_PER_PART: u64 = 100_000;
 
-/// A groom file loaded: the file, its mesh and guides.
+/// A groom file loaded: the file, its mesh and guides (and, for an
+/// animated groom, its skin and frames).
 pub struct Groom {
     source: SettingsSource,
     file: GroomFile,
     mesh: Arc<Mesh>,
     guides: Arc<Guides>,
     bind_report: Option<BindReport>,
+    animation: Option<LoadedAnimation>,
+}
+
+/// What `[animation]` (or `--frames`) loaded.
+struct LoadedAnimation {
+    skin: Arc<AnimatedSkin>,
+    spec: AnimationSpec,
+    fps: f64,
+    /// The guide file, when it is USD (regrow reads it frame by frame).
+    guides: Option<GuideMotion>,
 }
 
 impl std::fmt::Debug for Groom {
@@ -65,16 +79,119 @@ impl Groom {
 
     /// Parses the source, loads the mesh and the guides.
     pub fn from_source(source: SettingsSource) -> Result<Self, GroomError> {
+        Self::from_source_with_frames(source, None)
+    }
+
+    /// [`Self::load`], with `frames` replacing `[animation] frames` (and
+    /// making the groom animated when the file has no `[animation]`).
+    pub fn load_with_frames(path: &Path, frames: Option<FrameRange>) -> Result<Self, GroomError> {
+        Self::from_source_with_frames(SettingsSource::read_groom(path)?, frames)
+    }
+
+    /// [`Self::from_source`], with `frames` replacing `[animation] frames`.
+    pub fn from_source_with_frames(
+        source: SettingsSource,
+        frames: Option<FrameRange>,
+    ) -> Result<Self, GroomError> {
         let file = source.parse()?;
-        let mesh = Arc::new(load_mesh_section(&source, &file.mesh)?);
-        let (guides, bind_report) = load_guides(&source, &file, &mesh)?;
+        let animation = animation_spec(&source, &file, frames)?;
+        let (mesh, skin) = match &animation {
+            None => (load_mesh_section(&source, &file.mesh)?, None),
+            Some((spec, fps, clip)) => {
+                let skin = load_skin(&source, &file.mesh, *fps, clip.clone())?;
+                let mesh = skin
+                    .mesh_at(spec.rest_frame)
+                    .map_err(|e| source.error_at(file.mesh.path.span(), GroomErrorKind::Mesh(e)))?;
+                (mesh, Some(Arc::new(skin)))
+            }
+        };
+        let mesh = Arc::new(mesh);
+        let rest_time = animation.as_ref().map(|(spec, _, _)| spec.rest_frame);
+        let (guides, bind_report) = load_guides(&source, &file, &mesh, rest_time)?;
+        let animation = match (animation, skin) {
+            (Some((spec, fps, _)), Some(skin)) => {
+                let guide_file = file
+                    .guides
+                    .file
+                    .as_ref()
+                    .map(|p| source.folder().join(p.get_ref()));
+                let guides = guide_file.filter(|p| is_usd(p)).map(|path| {
+                    let total = bind_report
+                        .as_ref()
+                        .map_or(guides.len(), |r| r.kept + r.dropped.len());
+                    let dropped: std::collections::HashSet<usize> = bind_report
+                        .as_ref()
+                        .map(|r| r.dropped.iter().map(|d| d.index).collect())
+                        .unwrap_or_default();
+                    GuideMotion::File {
+                        path,
+                        kept: (0..total).filter(|i| !dropped.contains(i)).collect(),
+                    }
+                });
+                Some(LoadedAnimation {
+                    skin,
+                    spec,
+                    fps,
+                    guides,
+                })
+            }
+            _ => None,
+        };
         Ok(Self {
             source,
             file,
             mesh,
             guides: Arc::new(guides),
             bind_report,
+            animation,
         })
+    }
+
+    /// The frames and mode, for an animated groom.
+    pub fn animation(&self) -> Option<&AnimationSpec> {
+        self.animation.as_ref().map(|a| &a.spec)
+    }
+
+    /// Frames per second of an animated groom (`[animation] fps`).
+    pub fn fps(&self) -> Option<f64> {
+        self.animation.as_ref().map(|a| a.fps)
+    }
+
+    /// The animated skin, for an animated groom.
+    pub fn skin(&self) -> Option<&AnimatedSkin> {
+        self.animation.as_ref().map(|a| a.skin.as_ref())
+    }
+
+    /// The groom bound to its animated skin (`None` for a still groom);
+    /// `seed` overrides the file's.
+    pub fn animated(&self, seed: Option<u64>) -> Result<Option<AnimatedGroom>, GroomError> {
+        let Some(animation) = &self.animation else {
+            return Ok(None);
+        };
+        let mut spec = self.spec()?;
+        if let Some(seed) = seed {
+            spec.roots.seed = seed;
+        }
+        let guides = match animation.spec.mode {
+            AnimationMode::Deform => None,
+            AnimationMode::Regrow => {
+                let Some(guides) = animation.guides.clone() else {
+                    let span = self
+                        .file
+                        .animation
+                        .as_ref()
+                        .map_or(0..0, |a| a.frames.span());
+                    return Err(self.source.error_at(
+                        span,
+                        GroomErrorKind::Invalid(
+                            "mode = \"regrow\" needs time-sampled guides: a USD guide file in [guides] file".into(),
+                        ),
+                    ));
+                };
+                Some(guides)
+            }
+        };
+        AnimatedGroom::new(spec, animation.skin.clone(), animation.spec.clone(), guides).map(Some)
     }
 
     /// The parsed file.
@@ -338,10 +455,88 @@ fn load_mesh_section(source: &SettingsSource, section: &MeshSection) -> Result<M
         .map_err(|e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e)))
 }
 
+/// Whether a path names a USD file (by extension).
+fn is_usd(path: &Path) -> bool {
+    matches!(
+        path.extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref(),
+        Some("usda" | "usdc" | "usd")
+    )
+}
+
+/// The animation a groom file (or `--frames`) asks for: the spec, the
+/// frame rate and the glTF clip.
+fn animation_spec(
+    source: &SettingsSource,
+    file: &GroomFile,
+    frames: Option<FrameRange>,
+) -> Result<Option<(AnimationSpec, f64, Option<String>)>, GroomError> {
+    let section = file.animation.as_ref();
+    let frames = match (frames, section) {
+        (Some(f), _) => f,
+        (None, Some(s)) => FrameRange::parse(s.frames.get_ref()).map_err(|e| {
+            source.error_at(s.frames.span(), GroomErrorKind::Invalid(e.to_string()))
+        })?,
+        (None, None) => return Ok(None),
+    };
+    let fps = section.map_or(24.0, |s| s.fps);
+    if !(fps.is_finite() && fps > 0.0) {
+        let span = section.map_or(0..0, |s| s.frames.span());
+        return Err(source.error_at(
+            span,
+            GroomErrorKind::Invalid(format!("fps = {fps}: it must be a positive number")),
+        ));
+    }
+    let rest_frame = section
+        .and_then(|s| s.rest_frame)
+        .unwrap_or(f64::from(frames.first()));
+    if !rest_frame.is_finite() {
+        return Err(source.error_at(
+            section.map_or(0..0, |s| s.frames.span()),
+            GroomErrorKind::Invalid("rest_frame must be a finite number".into()),
+        ));
+    }
+    let mode = match section.map(|s| s.mode).unwrap_or_default() {
+        AnimationModeName::Deform => AnimationMode::Deform,
+        AnimationModeName::Regrow => AnimationMode::Regrow,
+    };
+    let spec = AnimationSpec {
+        frames,
+        rest_frame,
+        mode,
+        shutter: section.map(|s| s.motion_blur.clone()).unwrap_or_default(),
+    };
+    Ok(Some((spec, fps, section.and_then(|s| s.clip.clone()))))
+}
+
+/// The animated skin a `[mesh]` section names.
+fn load_skin(
+    source: &SettingsSource,
+    section: &MeshSection,
+    fps: f64,
+    clip: Option<String>,
+) -> Result<AnimatedSkin, GroomError> {
+    let error = |e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e));
+    let options = SkinOptions {
+        fps,
+        clip,
+        subdivide: section.subdivide,
+    };
+    match section.path.get_ref().as_str() {
+        "spot" => Ok(AnimatedSkin::still(
+            &crate::assets::spot().subdivided(section.subdivide),
+        )),
+        path => AnimatedSkin::load(&source.folder().join(path), &options).map_err(error),
+    }
+}
+
 fn load_guides(
     source: &SettingsSource,
     file: &GroomFile,
     mesh: &Mesh,
+    rest_time: Option<f64>,
 ) -> Result<(Guides, Option<BindReport>), GroomError> {
     let section = &file.guides;
     let invalid =
@@ -349,8 +544,12 @@ fn load_guides(
     match (&section.file, &section.generate) {
         (Some(path), None) => {
             let full = source.folder().join(path.get_ref());
-            let curves = crate::io::read_curves(&full)
-                .map_err(|e| source.error_at(path.span(), GroomErrorKind::Guides(e)))?;
+            // Animated guides are bound as they are at the rest frame.
+            let curves = match rest_time {
+                Some(t) if is_usd(&full) => crate::io::read_usd_curves_at(&full, Some(t)),
+                _ => crate::io::read_curves(&full),
+            }
+            .map_err(|e| source.error_at(path.span(), GroomErrorKind::Guides(e)))?;
             let (guides, report) = Guides::bind(mesh, &curves, section.points, section.tolerance);
             if guides.is_empty() {
                 return Err(invalid(

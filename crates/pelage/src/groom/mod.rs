@@ -23,6 +23,7 @@
 //! by (seed, hair id), so the output does not depend on threads, and any
 //! part generated alone equals that part of the full run.
 
+pub mod animate;
 mod diagnose;
 mod error;
 pub mod file;
@@ -36,6 +37,7 @@ mod ramp;
 mod source;
 mod spec;
 
+pub use animate::{AnimatedGroom, AnimationMode, AnimationProgress, AnimationSpec, GuideMotion};
 pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
 pub use file::{GroomFile, InterpolationKind};
 pub use generator::{Generator, GroomSummary, HAIRS_PER_PART};

@@ -91,19 +91,7 @@ impl Generator {
                 self.stream_parts(layer, parts, export, on_part)
             })
         })
-        .map_err(|e| {
-            // A part that could not grow comes back wrapped as an I/O
-            // error (see `write_usd`); the half-written file is gone.
-            if e.error
-                .get_ref()
-                .is_some_and(|inner| inner.is::<GroomError>())
-            {
-                let inner = e.error.into_inner().expect("checked above");
-                GroomWriteError::Groom(*inner.downcast::<GroomError>().expect("checked above"))
-            } else {
-                GroomWriteError::Write(e)
-            }
-        })?;
+        .map_err(unwrap_groom_error)?;
         Ok(summary)
     }
 
@@ -180,6 +168,21 @@ impl Generator {
             grower.join().expect("the part grower does not panic");
             Ok::<(), std::io::Error>(())
         })
+    }
+}
+
+/// A part that could not grow comes back from a streamed write wrapped
+/// as an I/O error (see `write_usd`; the half-written file is gone): this
+/// unwraps it, and leaves real write errors as they are.
+pub(super) fn unwrap_groom_error(e: WriteError) -> GroomWriteError {
+    if e.error
+        .get_ref()
+        .is_some_and(|inner| inner.is::<GroomError>())
+    {
+        let inner = e.error.into_inner().expect("checked above");
+        GroomWriteError::Groom(*inner.downcast::<GroomError>().expect("checked above"))
+    } else {
+        GroomWriteError::Write(e)
     }
 }
 

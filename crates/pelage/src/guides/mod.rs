@@ -255,6 +255,21 @@ impl Guides {
         })
     }
 
+    /// The same guides (roots, widths) in other shapes: `points` holds
+    /// every guide's points, `points_per_guide` each, in order.
+    pub fn with_points(&self, points: Vec<Vec3>) -> Result<Self, CurvesError> {
+        let curves = Curves::new(
+            points,
+            self.curves.widths().to_vec(),
+            self.curves.offsets().to_vec(),
+        )?
+        .with_roots(self.roots().to_vec())?;
+        Ok(Self {
+            curves,
+            points_per_guide: self.points_per_guide,
+        })
+    }
+
     /// The guides as curves (with their roots).
     pub fn curves(&self) -> &Curves {
         &self.curves

@@ -138,7 +138,7 @@ pub struct Interpolator {
     /// (a 12-byte `Vec3` went through the stack in two pieces and stalled
     /// the load that reassembled it).
     normals: Vec<Vec3A>,
-    weights: Box<dyn GuideWeights>,
+    weights: Arc<dyn GuideWeights>,
 }
 
 impl Interpolator {
@@ -162,7 +162,14 @@ impl Interpolator {
         guides: impl Into<Arc<Guides>>,
         weights: Box<dyn GuideWeights>,
     ) -> Self {
-        let guides = guides.into();
+        Self::with_shared_weights(mesh, guides.into(), Arc::from(weights))
+    }
+
+    fn with_shared_weights(
+        mesh: &Mesh,
+        guides: Arc<Guides>,
+        weights: Arc<dyn GuideWeights>,
+    ) -> Self {
         let mut offsets = Vec::with_capacity(guides.curves().points().len());
         for i in 0..guides.len() {
             let g = guides.guide(i);
@@ -179,6 +186,12 @@ impl Interpolator {
             normals,
             weights,
         }
+    }
+
+    /// The same weighting over `guides`: guides with the same roots as
+    /// this interpolator's, in other shapes (a frame of animated guides).
+    pub fn reshaped(&self, mesh: &Mesh, guides: impl Into<Arc<Guides>>) -> Self {
+        Self::with_shared_weights(mesh, guides.into(), self.weights.clone())
     }
 
     /// The guides.

@@ -1,0 +1,477 @@
+//! Grooms on animated skins (Sik §4.1: hair generated per frame and per
+//! part; Blender's Deform Curves on Surface). Roots are sampled once, on
+//! the skin's rest pose, and keep their triangle, barycentrics and id in
+//! every frame. Two modes:
+//!
+//! - **deform**: each part is grown once at rest, then carried to every
+//!   frame by its roots' surface frames ([`SkinBinding`]). Noise, clumps
+//!   and every other operator were evaluated at rest, so nothing swims.
+//! - **regrow**: every frame, the animated guides are brought back to
+//!   rest through their own roots' frames, the part is grown from them at
+//!   rest (operators still in rest space), and carried to the frame.
+//!   A hair at a guide's root reproduces that guide in every frame.
+//!
+//! Output is one file with time samples (usdc or Alembic): parts are
+//! written one after the other, each with all its frames, so memory holds
+//! one part (and the skin's poses) whatever the frame count.
+
+use super::error::{GroomError, GroomErrorKind};
+use super::generator::{Generator, GroomSummary};
+use super::output::{GroomWriteError, part_name};
+use super::spec::GroomSpec;
+use crate::Curves;
+use crate::anim::{AnimatedSkin, FrameRange, SkinBinding, SkinPose};
+use crate::guides::{Guides, resample_by_arc_length};
+use crate::io::{CurvesFormat, UsdOptions, write_atomically, write_streamed};
+use glam::Vec3;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// How an animated groom follows its skin.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AnimationMode {
+    /// Grow once at rest, carry every frame with the skin (fast).
+    #[default]
+    Deform,
+    /// Regrow every frame from animated guides, in rest space.
+    Regrow,
+}
+
+impl AnimationMode {
+    /// `deform` or `regrow`.
+    pub fn by_name(name: &str) -> Option<Self> {
+        match name {
+            "deform" => Some(Self::Deform),
+            "regrow" => Some(Self::Regrow),
+            _ => None,
+        }
+    }
+
+    /// The mode's name in groom files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Deform => "deform",
+            Self::Regrow => "regrow",
+        }
+    }
+}
+
+/// The frames of an animated groom and how they are made.
+#[derive(Debug, Clone)]
+pub struct AnimationSpec {
+    /// The frames written.
+    pub frames: FrameRange,
+    /// The frame whose skin the roots are sampled on (and the guides
+    /// bound to).
+    pub rest_frame: f64,
+    /// Deform or regrow.
+    pub mode: AnimationMode,
+    /// Shutter offsets in frames (e.g. `[-0.25, 0.25]`): each frame is
+    /// also written at these sub-frame times, for motion blur.
+    pub shutter: Vec<f64>,
+}
+
+impl AnimationSpec {
+    /// Every time code written: each frame, and each frame plus each
+    /// shutter offset, ascending.
+    pub fn sample_times(&self) -> Vec<f64> {
+        let mut times: Vec<f64> = self
+            .frames
+            .frames()
+            .iter()
+            .flat_map(|&f| {
+                std::iter::once(0.0)
+                    .chain(self.shutter.iter().copied())
+                    .map(move |o| f64::from(f) + o)
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+}
+
+/// Guide shapes over time, for [`AnimationMode::Regrow`].
+#[derive(Clone)]
+pub enum GuideMotion {
+    /// A time-sampled USD file of the guides (read at each frame);
+    /// `kept[i]` is the file's curve index of bound guide `i`.
+    File {
+        /// The guide file.
+        path: PathBuf,
+        /// Which of the file's curves were bound, in the guides' order.
+        kept: Vec<usize>,
+    },
+    /// A program giving every bound guide's points at a frame (one curve
+    /// per guide, in order).
+    Program(Arc<dyn Fn(f64) -> Curves + Send + Sync>),
+}
+
+impl std::fmt::Debug for GuideMotion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::File { path, .. } => write!(f, "GuideMotion::File({})", path.display()),
+            Self::Program(_) => f.write_str("GuideMotion::Program"),
+        }
+    }
+}
+
+/// How far an animated write has come.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AnimationProgress {
+    /// The part being written.
+    pub part: usize,
+    /// The time code just written.
+    pub time: f64,
+    /// (part, time) pairs written so far, and in all.
+    pub done: usize,
+    /// All of them.
+    pub total: usize,
+}
+
+/// A groom bound to an animated skin, ready to be grown frame by frame.
+pub struct AnimatedGroom {
+    spec: GroomSpec,
+    generator: Generator,
+    skin: Arc<AnimatedSkin>,
+    animation: AnimationSpec,
+    binding: SkinBinding,
+    guides: Option<GuideMotion>,
+}
+
+impl std::fmt::Debug for AnimatedGroom {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("AnimatedGroom")
+            .field("skin", &self.skin.name())
+            .field("frames", &self.animation.frames.to_string())
+            .field("mode", &self.animation.mode)
+            .finish()
+    }
+}
+
+impl AnimatedGroom {
+    /// Binds `spec` (whose mesh must be `skin` at the rest frame) to the
+    /// skin. `guides` moves the guides for regrow (required then).
+    pub fn new(
+        spec: GroomSpec,
+        skin: impl Into<Arc<AnimatedSkin>>,
+        animation: AnimationSpec,
+        guides: Option<GuideMotion>,
+    ) -> Result<Self, GroomError> {
+        let skin = skin.into();
+        let mesh_error = |e| spec.error("animation", GroomErrorKind::Mesh(e));
+        let rest = skin
+            .positions_at(animation.rest_frame)
+            .map_err(mesh_error)?;
+        let mesh = spec.mesh.clone();
+        if rest.len() != mesh.vertex_count() {
+            return Err(spec.error(
+                "animation",
+                GroomErrorKind::Invalid(format!(
+                    "the skin has {} vertices at its rest frame but the groom's mesh has {}",
+                    rest.len(),
+                    mesh.vertex_count()
+                )),
+            ));
+        }
+        if animation.mode == AnimationMode::Regrow && guides.is_none() {
+            return Err(spec.error(
+                "animation.mode",
+                GroomErrorKind::Invalid(
+                    "regrow needs animated guides: a time-sampled USD guide file ([guides] file)"
+                        .into(),
+                ),
+            ));
+        }
+        if let Some(bad) = animation
+            .shutter
+            .iter()
+            .find(|o| !(o.is_finite() && o.abs() < 1.0))
+        {
+            return Err(spec.error(
+                "animation.motion_blur",
+                GroomErrorKind::Invalid(format!(
+                    "shutter offset {bad}: offsets are fractions of a frame, between -1 and 1"
+                )),
+            ));
+        }
+        // The rest pose is the groom's own mesh, so a hair at rest is
+        // carried by exactly the identity.
+        let binding = SkinBinding::new(
+            mesh.triangles().to_vec(),
+            SkinPose::new(mesh.positions().to_vec(), mesh.triangles()),
+        );
+        let generator = Generator::new(spec.clone())?;
+        Ok(Self {
+            spec,
+            generator,
+            skin,
+            animation,
+            binding,
+            guides,
+        })
+    }
+
+    /// The generator at rest (parts, layout, operators).
+    pub fn generator(&self) -> &Generator {
+        &self.generator
+    }
+
+    /// The frames and mode.
+    pub fn animation(&self) -> &AnimationSpec {
+        &self.animation
+    }
+
+    /// The skin.
+    pub fn skin(&self) -> &AnimatedSkin {
+        &self.skin
+    }
+
+    /// The binding of hairs to the skin.
+    pub fn binding(&self) -> &SkinBinding {
+        &self.binding
+    }
+
+    /// The skin's pose at time code `time`.
+    pub fn pose(&self, time: f64) -> Result<SkinPose, GroomError> {
+        let positions = self
+            .skin
+            .positions_at(time)
+            .map_err(|e| self.spec.error("animation", GroomErrorKind::Mesh(e)))?;
+        Ok(self.binding.pose(positions))
+    }
+
+    /// The generator of the frame at `time` in regrow mode: the guides at
+    /// that time, brought back to rest through their roots' frames.
+    pub fn regrown_generator(&self, time: f64, pose: &SkinPose) -> Result<Generator, GroomError> {
+        let guides = self.guides_at(time, pose)?;
+        let mut spec = self.spec.clone();
+        spec.guides = Arc::new(guides);
+        self.generator.reshaped(spec)
+    }
+
+    /// The guides at `time`, in rest space.
+    fn guides_at(&self, time: f64, pose: &SkinPose) -> Result<Guides, GroomError> {
+        let rest = &self.spec.guides;
+        let n = rest.points_per_guide();
+        let (posed, kept): (Curves, Option<&[usize]>) = match &self.guides {
+            Some(GuideMotion::File { path, kept }) => (
+                crate::io::read_usd_curves_at(path, Some(time))
+                    .map_err(|e| self.spec.error("guides.file", GroomErrorKind::Guides(e)))?,
+                Some(kept),
+            ),
+            Some(GuideMotion::Program(f)) => (f(time), None),
+            None => return Ok((**rest).clone()),
+        };
+        let index = |i: usize| kept.map_or(Some(i), |k| k.get(i).copied());
+        let mut points = Vec::with_capacity(rest.len() * n);
+        let mut shape = vec![Vec3::ZERO; n];
+        for (i, &root) in rest.roots().iter().enumerate() {
+            let Some(c) = index(i).filter(|&c| c < posed.curve_count()) else {
+                return Err(self.spec.error(
+                    "guides.file",
+                    GroomErrorKind::Invalid(format!(
+                        "at frame {time} the guides have {} curves; the rest frame bound {} of them",
+                        posed.curve_count(),
+                        rest.len()
+                    )),
+                ));
+            };
+            let resampled = resample_by_arc_length(&posed.points()[posed.range(c)], n);
+            self.binding.to_rest(&resampled, root, pose, &mut shape);
+            points.extend_from_slice(&shape);
+        }
+        rest.with_points(points).map_err(|e| {
+            self.spec.error(
+                "guides.file",
+                GroomErrorKind::Invalid(format!("at frame {time}: {e}")),
+            )
+        })
+    }
+
+    /// Part `p` at `time` on `pose`: grown at rest by `generator` (the
+    /// rest generator in deform mode, the frame's in regrow mode) and
+    /// carried to the pose. `rest` caches the rest growth in deform mode.
+    fn part_at(
+        &self,
+        p: usize,
+        time: f64,
+        pose: &SkinPose,
+        generator: &Generator,
+        rest: &mut Option<Curves>,
+        out: &mut Curves,
+    ) -> Result<(), GroomError> {
+        let grown;
+        let at_rest = match self.animation.mode {
+            AnimationMode::Deform => {
+                if rest.is_none() {
+                    *rest = Some(generator.part(p)?);
+                }
+                rest.as_ref().expect("grown above")
+            }
+            AnimationMode::Regrow => {
+                grown = generator.part(p)?;
+                &grown
+            }
+        };
+        if !self.binding.carry_into(at_rest, pose, out) {
+            return Err(self.spec.error(
+                "animation",
+                GroomErrorKind::NotFinite(format!(
+                    "part {p} at frame {time}: the skin's pose moved a hair to a value that is not finite"
+                )),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The skin in `pose`, with the rest mesh's UVs.
+    pub fn posed_mesh(&self, pose: &SkinPose) -> Result<crate::Mesh, GroomError> {
+        let rest = &self.spec.mesh;
+        crate::Mesh::new(
+            rest.name(),
+            pose.positions().to_vec(),
+            rest.triangles().to_vec(),
+            None,
+            rest.uvs().cloned(),
+        )
+        .map_err(|e| self.spec.error("animation", GroomErrorKind::Mesh(e)))
+    }
+
+    /// The hair a root at guide `guide`'s root gets at `time` from the
+    /// guides alone (interpolated, no operator), carried to the skin's
+    /// pose: in regrow mode, the guide itself as the file poses it.
+    pub fn guide_hair(&self, guide: usize, time: f64) -> Result<Vec<Vec3>, GroomError> {
+        let pose = self.pose(time)?;
+        let regrown;
+        let generator = match self.animation.mode {
+            AnimationMode::Deform => &self.generator,
+            AnimationMode::Regrow => {
+                regrown = self.regrown_generator(time, &pose)?;
+                &regrown
+            }
+        };
+        let root = self.spec.guides.roots()[guide];
+        let n = self.spec.guides.points_per_guide();
+        let mut shape = vec![Vec3::ZERO; n];
+        generator
+            .interpolator
+            .hair(&self.spec.mesh, root, &mut Default::default(), &mut shape);
+        let at_rest = Curves::new(shape, vec![0.0; n], vec![0, n as u32])
+            .and_then(|c| c.with_roots(vec![root]))
+            .map_err(|e| {
+                self.spec
+                    .error("guides", GroomErrorKind::NotFinite(e.to_string()))
+            })?;
+        let carried = self.binding.carry(&at_rest, &pose).ok_or_else(|| {
+            self.spec.error(
+                "animation",
+                GroomErrorKind::NotFinite(format!("guide {guide} at frame {time}")),
+            )
+        })?;
+        Ok(carried.points().to_vec())
+    }
+
+    /// Part `p` at time code `time`, alone (tests, previews).
+    pub fn part(&self, p: usize, time: f64) -> Result<Curves, GroomError> {
+        let pose = self.pose(time)?;
+        let regrown;
+        let generator = match self.animation.mode {
+            AnimationMode::Deform => &self.generator,
+            AnimationMode::Regrow => {
+                regrown = self.regrown_generator(time, &pose)?;
+                &regrown
+            }
+        };
+        let mut out = Curves::default();
+        self.part_at(p, time, &pose, generator, &mut None, &mut out)?;
+        Ok(out)
+    }
+
+    /// Grows `parts` over every frame and writes them to `path` (`.usdc`
+    /// or `.abc`), atomically, with one time sample per frame (and shutter
+    /// offset). With `with_skin` the posed skin is written too, as a
+    /// time-sampled `Mesh` named `skin` (usdc only). `progress` is called
+    /// after each part's frame.
+    pub fn write(
+        &self,
+        path: &Path,
+        parts: Range<usize>,
+        options: &UsdOptions,
+        with_skin: bool,
+        mut progress: impl FnMut(AnimationProgress),
+    ) -> Result<GroomSummary, GroomWriteError> {
+        let format = match CurvesFormat::from_path(path) {
+            Some(f @ (CurvesFormat::Usdc | CurvesFormat::Abc)) => f,
+            _ => {
+                return Err(GroomWriteError::Groom(self.spec.error(
+                    "output.path",
+                    GroomErrorKind::Invalid(format!(
+                        "{}: animated grooms are written with time samples to .usdc, .usd or .abc",
+                        path.display()
+                    )),
+                )));
+            }
+        };
+        let times = self.animation.sample_times();
+        let mut poses = Vec::with_capacity(times.len());
+        for &t in &times {
+            poses.push(self.pose(t)?);
+        }
+        let generators = match self.animation.mode {
+            AnimationMode::Deform => Vec::new(),
+            AnimationMode::Regrow => times
+                .iter()
+                .zip(&poses)
+                .map(|(&t, pose)| self.regrown_generator(t, pose))
+                .collect::<Result<Vec<_>, _>>()?,
+        };
+        let mut summary = GroomSummary::default();
+        let total = parts.len() * times.len();
+        write_atomically(path, |out| {
+            write_streamed(out, format, options, |layer| {
+                if with_skin {
+                    for (&time, pose) in times.iter().zip(&poses) {
+                        let mesh = self.posed_mesh(pose).map_err(std::io::Error::other)?;
+                        layer
+                            .write_mesh_at("skin", time, &mesh)
+                            .map_err(std::io::Error::other)?;
+                    }
+                }
+                let mut out = Curves::default();
+                let mut done = 0;
+                for p in parts.clone() {
+                    let mut rest = None;
+                    for (k, (&time, pose)) in times.iter().zip(&poses).enumerate() {
+                        let generator = generators.get(k).unwrap_or(&self.generator);
+                        self.part_at(p, time, pose, generator, &mut rest, &mut out)
+                            .map_err(std::io::Error::other)?;
+                        if k == 0 {
+                            summary.hairs += out.curve_count() as u64;
+                            summary.points += out.points().len() as u64;
+                        }
+                        if out.curve_count() > 0 {
+                            layer
+                                .write_part_at(&part_name(p), time, &out)
+                                .map_err(std::io::Error::other)?;
+                        }
+                        done += 1;
+                        progress(AnimationProgress {
+                            part: p,
+                            time,
+                            done,
+                            total,
+                        });
+                    }
+                    if let Some(rest) = rest {
+                        self.generator.recycle(rest);
+                    }
+                }
+                Ok(())
+            })
+        })
+        .map_err(super::output::unwrap_groom_error)?;
+        Ok(summary)
+    }
+}

@@ -1,0 +1,438 @@
+//! Fur on animated skins: hairs bound at rest ride the skin exactly
+//! (rigid motion), stay rooted on a bending skin, keep their ids and
+//! counts every frame, and regrowing from animated guides reproduces each
+//! guide at its root; skins come from glTF skinning, USD time samples and
+//! OBJ sequences.
+
+use glam::{Affine3A, Mat3, Quat, Vec3};
+use pelage::anim::{AnimatedSkin, FrameRange, SkinOptions};
+use pelage::groom::{
+    AnimatedGroom, AnimationMode, AnimationSpec, ClumpParams, GroomOp, GroomSpec, GuideMotion,
+    NoiseParams, RootsSpec,
+};
+use pelage::guides::{GuideGrowth, Guides};
+use pelage::io::UsdcWriter;
+use pelage::{Curves, Map, Mesh};
+use std::sync::Arc;
+
+fn spot() -> Arc<Mesh> {
+    Arc::new(pelage::assets::spot())
+}
+
+/// A small groom on `mesh` with noise and clumps (spatial randomness that
+/// would swim if it were evaluated on the moving skin).
+fn groom(mesh: &Arc<Mesh>) -> GroomSpec {
+    let guides = Guides::grow(
+        mesh,
+        &GuideGrowth {
+            count: 60,
+            length: Map::Constant(0.08),
+            comb: Vec3::new(0.0, -0.5, -1.0),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mut roots = RootsSpec::new(4000);
+    roots.parts = Some(3);
+    let mut spec = GroomSpec::new(mesh.clone(), guides, roots);
+    spec.ops = vec![
+        GroomOp::Clump(ClumpParams::new(200)),
+        GroomOp::Noise(NoiseParams::new(Map::Constant(0.01))),
+    ];
+    spec
+}
+
+fn animation(frames: &str, mode: AnimationMode) -> AnimationSpec {
+    AnimationSpec {
+        frames: FrameRange::parse(frames).unwrap(),
+        rest_frame: 1.0,
+        mode,
+        shutter: Vec::new(),
+    }
+}
+
+/// A rigid motion that is the identity at frame 1.
+fn rigid(frame: f64) -> Affine3A {
+    let t = (frame - 1.0) as f32;
+    Affine3A::from_rotation_translation(
+        Quat::from_euler(glam::EulerRot::YXZ, 0.7 * t, 0.3 * t, -0.2 * t),
+        Vec3::new(0.5 * t, -0.25 * t, 2.0 * t),
+    )
+}
+
+/// A bend about the x axis growing with y: the skin's top folds over.
+fn bend(p: Vec3, frame: f64) -> Vec3 {
+    let angle = (frame - 1.0) as f32 * 0.6 * (p.y + 1.0);
+    Mat3::from_rotation_x(angle) * p
+}
+
+#[test]
+fn hairs_move_rigidly_with_a_rigidly_moving_skin() {
+    let mesh = spot();
+    let rest: Vec<Vec3> = mesh.positions().to_vec();
+    let skin = AnimatedSkin::from_fn(&mesh, move |f| {
+        let m = rigid(f);
+        rest.iter().map(|&p| m.transform_point3(p)).collect()
+    });
+    let groom = AnimatedGroom::new(
+        groom(&mesh),
+        skin,
+        animation("1-4", AnimationMode::Deform),
+        None,
+    )
+    .unwrap();
+    let size = {
+        let (lo, hi) = mesh.bounds();
+        (hi - lo).length()
+    };
+    for p in 0..groom.generator().parts().len() {
+        let at_rest = groom.part(p, 1.0).unwrap();
+        assert!(at_rest.curve_count() > 0);
+        for frame in [2.0, 3.0, 4.0] {
+            let moved = groom.part(p, frame).unwrap();
+            let m = rigid(frame);
+            let worst = at_rest
+                .points()
+                .iter()
+                .zip(moved.points())
+                .map(|(&a, &b)| (m.transform_point3(a) - b).length())
+                .fold(0.0f32, f32::max);
+            // Float precision of positions a few units from the origin.
+            assert!(
+                worst < 2e-6 * (size + 10.0),
+                "part {p} frame {frame}: a hair point is {worst} from the rigidly moved one"
+            );
+            let turned = at_rest
+                .normals()
+                .unwrap()
+                .iter()
+                .zip(moved.normals().unwrap())
+                .map(|(&a, &b)| (m.transform_vector3(a) - b).length())
+                .fold(0.0f32, f32::max);
+            // Frames come from edges of moved positions: a triangle 0.01
+            // across, moved several units, has its edges rounded at ~1e-6.
+            assert!(
+                turned < 1e-4,
+                "normals turn with the skin (off by {turned})"
+            );
+        }
+    }
+}
+
+#[test]
+fn roots_stay_on_a_bending_skin_with_the_same_hairs_every_frame() {
+    let mesh = spot();
+    let rest: Vec<Vec3> = mesh.positions().to_vec();
+    let skin = AnimatedSkin::from_fn(&mesh, move |f| rest.iter().map(|&p| bend(p, f)).collect());
+    let groom = AnimatedGroom::new(
+        groom(&mesh),
+        skin,
+        animation("1-3", AnimationMode::Deform),
+        None,
+    )
+    .unwrap();
+    for p in 0..groom.generator().parts().len() {
+        let first = groom.part(p, 1.0).unwrap();
+        for frame in [1.5, 2.0, 3.0] {
+            let posed = groom.part(p, frame).unwrap();
+            assert_eq!(posed.offsets(), first.offsets(), "same curves, same points");
+            assert_eq!(posed.ids(), first.ids(), "same hair ids in the same order");
+            // Each root on the bent surface: the barycentric point of its
+            // triangle on the bent mesh.
+            let bent = Mesh::new(
+                "bent",
+                mesh.positions().iter().map(|&p| bend(p, frame)).collect(),
+                mesh.triangles().to_vec(),
+                None,
+                None,
+            )
+            .unwrap();
+            for (i, root) in posed.roots().unwrap().iter().enumerate() {
+                let on_surface = root.position(&bent);
+                let first_point = posed.points()[posed.range(i)][0];
+                assert!(
+                    (on_surface - first_point).length() < 1e-5,
+                    "part {p} hair {i} frame {frame}: root {first_point} is off the surface point {on_surface}"
+                );
+            }
+            // The skin really moved.
+            let moved = posed
+                .points()
+                .iter()
+                .zip(first.points())
+                .map(|(a, b)| (*a - *b).length())
+                .fold(0.0f32, f32::max);
+            assert!(moved > 0.05, "frame {frame} moved hairs by {moved}");
+        }
+    }
+}
+
+#[test]
+fn regrowing_reproduces_every_animated_guide_at_its_root() {
+    let mesh = spot();
+    let rest: Vec<Vec3> = mesh.positions().to_vec();
+    let spec = groom(&mesh);
+    let guides = spec.guides.clone();
+    let skin = AnimatedSkin::from_fn(&mesh, move |f| rest.iter().map(|&p| bend(p, f)).collect());
+    // Animated guides as a simulation would give them: rooted on the bent
+    // skin, swinging about their roots by a frame-dependent turn.
+    let shared = mesh.clone();
+    let posed_mesh = move |f: f64| {
+        Mesh::new(
+            "bent",
+            shared.positions().iter().map(|&p| bend(p, f)).collect(),
+            shared.triangles().to_vec(),
+            None,
+            None,
+        )
+        .unwrap()
+    };
+    let animated = {
+        let guides = guides.clone();
+        let posed_mesh = posed_mesh.clone();
+        move |f: f64| -> Curves {
+            let bent = posed_mesh(f);
+            let swing = Mat3::from_rotation_z(0.4 * (f - 1.0) as f32);
+            let mut points = Vec::new();
+            for (i, root) in guides.roots().iter().enumerate() {
+                let g = guides.guide(i);
+                let base = root.position(&bent);
+                points.extend(g.iter().map(|&p| base + swing * (p - g[0])));
+            }
+            let n = guides.points_per_guide();
+            let offsets = (0..=guides.len() as u32).map(|i| i * n as u32).collect();
+            Curves::new(points, vec![0.01; guides.len() * n], offsets).unwrap()
+        }
+    };
+    let expected = animated.clone();
+    let groom = AnimatedGroom::new(
+        spec,
+        skin,
+        animation("1-3", AnimationMode::Regrow),
+        Some(GuideMotion::Program(Arc::new(animated))),
+    )
+    .unwrap();
+    for frame in [1.0, 2.0, 3.0] {
+        let want = expected(frame);
+        for i in 0..guides.len() {
+            let hair = groom.guide_hair(i, frame).unwrap();
+            let guide = &want.points()[want.range(i)];
+            let worst = hair
+                .iter()
+                .zip(guide)
+                .map(|(a, b)| (*a - *b).length())
+                .fold(0.0f32, f32::max);
+            assert!(
+                worst < 1e-5,
+                "frame {frame} guide {i}: the hair at its root is {worst} from it"
+            );
+        }
+        // Every part regrows with the same hairs.
+        let part = groom.part(0, frame).unwrap();
+        assert_eq!(
+            part.curve_count(),
+            groom.part(0, 1.0).unwrap().curve_count()
+        );
+    }
+}
+
+#[test]
+fn gltf_skinning_poses_the_fox_and_a_clip_is_chosen_by_name() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fox/Fox.gltf");
+    let options = |clip: &str| SkinOptions {
+        fps: 24.0,
+        clip: Some(clip.into()),
+        subdivide: 0,
+    };
+    let walk = AnimatedSkin::load(&path, &options("Walk")).unwrap();
+    assert!(walk.is_animated());
+    let (name, seconds) = walk.clip().unwrap();
+    assert_eq!(name, "Walk");
+    assert!(seconds > 0.5 && seconds < 1.0, "Walk lasts {seconds} s");
+    let still = Mesh::load(&path).unwrap();
+    let a = walk.mesh_at(1.0).unwrap();
+    let b = walk.mesh_at(9.0).unwrap();
+    assert_eq!(
+        a.triangles(),
+        still.triangles(),
+        "topology of the still mesh"
+    );
+    let moved = a
+        .positions()
+        .iter()
+        .zip(b.positions())
+        .map(|(p, q)| (*p - *q).length())
+        .fold(0.0f32, f32::max);
+    assert!(
+        moved > 5.0,
+        "the legs move between frames 1 and 9 ({moved})"
+    );
+    // Posed within the model's size of its bind pose (no exploded joints).
+    let (lo, hi) = still.bounds();
+    let (plo, phi) = a.bounds();
+    assert!((plo - lo).length() < 0.3 * (hi - lo).length());
+    assert!((phi - hi).length() < 0.3 * (hi - lo).length());
+    // An unknown clip names the ones there are.
+    let error = AnimatedSkin::load(&path, &options("Dance"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("Fox.gltf") && error.contains("\"Survey\", \"Walk\", \"Run\""),
+        "{error}"
+    );
+}
+
+/// A glTF with one joint turned 90° about z at t = 1 s; a vertex weighted
+/// fully to it must turn exactly so.
+#[test]
+fn linear_blend_skinning_matches_the_hand_computed_pose() {
+    let floats = |v: &[f32]| v.iter().flat_map(|f| f.to_le_bytes()).collect::<Vec<u8>>();
+    let mut buffer = Vec::new();
+    // Positions: a triangle at x = 1..2.
+    buffer.extend(floats(&[1.0, 0.0, 0.0, 2.0, 0.0, 0.0, 1.0, 1.0, 0.0]));
+    // Joints (u8 ×4) and weights: vertex 0 half on each joint, others on 1.
+    buffer.extend([0u8, 1, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0]);
+    buffer.extend(floats(&[
+        0.5, 0.5, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0,
+    ]));
+    // Animation: times and rotations.
+    buffer.extend(floats(&[0.0, 1.0]));
+    let half = std::f32::consts::FRAC_PI_4;
+    buffer.extend(floats(&[
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        half.sin(),
+        half.cos(),
+    ]));
+    let uri = "turn.bin";
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1]}}],
+        "nodes":[{{"mesh":0,"skin":0}},{{"children":[2]}},{{}}],
+        "skins":[{{"joints":[1,2]}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"JOINTS_0":1,"WEIGHTS_0":2}}}}]}}],
+        "animations":[{{"name":"turn","channels":[{{"sampler":0,"target":{{"node":2,"path":"rotation"}}}}],
+          "samplers":[{{"input":3,"output":4,"interpolation":"LINEAR"}}]}}],
+        "buffers":[{{"byteLength":{len},"uri":"{uri}"}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":12}},
+          {{"buffer":0,"byteOffset":48,"byteLength":48}},{{"buffer":0,"byteOffset":96,"byteLength":8}},
+          {{"buffer":0,"byteOffset":104,"byteLength":32}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[1,0,0],"max":[2,1,0]}},
+          {{"bufferView":1,"componentType":5121,"count":3,"type":"VEC4"}},
+          {{"bufferView":2,"componentType":5126,"count":3,"type":"VEC4"}},
+          {{"bufferView":3,"componentType":5126,"count":2,"type":"SCALAR","min":[0],"max":[1]}},
+          {{"bufferView":4,"componentType":5126,"count":2,"type":"VEC4"}}]}}"#,
+        len = buffer.len()
+    );
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join(uri), &buffer).unwrap();
+    let path = dir.path().join("turn.gltf");
+    std::fs::write(&path, json).unwrap();
+    let skin = AnimatedSkin::load(
+        &path,
+        &SkinOptions {
+            fps: 2.0,
+            ..SkinOptions::default()
+        },
+    )
+    .unwrap();
+    // Frame 1: time 0 (no turn); frame 2: 0.5 s (45°); frame 3: 1 s (90°).
+    let p = |f: f64| skin.positions_at(f).unwrap();
+    assert!((p(1.0)[1] - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-6);
+    let turned = p(3.0);
+    assert!(
+        (turned[1] - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-5,
+        "{}",
+        turned[1]
+    );
+    assert!(
+        (turned[2] - Vec3::new(-1.0, 1.0, 0.0)).length() < 1e-5,
+        "{}",
+        turned[2]
+    );
+    // Half on the still joint, half on the turned one: the average.
+    let blended = 0.5 * (Vec3::new(1.0, 0.0, 0.0) + Vec3::new(0.0, 1.0, 0.0));
+    assert!((turned[0] - blended).length() < 1e-5, "{}", turned[0]);
+    let (s, c) = (
+        std::f32::consts::FRAC_PI_4.sin(),
+        std::f32::consts::FRAC_PI_4.cos(),
+    );
+    assert!(
+        (p(2.0)[1] - 2.0 * Vec3::new(c, s, 0.0)).length() < 1e-5,
+        "slerped halfway"
+    );
+}
+
+#[test]
+fn usd_skins_move_by_their_point_samples() {
+    let mesh = spot();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("skin.usdc");
+    let lifted = |dy: f32| {
+        Mesh::new(
+            "spot",
+            mesh.positions().iter().map(|&p| p + Vec3::Y * dy).collect(),
+            mesh.triangles().to_vec(),
+            None,
+            mesh.uvs().cloned(),
+        )
+        .unwrap()
+    };
+    let file = std::fs::File::create(&path).unwrap();
+    let mut usd = UsdcWriter::new(std::io::BufWriter::new(file), &Default::default()).unwrap();
+    usd.write_mesh_at("skin", 1.0, &lifted(0.0)).unwrap();
+    usd.write_mesh_at("skin", 3.0, &lifted(1.0)).unwrap();
+    usd.finish().unwrap();
+    let skin = AnimatedSkin::load(&path, &SkinOptions::default()).unwrap();
+    assert!(skin.is_animated());
+    assert_eq!(skin.sample_times(), [1.0, 3.0]);
+    let at = |f: f64| skin.positions_at(f).unwrap();
+    for (frame, dy) in [(0.0, 0.0), (1.0, 0.0), (2.0, 0.5), (3.0, 1.0), (9.0, 1.0)] {
+        let worst = at(frame)
+            .iter()
+            .zip(mesh.positions())
+            .map(|(a, b)| (*a - (*b + Vec3::Y * dy)).length())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-5, "frame {frame}: off by {worst}");
+    }
+    // The still reader takes the first sample, with UVs.
+    let still = Mesh::load(&path).unwrap();
+    assert_eq!(still.triangle_count(), mesh.triangle_count());
+    assert!(still.has_uvs());
+}
+
+#[test]
+fn an_obj_sequence_whose_topology_changes_names_the_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let quad =
+        |dz: f32, faces: &str| format!("v 0 0 {dz}\nv 1 0 {dz}\nv 1 1 {dz}\nv 0 1 {dz}\n{faces}");
+    std::fs::write(
+        dir.path().join("skin.0001.obj"),
+        quad(0.0, "f 1 2 3\nf 1 3 4\n"),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("skin.0002.obj"),
+        quad(0.5, "f 1 2 3\nf 1 3 4\n"),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("skin.0003.obj"),
+        quad(1.0, "f 1 2 4\nf 2 3 4\n"),
+    )
+    .unwrap();
+    let skin =
+        AnimatedSkin::load(&dir.path().join("skin.####.obj"), &SkinOptions::default()).unwrap();
+    assert!((skin.positions_at(2.0).unwrap()[2].z - 0.5).abs() < 1e-6);
+    assert!((skin.positions_at(1.5).unwrap()[0].z - 0.25).abs() < 1e-6);
+    let error = skin.positions_at(3.0).unwrap_err().to_string();
+    assert!(
+        error.contains("skin.0003.obj") && error.contains("frame 3") && error.contains("topology"),
+        "{error}"
+    );
+    let missing = skin.positions_at(7.0).unwrap_err().to_string();
+    assert!(missing.contains("skin.0007.obj"), "{missing}");
+}
