@@ -6,7 +6,8 @@ use crate::format::thousands;
 use anyhow::{Context, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use pelage::groom::{Groom, part_file, part_slice, write_assembly};
+use pelage::anim::FrameRange;
+use pelage::groom::{AnimatedGroom, Groom, part_file, part_slice, write_assembly};
 use pelage::io::{CurvesExport, CurvesFormat, UsdOptions};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -37,6 +38,11 @@ pub struct GroomArgs {
     /// Override the groom file's seed.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Frames of an animated skin, e.g. 1-24 (replaces `[animation]
+    /// frames`; makes the groom animated when the file has no
+    /// `[animation]`). Output: one .usdc or .abc with time samples.
+    #[arg(long, value_name = "RANGE", value_parser = parse_frames)]
+    pub frames: Option<FrameRange>,
     /// Also draw the hairs on the skin into this PNG (headless GPU; at
     /// most 300,000 hairs, evenly chosen).
     #[arg(long, value_name = "PNG")]
@@ -44,6 +50,10 @@ pub struct GroomArgs {
     /// Do not print the progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+fn parse_frames(s: &str) -> Result<FrameRange, String> {
+    FrameRange::parse(s).map_err(|e| e.to_string())
 }
 
 fn parse_part(s: &str) -> Result<(usize, usize), String> {
@@ -72,7 +82,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
             .context("cannot set up the worker threads")?;
     }
     let start = Instant::now();
-    let groom = Groom::load(&args.file)?;
+    let groom = Groom::load_with_frames(&args.file, args.frames.clone())?;
     let output = args.output.clone().unwrap_or_else(|| groom.output_path());
     if args.assemble {
         return assemble(&output, &UsdOptions::default());
@@ -81,6 +91,9 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         for dropped in &report.dropped {
             eprintln!("warning: guides: {dropped}");
         }
+    }
+    if let Some(animated) = groom.animated(args.seed)? {
+        return run_animated(args, &groom, &animated, &output, start);
     }
     let generator = groom.generator(args.seed)?;
     let prepared = start.elapsed();
@@ -191,6 +204,101 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
             Err(e) => eprintln!("warning: no preview: {e:#}"),
         }
     }
+    Ok(())
+}
+
+/// `pelage groom` for an animated groom: every part over every frame,
+/// into one file with time samples.
+fn run_animated(
+    args: &GroomArgs,
+    groom: &Groom,
+    animated: &AnimatedGroom,
+    output: &Path,
+    start: Instant,
+) -> anyhow::Result<()> {
+    if args.preview.is_some() {
+        bail!(
+            "--preview draws still grooms; for an animated one, render its frames: pelage render FILE --frames {}",
+            animated.animation().frames
+        );
+    }
+    let generator = animated.generator();
+    let parts = generator.parts().len();
+    let (range, path) = match args.part {
+        Some((k, n)) => {
+            if n > parts {
+                bail!(
+                    "--part {k}/{n}: the groom has {parts} parts, so at most {parts} runs; set [roots] parts in {} for more",
+                    args.file.display()
+                );
+            }
+            (part_slice(k, n, parts), part_file(output, k, n))
+        }
+        None => (0..parts, output.to_path_buf()),
+    };
+    let animation = animated.animation();
+    let times = animation.sample_times();
+    let planned: u64 = generator.parts()[range.clone()]
+        .iter()
+        .map(|p| p.hair_count)
+        .sum();
+    let clip = match animated.skin().clip() {
+        Some((name, seconds)) => format!(", clip {name:?} ({seconds:.2} s)"),
+        None => String::new(),
+    };
+    println!(
+        "{}: {} hairs on {} ({} triangles) from {} guides, {}; frames {} ({} samples, rest frame {}, {}{clip})",
+        args.file.display(),
+        thousands(planned),
+        groom.mesh().name(),
+        thousands(groom.mesh().triangle_count() as u64),
+        thousands(groom.guides().len() as u64),
+        parts_text(range.len()),
+        animation.frames,
+        times.len(),
+        animation.rest_frame,
+        animation.mode.name(),
+    );
+    if !animated.skin().is_animated() {
+        eprintln!(
+            "warning: {} does not move; every frame will be the rest frame",
+            groom.mesh().name()
+        );
+    }
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        let bar = ProgressBar::new((range.len() * times.len()) as u64);
+        bar.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} part-frames, {msg} {eta} left")
+                .expect("the template is valid"),
+        );
+        bar
+    };
+    let options = UsdOptions {
+        basis: groom.file().output.basis,
+        time_codes_per_second: groom.fps().unwrap_or(24.0),
+        ..UsdOptions::default()
+    };
+    let growing = Instant::now();
+    let with_skin = groom.file().output.with_mesh;
+    let summary = animated.write(&path, range.clone(), &options, with_skin, |p| {
+        bar.set_message(format!("part {} frame {}", p.part, p.time));
+        bar.set_position(p.done as u64);
+    })?;
+    bar.finish_and_clear();
+    let seconds = growing.elapsed().as_secs_f64();
+    println!(
+        "{} hairs, {} points × {} samples in {} → {} in {:.2} s ({:.3} s a frame; setup {:.2} s)",
+        thousands(summary.hairs),
+        thousands(summary.points),
+        times.len(),
+        parts_text(range.len()),
+        path.display(),
+        seconds,
+        seconds / times.len() as f64,
+        start.elapsed().as_secs_f64() - seconds
+    );
     Ok(())
 }
 

@@ -44,6 +44,19 @@ pub struct RenderArgs {
     /// Draw the embedded Spot without its texture.
     #[arg(long)]
     pub no_texture: bool,
+    /// Render these frames of an animated USD file (e.g. 1-24): OUTPUT is
+    /// then a folder that gets one PNG a frame and an animated GIF. The
+    /// file's time-sampled `skin` mesh (`[output] with_mesh`) is drawn
+    /// under the curves, moving with them.
+    #[arg(long, value_name = "RANGE", value_parser = parse_frames)]
+    pub frames: Option<pelage::anim::FrameRange>,
+    /// Frames per second of the GIF.
+    #[arg(long, default_value_t = 24.0)]
+    pub fps: f64,
+}
+
+fn parse_frames(s: &str) -> Result<pelage::anim::FrameRange, String> {
+    pelage::anim::FrameRange::parse(s).map_err(|e| e.to_string())
 }
 
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -92,6 +105,9 @@ pub(crate) fn file_kind(path: &Path) -> anyhow::Result<FileKind> {
 }
 
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
+    if let Some(frames) = &args.frames {
+        return run_frames(args, frames);
+    }
     let under = || -> anyhow::Result<Option<pelage::Mesh>> {
         match args.mesh.as_deref() {
             None => Ok(None),
@@ -164,6 +180,126 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             (None, n, None) => format!("{n} points"),
         },
         adapter
+    );
+    Ok(())
+}
+
+/// `pelage render FILE --frames RANGE -o DIR`: one PNG a frame of an
+/// animated USD file, with its animated skin, from one fixed camera, and
+/// the frames as a GIF.
+fn run_frames(args: &RenderArgs, frames: &pelage::anim::FrameRange) -> anyhow::Result<()> {
+    use pelage::anim::{AnimatedSkin, SkinOptions};
+    use pelage::io::UsdCurvesSequence;
+    let Some(file) = &args.file else {
+        anyhow::bail!("--frames renders an animated USD file: give its path");
+    };
+    if !matches!(
+        CurvesFormat::from_path(file),
+        Some(CurvesFormat::Usda | CurvesFormat::Usdc)
+    ) {
+        anyhow::bail!(
+            "{}: --frames reads animated USD (.usdc, .usd, .usda), as `pelage groom` writes with [animation]",
+            file.display()
+        );
+    }
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        anyhow::bail!("--fps {}: it must be a positive number", args.fps);
+    }
+    let curves = UsdCurvesSequence::open(file).context("cannot load the curves")?;
+    // The skin written beside the curves moves with them; a --mesh stands
+    // still under them.
+    let skin = match args.mesh.as_deref() {
+        Some(m) if m == Path::new("spot") => Some(AnimatedSkin::still(&load_mesh(None)?)),
+        Some(m) => {
+            Some(AnimatedSkin::load(m, &SkinOptions::default()).context("cannot load the mesh")?)
+        }
+        None => AnimatedSkin::load(file, &SkinOptions::default()).ok(),
+    };
+    let out = &args.output;
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create the folder {}", out.display()))?;
+    let (width, height) = args.size;
+    // One camera for every frame: framed on the skin's (or the first
+    // frame's) bounds over all frames.
+    let mut bounds: Option<(glam::Vec3, glam::Vec3)> = None;
+    let mut grow = |lo: glam::Vec3, hi: glam::Vec3| {
+        bounds = Some(match bounds {
+            Some((a, b)) => (a.min(lo), b.max(hi)),
+            None => (lo, hi),
+        });
+    };
+    for &f in frames.frames() {
+        if let Some(skin) = &skin {
+            let m = skin.mesh_at(f64::from(f))?;
+            let (lo, hi) = m.bounds();
+            grow(lo, hi);
+        }
+    }
+    let first = curves.at(f64::from(frames.first()))?;
+    if let Some((lo, hi)) = first.bounds() {
+        grow(lo, hi);
+    }
+    let Some((lo, hi)) = bounds else {
+        anyhow::bail!("{}: nothing to draw", file.display());
+    };
+    let camera = match args.eye {
+        Some(eye) => Camera {
+            eye: eye.into(),
+            target: args.target.map_or(0.5 * (lo + hi), Into::into),
+            fov_y_degrees: args.fov,
+        },
+        None => Camera::framing(lo, hi, width as f32 / height as f32),
+    };
+    let style = PreviewStyle {
+        background: super::FUR_BACKGROUND,
+        ..Default::default()
+    };
+    let ctx = pelage_gpu::GpuContext::headless()?;
+    let renderer = pelage_gpu::Renderer::new(&ctx);
+    let stem = file
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("frames")
+        .to_string();
+    let mut images = Vec::with_capacity(frames.len());
+    for &f in frames.frames() {
+        let time = f64::from(f);
+        let hairs = curves.at(time)?;
+        let mesh = skin.as_ref().map(|s| s.mesh_at(time)).transpose()?;
+        let scene = PreviewScene {
+            mesh: mesh.as_ref(),
+            points: &[],
+            curves: Some(&hairs),
+            skin_texture: None,
+        };
+        let image = renderer.render(&ctx, &scene, &style, Some(camera), width, height)?;
+        let png = out.join(format!("{stem}.{f:04}.png"));
+        pelage::io::write_atomically(&png, |w| {
+            image
+                .write_to(w, image::ImageFormat::Png)
+                .map_err(std::io::Error::other)
+        })?;
+        images.push(image);
+    }
+    let gif = out.join(format!("{stem}.gif"));
+    let delay = image::Delay::from_numer_denom_ms(1000, args.fps.round().max(1.0) as u32);
+    pelage::io::write_atomically(&gif, |w| {
+        let mut encoder = image::codecs::gif::GifEncoder::new_with_speed(w, 10);
+        encoder
+            .set_repeat(image::codecs::gif::Repeat::Infinite)
+            .map_err(std::io::Error::other)?;
+        for image in &images {
+            let frame = image::Frame::from_parts(image.clone(), 0, 0, delay);
+            encoder.encode_frame(frame).map_err(std::io::Error::other)?;
+        }
+        Ok(())
+    })?;
+    println!(
+        "wrote {} frames ({width}×{height}) and {} to {} (rendered on {})",
+        images.len(),
+        gif.display(),
+        out.display(),
+        ctx.adapter_name()
     );
     Ok(())
 }
