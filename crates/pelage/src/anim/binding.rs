@@ -80,6 +80,10 @@ pub struct SkinBinding {
     rest: SkinPose,
 }
 
+/// Each curve's root and surface frame at rest ([`SkinBinding::rest_frames`]).
+#[derive(Debug, Clone, Default)]
+pub struct RestFrames(Vec<(Vec3, Mat3)>);
+
 /// Hairs a worker carries between hand-overs.
 const CHUNK: usize = 1024;
 
@@ -113,12 +117,88 @@ impl SkinBinding {
     /// # Panics
     /// When `rest` has no roots (only grown curves can be carried).
     pub fn carry_into(&self, rest: &Curves, pose: &SkinPose, out: &mut Curves) -> bool {
+        out.copy_unmoved_from(rest);
+        self.carry_points(rest, None, pose, out)
+    }
+
+    /// Each curve's root and surface frame at rest, for carrying the same
+    /// curves to many poses ([`Self::carry_again`]).
+    pub fn rest_frames(&self, rest: &Curves) -> RestFrames {
         let roots = rest.roots().expect("carried curves have roots");
-        out.clone_from(rest);
-        let offsets = rest.offsets();
-        let (points, normals) = out.points_and_normals_mut();
-        let rest_points = rest.points();
-        let rest_normals = rest.normals();
+        RestFrames(
+            roots
+                .par_iter()
+                .map(|&r| self.rest.frame_at(&self.triangles, r))
+                .collect(),
+        )
+    }
+
+    /// [`Self::carry_into`] for an `out` that already holds `rest` carried
+    /// to another pose: only points and normals are rewritten, and the
+    /// rest frames come from `frames` (deform mode: one growth, every
+    /// frame).
+    ///
+    /// # Panics
+    /// When `out` or `frames` were not made from `rest`.
+    pub fn carry_again(
+        &self,
+        rest: &Curves,
+        frames: &RestFrames,
+        pose: &SkinPose,
+        out: &mut Curves,
+    ) -> bool {
+        assert_eq!(out.offsets(), rest.offsets(), "out holds rest's curves");
+        assert_eq!(
+            frames.0.len(),
+            rest.curve_count(),
+            "frames of rest's curves"
+        );
+        self.carry_points(rest, Some(&frames.0), pose, out)
+    }
+
+    /// Curves grown at rest carried to `pose` where they are (no copy:
+    /// regrow mode grows a part for each frame and moves it).
+    pub fn carry_in_place(&self, curves: &mut Curves, pose: &SkinPose) -> bool {
+        let (points, normals, offsets, roots) = curves.carry_view();
+        let roots = roots.expect("carried curves have roots");
+        self.carry_slices(roots, offsets, None, pose, points, normals, None)
+    }
+
+    /// Writes `out`'s points and normals: `rest`'s carried to `pose`.
+    fn carry_points(
+        &self,
+        rest: &Curves,
+        rest_frames: Option<&[(Vec3, Mat3)]>,
+        pose: &SkinPose,
+        out: &mut Curves,
+    ) -> bool {
+        let roots = rest.roots().expect("carried curves have roots");
+        let (points, normals, _, _) = out.carry_view();
+        let from = Some((rest.points(), rest.normals()));
+        self.carry_slices(
+            roots,
+            rest.offsets(),
+            rest_frames,
+            pose,
+            points,
+            normals,
+            from,
+        )
+    }
+
+    /// The carry: each curve's points (read from `from`, or from `points`
+    /// themselves when `None`) turned by its root's change of frame.
+    #[allow(clippy::too_many_arguments)]
+    fn carry_slices(
+        &self,
+        roots: &[SurfacePoint],
+        offsets: &[u32],
+        rest_frames: Option<&[(Vec3, Mat3)]>,
+        pose: &SkinPose,
+        points: &mut [Vec3],
+        normals: Option<&mut [Vec3]>,
+        from: Option<(&[Vec3], Option<&[Vec3]>)>,
+    ) -> bool {
         // Split the point arrays at chunk boundaries so each worker owns
         // its hairs' slices.
         let curves = roots.len();
@@ -145,18 +225,35 @@ impl SkinBinding {
             .map(|(hairs, base, p, mut n)| {
                 let mut finite = true;
                 for i in hairs {
-                    let (root0, frame0) = self.rest.frame_at(&self.triangles, roots[i]);
+                    let (root0, frame0) = match rest_frames {
+                        Some(f) => f[i],
+                        None => self.rest.frame_at(&self.triangles, roots[i]),
+                    };
                     let (root1, frame1) = pose.frame_at(&self.triangles, roots[i]);
                     let turn = frame1 * frame0.transpose();
                     let range = offsets[i] as usize..offsets[i + 1] as usize;
                     let local = range.start - base..range.end - base;
-                    for (out, &q) in p[local.clone()].iter_mut().zip(&rest_points[range.clone()]) {
-                        *out = root1 + turn * (q - root0);
-                        finite &= out.is_finite();
+                    let out = &mut p[local.clone()];
+                    match from {
+                        Some((rest, _)) => {
+                            for (o, &q) in out.iter_mut().zip(&rest[range.clone()]) {
+                                *o = root1 + turn * (q - root0);
+                            }
+                        }
+                        None => out
+                            .iter_mut()
+                            .for_each(|o| *o = root1 + turn * (*o - root0)),
                     }
-                    if let (Some(n), Some(rn)) = (n.as_deref_mut(), rest_normals) {
-                        for (out, &v) in n[local].iter_mut().zip(&rn[range]) {
-                            *out = turn * v;
+                    finite &= out.iter().all(|o| o.is_finite());
+                    if let Some(n) = n.as_deref_mut() {
+                        let out = &mut n[local];
+                        match from {
+                            Some((_, Some(rest))) => {
+                                for (o, &v) in out.iter_mut().zip(&rest[range]) {
+                                    *o = turn * v;
+                                }
+                            }
+                            _ => out.iter_mut().for_each(|o| *o = turn * *o),
                         }
                     }
                 }

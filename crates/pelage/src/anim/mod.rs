@@ -10,6 +10,6 @@ mod frames;
 mod gltf_skin;
 mod skin;
 
-pub use binding::{SkinBinding, SkinPose};
+pub use binding::{RestFrames, SkinBinding, SkinPose};
 pub use frames::{FrameRange, FrameRangeError, MAX_FRAMES};
 pub use skin::{AnimatedSkin, SkinOptions, sequence_file};

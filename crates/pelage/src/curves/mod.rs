@@ -51,6 +51,15 @@ pub struct Curves {
     ids: Option<Vec<u64>>,
 }
 
+/// What the skin binding moves (points, normals) beside what it reads
+/// (offsets, roots), borrowed together.
+pub(crate) type CarryView<'a> = (
+    &'a mut [Vec3],
+    Option<&'a mut [Vec3]>,
+    &'a [u32],
+    Option<&'a [SurfacePoint]>,
+);
+
 /// Every array of a [`Curves`], taken back by [`Curves::into_arrays`] to
 /// reuse their memory (an attribute the curves lacked is empty).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -289,11 +298,49 @@ impl Curves {
         }
     }
 
+    /// Makes these curves `other`'s in everything but the values of
+    /// points and normals, which are sized to match but left to the caller
+    /// to write (the skin binding's carry: copying them only to overwrite
+    /// them cost a quarter of a frame).
+    pub(crate) fn copy_unmoved_from(&mut self, other: &Curves) {
+        fn copy<T: Copy>(to: &mut Vec<T>, from: &[T]) {
+            to.clear();
+            to.extend_from_slice(from);
+        }
+        fn copy_opt<T: Copy>(to: &mut Option<Vec<T>>, from: Option<&Vec<T>>) {
+            match from {
+                Some(f) => copy(to.get_or_insert_with(Vec::new), f),
+                None => *to = None,
+            }
+        }
+        fn sized<T: Copy + Default>(to: &mut Vec<T>, len: usize) {
+            to.truncate(len);
+            to.resize(len, T::default());
+        }
+        copy(&mut self.widths, &other.widths);
+        copy(&mut self.offsets, &other.offsets);
+        copy_opt(&mut self.colors, other.colors.as_ref());
+        copy_opt(&mut self.opacities, other.opacities.as_ref());
+        copy_opt(&mut self.roots, other.roots.as_ref());
+        copy_opt(&mut self.root_uvs, other.root_uvs.as_ref());
+        copy_opt(&mut self.ids, other.ids.as_ref());
+        sized(&mut self.points, other.points.len());
+        match &other.normals {
+            Some(n) => sized(self.normals.get_or_insert_with(Vec::new), n.len()),
+            None => self.normals = None,
+        }
+    }
+
     /// The points and (if present) normals, to move in place: counts and
     /// every other attribute stay as they are (the skin binding carries a
     /// part from pose to pose this way). The caller keeps them finite.
-    pub(crate) fn points_and_normals_mut(&mut self) -> (&mut [Vec3], Option<&mut [Vec3]>) {
-        (&mut self.points, self.normals.as_deref_mut())
+    pub(crate) fn carry_view(&mut self) -> CarryView<'_> {
+        (
+            &mut self.points,
+            self.normals.as_deref_mut(),
+            &self.offsets,
+            self.roots.as_deref(),
+        )
     }
 
     /// Adds per-point normals (the orientation of flat ribbons; USD

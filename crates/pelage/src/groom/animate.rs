@@ -20,7 +20,7 @@ use super::generator::{Generator, GroomSummary};
 use super::output::{GroomWriteError, part_name};
 use super::spec::GroomSpec;
 use crate::Curves;
-use crate::anim::{AnimatedSkin, FrameRange, SkinBinding, SkinPose};
+use crate::anim::{AnimatedSkin, FrameRange, RestFrames, SkinBinding, SkinPose};
 use crate::guides::{Guides, resample_by_arc_length};
 use crate::io::{CurvesFormat, UsdOptions, write_atomically, write_streamed};
 use glam::Vec3;
@@ -299,23 +299,31 @@ impl AnimatedGroom {
         time: f64,
         pose: &SkinPose,
         generator: &Generator,
-        rest: &mut Option<Curves>,
+        rest: &mut Option<(Curves, RestFrames)>,
         out: &mut Curves,
     ) -> Result<(), GroomError> {
-        let grown;
-        let at_rest = match self.animation.mode {
-            AnimationMode::Deform => {
-                if rest.is_none() {
-                    *rest = Some(generator.part(p)?);
+        let carried = match self.animation.mode {
+            AnimationMode::Deform => match rest {
+                // Later frames: the same hairs, only moved.
+                Some((curves, frames)) => self.binding.carry_again(curves, frames, pose, out),
+                None => {
+                    let curves = generator.part(p)?;
+                    let frames = self.binding.rest_frames(&curves);
+                    let carried = self.binding.carry_into(&curves, pose, out);
+                    *rest = Some((curves, frames));
+                    carried
                 }
-                rest.as_ref().expect("grown above")
-            }
+            },
             AnimationMode::Regrow => {
-                grown = generator.part(p)?;
-                &grown
+                // A fresh growth every frame: moved where it lies.
+                let mut grown = generator.part(p)?;
+                let carried = self.binding.carry_in_place(&mut grown, pose);
+                let spent = std::mem::replace(out, grown);
+                generator.recycle(spent);
+                carried
             }
         };
-        if !self.binding.carry_into(at_rest, pose, out) {
+        if !carried {
             return Err(self.spec.error(
                 "animation",
                 GroomErrorKind::NotFinite(format!(
@@ -464,7 +472,7 @@ impl AnimatedGroom {
                             total,
                         });
                     }
-                    if let Some(rest) = rest {
+                    if let Some((rest, _)) = rest {
                         self.generator.recycle(rest);
                     }
                 }

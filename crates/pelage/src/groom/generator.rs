@@ -63,7 +63,7 @@ pub struct Generator {
     pub(super) normals: bool,
     pub(super) seed: u64,
     /// Arrays of parts handed back by [`Self::recycle`], for the next parts.
-    pub(super) spare: Mutex<Vec<CurveArrays>>,
+    pub(super) spare: Arc<Mutex<Vec<CurveArrays>>>,
     /// The part asked for last (`usize::MAX`: none yet), and the roots of
     /// the one after it, sampled ahead.
     last_part: AtomicUsize,
@@ -181,7 +181,9 @@ impl Generator {
             opacities,
             clumps: false,
             normals: finish.normals,
-            spare: Mutex::new(Vec::new()),
+            // A frame's generator (`reshaped`) grows parts of the same
+            // sizes: it reuses its parent's arrays.
+            spare: shared.map_or_else(Default::default, |g| g.spare.clone()),
             last_part: AtomicUsize::new(usize::MAX),
             prefetched: Mutex::new(None),
         };

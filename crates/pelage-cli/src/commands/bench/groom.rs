@@ -150,7 +150,7 @@ generate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }
 
 /// The Stubble figure: `method` interpolation, clump + noise, 16 points,
 /// normals and widths.
-fn groom_text(hairs: u64, method: &str) -> String {
+pub(super) fn groom_text(hairs: u64, method: &str) -> String {
     format!(
         r#"{head}
 [interpolation]
@@ -196,7 +196,7 @@ fn grow_all(groom: &Groom) -> anyhow::Result<(u64, u64)> {
 }
 
 /// Peak resident memory of this process (Linux `VmHWM`), in bytes.
-fn peak_rss_bytes() -> Option<u64> {
+pub(super) fn peak_rss_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;

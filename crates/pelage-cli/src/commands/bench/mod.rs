@@ -5,6 +5,7 @@
 //! Machines here are small and noisy: every figure is the median of several
 //! runs, and comparisons are ratios taken within one run.
 
+pub mod animation;
 pub mod dynamics;
 pub mod groom;
 pub mod interp;
@@ -40,6 +41,8 @@ pub enum BenchWhat {
     Shells(shells::ShellsBenchArgs),
     /// Writing a large groom as usdc, usda and Alembic: throughput, size, peak memory.
     Io(io::IoBenchArgs),
+    /// Animated grooms: a frame of deform and of regrow against growing once.
+    Animation(animation::AnimationBenchArgs),
 }
 
 /// The repository's test meshes (blub), where the benchmarks that go past
@@ -64,6 +67,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Groom(a) => groom::run(a),
         BenchWhat::Shells(a) => shells::run(a),
         BenchWhat::Dynamics(a) => dynamics::run(a),
+        BenchWhat::Animation(a) => animation::run(a),
     }
 }
 

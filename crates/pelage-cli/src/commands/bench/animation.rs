@@ -1,0 +1,244 @@
+//! `pelage bench animation`: the Stubble figure (spot ×2, 1.6 M hairs of
+//! 16 points, clump + noise) on a skin the bench twists over 24 frames.
+//! Figures: growing the groom once; a frame of `deform` (the skin's pose
+//! and every hair carried to it); a frame of `regrow` (guides brought back
+//! to rest, every part regrown and carried) — the part-by-part loop that
+//! `pelage groom` runs, without the file. The paper's baseline is Stubble's
+//! per-frame generation (Sik §4.1–4.2: every frame generated anew, 1.6 M
+//! hairs in 3.2 s on two cores); the peer measured in the same run is that
+//! approach done by pelage: a generator prepared from scratch and the
+//! groom grown, every frame.
+
+use super::groom::{groom_text, peak_rss_bytes};
+use super::median_seconds;
+use crate::format::thousands;
+use clap::Args;
+use glam::{Mat3, Vec3};
+use pelage::anim::{AnimatedSkin, FrameRange};
+use pelage::groom::{AnimatedGroom, AnimationMode, AnimationSpec, Groom, GuideMotion};
+use pelage::{Curves, Mesh};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Arguments of `pelage bench animation`.
+#[derive(Debug, Args)]
+pub struct AnimationBenchArgs {
+    /// A reduced run (200,000 hairs).
+    #[arg(long)]
+    pub quick: bool,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Frames of the deformed skin.
+const FRAMES: i32 = 24;
+/// Frames regrown (regrowing is a whole groom a frame: a few tell its
+/// cost).
+const REGROWN_FRAMES: usize = 3;
+/// The paper's time for 1.6 M hairs on two cores (Sik §4.2.2): what
+/// Stubble spends on every frame.
+const PAPER_SECONDS: f64 = 3.2;
+
+/// The bench's deformation: a twist about the vertical axis that grows
+/// with height and with the frame, plus a sway.
+fn twist(p: Vec3, frame: f64) -> Vec3 {
+    let t = (frame - 1.0) as f32 / (FRAMES - 1) as f32;
+    let angle = 1.2 * t * (p.y + 0.5);
+    Mat3::from_rotation_y(angle) * p + Vec3::new(0.1 * t, 0.0, 0.0)
+}
+
+pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
+    let (hairs, runs) = if args.quick {
+        (200_000u64, 3)
+    } else {
+        (1_600_000, 3)
+    };
+    let threads = rayon::current_num_threads();
+    let groom = Groom::from_text("<bench>", groom_text(hairs, "shepard"))?;
+    let spec = groom.spec()?;
+    let mesh: Arc<Mesh> = spec.mesh.clone();
+    let rest: Vec<Vec3> = mesh.positions().to_vec();
+    let skin = AnimatedSkin::from_fn(&mesh, move |f| rest.iter().map(|&p| twist(p, f)).collect());
+    let skin = Arc::new(skin);
+    let frames = FrameRange::parse(&format!("1-{FRAMES}"))?;
+    let animation = |mode| AnimationSpec {
+        frames: frames.clone(),
+        rest_frame: 1.0,
+        mode,
+        shutter: Vec::new(),
+    };
+    // Guides that ride the twisting skin, as a simulation following it
+    // would give them.
+    let guides = spec.guides.clone();
+    let guide_mesh = mesh.clone();
+    let animated_guides = move |f: f64| -> Curves {
+        let n = guides.points_per_guide();
+        let twisted: Vec<Vec3> = guide_mesh
+            .positions()
+            .iter()
+            .map(|&p| twist(p, f))
+            .collect();
+        let posed = Mesh::new(
+            "twisted",
+            twisted,
+            guide_mesh.triangles().to_vec(),
+            None,
+            None,
+        )
+        .expect("a twisted mesh is a mesh");
+        let mut points = Vec::with_capacity(guides.len() * n);
+        for (i, root) in guides.roots().iter().enumerate() {
+            let g = guides.guide(i);
+            let (p0, n0) = (root.position(&guide_mesh), root.normal(&guide_mesh));
+            let (p1, n1) = (root.position(&posed), root.normal(&posed));
+            let turn = Mat3::from_quat(glam::Quat::from_rotation_arc(n0, n1));
+            points.extend(g.iter().map(|&q| p1 + turn * (q - p0)));
+        }
+        let offsets = (0..=guides.len() as u32).map(|i| i * n as u32).collect();
+        Curves::new(points, vec![0.001; guides.len() * n], offsets).expect("finite guides")
+    };
+    let deform = AnimatedGroom::new(
+        spec.clone(),
+        skin.clone(),
+        animation(AnimationMode::Deform),
+        None,
+    )?;
+    let regrow = AnimatedGroom::new(
+        spec.clone(),
+        skin.clone(),
+        animation(AnimationMode::Regrow),
+        Some(GuideMotion::Program(Arc::new(animated_guides))),
+    )?;
+    let generator = deform.generator();
+    let parts = generator.parts().len();
+
+    // Growing once, at rest.
+    let (grow_s, counted) = median_seconds(runs, true, || -> anyhow::Result<(u64, u64)> {
+        let (mut h, mut p) = (0u64, 0u64);
+        for k in 0..parts {
+            let c = generator.part(k)?;
+            h += c.curve_count() as u64;
+            p += c.points().len() as u64;
+            generator.recycle(c);
+        }
+        Ok((h, p))
+    });
+    let (hair_count, point_count) = counted?;
+
+    // Deform: the poses of every frame, then part by part every frame
+    // carried (growth itself is timed apart).
+    let times: Vec<f64> = frames.frames().iter().map(|&f| f64::from(f)).collect();
+    let mut deform_s = 0.0;
+    let start = Instant::now();
+    let poses = times
+        .iter()
+        .map(|&t| deform.pose(t))
+        .collect::<Result<Vec<_>, _>>()?;
+    deform_s += start.elapsed().as_secs_f64();
+    let mut out = Curves::default();
+    let mut carried_points = 0u64;
+    for k in 0..parts {
+        let rest = generator.part(k)?;
+        let start = Instant::now();
+        let binding = deform.binding();
+        let frames = binding.rest_frames(&rest);
+        for (f, pose) in poses.iter().enumerate() {
+            let carried = if f == 0 {
+                binding.carry_into(&rest, pose, &mut out)
+            } else {
+                binding.carry_again(&rest, &frames, pose, &mut out)
+            };
+            anyhow::ensure!(carried, "a hair moved to a value that is not finite");
+            carried_points += out.points().len() as u64;
+        }
+        deform_s += start.elapsed().as_secs_f64();
+        generator.recycle(rest);
+    }
+    anyhow::ensure!(carried_points == point_count * times.len() as u64);
+    let deform_per_frame = deform_s / times.len() as f64;
+
+    // Regrow: a few frames, whole (guides to rest, generator, every part
+    // grown and carried).
+    let regrown: Vec<f64> = [
+        times[FRAMES as usize / 3],
+        times[FRAMES as usize / 2],
+        times[FRAMES as usize - 1],
+    ]
+    .into_iter()
+    .take(REGROWN_FRAMES)
+    .collect();
+    let start = Instant::now();
+    for &t in &regrown {
+        let pose = regrow.pose(t)?;
+        let frame_generator = regrow.regrown_generator(t, &pose)?;
+        for k in 0..parts {
+            let mut grown = frame_generator.part(k)?;
+            anyhow::ensure!(regrow.binding().carry_in_place(&mut grown, &pose));
+            frame_generator.recycle(grown);
+        }
+    }
+    let regrow_per_frame = start.elapsed().as_secs_f64() / regrown.len() as f64;
+
+    // The peer: Stubble's way, a generator prepared from scratch and the
+    // whole groom grown, every frame.
+    let (scratch_s, scratch) = median_seconds(1, false, || -> anyhow::Result<()> {
+        let g = groom.generator(None)?;
+        for k in 0..g.parts().len() {
+            let c = g.part(k)?;
+            g.recycle(c);
+        }
+        Ok(())
+    });
+    scratch?;
+    let rss = peak_rss_bytes().unwrap_or(0);
+    let paper_scaled = PAPER_SECONDS * hairs as f64 / 1.6e6;
+
+    if args.json {
+        let report = serde_json::json!({
+            "hairs": hair_count,
+            "points": point_count,
+            "frames": times.len(),
+            "threads": threads,
+            "grow_s": grow_s,
+            "deform_s_per_frame": deform_per_frame,
+            "regrow_s_per_frame": regrow_per_frame,
+            "regrown_frames": regrown.len(),
+            "deform_over_grow": deform_per_frame / grow_s,
+            "regrow_over_grow": regrow_per_frame / grow_s,
+            "peer_from_scratch_s_per_frame": scratch_s,
+            "paper_s_per_frame": paper_scaled,
+            "peak_rss_bytes": rss,
+        });
+        println!("{report}");
+        return Ok(());
+    }
+    println!(
+        "pelage bench animation — the Stubble figure ({} hairs × 16 points on spot ×2, clump + noise) on a skin twisted over {} frames; {threads} threads\n",
+        thousands(hair_count),
+        times.len()
+    );
+    println!("{:<58} {:>12} {:>12}", "", "s / frame", "× growing");
+    let row = |name: &str, s: f64| {
+        println!("{name:<58} {s:>12.3} {:>12.2}", s / grow_s);
+    };
+    row(
+        &format!("growing the groom once (median of {runs})"),
+        grow_s,
+    );
+    row("deform: pose + every hair carried", deform_per_frame);
+    row(
+        &format!(
+            "regrow: guides to rest + regrown + carried ({} frames)",
+            regrown.len()
+        ),
+        regrow_per_frame,
+    );
+    row("peer: from scratch every frame (Stubble's way)", scratch_s);
+    row("paper: Stubble, 2 cores (Sik §4.2.2)", paper_scaled);
+    println!(
+        "\ntargets: deform ≤ 0.25× growing, regrow ≤ 1.2× growing. Peak RSS {:.0} MB.",
+        rss as f64 / 1e6
+    );
+    Ok(())
+}
