@@ -7,7 +7,10 @@ use anyhow::{Context, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use pelage::anim::FrameRange;
-use pelage::groom::{AnimatedGroom, Groom, part_file, part_slice, write_assembly};
+use pelage::groom::{
+    AnimatedGroom, FrameFile, FrameOutput, Groom, find_frame_files, frames_file, part_file,
+    part_slice, write_assembly, write_clip_assembly,
+};
 use pelage::io::{CurvesExport, CurvesFormat, UsdOptions};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -43,6 +46,11 @@ pub struct GroomArgs {
     /// `[animation]`). Output: one .usdc or .abc with time samples.
     #[arg(long, value_name = "RANGE", value_parser = parse_frames)]
     pub frames: Option<FrameRange>,
+    /// Animated grooms: write one .usdc a frame beside OUTPUT
+    /// (`NAME.f0001.usdc`, …) and OUTPUT itself (.usda) as the layer that
+    /// stitches them with USD value clips.
+    #[arg(long, conflicts_with_all = ["part", "assemble"])]
+    pub frame_files: bool,
     /// Also draw the hairs on the skin into this PNG (headless GPU; at
     /// most 300,000 hairs, evenly chosen).
     #[arg(long, value_name = "PNG")]
@@ -85,6 +93,9 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     let groom = Groom::load_with_frames(&args.file, args.frames.clone())?;
     let output = args.output.clone().unwrap_or_else(|| groom.output_path());
     if args.assemble {
+        if let Some(animation) = groom.animation() {
+            return assemble_frames(&output, &animation.frames);
+        }
         return assemble(&output, &UsdOptions::default());
     }
     if let Some(report) = groom.bind_report() {
@@ -224,7 +235,14 @@ fn run_animated(
     }
     let generator = animated.generator();
     let parts = generator.parts().len();
-    let (range, path) = match args.part {
+    let animation = animated.animation();
+    let frames = animation.frames.frames();
+    // Split outputs are binary USD beside a text stitching layer.
+    let data = match output.extension().and_then(|e| e.to_str()) {
+        Some("usda") if args.part.is_some() || args.frame_files => output.with_extension("usdc"),
+        _ => output.to_path_buf(),
+    };
+    let (range, outputs) = match args.part {
         Some((k, n)) => {
             if n > parts {
                 bail!(
@@ -232,12 +250,47 @@ fn run_animated(
                     args.file.display()
                 );
             }
-            (part_slice(k, n, parts), part_file(output, k, n))
+            let path = frames_file(
+                &data,
+                Some((k, n)),
+                animation.frames.first(),
+                animation.frames.last(),
+            );
+            let output = FrameOutput {
+                path,
+                times: animated.times_of(frames),
+            };
+            (part_slice(k, n, parts), vec![output])
         }
-        None => (0..parts, output.to_path_buf()),
+        None if args.frame_files => {
+            if output.extension().and_then(|e| e.to_str()) != Some("usda") {
+                bail!(
+                    "{}: with --frame-files the output is the stitching layer: name it .usda",
+                    output.display()
+                );
+            }
+            let outputs = frames
+                .iter()
+                .map(|&f| FrameOutput {
+                    path: frames_file(&data, None, f, f),
+                    times: animated.times_of(&[f]),
+                })
+                .collect();
+            (0..parts, outputs)
+        }
+        None => {
+            let output = FrameOutput {
+                path: output.to_path_buf(),
+                times: animated.times_of(frames),
+            };
+            (0..parts, vec![output])
+        }
     };
-    let animation = animated.animation();
-    let times = animation.sample_times();
+    let path = outputs[0].path.clone();
+    let times: Vec<f64> = outputs
+        .iter()
+        .flat_map(|o| o.times.iter().copied())
+        .collect();
     let planned: u64 = generator.parts()[range.clone()]
         .iter()
         .map(|p| p.hair_count)
@@ -281,23 +334,72 @@ fn run_animated(
         ..UsdOptions::default()
     };
     let growing = Instant::now();
-    let with_skin = groom.file().output.with_mesh;
-    let summary = animated.write(&path, range.clone(), &options, with_skin, |p| {
+    // In a farm, the first run writes the skin.
+    let with_skin = groom.file().output.with_mesh && args.part.is_none_or(|(k, _)| k == 1);
+    let summary = animated.write_files(&outputs, range.clone(), &options, with_skin, |p| {
         bar.set_message(format!("part {} frame {}", p.part, p.time));
         bar.set_position(p.done as u64);
     })?;
     bar.finish_and_clear();
     let seconds = growing.elapsed().as_secs_f64();
+    let written = match outputs.len() {
+        1 => path.display().to_string(),
+        n => format!("{n} frame files ({} …)", path.display()),
+    };
     println!(
-        "{} hairs, {} points × {} samples in {} → {} in {:.2} s ({:.3} s a frame; setup {:.2} s)",
+        "{} hairs, {} points × {} samples in {} → {written} in {:.2} s ({:.3} s a frame; setup {:.2} s)",
         thousands(summary.hairs),
         thousands(summary.points),
         times.len(),
         parts_text(range.len()),
-        path.display(),
         seconds,
         seconds / times.len() as f64,
         start.elapsed().as_secs_f64() - seconds
+    );
+    if args.frame_files {
+        let files: Vec<FrameFile> = outputs
+            .iter()
+            .zip(frames)
+            .map(|(o, &f)| FrameFile {
+                path: o.path.clone(),
+                run: (1, 1),
+                first: f,
+                last: f,
+            })
+            .collect();
+        let stitched = write_clip_assembly(output, &files, &animation.frames)?;
+        println!(
+            "{} → {} frame files stitched with value clips ({} prims, time codes {} to {})",
+            output.display(),
+            stitched.files,
+            stitched.prims,
+            stitched.time_range.0,
+            stitched.time_range.1
+        );
+    }
+    Ok(())
+}
+
+/// `--assemble` for an animated groom: the farm's frame files beside
+/// OUTPUT stitched with value clips.
+fn assemble_frames(output: &Path, frames: &FrameRange) -> anyhow::Result<()> {
+    let found = find_frame_files(output)
+        .with_context(|| format!("cannot list the folder of {}", output.display()))?;
+    if found.is_empty() {
+        bail!(
+            "no frame files beside {} (NAME.part-K-of-N.fA-B.usdc); run `pelage groom FILE --part K/N` first",
+            output.display()
+        );
+    }
+    let stitched = write_clip_assembly(output, &found, frames)?;
+    println!(
+        "{} → {} files of {} runs stitched with value clips ({} prims, time codes {} to {})",
+        output.display(),
+        stitched.files,
+        stitched.runs,
+        stitched.prims,
+        stitched.time_range.0,
+        stitched.time_range.1
     );
     Ok(())
 }

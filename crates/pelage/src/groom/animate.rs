@@ -22,7 +22,7 @@ use super::spec::GroomSpec;
 use crate::Curves;
 use crate::anim::{AnimatedSkin, FrameRange, RestFrames, SkinBinding, SkinPose};
 use crate::guides::{Guides, resample_by_arc_length};
-use crate::io::{CurvesFormat, UsdOptions, write_atomically, write_streamed};
+use crate::io::{AbcWriter, AtomicFile, CurvesFormat, UsdOptions, UsdPrimWriter, UsdcWriter};
 use glam::Vec3;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -397,6 +397,22 @@ impl AnimatedGroom {
         Ok(out)
     }
 
+    /// The time codes written for `frames`: each frame, and each frame
+    /// plus each shutter offset, ascending.
+    pub fn times_of(&self, frames: &[i32]) -> Vec<f64> {
+        let mut times: Vec<f64> = frames
+            .iter()
+            .flat_map(|&f| {
+                std::iter::once(0.0)
+                    .chain(self.animation.shutter.iter().copied())
+                    .map(move |o| f64::from(f) + o)
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+
     /// Grows `parts` over every frame and writes them to `path` (`.usdc`
     /// or `.abc`), atomically, with one time sample per frame (and shutter
     /// offset). With `with_skin` the posed skin is written too, as a
@@ -408,21 +424,63 @@ impl AnimatedGroom {
         parts: Range<usize>,
         options: &UsdOptions,
         with_skin: bool,
+        progress: impl FnMut(AnimationProgress),
+    ) -> Result<GroomSummary, GroomWriteError> {
+        let output = FrameOutput {
+            path: path.to_path_buf(),
+            times: self.animation.sample_times(),
+        };
+        self.write_files(&[output], parts, options, with_skin, progress)
+    }
+
+    /// [`Self::write`] into several files at once, each with its own time
+    /// codes (one file a frame, or a farm task's frame range): every part
+    /// is grown once (deform) and carried to every file's frames. All the
+    /// files are written, or none.
+    pub fn write_files(
+        &self,
+        outputs: &[FrameOutput],
+        parts: Range<usize>,
+        options: &UsdOptions,
+        with_skin: bool,
         mut progress: impl FnMut(AnimationProgress),
     ) -> Result<GroomSummary, GroomWriteError> {
-        let format = match CurvesFormat::from_path(path) {
-            Some(f @ (CurvesFormat::Usdc | CurvesFormat::Abc)) => f,
-            _ => {
-                return Err(GroomWriteError::Groom(self.spec.error(
-                    "output.path",
-                    GroomErrorKind::Invalid(format!(
-                        "{}: animated grooms are written with time samples to .usdc, .usd or .abc",
-                        path.display()
-                    )),
-                )));
-            }
+        let write_error = |path: &Path, e: &dyn std::fmt::Display| {
+            GroomWriteError::Write(crate::io::WriteError {
+                path: path.to_path_buf(),
+                error: std::io::Error::other(e.to_string()),
+            })
         };
-        let times = self.animation.sample_times();
+        let mut layers = Vec::with_capacity(outputs.len());
+        for output in outputs {
+            let format = match CurvesFormat::from_path(&output.path) {
+                Some(f @ (CurvesFormat::Usdc | CurvesFormat::Abc)) => f,
+                _ => {
+                    return Err(GroomWriteError::Groom(self.spec.error(
+                        "output.path",
+                        GroomErrorKind::Invalid(format!(
+                            "{}: animated grooms are written with time samples to .usdc, .usd or .abc",
+                            output.path.display()
+                        )),
+                    )));
+                }
+            };
+            let file = AtomicFile::create(&output.path)?;
+            let layer = match format {
+                CurvesFormat::Usdc => UsdcWriter::new(file, options).map(TimeSampledLayer::Usdc),
+                _ => AbcWriter::new(file, options).map(TimeSampledLayer::Abc),
+            }
+            .map_err(|e| write_error(&output.path, &e))?;
+            layers.push(layer);
+        }
+        // Poses once for every time of every file (files may share times).
+        let mut times: Vec<f64> = outputs
+            .iter()
+            .flat_map(|o| o.times.iter().copied())
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        let index = |t: f64| times.partition_point(|&x| x < t);
         let mut poses = Vec::with_capacity(times.len());
         for &t in &times {
             poses.push(self.pose(t)?);
@@ -435,51 +493,91 @@ impl AnimatedGroom {
                 .map(|(&t, pose)| self.regrown_generator(t, pose))
                 .collect::<Result<Vec<_>, _>>()?,
         };
+        if with_skin {
+            for (output, layer) in outputs.iter().zip(&mut layers) {
+                for &time in &output.times {
+                    let mesh = self.posed_mesh(&poses[index(time)])?;
+                    layer
+                        .prims()
+                        .write_mesh_at("skin", time, &mesh)
+                        .map_err(|e| write_error(&output.path, &e))?;
+                }
+            }
+        }
         let mut summary = GroomSummary::default();
-        let total = parts.len() * times.len();
-        write_atomically(path, |out| {
-            write_streamed(out, format, options, |layer| {
-                if with_skin {
-                    for (&time, pose) in times.iter().zip(&poses) {
-                        let mesh = self.posed_mesh(pose).map_err(std::io::Error::other)?;
+        let total = parts.len() * outputs.iter().map(|o| o.times.len()).sum::<usize>();
+        let mut done = 0;
+        let mut out = Curves::default();
+        for p in parts {
+            let mut rest = None;
+            let mut counted = false;
+            for (output, layer) in outputs.iter().zip(&mut layers) {
+                for &time in &output.times {
+                    let k = index(time);
+                    let generator = generators.get(k).unwrap_or(&self.generator);
+                    self.part_at(p, time, &poses[k], generator, &mut rest, &mut out)?;
+                    if !counted {
+                        summary.hairs += out.curve_count() as u64;
+                        summary.points += out.points().len() as u64;
+                        counted = true;
+                    }
+                    if out.curve_count() > 0 {
                         layer
-                            .write_mesh_at("skin", time, &mesh)
-                            .map_err(std::io::Error::other)?;
+                            .prims()
+                            .write_part_at(&part_name(p), time, &out)
+                            .map_err(|e| write_error(&output.path, &e))?;
                     }
+                    done += 1;
+                    progress(AnimationProgress {
+                        part: p,
+                        time,
+                        done,
+                        total,
+                    });
                 }
-                let mut out = Curves::default();
-                let mut done = 0;
-                for p in parts.clone() {
-                    let mut rest = None;
-                    for (k, (&time, pose)) in times.iter().zip(&poses).enumerate() {
-                        let generator = generators.get(k).unwrap_or(&self.generator);
-                        self.part_at(p, time, pose, generator, &mut rest, &mut out)
-                            .map_err(std::io::Error::other)?;
-                        if k == 0 {
-                            summary.hairs += out.curve_count() as u64;
-                            summary.points += out.points().len() as u64;
-                        }
-                        if out.curve_count() > 0 {
-                            layer
-                                .write_part_at(&part_name(p), time, &out)
-                                .map_err(std::io::Error::other)?;
-                        }
-                        done += 1;
-                        progress(AnimationProgress {
-                            part: p,
-                            time,
-                            done,
-                            total,
-                        });
-                    }
-                    if let Some((rest, _)) = rest {
-                        self.generator.recycle(rest);
-                    }
-                }
-                Ok(())
-            })
-        })
-        .map_err(super::output::unwrap_groom_error)?;
+            }
+            if let Some((rest, _)) = rest {
+                self.generator.recycle(rest);
+            }
+        }
+        let mut files = Vec::with_capacity(layers.len());
+        for (output, layer) in outputs.iter().zip(layers) {
+            files.push(layer.finish().map_err(|e| write_error(&output.path, &e))?);
+        }
+        for file in files {
+            file.commit()?;
+        }
         Ok(summary)
+    }
+}
+
+/// A file of an animated groom and the time codes it holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameOutput {
+    /// Where (`.usdc` or `.abc`).
+    pub path: PathBuf,
+    /// Its time codes, ascending.
+    pub times: Vec<f64>,
+}
+
+/// An open time-sampled output.
+enum TimeSampledLayer {
+    Usdc(UsdcWriter<AtomicFile>),
+    Abc(AbcWriter<AtomicFile>),
+}
+
+impl TimeSampledLayer {
+    fn prims(&mut self) -> &mut dyn UsdPrimWriter {
+        match self {
+            Self::Usdc(w) => w,
+            Self::Abc(w) => w,
+        }
+    }
+
+    fn finish(self) -> Result<AtomicFile, crate::io::UsdWriteError> {
+        match self {
+            Self::Usdc(w) => w.finish(),
+            Self::Abc(w) => w.finish(),
+        }
     }
 }

@@ -489,9 +489,18 @@ fn animation_spec(
             GroomErrorKind::Invalid(format!("fps = {fps}: it must be a positive number")),
         ));
     }
+    // The rest frame never depends on which frames a run writes (farm
+    // tasks split the range): the file's rest_frame, else the first of the
+    // file's frames, else frame 1.
+    let file_first = match section {
+        Some(s) => FrameRange::parse(s.frames.get_ref())
+            .map_err(|e| source.error_at(s.frames.span(), GroomErrorKind::Invalid(e.to_string())))?
+            .first(),
+        None => 1,
+    };
     let rest_frame = section
         .and_then(|s| s.rest_frame)
-        .unwrap_or(f64::from(frames.first()));
+        .unwrap_or(f64::from(file_first));
     if !rest_frame.is_finite() {
         return Err(source.error_at(
             section.map_or(0..0, |s| s.frames.span()),

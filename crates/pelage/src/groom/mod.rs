@@ -24,6 +24,7 @@
 //! part generated alone equals that part of the full run.
 
 pub mod animate;
+mod clips;
 mod diagnose;
 mod error;
 pub mod file;
@@ -37,7 +38,10 @@ mod ramp;
 mod source;
 mod spec;
 
-pub use animate::{AnimatedGroom, AnimationMode, AnimationProgress, AnimationSpec, GuideMotion};
+pub use animate::{
+    AnimatedGroom, AnimationMode, AnimationProgress, AnimationSpec, FrameOutput, GuideMotion,
+};
+pub use clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
 pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
 pub use file::{GroomFile, InterpolationKind};
 pub use generator::{Generator, GroomSummary, HAIRS_PER_PART};

@@ -28,7 +28,7 @@ mod usda;
 mod usdc;
 
 pub use abc::{AbcWriter, read_abc_curves};
-pub use atomic::write_atomically;
+pub use atomic::{AtomicFile, write_atomically};
 pub use curves_file::{
     CurvesExport, CurvesFormat, join, read_curves, write_curves, write_streamed,
 };
@@ -40,7 +40,8 @@ pub use points_ply::{
 pub use read_error::{CurvesReadError, CurvesReadErrorKind};
 pub use render_text::{bezier_control_points, write_pbrt, write_rib};
 pub use usd_read::{
-    DEFAULT_WIDTH, UsdCurvesSequence, read_usd_curves, read_usd_curves_at, read_usd_extent,
+    DEFAULT_WIDTH, UsdCurvesSequence, UsdLayerInfo, read_usd_curves, read_usd_curves_at,
+    read_usd_extent, read_usd_layer_info,
 };
 pub(crate) use usd_read::{UsdSkin, read_usd_skin};
 pub use usd_schema::{SurfacePoints, UsdPrimWriter};

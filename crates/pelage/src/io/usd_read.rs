@@ -246,6 +246,68 @@ pub fn read_usd_extent(path: &Path) -> Result<Option<(glam::Vec3, glam::Vec3)>, 
     Ok(bounds)
 }
 
+/// What a USD layer says about itself: its stage metadata and the prims
+/// under its default prim (for stitching frame files with value clips).
+#[derive(Debug, Clone, PartialEq)]
+pub struct UsdLayerInfo {
+    /// The default prim's name.
+    pub default_prim: String,
+    /// The default prim's children, in order.
+    pub children: Vec<String>,
+    /// `metersPerUnit` (1 when not authored).
+    pub meters_per_unit: f64,
+    /// `upAxis` (`Y` when not authored).
+    pub up_axis: String,
+    /// `timeCodesPerSecond` (24 when not authored).
+    pub time_codes_per_second: f64,
+    /// `startTimeCode` and `endTimeCode`, when authored.
+    pub time_range: Option<(f64, f64)>,
+}
+
+/// Reads a layer's [`UsdLayerInfo`].
+pub fn read_usd_layer_info(path: &Path) -> Result<UsdLayerInfo, CurvesReadError> {
+    let layer = open_layer(path)?;
+    let data = layer.as_ref();
+    let root = sdf::Path::abs_root();
+    let field = |name: &str| {
+        data.try_field(&root, name)
+            .ok()
+            .flatten()
+            .map(|v| v.into_owned())
+    };
+    let number = |name: &str| match field(name) {
+        Some(Value::Double(d)) => Some(d),
+        Some(Value::Float(f)) => Some(f64::from(f)),
+        Some(Value::Int(i)) => Some(f64::from(i)),
+        _ => None,
+    };
+    let default_prim = token(data, &root, "defaultPrim").ok_or_else(|| {
+        CurvesReadError::whole(
+            path,
+            Kind::Inconsistent("the layer has no defaultPrim".into()),
+        )
+    })?;
+    let prim = sdf::Path::new(&format!("/{default_prim}"))
+        .map_err(|e| CurvesReadError::whole(path, Kind::Inconsistent(e.to_string())))?;
+    let children = match data
+        .try_field(&prim, "primChildren")
+        .ok()
+        .flatten()
+        .as_deref()
+    {
+        Some(Value::TokenVec(names)) => names.iter().map(|t| t.as_str().to_string()).collect(),
+        _ => Vec::new(),
+    };
+    Ok(UsdLayerInfo {
+        default_prim,
+        children,
+        meters_per_unit: number("metersPerUnit").unwrap_or(1.0),
+        up_axis: token(data, &root, "upAxis").unwrap_or_else(|| "Y".into()),
+        time_codes_per_second: number("timeCodesPerSecond").unwrap_or(24.0),
+        time_range: number("startTimeCode").zip(number("endTimeCode")),
+    })
+}
+
 /// Parses a usda or usdc layer (by its first bytes), with only the first
 /// time sample of animated values (binary layers).
 fn open_layer(path: &Path) -> Result<Box<dyn AbstractData>, CurvesReadError> {
