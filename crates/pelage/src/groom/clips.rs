@@ -103,7 +103,7 @@ pub fn find_frame_files(output: &Path) -> std::io::Result<Vec<FrameFile>> {
             last,
         });
     }
-    found.sort_by(|a, b| (a.run, a.first).cmp(&(b.run, b.first)));
+    found.sort_by_key(|f| (f.run, f.first));
     Ok(found)
 }
 
