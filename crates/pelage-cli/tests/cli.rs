@@ -864,3 +864,294 @@ fn view_without_the_viewer_feature_says_how_to_get_it() {
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("--features viewer"), "{stderr}");
 }
+
+/// A small groom on the walking Khronos Fox (tests/data/fox), `extra`
+/// appended to its `[animation]`.
+fn fox_groom(dir: &Path, extra: &str) -> std::path::PathBuf {
+    let fox = repo("crates/pelage/tests/data/fox/Fox.gltf");
+    let text = format!(
+        r#"[mesh]
+path = "{}"
+[roots]
+count = 2000
+parts = 4
+[guides]
+generate = {{ count = 100, length = 5, comb = [0, 0, -0.6], gravity = 0.3 }}
+[[ops]]
+noise = {{ amplitude = 0.5, frequency = 0.2 }}
+[finish]
+points = 6
+width = {{ root = 0.3, tip = 0.05 }}
+[output]
+with_mesh = true
+[animation]
+frames = "1-6"
+clip = "Walk"
+{extra}
+"#,
+        fox.display()
+    );
+    let path = dir.join("fox.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn an_animated_groom_is_one_time_sampled_file_that_usd_and_blender_read_frame_by_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = fox_groom(dir.path(), "");
+    let out_path = dir.path().join("fox.usdc");
+    let out = pelage(&[
+        "groom",
+        groom.to_str().unwrap(),
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(
+        text.contains("frames 1-6 (6 samples, rest frame 1, deform, clip \"Walk\""),
+        "{text}"
+    );
+    // Every frame holds the same hairs, in the same order.
+    let frame = |t: f64| pelage::io::read_usd_curves_at(&out_path, Some(t)).unwrap();
+    let (first, later) = (frame(1.0), frame(5.0));
+    assert_eq!(first.curve_count(), 2000);
+    assert_eq!(first.offsets(), later.offsets());
+    assert_eq!(first.ids(), later.ids());
+    let moved = first
+        .points()
+        .iter()
+        .zip(later.points())
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0f32, f32::max);
+    assert!(moved > 1.0, "the fur walks with the fox ({moved})");
+    if let Some((ok, report)) = usdcheck(&[&out_path]) {
+        assert!(ok, "{report}");
+        assert!(
+            report.contains("2000 curves") && report.contains("6 frames"),
+            "{report}"
+        );
+    }
+    // Blender's importer: the same points at frames 1 and 5 (point 0 of
+    // the first part object).
+    let index = "0";
+    let args = [
+        out_path.to_str().unwrap(),
+        "--point",
+        index,
+        "--frames",
+        "1,5",
+    ];
+    if let Some((ok, report)) = blendercheck(&args) {
+        assert!(ok, "{report}");
+        let counts: Vec<&str> = report
+            .lines()
+            .filter(|l| l.starts_with("object part_") && l.contains(" curves, "))
+            .collect();
+        assert_eq!(counts.len(), 4, "{report}");
+        for (t, want) in [(1, first.points()[0]), (5, later.points()[0])] {
+            let got = support::numbers_after(&report, &format!("frame {t}: part_0000 point[0] = "));
+            for k in 0..3 {
+                assert!(
+                    (got[k] as f32 - want[k]).abs() < 1e-4,
+                    "frame {t}: Blender reads {got:?}, pelage wrote {want}\n{report}"
+                );
+            }
+        }
+        assert!(
+            report.contains("mesh skin:"),
+            "the walking skin imports too\n{report}"
+        );
+    }
+    // The preview renders the frames from one camera, and a GIF.
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() {
+        let frames = dir.path().join("frames");
+        let out = pelage(&[
+            "render",
+            out_path.to_str().unwrap(),
+            "--frames",
+            "1-6x5",
+            "--size",
+            "320x200",
+            "-o",
+            frames.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        for name in ["fox.0001.png", "fox.0006.png", "fox.gif"] {
+            assert!(
+                frames.join(name).exists(),
+                "{name} missing: {}",
+                stdout(&out)
+            );
+        }
+        let a = image::open(frames.join("fox.0001.png")).unwrap().to_rgba8();
+        let b = image::open(frames.join("fox.0006.png")).unwrap().to_rgba8();
+        assert_eq!(a.dimensions(), (320, 200));
+        assert_ne!(a.as_raw(), b.as_raw(), "the frames differ");
+    }
+}
+
+#[test]
+fn frame_files_and_a_farm_of_parts_by_frame_ranges_stitch_to_the_single_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = fox_groom(dir.path(), "motion_blur = [-0.25, 0.25]");
+    let g = groom.to_str().unwrap();
+    let run = |args: &[&str]| {
+        let mut all = vec!["groom", g, "--quiet"];
+        all.extend_from_slice(args);
+        let out = pelage(&all);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stdout(&out)
+    };
+    let single = dir.path().join("single.usdc");
+    run(&["-o", single.to_str().unwrap(), "--threads", "2"]);
+    // One process, one file a frame.
+    let frames = dir.path().join("frames.usda");
+    let text = run(&[
+        "-o",
+        frames.to_str().unwrap(),
+        "--frame-files",
+        "--threads",
+        "1",
+    ]);
+    assert!(
+        text.contains("6 frame files stitched with value clips"),
+        "{text}"
+    );
+    assert!(dir.path().join("frames.f0003.usdc").exists());
+    // A farm: 2 runs × 2 frame ranges, in any order.
+    let farm = dir.path().join("farm.usda");
+    for (part, range) in [("2/2", "4-6"), ("1/2", "1-3"), ("2/2", "1-3")] {
+        run(&[
+            "-o",
+            farm.to_str().unwrap(),
+            "--part",
+            part,
+            "--frames",
+            range,
+        ]);
+    }
+    let assemble = || pelage(&["groom", g, "--assemble", "-o", farm.to_str().unwrap()]);
+    let out = assemble();
+    assert_eq!(out.status.code(), Some(2), "a missing task is an error");
+    assert!(
+        stderr(&out).contains("frame 4 of run 1 of 2 is in 0 files"),
+        "{}",
+        stderr(&out)
+    );
+    run(&[
+        "-o",
+        farm.to_str().unwrap(),
+        "--part",
+        "1/2",
+        "--frames",
+        "4-6",
+    ]);
+    let out = assemble();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("4 files of 2 runs"),
+        "{}",
+        stdout(&out)
+    );
+    for stitched in [&frames, &farm] {
+        if let Some((ok, report)) = usdcheck(&[Path::new("--same-stage"), stitched, &single]) {
+            assert!(ok, "{} ≠ the single run:\n{report}", stitched.display());
+        }
+    }
+}
+
+#[test]
+fn animated_grooms_refuse_what_they_cannot_write_with_a_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = fox_groom(dir.path(), "");
+    let g = groom.to_str().unwrap();
+    let text_out = dir.path().join("fox.usda");
+    let out = pelage(&["groom", g, "-o", text_out.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out)
+            .contains("animated grooms are written with time samples to .usdc, .usd or .abc"),
+        "{}",
+        stderr(&out)
+    );
+    let out = pelage(&["groom", g, "--frames", "9-2"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("9-2 runs backwards"),
+        "{}",
+        stderr(&out)
+    );
+    let out = pelage(&["groom", g, "--preview", "p.png"]);
+    assert!(
+        stderr(&out).contains("pelage render FILE --frames 1-6"),
+        "{}",
+        stderr(&out)
+    );
+    // A clip the file does not have names the ones it has, at its line.
+    std::fs::write(
+        &groom,
+        std::fs::read_to_string(&groom)
+            .unwrap()
+            .replace("\"Walk\"", "\"Dance\""),
+    )
+    .unwrap();
+    let out = pelage(&["groom", g]);
+    assert!(
+        stderr(&out).contains("fox.toml:2:")
+            && stderr(&out).contains("no animation called \"Dance\""),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn regrow_follows_time_sampled_guides_from_a_usd_file() {
+    let dir = tempfile::tempdir().unwrap();
+    // Animated guides: a sparse deforming groom of the fox, written as
+    // time-sampled curves, then used as the guides of a regrown groom.
+    let guides_groom = fox_groom(dir.path(), "");
+    let text = std::fs::read_to_string(&guides_groom)
+        .unwrap()
+        .replace("count = 2000\nparts = 4", "count = 80\nparts = 1")
+        .replace("with_mesh = true", "with_mesh = false");
+    let guide_toml = dir.path().join("guides.toml");
+    std::fs::write(&guide_toml, text).unwrap();
+    let guides = dir.path().join("guides.usdc");
+    let out = pelage(&[
+        "groom",
+        guide_toml.to_str().unwrap(),
+        "-o",
+        guides.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let fox = repo("crates/pelage/tests/data/fox/Fox.gltf");
+    let regrow = dir.path().join("regrow.toml");
+    std::fs::write(
+        &regrow,
+        format!(
+            "[mesh]\npath = \"{}\"\n[roots]\ncount = 1500\n[guides]\nfile = \"guides.usdc\"\n[finish]\npoints = 6\n[animation]\nframes = \"1-4\"\nclip = \"Walk\"\nmode = \"regrow\"\n",
+            fox.display()
+        ),
+    )
+    .unwrap();
+    let out_path = dir.path().join("regrown.usdc");
+    let out = pelage(&[
+        "groom",
+        regrow.to_str().unwrap(),
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("regrow"), "{}", stdout(&out));
+    let a = pelage::io::read_usd_curves_at(&out_path, Some(1.0)).unwrap();
+    let b = pelage::io::read_usd_curves_at(&out_path, Some(4.0)).unwrap();
+    assert_eq!(a.curve_count(), 1500);
+    assert_eq!(a.ids(), b.ids());
+    assert_ne!(a.points(), b.points());
+    if let Some((ok, report)) = usdcheck(&[&out_path]) {
+        assert!(ok, "{report}");
+    }
+}
