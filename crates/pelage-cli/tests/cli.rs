@@ -868,7 +868,7 @@ fn view_without_the_viewer_feature_says_how_to_get_it() {
 /// A small groom on the walking Khronos Fox (tests/data/fox), `extra`
 /// appended to its `[animation]`.
 fn fox_groom(dir: &Path, extra: &str) -> std::path::PathBuf {
-    let fox = repo("crates/pelage/tests/data/fox/Fox.gltf");
+    let fox = repo("crates/pelage/assets/fox/Fox.gltf");
     let text = format!(
         r#"[mesh]
 path = "{}"
@@ -1127,7 +1127,7 @@ fn regrow_follows_time_sampled_guides_from_a_usd_file() {
         "-q",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let fox = repo("crates/pelage/tests/data/fox/Fox.gltf");
+    let fox = repo("crates/pelage/assets/fox/Fox.gltf");
     let regrow = dir.path().join("regrow.toml");
     std::fs::write(
         &regrow,

@@ -1,6 +1,7 @@
 //! Assets compiled into the library, so every command has something to work
-//! on with no files at hand: Keenan Crane's "Spot" (public domain; see
-//! `assets/README.md`).
+//! on with no files at hand: Keenan Crane's "Spot" (public domain) and the
+//! Khronos Fox, skinned and animated (CC0 mesh, CC BY 4.0 rig: see
+//! `assets/README.md` and `assets/fox/LICENSE.md`).
 
 use crate::map::{Channel, ImageMap, Wrap};
 use crate::mesh::{Mesh, MeshFormat};
@@ -13,6 +14,17 @@ pub const SPOT_OBJ: &[u8] = include_bytes!("../assets/spot_triangulated.obj");
 
 /// Spot's colour texture (PNG, 1024×1024).
 pub const SPOT_TEXTURE_PNG: &[u8] = include_bytes!("../assets/spot_texture.png");
+
+/// The Khronos Fox as a self-contained glTF: 576 triangles, a skin, and
+/// the animations Survey, Walk and Run.
+pub const FOX_GLTF: &[u8] = include_bytes!("../assets/fox/Fox.gltf");
+
+/// The Fox's colour texture (PNG, 1024×1024), as its glTF embeds it.
+pub const FOX_TEXTURE_PNG: &[u8] = include_bytes!("../assets/fox/fox.png");
+
+/// The Fox's licences and credits (its rig and animations are CC BY 4.0:
+/// ship this beside any copy).
+pub const FOX_LICENSE: &str = include_str!("../assets/fox/LICENSE.md");
 
 /// The embedded Spot mesh.
 pub fn spot() -> Mesh {

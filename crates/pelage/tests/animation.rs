@@ -238,7 +238,7 @@ fn regrowing_reproduces_every_animated_guide_at_its_root() {
 
 #[test]
 fn gltf_skinning_poses_the_fox_and_a_clip_is_chosen_by_name() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fox/Fox.gltf");
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/fox/Fox.gltf");
     let options = |clip: &str| SkinOptions {
         fps: 24.0,
         clip: Some(clip.into()),

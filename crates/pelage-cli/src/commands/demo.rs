@@ -20,10 +20,26 @@ use std::time::Instant;
 /// Arguments of `pelage demo`.
 #[derive(Debug, Args)]
 pub struct DemoArgs {
-    /// Folder the demo writes into.
-    #[arg(long, default_value = "pelage-demo")]
-    pub out: PathBuf,
+    /// Which demo: `spot` (a still groom) or `fox` (the Khronos Fox
+    /// walking, its fur following the skin frame by frame).
+    #[arg(value_enum, default_value = "spot")]
+    pub which: DemoName,
+    /// Folder the demo writes into (default: pelage-demo, or pelage-fox).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }
+
+/// The demos.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DemoName {
+    /// A still groom on the embedded Spot.
+    Spot,
+    /// An animated groom on the embedded Khronos Fox (walk cycle).
+    Fox,
+}
+
+/// The fox demo's groom file, as written for the user.
+pub const FOX_GROOM: &str = include_str!("../demo_fox.toml");
 
 /// The demo's groom file, as written for the user.
 pub const DEMO_GROOM: &str = include_str!("../demo.toml");
@@ -56,6 +72,10 @@ fn render_preview(
 }
 
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
+    if args.which == DemoName::Fox {
+        return run_fox(&args.out.clone().unwrap_or_else(|| PathBuf::from("pelage-fox")));
+    }
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("pelage-demo"));
     let start = Instant::now();
     let spot = pelage::assets::spot();
     println!(
@@ -64,11 +84,11 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     );
     print!("{}", MeshSummary::of(&spot, 0).table());
 
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create the folder {}", args.out.display()))?;
-    let groom_path = args.out.join("demo.toml");
+    std::fs::create_dir_all(&out)
+        .with_context(|| format!("cannot create the folder {}", out.display()))?;
+    let groom_path = out.join("demo.toml");
     write_atomically(&groom_path, |out| out.write_all(DEMO_GROOM.as_bytes()))?;
-    let texture_path = args.out.join("spot.png");
+    let texture_path = out.join("spot.png");
     write_atomically(&texture_path, |out| {
         out.write_all(pelage::assets::SPOT_TEXTURE_PNG)
     })?;
@@ -113,7 +133,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         texture_path.display()
     );
     let curves = pelage::io::join(grown.iter())?;
-    let preview = args.out.join("preview.png");
+    let preview = out.join("preview.png");
     match render_preview(&spot, &curves, &preview) {
         Ok(adapter) => println!("preview → {} (rendered on {adapter})", preview.display()),
         // The demo still did its job; say why there is no picture.
@@ -127,6 +147,92 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     );
     println!(
         "      `pelage render {} --mesh spot -o groom.png`, `pelage bench groom --quick`.",
+        output.display()
+    );
+    Ok(())
+}
+
+/// `pelage demo fox`: the fox groom grown over the walk cycle into one
+/// time-sampled usdc (with the walking skin), rendered to a PNG a frame
+/// and a GIF.
+fn run_fox(out: &std::path::Path) -> anyhow::Result<()> {
+    let start = Instant::now();
+    println!(
+        "pelage {} demo — fur on the walking Khronos Fox\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create the folder {}", out.display()))?;
+    for (name, bytes) in [
+        ("fox.toml", FOX_GROOM.as_bytes()),
+        ("Fox.gltf", pelage::assets::FOX_GLTF),
+        ("fox.png", pelage::assets::FOX_TEXTURE_PNG),
+        ("LICENSE-fox.md", pelage::assets::FOX_LICENSE.as_bytes()),
+    ] {
+        write_atomically(&out.join(name), |w| w.write_all(bytes))?;
+    }
+    let groom_path = out.join("fox.toml");
+    let groom = Groom::load(&groom_path)?;
+    let animated = groom
+        .animated(None)?
+        .context("the fox groom file has an [animation] section")?;
+    let output = groom.output_path();
+    let animation = animated.animation();
+    let frames = animation.frames.frames().to_vec();
+    let clip = animated
+        .skin()
+        .clip()
+        .map_or(String::new(), |(n, s)| format!(", clip {n:?} ({s:.2} s)"));
+    println!(
+        "growing {} hairs from {} guides on {} ({} triangles), carried over frames {}{clip} …",
+        thousands(animated.generator().parts().iter().map(|p| p.hair_count).sum()),
+        thousands(groom.guides().len() as u64),
+        groom.mesh().name(),
+        thousands(groom.mesh().triangle_count() as u64),
+        animation.frames,
+    );
+    let options = UsdOptions {
+        time_codes_per_second: groom.fps().unwrap_or(24.0),
+        ..UsdOptions::default()
+    };
+    let growing = Instant::now();
+    let parts = 0..animated.generator().parts().len();
+    let summary = animated.write(&output, parts, &options, true, |_| {})?;
+    println!(
+        "{} hairs, {} points × {} frames → {} in {:.2} s",
+        thousands(summary.hairs),
+        thousands(summary.points),
+        frames.len(),
+        output.display(),
+        growing.elapsed().as_secs_f64()
+    );
+    let folder = out.join("frames");
+    let render = super::render::RenderArgs {
+        file: Some(output.clone()),
+        mesh: None,
+        output: folder.clone(),
+        size: (640, 400),
+        eye: None,
+        target: None,
+        fov: 30.0,
+        point_radius: 1.5,
+        texture: Some(out.join("fox.png")),
+        no_texture: false,
+        frames: Some(animation.frames.clone()),
+        fps: options.time_codes_per_second,
+    };
+    if let Err(e) = super::render::run(&render) {
+        // The demo still did its job; say why there are no pictures.
+        println!("frames skipped: {e:#}");
+    }
+    println!("done in {:.2} s\n", start.elapsed().as_secs_f64());
+    println!(
+        "Next: edit {} and run `pelage groom {}`;",
+        groom_path.display(),
+        groom_path.display()
+    );
+    println!(
+        "      open {} in Blender (File › Import › USD) or usdview; `pelage bench animation --quick`.",
         output.display()
     );
     Ok(())

@@ -254,6 +254,14 @@ fn run_frames(args: &RenderArgs, frames: &pelage::anim::FrameRange) -> anyhow::R
         background: super::FUR_BACKGROUND,
         ..Default::default()
     };
+    let texture = match &args.texture {
+        Some(path) => Some(
+            image::open(path)
+                .with_context(|| format!("cannot read the texture {}", path.display()))?
+                .to_rgba8(),
+        ),
+        None => None,
+    };
     let ctx = pelage_gpu::GpuContext::headless()?;
     let renderer = pelage_gpu::Renderer::new(&ctx);
     let stem = file
@@ -270,7 +278,7 @@ fn run_frames(args: &RenderArgs, frames: &pelage::anim::FrameRange) -> anyhow::R
             mesh: mesh.as_ref(),
             points: &[],
             curves: Some(&hairs),
-            skin_texture: None,
+            skin_texture: texture.as_ref(),
         };
         let image = renderer.render(&ctx, &scene, &style, Some(camera), width, height)?;
         let png = out.join(format!("{stem}.{f:04}.png"));

@@ -2,6 +2,9 @@
 //! of the default scene (or of every scene, or every mesh when there is no
 //! scene), with node transforms applied, merged into one mesh.
 //!
+//! UVs are flipped vertically on reading (`v → 1 − v`): glTF's origin is
+//! the image's top-left corner, pelage's the bottom-left.
+//!
 //! glTF splits vertices wherever any attribute differs, so a UV seam becomes
 //! an open border. pelage welds vertices whose positions are bit-identical
 //! and keeps the UVs per corner, so a closed model stays closed for the
@@ -118,9 +121,12 @@ pub(crate) fn parse_with_sources(
                 .collect();
             let normals: Option<Vec<Vec3>> =
                 reader.read_normals().map(|n| n.map(Vec3::from).collect());
+            // glTF puts UV (0, 0) at the image's top-left corner; pelage's
+            // maps (as OBJ, PLY and USD) at its bottom-left: v is flipped,
+            // as Blender's importer does.
             let uvs: Option<Vec<Vec2>> = reader
                 .read_tex_coords(0)
-                .map(|t| t.into_f32().map(Vec2::from).collect());
+                .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
             match uv_presence {
                 None => uv_presence = Some(uvs.is_some()),
                 Some(p) if p != uvs.is_some() => {
