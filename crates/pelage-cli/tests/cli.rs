@@ -160,6 +160,46 @@ fn demo_runs_on_the_embedded_asset_from_any_folder() {
 }
 
 #[test]
+fn demo_fox_grows_fur_that_walks_with_the_fox() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_pelage"))
+        .args(["demo", "fox"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(
+        text.contains("60,000 hairs, 480,000 points × 24 frames → pelage-fox/fox.usdc"),
+        "{text}"
+    );
+    let folder = dir.path().join("pelage-fox");
+    for name in ["fox.toml", "Fox.gltf", "fox.png", "LICENSE-fox.md"] {
+        assert!(folder.join(name).exists(), "{name} missing");
+    }
+    let licence = std::fs::read_to_string(folder.join("LICENSE-fox.md")).unwrap();
+    assert!(licence.contains("CC BY 4.0") && licence.contains("@tomkranis"));
+    let usdc = folder.join("fox.usdc");
+    let at = |t: f64| pelage::io::read_usd_curves_at(&usdc, Some(t)).unwrap();
+    let (a, b) = (at(1.0), at(12.0));
+    assert_eq!(a.curve_count(), 60_000);
+    assert_eq!(a.ids(), b.ids());
+    assert_ne!(a.points(), b.points(), "the fur moves");
+    let skin = pelage::anim::AnimatedSkin::load(&usdc, &Default::default()).unwrap();
+    assert_eq!(
+        skin.sample_times().len(),
+        24,
+        "the walking skin is in the file"
+    );
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() {
+        let gif = folder.join("frames/fox.gif");
+        assert!(gif.exists(), "{text}");
+        let png = image::open(folder.join("frames/fox.0024.png")).unwrap();
+        assert_eq!((png.width(), png.height()), (640, 400));
+    }
+}
+
+#[test]
 fn sample_gives_byte_identical_files_on_one_and_two_threads() {
     let dir = tempfile::tempdir().unwrap();
     let run = |threads: &str, name: &str| {

@@ -73,9 +73,17 @@ fn render_preview(
 
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     if args.which == DemoName::Fox {
-        return run_fox(&args.out.clone().unwrap_or_else(|| PathBuf::from("pelage-fox")));
+        return run_fox(
+            &args
+                .out
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("pelage-fox")),
+        );
     }
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("pelage-demo"));
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("pelage-demo"));
     let start = Instant::now();
     let spot = pelage::assets::spot();
     println!(
@@ -185,7 +193,14 @@ fn run_fox(out: &std::path::Path) -> anyhow::Result<()> {
         .map_or(String::new(), |(n, s)| format!(", clip {n:?} ({s:.2} s)"));
     println!(
         "growing {} hairs from {} guides on {} ({} triangles), carried over frames {}{clip} …",
-        thousands(animated.generator().parts().iter().map(|p| p.hair_count).sum()),
+        thousands(
+            animated
+                .generator()
+                .parts()
+                .iter()
+                .map(|p| p.hair_count)
+                .sum()
+        ),
         thousands(groom.guides().len() as u64),
         groom.mesh().name(),
         thousands(groom.mesh().triangle_count() as u64),

@@ -12,6 +12,7 @@ use pelage::groom::{
     part_slice, write_assembly, write_clip_assembly,
 };
 use pelage::io::{CurvesExport, CurvesFormat, UsdOptions};
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -110,15 +111,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     let prepared = start.elapsed();
     let parts = generator.parts().len();
     let (range, path) = match args.part {
-        Some((k, n)) => {
-            if n > parts {
-                bail!(
-                    "--part {k}/{n}: the groom has {parts} parts, so at most {parts} runs; set [roots] parts in {} for more",
-                    args.file.display()
-                );
-            }
-            (part_slice(k, n, parts), part_file(&output, k, n))
-        }
+        Some((k, n)) => (run_parts(args, k, n, parts)?, part_file(&output, k, n)),
         None => (0..parts, output.clone()),
     };
     // Refuse an output pelage cannot write before growing anything.
@@ -244,12 +237,7 @@ fn run_animated(
     };
     let (range, outputs) = match args.part {
         Some((k, n)) => {
-            if n > parts {
-                bail!(
-                    "--part {k}/{n}: the groom has {parts} parts, so at most {parts} runs; set [roots] parts in {} for more",
-                    args.file.display()
-                );
-            }
+            let range = run_parts(args, k, n, parts)?;
             let path = frames_file(
                 &data,
                 Some((k, n)),
@@ -260,7 +248,7 @@ fn run_animated(
                 path,
                 times: animated.times_of(frames),
             };
-            (part_slice(k, n, parts), vec![output])
+            (range, vec![output])
         }
         None if args.frame_files => {
             if output.extension().and_then(|e| e.to_str()) != Some("usda") {
@@ -402,6 +390,18 @@ fn assemble_frames(output: &Path, frames: &FrameRange) -> anyhow::Result<()> {
         stitched.time_range.1
     );
     Ok(())
+}
+
+/// The parts run `k` of `n` grows, or an error when there are fewer parts
+/// than runs.
+fn run_parts(args: &GroomArgs, k: usize, n: usize, parts: usize) -> anyhow::Result<Range<usize>> {
+    if n > parts {
+        bail!(
+            "--part {k}/{n}: the groom has {parts} parts, so at most {parts} runs; set [roots] parts in {} for more",
+            args.file.display()
+        );
+    }
+    Ok(part_slice(k, n, parts))
 }
 
 /// "1 part", "3 parts".

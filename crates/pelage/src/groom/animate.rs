@@ -281,6 +281,15 @@ impl AnimatedGroom {
         self.generator.reshaped(spec)
     }
 
+    /// The frame's own generator in regrow mode; `None` in deform mode,
+    /// where the rest generator grows every frame.
+    fn frame_generator(&self, time: f64, pose: &SkinPose) -> Result<Option<Generator>, GroomError> {
+        match self.animation.mode {
+            AnimationMode::Deform => Ok(None),
+            AnimationMode::Regrow => self.regrown_generator(time, pose).map(Some),
+        }
+    }
+
     /// The guides at `time`, in rest space.
     fn guides_at(&self, time: f64, pose: &SkinPose) -> Result<Guides, GroomError> {
         let rest = &self.spec.guides;
@@ -382,14 +391,8 @@ impl AnimatedGroom {
     /// pose: in regrow mode, the guide itself as the file poses it.
     pub fn guide_hair(&self, guide: usize, time: f64) -> Result<Vec<Vec3>, GroomError> {
         let pose = self.pose(time)?;
-        let regrown;
-        let generator = match self.animation.mode {
-            AnimationMode::Deform => &self.generator,
-            AnimationMode::Regrow => {
-                regrown = self.regrown_generator(time, &pose)?;
-                &regrown
-            }
-        };
+        let regrown = self.frame_generator(time, &pose)?;
+        let generator = regrown.as_ref().unwrap_or(&self.generator);
         let root = self.spec.guides.roots()[guide];
         let n = self.spec.guides.points_per_guide();
         let mut shape = vec![Vec3::ZERO; n];
@@ -414,14 +417,8 @@ impl AnimatedGroom {
     /// Part `p` at time code `time`, alone (tests, previews).
     pub fn part(&self, p: usize, time: f64) -> Result<Curves, GroomError> {
         let pose = self.pose(time)?;
-        let regrown;
-        let generator = match self.animation.mode {
-            AnimationMode::Deform => &self.generator,
-            AnimationMode::Regrow => {
-                regrown = self.regrown_generator(time, &pose)?;
-                &regrown
-            }
-        };
+        let regrown = self.frame_generator(time, &pose)?;
+        let generator = regrown.as_ref().unwrap_or(&self.generator);
         let mut out = Curves::default();
         self.part_at(p, time, &pose, generator, &mut None, &mut out)?;
         Ok(out)
@@ -515,14 +512,11 @@ impl AnimatedGroom {
         for &t in &times {
             poses.push(self.pose(t)?);
         }
-        let generators = match self.animation.mode {
-            AnimationMode::Deform => Vec::new(),
-            AnimationMode::Regrow => times
-                .iter()
-                .zip(&poses)
-                .map(|(&t, pose)| self.regrown_generator(t, pose))
-                .collect::<Result<Vec<_>, _>>()?,
-        };
+        let generators = times
+            .iter()
+            .zip(&poses)
+            .map(|(&t, pose)| self.frame_generator(t, pose))
+            .collect::<Result<Vec<_>, _>>()?;
         if with_skin {
             for (output, layer) in outputs.iter().zip(&mut layers) {
                 for &time in &output.times {
@@ -544,7 +538,7 @@ impl AnimatedGroom {
             for (output, layer) in outputs.iter().zip(&mut layers) {
                 for &time in &output.times {
                     let k = index(time);
-                    let generator = generators.get(k).unwrap_or(&self.generator);
+                    let generator = generators[k].as_ref().unwrap_or(&self.generator);
                     self.part_at(p, time, &poses[k], generator, &mut rest, &mut out)?;
                     if !counted {
                         summary.hairs += out.curve_count() as u64;

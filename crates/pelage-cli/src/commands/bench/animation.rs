@@ -247,7 +247,10 @@ pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
         ),
         regrow_per_frame,
     );
-    row("peer: from scratch on the posed skin (Stubble's way)", scratch_s);
+    row(
+        "peer: from scratch on the posed skin (Stubble's way)",
+        scratch_s,
+    );
     row("paper: Stubble, 2 cores (Sik §4.2.2)", paper_scaled);
     println!(
         "\ntargets: deform ≤ 0.25× growing, regrow ≤ 1.2× growing. Peak RSS {:.0} MB.",
