@@ -1147,10 +1147,11 @@ fn animated_grooms_refuse_what_they_cannot_write_with_a_reason() {
 }
 
 #[test]
-fn regrow_follows_time_sampled_guides_from_a_usd_file() {
+fn regrow_follows_time_sampled_guides_from_usd_and_alembic_alike() {
     let dir = tempfile::tempdir().unwrap();
     // Animated guides: a sparse deforming groom of the fox, written as
-    // time-sampled curves, then used as the guides of a regrown groom.
+    // time-sampled curves (usdc and Alembic), then the guides of a
+    // regrown groom.
     let guides_groom = fox_groom(dir.path(), "");
     let text = std::fs::read_to_string(&guides_groom)
         .unwrap()
@@ -1158,40 +1159,50 @@ fn regrow_follows_time_sampled_guides_from_a_usd_file() {
         .replace("with_mesh = true", "with_mesh = false");
     let guide_toml = dir.path().join("guides.toml");
     std::fs::write(&guide_toml, text).unwrap();
-    let guides = dir.path().join("guides.usdc");
-    let out = pelage(&[
-        "groom",
-        guide_toml.to_str().unwrap(),
-        "-o",
-        guides.to_str().unwrap(),
-        "-q",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
     let fox = repo("crates/pelage/assets/fox/Fox.gltf");
-    let regrow = dir.path().join("regrow.toml");
-    std::fs::write(
-        &regrow,
-        format!(
-            "[mesh]\npath = \"{}\"\n[roots]\ncount = 1500\n[guides]\nfile = \"guides.usdc\"\n[finish]\npoints = 6\n[animation]\nframes = \"1-4\"\nclip = \"Walk\"\nmode = \"regrow\"\n",
-            fox.display()
-        ),
-    )
-    .unwrap();
-    let out_path = dir.path().join("regrown.usdc");
-    let out = pelage(&[
-        "groom",
-        regrow.to_str().unwrap(),
-        "-o",
-        out_path.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stdout(&out).contains("regrow"), "{}", stdout(&out));
-    let a = pelage::io::read_usd_curves_at(&out_path, Some(1.0)).unwrap();
-    let b = pelage::io::read_usd_curves_at(&out_path, Some(4.0)).unwrap();
-    assert_eq!(a.curve_count(), 1500);
-    assert_eq!(a.ids(), b.ids());
-    assert_ne!(a.points(), b.points());
-    if let Some((ok, report)) = usdcheck(&[&out_path]) {
-        assert!(ok, "{report}");
+    let mut regrown = Vec::new();
+    for ext in ["usdc", "abc"] {
+        let guides = dir.path().join(format!("guides.{ext}"));
+        let out = pelage(&[
+            "groom",
+            guide_toml.to_str().unwrap(),
+            "-o",
+            guides.to_str().unwrap(),
+            "-q",
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let regrow = dir.path().join(format!("regrow-{ext}.toml"));
+        std::fs::write(
+            &regrow,
+            format!(
+                "[mesh]\npath = \"{}\"\n[roots]\ncount = 1500\n[guides]\nfile = \"guides.{ext}\"\n[finish]\npoints = 6\n[animation]\nframes = \"1-4\"\nclip = \"Walk\"\nmode = \"regrow\"\n",
+                fox.display()
+            ),
+        )
+        .unwrap();
+        let out_path = dir.path().join(format!("regrown-{ext}.usdc"));
+        let out = pelage(&[
+            "groom",
+            regrow.to_str().unwrap(),
+            "-o",
+            out_path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(stdout(&out).contains("regrow"), "{}", stdout(&out));
+        let a = pelage::io::read_usd_curves_at(&out_path, Some(1.0)).unwrap();
+        let b = pelage::io::read_usd_curves_at(&out_path, Some(4.0)).unwrap();
+        assert_eq!(a.curve_count(), 1500);
+        assert_eq!(a.ids(), b.ids());
+        assert_ne!(a.points(), b.points());
+        if let Some((ok, report)) = usdcheck(&[&out_path]) {
+            assert!(ok, "{report}");
+        }
+        regrown.push(b);
     }
+    // The same guides, frame for frame, from either file.
+    assert_eq!(
+        regrown[0].points(),
+        regrown[1].points(),
+        "regrown from usdc ≠ from Alembic at frame 4"
+    );
 }

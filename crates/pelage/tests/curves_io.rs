@@ -234,6 +234,14 @@ fn animated_usdc_holds_each_frame_and_the_stage_time_range() {
         &first.points()[..frames[0].1.points().len()],
         frames[0].1.points()
     );
+    // Damaged copies read with every time sample: errors or curves, never
+    // a panic or an allocation a corrupted count claims.
+    let bytes = std::fs::read(&path).unwrap();
+    let bad = dir.path().join("bad.usdc");
+    for damaged in damaged_copies(&bytes, 11, 0, 0x0dd_ba11_5ca1_ab1e) {
+        std::fs::write(&bad, &damaged).unwrap();
+        let _ = pelage::io::read_usd_curves_at(&bad, Some(1.5));
+    }
     // A frame with other curves is refused, naming the part and time.
     let mut usd =
         UsdcWriter::new(std::io::Cursor::new(Vec::new()), &UsdOptions::default()).unwrap();
@@ -419,8 +427,27 @@ fn animated_alembic_holds_each_frame_for_blender() {
         Ok(())
     })
     .unwrap();
-    // pelage reads the first frame.
+    // pelage reads the first frame, or the frame at a time (seconds at
+    // 24 frames a second), held past the ends.
     assert_eq!(read_curves(&path).unwrap().points(), frames[0].1.points());
+    let at = |t: f64| {
+        pelage::io::read_abc_curves_at(&path, Some(t / 24.0))
+            .unwrap()
+            .points()
+            .to_vec()
+    };
+    for (time, curves) in &frames {
+        assert_eq!(at(*time), curves.points(), "frame {time}");
+    }
+    assert_eq!(at(0.0), frames[0].1.points());
+    assert_eq!(at(99.0), frames[3].1.points());
+    // Damaged copies of an animated file: errors or curves, never a panic.
+    let bytes = std::fs::read(&path).unwrap();
+    let bad = dir.path().join("bad.abc");
+    for damaged in damaged_copies(&bytes, 11, 0, 0x51ed_2701_f00d_cafe) {
+        std::fs::write(&bad, &damaged).unwrap();
+        let _ = pelage::io::read_abc_curves_at(&bad, Some(0.5));
+    }
     // Frames out of order are refused.
     let mut abc = AbcWriter::new(std::io::Cursor::new(Vec::new()), &UsdOptions::default()).unwrap();
     abc.write_part_at("a", 2.0, &rest).unwrap();

@@ -125,13 +125,15 @@ impl AnimationSpec {
 /// Guide shapes over time, for [`AnimationMode::Regrow`].
 #[derive(Clone)]
 pub enum GuideMotion {
-    /// A time-sampled USD file of the guides (read at each frame);
-    /// `kept[i]` is the file's curve index of bound guide `i`.
+    /// A time-sampled USD or Alembic file of the guides (read at each
+    /// frame); `kept[i]` is the file's curve index of bound guide `i`.
     File {
         /// The guide file.
         path: PathBuf,
         /// Which of the file's curves were bound, in the guides' order.
         kept: Vec<usize>,
+        /// Frames per second: Alembic samples are timed in seconds.
+        fps: f64,
     },
     /// A program giving every bound guide's points at a frame (one curve
     /// per guide, in order).
@@ -209,7 +211,7 @@ impl AnimatedGroom {
             return Err(spec.error(
                 "animation.mode",
                 GroomErrorKind::Invalid(
-                    "regrow needs animated guides: a time-sampled USD guide file ([guides] file)"
+                    "regrow needs animated guides: a time-sampled USD or Alembic guide file ([guides] file)"
                         .into(),
                 ),
             ));
@@ -295,8 +297,8 @@ impl AnimatedGroom {
         let rest = &self.spec.guides;
         let n = rest.points_per_guide();
         let (posed, kept): (Curves, Option<&[usize]>) = match &self.guides {
-            Some(GuideMotion::File { path, kept }) => (
-                crate::io::read_usd_curves_at(path, Some(time))
+            Some(GuideMotion::File { path, kept, fps }) => (
+                read_guides_at(path, time, *fps)
                     .map_err(|e| self.spec.error("guides.file", GroomErrorKind::Guides(e)))?,
                 Some(kept),
             ),
@@ -572,6 +574,22 @@ impl AnimatedGroom {
             file.commit()?;
         }
         Ok(summary)
+    }
+}
+
+/// Guide curves from a time-sampled file at time code `time`: USD at that
+/// time code, Alembic at `time / fps` seconds; other formats do not move.
+pub(crate) fn read_guides_at(
+    path: &Path,
+    time: f64,
+    fps: f64,
+) -> Result<Curves, crate::io::CurvesReadError> {
+    match CurvesFormat::from_path(path) {
+        Some(CurvesFormat::Usda | CurvesFormat::Usdc) => {
+            crate::io::read_usd_curves_at(path, Some(time))
+        }
+        Some(CurvesFormat::Abc) => crate::io::read_abc_curves_at(path, Some(time / fps)),
+        _ => crate::io::read_curves(path),
     }
 }
 

@@ -106,7 +106,9 @@ impl Groom {
             }
         };
         let mesh = Arc::new(mesh);
-        let rest_time = animation.as_ref().map(|(spec, _, _)| spec.rest_frame);
+        let rest_time = animation
+            .as_ref()
+            .map(|(spec, fps, _)| (spec.rest_frame, *fps));
         let (guides, bind_report) = load_guides(&source, &file, &mesh, rest_time)?;
         let animation = match (animation, skin) {
             (Some((spec, fps, _)), Some(skin)) => {
@@ -115,7 +117,7 @@ impl Groom {
                     .file
                     .as_ref()
                     .map(|p| source.folder().join(p.get_ref()));
-                let guides = guide_file.filter(|p| is_usd(p)).map(|path| {
+                let guides = guide_file.filter(|p| is_animatable(p)).map(|path| {
                     let total = bind_report
                         .as_ref()
                         .map_or(guides.len(), |r| r.kept + r.dropped.len());
@@ -126,6 +128,7 @@ impl Groom {
                     GuideMotion::File {
                         path,
                         kept: (0..total).filter(|i| !dropped.contains(i)).collect(),
+                        fps,
                     }
                 });
                 Some(LoadedAnimation {
@@ -184,7 +187,7 @@ impl Groom {
                     return Err(self.source.error_at(
                         span,
                         GroomErrorKind::Invalid(
-                            "mode = \"regrow\" needs time-sampled guides: a USD guide file in [guides] file".into(),
+                            "mode = \"regrow\" needs time-sampled guides: a USD or Alembic guide file in [guides] file".into(),
                         ),
                     ));
                 };
@@ -455,17 +458,17 @@ fn load_mesh_section(source: &SettingsSource, section: &MeshSection) -> Result<M
         .map_err(|e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e)))
 }
 
-/// Whether a path names a USD file (by extension).
-fn is_usd(path: &Path) -> bool {
+/// Whether a path names a curves file that can hold time samples (USD,
+/// Alembic), by extension.
+fn is_animatable(path: &Path) -> bool {
     matches!(
         path.extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase)
             .as_deref(),
-        Some("usda" | "usdc" | "usd")
+        Some("usda" | "usdc" | "usd" | "abc")
     )
 }
-
 /// The animation a groom file (or `--frames`) asks for: the spec, the
 /// frame rate and the glTF clip.
 fn animation_spec(
@@ -545,7 +548,7 @@ fn load_guides(
     source: &SettingsSource,
     file: &GroomFile,
     mesh: &Mesh,
-    rest_time: Option<f64>,
+    rest_time: Option<(f64, f64)>,
 ) -> Result<(Guides, Option<BindReport>), GroomError> {
     let section = &file.guides;
     let invalid =
@@ -555,8 +558,8 @@ fn load_guides(
             let full = source.folder().join(path.get_ref());
             // Animated guides are bound as they are at the rest frame.
             let curves = match rest_time {
-                Some(t) if is_usd(&full) => crate::io::read_usd_curves_at(&full, Some(t)),
-                _ => crate::io::read_curves(&full),
+                Some((t, fps)) => super::animate::read_guides_at(&full, t, fps),
+                None => crate::io::read_curves(&full),
             }
             .map_err(|e| source.error_at(path.span(), GroomErrorKind::Guides(e)))?;
             let (guides, report) = Guides::bind(mesh, &curves, section.points, section.tolerance);

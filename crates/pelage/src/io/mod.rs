@@ -27,7 +27,7 @@ mod usd_schema;
 mod usda;
 mod usdc;
 
-pub use abc::{AbcWriter, read_abc_curves};
+pub use abc::{AbcWriter, read_abc_curves, read_abc_curves_at};
 pub use atomic::{AtomicFile, write_atomically};
 pub use curves_file::{
     CurvesExport, CurvesFormat, join, read_curves, write_curves, write_streamed,

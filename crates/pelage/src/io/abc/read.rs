@@ -182,6 +182,12 @@ struct PropertyHeader {
     kind: u32,
     pod: u8,
     extent: u8,
+    /// Samples in all, the first and last that differ from their
+    /// predecessors (only those and sample 0 are stored), and the time
+    /// sampling they follow.
+    samples: u32,
+    changed: (u32, u32),
+    time_sampling: u32,
 }
 
 fn property_headers(block: &[u8], indexed: &[String]) -> Option<Vec<PropertyHeader>> {
@@ -199,16 +205,17 @@ fn property_headers(block: &[u8], indexed: &[String]) -> Option<Vec<PropertyHead
         };
         let hint = (info >> 2) & 3;
         let (mut pod, mut extent) = (0, 0);
+        let (mut samples, mut changed, mut time_sampling) = (0, (0, 0), 0);
         if kind != 0 {
             pod = ((info >> 4) & 0xf) as u8;
             extent = ((info >> 12) & 0xff) as u8;
-            f.sized(hint)?; // sample count
+            samples = f.sized(hint)?;
+            changed = (1, samples.saturating_sub(1));
             if info & 0x200 != 0 {
-                f.sized(hint)?; // first changed
-                f.sized(hint)?; // last changed
+                changed = (f.sized(hint)?, f.sized(hint)?);
             }
             if info & 0x100 != 0 {
-                f.sized(hint)?; // time sampling
+                time_sampling = f.sized(hint)?;
             }
         }
         let name_size = f.sized(hint)?;
@@ -226,6 +233,9 @@ fn property_headers(block: &[u8], indexed: &[String]) -> Option<Vec<PropertyHead
             kind,
             pod,
             extent,
+            samples,
+            changed,
+            time_sampling,
         });
     }
     Some(out)
@@ -311,11 +321,32 @@ impl Compound {
 /// int64 or double).
 fn first_sample<'a>(
     file: &Ogawa<'a>,
+    property: &(PropertyHeader, Child),
+    what: &str,
+) -> Result<&'a [u8], CurvesReadError> {
+    sample(file, property, 0, what)
+}
+
+/// Sample `k` of an array or scalar property (the last one past its end).
+fn sample<'a>(
+    file: &Ogawa<'a>,
     (header, group): &(PropertyHeader, Child),
+    k: usize,
     what: &str,
 ) -> Result<&'a [u8], CurvesReadError> {
     let children = file.group(*group, what)?;
-    let Some(&first) = children.first() else {
+    // Only sample 0 and the changed ones are stored: a sample before the
+    // first change is sample 0, one after the last change is the last.
+    let (first_changed, last_changed) = (header.changed.0 as usize, header.changed.1 as usize);
+    let k = k.min(header.samples.saturating_sub(1) as usize);
+    let stored = if k == 0 || k < first_changed || first_changed == 0 {
+        0
+    } else {
+        k.min(last_changed) - first_changed + 1
+    };
+    // Arrays store (data, dimensions) a sample; scalars the data alone.
+    let per_sample = if header.kind == 2 { 2 } else { 1 };
+    let Some(&first) = children.get(stored * per_sample).or(children.first()) else {
         return Ok(&[]);
     };
     let block = file.data(first, what)?;
@@ -363,6 +394,14 @@ fn floats(bytes: &[u8]) -> impl Iterator<Item = f32> + '_ {
 
 /// Reads every `ICurves` object of an Alembic file into one [`Curves`].
 pub fn read_abc_curves(path: &Path) -> Result<Curves, CurvesReadError> {
+    read_abc_curves_at(path, None)
+}
+
+/// [`read_abc_curves`] with the points of the sample at `seconds` (the
+/// one whose time is nearest; held before the first and after the last);
+/// everything else is read from the first sample. `None`: the first
+/// sample.
+pub fn read_abc_curves_at(path: &Path, seconds: Option<f64>) -> Result<Curves, CurvesReadError> {
     let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
     let (file, root) = Ogawa::open(&bytes, path)?;
     let top = file.group(root, "the archive")?;
@@ -395,9 +434,19 @@ pub fn read_abc_curves(path: &Path) -> Result<Curves, CurvesReadError> {
             Kind::Empty(" (no ICurves object)"),
         ));
     }
+    let samplings = match seconds {
+        Some(_) => time_samplings(file.data(top[4], "the time samplings")?).ok_or_else(|| {
+            file.fail(
+                top[4] & !EMPTY_DATA,
+                "the time samplings are cut short".into(),
+            )
+        })?,
+        None => Vec::new(),
+    };
+    let at = seconds.map(|s| (s, &samplings[..]));
     let mut parts = Vec::with_capacity(found.len());
     for (name, geom, world) in found {
-        parts.push(read_curves_object(&file, &name, geom, &indexed, world)?);
+        parts.push(read_curves_object(&file, &name, geom, &indexed, world, at)?);
     }
     super::super::join(&parts).map_err(|e| CurvesReadError::whole(path, e.into()))
 }
@@ -542,12 +591,91 @@ fn read_xform(
     Ok((local, inherits))
 }
 
+/// A time sampling: time per cycle and the sample times of one cycle
+/// (seconds). Acyclic samplings list every time.
+#[derive(Debug, Clone)]
+struct TimeSampling {
+    per_cycle: f64,
+    times: Vec<f64>,
+}
+
+impl TimeSampling {
+    fn acyclic(&self) -> bool {
+        self.per_cycle >= f64::MAX / 64.0
+    }
+
+    /// The time of sample `k`.
+    fn time(&self, k: usize) -> f64 {
+        let n = self.times.len().max(1);
+        if self.acyclic() {
+            return self
+                .times
+                .get(k)
+                .or(self.times.last())
+                .copied()
+                .unwrap_or(0.0);
+        }
+        self.times.get(k % n).copied().unwrap_or(0.0) + (k / n) as f64 * self.per_cycle
+    }
+
+    /// The sample (of `count`) whose time is nearest `seconds`.
+    fn nearest(&self, seconds: f64, count: usize) -> usize {
+        let n = self.times.len().max(1);
+        // Candidates: every listed time (acyclic), or the cycles around
+        // `seconds` (a file's sample count alone must not set the work).
+        let candidates = if self.acyclic() {
+            0..count.min(n)
+        } else {
+            let cycle = ((seconds - self.time(0)) / self.per_cycle).floor();
+            let first = if cycle.is_finite() && cycle > 0.0 {
+                (cycle as usize).saturating_sub(1).saturating_mul(n)
+            } else {
+                0
+            };
+            first.min(count.saturating_sub(1))..first.saturating_add(3 * n).min(count)
+        };
+        candidates
+            .min_by(|&a, &b| {
+                (self.time(a) - seconds)
+                    .abs()
+                    .total_cmp(&(self.time(b) - seconds).abs())
+            })
+            .unwrap_or(0)
+    }
+}
+
+/// The archive's time samplings: per sampling, `u32` max sample, `f64`
+/// time per cycle, `u32` samples a cycle and their `f64` times.
+fn time_samplings(block: &[u8]) -> Option<Vec<TimeSampling>> {
+    let mut out = Vec::new();
+    let mut at = 0;
+    let take = |at: &mut usize, n: usize| -> Option<&[u8]> {
+        let bytes = block.get(*at..*at + n)?;
+        *at += n;
+        Some(bytes)
+    };
+    while at < block.len() {
+        take(&mut at, 4)?; // max sample
+        let per_cycle = f64::from_le_bytes(take(&mut at, 8)?.try_into().ok()?);
+        let n = u32::from_le_bytes(take(&mut at, 4)?.try_into().ok()?) as usize;
+        if n > (block.len() - at) / 8 {
+            return None;
+        }
+        let times = (0..n)
+            .map(|_| Some(f64::from_le_bytes(take(&mut at, 8)?.try_into().ok()?)))
+            .collect::<Option<Vec<f64>>>()?;
+        out.push(TimeSampling { per_cycle, times });
+    }
+    Some(out)
+}
+
 fn read_curves_object(
     file: &Ogawa,
     path: &str,
     geom: Child,
     indexed: &[String],
     world: DMat4,
+    at: Option<(f64, &[TimeSampling])>,
 ) -> Result<Curves, CurvesReadError> {
     let what = |p: &str| format!("{path}/.geom/{p}");
     let fail = |message: String| file.fail(geom, message);
@@ -575,7 +703,23 @@ fn read_curves_object(
     // Into world space; normals turn with the inverse transpose.
     let moved = world != DMat4::IDENTITY;
     let turn = world.inverse().transpose();
-    let points: Vec<Vec3> = match property("P", &[10], 3)? {
+    // Points at the asked time: the sample of P's own time sampling
+    // nearest to it.
+    let p_at = match (at, geom.get("P")) {
+        (Some((seconds, samplings)), Some(p)) if p.0.samples > 1 => {
+            let k = samplings
+                .get(p.0.time_sampling as usize)
+                .map_or(0, |ts| ts.nearest(seconds, p.0.samples as usize));
+            property("P", &[10], 3)?;
+            Some(sample(file, p, k, &what("P"))?)
+        }
+        _ => None,
+    };
+    let p_bytes = match p_at {
+        Some(b) => Some(b),
+        None => property("P", &[10], 3)?,
+    };
+    let points: Vec<Vec3> = match p_bytes {
         Some(b) => floats(b)
             .collect::<Vec<_>>()
             .chunks_exact(3)
