@@ -69,7 +69,8 @@ pub fn find_frame_files(output: &Path) -> std::io::Result<Vec<FrameFile>> {
             continue;
         };
         let mut fields: Vec<&str> = rest.split('.').collect();
-        if fields.len() < 2 || !matches!(fields.pop(), Some("usdc" | "usd" | "abc")) {
+        // Value clips are USD: Alembic frame files cannot be stitched.
+        if fields.len() < 2 || !matches!(fields.pop(), Some("usdc" | "usd")) {
             continue;
         }
         let run = match fields.as_slice() {
