@@ -145,13 +145,8 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         bar
     };
     println!(
-        "{}: {} hairs on {} ({} triangles) from {} guides, {}; operators: {}",
-        args.file.display(),
-        thousands(planned),
-        groom.mesh().name(),
-        thousands(groom.mesh().triangle_count() as u64),
-        thousands(groom.guides().len() as u64),
-        parts_text(range.len()),
+        "{}; operators: {}",
+        heading(args, &groom, planned, range.len()),
         match generator.operators().len() {
             0 => "none".to_string(),
             _ => generator
@@ -288,13 +283,8 @@ fn run_animated(
         None => String::new(),
     };
     println!(
-        "{}: {} hairs on {} ({} triangles) from {} guides, {}; frames {} ({} samples, rest frame {}, {}{clip})",
-        args.file.display(),
-        thousands(planned),
-        groom.mesh().name(),
-        thousands(groom.mesh().triangle_count() as u64),
-        thousands(groom.guides().len() as u64),
-        parts_text(range.len()),
+        "{}; frames {} ({} samples, rest frame {}, {}{clip})",
+        heading(args, groom, planned, range.len()),
         animation.frames,
         times.len(),
         animation.rest_frame,
@@ -402,6 +392,20 @@ fn run_parts(args: &GroomArgs, k: usize, n: usize, parts: usize) -> anyhow::Resu
         );
     }
     Ok(part_slice(k, n, parts))
+}
+
+/// "FILE: N hairs on MESH (T triangles) from G guides, P parts": what a
+/// run is about to grow.
+fn heading(args: &GroomArgs, groom: &Groom, planned: u64, parts: usize) -> String {
+    format!(
+        "{}: {} hairs on {} ({} triangles) from {} guides, {}",
+        args.file.display(),
+        thousands(planned),
+        groom.mesh().name(),
+        thousands(groom.mesh().triangle_count() as u64),
+        thousands(groom.guides().len() as u64),
+        parts_text(parts),
+    )
 }
 
 /// "1 part", "3 parts".
