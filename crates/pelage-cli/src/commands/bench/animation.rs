@@ -5,13 +5,16 @@
 //! to rest, every part regrown and carried) — the part-by-part loop that
 //! `pelage groom` runs, without the file. The paper's baseline is Stubble's
 //! per-frame generation (Sik §4.1–4.2: every frame generated anew, 1.6 M
-//! hairs in 3.2 s on two cores); the peer measured in the same run is that
-//! approach done by pelage: a generator prepared from scratch and the
-//! groom grown, every frame.
+//! hairs in 3.2 s on two cores). Peers measured in the same run: that
+//! approach done by pelage (a generator prepared from scratch on the posed
+//! skin, the groom grown, every frame), and with `--peer blender`
+//! Blender's Deform Curves on Surface moving the same grown curves
+//! (`blender_deform.py`).
 
 use super::groom::{groom_text, peak_rss_bytes};
 use super::median_seconds;
 use crate::format::thousands;
+use anyhow::Context;
 use clap::Args;
 use glam::{Mat3, Vec3};
 use pelage::anim::{AnimatedSkin, FrameRange};
@@ -29,6 +32,106 @@ pub struct AnimationBenchArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Also measure a peer in the same run: `blender` moves the same
+    /// grown groom with Blender's Deform Curves on Surface node on the
+    /// skin twisted by its Simple Deform modifier (bpy from PyPI, set up
+    /// in a cached venv by tools/bpy-python).
+    #[arg(long, value_enum)]
+    pub peer: Option<super::groom::Peer>,
+}
+
+/// Blender's per-frame deform, measured by Blender itself in this run.
+#[derive(Debug)]
+struct BlenderDeform {
+    seconds: f64,
+    hairs: u64,
+    version: String,
+}
+
+/// Runs `blender_deform.py` on the groom grown at rest by `groom`: the
+/// skin (positions, triangles, corner UVs), every part's points and root
+/// UVs. An error says why it was not measured.
+fn measure_blender(groom: &AnimatedGroom, twist_radians: f32) -> anyhow::Result<BlenderDeform> {
+    let python = super::tools_dir().join("bpy-python");
+    anyhow::ensure!(python.exists(), "{} not found", python.display());
+    let dir = std::env::temp_dir().join(format!("pelage-blender-deform-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let result = (|| {
+        let generator = groom.generator();
+        let mesh = generator.mesh();
+        let bytes = |v: &mut dyn Iterator<Item = f32>| -> Vec<u8> {
+            v.flat_map(f32::to_le_bytes).collect()
+        };
+        std::fs::write(
+            dir.join("positions.f32"),
+            bytes(&mut mesh.positions().iter().flat_map(|p| p.to_array())),
+        )?;
+        let triangles: Vec<u8> = mesh
+            .triangles()
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
+        std::fs::write(dir.join("triangles.u32"), triangles)?;
+        let corners = (0..mesh.triangle_count())
+            .map(|t| mesh.triangle_uvs(t).unwrap_or_default())
+            .flat_map(|uvs| uvs.into_iter().flat_map(|uv| uv.to_array()))
+            .collect::<Vec<f32>>();
+        std::fs::write(dir.join("corner_uvs.f32"), bytes(&mut corners.into_iter()))?;
+        let (mut points, mut uvs, mut hairs) = (Vec::new(), Vec::new(), 0u64);
+        for k in 0..generator.parts().len() {
+            let part = generator.part(k)?;
+            points.extend(part.points().iter().flat_map(|p| p.to_array()));
+            let roots = part.root_uvs().context("a mesh with UVs gives root UVs")?;
+            uvs.extend(roots.iter().flat_map(|uv| uv.to_array()));
+            hairs += part.curve_count() as u64;
+        }
+        std::fs::write(dir.join("points.f32"), bytes(&mut points.into_iter()))?;
+        std::fs::write(dir.join("root_uvs.f32"), bytes(&mut uvs.into_iter()))?;
+        let case = serde_json::json!({
+            "hairs": hairs,
+            "points_per_hair": generator.points_per_hair(),
+            "frames": FRAMES,
+            "twist_radians": twist_radians,
+        });
+        std::fs::write(dir.join("case.json"), case.to_string())?;
+        let script = dir.join("blender_deform.py");
+        std::fs::write(&script, include_str!("blender_deform.py"))?;
+        let out = std::process::Command::new(&python)
+            .arg(&script)
+            .arg(&dir)
+            .output()?;
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        match out.status.code() {
+            Some(0) => {}
+            Some(2) => anyhow::bail!("bpy could not be set up: {}", stderr.trim()),
+            _ => anyhow::bail!("Blender's case failed: {}", stderr.trim()),
+        }
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let line = stdout
+            .lines()
+            .rev()
+            .find(|l| l.starts_with('{'))
+            .unwrap_or("");
+        let report: serde_json::Value = serde_json::from_str(line)
+            .with_context(|| format!("unexpected output from Blender's case: {stdout:?}"))?;
+        let travel = report["max_travel"].as_f64().unwrap_or(0.0);
+        anyhow::ensure!(
+            travel > 1e-3,
+            "Blender's node moved no hair (largest travel {travel}): it found no root by UV"
+        );
+        Ok(BlenderDeform {
+            seconds: report["seconds"]
+                .as_f64()
+                .context("seconds in Blender's report")?,
+            hairs: report["hairs"]
+                .as_u64()
+                .context("hairs in Blender's report")?,
+            version: report["blender"].as_str().unwrap_or("?").to_string(),
+        })
+    })();
+    let _ = std::fs::remove_dir_all(&dir);
+    result
 }
 
 /// Frames of the deformed skin.
@@ -205,6 +308,13 @@ pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
     });
     scratch?;
     let rss = peak_rss_bytes().unwrap_or(0);
+    let peer = match args.peer {
+        Some(super::groom::Peer::Blender) => {
+            eprintln!("measuring Blender's Deform Curves on Surface with bpy (tools/bpy-python)…");
+            measure_blender(&deform, 1.2).map_err(|e| format!("{e:#}"))
+        }
+        None => Err("run with --peer blender".to_string()),
+    };
     let paper_scaled = PAPER_SECONDS * hairs as f64 / 1.6e6;
 
     if args.json {
@@ -222,6 +332,15 @@ pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
             "peer_from_scratch_s_per_frame": scratch_s,
             "paper_s_per_frame": paper_scaled,
             "peak_rss_bytes": rss,
+            "blender": match &peer {
+                Ok(b) => serde_json::json!({
+                    "version": b.version,
+                    "deform_s_per_frame": b.seconds,
+                    "hairs": b.hairs,
+                    "pelage_speedup": b.seconds / deform_per_frame,
+                }),
+                Err(why) => serde_json::json!({ "not_measured": why }),
+            },
         });
         println!("{report}");
         return Ok(());
@@ -231,9 +350,9 @@ pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
         thousands(hair_count),
         times.len()
     );
-    println!("{:<58} {:>12} {:>12}", "", "s / frame", "× growing");
+    println!("{:<66} {:>12} {:>12}", "", "s / frame", "× growing");
     let row = |name: &str, s: f64| {
-        println!("{name:<58} {s:>12.3} {:>12.2}", s / grow_s);
+        println!("{name:<66} {s:>12.3} {:>12.2}", s / grow_s);
     };
     row(
         &format!("growing the groom once (median of {runs})"),
@@ -252,6 +371,24 @@ pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
         scratch_s,
     );
     row("paper: Stubble, 2 cores (Sik §4.2.2)", paper_scaled);
+    match &peer {
+        Ok(b) => {
+            row(
+                &format!(
+                    "peer: Blender {} Deform Curves on Surface ({} hairs)",
+                    b.version,
+                    thousands(b.hairs)
+                ),
+                b.seconds,
+            );
+            println!(
+                "{:66} pelage's deform {:.1}× faster",
+                "",
+                b.seconds / deform_per_frame
+            );
+        }
+        Err(why) => println!("{:<66} not measured: {why}", "peer: Blender"),
+    }
     println!(
         "\ntargets: deform ≤ 0.25× growing, regrow ≤ 1.2× growing. Peak RSS {:.0} MB.",
         rss as f64 / 1e6
