@@ -241,7 +241,7 @@ fn run_animated(
             );
             let output = FrameOutput {
                 path,
-                times: animated.times_of(frames),
+                times: animation.times_of(frames),
             };
             (range, vec![output])
         }
@@ -256,7 +256,7 @@ fn run_animated(
                 .iter()
                 .map(|&f| FrameOutput {
                     path: frames_file(&data, None, f, f),
-                    times: animated.times_of(&[f]),
+                    times: animation.times_of(&[f]),
                 })
                 .collect();
             (0..parts, outputs)
@@ -264,7 +264,7 @@ fn run_animated(
         None => {
             let output = FrameOutput {
                 path: output.to_path_buf(),
-                times: animated.times_of(frames),
+                times: animation.times_of(frames),
             };
             (0..parts, vec![output])
         }

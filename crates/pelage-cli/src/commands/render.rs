@@ -131,11 +131,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         (file, _) => (Vec::new(), None, Some(load_mesh(file.as_deref())?)),
     };
     let texture = match &args.texture {
-        Some(path) => Some(
-            image::open(path)
-                .with_context(|| format!("cannot read the texture {}", path.display()))?
-                .to_rgba8(),
-        ),
+        Some(path) => Some(load_texture(path)?),
         // The embedded Spot gets its own texture.
         None if (args.file.is_none() || args.mesh.as_deref() == Some(Path::new("spot")))
             && !args.no_texture =>
@@ -182,6 +178,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         adapter
     );
     Ok(())
+}
+
+/// The skin's colour texture (`--texture`).
+fn load_texture(path: &Path) -> anyhow::Result<image::RgbaImage> {
+    Ok(image::open(path)
+        .with_context(|| format!("cannot read the texture {}", path.display()))?
+        .to_rgba8())
 }
 
 /// `pelage render FILE --frames RANGE -o DIR`: one PNG a frame of an
@@ -254,14 +257,7 @@ fn run_frames(args: &RenderArgs, frames: &pelage::anim::FrameRange) -> anyhow::R
         background: super::FUR_BACKGROUND,
         ..Default::default()
     };
-    let texture = match &args.texture {
-        Some(path) => Some(
-            image::open(path)
-                .with_context(|| format!("cannot read the texture {}", path.display()))?
-                .to_rgba8(),
-        ),
-        None => None,
-    };
+    let texture = args.texture.as_deref().map(load_texture).transpose()?;
     let ctx = pelage_gpu::GpuContext::headless()?;
     let renderer = pelage_gpu::Renderer::new(&ctx);
     let stem = file

@@ -48,8 +48,10 @@ enum Motion {
 /// A mesh moving over frames with fixed triangles.
 pub struct AnimatedSkin {
     name: String,
-    /// The base mesh's triangles and UVs (before subdivision).
+    /// The base mesh's triangles, vertex count and UVs (before
+    /// subdivision): every frame must have that many vertices.
     triangles: Vec<[u32; 3]>,
+    vertex_count: usize,
     uvs: Option<Uvs>,
     fps: f64,
     subdivide: u32,
@@ -171,6 +173,7 @@ impl AnimatedSkin {
         Self {
             name: mesh.name().to_string(),
             triangles: mesh.triangles().to_vec(),
+            vertex_count: mesh.vertex_count(),
             uvs: mesh.uvs().cloned(),
             fps: 24.0,
             subdivide: 0,
@@ -257,7 +260,7 @@ impl AnimatedSkin {
                 }
             }
         };
-        let expected = self.vertex_count();
+        let expected = self.vertex_count;
         if positions.len() != expected {
             return Err(at_frame(format!(
                 "{} vertices, not {expected}: the skin's topology must not change over time",
@@ -268,19 +271,6 @@ impl AnimatedSkin {
             return Err(at_frame(format!("vertex {i} is not a finite position")));
         }
         Ok(positions)
-    }
-
-    fn vertex_count(&self) -> usize {
-        self.triangles
-            .iter()
-            .flatten()
-            .map(|&i| i as usize + 1)
-            .max()
-            .unwrap_or(0)
-            .max(match &self.motion {
-                Motion::Still(p) => p.len(),
-                _ => 0,
-            })
     }
 
     /// One file of an OBJ/PLY sequence, checked against the first.

@@ -106,9 +106,13 @@ impl AnimationSpec {
     /// Every time code written: each frame, and each frame plus each
     /// shutter offset, ascending.
     pub fn sample_times(&self) -> Vec<f64> {
-        let mut times: Vec<f64> = self
-            .frames
-            .frames()
+        self.times_of(self.frames.frames())
+    }
+
+    /// The time codes written for `frames` (a run's share of them): each
+    /// frame, and each frame plus each shutter offset, ascending.
+    pub fn times_of(&self, frames: &[i32]) -> Vec<f64> {
+        let mut times: Vec<f64> = frames
             .iter()
             .flat_map(|&f| {
                 std::iter::once(0.0)
@@ -424,22 +428,6 @@ impl AnimatedGroom {
         let mut out = Curves::default();
         self.part_at(p, time, &pose, generator, &mut None, &mut out)?;
         Ok(out)
-    }
-
-    /// The time codes written for `frames`: each frame, and each frame
-    /// plus each shutter offset, ascending.
-    pub fn times_of(&self, frames: &[i32]) -> Vec<f64> {
-        let mut times: Vec<f64> = frames
-            .iter()
-            .flat_map(|&f| {
-                std::iter::once(0.0)
-                    .chain(self.animation.shutter.iter().copied())
-                    .map(move |o| f64::from(f) + o)
-            })
-            .collect();
-        times.sort_by(f64::total_cmp);
-        times.dedup();
-        times
     }
 
     /// Grows `parts` over every frame and writes them to `path` (`.usdc`

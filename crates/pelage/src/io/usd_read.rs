@@ -535,7 +535,8 @@ pub(crate) fn read_usd_skin(path: &Path) -> Result<UsdSkin, CurvesReadError> {
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
     let (mut uv_values, mut uv_triangles) = (Vec::new(), Vec::new());
-    let mut uv_kinds = Vec::new();
+    // UVs count only when every prim has them.
+    let mut all_have_uvs = true;
     let mut times = Vec::new();
     let mut prims = Vec::new();
     for prim in prim_paths {
@@ -619,7 +620,7 @@ pub(crate) fn read_usd_skin(path: &Path) -> Result<UsdSkin, CurvesReadError> {
                 };
                 Some((values, interpolation, indices))
             });
-        let kind = match st {
+        let has_uvs = match st {
             Some((values, interpolation, st_indices)) => {
                 let lookup = |k: usize| -> Option<u32> {
                     let i = match &st_indices {
@@ -638,7 +639,7 @@ pub(crate) fn read_usd_skin(path: &Path) -> Result<UsdSkin, CurvesReadError> {
                             uv_triangles.push([a, b, c]);
                         }
                         uv_values.extend(values);
-                        "corner"
+                        true
                     }
                     Some("vertex") | Some("varying") if values.len() == points.len() => {
                         let start = uv_values.len() as u32;
@@ -646,27 +647,24 @@ pub(crate) fn read_usd_skin(path: &Path) -> Result<UsdSkin, CurvesReadError> {
                             uv_triangles.push(t.map(|i| i - base + start));
                         }
                         uv_values.extend(values);
-                        "vertex"
+                        true
                     }
-                    _ => "none",
+                    _ => false,
                 }
             }
-            None => "none",
+            None => false,
         };
-        uv_kinds.push(kind);
+        all_have_uvs &= has_uvs;
         positions.extend_from_slice(&points);
         triangles.extend(prim_triangles);
         prims.push(samples);
     }
     times.sort_by(f64::total_cmp);
     times.dedup();
-    let uvs = uv_kinds
-        .iter()
-        .all(|k| *k != "none")
-        .then_some(crate::mesh::Uvs::PerCorner {
-            values: uv_values,
-            indices: uv_triangles,
-        });
+    let uvs = all_have_uvs.then_some(crate::mesh::Uvs::PerCorner {
+        values: uv_values,
+        indices: uv_triangles,
+    });
     Ok(UsdSkin {
         positions,
         triangles,

@@ -52,11 +52,8 @@ struct BlenderDeform {
 /// skin (positions, triangles, corner UVs), every part's points and root
 /// UVs. An error says why it was not measured.
 fn measure_blender(groom: &AnimatedGroom, twist_radians: f32) -> anyhow::Result<BlenderDeform> {
-    let python = super::tools_dir().join("bpy-python");
-    anyhow::ensure!(python.exists(), "{} not found", python.display());
-    let dir = std::env::temp_dir().join(format!("pelage-blender-deform-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let result = (|| {
+    let script = include_str!("blender_deform.py");
+    let report = super::run_bpy_case("blender_deform.py", script, |dir| {
         let generator = groom.generator();
         let mesh = generator.mesh();
         let bytes = |v: &mut dyn Iterator<Item = f32>| -> Vec<u8> {
@@ -95,43 +92,22 @@ fn measure_blender(groom: &AnimatedGroom, twist_radians: f32) -> anyhow::Result<
             "twist_radians": twist_radians,
         });
         std::fs::write(dir.join("case.json"), case.to_string())?;
-        let script = dir.join("blender_deform.py");
-        std::fs::write(&script, include_str!("blender_deform.py"))?;
-        let out = std::process::Command::new(&python)
-            .arg(&script)
-            .arg(&dir)
-            .output()?;
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        match out.status.code() {
-            Some(0) => {}
-            Some(2) => anyhow::bail!("bpy could not be set up: {}", stderr.trim()),
-            _ => anyhow::bail!("Blender's case failed: {}", stderr.trim()),
-        }
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        let line = stdout
-            .lines()
-            .rev()
-            .find(|l| l.starts_with('{'))
-            .unwrap_or("");
-        let report: serde_json::Value = serde_json::from_str(line)
-            .with_context(|| format!("unexpected output from Blender's case: {stdout:?}"))?;
-        let travel = report["max_travel"].as_f64().unwrap_or(0.0);
-        anyhow::ensure!(
-            travel > 1e-3,
-            "Blender's node moved no hair (largest travel {travel}): it found no root by UV"
-        );
-        Ok(BlenderDeform {
-            seconds: report["seconds"]
-                .as_f64()
-                .context("seconds in Blender's report")?,
-            hairs: report["hairs"]
-                .as_u64()
-                .context("hairs in Blender's report")?,
-            version: report["blender"].as_str().unwrap_or("?").to_string(),
-        })
-    })();
-    let _ = std::fs::remove_dir_all(&dir);
-    result
+        Ok(())
+    })?;
+    let travel = report["max_travel"].as_f64().unwrap_or(0.0);
+    anyhow::ensure!(
+        travel > 1e-3,
+        "Blender's node moved no hair (largest travel {travel}): it found no root by UV"
+    );
+    Ok(BlenderDeform {
+        seconds: report["seconds"]
+            .as_f64()
+            .context("seconds in Blender's report")?,
+        hairs: report["hairs"]
+            .as_u64()
+            .context("hairs in Blender's report")?,
+        version: report["blender"].as_str().unwrap_or("?").to_string(),
+    })
 }
 
 /// Frames of the deformed skin.

@@ -56,70 +56,35 @@ struct BlenderRun {
 /// guides for `hairs` hairs, with bpy from tools/bpy-python. An error says
 /// why it was not measured.
 fn measure_blender(groom: &Groom, hairs: u64, runs: usize) -> anyhow::Result<BlenderRun> {
-    let python = super::tools_dir().join("bpy-python");
-    anyhow::ensure!(python.exists(), "{} not found", python.display());
-    let dir = std::env::temp_dir().join(format!("pelage-blender-peer-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let result = run_blender_case(&python, &dir, groom, hairs, runs);
-    let _ = std::fs::remove_dir_all(&dir);
-    result
-}
-
-/// Writes Blender's case (mesh, guides, counts, script) into `dir` and runs
-/// it with `python`; the report it prints.
-fn run_blender_case(
-    python: &std::path::Path,
-    dir: &std::path::Path,
-    groom: &Groom,
-    hairs: u64,
-    runs: usize,
-) -> anyhow::Result<BlenderRun> {
-    let mesh = groom.mesh();
-    let floats = |v: &[glam::Vec3]| -> Vec<u8> {
-        v.iter()
-            .flat_map(|p| p.to_array())
-            .flat_map(f32::to_le_bytes)
-            .collect()
-    };
-    std::fs::write(dir.join("positions.f32"), floats(mesh.positions()))?;
-    let triangles: Vec<u8> = mesh
-        .triangles()
-        .iter()
-        .flatten()
-        .flat_map(|i| i.to_le_bytes())
-        .collect();
-    std::fs::write(dir.join("triangles.u32"), triangles)?;
-    let guides = groom.guides();
-    std::fs::write(dir.join("guides.f32"), floats(guides.curves().points()))?;
-    let case = serde_json::json!({
-        "hairs": hairs,
-        "area": mesh.surface_area(),
-        "guides": guides.len(),
-        "points_per_guide": guides.points_per_guide(),
-        "neighbours": 4,
-        "runs": runs,
-    });
-    std::fs::write(dir.join("case.json"), case.to_string())?;
-    let script = dir.join("blender_hair.py");
-    std::fs::write(&script, include_str!("blender_hair.py"))?;
-    let out = std::process::Command::new(python)
-        .arg(&script)
-        .arg(dir)
-        .output()?;
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    match out.status.code() {
-        Some(0) => {}
-        Some(2) => anyhow::bail!("bpy could not be set up: {}", stderr.trim()),
-        _ => anyhow::bail!("Blender's case failed: {}", stderr.trim()),
-    }
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout
-        .lines()
-        .rev()
-        .find(|l| l.starts_with('{'))
-        .unwrap_or("");
-    let report: serde_json::Value = serde_json::from_str(line)
-        .with_context(|| format!("unexpected output from Blender's case: {stdout:?}"))?;
+    let report = super::run_bpy_case("blender_hair.py", include_str!("blender_hair.py"), |dir| {
+        let mesh = groom.mesh();
+        let floats = |v: &[glam::Vec3]| -> Vec<u8> {
+            v.iter()
+                .flat_map(|p| p.to_array())
+                .flat_map(f32::to_le_bytes)
+                .collect()
+        };
+        std::fs::write(dir.join("positions.f32"), floats(mesh.positions()))?;
+        let triangles: Vec<u8> = mesh
+            .triangles()
+            .iter()
+            .flatten()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
+        std::fs::write(dir.join("triangles.u32"), triangles)?;
+        let guides = groom.guides();
+        std::fs::write(dir.join("guides.f32"), floats(guides.curves().points()))?;
+        let case = serde_json::json!({
+            "hairs": hairs,
+            "area": mesh.surface_area(),
+            "guides": guides.len(),
+            "points_per_guide": guides.points_per_guide(),
+            "neighbours": 4,
+            "runs": runs,
+        });
+        std::fs::write(dir.join("case.json"), case.to_string())?;
+        Ok(())
+    })?;
     let number = |key: &str| report[key].as_f64().context("a number in Blender's report");
     Ok(BlenderRun {
         seconds: number("seconds")?,

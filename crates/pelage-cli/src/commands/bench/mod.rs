@@ -71,6 +71,49 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     }
 }
 
+/// Runs one of Blender's cases, `script` (its text; `name` is its file
+/// name), with Blender as a Python module (tools/bpy-python, which sets bpy
+/// up in a cached venv) on a temporary case folder that `write_case` fills.
+/// Returns the JSON object the script prints last; an error says why the
+/// case was not measured. The folder is removed either way.
+pub fn run_bpy_case(
+    name: &str,
+    script: &str,
+    write_case: impl FnOnce(&std::path::Path) -> anyhow::Result<()>,
+) -> anyhow::Result<serde_json::Value> {
+    use anyhow::Context;
+    let python = tools_dir().join("bpy-python");
+    anyhow::ensure!(python.exists(), "{} not found", python.display());
+    let stem = name.trim_end_matches(".py");
+    let dir = std::env::temp_dir().join(format!("pelage-{stem}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let result = (|| {
+        write_case(&dir)?;
+        let path = dir.join(name);
+        std::fs::write(&path, script)?;
+        let out = std::process::Command::new(&python)
+            .arg(&path)
+            .arg(&dir)
+            .output()?;
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        match out.status.code() {
+            Some(0) => {}
+            Some(2) => anyhow::bail!("bpy could not be set up: {}", stderr.trim()),
+            _ => anyhow::bail!("Blender's case failed: {}", stderr.trim()),
+        }
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let line = stdout
+            .lines()
+            .rev()
+            .find(|l| l.starts_with('{'))
+            .unwrap_or("");
+        serde_json::from_str(line)
+            .with_context(|| format!("unexpected output from Blender's case: {stdout:?}"))
+    })();
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}
+
 /// Median wall time in seconds of `runs` calls of `f` (after one warm-up
 /// call when `warm_up`), and the last result.
 pub fn median_seconds<T>(runs: usize, warm_up: bool, mut f: impl FnMut() -> T) -> (f64, T) {
