@@ -75,11 +75,13 @@ fn one_f32() -> f32 {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GroomFile {
-    /// The surface.
-    pub mesh: MeshSection,
+    /// The surface (absent only when a program gives the mesh as a value,
+    /// [`super::GroomInputs`]).
+    pub mesh: Option<MeshSection>,
     /// Where hairs grow.
     pub roots: RootsSection,
     /// The guide curves.
+    #[serde(default)]
     pub guides: GuidesSection,
     /// How hairs take their shape from the guides.
     #[serde(default)]
@@ -196,6 +198,19 @@ pub struct GuidesSection {
     /// Points every guide is resampled to.
     #[serde(default = "default_guide_points")]
     pub points: usize,
+}
+
+impl Default for GuidesSection {
+    /// No guides named: a program gives them as a value
+    /// ([`super::GroomInputs`]).
+    fn default() -> Self {
+        Self {
+            file: None,
+            tolerance: default_tolerance(),
+            generate: None,
+            points: default_guide_points(),
+        }
+    }
 }
 
 fn default_tolerance() -> f32 {

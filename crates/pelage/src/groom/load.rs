@@ -59,6 +59,19 @@ impl std::fmt::Debug for Groom {
     }
 }
 
+/// Values a program gives a groom in place of files its settings would
+/// name: the Python binding builds grooms from arrays this way. The
+/// settings (roots, operators, finish) still come as groom-file text, so
+/// they are checked, and their errors worded, exactly as a file's.
+#[derive(Debug, Clone, Default)]
+pub struct GroomInputs {
+    /// The surface, instead of `[mesh] path`.
+    pub mesh: Option<Arc<Mesh>>,
+    /// Guide curves to bind to the surface (with `[guides] points` and
+    /// `tolerance`), instead of `[guides] file` or `[guides.generate]`.
+    pub guides: Option<crate::Curves>,
+}
+
 impl Groom {
     /// Reads, parses and loads the groom file at `path`.
     pub fn load(path: &Path) -> Result<Self, GroomError> {
@@ -93,23 +106,70 @@ impl Groom {
         source: SettingsSource,
         frames: Option<FrameRange>,
     ) -> Result<Self, GroomError> {
+        Self::from_source_with_inputs(source, frames, GroomInputs::default())
+    }
+
+    /// [`Self::from_source_with_frames`], with the mesh and guides given
+    /// as values where `inputs` has them. A value and a setting for the
+    /// same thing (`[mesh] path` and `inputs.mesh`) is an error, as is an
+    /// animated groom on a mesh value (a skin comes from a file).
+    pub fn from_source_with_inputs(
+        source: SettingsSource,
+        frames: Option<FrameRange>,
+        inputs: GroomInputs,
+    ) -> Result<Self, GroomError> {
         let file = source.parse()?;
         let animation = animation_spec(&source, &file, frames)?;
-        let (mesh, skin) = match &animation {
-            None => (load_mesh_section(&source, &file.mesh)?, None),
-            Some((spec, fps, clip)) => {
-                let skin = load_skin(&source, &file.mesh, *fps, clip.clone())?;
+        let invalid = |key: &str, message: &str| {
+            GroomError::new(
+                source.path.clone(),
+                None,
+                Some(key.to_string()),
+                GroomErrorKind::Invalid(message.to_string()),
+            )
+        };
+        let (mesh, skin) = match (&file.mesh, inputs.mesh, &animation) {
+            (Some(_), Some(_), _) => {
+                return Err(invalid(
+                    "mesh",
+                    "the mesh is given twice, as a value and as [mesh] path; give one",
+                ));
+            }
+            (None, None, _) => {
+                return Err(invalid(
+                    "mesh",
+                    "no mesh: add a [mesh] table with `path = \"model.obj\"`",
+                ));
+            }
+            (None, Some(_), Some(_)) => {
+                return Err(invalid(
+                    "animation",
+                    "an animated groom reads its skin from [mesh] path (glTF, USD or an OBJ sequence); a mesh given as a value does not move",
+                ));
+            }
+            (None, Some(mesh), None) => (mesh, None),
+            (Some(section), None, None) => (Arc::new(load_mesh_section(&source, section)?), None),
+            (Some(section), None, Some((spec, fps, clip))) => {
+                let skin = load_skin(&source, section, *fps, clip.clone())?;
                 let mesh = skin
                     .mesh_at(spec.rest_frame)
-                    .map_err(|e| source.error_at(file.mesh.path.span(), GroomErrorKind::Mesh(e)))?;
-                (mesh, Some(Arc::new(skin)))
+                    .map_err(|e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e)))?;
+                (Arc::new(mesh), Some(Arc::new(skin)))
             }
         };
-        let mesh = Arc::new(mesh);
         let rest_time = animation
             .as_ref()
             .map(|(spec, fps, _)| (spec.rest_frame, *fps));
-        let (guides, bind_report) = load_guides(&source, &file, &mesh, rest_time)?;
+        let (guides, bind_report) = match inputs.guides {
+            Some(_) if file.guides.file.is_some() || file.guides.generate.is_some() => {
+                return Err(invalid(
+                    "guides",
+                    "the guides are given twice, as curves and in [guides]; give one",
+                ));
+            }
+            Some(curves) => bind_guides(&source, &file, &mesh, &curves, 0..0)?,
+            None => load_guides(&source, &file, &mesh, rest_time)?,
+        };
         let animation = match (animation, skin) {
             (Some((spec, fps, _)), Some(skin)) => {
                 let guide_file = file
@@ -544,6 +604,32 @@ fn load_skin(
     }
 }
 
+/// Binds guide curves to the mesh with `[guides] points` and `tolerance`;
+/// none within the tolerance is an error at `span` (the file's path).
+fn bind_guides(
+    source: &SettingsSource,
+    file: &GroomFile,
+    mesh: &Mesh,
+    curves: &crate::Curves,
+    span: std::ops::Range<usize>,
+) -> Result<(Guides, Option<BindReport>), GroomError> {
+    let section = &file.guides;
+    let (guides, report) = Guides::bind(mesh, curves, section.points, section.tolerance);
+    if guides.is_empty() {
+        let message = "no guide is within the tolerance of the mesh; check that the guides belong to this mesh, or raise [guides] tolerance";
+        return Err(match span {
+            std::ops::Range { start: 0, end: 0 } => GroomError::new(
+                source.path.clone(),
+                None,
+                Some("guides".into()),
+                GroomErrorKind::Invalid(message.into()),
+            ),
+            s => source.error_at(s, GroomErrorKind::Invalid(message.into())),
+        });
+    }
+    Ok((guides, Some(report)))
+}
+
 fn load_guides(
     source: &SettingsSource,
     file: &GroomFile,
@@ -551,8 +637,6 @@ fn load_guides(
     rest_time: Option<(f64, f64)>,
 ) -> Result<(Guides, Option<BindReport>), GroomError> {
     let section = &file.guides;
-    let invalid =
-        |span, message: &str| source.error_at(span, GroomErrorKind::Invalid(message.to_string()));
     match (&section.file, &section.generate) {
         (Some(path), None) => {
             let full = source.folder().join(path.get_ref());
@@ -562,14 +646,7 @@ fn load_guides(
                 None => crate::io::read_curves(&full),
             }
             .map_err(|e| source.error_at(path.span(), GroomErrorKind::Guides(e)))?;
-            let (guides, report) = Guides::bind(mesh, &curves, section.points, section.tolerance);
-            if guides.is_empty() {
-                return Err(invalid(
-                    path.span(),
-                    "no guide is within the tolerance of the mesh; check that the guides belong to this mesh, or raise [guides] tolerance",
-                ));
-            }
-            Ok((guides, Some(report)))
+            bind_guides(source, file, mesh, &curves, path.span())
         }
         (None, Some(generate)) => {
             let map = |v: &MapValue| map_on_mesh(source, mesh, v);

@@ -45,7 +45,7 @@ pub use clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_cl
 pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
 pub use file::{GroomFile, InterpolationKind};
 pub use generator::{Generator, GroomSummary, HAIRS_PER_PART};
-pub use load::Groom;
+pub use load::{Groom, GroomInputs};
 pub use output::{GroomWriteError, part_file, part_name, part_slice, write_assembly};
 pub use parts::{Part, PartLayout};
 pub use ramp::Ramp;

@@ -1,0 +1,318 @@
+//! `pelage.Curves`: hair curves as structure of arrays (points, offsets,
+//! widths and optional attributes), with read-only numpy views, and
+//! `read_curves` / `write_curves` for every format pelage reads or writes.
+
+use crate::convert::{column, flat2, flat3, rows, vec2s, vec3s, view1, view2};
+use crate::mesh::{PyMesh, offsets_column};
+use crate::to_py_err;
+use numpy::{PyArray1, PyArray2};
+use pelage::Curves;
+use pelage::io::{CurveBasis, CurvesExport, UpAxis, UsdOptions};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+/// Hair curves: curve `i` is `points[offsets[i]:offsets[i + 1]]`
+/// (Blender's `CurvesGeometry`, USD's `BasisCurves`). The arrays are
+/// read-only numpy views of pelage's own memory; `.copy()` one to edit it,
+/// then build new curves with `Curves.from_arrays`.
+#[pyclass(name = "Curves", module = "pelage", frozen)]
+pub struct PyCurves {
+    pub(crate) inner: Curves,
+}
+
+impl PyCurves {
+    pub(crate) fn new(inner: Curves) -> Self {
+        Self { inner }
+    }
+}
+
+#[pymethods]
+impl PyCurves {
+    /// Builds curves from arrays: `points` (n, 3), `offsets` (curves + 1,)
+    /// starting at 0 and ending at n, `widths` (n,) (default 0.001), and
+    /// optionally per point `colors` (n, 3), `opacities` (n,), `normals`
+    /// (n, 3), and per curve `root_uvs` (curves, 2) and `ids` (curves,).
+    #[staticmethod]
+    #[pyo3(signature = (points, offsets, widths = None, colors = None, opacities = None, normals = None, root_uvs = None, ids = None))]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "one keyword argument an attribute"
+    )]
+    fn from_arrays(
+        points: &Bound<'_, PyAny>,
+        offsets: &Bound<'_, PyAny>,
+        widths: Option<&Bound<'_, PyAny>>,
+        colors: Option<&Bound<'_, PyAny>>,
+        opacities: Option<&Bound<'_, PyAny>>,
+        normals: Option<&Bound<'_, PyAny>>,
+        root_uvs: Option<&Bound<'_, PyAny>>,
+        ids: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let points = vec3s(rows::<f32, 3>(points, "points")?);
+        let offsets = offsets_column(offsets)?;
+        let widths = match widths {
+            Some(w) => column::<f32>(w, "widths")?,
+            None => vec![0.001; points.len()],
+        };
+        let mut curves = Curves::new(points, widths, offsets).map_err(to_py_err)?;
+        if let Some(c) = colors {
+            curves = curves
+                .with_colors(vec3s(rows::<f32, 3>(c, "colors")?))
+                .map_err(to_py_err)?;
+        }
+        if let Some(o) = opacities {
+            curves = curves
+                .with_opacities(column::<f32>(o, "opacities")?)
+                .map_err(to_py_err)?;
+        }
+        if let Some(n) = normals {
+            curves = curves
+                .with_normals(vec3s(rows::<f32, 3>(n, "normals")?))
+                .map_err(to_py_err)?;
+        }
+        if let Some(u) = root_uvs {
+            curves = curves
+                .with_root_uvs(vec2s(rows::<f32, 2>(u, "root_uvs")?))
+                .map_err(to_py_err)?;
+        }
+        if let Some(i) = ids {
+            curves = curves
+                .with_ids(column::<u64>(i, "ids")?)
+                .map_err(to_py_err)?;
+        }
+        Ok(Self::new(curves))
+    }
+
+    /// Points, (n, 3) float32.
+    #[getter]
+    fn points<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        view2(slf.clone().into_any(), flat3(slf.get().inner.points()), 3)
+    }
+
+    /// Offsets, (curves + 1,) uint32: curve i is points[offsets[i]:offsets[i+1]].
+    #[getter]
+    fn offsets<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<u32>>> {
+        view1(slf.clone().into_any(), slf.get().inner.offsets())
+    }
+
+    /// Widths (diameters), (n,) float32.
+    #[getter]
+    fn widths<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        view1(slf.clone().into_any(), slf.get().inner.widths())
+    }
+
+    /// Colours, (n, 3) float32 linear RGB, or `None`.
+    #[getter]
+    fn colors<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray2<f32>>>> {
+        slf.get()
+            .inner
+            .colors()
+            .map(|c| view2(slf.clone().into_any(), flat3(c), 3))
+            .transpose()
+    }
+
+    /// Opacities, (n,) float32, or `None`.
+    #[getter]
+    fn opacities<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray1<f32>>>> {
+        slf.get()
+            .inner
+            .opacities()
+            .map(|o| view1(slf.clone().into_any(), o))
+            .transpose()
+    }
+
+    /// Ribbon normals (rotation-minimizing), (n, 3) float32, or `None`.
+    #[getter]
+    fn normals<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray2<f32>>>> {
+        slf.get()
+            .inner
+            .normals()
+            .map(|n| view2(slf.clone().into_any(), flat3(n), 3))
+            .transpose()
+    }
+
+    /// The surface UV under each root, (curves, 2) float32, or `None`.
+    #[getter]
+    fn root_uvs<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray2<f32>>>> {
+        slf.get()
+            .inner
+            .root_uvs()
+            .map(|u| view2(slf.clone().into_any(), flat2(u), 2))
+            .transpose()
+    }
+
+    /// Stable hair ids, (curves,) uint64, or `None`.
+    #[getter]
+    fn ids<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray1<u64>>>> {
+        slf.get()
+            .inner
+            .ids()
+            .map(|i| view1(slf.clone().into_any(), i))
+            .transpose()
+    }
+
+    /// The mesh triangle under each root, (curves,) uint32, or `None`
+    /// when the curves carry no roots (read from a file).
+    #[getter]
+    fn root_triangles<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<u32>>> {
+        let roots = self.inner.roots()?;
+        Some(PyArray1::from_vec(
+            py,
+            roots.iter().map(|r| r.tri).collect(),
+        ))
+    }
+
+    /// Barycentric coordinates (u, v) of each root in its triangle,
+    /// (curves, 2) float32, or `None`.
+    #[getter]
+    fn root_barycentrics<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Option<Bound<'py, PyArray2<f32>>>> {
+        let Some(roots) = self.inner.roots() else {
+            return Ok(None);
+        };
+        let bary = roots.iter().map(|r| glam::Vec2::from(r.bary)).collect();
+        crate::convert::owned2(py, bary).map(Some)
+    }
+
+    /// Number of curves.
+    #[getter]
+    fn curve_count(&self) -> usize {
+        self.inner.curve_count()
+    }
+
+    /// Number of points (all curves).
+    #[getter]
+    fn point_count(&self) -> usize {
+        self.inner.points().len()
+    }
+
+    /// Axis-aligned bounds `((x, y, z), (x, y, z))`, or `None` when empty.
+    #[getter]
+    fn bounds(&self) -> Option<([f32; 3], [f32; 3])> {
+        self.inner
+            .bounds()
+            .map(|(lo, hi)| (lo.to_array(), hi.to_array()))
+    }
+
+    /// Writes the curves; see `pelage.write_curves`.
+    #[pyo3(signature = (path, *, basis = "catmull-rom", up_axis = "y", mesh = None))]
+    fn write(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        basis: &str,
+        up_axis: &str,
+        mesh: Option<&PyMesh>,
+    ) -> PyResult<()> {
+        write_one(py, &self.inner, path, basis, up_axis, mesh)
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.curve_count()
+    }
+
+    fn __repr__(&self) -> String {
+        let mut attributes = vec!["widths"];
+        let c = &self.inner;
+        for (has, name) in [
+            (c.colors().is_some(), "colors"),
+            (c.opacities().is_some(), "opacities"),
+            (c.normals().is_some(), "normals"),
+            (c.root_uvs().is_some(), "root_uvs"),
+            (c.ids().is_some(), "ids"),
+        ] {
+            if has {
+                attributes.push(name);
+            }
+        }
+        format!(
+            "<pelage.Curves: {} curves, {} points; {}>",
+            c.curve_count(),
+            c.points().len(),
+            attributes.join(", ")
+        )
+    }
+}
+
+/// Reads a curves file: USD (.usda, .usdc, .usd: every BasisCurves prim,
+/// joined), Alembic (.abc), Cem Yuksel's .hair, or PLY curves. `time`
+/// picks a time sample (USD time code, Alembic seconds) of an animated
+/// file; the default is the file's default or first sample.
+#[pyfunction]
+#[pyo3(signature = (path, *, time = None))]
+pub fn read_curves(py: Python<'_>, path: PathBuf, time: Option<f64>) -> PyResult<PyCurves> {
+    let curves = py.detach(|| {
+        let is = |ext: &[&str]| {
+            path.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| ext.contains(&e.to_ascii_lowercase().as_str()))
+        };
+        match time {
+            Some(t) if is(&["usda", "usdc", "usd"]) => {
+                pelage::io::read_usd_curves_at(&path, Some(t))
+            }
+            Some(t) if is(&["abc"]) => pelage::io::read_abc_curves_at(&path, Some(t)),
+            _ => pelage::io::read_curves(&path),
+        }
+    });
+    curves.map(PyCurves::new).map_err(to_py_err)
+}
+
+/// Writes curves to `path`, in the format its extension names: .usdc
+/// (or .usd), .usda, .abc, .hair, .ply, .rib, .pbrt. The file appears
+/// whole or not at all (written to a temporary name, then renamed).
+/// `basis`: "catmull-rom" or "linear"; `up_axis`: "y" or "z" (USD);
+/// `mesh`: also write the skin (USD).
+#[pyfunction]
+#[pyo3(signature = (curves, path, *, basis = "catmull-rom", up_axis = "y", mesh = None))]
+pub fn write_curves(
+    py: Python<'_>,
+    curves: &PyCurves,
+    path: PathBuf,
+    basis: &str,
+    up_axis: &str,
+    mesh: Option<&PyMesh>,
+) -> PyResult<()> {
+    write_one(py, &curves.inner, path, basis, up_axis, mesh)
+}
+
+fn write_one(
+    py: Python<'_>,
+    curves: &Curves,
+    path: PathBuf,
+    basis: &str,
+    up_axis: &str,
+    mesh: Option<&PyMesh>,
+) -> PyResult<()> {
+    let export = CurvesExport {
+        usd: UsdOptions {
+            basis: parse_basis(basis)?,
+            up_axis: match up_axis.to_ascii_lowercase().as_str() {
+                "y" => UpAxis::Y,
+                "z" => UpAxis::Z,
+                other => {
+                    return Err(PyValueError::new_err(format!(
+                        "up_axis = {other:?}: use \"y\" or \"z\""
+                    )));
+                }
+            },
+            ..UsdOptions::default()
+        },
+        mesh: mesh.map(|m| m.inner.as_ref()),
+    };
+    py.detach(|| pelage::io::write_curves(&path, [("curves".to_string(), curves)], &export))
+        .map_err(to_py_err)
+}
+
+pub(crate) fn parse_basis(basis: &str) -> PyResult<CurveBasis> {
+    match basis {
+        "catmull-rom" | "catmullRom" => Ok(CurveBasis::CatmullRom),
+        "linear" => Ok(CurveBasis::Linear),
+        other => Err(PyValueError::new_err(format!(
+            "basis = {other:?}: use \"catmull-rom\" or \"linear\""
+        ))),
+    }
+}

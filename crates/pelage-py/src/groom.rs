@@ -1,0 +1,551 @@
+//! `pelage.Groom`: a groom file, or a groom built from Python values, and
+//! its generation (Sik §4) part by part.
+//!
+//! A groom built in Python becomes the groom file it would have been: the
+//! dicts are written as TOML and read by the library's own groom-file
+//! front end, so every setting is checked by the same code and an error
+//! names the same key (`ops[1].clump.count`). `Groom.settings` shows that
+//! text; save it and `pelage groom` grows the same hairs.
+
+use crate::curves::PyCurves;
+use crate::mesh::PyMesh;
+use crate::to_py_err;
+use pelage::groom::{
+    Generator, Groom, GroomError, GroomInputs, GroomWriteError, part_file, part_slice,
+};
+use pelage::io::{CurvesExport, UsdOptions};
+use pelage::settings::SettingsSource;
+use pyo3::exceptions::{PyIndexError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyTuple};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+
+/// What errors call a groom built from Python values.
+const PYTHON_GROOM: &str = "<python groom>";
+
+/// A groom: a surface, guides, roots, operators and a finish, ready to
+/// grow hair curves part by part.
+///
+/// Load a groom file with `Groom.load("fur.toml")`, or build one from
+/// values::
+///
+///     groom = pelage.Groom(
+///         mesh=pelage.Mesh.load("model.obj"),
+///         guides={"generate": {"count": 400, "length": 0.05}},
+///         roots={"count": 200_000, "seed": 3},
+///         ops=[pelage.ops.clump(count=2_000, rate=0.6)],
+///     )
+///
+/// The tables are those of the groom file format (docs/groom-format.md):
+/// `roots`, `guides`, `interpolation`, `ops`, `finish`, `output`,
+/// `animation`. `mesh` is a `Mesh` or a path; `guides` is a table, a
+/// path, or `Curves` to bind to the mesh (`{"curves": c, "points": 8}`
+/// binds them with the table's settings).
+#[pyclass(name = "Groom", module = "pelage", frozen)]
+pub struct PyGroom {
+    groom: Groom,
+    /// Whether the settings are Python values (errors then name keys, not
+    /// lines of a text the user never wrote).
+    from_values: bool,
+    /// The generator for the groom's own seed, built on first use.
+    generator: OnceLock<Arc<Generator>>,
+}
+
+impl PyGroom {
+    /// Wraps a loaded groom and prepares its generator, so that a setting
+    /// the generator refuses (`clump.count = 0`) is an error here, where
+    /// the groom is made, not at its first `grow()`.
+    fn wrap(py: Python<'_>, groom: Groom, from_values: bool) -> PyResult<Self> {
+        let this = Self {
+            groom,
+            from_values,
+            generator: OnceLock::new(),
+        };
+        this.generator(py, None)?;
+        Ok(this)
+    }
+
+    fn error(&self, error: GroomError) -> PyErr {
+        groom_error(error, self.from_values)
+    }
+
+    /// The generator for `seed` (the groom's own when `None`, cached).
+    fn generator(&self, py: Python<'_>, seed: Option<u64>) -> PyResult<Arc<Generator>> {
+        if seed.is_some() {
+            return py
+                .detach(|| self.groom.generator(seed))
+                .map(Arc::new)
+                .map_err(|e| self.error(e));
+        }
+        if let Some(g) = self.generator.get() {
+            return Ok(g.clone());
+        }
+        let generator = py
+            .detach(|| self.groom.generator(None))
+            .map_err(|e| self.error(e))?;
+        Ok(self.generator.get_or_init(|| Arc::new(generator)).clone())
+    }
+}
+
+#[pymethods]
+impl PyGroom {
+    #[new]
+    #[pyo3(signature = (*, mesh, guides, roots, ops = None, interpolation = None, finish = None, output = None, animation = None, base_dir = None))]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "one keyword argument a groom-file table"
+    )]
+    fn new(
+        py: Python<'_>,
+        mesh: &Bound<'_, PyAny>,
+        guides: &Bound<'_, PyAny>,
+        roots: &Bound<'_, PyAny>,
+        ops: Option<&Bound<'_, PyAny>>,
+        interpolation: Option<&Bound<'_, PyAny>>,
+        finish: Option<&Bound<'_, PyAny>>,
+        output: Option<&Bound<'_, PyAny>>,
+        animation: Option<&Bound<'_, PyAny>>,
+        base_dir: Option<PathBuf>,
+    ) -> PyResult<Self> {
+        let mut table = toml::Table::new();
+        let mut inputs = GroomInputs::default();
+        // The surface: a Mesh value, or what `[mesh]` takes.
+        if let Ok(m) = mesh.cast::<PyMesh>() {
+            inputs.mesh = Some(m.get().inner.clone());
+        } else if let Ok(path) = mesh.extract::<PathBuf>() {
+            let mut section = toml::Table::new();
+            section.insert("path".into(), path_value(&path, "mesh")?);
+            table.insert("mesh".into(), section.into());
+        } else {
+            table.insert("mesh".into(), to_toml(mesh, "mesh")?);
+        }
+        // The guides: curves to bind, a file, or the `[guides]` table.
+        if let Ok(c) = guides.cast::<PyCurves>() {
+            inputs.guides = Some(c.get().inner.clone());
+        } else if let Ok(path) = guides.extract::<PathBuf>() {
+            let mut section = toml::Table::new();
+            section.insert("file".into(), path_value(&path, "guides")?);
+            table.insert("guides".into(), section.into());
+        } else if let Ok(section) = guides.cast::<PyDict>() {
+            // `{"curves": Curves, "points": 8, "tolerance": 1e-3}`: curves
+            // with the `[guides]` settings that bind them.
+            let section = section.copy()?;
+            if let Some(curves) = section.get_item("curves")? {
+                let curves = curves
+                    .cast::<PyCurves>()
+                    .map_err(|_| PyTypeError::new_err("guides.curves: expected pelage.Curves"))?;
+                inputs.guides = Some(curves.get().inner.clone());
+                section.del_item("curves")?;
+            }
+            table.insert("guides".into(), to_toml(section.as_any(), "guides")?);
+        } else {
+            table.insert("guides".into(), to_toml(guides, "guides")?);
+        }
+        // `roots=200_000` is short for `roots={"count": 200_000}`.
+        let roots = match roots.extract::<u64>() {
+            Ok(count) if !roots.is_instance_of::<pyo3::types::PyBool>() => {
+                let mut section = toml::Table::new();
+                section.insert("count".into(), to_toml_int(count, "roots")?);
+                section.into()
+            }
+            _ => to_toml(roots, "roots")?,
+        };
+        table.insert("roots".into(), roots);
+        for (key, value) in [
+            ("interpolation", interpolation),
+            ("ops", ops),
+            ("finish", finish),
+            ("output", output),
+            ("animation", animation),
+        ] {
+            if let Some(value) = value.filter(|v| !v.is_none()) {
+                table.insert(key.into(), to_toml(value, key)?);
+            }
+        }
+        let text = toml::to_string(&table)
+            .map_err(|e| PyValueError::new_err(format!("the groom's settings: {e}")))?;
+        let path = match base_dir {
+            Some(dir) => dir.join(PYTHON_GROOM),
+            None => PathBuf::from(PYTHON_GROOM),
+        };
+        let source = SettingsSource { path, text };
+        let groom = py
+            .detach(|| Groom::from_source_with_inputs(source, None, inputs))
+            .map_err(|e| groom_error(e, true))?;
+        Self::wrap(py, groom, true)
+    }
+
+    /// Loads a groom file (docs/groom-format.md) with its mesh and guides.
+    /// `frames` ("1-24", "1-48x2") makes it animated, or replaces the
+    /// frames of its `[animation]`.
+    #[staticmethod]
+    #[pyo3(signature = (path, *, frames = None))]
+    fn load(py: Python<'_>, path: PathBuf, frames: Option<&str>) -> PyResult<Self> {
+        let frames = frames
+            .map(pelage::anim::FrameRange::parse)
+            .transpose()
+            .map_err(|e| PyValueError::new_err(format!("frames: {e}")))?;
+        let groom = py
+            .detach(|| Groom::load_with_frames(&path, frames))
+            .map_err(|e| groom_error(e, false))?;
+        Self::wrap(py, groom, false)
+    }
+
+    /// A groom from groom-file text; `path` names it in errors and is the
+    /// folder relative paths start from.
+    #[staticmethod]
+    #[pyo3(signature = (text, *, path = PathBuf::from("<groom>")))]
+    fn from_text(py: Python<'_>, text: String, path: PathBuf) -> PyResult<Self> {
+        let groom = py
+            .detach(|| Groom::from_text(path, text))
+            .map_err(|e| groom_error(e, false))?;
+        Self::wrap(py, groom, false)
+    }
+
+    /// The groom's settings as groom-file text (for a groom built from
+    /// values: the file it amounts to).
+    #[getter]
+    fn settings(&self) -> String {
+        self.groom.source().text.clone()
+    }
+
+    /// The surface.
+    #[getter]
+    fn mesh(&self) -> PyMesh {
+        PyMesh {
+            inner: Arc::new(self.groom.mesh().clone()),
+        }
+    }
+
+    /// The guides, bound to the surface and resampled, as curves.
+    #[getter]
+    fn guides(&self) -> PyCurves {
+        PyCurves::new(self.groom.guides().curves().clone())
+    }
+
+    /// Number of parts (spatially compact groups of roots; each grows
+    /// alone, in any order, in any process).
+    #[getter]
+    fn part_count(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(self.generator(py, None)?.parts().len())
+    }
+
+    /// Hairs in each part (before `strands` multiplies them).
+    #[getter]
+    fn part_hair_counts(&self, py: Python<'_>) -> PyResult<Vec<u64>> {
+        Ok(self
+            .generator(py, None)?
+            .parts()
+            .iter()
+            .map(|p| p.hair_count)
+            .collect())
+    }
+
+    /// Where `write()` writes by default: `[output] path`, or the groom
+    /// file's name with .usdc.
+    #[getter]
+    fn output_path(&self) -> PathBuf {
+        self.groom.output_path()
+    }
+
+    /// The frames of an animated groom ("1-24"), or `None`.
+    #[getter]
+    fn frames(&self) -> Option<Vec<f64>> {
+        let animation = self.groom.animation()?;
+        Some(
+            animation
+                .frames
+                .frames()
+                .iter()
+                .map(|&f| f64::from(f))
+                .collect(),
+        )
+    }
+
+    /// Grows hair curves: one part (`part=k`), or all of them joined
+    /// (`part=None`). `seed` replaces the groom's. `progress(done, total)`
+    /// is called after each part. The interpreter is released while
+    /// hairs grow.
+    #[pyo3(signature = (part = None, *, seed = None, progress = None))]
+    fn grow(
+        &self,
+        py: Python<'_>,
+        part: Option<usize>,
+        seed: Option<u64>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<PyCurves> {
+        let generator = self.generator(py, seed)?;
+        let parts = generator.parts().len();
+        if let Some(p) = part {
+            if p >= parts {
+                return Err(PyIndexError::new_err(format!(
+                    "part {p}: the groom has {parts} parts (0 to {})",
+                    parts - 1
+                )));
+            }
+            let curves = py.detach(|| generator.part(p)).map_err(|e| self.error(e))?;
+            return Ok(PyCurves::new(curves));
+        }
+        let mut grown = Vec::with_capacity(parts);
+        for p in 0..parts {
+            grown.push(py.detach(|| generator.part(p)).map_err(|e| self.error(e))?);
+            if let Some(progress) = &progress {
+                progress.call1(py, (p + 1, parts))?;
+            }
+        }
+        let joined = py
+            .detach(|| pelage::io::join(grown.iter()))
+            .map_err(to_py_err)?;
+        Ok(PyCurves::new(joined))
+    }
+
+    /// Iterates over the parts, growing each as it is asked for, so memory
+    /// holds one part at a time: `for curves in groom.parts(): ...`.
+    #[pyo3(signature = (*, seed = None))]
+    fn parts(&self, py: Python<'_>, seed: Option<u64>) -> PyResult<PartIter> {
+        Ok(PartIter {
+            generator: self.generator(py, seed)?,
+            from_values: self.from_values,
+            next: std::sync::atomic::AtomicUsize::new(0),
+        })
+    }
+
+    /// Grows and writes the groom to `path` (default `output_path`),
+    /// format by extension (.usdc, .usda, .abc, .hair, .ply, .rib, .pbrt),
+    /// atomically. USD and Alembic stream: memory holds about two parts.
+    /// `part=(k, n)` writes run k of n of a farm (docs/farm.md) to the
+    /// part file beside `path`. An animated groom writes every frame.
+    /// `progress(done, total)` is called as parts (and frames) are
+    /// written. Returns `{"path", "hairs", "points"}`.
+    #[pyo3(signature = (path = None, *, part = None, seed = None, progress = None))]
+    fn write<'py>(
+        &self,
+        py: Python<'py>,
+        path: Option<PathBuf>,
+        part: Option<(usize, usize)>,
+        seed: Option<u64>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let output = path.unwrap_or_else(|| self.groom.output_path());
+        let file = self.groom.file();
+        // A progress callback runs Python: it re-attaches from the writer's
+        // thread; its first exception is raised when the write returns.
+        let callback_error: std::sync::Mutex<Option<PyErr>> = std::sync::Mutex::new(None);
+        let report = |done: usize, total: usize| {
+            if let Some(progress) = &progress {
+                Python::attach(|py| {
+                    if let Err(e) = progress.call1(py, (done, total)) {
+                        callback_error
+                            .lock()
+                            .expect("not poisoned")
+                            .get_or_insert(e);
+                    }
+                });
+            }
+        };
+        let (summary, written) = if let Some(animated) = py
+            .detach(|| self.groom.animated(seed))
+            .map_err(|e| self.error(e))?
+        {
+            let parts = animated.generator().parts().len();
+            let (range, path) = farm_slice(&output, part, parts)?;
+            let options = UsdOptions {
+                basis: file.output.basis,
+                time_codes_per_second: self.groom.fps().unwrap_or(24.0),
+                ..UsdOptions::default()
+            };
+            let with_skin = file.output.with_mesh && part.is_none_or(|(k, _)| k == 1);
+            let summary = py.detach(|| {
+                animated.write(&path, range, &options, with_skin, |p| {
+                    report(p.done, p.total)
+                })
+            });
+            (summary, path)
+        } else {
+            let generator = self.generator(py, seed)?;
+            let parts = generator.parts().len();
+            let (range, path) = farm_slice(&output, part, parts)?;
+            let export = CurvesExport {
+                usd: UsdOptions {
+                    basis: file.output.basis,
+                    ..UsdOptions::default()
+                },
+                mesh: file.output.with_mesh.then(|| self.groom.mesh()),
+            };
+            let total = range.len();
+            let mut done = 0;
+            let summary = py.detach(|| {
+                generator.write(&path, range, &export, |_, _| {
+                    done += 1;
+                    report(done, total);
+                })
+            });
+            (summary, path)
+        };
+        if let Some(e) = callback_error.into_inner().expect("not poisoned") {
+            return Err(e);
+        }
+        let summary = summary.map_err(|e| match e {
+            GroomWriteError::Groom(e) => self.error(e),
+            GroomWriteError::Write(e) => to_py_err(e),
+        })?;
+        let result = PyDict::new(py);
+        result.set_item("path", written)?;
+        result.set_item("hairs", summary.hairs)?;
+        result.set_item("points", summary.points)?;
+        Ok(result)
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let parts = self
+            .generator(py, None)
+            .map(|g| g.parts().len().to_string())
+            .unwrap_or_else(|_| "?".into());
+        format!(
+            "<pelage.Groom {}: {} guides on {:?}, {} parts>",
+            self.groom.source().path.display(),
+            self.groom.guides().len(),
+            self.groom.mesh().name(),
+            parts
+        )
+    }
+}
+
+/// The parts of a groom, grown one at a time as they are iterated.
+#[pyclass(name = "PartIterator", module = "pelage", frozen)]
+pub struct PartIter {
+    generator: Arc<Generator>,
+    from_values: bool,
+    next: std::sync::atomic::AtomicUsize,
+}
+
+#[pymethods]
+impl PartIter {
+    fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __next__(&self, py: Python<'_>) -> PyResult<Option<PyCurves>> {
+        let p = self.next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        if p >= self.generator.parts().len() {
+            return Ok(None);
+        }
+        let curves = py
+            .detach(|| self.generator.part(p))
+            .map_err(|e| groom_error(e, self.from_values))?;
+        Ok(Some(PyCurves::new(curves)))
+    }
+
+    fn __len__(&self) -> usize {
+        self.generator.parts().len()
+    }
+}
+
+/// The parts run `k` of `n` writes and the file it writes them to, or
+/// every part to `output`.
+fn farm_slice(
+    output: &Path,
+    part: Option<(usize, usize)>,
+    parts: usize,
+) -> PyResult<(std::ops::Range<usize>, PathBuf)> {
+    match part {
+        None => Ok((0..parts, output.to_path_buf())),
+        Some((k, n)) if n >= 1 && (1..=n).contains(&k) => {
+            Ok((part_slice(k, n, parts), part_file(output, k, n)))
+        }
+        Some((k, n)) => Err(PyValueError::new_err(format!(
+            "part = ({k}, {n}): run k of n, with 1 <= k <= n"
+        ))),
+    }
+}
+
+/// A groom error as a `PelageError`. For a groom built from values, the
+/// line (of a text the user never wrote) is left out: the key says where.
+fn groom_error(error: GroomError, from_values: bool) -> PyErr {
+    if !from_values {
+        return to_py_err(error);
+    }
+    let mut message = String::from("groom");
+    if let Some(key) = &error.key {
+        message.push_str(": ");
+        message.push_str(key);
+    }
+    message.push_str(": ");
+    message.push_str(&error.kind.to_string());
+    let mut source = std::error::Error::source(&error.kind);
+    while let Some(cause) = source {
+        let text = cause.to_string();
+        if !message.contains(&text) {
+            message.push_str(": ");
+            message.push_str(&text);
+        }
+        source = cause.source();
+    }
+    crate::PelageError::new_err(message)
+}
+
+fn path_value(path: &Path, what: &str) -> PyResult<toml::Value> {
+    path.to_str()
+        .map(|s| toml::Value::String(s.to_string()))
+        .ok_or_else(|| PyValueError::new_err(format!("{what}: the path is not valid UTF-8")))
+}
+
+fn to_toml_int(value: u64, what: &str) -> PyResult<toml::Value> {
+    i64::try_from(value)
+        .map(toml::Value::Integer)
+        .map_err(|_| PyValueError::new_err(format!("{what}: {value} is too large")))
+}
+
+/// A Python value as a TOML value: dicts (string keys), lists and tuples,
+/// bools, integers, floats, strings and paths. `key` names it in errors
+/// (`ops[1].clump`).
+fn to_toml(value: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
+    if let Ok(dict) = value.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (k, v) in dict.iter() {
+            let name: String = k.extract().map_err(|_| {
+                PyTypeError::new_err(format!("{key}: keys must be strings, got {k:?}"))
+            })?;
+            if v.is_none() {
+                continue; // None: the setting's default
+            }
+            let child = format!("{key}.{name}");
+            table.insert(name, to_toml(&v, &child)?);
+        }
+        return Ok(toml::Value::Table(table));
+    }
+    if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
+        let items = value
+            .try_iter()?
+            .enumerate()
+            .map(|(i, v)| to_toml(&v?, &format!("{key}[{i}]")))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(toml::Value::Array(items));
+    }
+    if value.is_instance_of::<pyo3::types::PyBool>() {
+        return Ok(toml::Value::Boolean(value.extract()?));
+    }
+    if let Ok(s) = value.extract::<String>() {
+        return Ok(toml::Value::String(s));
+    }
+    if (value.is_instance_of::<pyo3::types::PyInt>() || value.hasattr("__index__")?)
+        && let Ok(i) = value.extract::<i64>()
+    {
+        return Ok(toml::Value::Integer(i));
+    }
+    if let Ok(x) = value.extract::<f64>() {
+        return Ok(toml::Value::Float(x));
+    }
+    if let Ok(p) = value.extract::<PathBuf>() {
+        return path_value(&p, key);
+    }
+    // A numpy array of numbers (a comb direction, a colour).
+    if value.hasattr("tolist")? {
+        return to_toml(&value.call_method0("tolist")?, key);
+    }
+    Err(PyTypeError::new_err(format!(
+        "{key}: cannot use a {} as a groom setting (use dicts, lists, numbers, strings)",
+        value.get_type().name()?
+    )))
+}

@@ -1,0 +1,63 @@
+//! pelage for Python: the `pelage._pelage` extension module.
+//!
+//! A thin layer over the library (DESIGN.md, "Bindings": it holds no logic
+//! the library lacks). Each Python class wraps one Rust value:
+//!
+//! - [`mesh::PyMesh`] wraps [`pelage::Mesh`] (loaded, or built from numpy
+//!   arrays);
+//! - [`sample::sample`] runs the density sampler (Sik §3) and hands back
+//!   numpy arrays;
+//! - [`groom::PyGroom`] wraps a [`pelage::groom::Groom`]: a groom file, or
+//!   Python dicts turned into the same settings and checked by the same
+//!   code, so errors name the same keys;
+//! - [`curves::PyCurves`] wraps [`pelage::Curves`], with read-only numpy
+//!   views of its arrays (no copy) and every curves format in and out.
+//!
+//! Errors become `pelage.PelageError` carrying pelage's message (file,
+//! line, key). Long work (loading, growing, writing) runs with the
+//! interpreter detached, so other Python threads keep running.
+
+use pyo3::prelude::*;
+
+mod convert;
+mod curves;
+mod groom;
+mod mesh;
+mod sample;
+
+pyo3::create_exception!(
+    _pelage,
+    PelageError,
+    pyo3::exceptions::PyException,
+    "An error from pelage: a file that cannot be read or written, a groom setting that is out of range, a mesh that is malformed. The message names the file, the line and the setting where there is one."
+);
+
+/// Turns any pelage error into a `PelageError` carrying its message and
+/// the messages of its causes.
+pub(crate) fn to_py_err(error: impl std::error::Error) -> PyErr {
+    let mut message = error.to_string();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        let text = cause.to_string();
+        if !message.contains(&text) {
+            message.push_str(": ");
+            message.push_str(&text);
+        }
+        source = cause.source();
+    }
+    PelageError::new_err(message)
+}
+
+#[pymodule]
+fn _pelage(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("PelageError", m.py().get_type::<PelageError>())?;
+    m.add_class::<mesh::PyMesh>()?;
+    m.add_class::<curves::PyCurves>()?;
+    m.add_class::<groom::PyGroom>()?;
+    m.add_class::<sample::PySamples>()?;
+    m.add_function(wrap_pyfunction!(sample::sample, m)?)?;
+    m.add_function(wrap_pyfunction!(curves::read_curves, m)?)?;
+    m.add_function(wrap_pyfunction!(curves::write_curves, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,258 @@
+//! `pelage.Mesh`: the surface hair grows on, loaded from a file or built
+//! from numpy arrays.
+
+use crate::convert::{column, flat3, rows, vec2s, vec3s, view2};
+use crate::to_py_err;
+use numpy::PyArray2;
+use pelage::mesh::Uvs;
+use pelage::{Mesh, MeshError};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// Most triangles a subdivided mesh may have: `subdivide` multiplies the
+/// count by 4 a level, and a typo (`subdivide=12`) should be an error, not
+/// an exhausted machine.
+const MAX_SUBDIVIDED_TRIANGLES: u64 = 1 << 28;
+
+/// A triangle mesh: positions, triangles, normals and optional UVs
+/// (per vertex or per corner). Immutable; build a new one to change it.
+#[pyclass(name = "Mesh", module = "pelage", frozen)]
+pub struct PyMesh {
+    pub(crate) inner: Arc<Mesh>,
+}
+
+#[pymethods]
+impl PyMesh {
+    /// Loads a mesh file: .obj, .ply (ascii or binary), .gltf, .glb, or a
+    /// USD mesh (.usda/.usdc/.usd); `"spot"` is the embedded demo cow.
+    /// `subdivide` applies midpoint subdivision that many times (each ×4
+    /// triangles).
+    #[staticmethod]
+    #[pyo3(signature = (path, subdivide = 0))]
+    fn load(py: Python<'_>, path: PathBuf, subdivide: u32) -> PyResult<Self> {
+        let mesh = py.detach(|| -> Result<Mesh, MeshError> {
+            match path.to_str() {
+                Some("spot") => Ok(pelage::assets::spot()),
+                _ => Mesh::load(&path),
+            }
+        });
+        let mesh = mesh.map_err(to_py_err)?;
+        Ok(Self {
+            inner: Arc::new(subdivide_checked(py, mesh, subdivide)?),
+        })
+    }
+
+    /// The embedded demo mesh (Keenan Crane's Spot, with UVs).
+    #[staticmethod]
+    fn spot() -> Self {
+        Self {
+            inner: Arc::new(pelage::assets::spot()),
+        }
+    }
+
+    /// Builds a mesh from arrays: `positions` (n, 3) floats, `triangles`
+    /// (m, 3) vertex indices, and optionally `uvs`: (n, 2) per vertex, or
+    /// (3m, 2) per corner (three a triangle, in the triangles' order, as
+    /// Blender's UV layers are). `normals` (n, 3) when you have them
+    /// (computed otherwise). Everything is checked: finite values, indices
+    /// in range, matching sizes.
+    #[staticmethod]
+    #[pyo3(signature = (positions, triangles, uvs = None, normals = None, name = "<python mesh>".to_string()))]
+    fn from_arrays(
+        positions: &Bound<'_, PyAny>,
+        triangles: &Bound<'_, PyAny>,
+        uvs: Option<&Bound<'_, PyAny>>,
+        normals: Option<&Bound<'_, PyAny>>,
+        name: String,
+    ) -> PyResult<Self> {
+        let positions = vec3s(rows::<f32, 3>(positions, "positions")?);
+        let triangles = triangle_rows(triangles)?;
+        let normals = normals
+            .map(|n| rows::<f32, 3>(n, "normals").map(vec3s))
+            .transpose()?;
+        let uvs = match uvs {
+            None => None,
+            Some(uvs) => {
+                let values = vec2s(rows::<f32, 2>(uvs, "uvs")?);
+                if values.len() == positions.len() {
+                    Some(Uvs::PerVertex(values))
+                } else if values.len() == 3 * triangles.len() {
+                    let corners = (0..triangles.len() as u32)
+                        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                        .collect();
+                    Some(Uvs::PerCorner {
+                        values,
+                        indices: corners,
+                    })
+                } else {
+                    return Err(PyValueError::new_err(format!(
+                        "uvs: {} rows; expected one per vertex ({}) or one per triangle corner ({})",
+                        values.len(),
+                        positions.len(),
+                        3 * triangles.len()
+                    )));
+                }
+            }
+        };
+        let mesh = Mesh::new(name, positions, triangles, normals, uvs).map_err(to_py_err)?;
+        Ok(Self {
+            inner: Arc::new(mesh),
+        })
+    }
+
+    /// The mesh subdivided `levels` times (midpoint, ×4 triangles a level).
+    fn subdivided(&self, py: Python<'_>, levels: u32) -> PyResult<Self> {
+        Ok(Self {
+            inner: Arc::new(subdivide_checked(py, (*self.inner).clone(), levels)?),
+        })
+    }
+
+    /// Vertex positions, (n, 3) float32, read-only (a view, no copy).
+    #[getter]
+    fn positions<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        view2(
+            slf.clone().into_any(),
+            flat3(slf.get().inner.positions()),
+            3,
+        )
+    }
+
+    /// Triangles, (m, 3) uint32 vertex indices, read-only.
+    #[getter]
+    fn triangles<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<u32>>> {
+        let flat: &[u32] = bytemuck::cast_slice(slf.get().inner.triangles());
+        view2(slf.clone().into_any(), flat, 3)
+    }
+
+    /// Vertex normals, (n, 3) float32, read-only.
+    #[getter]
+    fn normals<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        view2(slf.clone().into_any(), flat3(slf.get().inner.normals()), 3)
+    }
+
+    /// UVs per triangle corner, (3m, 2) float32, or `None` without UVs.
+    #[getter]
+    fn corner_uvs<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray2<f32>>>> {
+        let mesh = &slf.get().inner;
+        if !mesh.has_uvs() {
+            return Ok(None);
+        }
+        let corners: Vec<glam::Vec2> = (0..mesh.triangle_count())
+            .flat_map(|t| mesh.triangle_uvs(t).expect("the mesh has UVs"))
+            .collect();
+        let array = crate::convert::owned2(slf.py(), corners)?;
+        Ok(Some(array))
+    }
+
+    /// Number of vertices.
+    #[getter]
+    fn vertex_count(&self) -> usize {
+        self.inner.vertex_count()
+    }
+
+    /// Number of triangles.
+    #[getter]
+    fn triangle_count(&self) -> usize {
+        self.inner.triangle_count()
+    }
+
+    /// Whether the mesh has UVs (maps read from images need them).
+    #[getter]
+    fn has_uvs(&self) -> bool {
+        self.inner.has_uvs()
+    }
+
+    /// The name errors call the mesh (its path, for a loaded one).
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name().to_string()
+    }
+
+    /// What `pelage info` prints, as a dict: counts, bounds, surface area,
+    /// UVs, degenerate triangles, boundary and non-manifold edges.
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let mesh = &self.inner;
+        let topology = py.detach(|| mesh.topology_report());
+        let (lo, hi) = mesh.bounds();
+        let info = PyDict::new(py);
+        info.set_item("name", mesh.name())?;
+        info.set_item("vertices", mesh.vertex_count())?;
+        info.set_item("triangles", mesh.triangle_count())?;
+        info.set_item("bounds", (lo.to_array(), hi.to_array()))?;
+        info.set_item("surface_area", mesh.surface_area())?;
+        info.set_item(
+            "uvs",
+            match mesh.uvs() {
+                None => None,
+                Some(Uvs::PerVertex(_)) => Some("per vertex"),
+                Some(Uvs::PerCorner { .. }) => Some("per corner"),
+            },
+        )?;
+        info.set_item("degenerate_triangles", mesh.degenerate_triangle_count())?;
+        info.set_item("edges", topology.edges)?;
+        info.set_item("boundary_edges", topology.boundary_edges)?;
+        info.set_item("non_manifold_edges", topology.non_manifold_edges)?;
+        info.set_item("isolated_vertices", topology.isolated_vertices)?;
+        Ok(info)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<pelage.Mesh {:?}: {} vertices, {} triangles{}>",
+            self.inner.name(),
+            self.inner.vertex_count(),
+            self.inner.triangle_count(),
+            if self.inner.has_uvs() { ", UVs" } else { "" }
+        )
+    }
+}
+
+/// Triangles as (m, 3) indices: any integer array, checked non-negative
+/// and below 2³² before it narrows.
+fn triangle_rows(triangles: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
+    let wide = rows::<i64, 3>(triangles, "triangles")?;
+    wide.into_iter()
+        .enumerate()
+        .map(|(t, [a, b, c])| {
+            let narrow = |i: i64| u32::try_from(i).ok();
+            match (narrow(a), narrow(b), narrow(c)) {
+                (Some(a), Some(b), Some(c)) => Ok([a, b, c]),
+                _ => Err(PyValueError::new_err(format!(
+                    "triangles[{t}] = [{a}, {b}, {c}]: vertex indices must be between 0 and 2^32 - 1"
+                ))),
+            }
+        })
+        .collect()
+}
+
+fn subdivide_checked(py: Python<'_>, mesh: Mesh, levels: u32) -> PyResult<Mesh> {
+    if levels == 0 {
+        return Ok(mesh);
+    }
+    let triangles = (mesh.triangle_count() as u64).saturating_mul(4u64.saturating_pow(levels));
+    if triangles > MAX_SUBDIVIDED_TRIANGLES {
+        return Err(PyValueError::new_err(format!(
+            "subdivide = {levels} would make {triangles} triangles from {}; at most {MAX_SUBDIVIDED_TRIANGLES} are allowed",
+            mesh.triangle_count()
+        )));
+    }
+    Ok(py.detach(|| mesh.subdivided(levels)))
+}
+
+/// Reads a 1-D integer column (used by curves for offsets).
+pub(crate) fn offsets_column(value: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
+    let wide = column::<i64>(value, "offsets")?;
+    wide.into_iter()
+        .enumerate()
+        .map(|(i, o)| {
+            u32::try_from(o).map_err(|_| {
+                PyValueError::new_err(format!(
+                    "offsets[{i}] = {o}: offsets must be between 0 and 2^32 - 1"
+                ))
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,169 @@
+"""Grooms from files and from Python values; growth part by part."""
+
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import pelage
+from conftest import REPO, small_groom
+
+
+def test_values_and_their_settings_text_grow_the_same_hairs(spot, tmp_path):
+    from_values = small_groom(spot, finish={"points": 8}, base_dir=tmp_path)
+    # The settings text is the groom file the values amount to; with the
+    # mesh named instead of given, `pelage groom` would read it.
+    text = 'mesh = { path = "spot" }\n' + from_values.settings
+    from_text = pelage.Groom.from_text(text, path=tmp_path / "fur.toml")
+    a, b = from_values.grow(), from_text.grow()
+    assert a.curve_count == b.curve_count == 5_000
+    assert np.array_equal(a.points, b.points)
+    assert np.array_equal(a.widths, b.widths)
+
+
+def test_all_parts_joined_equal_the_parts_one_by_one(groom):
+    whole = groom.grow()
+    parts = list(groom.parts())
+    assert len(parts) == groom.part_count == 4
+    assert sum(p.curve_count for p in parts) == whole.curve_count == 5_000
+    assert np.array_equal(np.concatenate([p.points for p in parts]), whole.points)
+    assert np.array_equal(groom.grow(2).points, parts[2].points)
+    assert list(groom.part_hair_counts) == [p.curve_count for p in parts]
+    with pytest.raises(IndexError, match="4 parts"):
+        groom.grow(4)
+
+
+def test_same_seed_same_hairs_and_another_seed_other_hairs(groom, spot):
+    again = small_groom(spot)
+    assert np.array_equal(groom.grow().points, again.grow().points)
+    assert not np.array_equal(groom.grow(seed=4).points, groom.grow().points)
+
+
+def test_curves_have_the_finish_and_views_share_memory(groom):
+    curves = groom.grow(0)
+    n = curves.curve_count
+    assert curves.offsets.shape == (n + 1,) and curves.offsets[0] == 0
+    assert np.all(np.diff(curves.offsets) == 8), "finish.points = 8"
+    assert curves.points.shape == (8 * n, 3)
+    assert curves.normals.shape == (8 * n, 3)
+    assert np.allclose(np.linalg.norm(curves.normals, axis=1), 1, atol=1e-4)
+    assert curves.root_uvs.shape == (n, 2)
+    assert len(np.unique(curves.ids)) == n
+    assert np.shares_memory(curves.points, curves.points)
+    assert not curves.points.flags.writeable
+    # Widths taper root to tip (finish default: 0.002 to 0.0002).
+    w = curves.widths.reshape(n, 8)
+    assert np.all(w[:, 0] > w[:, -1])
+
+
+def test_roots_lie_on_the_mesh(groom, spot):
+    curves = groom.grow(1)
+    roots = curves.points[curves.offsets[:-1]]
+    tri = spot.triangles[curves.root_triangles]
+    p = spot.positions
+    b = curves.root_barycentrics
+    on_mesh = (1 - b[:, 0] - b[:, 1])[:, None] * p[tri[:, 0]] + b[:, :1] * p[tri[:, 1]] + b[:, 1:] * p[tri[:, 2]]
+    assert np.allclose(roots, on_mesh, atol=1e-5)
+
+
+def test_guides_given_as_curves_are_reproduced_at_their_roots(spot):
+    grown = small_groom(spot).guides
+    groom = pelage.Groom(
+        mesh=spot,
+        guides={"curves": grown, "points": 6},
+        roots={"count": 2_000},
+        interpolation={"method": "style-mesh"},
+        finish={"points": grown.point_count // grown.curve_count},
+    )
+    assert groom.guides.curve_count == grown.curve_count
+    assert np.allclose(groom.guides.points, grown.points, atol=1e-5)
+
+
+def test_a_bad_setting_names_the_key(spot):
+    with pytest.raises(pelage.PelageError, match=r"ops\[1\]\.clump\.count"):
+        small_groom(spot, ops=[pelage.ops.noise(amplitude=0.001), pelage.ops.clump(count=0)])
+    with pytest.raises(pelage.PelageError, match=r"ops\[0\]\.curl\.turn.*unknown field"):
+        small_groom(spot, ops=[{"curl": {"radius": 0.01, "turn": 3}}])
+    with pytest.raises(pelage.PelageError, match=r"\[mesh\]: missing field `path`") as error:
+        pelage.Groom(mesh={}, guides={"generate": {"count": 3, "length": 0.1}}, roots=10)
+    assert "<python groom>:" not in str(error.value), "no line of a text the user never wrote"
+    with pytest.raises(TypeError, match="finish.points"):
+        small_groom(spot, finish={"points": object()})
+
+
+def test_a_groom_file_error_names_file_and_line(tmp_path):
+    path = tmp_path / "fur.toml"
+    path.write_text(
+        '[mesh]\npath = "spot"\n\n[roots]\ncount = 100\n\n'
+        '[guides]\ngenerate = { count = 10, length = 0.05 }\n\n'
+        "[[ops]]\nclump = { count = 10, rait = 0.5 }\n"
+    )
+    with pytest.raises(pelage.PelageError, match=r"fur\.toml:11:.*rait"):
+        pelage.Groom.load(path)
+
+
+def test_progress_is_called_per_part_and_its_exception_is_raised(groom, tmp_path):
+    calls = []
+    groom.grow(progress=lambda done, total: calls.append((done, total)))
+    assert calls == [(1, 4), (2, 4), (3, 4), (4, 4)]
+    calls.clear()
+    summary = groom.write(tmp_path / "fur.usdc", progress=lambda d, t: calls.append((d, t)))
+    assert calls[-1] == (4, 4)
+    assert summary["hairs"] == 5_000 and summary["points"] == 40_000
+
+    def stop(done, total):
+        raise KeyError("stop")
+
+    with pytest.raises(KeyError):
+        groom.grow(progress=stop)
+
+
+def test_farm_runs_write_part_files(groom, tmp_path):
+    out = tmp_path / "fur.usda"
+    written = [groom.write(out, part=(k, 2))["path"] for k in (1, 2)]
+    assert [p.name for p in written] == ["fur.part-1-of-2.usda", "fur.part-2-of-2.usda"]
+    total = sum(pelage.read_curves(p).curve_count for p in written)
+    assert total == 5_000
+    with pytest.raises(ValueError, match="1 <= k <= n"):
+        groom.write(out, part=(3, 2))
+
+
+def test_growth_releases_the_interpreter(spot):
+    groom = small_groom(spot, count=150_000)
+    done = threading.Event()
+    ticks = 0
+
+    def grow():
+        groom.grow()
+        done.set()
+
+    worker = threading.Thread(target=grow)
+    start = time.perf_counter()
+    worker.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    worker.join()
+    seconds = time.perf_counter() - start
+    # Holding the interpreter would leave this loop a handful of ticks at
+    # the switch interval; released, it ticks about once a millisecond.
+    assert ticks > 0.2 * seconds * 1000 / 2, (ticks, seconds)
+
+
+def test_an_animated_groom_writes_every_frame(tmp_path):
+    fox = REPO / "crates" / "pelage" / "assets" / "fox"
+    gltf = next(fox.glob("*.gl*"))
+    groom = pelage.Groom(
+        mesh=str(gltf),
+        guides={"generate": {"count": 40, "length": 3.0}},
+        roots=500,
+        animation={"frames": "1-3"},
+    )
+    assert groom.frames == [1.0, 2.0, 3.0]
+    out = tmp_path / "fox.usdc"
+    groom.write(out)
+    first = pelage.read_curves(out, time=1)
+    last = pelage.read_curves(out, time=3)
+    assert first.curve_count == last.curve_count == 500
+    assert not np.array_equal(first.points, last.points), "the fur moves with the walk"

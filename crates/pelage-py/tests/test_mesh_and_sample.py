@@ -1,0 +1,101 @@
+"""Meshes from files and arrays, and root sampling (Sik §3)."""
+
+import numpy as np
+import pytest
+
+import pelage
+from conftest import MESHES
+
+
+def quad(uvs=True):
+    """Two triangles with areas 1 and 4, flat in z = 0."""
+    positions = np.array([[0, 0, 0], [1, 0, 0], [4, 2, 0], [0, 2, 0]], dtype=np.float32)
+    triangles = np.array([[0, 1, 3], [1, 2, 3]])
+    uv = positions[:, :2] / 4 if uvs else None
+    return pelage.Mesh.from_arrays(positions, triangles, uvs=uv)
+
+
+def test_version_is_the_crates():
+    assert pelage.__version__.count(".") == 2
+
+
+def test_load_reports_what_pelage_info_prints():
+    mesh = pelage.Mesh.load(MESHES / "blub_triangulated.obj")
+    info = mesh.info()
+    assert (info["vertices"], info["triangles"]) == (7106, 14208)
+    assert info["boundary_edges"] == 0 and info["non_manifold_edges"] == 0
+    assert info["uvs"] == "per corner"
+    assert mesh.positions.shape == (7106, 3) and mesh.triangles.shape == (14208, 3)
+
+
+def test_arrays_are_read_only_views_of_the_mesh():
+    mesh = quad()
+    a, b = mesh.positions, mesh.positions
+    assert np.shares_memory(a, b), "a view of pelage's memory, not a copy"
+    assert not a.flags.writeable
+    with pytest.raises(ValueError):
+        a[0, 0] = 1.0
+
+
+def test_from_arrays_checks_indices_and_shapes():
+    positions = np.zeros((3, 3), dtype=np.float32)
+    positions[1, 0] = positions[2, 1] = 1
+    with pytest.raises(pelage.PelageError, match="triangle 0"):
+        pelage.Mesh.from_arrays(positions, [[0, 1, 7]])
+    with pytest.raises(ValueError, match=r"shape \(n, 3\)"):
+        pelage.Mesh.from_arrays(positions[:, :2], [[0, 1, 2]])
+    with pytest.raises(ValueError, match="between 0 and"):
+        pelage.Mesh.from_arrays(positions, [[0, 1, -2]])
+    with pytest.raises(ValueError, match="one per vertex"):
+        pelage.Mesh.from_arrays(positions, [[0, 1, 2]], uvs=np.zeros((5, 2)))
+
+
+def test_a_missing_file_is_an_error_naming_it():
+    with pytest.raises(pelage.PelageError, match="no-such-mesh.obj"):
+        pelage.Mesh.load("no-such-mesh.obj")
+
+
+def test_subdivide_too_far_is_refused_not_attempted(spot):
+    with pytest.raises(ValueError, match="triangles"):
+        spot.subdivided(20)
+
+
+def test_uniform_samples_follow_area_chi_square():
+    mesh = quad()
+    n = 40_000
+    s = pelage.sample(mesh, n, seed=5)
+    counts = np.bincount(s.triangles, minlength=2)
+    expected = np.array([0.2, 0.8]) * n
+    chi2 = (((counts - expected) ** 2) / expected).sum()
+    # One degree of freedom: 10.83 is the 0.1 % critical value.
+    assert chi2 < 10.83, (counts, chi2)
+    assert np.allclose(s.positions[:, 2], 0)
+    assert np.allclose(s.normals, [0, 0, 1], atol=1e-5)
+
+
+def test_a_density_map_moves_roots_and_zero_density_is_an_error(spot):
+    uniform = pelage.sample(spot, 5_000, seed=2)
+    noisy = pelage.sample(spot, 5_000, density="noise:frequency=4,offset=0.5,scale=0.5", seed=2)
+    assert not np.array_equal(uniform.triangles, noisy.triangles)
+    with pytest.raises(pelage.PelageError, match="zero"):
+        pelage.sample(spot, 10, density=0.0)
+
+
+def test_same_seed_same_roots_and_batches_add_up(spot):
+    whole = pelage.sample(spot, 3_000, seed=9)
+    again = pelage.sample(spot, 3_000, seed=9)
+    first = pelage.sample(spot, 1_000, seed=9)
+    rest = pelage.sample(spot, 2_000, seed=9, first=1_000)
+    assert np.array_equal(whole.positions, again.positions)
+    assert np.array_equal(whole.positions, np.concatenate([first.positions, rest.positions]))
+    other = pelage.sample(spot, 3_000, seed=10)
+    assert not np.array_equal(whole.positions, other.positions)
+
+
+def test_roots_lie_on_their_triangles(spot):
+    s = pelage.sample(spot, 500, seed=1)
+    tri = spot.triangles[s.triangles]
+    p = spot.positions
+    u, v = s.barycentrics[:, 0], s.barycentrics[:, 1]
+    rebuilt = (1 - u - v)[:, None] * p[tri[:, 0]] + u[:, None] * p[tri[:, 1]] + v[:, None] * p[tri[:, 2]]
+    assert np.allclose(rebuilt, s.positions, atol=1e-5)
