@@ -178,27 +178,49 @@ impl PyGroom {
 
     /// Loads a groom file (docs/groom-format.md) with its mesh and guides.
     /// `frames` ("1-24", "1-48x2") makes it animated, or replaces the
-    /// frames of its `[animation]`.
+    /// frames of its `[animation]`. `mesh` replaces the file's `[mesh]`
+    /// (a DCC's mesh under a groom written for the command line).
     #[staticmethod]
-    #[pyo3(signature = (path, *, frames = None))]
-    fn load(py: Python<'_>, path: PathBuf, frames: Option<&str>) -> PyResult<Self> {
+    #[pyo3(signature = (path, *, frames = None, mesh = None))]
+    fn load(
+        py: Python<'_>,
+        path: PathBuf,
+        frames: Option<&str>,
+        mesh: Option<&PyMesh>,
+    ) -> PyResult<Self> {
         let frames = frames
             .map(pelage::anim::FrameRange::parse)
             .transpose()
             .map_err(|e| PyValueError::new_err(format!("frames: {e}")))?;
+        let inputs = GroomInputs {
+            mesh: mesh.map(|m| m.inner.clone()),
+            guides: None,
+        };
         let groom = py
-            .detach(|| Groom::load_with_frames(&path, frames))
+            .detach(|| {
+                let source = SettingsSource::read_groom(&path)?;
+                Groom::from_source_with_inputs(source, frames, inputs)
+            })
             .map_err(|e| groom_error(e, false))?;
         Self::wrap(py, groom, false)
     }
 
     /// A groom from groom-file text; `path` names it in errors and is the
-    /// folder relative paths start from.
+    /// folder relative paths start from. `mesh` replaces its `[mesh]`.
     #[staticmethod]
-    #[pyo3(signature = (text, *, path = PathBuf::from("<groom>")))]
-    fn from_text(py: Python<'_>, text: String, path: PathBuf) -> PyResult<Self> {
+    #[pyo3(signature = (text, *, path = PathBuf::from("<groom>"), mesh = None))]
+    fn from_text(
+        py: Python<'_>,
+        text: String,
+        path: PathBuf,
+        mesh: Option<&PyMesh>,
+    ) -> PyResult<Self> {
+        let inputs = GroomInputs {
+            mesh: mesh.map(|m| m.inner.clone()),
+            guides: None,
+        };
         let groom = py
-            .detach(|| Groom::from_text(path, text))
+            .detach(|| Groom::from_source_with_inputs(SettingsSource { path, text }, None, inputs))
             .map_err(|e| groom_error(e, false))?;
         Self::wrap(py, groom, false)
     }

@@ -167,3 +167,16 @@ def test_an_animated_groom_writes_every_frame(tmp_path):
     last = pelage.read_curves(out, time=3)
     assert first.curve_count == last.curve_count == 500
     assert not np.array_equal(first.points, last.points), "the fur moves with the walk"
+
+
+def test_a_mesh_value_replaces_the_files_mesh(tmp_path):
+    path = tmp_path / "fur.toml"
+    path.write_text(
+        '[mesh]\npath = "spot"\n\n[roots]\ncount = 300\n\n'
+        '[guides]\ngenerate = { count = 10, length = 0.05 }\n'
+    )
+    blub = pelage.Mesh.load(REPO / "tests" / "data" / "meshes" / "blub_triangulated.obj")
+    groom = pelage.Groom.load(path, mesh=blub)
+    assert groom.mesh.vertex_count == blub.vertex_count
+    curves = groom.grow()
+    assert curves.root_triangles.max() >= pelage.Mesh.spot().triangle_count, "roots on blub's triangles"

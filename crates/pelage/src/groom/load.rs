@@ -65,7 +65,7 @@ impl std::fmt::Debug for Groom {
 /// they are checked, and their errors worded, exactly as a file's.
 #[derive(Debug, Clone, Default)]
 pub struct GroomInputs {
-    /// The surface, instead of `[mesh] path`.
+    /// The surface, replacing `[mesh]` when the settings have one.
     pub mesh: Option<Arc<Mesh>>,
     /// Guide curves to bind to the surface (with `[guides] points` and
     /// `tolerance`), instead of `[guides] file` or `[guides.generate]`.
@@ -110,9 +110,9 @@ impl Groom {
     }
 
     /// [`Self::from_source_with_frames`], with the mesh and guides given
-    /// as values where `inputs` has them. A value and a setting for the
-    /// same thing (`[mesh] path` and `inputs.mesh`) is an error, as is an
-    /// animated groom on a mesh value (a skin comes from a file).
+    /// as values where `inputs` has them. A mesh value replaces `[mesh]`;
+    /// guide curves and a `[guides]` source together are an error, as is
+    /// an animated groom on a mesh value (a skin comes from a file).
     pub fn from_source_with_inputs(
         source: SettingsSource,
         frames: Option<FrameRange>,
@@ -128,26 +128,22 @@ impl Groom {
                 GroomErrorKind::Invalid(message.to_string()),
             )
         };
+        // A mesh value replaces `[mesh]`: a groom file written for the
+        // command line grows on whatever mesh a DCC hands over.
         let (mesh, skin) = match (&file.mesh, inputs.mesh, &animation) {
-            (Some(_), Some(_), _) => {
+            (_, Some(_), Some(_)) => {
                 return Err(invalid(
-                    "mesh",
-                    "the mesh is given twice, as a value and as [mesh] path; give one",
+                    "animation",
+                    "an animated groom reads its skin from [mesh] path (glTF, USD or an OBJ sequence); a mesh given as a value does not move",
                 ));
             }
+            (_, Some(mesh), None) => (mesh, None),
             (None, None, _) => {
                 return Err(invalid(
                     "mesh",
                     "no mesh: add a [mesh] table with `path = \"model.obj\"`",
                 ));
             }
-            (None, Some(_), Some(_)) => {
-                return Err(invalid(
-                    "animation",
-                    "an animated groom reads its skin from [mesh] path (glTF, USD or an OBJ sequence); a mesh given as a value does not move",
-                ));
-            }
-            (None, Some(mesh), None) => (mesh, None),
             (Some(section), None, None) => (Arc::new(load_mesh_section(&source, section)?), None),
             (Some(section), None, Some((spec, fps, clip))) => {
                 let skin = load_skin(&source, section, *fps, clip.clone())?;

@@ -222,6 +222,9 @@ pub fn join<'c>(
     if let Some(ids) = concat_all(&parts, Curves::ids) {
         joined = joined.with_ids(ids)?;
     }
+    if let Some(roots) = concat_all(&parts, Curves::roots) {
+        joined = joined.with_roots(roots)?;
+    }
     Ok(joined)
 }
 

@@ -1,0 +1,161 @@
+"""pelage fur for Blender: "Grow pelage fur" on the active mesh.
+
+Reads the active object's evaluated mesh (with its active UV map), grows a
+pelage groom on it (a groom file, or the panel's count, length, clump,
+curl and noise), and adds a native hair Curves object parented to the
+mesh, bound to it for Blender's Deform Curves on Surface. The panel lives
+in the 3D Viewport's sidebar (N), tab "pelage"; "Export USD" and "Export
+Alembic" write the same groom with pelage's own writers.
+"""
+
+import bpy
+from bpy.props import FloatProperty, IntProperty, PointerProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper
+
+from . import fur
+
+
+class PelageFurSettings(bpy.types.PropertyGroup):
+    """What the panel grows (per object)."""
+
+    groom_file: StringProperty(
+        name="Groom file",
+        description="A pelage groom file (.toml); its [mesh] is replaced by this object. Empty: use the settings below",
+        subtype="FILE_PATH",
+    )
+    count: IntProperty(name="Count", description="Hairs", default=20_000, min=1, soft_max=2_000_000)
+    guides: IntProperty(name="Guides", description="Guide curves grown on the surface", default=200, min=1, soft_max=5_000)
+    length: FloatProperty(name="Length", description="Guide length", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
+    width: FloatProperty(name="Width", description="Hair width at the root", default=0.002, min=0.0, soft_max=0.01, subtype="DISTANCE", precision=4)
+    gravity: FloatProperty(name="Gravity", description="Pull of the guides toward -Y", default=0.3, min=0.0, max=1.0)
+    points: IntProperty(name="Points", description="Points per hair", default=12, min=2, max=64)
+    clump: FloatProperty(name="Clump", description="How far hairs pull toward clump centres (0: off)", default=0.4, min=0.0, max=1.0)
+    curl: FloatProperty(name="Curl", description="Curl radius, relative to the length (0: off)", default=0.0, min=0.0, max=2.0)
+    noise: FloatProperty(name="Noise", description="Noise amplitude, relative to the length (0: off)", default=0.1, min=0.0, max=2.0)
+    seed: IntProperty(name="Seed", default=1, min=0)
+
+
+def surface_of(context):
+    obj = context.active_object
+    return obj if obj is not None and obj.type == "MESH" else None
+
+
+class PELAGE_OT_grow_fur(bpy.types.Operator):
+    """Grow pelage fur on the active mesh as a hair Curves object"""
+
+    bl_idname = "pelage.grow_fur"
+    bl_label = "Grow pelage fur"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return surface_of(context) is not None
+
+    def execute(self, context):
+        surface = surface_of(context)
+        settings = surface.pelage_fur
+        wm = context.window_manager
+        wm.progress_begin(0, 1)
+        try:
+            obj, grown = fur.grow_on_object(
+                context, surface, settings, progress=lambda done, total: wm.progress_update(done / total)
+            )
+        except fur.pelage.PelageError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        self.report({"INFO"}, f"pelage: {grown.curve_count:,} hairs, {grown.point_count:,} points on {surface.name}")
+        return {"FINISHED"}
+
+
+class _PelageExport(ExportHelper):
+    """Grows the active mesh's groom and writes it with pelage's writer."""
+
+    bl_options = {"REGISTER"}
+
+    @classmethod
+    def poll(cls, context):
+        return surface_of(context) is not None
+
+    def execute(self, context):
+        surface = surface_of(context)
+        depsgraph = context.evaluated_depsgraph_get()
+        try:
+            mesh, _ = fur.mesh_to_pelage(surface, depsgraph)
+            groom = fur.groom_from_settings(mesh, surface.pelage_fur)
+            summary = groom.write(self.filepath)
+        except fur.pelage.PelageError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"pelage: wrote {summary['hairs']:,} hairs to {summary['path']}")
+        return {"FINISHED"}
+
+
+class PELAGE_OT_export_usd(_PelageExport, bpy.types.Operator):
+    """Grow the active mesh's pelage fur and write it as binary USD"""
+
+    bl_idname = "pelage.export_usd"
+    bl_label = "Export USD"
+    filename_ext = ".usdc"
+    filter_glob: StringProperty(default="*.usdc;*.usda;*.usd", options={"HIDDEN"})
+
+
+class PELAGE_OT_export_alembic(_PelageExport, bpy.types.Operator):
+    """Grow the active mesh's pelage fur and write it as Alembic"""
+
+    bl_idname = "pelage.export_alembic"
+    bl_label = "Export Alembic"
+    filename_ext = ".abc"
+    filter_glob: StringProperty(default="*.abc", options={"HIDDEN"})
+
+
+class PELAGE_PT_fur(bpy.types.Panel):
+    bl_label = "pelage fur"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "pelage"
+
+    @classmethod
+    def poll(cls, context):
+        return surface_of(context) is not None
+
+    def draw(self, context):
+        layout = self.layout
+        settings = surface_of(context).pelage_fur
+        layout.prop(settings, "groom_file")
+        column = layout.column(align=True)
+        column.enabled = not settings.groom_file
+        for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed"):
+            column.prop(settings, name)
+        layout.operator(PELAGE_OT_grow_fur.bl_idname, icon="CURVES")
+        row = layout.row(align=True)
+        row.operator(PELAGE_OT_export_usd.bl_idname)
+        row.operator(PELAGE_OT_export_alembic.bl_idname)
+
+
+CLASSES = (
+    PelageFurSettings,
+    PELAGE_OT_grow_fur,
+    PELAGE_OT_export_usd,
+    PELAGE_OT_export_alembic,
+    PELAGE_PT_fur,
+)
+
+
+def menu_entry(self, context):
+    self.layout.operator(PELAGE_OT_grow_fur.bl_idname, icon="CURVES")
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.Object.pelage_fur = PointerProperty(type=PelageFurSettings)
+    bpy.types.VIEW3D_MT_object.append(menu_entry)
+
+
+def unregister():
+    bpy.types.VIEW3D_MT_object.remove(menu_entry)
+    del bpy.types.Object.pelage_fur
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,157 @@
+"""Blender meshes in, pelage grooms grown, Blender hair curves out.
+
+Everything here moves data in bulk (``foreach_get`` / ``foreach_set`` with
+numpy arrays): no Python loop runs per vertex, point or curve, so a
+million hairs become a Curves object in about a second.
+
+The Curves object is what Blender's own hair tools make: points in the
+surface object's space, ``radius`` per point, ``surface_uv_coordinate`` per
+curve with ``surface`` and ``surface_uv_map`` set, so Blender's "Deform
+Curves on Surface" node carries the fur when the mesh is animated.
+"""
+
+import numpy as np
+
+import pelage
+
+#: Attribute names on the created curves.
+HAIR_ID = "hair_id"
+COLOR = "color"
+
+
+def mesh_to_pelage(obj, depsgraph):
+    """The evaluated mesh of ``obj`` (modifiers applied), triangulated, as a
+    ``pelage.Mesh`` in object space, with the active UV map's UVs per
+    triangle corner. Returns ``(mesh, uv_map_name or None)``."""
+    evaluated = obj.evaluated_get(depsgraph)
+    mesh = evaluated.to_mesh()
+    try:
+        mesh.calc_loop_triangles()
+        positions = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", positions)
+        count = len(mesh.loop_triangles)
+        if count == 0:
+            raise pelage.PelageError(f"{obj.name}: the mesh has no faces to grow fur on")
+        triangles = np.empty(count * 3, dtype=np.int32)
+        mesh.loop_triangles.foreach_get("vertices", triangles)
+        uv_layer = mesh.uv_layers.active
+        corner_uvs = None
+        if uv_layer is not None:
+            loops = np.empty(count * 3, dtype=np.int32)
+            mesh.loop_triangles.foreach_get("loops", loops)
+            uvs = np.empty(len(mesh.loops) * 2, dtype=np.float32)
+            uv_layer.data.foreach_get("uv", uvs)
+            corner_uvs = uvs.reshape(-1, 2)[loops]
+        result = pelage.Mesh.from_arrays(
+            positions.reshape(-1, 3),
+            triangles.reshape(-1, 3),
+            uvs=corner_uvs,
+            name=obj.name,
+        )
+        return result, (uv_layer.name if uv_layer is not None else None)
+    finally:
+        evaluated.to_mesh_clear()
+
+
+def groom_from_settings(mesh, settings):
+    """A ``pelage.Groom`` on ``mesh`` from the panel's settings: the groom
+    file when one is set (its ``[mesh]`` replaced by ``mesh``), else
+    grown guides, roots and the clump, curl and noise operators."""
+    if settings.groom_file:
+        import bpy
+
+        return pelage.Groom.load(bpy.path.abspath(settings.groom_file), mesh=mesh)
+    ops = []
+    if settings.clump > 0:
+        clumps = max(1, settings.count // 100)
+        ops.append(pelage.ops.clump(count=clumps, rate=settings.clump))
+    if settings.curl > 0:
+        ops.append(pelage.ops.curl(radius=settings.curl * settings.length * 0.05, turns=3))
+    if settings.noise > 0:
+        ops.append(pelage.ops.noise(amplitude=settings.noise * settings.length * 0.2,
+                                    frequency=4.0 / max(settings.length, 1e-6)))
+    return pelage.Groom(
+        mesh=mesh,
+        guides={"generate": {"count": settings.guides, "length": settings.length,
+                             "gravity": settings.gravity, "seed": settings.seed}},
+        roots={"count": settings.count, "seed": settings.seed},
+        ops=ops,
+        finish={"points": settings.points,
+                "width": {"root": settings.width, "tip": settings.width * 0.1}},
+    )
+
+
+def curves_to_blender(name, curves, surface=None, uv_map=None):
+    """A new hair Curves datablock holding ``curves`` (a ``pelage.Curves``):
+    positions, ``radius`` (half pelage's widths), ``color`` when the groom
+    has colours, ``hair_id`` per curve (pelage's stable id, low 31 bits)
+    and ``surface_uv_coordinate`` bound to ``surface``'s ``uv_map``."""
+    import bpy
+
+    data = bpy.data.hair_curves.new(name)
+    sizes = np.diff(curves.offsets.astype(np.int64))
+    data.add_curves(sizes.tolist())
+    data.position_data.foreach_set("vector", curves.points.ravel())
+    radius = data.attributes.get("radius") or data.attributes.new("radius", "FLOAT", "POINT")
+    radius.data.foreach_set("value", curves.widths * np.float32(0.5))
+    if curves.colors is not None:
+        color = data.attributes.new(COLOR, "FLOAT_COLOR", "POINT")
+        rgba = np.ones((curves.point_count, 4), dtype=np.float32)
+        rgba[:, :3] = curves.colors
+        color.data.foreach_set("color", rgba.ravel())
+    if curves.ids is not None:
+        ids = data.attributes.new(HAIR_ID, "INT", "CURVE")
+        ids.data.foreach_set("value", (curves.ids & 0x7FFFFFFF).astype(np.int32))
+    if curves.root_uvs is not None:
+        uv = data.attributes.new("surface_uv_coordinate", "FLOAT2", "CURVE")
+        uv.data.foreach_set("vector", curves.root_uvs.ravel())
+    if surface is not None:
+        data.surface = surface
+        if uv_map:
+            data.surface_uv_map = uv_map
+    return data
+
+
+def deform_on_surface_modifier(obj):
+    """Adds a geometry-nodes modifier with Blender's Deform Curves on
+    Surface node to the curves object ``obj``: the fur follows its surface
+    when the surface deforms (armature, shape keys)."""
+    import bpy
+
+    tree = bpy.data.node_groups.get("pelage: deform curves on surface")
+    if tree is None:
+        tree = bpy.data.node_groups.new("pelage: deform curves on surface", "GeometryNodeTree")
+        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+        group_in = tree.nodes.new("NodeGroupInput")
+        group_out = tree.nodes.new("NodeGroupOutput")
+        deform = tree.nodes.new("GeometryNodeDeformCurvesOnSurface")
+        tree.links.new(group_in.outputs["Geometry"], deform.inputs["Curves"])
+        tree.links.new(deform.outputs["Curves"], group_out.inputs["Geometry"])
+    modifier = obj.modifiers.new("Deform Curves on Surface", "NODES")
+    modifier.node_group = tree
+    return modifier
+
+
+def grow_on_object(context, surface, settings, progress=None):
+    """Grows fur on the mesh object ``surface`` and links a Curves object
+    parented to it. Returns ``(curves_object, pelage_curves)``."""
+    import bpy
+
+    depsgraph = context.evaluated_depsgraph_get()
+    mesh, uv_map = mesh_to_pelage(surface, depsgraph)
+    groom = groom_from_settings(mesh, settings)
+    grown = groom.grow(progress=progress)
+    data = curves_to_blender(f"{surface.name} fur", grown, surface, uv_map)
+    obj = bpy.data.objects.new(f"{surface.name} fur", data)
+    for collection in surface.users_collection:
+        collection.objects.link(obj)
+    obj.parent = surface
+    # Curves points are in the surface's space: the object sits on it.
+    obj.matrix_parent_inverse.identity()
+    if uv_map is not None:
+        # The node compares the deformed surface with its rest positions.
+        surface.add_rest_position_attribute = True
+        deform_on_surface_modifier(obj)
+    obj["pelage_settings"] = groom.settings
+    return obj, grown

@@ -1,0 +1,163 @@
+"""The add-on under Blender as a Python module (bpy from PyPI), headless.
+
+    tools/bpy-python blender/tests/test_addon.py EXTENSION.zip
+
+Installs the extension zip (its bundled wheel included) into a fresh user
+folder, runs "Grow pelage fur" on meshes with UVs, and checks what a user
+would: curve and point counts, the attributes Blender's hair tools need,
+roots on the surface, and that Blender's own Deform Curves on Surface
+carries the fur when the mesh deforms. Exits non-zero on the first
+failure; prints one line a check.
+"""
+
+import os
+import sys
+import tempfile
+
+# A fresh user folder, so the test installs the add-on itself and never
+# touches (or depends on) one already installed.
+os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="pelage-blender-")
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+zip_path = os.path.abspath(sys.argv[1])
+result = bpy.ops.extensions.package_install_files(
+    filepath=zip_path, repo="user_default", enable_on_install=True
+)
+assert result == {"FINISHED"}, result
+assert hasattr(bpy.ops.pelage, "grow_fur"), "the add-on registered its operator"
+import pelage  # noqa: E402  (the wheel the extension bundles)
+
+print(f"installed {os.path.basename(zip_path)}: pelage {pelage.__version__} in Blender {bpy.app.version_string}")
+
+
+def clear_scene():
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+
+
+def fur_of(surface):
+    found = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == surface]
+    assert len(found) == 1, found
+    return found[0]
+
+
+def arrays(curves):
+    points = np.empty(len(curves.points) * 3, np.float32)
+    curves.position_data.foreach_get("vector", points)
+    offsets = np.empty(len(curves.curves) + 1, np.int32)
+    curves.curve_offset_data.foreach_get("value", offsets)
+    return points.reshape(-1, 3), offsets
+
+
+def evaluated_roots(obj):
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    # The geometry set owns the curves: keep it alive while reading.
+    geometry = obj.evaluated_get(depsgraph).evaluated_geometry()
+    curves = geometry.curves
+    points = np.empty(len(curves.points) * 3, np.float32)
+    curves.attributes["position"].data.foreach_get("vector", points)
+    offsets = np.empty(len(curves.curves) + 1, np.int32)
+    curves.curve_offset_data.foreach_get("value", offsets)
+    return points.reshape(-1, 3)[offsets[:-1]]
+
+
+# 1. A flat grid: counts, attributes, roots on the surface.
+clear_scene()
+bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=8, size=2.0)
+grid = bpy.context.active_object
+settings = grid.pelage_fur
+settings.count, settings.points, settings.length, settings.seed = 3_000, 10, 0.1, 4
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+fur = fur_of(grid)
+curves = fur.data
+assert len(curves.curves) == 3_000, len(curves.curves)
+assert len(curves.points) == 30_000, len(curves.points)
+names = {a.name for a in curves.attributes}
+for name in ("position", "radius", "hair_id", "surface_uv_coordinate"):
+    assert name in names, (name, names)
+assert curves.surface == grid and curves.surface_uv_map == grid.data.uv_layers.active.name
+points, offsets = arrays(curves)
+assert np.all(np.diff(offsets) == 10)
+roots = points[offsets[:-1]]
+assert np.allclose(roots[:, 2], 0.0, atol=1e-6), "roots lie on the grid (z = 0)"
+assert np.all(np.abs(roots[:, :2]) <= 1.0 + 1e-6), "roots lie within the grid"
+tips = points[offsets[1:] - 1]
+assert np.all(tips[:, 2] > 0.02), "hairs grow out of the surface, along +Z"
+radius = np.empty(len(curves.points), np.float32)
+curves.attributes["radius"].data.foreach_get("value", radius)
+assert np.all(radius > 0) and np.all(radius[offsets[:-1]] > radius[offsets[1:] - 1]), "radius tapers"
+ids = np.empty(len(curves.curves), np.int32)
+curves.attributes["hair_id"].data.foreach_get("value", ids)
+assert len(np.unique(ids)) == len(ids), "hair ids are distinct"
+uvs = np.empty(len(curves.curves) * 2, np.float32)
+curves.attributes["surface_uv_coordinate"].data.foreach_get("vector", uvs)
+uvs = uvs.reshape(-1, 2)
+# The grid's UVs map [-1, 1]² to [0, 1]²: the root's UV says where it is.
+assert np.allclose(uvs, (roots[:, :2] + 1) / 2, atol=1e-4), "surface UVs match the roots"
+print("grid: 3,000 curves × 10 points; radius, hair_id, surface_uv_coordinate; roots on the surface")
+
+# The same seed grows the same fur (the operator is deterministic).
+bpy.ops.pelage.grow_fur()
+second = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+assert np.array_equal(arrays(second.data)[0], points)
+bpy.data.objects.remove(second)
+print("grid: the same settings grow the same points")
+
+# 2. A sphere that grows under a shape key: Deform Curves on Surface
+#    carries the fur.
+clear_scene()
+bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=24, ring_count=12)
+sphere = bpy.context.active_object
+sphere.pelage_fur.count = 2_000
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+fur = fur_of(sphere)
+assert any(m.type == "NODES" for m in fur.modifiers)
+rest = np.linalg.norm(evaluated_roots(fur), axis=1)
+assert rest.min() > 0.95 and rest.max() < 1.0 + 1e-4, (rest.min(), rest.max())
+sphere.shape_key_add(name="Basis")
+grown = sphere.shape_key_add(name="grown")
+co = np.empty(len(sphere.data.vertices) * 3, np.float32)
+grown.data.foreach_get("co", co)
+grown.data.foreach_set("co", co * 2.0)
+grown.value = 1.0
+moved = np.linalg.norm(evaluated_roots(fur), axis=1)
+assert np.allclose(moved, 2 * rest, rtol=1e-3), (moved[:4], rest[:4])
+print("sphere: the fur follows the surface when a shape key doubles it (Deform Curves on Surface)")
+
+# 3. A groom file drives the add-on; its errors reach the user.
+with tempfile.TemporaryDirectory() as folder:
+    good = os.path.join(folder, "fur.toml")
+    with open(good, "w") as f:
+        f.write('[mesh]\npath = "spot"\n[roots]\ncount = 700\n'
+                '[guides]\ngenerate = { count = 20, length = 0.05 }\n[finish]\npoints = 5\n')
+    clear_scene()
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=3)
+    ico = bpy.context.active_object
+    bpy.ops.mesh.uv_texture_add()
+    ico.pelage_fur.groom_file = good
+    assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+    assert len(fur_of(ico).data.curves) == 700 and len(fur_of(ico).data.points) == 3_500
+    bad = os.path.join(folder, "bad.toml")
+    with open(bad, "w") as f:
+        f.write('[mesh]\npath = "spot"\n[roots]\ncount = 700\ncolour = 3\n')
+    ico.pelage_fur.groom_file = bad
+    try:
+        bpy.ops.pelage.grow_fur()
+    except RuntimeError as error:
+        assert "bad.toml:5" in str(error) and "colour" in str(error), error
+    else:
+        raise AssertionError("a bad groom file must fail the operator")
+    print("groom file: grown on the active mesh; a bad key is reported with file and line")
+
+    # 4. Export buttons write pelage's own files.
+    ico.pelage_fur.groom_file = good
+    for ext in ("usdc", "abc"):
+        out = os.path.join(folder, f"fur.{ext}")
+        op = bpy.ops.pelage.export_usd if ext == "usdc" else bpy.ops.pelage.export_alembic
+        assert op(filepath=out) == {"FINISHED"}
+        assert pelage.read_curves(out).curve_count == 700
+    print("export: USD and Alembic written, 700 curves each")
+
+print("add-on: all checks passed")
