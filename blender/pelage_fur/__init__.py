@@ -12,6 +12,8 @@ import bpy
 from bpy.props import FloatProperty, IntProperty, PointerProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper
 
+from pelage import PelageError
+
 from . import fur
 
 
@@ -60,7 +62,7 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
             obj, grown = fur.grow_on_object(
                 context, surface, settings, progress=lambda done, total: wm.progress_update(done / total)
             )
-        except fur.pelage.PelageError as error:
+        except PelageError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         finally:
@@ -85,7 +87,7 @@ class _PelageExport(ExportHelper):
             mesh, _ = fur.mesh_to_pelage(surface, depsgraph)
             groom = fur.groom_from_settings(mesh, surface.pelage_fur)
             summary = groom.write(self.filepath)
-        except fur.pelage.PelageError as error:
+        except PelageError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         self.report({"INFO"}, f"pelage: wrote {summary['hairs']:,} hairs to {summary['path']}")

@@ -1,5 +1,8 @@
 """Blender meshes in, pelage grooms grown, Blender hair curves out.
 
+pelage is imported where it is used, so that ``curves_to_blender`` also
+serves scripts (and pelage's benchmark) that only have arrays.
+
 Everything here moves data in bulk (``foreach_get`` / ``foreach_set`` with
 numpy arrays): no Python loop runs per vertex, point or curve, so a
 million hairs become a Curves object in about a second.
@@ -12,8 +15,6 @@ Curves on Surface" node carries the fur when the mesh is animated.
 
 import numpy as np
 
-import pelage
-
 #: Attribute names on the created curves.
 HAIR_ID = "hair_id"
 COLOR = "color"
@@ -23,6 +24,8 @@ def mesh_to_pelage(obj, depsgraph):
     """The evaluated mesh of ``obj`` (modifiers applied), triangulated, as a
     ``pelage.Mesh`` in object space, with the active UV map's UVs per
     triangle corner. Returns ``(mesh, uv_map_name or None)``."""
+    import pelage
+
     evaluated = obj.evaluated_get(depsgraph)
     mesh = evaluated.to_mesh()
     try:
@@ -57,6 +60,8 @@ def groom_from_settings(mesh, settings):
     """A ``pelage.Groom`` on ``mesh`` from the panel's settings: the groom
     file when one is set (its ``[mesh]`` replaced by ``mesh``), else
     grown guides, roots and the clump, curl and noise operators."""
+    import pelage
+
     if settings.groom_file:
         import bpy
 

@@ -7,10 +7,12 @@ use crate::mesh::{PyMesh, offsets_column};
 use crate::to_py_err;
 use numpy::{PyArray1, PyArray2};
 use pelage::Curves;
+use pelage::groom::Generator;
 use pelage::io::{CurveBasis, CurvesExport, UpAxis, UsdOptions};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Hair curves: curve `i` is `points[offsets[i]:offsets[i + 1]]`
 /// (Blender's `CurvesGeometry`, USD's `BasisCurves`). The arrays are
@@ -19,11 +21,37 @@ use std::path::PathBuf;
 #[pyclass(name = "Curves", module = "pelage", frozen)]
 pub struct PyCurves {
     pub(crate) inner: Curves,
+    /// The generator that grew these curves: their memory goes back to it
+    /// when Python lets go of them, so the next part reuses it instead of
+    /// faulting in fresh pages (as the CLI's loop does).
+    recycle_into: Option<Arc<Generator>>,
 }
 
 impl PyCurves {
     pub(crate) fn new(inner: Curves) -> Self {
-        Self { inner }
+        Self {
+            inner,
+            recycle_into: None,
+        }
+    }
+
+    /// Curves grown by `generator`, handed back to it when dropped.
+    pub(crate) fn grown_by(inner: Curves, generator: Arc<Generator>) -> Self {
+        Self {
+            inner,
+            recycle_into: Some(generator),
+        }
+    }
+}
+
+impl Drop for PyCurves {
+    fn drop(&mut self) {
+        if let Some(generator) = self.recycle_into.take() {
+            let empty = Curves::new(Vec::new(), Vec::new(), vec![0]);
+            if let Ok(empty) = empty {
+                generator.recycle(std::mem::replace(&mut self.inner, empty));
+            }
+        }
     }
 }
 

@@ -307,7 +307,7 @@ impl PyGroom {
                 )));
             }
             let curves = py.detach(|| generator.part(p)).map_err(|e| self.error(e))?;
-            return Ok(PyCurves::new(curves));
+            return Ok(PyCurves::grown_by(curves, generator));
         }
         let mut grown = Vec::with_capacity(parts);
         for p in 0..parts {
@@ -456,7 +456,7 @@ impl PartIter {
         let curves = py
             .detach(|| self.generator.part(p))
             .map_err(|e| groom_error(e, self.from_values))?;
-        Ok(Some(PyCurves::new(curves)))
+        Ok(Some(PyCurves::grown_by(curves, self.generator.clone())))
     }
 
     fn __len__(&self) -> usize {

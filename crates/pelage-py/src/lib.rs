@@ -51,6 +51,13 @@ pub(crate) fn to_py_err(error: impl std::error::Error) -> PyErr {
 #[pymodule]
 fn _pelage(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // Benchmarks refuse to compare a debug build with a release one.
+    let profile = if cfg!(debug_assertions) {
+        "debug"
+    } else {
+        "release"
+    };
+    m.add("__build_profile__", profile)?;
     m.add("PelageError", m.py().get_type::<PelageError>())?;
     m.add_class::<mesh::PyMesh>()?;
     m.add_class::<curves::PyCurves>()?;

@@ -148,7 +148,7 @@ fn blender_case_text(hairs: u64) -> String {
 
 /// Generates every part (in memory, each handed back when counted, as the
 /// USD writer does); returns the hairs and points grown.
-fn grow_all(groom: &Groom) -> anyhow::Result<(u64, u64)> {
+pub(super) fn grow_all(groom: &Groom) -> anyhow::Result<(u64, u64)> {
     let generator = groom.generator(None)?;
     let (mut hairs, mut points) = (0u64, 0u64);
     for p in 0..generator.parts().len() {

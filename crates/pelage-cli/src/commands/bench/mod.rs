@@ -10,6 +10,7 @@ pub mod dynamics;
 pub mod groom;
 pub mod interp;
 pub mod io;
+pub mod python;
 pub mod render;
 pub mod sampler;
 pub mod shells;
@@ -43,6 +44,9 @@ pub enum BenchWhat {
     Io(io::IoBenchArgs),
     /// Animated grooms: a frame of deform and of regrow against growing once.
     Animation(animation::AnimationBenchArgs),
+    /// The Python package against the library, and the Blender add-on
+    /// making hair Curves (`--blender`).
+    Python(python::PythonBenchArgs),
 }
 
 /// The repository's test meshes (blub), where the benchmarks that go past
@@ -68,6 +72,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Shells(a) => shells::run(a),
         BenchWhat::Dynamics(a) => dynamics::run(a),
         BenchWhat::Animation(a) => animation::run(a),
+        BenchWhat::Python(a) => python::run(a),
     }
 }
 
