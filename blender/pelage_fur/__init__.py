@@ -29,7 +29,7 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     guides: IntProperty(name="Guides", description="Guide curves grown on the surface", default=200, min=1, soft_max=5_000)
     length: FloatProperty(name="Length", description="Guide length", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
     width: FloatProperty(name="Width", description="Hair width at the root", default=0.002, min=0.0, soft_max=0.01, subtype="DISTANCE", precision=4)
-    gravity: FloatProperty(name="Gravity", description="Pull of the guides toward -Y", default=0.3, min=0.0, max=1.0)
+    gravity: FloatProperty(name="Gravity", description="Pull of the guides downward (world -Z)", default=0.3, min=0.0, max=1.0)
     points: IntProperty(name="Points", description="Points per hair", default=12, min=2, max=64)
     clump: FloatProperty(name="Clump", description="How far hairs pull toward clump centres (0: off)", default=0.4, min=0.0, max=1.0)
     curl: FloatProperty(name="Curl", description="Curl radius, relative to the length (0: off)", default=0.0, min=0.0, max=2.0)

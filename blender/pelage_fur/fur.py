@@ -20,10 +20,33 @@ HAIR_ID = "hair_id"
 COLOR = "color"
 
 
+#: Blender's world is Z-up, pelage's (its gravity, its combs) Y-up, as USD's
+#: default: (x, y, z) in Blender is (x, z, -y) in pelage.
+Z_UP_TO_Y_UP = np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], dtype=np.float64)
+
+
+def to_pelage_space(obj):
+    """The 4×4 matrix from ``obj``'s local space to pelage's Y-up world:
+    the object's world matrix, then Z-up to Y-up. Gravity and combs then
+    point where they would in any Y-up DCC, whatever the object's
+    rotation."""
+    world = np.array(obj.matrix_world, dtype=np.float64)
+    to_y_up = np.eye(4)
+    to_y_up[:3, :3] = Z_UP_TO_Y_UP
+    return to_y_up @ world
+
+
+def transform_points(matrix, points):
+    """``points`` (n, 3) through the affine 4×4 ``matrix``, as float32."""
+    p = np.asarray(points, dtype=np.float64)
+    return (p @ matrix[:3, :3].T + matrix[:3, 3]).astype(np.float32)
+
+
 def mesh_to_pelage(obj, depsgraph):
     """The evaluated mesh of ``obj`` (modifiers applied), triangulated, as a
-    ``pelage.Mesh`` in object space, with the active UV map's UVs per
-    triangle corner. Returns ``(mesh, uv_map_name or None)``."""
+    ``pelage.Mesh`` in pelage's Y-up world (``to_pelage_space``), with the
+    active UV map's UVs per triangle corner. Returns ``(mesh, uv_map_name
+    or None)``."""
     import pelage
 
     evaluated = obj.evaluated_get(depsgraph)
@@ -32,6 +55,7 @@ def mesh_to_pelage(obj, depsgraph):
         mesh.calc_loop_triangles()
         positions = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
         mesh.vertices.foreach_get("co", positions)
+        positions = transform_points(to_pelage_space(obj), positions.reshape(-1, 3))
         count = len(mesh.loop_triangles)
         if count == 0:
             raise pelage.PelageError(f"{obj.name}: the mesh has no faces to grow fur on")
@@ -86,17 +110,19 @@ def groom_from_settings(mesh, settings):
     )
 
 
-def curves_to_blender(name, curves, surface=None, uv_map=None):
+def curves_to_blender(name, curves, surface=None, uv_map=None, matrix=None):
     """A new hair Curves datablock holding ``curves`` (a ``pelage.Curves``):
-    positions, ``radius`` (half pelage's widths), ``color`` when the groom
-    has colours, ``hair_id`` per curve (pelage's stable id, low 31 bits)
-    and ``surface_uv_coordinate`` bound to ``surface``'s ``uv_map``."""
+    positions (through the 4×4 ``matrix`` when given), ``radius`` (half
+    pelage's widths), ``color`` when the groom has colours, ``hair_id`` per
+    curve (pelage's stable id, low 31 bits) and ``surface_uv_coordinate``
+    bound to ``surface``'s ``uv_map``."""
     import bpy
 
     data = bpy.data.hair_curves.new(name)
     sizes = np.diff(curves.offsets.astype(np.int64))
     data.add_curves(sizes.tolist())
-    data.position_data.foreach_set("vector", curves.points.ravel())
+    points = curves.points if matrix is None else transform_points(matrix, curves.points)
+    data.position_data.foreach_set("vector", points.ravel())
     radius = data.attributes.get("radius") or data.attributes.new("radius", "FLOAT", "POINT")
     radius.data.foreach_set("value", curves.widths * np.float32(0.5))
     if curves.colors is not None:
@@ -147,7 +173,10 @@ def grow_on_object(context, surface, settings, progress=None):
     mesh, uv_map = mesh_to_pelage(surface, depsgraph)
     groom = groom_from_settings(mesh, settings)
     grown = groom.grow(progress=progress)
-    data = curves_to_blender(f"{surface.name} fur", grown, surface, uv_map)
+    # Back from pelage's Y-up world into the surface's local space, where
+    # Blender keeps the points of curves parented to it.
+    back = np.linalg.inv(to_pelage_space(surface))
+    data = curves_to_blender(f"{surface.name} fur", grown, surface, uv_map, back)
     obj = bpy.data.objects.new(f"{surface.name} fur", data)
     for collection in surface.users_collection:
         collection.objects.link(obj)

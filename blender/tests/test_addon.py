@@ -105,6 +105,20 @@ assert np.array_equal(arrays(second.data)[0], points)
 bpy.data.objects.remove(second)
 print("grid: the same settings grow the same points")
 
+# Gravity pulls down in Blender's world (-Z), whatever the object's
+# rotation: a wall (a grid stood up, facing -Y) grows hair that droops.
+clear_scene()
+bpy.ops.mesh.primitive_grid_add(size=2.0, rotation=(np.pi / 2, 0, 0))
+wall = bpy.context.active_object
+wall.pelage_fur.count, wall.pelage_fur.length, wall.pelage_fur.gravity = 1_000, 0.3, 1.0
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+local, offsets = arrays(fur_of(wall).data)
+matrix = np.array(wall.matrix_world)
+world = local @ matrix[:3, :3].T + matrix[:3, 3]
+droop = world[offsets[1:] - 1, 2] - world[offsets[:-1], 2]
+assert np.median(droop) < -0.05, np.median(droop)
+print(f"wall: hair droops under gravity along world -Z (median {np.median(droop):.3f})")
+
 # 2. A sphere that grows under a shape key: Deform Curves on Surface
 #    carries the fur.
 clear_scene()

@@ -414,3 +414,75 @@ fn a_hair_grown_past_the_float_range_is_an_error_at_the_operator_not_a_panic() {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 }
+
+/// A program hands the mesh and the guide curves over as values
+/// (the Python binding and the Blender add-on do).
+#[test]
+fn a_mesh_and_guides_given_as_values_replace_the_files() {
+    use pelage::groom::GroomInputs;
+    use pelage::settings::SettingsSource;
+    let text = "[mesh]\npath = \"no-such-mesh.obj\"\n\n[roots]\ncount = 400\n\n[guides]\ngenerate = { count = 12, length = 0.05 }\n";
+    let source = |text: &str| SettingsSource {
+        path: "values.toml".into(),
+        text: text.to_string(),
+    };
+    // Without a value the file's mesh is read, and is missing.
+    let missing = Groom::from_source_with_inputs(source(text), None, GroomInputs::default())
+        .expect_err("the mesh file does not exist");
+    assert!(
+        missing.to_string().contains("no-such-mesh.obj"),
+        "{missing}"
+    );
+    // A mesh value replaces [mesh]: roots land on it.
+    let blub = Arc::new(
+        pelage::Mesh::load(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../tests/data/meshes/blub_triangulated.obj"
+        ))
+        .unwrap(),
+    );
+    let inputs = GroomInputs {
+        mesh: Some(blub.clone()),
+        guides: None,
+    };
+    let on_blub = Groom::from_source_with_inputs(source(text), None, inputs).unwrap();
+    let curves = on_blub.generator(None).unwrap().part(0).unwrap();
+    assert_eq!(on_blub.mesh().triangle_count(), blub.triangle_count());
+    assert!(
+        curves
+            .roots()
+            .unwrap()
+            .iter()
+            .all(|r| r.is_valid_for(&blub))
+    );
+    // Guide curves as a value, with [guides] points: bound to the mesh.
+    let guides = on_blub.guides().curves().clone();
+    let no_guides = "[roots]\ncount = 400\n\n[guides]\npoints = 8\n";
+    let inputs = GroomInputs {
+        mesh: Some(blub.clone()),
+        guides: Some(guides.clone()),
+    };
+    let bound = Groom::from_source_with_inputs(source(no_guides), None, inputs).unwrap();
+    assert_eq!(bound.guides().len(), 12);
+    // Binding projects roots onto the surface and resamples: the same
+    // curves to float rounding.
+    let bound_points = bound.guides().curves().points();
+    assert_eq!(bound_points.len(), guides.points().len());
+    let worst = bound_points
+        .iter()
+        .zip(guides.points())
+        .map(|(a, b)| (*a - *b).abs().max_element())
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-5, "{worst}");
+    // Curves and a [guides] source together, or no mesh at all: errors
+    // naming the setting.
+    let twice = GroomInputs {
+        mesh: Some(blub),
+        guides: Some(guides),
+    };
+    let e = Groom::from_source_with_inputs(source(text), None, twice).unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("guides"), "{e}");
+    let e = Groom::from_source_with_inputs(source(no_guides), None, GroomInputs::default())
+        .unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("mesh"), "{e}");
+}

@@ -7,6 +7,7 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+__build_profile__: str  # "release" or "debug"
 
 _Path = Union[str, PathLike[str]]
 _Map = Union[float, str]

@@ -1,0 +1,95 @@
+"""Render fur grown by the add-on with Cycles, for the gallery:
+
+    tools/bpy-python blender/render_gallery.py EXTENSION.zip OUT.png
+
+Installs the extension into a fresh user folder, grows fur on Suzanne with
+"Grow pelage fur" (the panel's settings below), gives it Cycles'
+Principled Hair BSDF and renders 800×600 on the CPU (a few minutes on two
+cores). docs/gallery/blender-addon-suzanne.png is made this way.
+"""
+
+import math
+import os
+import sys
+import tempfile
+
+os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="pelage-blender-")
+
+import bpy  # noqa: E402
+import mathutils  # noqa: E402
+
+zip_path, out = os.path.abspath(sys.argv[-2]), os.path.abspath(sys.argv[-1])
+assert bpy.ops.extensions.package_install_files(
+    filepath=zip_path, repo="user_default", enable_on_install=True
+) == {"FINISHED"}
+
+for obj in list(bpy.data.objects):
+    bpy.data.objects.remove(obj)
+scene = bpy.context.scene
+
+bpy.ops.mesh.primitive_monkey_add(size=1.6)
+head = bpy.context.active_object
+head.rotation_euler = (0, 0, math.radians(-15))
+subsurf = head.modifiers.new("smooth", "SUBSURF")
+subsurf.levels = subsurf.render_levels = 2
+bpy.ops.object.shade_smooth()
+skin = bpy.data.materials.new("skin")
+skin.use_nodes = True
+skin.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.25, 0.12, 0.06, 1)
+head.data.materials.append(skin)
+
+settings = head.pelage_fur
+settings.count = 200_000
+settings.guides = 800
+settings.length = 0.05
+settings.width = 0.0025
+settings.gravity = 0.3
+settings.points = 10
+settings.clump = 0.35
+settings.curl = 0.0
+settings.noise = 0.15
+settings.seed = 3
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+fur = [o for o in bpy.data.objects if o.type == "CURVES"][0]
+hair = bpy.data.materials.new("hair")
+hair.use_nodes = True
+nodes = hair.node_tree.nodes
+nodes.remove(nodes["Principled BSDF"])
+bsdf = nodes.new("ShaderNodeBsdfHairPrincipled")
+bsdf.parametrization = "MELANIN"
+bsdf.inputs["Melanin"].default_value = 0.55
+bsdf.inputs["Melanin Redness"].default_value = 0.8
+bsdf.inputs["Roughness"].default_value = 0.35
+hair.node_tree.links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
+fur.data.materials.append(hair)
+
+camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+scene.collection.objects.link(camera)
+scene.camera = camera
+camera.location = (1.6, -4.4, 1.1)
+target = mathutils.Vector((0.0, 0.0, 0.05))
+camera.rotation_euler = (target - camera.location).to_track_quat("-Z", "Y").to_euler()
+camera.data.lens = 60
+key = bpy.data.objects.new("key", bpy.data.lights.new("key", "AREA"))
+key.data.energy, key.data.size = 900, 3
+key.location = (-3, -3, 4)
+key.rotation_euler = (mathutils.Vector((0, 0, 0)) - key.location).to_track_quat("-Z", "Y").to_euler()
+rim = bpy.data.objects.new("rim", bpy.data.lights.new("rim", "AREA"))
+rim.data.energy, rim.data.size = 700, 2
+rim.location = (2.5, 3, 2.5)
+rim.rotation_euler = (mathutils.Vector((0, 0, 0)) - rim.location).to_track_quat("-Z", "Y").to_euler()
+for light in (key, rim):
+    scene.collection.objects.link(light)
+world = bpy.data.worlds.new("world")
+world.use_nodes = True
+world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.05, 0.06, 0.08, 1)
+scene.world = world
+
+scene.render.engine = "CYCLES"
+scene.cycles.device = "CPU"
+scene.cycles.samples = 32
+scene.cycles.use_denoising = False
+scene.render.resolution_x, scene.render.resolution_y = 800, 600
+scene.render.filepath = out
+bpy.ops.render.render(write_still=True)
+print(f"rendered {out}: {len(fur.data.curves):,} curves grown by the add-on")
