@@ -9,7 +9,7 @@ Alembic" write the same groom with pelage's own writers.
 """
 
 import bpy
-from bpy.props import FloatProperty, IntProperty, PointerProperty, StringProperty
+from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper
 
 from pelage import PelageError
@@ -17,9 +17,47 @@ from pelage import PelageError
 from . import fur
 
 
+#: The panel's presets: settings, with lengths and widths as fractions of
+#: the object's largest dimension (so a preset suits a mouse or a bear).
+PRESETS = {
+    "SHORT": dict(count=60_000, guides=300, length=0.03, width=0.0015, gravity=0.2, points=8,
+                  clump=0.3, curl=0.0, noise=0.1),
+    "LONG": dict(count=40_000, guides=400, length=0.12, width=0.002, gravity=0.6, points=16,
+                 clump=0.6, curl=0.0, noise=0.15),
+    "CURLY": dict(count=40_000, guides=300, length=0.06, width=0.002, gravity=0.2, points=24,
+                  clump=0.4, curl=0.6, noise=0.05),
+    "STUBBLE": dict(count=150_000, guides=200, length=0.008, width=0.0008, gravity=0.0, points=4,
+                    clump=0.0, curl=0.0, noise=0.2),
+}
+SIZED = ("length", "width")
+
+
+def apply_preset(settings, context):
+    values = PRESETS.get(settings.preset)
+    obj = context.active_object if context is not None else None
+    if values is None or obj is None:
+        return
+    size = max(obj.dimensions) or 1.0
+    for name, value in values.items():
+        setattr(settings, name, value * size if name in SIZED else value)
+
+
 class PelageFurSettings(bpy.types.PropertyGroup):
     """What the panel grows (per object)."""
 
+    preset: EnumProperty(
+        name="Preset",
+        description="Fill the settings below for a kind of fur, sized to the object",
+        items=[
+            ("CUSTOM", "Custom", "The settings as they are"),
+            ("SHORT", "Short fur", "Dense short fur, lightly clumped"),
+            ("LONG", "Long fur", "Long clumped fur that hangs"),
+            ("CURLY", "Curly", "Curled locks"),
+            ("STUBBLE", "Stubble", "Very short, very dense, straight"),
+        ],
+        default="CUSTOM",
+        update=apply_preset,
+    )
     groom_file: StringProperty(
         name="Groom file",
         description="A pelage groom file (.toml); its [mesh] is replaced by this object. Empty: use the settings below",
@@ -128,6 +166,7 @@ class PELAGE_PT_fur(bpy.types.Panel):
         layout.prop(settings, "groom_file")
         column = layout.column(align=True)
         column.enabled = not settings.groom_file
+        column.prop(settings, "preset")
         for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed"):
             column.prop(settings, name)
         layout.operator(PELAGE_OT_grow_fur.bl_idname, icon="CURVES")

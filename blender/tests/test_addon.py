@@ -119,6 +119,11 @@ droop = world[offsets[1:] - 1, 2] - world[offsets[:-1], 2]
 assert np.median(droop) < -0.05, np.median(droop)
 print(f"wall: hair droops under gravity along world -Z (median {np.median(droop):.3f})")
 
+# A preset fills the settings, sized to the object.
+wall.pelage_fur.preset = "CURLY"
+assert wall.pelage_fur.curl > 0 and abs(wall.pelage_fur.length - 0.06 * max(wall.dimensions)) < 1e-6
+print("presets: Curly sets curl and a length sized to the object")
+
 # 2. A sphere that grows under a shape key: Deform Curves on Surface
 #    carries the fur.
 clear_scene()
