@@ -47,10 +47,7 @@ impl PyCurves {
 impl Drop for PyCurves {
     fn drop(&mut self) {
         if let Some(generator) = self.recycle_into.take() {
-            let empty = Curves::new(Vec::new(), Vec::new(), vec![0]);
-            if let Ok(empty) = empty {
-                generator.recycle(std::mem::replace(&mut self.inner, empty));
-            }
+            generator.recycle(std::mem::take(&mut self.inner));
         }
     }
 }

@@ -11,7 +11,8 @@ use crate::curves::PyCurves;
 use crate::mesh::PyMesh;
 use crate::to_py_err;
 use pelage::groom::{
-    Generator, Groom, GroomError, GroomInputs, GroomWriteError, part_file, part_slice,
+    AnimatedGroom, Generator, Groom, GroomError, GroomInputs, GroomWriteError, part_file,
+    part_slice,
 };
 use pelage::io::{CurvesExport, UsdOptions};
 use pelage::settings::SettingsSource;
@@ -50,6 +51,8 @@ pub struct PyGroom {
     from_values: bool,
     /// The generator for the groom's own seed, built on first use.
     generator: OnceLock<Arc<Generator>>,
+    /// An animated groom bound to its skin, built on first use.
+    animated: OnceLock<Arc<AnimatedGroom>>,
 }
 
 impl PyGroom {
@@ -61,6 +64,7 @@ impl PyGroom {
             groom,
             from_values,
             generator: OnceLock::new(),
+            animated: OnceLock::new(),
         };
         this.generator(py, None)?;
         Ok(this)
@@ -68,6 +72,23 @@ impl PyGroom {
 
     fn error(&self, error: GroomError) -> PyErr {
         groom_error(error, self.from_values)
+    }
+
+    /// The groom bound to its animated skin (cached); an error for a still
+    /// groom.
+    fn animated(&self, py: Python<'_>) -> PyResult<Arc<AnimatedGroom>> {
+        if let Some(a) = self.animated.get() {
+            return Ok(a.clone());
+        }
+        let animated = py
+            .detach(|| self.groom.animated(None))
+            .map_err(|e| self.error(e))?
+            .ok_or_else(|| {
+                PyValueError::new_err(
+                    "the groom is not animated: give it an [animation] table (animation={\"frames\": \"1-24\"}) or load it with frames=",
+                )
+            })?;
+        Ok(self.animated.get_or_init(|| Arc::new(animated)).clone())
     }
 
     /// The generator for `seed` (the groom's own when `None`, cached).
@@ -320,6 +341,46 @@ impl PyGroom {
             .detach(|| pelage::io::join(grown.iter()))
             .map_err(to_py_err)?;
         Ok(PyCurves::new(joined))
+    }
+
+    /// An animated groom at time code `time` (a frame number; fractions
+    /// are sub-frames): one part (`part=k`) or all of them joined. Roots
+    /// are bound at the rest frame and carried with the skin (`deform`),
+    /// or regrown from the guides at that time (`regrow`). For every
+    /// frame at once, `write()` is faster: it poses the skin once a frame.
+    #[pyo3(signature = (time, part = None))]
+    fn grow_frame(&self, py: Python<'_>, time: f64, part: Option<usize>) -> PyResult<PyCurves> {
+        if !time.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "time = {time}: a finite frame number"
+            )));
+        }
+        let animated = self.animated(py)?;
+        let parts = animated.generator().parts().len();
+        let range = match part {
+            Some(p) if p >= parts => {
+                return Err(PyIndexError::new_err(format!(
+                    "part {p}: the groom has {parts} parts (0 to {})",
+                    parts - 1
+                )));
+            }
+            Some(p) => p..p + 1,
+            None => 0..parts,
+        };
+        let grown = py
+            .detach(|| {
+                range
+                    .map(|p| animated.part(p, time))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(|e| self.error(e))?;
+        let curves = match grown.len() {
+            1 => grown.into_iter().next().unwrap_or_default(),
+            _ => py
+                .detach(|| pelage::io::join(grown.iter()))
+                .map_err(to_py_err)?,
+        };
+        Ok(PyCurves::new(curves))
     }
 
     /// Iterates over the parts, growing each as it is asked for, so memory

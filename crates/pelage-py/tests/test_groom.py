@@ -167,6 +167,18 @@ def test_an_animated_groom_writes_every_frame(tmp_path):
     last = pelage.read_curves(out, time=3)
     assert first.curve_count == last.curve_count == 500
     assert not np.array_equal(first.points, last.points), "the fur moves with the walk"
+    # One frame in memory equals that frame of the file.
+    frame3 = groom.grow_frame(3)
+    assert frame3.curve_count == 500
+    assert np.allclose(frame3.points, last.points, atol=1e-4)
+    with pytest.raises(IndexError):
+        groom.grow_frame(3, part=99)
+
+
+def test_a_still_groom_has_no_frames(groom):
+    assert groom.frames is None
+    with pytest.raises(ValueError, match="not animated"):
+        groom.grow_frame(1)
 
 
 def test_a_mesh_value_replaces_the_files_mesh(tmp_path):
