@@ -130,3 +130,33 @@ pub fn owned2<'py>(py: Python<'py>, v: Vec<Vec2>) -> PyResult<Bound<'py, PyArray
     let flat: Vec<f32> = bytemuck::allocation::cast_vec(v);
     PyArray1::from_vec(py, flat).reshape([n, 2])
 }
+
+/// A 2-D array as `(height, width, texels)`, float32, row-major.
+pub fn image(value: &Bound<'_, PyAny>, what: &str) -> PyResult<(u32, u32, Vec<f32>)> {
+    let py = value.py();
+    let numpy = py.import("numpy")?;
+    let array = numpy
+        .call_method1("ascontiguousarray", (value, numpy::dtype::<f32>(py)))
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    let array = array
+        .cast_into::<numpy::PyArrayDyn<f32>>()
+        .map_err(|_| PyValueError::new_err(format!("{what}: expected a numeric array")))?;
+    let (height, width) = match array.shape() {
+        [h, w] => (*h, *w),
+        shape => {
+            return Err(PyValueError::new_err(format!(
+                "{what}: expected a 2-D array (height, width), got shape {shape:?}"
+            )));
+        }
+    };
+    let narrow = |n: usize| {
+        u32::try_from(n)
+            .map_err(|_| PyValueError::new_err(format!("{what}: {n} texels across is too many")))
+    };
+    let readonly = array.readonly();
+    let texels = readonly
+        .as_slice()
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?
+        .to_vec();
+    Ok((narrow(height)?, narrow(width)?, texels))
+}

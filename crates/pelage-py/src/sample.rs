@@ -45,8 +45,9 @@ impl PySamples {
 }
 
 /// Samples `n` hair roots on `mesh`, distributed by `density`: a number
-/// (uniform), or a map string as in groom files (`"density.png:r"`,
-/// `"noise:frequency=8"`). Sample i depends only on (`seed`, `first` + i),
+/// (uniform), a map string as in groom files (`"density.png:r"`,
+/// `"noise:frequency=8"`), or a 2-D numpy array read like an image over
+/// the mesh's UVs (row 0 at the top, v = 1). Sample i depends only on (`seed`, `first` + i),
 /// so batches with `first=` add up to one big sample and any thread count
 /// gives the same roots.
 #[pyfunction]
@@ -101,10 +102,19 @@ pub fn sample(
     })
 }
 
-/// A map argument: a number (constant) or a map string.
+/// A map argument: a number (constant), a map string, or a 2-D array of
+/// texels (rows from the top of the image, as an image file's; repeated
+/// past the UV square, bilinear).
 pub(crate) fn map_argument(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Map> {
     if let Ok(x) = value.extract::<f64>() {
         return Ok(Map::Constant(x as f32));
+    }
+    if value.hasattr("ndim")? && value.getattr("ndim")?.extract::<usize>()? == 2 {
+        let (height, width, texels) = crate::convert::image(value, what)?;
+        let image =
+            pelage::map::ImageMap::from_texels(width, height, texels, pelage::map::Wrap::Repeat)
+                .map_err(|kind| PyValueError::new_err(format!("{what}: {kind}")))?;
+        return Ok(Map::Image(image));
     }
     let text: String = value.extract().map_err(|_| {
         PyValueError::new_err(format!(

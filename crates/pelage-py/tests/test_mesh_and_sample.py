@@ -99,3 +99,16 @@ def test_roots_lie_on_their_triangles(spot):
     u, v = s.barycentrics[:, 0], s.barycentrics[:, 1]
     rebuilt = (1 - u - v)[:, None] * p[tri[:, 0]] + u[:, None] * p[tri[:, 1]] + v[:, None] * p[tri[:, 2]]
     assert np.allclose(rebuilt, s.positions, atol=1e-5)
+
+
+def test_a_numpy_density_image_follows_the_uvs():
+    mesh = quad()  # UVs: positions / 4
+    # Two columns: density 0 on the left texel, 1 on the right (repeated
+    # past the UV square and bilinear, as an image file's texels are).
+    image = np.array([[0.0, 1.0]] * 4, dtype=np.float32)
+    painted = pelage.sample(mesh, 20_000, density=image, seed=1)
+    uniform = pelage.sample(mesh, 20_000, seed=1)
+    right = lambda s: float(np.mean(s.uvs[:, 0] >= 0.5))
+    assert right(painted) > right(uniform) + 0.15, (right(painted), right(uniform))
+    with pytest.raises(ValueError, match="2-D"):
+        pelage.sample(mesh, 10, density=np.zeros((2, 2, 2)))

@@ -60,7 +60,12 @@ class Samples:
     def __len__(self) -> int: ...
 
 def sample(
-    mesh: Mesh, n: int, *, density: Optional[_Map] = None, seed: int = 1, first: int = 0
+    mesh: Mesh,
+    n: int,
+    *,
+    density: Optional[Union[_Map, npt.NDArray[np.floating[Any]]]] = None,
+    seed: int = 1,
+    first: int = 0,
 ) -> Samples: ...
 
 class Curves:
