@@ -109,7 +109,7 @@ pub(crate) fn map_argument(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Map
     if let Ok(x) = value.extract::<f64>() {
         return Ok(Map::Constant(x as f32));
     }
-    if value.hasattr("ndim")? && value.getattr("ndim")?.extract::<usize>()? == 2 {
+    if value.hasattr("ndim")? && value.hasattr("shape")? {
         let (height, width, texels) = crate::convert::image(value, what)?;
         let image =
             pelage::map::ImageMap::from_texels(width, height, texels, pelage::map::Wrap::Repeat)
