@@ -4,8 +4,9 @@
 //! - The Stubble figure (Sik §4.2.2: spot ×2, 1.6 M hairs of 16 points,
 //!   clump + noise) loaded and grown part by part, by the library in this
 //!   process (the CLI's path) and by `pelage.Groom.load(...).parts()` in
-//!   Python (`python_grow.py`), medians from the same run. Target: Python
-//!   ≤ 1.05× the library.
+//!   Python (`python_grow.py`), in alternating rounds of the same run;
+//!   the ratio is the median of the rounds' ratios. Target: Python ≤
+//!   1.05× the library.
 //! - With `--blender`: 1 M hairs × 16 points made into a Blender hair
 //!   Curves object by the add-on's bulk transfer (`blender_curves.py`,
 //!   target ≤ 2 s), beside the peer measured in the same run: Blender's
@@ -177,9 +178,15 @@ fn measure_blender(hairs: u64, dir: &Path) -> anyhow::Result<BlenderCurves> {
     })
 }
 
+fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted.get(sorted.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
 pub fn run(args: &PythonBenchArgs) -> anyhow::Result<()> {
     let hairs: u64 = if args.quick { 200_000 } else { 1_600_000 };
-    let runs: usize = if args.quick { 3 } else { 5 };
+    let (rounds, runs): (usize, usize) = if args.quick { (3, 3) } else { (5, 3) };
     let dir = std::env::temp_dir().join(format!("pelage-bench-python-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let result = (|| -> anyhow::Result<()> {
@@ -187,15 +194,39 @@ pub fn run(args: &PythonBenchArgs) -> anyhow::Result<()> {
         std::fs::write(&groom_path, groom_text(hairs, "shepard"))?;
         let load_and_grow =
             || -> anyhow::Result<(u64, u64)> { grow_all(&Groom::load(&groom_path)?) };
-        // The library before and after Python, so drift on a noisy
-        // machine lands on both sides.
-        let (before, grown) = median_seconds(runs.div_ceil(2), true, load_and_grow);
-        let (hair_count, point_count) = grown?;
+        // Rounds of (library, Python), each side a median of `runs`; the
+        // ratio is taken within each round and its median reported, so
+        // the drift of a noisy machine lands on both sides of a ratio.
         let python = python_of(args);
-        eprintln!("growing through Python ({})…", python.display());
-        let py = measure_python(&python, &groom_path, runs).map_err(|e| format!("{e:#}"));
-        let (after, _) = median_seconds(runs / 2 + 1, false, load_and_grow);
-        let rust_s = before.min(after);
+        eprintln!(
+            "growing through the library and through Python ({})…",
+            python.display()
+        );
+        let mut library = Vec::new();
+        let mut through_python = Vec::new();
+        let mut ratios = Vec::new();
+        let mut grown = (0, 0);
+        let mut py: Result<PythonRun, String> = Err("not run".into());
+        for round in 0..rounds {
+            let (lib_s, counts) = median_seconds(runs, round == 0, load_and_grow);
+            grown = counts?;
+            library.push(lib_s);
+            py = measure_python(&python, &groom_path, runs).map_err(|e| format!("{e:#}"));
+            match &py {
+                Ok(p) => {
+                    through_python.push(p.seconds);
+                    ratios.push(p.seconds / lib_s);
+                }
+                Err(_) => break,
+            }
+        }
+        let (hair_count, point_count) = grown;
+        let rust_s = median(&library);
+        let ratio = (!ratios.is_empty()).then(|| median(&ratios));
+        let py = py.map(|p| PythonRun {
+            seconds: median(&through_python),
+            ..p
+        });
         let blender = match args.blender {
             true => {
                 let hairs = if args.quick { 100_000 } else { 1_000_000 };
@@ -207,7 +238,6 @@ pub fn run(args: &PythonBenchArgs) -> anyhow::Result<()> {
             }
             false => Err("run with --blender".to_string()),
         };
-        let ratio = py.as_ref().map(|p| p.seconds / rust_s).ok();
         if args.json {
             let report = serde_json::json!({
                 "hairs": hair_count,
@@ -220,6 +250,7 @@ pub fn run(args: &PythonBenchArgs) -> anyhow::Result<()> {
                         "version": p.version,
                         "profile": p.profile,
                         "over_library": ratio,
+                        "over_library_each_round": ratios,
                     }),
                     Err(why) => serde_json::json!({ "not_measured": why }),
                 },
@@ -247,6 +278,10 @@ pub fn run(args: &PythonBenchArgs) -> anyhow::Result<()> {
             "{:<60} {rust_s:>10.3} {:>12.2}",
             "library (the CLI's path), in this process", 1.0
         );
+        println!(
+            "{:<60} medians of {rounds} rounds, {runs} runs a side; the ratio: the median of the rounds'",
+            ""
+        );
         match &py {
             Ok(p) => {
                 println!(
@@ -256,8 +291,10 @@ pub fn run(args: &PythonBenchArgs) -> anyhow::Result<()> {
                         p.version, p.profile
                     ),
                     p.seconds,
-                    p.seconds / rust_s
+                    ratio.unwrap_or(f64::NAN)
                 );
+                let each: Vec<String> = ratios.iter().map(|r| format!("{r:.3}")).collect();
+                println!("{:<60} each round: {}", "", each.join(", "));
                 if p.profile != "release" {
                     println!(
                         "{:<60} warning: a {} wheel; build a release one (tools/python-wheel --release)",
