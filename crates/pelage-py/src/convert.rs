@@ -3,26 +3,47 @@
 
 use glam::{Vec2, Vec3};
 use numpy::ndarray::{ArrayView1, ArrayView2};
-use numpy::{Element, PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{Element, PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+
+/// `value` (anything `numpy.asarray` accepts) as a C-contiguous numpy
+/// array of `T`, converted if need be. `what` names the argument in
+/// errors.
+fn contiguous<'py, T: Element>(
+    value: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+    let py = value.py();
+    let numpy = py.import("numpy")?;
+    numpy
+        .call_method1("ascontiguousarray", (value, numpy::dtype::<T>(py)))
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?
+        .cast_into::<PyArrayDyn<T>>()
+        .map_err(|_| PyValueError::new_err(format!("{what}: expected a numeric array")))
+}
+
+/// `f` of the values of a contiguous array, in order.
+fn with_values<T: Element, R>(
+    array: &Bound<'_, PyArrayDyn<T>>,
+    what: &str,
+    f: impl FnOnce(&[T]) -> R,
+) -> PyResult<R> {
+    let readonly = array.readonly();
+    let values = readonly
+        .as_slice()
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    Ok(f(values))
+}
 
 /// A numpy array (or anything `numpy.asarray` accepts) as a contiguous
 /// `(n, WIDTH)` array of `T`, copied into a vector. `what` names the
 /// argument in errors.
-pub fn rows<'py, T: Element + Copy, const WIDTH: usize>(
-    value: &Bound<'py, PyAny>,
+pub fn rows<T: Element + Copy, const WIDTH: usize>(
+    value: &Bound<'_, PyAny>,
     what: &str,
 ) -> PyResult<Vec<[T; WIDTH]>> {
-    let py = value.py();
-    let numpy = py.import("numpy")?;
-    let dtype = numpy::dtype::<T>(py);
-    let array = numpy
-        .call_method1("ascontiguousarray", (value, dtype))
-        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
-    let array = array
-        .cast_into::<numpy::PyArrayDyn<T>>()
-        .map_err(|_| PyValueError::new_err(format!("{what}: expected a numeric array")))?;
+    let array = contiguous::<T>(value, what)?;
     let shape = array.shape().to_vec();
     let shape_ok = match shape.as_slice() {
         [_, w] => *w == WIDTH,
@@ -34,37 +55,42 @@ pub fn rows<'py, T: Element + Copy, const WIDTH: usize>(
             "{what}: expected an array of shape (n, {WIDTH}), got {shape:?}"
         )));
     }
-    let readonly = array.readonly();
-    let flat = readonly
-        .as_slice()
-        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
-    Ok(flat
-        .chunks_exact(WIDTH)
-        .map(|c| std::array::from_fn(|i| c[i]))
-        .collect())
+    with_values(&array, what, |flat| {
+        flat.chunks_exact(WIDTH)
+            .map(|c| std::array::from_fn(|i| c[i]))
+            .collect()
+    })
 }
 
 /// A 1-D array of `T`, copied.
-pub fn column<'py, T: Element + Copy>(value: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<T>> {
-    let py = value.py();
-    let numpy = py.import("numpy")?;
-    let array = numpy
-        .call_method1("ascontiguousarray", (value, numpy::dtype::<T>(py)))
-        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
-    let array = array
-        .cast_into::<numpy::PyArrayDyn<T>>()
-        .map_err(|_| PyValueError::new_err(format!("{what}: expected a numeric array")))?;
+pub fn column<T: Element + Copy>(value: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<T>> {
+    let array = contiguous::<T>(value, what)?;
     if array.ndim() != 1 {
         return Err(PyValueError::new_err(format!(
             "{what}: expected a 1-D array, got shape {:?}",
             array.shape()
         )));
     }
-    let readonly = array.readonly();
-    Ok(readonly
-        .as_slice()
-        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?
-        .to_vec())
+    with_values(&array, what, <[T]>::to_vec)
+}
+
+/// A 2-D array as `(height, width, texels)`, float32, row-major.
+pub fn image(value: &Bound<'_, PyAny>, what: &str) -> PyResult<(u32, u32, Vec<f32>)> {
+    let array = contiguous::<f32>(value, what)?;
+    let (height, width) = match array.shape() {
+        [h, w] => (*h, *w),
+        shape => {
+            return Err(PyValueError::new_err(format!(
+                "{what}: expected a 2-D array (height, width), got shape {shape:?}"
+            )));
+        }
+    };
+    let narrow = |n: usize| {
+        u32::try_from(n)
+            .map_err(|_| PyValueError::new_err(format!("{what}: {n} texels across is too many")))
+    };
+    let texels = with_values(&array, what, <[f32]>::to_vec)?;
+    Ok((narrow(height)?, narrow(width)?, texels))
 }
 
 pub fn vec3s(rows: Vec<[f32; 3]>) -> Vec<Vec3> {
@@ -107,56 +133,18 @@ pub fn view1<'py, T: Element>(
     Ok(array)
 }
 
-/// Floats of `Vec3`s, as a flat slice (Vec3 is three packed f32).
-pub fn flat3(v: &[Vec3]) -> &[f32] {
+/// The f32s of packed float vectors (`Vec2`, `Vec3`), as one flat slice.
+pub fn floats<V: bytemuck::Pod>(v: &[V]) -> &[f32] {
     bytemuck::cast_slice(v)
 }
 
-/// Floats of `Vec2`s, as a flat slice.
-pub fn flat2(v: &[Vec2]) -> &[f32] {
-    bytemuck::cast_slice(v)
-}
-
-/// Owned `(n, 3)` array from `Vec3`s (moved, not copied element-wise).
-pub fn owned3<'py>(py: Python<'py>, v: Vec<Vec3>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let n = v.len();
+/// An owned `(n, k)` float32 array from `n` values of `k` packed f32s
+/// (`Vec2`, `Vec3`): the vector is handed to numpy, not copied.
+pub fn owned_rows<V: bytemuck::Pod>(
+    py: Python<'_>,
+    v: Vec<V>,
+) -> PyResult<Bound<'_, PyArray2<f32>>> {
+    let (n, width) = (v.len(), size_of::<V>() / size_of::<f32>());
     let flat: Vec<f32> = bytemuck::allocation::cast_vec(v);
-    PyArray1::from_vec(py, flat).reshape([n, 3])
-}
-
-/// Owned `(n, 2)` array from `Vec2`s.
-pub fn owned2<'py>(py: Python<'py>, v: Vec<Vec2>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let n = v.len();
-    let flat: Vec<f32> = bytemuck::allocation::cast_vec(v);
-    PyArray1::from_vec(py, flat).reshape([n, 2])
-}
-
-/// A 2-D array as `(height, width, texels)`, float32, row-major.
-pub fn image(value: &Bound<'_, PyAny>, what: &str) -> PyResult<(u32, u32, Vec<f32>)> {
-    let py = value.py();
-    let numpy = py.import("numpy")?;
-    let array = numpy
-        .call_method1("ascontiguousarray", (value, numpy::dtype::<f32>(py)))
-        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
-    let array = array
-        .cast_into::<numpy::PyArrayDyn<f32>>()
-        .map_err(|_| PyValueError::new_err(format!("{what}: expected a numeric array")))?;
-    let (height, width) = match array.shape() {
-        [h, w] => (*h, *w),
-        shape => {
-            return Err(PyValueError::new_err(format!(
-                "{what}: expected a 2-D array (height, width), got shape {shape:?}"
-            )));
-        }
-    };
-    let narrow = |n: usize| {
-        u32::try_from(n)
-            .map_err(|_| PyValueError::new_err(format!("{what}: {n} texels across is too many")))
-    };
-    let readonly = array.readonly();
-    let texels = readonly
-        .as_slice()
-        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?
-        .to_vec();
-    Ok((narrow(height)?, narrow(width)?, texels))
+    PyArray1::from_vec(py, flat).reshape([n, width])
 }

@@ -2,8 +2,8 @@
 //! widths and optional attributes), with read-only numpy views, and
 //! `read_curves` / `write_curves` for every format pelage reads or writes.
 
-use crate::convert::{column, flat2, flat3, rows, vec2s, vec3s, view1, view2};
-use crate::mesh::{PyMesh, offsets_column};
+use crate::convert::{column, floats, rows, vec2s, vec3s, view1, view2};
+use crate::mesh::PyMesh;
 use crate::to_py_err;
 use numpy::{PyArray1, PyArray2};
 use pelage::Curves;
@@ -112,7 +112,7 @@ impl PyCurves {
     /// Points, (n, 3) float32.
     #[getter]
     fn points<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        view2(slf.clone().into_any(), flat3(slf.get().inner.points()), 3)
+        view2(slf.clone().into_any(), floats(slf.get().inner.points()), 3)
     }
 
     /// Offsets, (curves + 1,) uint32: curve i is points[offsets[i]:offsets[i+1]].
@@ -133,7 +133,7 @@ impl PyCurves {
         slf.get()
             .inner
             .colors()
-            .map(|c| view2(slf.clone().into_any(), flat3(c), 3))
+            .map(|c| view2(slf.clone().into_any(), floats(c), 3))
             .transpose()
     }
 
@@ -153,7 +153,7 @@ impl PyCurves {
         slf.get()
             .inner
             .normals()
-            .map(|n| view2(slf.clone().into_any(), flat3(n), 3))
+            .map(|n| view2(slf.clone().into_any(), floats(n), 3))
             .transpose()
     }
 
@@ -163,7 +163,7 @@ impl PyCurves {
         slf.get()
             .inner
             .root_uvs()
-            .map(|u| view2(slf.clone().into_any(), flat2(u), 2))
+            .map(|u| view2(slf.clone().into_any(), floats(u), 2))
             .transpose()
     }
 
@@ -199,7 +199,7 @@ impl PyCurves {
             return Ok(None);
         };
         let bary = roots.iter().map(|r| glam::Vec2::from(r.bary)).collect();
-        crate::convert::owned2(py, bary).map(Some)
+        crate::convert::owned_rows(py, bary).map(Some)
     }
 
     /// Number of curves.
@@ -340,4 +340,19 @@ pub(crate) fn parse_basis(basis: &str) -> PyResult<CurveBasis> {
             "basis = {other:?}: use \"catmull-rom\" or \"linear\""
         ))),
     }
+}
+
+/// Offsets: a 1-D integer column, checked to fit u32 before it narrows.
+fn offsets_column(value: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
+    let wide = column::<i64>(value, "offsets")?;
+    wide.into_iter()
+        .enumerate()
+        .map(|(i, o)| {
+            u32::try_from(o).map_err(|_| {
+                PyValueError::new_err(format!(
+                    "offsets[{i}] = {o}: offsets must be between 0 and 2^32 - 1"
+                ))
+            })
+        })
+        .collect()
 }

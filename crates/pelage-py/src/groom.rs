@@ -135,9 +135,7 @@ impl PyGroom {
         if let Ok(m) = mesh.cast::<PyMesh>() {
             inputs.mesh = Some(m.get().inner.clone());
         } else if let Ok(path) = mesh.extract::<PathBuf>() {
-            let mut section = toml::Table::new();
-            section.insert("path".into(), path_value(&path, "mesh")?);
-            table.insert("mesh".into(), section.into());
+            table.insert("mesh".into(), one_key("path", path_value(&path, "mesh")?));
         } else {
             table.insert("mesh".into(), to_toml(mesh, "mesh")?);
         }
@@ -145,9 +143,10 @@ impl PyGroom {
         if let Ok(c) = guides.cast::<PyCurves>() {
             inputs.guides = Some(c.get().inner.clone());
         } else if let Ok(path) = guides.extract::<PathBuf>() {
-            let mut section = toml::Table::new();
-            section.insert("file".into(), path_value(&path, "guides")?);
-            table.insert("guides".into(), section.into());
+            table.insert(
+                "guides".into(),
+                one_key("file", path_value(&path, "guides")?),
+            );
         } else if let Ok(section) = guides.cast::<PyDict>() {
             // `{"curves": Curves, "points": 8, "tolerance": 1e-3}`: curves
             // with the `[guides]` settings that bind them.
@@ -166,9 +165,7 @@ impl PyGroom {
         // `roots=200_000` is short for `roots={"count": 200_000}`.
         let roots = match roots.extract::<u64>() {
             Ok(count) if !roots.is_instance_of::<pyo3::types::PyBool>() => {
-                let mut section = toml::Table::new();
-                section.insert("count".into(), to_toml_int(count, "roots")?);
-                section.into()
+                one_key("count", to_toml_int(count, "roots")?)
             }
             _ => to_toml(roots, "roots")?,
         };
@@ -321,12 +318,7 @@ impl PyGroom {
         let generator = self.generator(py, seed)?;
         let parts = generator.parts().len();
         if let Some(p) = part {
-            if p >= parts {
-                return Err(PyIndexError::new_err(format!(
-                    "part {p}: the groom has {parts} parts (0 to {})",
-                    parts - 1
-                )));
-            }
+            check_part(p, parts)?;
             let curves = py.detach(|| generator.part(p)).map_err(|e| self.error(e))?;
             return Ok(PyCurves::grown_by(curves, generator));
         }
@@ -358,13 +350,7 @@ impl PyGroom {
         let animated = self.animated(py)?;
         let parts = animated.generator().parts().len();
         let range = match part {
-            Some(p) if p >= parts => {
-                return Err(PyIndexError::new_err(format!(
-                    "part {p}: the groom has {parts} parts (0 to {})",
-                    parts - 1
-                )));
-            }
-            Some(p) => p..p + 1,
+            Some(p) => check_part(p, parts).map(|()| p..p + 1)?,
             None => 0..parts,
         };
         let grown = py
@@ -427,10 +413,16 @@ impl PyGroom {
                 });
             }
         };
-        let (summary, written) = if let Some(animated) = py
-            .detach(|| self.groom.animated(seed))
-            .map_err(|e| self.error(e))?
-        {
+        // An animated groom with its own seed is the one grow_frame uses.
+        let animated = match (self.groom.animation(), seed) {
+            (None, _) => None,
+            (Some(_), None) => Some(self.animated(py)?),
+            (Some(_), Some(_)) => py
+                .detach(|| self.groom.animated(seed))
+                .map_err(|e| self.error(e))?
+                .map(Arc::new),
+        };
+        let (summary, written) = if let Some(animated) = animated {
             let parts = animated.generator().parts().len();
             let (range, path) = farm_slice(&output, part, parts)?;
             let options = UsdOptions {
@@ -525,6 +517,17 @@ impl PartIter {
     }
 }
 
+/// An error unless `p` names one of `parts` parts.
+fn check_part(p: usize, parts: usize) -> PyResult<()> {
+    if p < parts {
+        return Ok(());
+    }
+    Err(PyIndexError::new_err(format!(
+        "part {p}: the groom has {parts} parts (0 to {})",
+        parts.saturating_sub(1)
+    )))
+}
+
 /// The parts run `k` of `n` writes and the file it writes them to, or
 /// every part to `output`.
 fn farm_slice(
@@ -556,16 +559,13 @@ fn groom_error(error: GroomError, from_values: bool) -> PyErr {
     }
     message.push_str(": ");
     message.push_str(&error.kind.to_string());
-    let mut source = std::error::Error::source(&error.kind);
-    while let Some(cause) = source {
-        let text = cause.to_string();
-        if !message.contains(&text) {
-            message.push_str(": ");
-            message.push_str(&text);
-        }
-        source = cause.source();
-    }
+    let message = crate::with_causes(message, std::error::Error::source(&error.kind));
     crate::PelageError::new_err(message)
+}
+
+/// A table of one setting, `{ key = value }`.
+fn one_key(key: &str, value: toml::Value) -> toml::Value {
+    toml::Value::Table(toml::Table::from_iter([(key.to_string(), value)]))
 }
 
 fn path_value(path: &Path, what: &str) -> PyResult<toml::Value> {

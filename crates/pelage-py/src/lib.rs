@@ -35,17 +35,25 @@ pyo3::create_exception!(
 /// Turns any pelage error into a `PelageError` carrying its message and
 /// the messages of its causes.
 pub(crate) fn to_py_err(error: impl std::error::Error) -> PyErr {
-    let mut message = error.to_string();
-    let mut source = error.source();
-    while let Some(cause) = source {
-        let text = cause.to_string();
+    PelageError::new_err(with_causes(error.to_string(), error.source()))
+}
+
+/// `message`, then the message of `cause` and of each cause under it,
+/// leaving out those the text already holds (errors that print their
+/// cause and also give it as their source).
+pub(crate) fn with_causes(
+    mut message: String,
+    mut cause: Option<&(dyn std::error::Error + 'static)>,
+) -> String {
+    while let Some(error) = cause {
+        let text = error.to_string();
         if !message.contains(&text) {
             message.push_str(": ");
             message.push_str(&text);
         }
-        source = cause.source();
+        cause = error.source();
     }
-    PelageError::new_err(message)
+    message
 }
 
 #[pymodule]

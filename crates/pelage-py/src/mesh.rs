@@ -1,7 +1,7 @@
 //! `pelage.Mesh`: the surface hair grows on, loaded from a file or built
 //! from numpy arrays.
 
-use crate::convert::{column, flat3, rows, vec2s, vec3s, view2};
+use crate::convert::{floats, rows, vec2s, vec3s, view2};
 use crate::to_py_err;
 use numpy::PyArray2;
 use pelage::mesh::Uvs;
@@ -115,7 +115,7 @@ impl PyMesh {
     fn positions<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
         view2(
             slf.clone().into_any(),
-            flat3(slf.get().inner.positions()),
+            floats(slf.get().inner.positions()),
             3,
         )
     }
@@ -130,7 +130,7 @@ impl PyMesh {
     /// Vertex normals, (n, 3) float32, read-only.
     #[getter]
     fn normals<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        view2(slf.clone().into_any(), flat3(slf.get().inner.normals()), 3)
+        view2(slf.clone().into_any(), floats(slf.get().inner.normals()), 3)
     }
 
     /// UVs per triangle corner, (3m, 2) float32, or `None` without UVs.
@@ -143,7 +143,7 @@ impl PyMesh {
         let corners: Vec<glam::Vec2> = (0..mesh.triangle_count())
             .flat_map(|t| mesh.triangle_uvs(t).expect("the mesh has UVs"))
             .collect();
-        let array = crate::convert::owned2(slf.py(), corners)?;
+        let array = crate::convert::owned_rows(slf.py(), corners)?;
         Ok(Some(array))
     }
 
@@ -240,19 +240,4 @@ fn subdivide_checked(py: Python<'_>, mesh: Mesh, levels: u32) -> PyResult<Mesh> 
         )));
     }
     Ok(py.detach(|| mesh.subdivided(levels)))
-}
-
-/// Reads a 1-D integer column (used by curves for offsets).
-pub(crate) fn offsets_column(value: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
-    let wide = column::<i64>(value, "offsets")?;
-    wide.into_iter()
-        .enumerate()
-        .map(|(i, o)| {
-            u32::try_from(o).map_err(|_| {
-                PyValueError::new_err(format!(
-                    "offsets[{i}] = {o}: offsets must be between 0 and 2^32 - 1"
-                ))
-            })
-        })
-        .collect()
 }

@@ -2,7 +2,7 @@
 //! density sampler's sub-triangle records and alias table), as numpy
 //! arrays.
 
-use crate::convert::owned3;
+use crate::convert::owned_rows;
 use crate::mesh::PyMesh;
 use crate::to_py_err;
 use numpy::{PyArray1, PyArray2};
@@ -70,31 +70,29 @@ pub fn sample(
         Some(d) => map_argument(d, "density")?,
     };
     let mesh = mesh.inner.clone();
-    let roots: Vec<SurfacePoint> = py
+    let (roots, positions, normals, uvs) = py
         .detach(|| {
             let sampler = DensitySampler::new(&mesh, &density, DensitySamplerOptions::default())?;
-            Ok::<_, pelage::sample::SampleError>(sample_range(&sampler, seed, first..first + n))
+            let roots: Vec<SurfacePoint> = sample_range(&sampler, seed, first..first + n);
+            let positions: Vec<glam::Vec3> = roots.iter().map(|r| r.position(&mesh)).collect();
+            let normals: Vec<glam::Vec3> = roots.iter().map(|r| r.normal(&mesh)).collect();
+            let uvs: Option<Vec<glam::Vec2>> = mesh.has_uvs().then(|| {
+                roots
+                    .iter()
+                    .map(|r| r.uv(&mesh).unwrap_or_default())
+                    .collect()
+            });
+            Ok::<_, pelage::sample::SampleError>((roots, positions, normals, uvs))
         })
         .map_err(to_py_err)?;
-    let (positions, normals, uvs) = py.detach(|| {
-        let positions: Vec<glam::Vec3> = roots.iter().map(|r| r.position(&mesh)).collect();
-        let normals: Vec<glam::Vec3> = roots.iter().map(|r| r.normal(&mesh)).collect();
-        let uvs: Option<Vec<glam::Vec2>> = mesh.has_uvs().then(|| {
-            roots
-                .iter()
-                .map(|r| r.uv(&mesh).unwrap_or_default())
-                .collect()
-        });
-        (positions, normals, uvs)
-    });
     Ok(PySamples {
-        positions: owned3(py, positions)?.unbind(),
-        normals: owned3(py, normals)?.unbind(),
+        positions: owned_rows(py, positions)?.unbind(),
+        normals: owned_rows(py, normals)?.unbind(),
         uvs: uvs
-            .map(|u| crate::convert::owned2(py, u).map(Bound::unbind))
+            .map(|u| crate::convert::owned_rows(py, u).map(Bound::unbind))
             .transpose()?,
         triangles: PyArray1::from_vec(py, roots.iter().map(|r| r.tri).collect()).unbind(),
-        barycentrics: crate::convert::owned2(
+        barycentrics: crate::convert::owned_rows(
             py,
             roots.iter().map(|r| glam::Vec2::from(r.bary)).collect(),
         )?

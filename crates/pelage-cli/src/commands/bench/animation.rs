@@ -56,25 +56,11 @@ fn measure_blender(groom: &AnimatedGroom, twist_radians: f32) -> anyhow::Result<
     let report = super::run_bpy_case("blender_deform.py", script, |dir| {
         let generator = groom.generator();
         let mesh = generator.mesh();
-        let bytes = |v: &mut dyn Iterator<Item = f32>| -> Vec<u8> {
-            v.flat_map(f32::to_le_bytes).collect()
-        };
-        std::fs::write(
-            dir.join("positions.f32"),
-            bytes(&mut mesh.positions().iter().flat_map(|p| p.to_array())),
-        )?;
-        let triangles: Vec<u8> = mesh
-            .triangles()
-            .iter()
-            .flatten()
-            .flat_map(|i| i.to_le_bytes())
-            .collect();
-        std::fs::write(dir.join("triangles.u32"), triangles)?;
+        super::write_mesh_case(dir, mesh)?;
         let corners = (0..mesh.triangle_count())
             .map(|t| mesh.triangle_uvs(t).unwrap_or_default())
-            .flat_map(|uvs| uvs.into_iter().flat_map(|uv| uv.to_array()))
-            .collect::<Vec<f32>>();
-        std::fs::write(dir.join("corner_uvs.f32"), bytes(&mut corners.into_iter()))?;
+            .flat_map(|uvs| uvs.into_iter().flat_map(|uv| uv.to_array()));
+        super::write_le(&dir.join("corner_uvs.f32"), corners.map(f32::to_le_bytes))?;
         let (mut points, mut uvs, mut hairs) = (Vec::new(), Vec::new(), 0u64);
         for k in 0..generator.parts().len() {
             let part = generator.part(k)?;
@@ -83,13 +69,20 @@ fn measure_blender(groom: &AnimatedGroom, twist_radians: f32) -> anyhow::Result<
             uvs.extend(roots.iter().flat_map(|uv| uv.to_array()));
             hairs += part.curve_count() as u64;
         }
-        std::fs::write(dir.join("points.f32"), bytes(&mut points.into_iter()))?;
-        std::fs::write(dir.join("root_uvs.f32"), bytes(&mut uvs.into_iter()))?;
+        super::write_le(
+            &dir.join("points.f32"),
+            points.into_iter().map(f32::to_le_bytes),
+        )?;
+        super::write_le(
+            &dir.join("root_uvs.f32"),
+            uvs.into_iter().map(f32::to_le_bytes),
+        )?;
         let case = serde_json::json!({
             "hairs": hairs,
             "points_per_hair": generator.points_per_hair(),
             "frames": FRAMES,
             "twist_radians": twist_radians,
+            "addon_dir": super::addon_dir()?,
         });
         std::fs::write(dir.join("case.json"), case.to_string())?;
         Ok(())

@@ -6,7 +6,8 @@ the frames).
 Run by `pelage bench animation --peer blender` with Blender as a Python
 module:
     python blender_deform.py CASE_DIR
-CASE_DIR holds case.json (counts, frames, twist), positions.f32,
+CASE_DIR holds case.json (counts, frames, twist, the add-on's folder,
+whose fur.py makes the Deform Curves on Surface modifier), positions.f32,
 triangles.u32, corner_uvs.f32 (a UV per triangle corner), points.f32 (the
 groom grown at rest, every curve `points_per_hair` points) and
 root_uvs.f32 (a UV per curve). Prints one JSON line: the median seconds a
@@ -24,6 +25,8 @@ import numpy as np
 
 case_dir = Path(sys.argv[1])
 case = json.loads((case_dir / "case.json").read_text())
+sys.path.insert(0, case["addon_dir"])
+import fur as addon_fur  # noqa: E402  (blender/pelage_fur/fur.py)
 read = lambda name, dtype: np.fromfile(case_dir / name, dtype=dtype)
 positions = read("positions.f32", np.float32).reshape(-1, 3)
 triangles = read("triangles.u32", np.uint32).reshape(-1, 3)
@@ -62,15 +65,8 @@ curves.surface_uv_map = "UVMap"
 fur = bpy.data.objects.new("fur", curves)
 scene.collection.objects.link(fur)
 
-tree = bpy.data.node_groups.new("deform", "GeometryNodeTree")
-tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
-tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
-group_in = tree.nodes.new("NodeGroupInput")
-group_out = tree.nodes.new("NodeGroupOutput")
-deform = tree.nodes.new("GeometryNodeDeformCurvesOnSurface")
-tree.links.new(group_in.outputs["Geometry"], deform.inputs["Curves"])
-tree.links.new(deform.outputs["Curves"], group_out.inputs["Geometry"])
-fur.modifiers.new("deform", "NODES").node_group = tree
+# The add-on's modifier: Deform Curves on Surface in a node group.
+addon_fur.deform_on_surface_modifier(fur)
 
 times = []
 moved = 0

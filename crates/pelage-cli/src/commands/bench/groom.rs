@@ -58,22 +58,10 @@ struct BlenderRun {
 fn measure_blender(groom: &Groom, hairs: u64, runs: usize) -> anyhow::Result<BlenderRun> {
     let report = super::run_bpy_case("blender_hair.py", include_str!("blender_hair.py"), |dir| {
         let mesh = groom.mesh();
-        let floats = |v: &[glam::Vec3]| -> Vec<u8> {
-            v.iter()
-                .flat_map(|p| p.to_array())
-                .flat_map(f32::to_le_bytes)
-                .collect()
-        };
-        std::fs::write(dir.join("positions.f32"), floats(mesh.positions()))?;
-        let triangles: Vec<u8> = mesh
-            .triangles()
-            .iter()
-            .flatten()
-            .flat_map(|i| i.to_le_bytes())
-            .collect();
-        std::fs::write(dir.join("triangles.u32"), triangles)?;
+        super::write_mesh_case(dir, mesh)?;
         let guides = groom.guides();
-        std::fs::write(dir.join("guides.f32"), floats(guides.curves().points()))?;
+        let points = guides.curves().points().iter().flat_map(|p| p.to_array());
+        super::write_le(&dir.join("guides.f32"), points.map(f32::to_le_bytes))?;
         let case = serde_json::json!({
             "hairs": hairs,
             "area": mesh.surface_area(),

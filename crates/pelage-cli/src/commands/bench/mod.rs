@@ -86,7 +86,6 @@ pub fn run_bpy_case(
     script: &str,
     write_case: impl FnOnce(&std::path::Path) -> anyhow::Result<()>,
 ) -> anyhow::Result<serde_json::Value> {
-    use anyhow::Context;
     let python = tools_dir().join("bpy-python");
     anyhow::ensure!(python.exists(), "{} not found", python.display());
     let stem = name.trim_end_matches(".py");
@@ -106,17 +105,55 @@ pub fn run_bpy_case(
             Some(2) => anyhow::bail!("bpy could not be set up: {}", stderr.trim()),
             _ => anyhow::bail!("Blender's case failed: {}", stderr.trim()),
         }
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        let line = stdout
-            .lines()
-            .rev()
-            .find(|l| l.starts_with('{'))
-            .unwrap_or("");
-        serde_json::from_str(line)
-            .with_context(|| format!("unexpected output from Blender's case: {stdout:?}"))
+        last_json_line(&String::from_utf8_lossy(&out.stdout), name)
     })();
     let _ = std::fs::remove_dir_all(&dir);
     result
+}
+
+/// Writes numbers as their little-endian bytes, one after another: the
+/// arrays a Python case reads with `numpy.fromfile`.
+pub fn write_le<const N: usize>(
+    path: &std::path::Path,
+    values: impl IntoIterator<Item = [u8; N]>,
+) -> std::io::Result<()> {
+    std::fs::write(path, values.into_iter().flatten().collect::<Vec<u8>>())
+}
+
+/// Writes `mesh` into a case folder: `positions.f32` (xyz a vertex) and
+/// `triangles.u32` (three indices a triangle).
+pub fn write_mesh_case(dir: &std::path::Path, mesh: &pelage::Mesh) -> std::io::Result<()> {
+    let positions = mesh.positions().iter().flat_map(|p| p.to_array());
+    write_le(&dir.join("positions.f32"), positions.map(f32::to_le_bytes))?;
+    let triangles = mesh.triangles().iter().flatten();
+    write_le(
+        &dir.join("triangles.u32"),
+        triangles.map(|i| i.to_le_bytes()),
+    )
+}
+
+/// The repository's Blender add-on (blender/pelage_fur), whose `fur.py`
+/// the Blender cases import, beside the source tree this binary was built
+/// from.
+pub fn addon_dir() -> anyhow::Result<std::path::PathBuf> {
+    use anyhow::Context;
+    let addon = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../blender/pelage_fur");
+    addon
+        .canonicalize()
+        .with_context(|| format!("the add-on is not at {}", addon.display()))
+}
+
+/// The JSON object a case script printed last on `stdout`; `script`
+/// names it in the error.
+pub fn last_json_line(stdout: &str, script: &str) -> anyhow::Result<serde_json::Value> {
+    use anyhow::Context;
+    let line = stdout
+        .lines()
+        .rev()
+        .find(|l| l.starts_with('{'))
+        .unwrap_or("");
+    serde_json::from_str(line)
+        .with_context(|| format!("unexpected output from {script}: {stdout:?}"))
 }
 
 /// Median wall time in seconds of `runs` calls of `f` (after one warm-up

@@ -87,14 +87,7 @@ fn measure_python(python: &Path, groom: &Path, runs: usize) -> anyhow::Result<Py
         }
         anyhow::bail!("the Python run failed: {}", stderr.trim());
     }
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout
-        .lines()
-        .rev()
-        .find(|l| l.starts_with('{'))
-        .unwrap_or("");
-    let v: serde_json::Value = serde_json::from_str(line)
-        .with_context(|| format!("unexpected output from python_grow.py: {stdout:?}"))?;
+    let v = super::last_json_line(&String::from_utf8_lossy(&out.stdout), "python_grow.py")?;
     Ok(PythonRun {
         seconds: v["seconds"].as_f64().unwrap_or(f64::NAN),
         hairs: v["hairs"].as_u64().unwrap_or(0),
@@ -125,46 +118,31 @@ fn measure_blender(hairs: u64, dir: &Path) -> anyhow::Result<BlenderCurves> {
         .collect::<Result<_, _>>()?;
     let curves = pelage::io::join(parts.iter())?;
     drop(parts);
-    let addon = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../blender/pelage_fur");
     let report = super::run_bpy_case(
         "blender_curves.py",
         include_str!("blender_curves.py"),
         |case| {
-            let f32s = |v: &[f32]| -> Vec<u8> { v.iter().flat_map(|x| x.to_le_bytes()).collect() };
-            std::fs::write(
-                case.join("points.f32"),
-                f32s(
-                    &curves
-                        .points()
-                        .iter()
-                        .flat_map(|p| p.to_array())
-                        .collect::<Vec<_>>(),
-                ),
-            )?;
-            std::fs::write(case.join("widths.f32"), f32s(curves.widths()))?;
-            let offsets: Vec<u8> = curves
-                .offsets()
-                .iter()
-                .flat_map(|o| o.to_le_bytes())
-                .collect();
-            std::fs::write(case.join("offsets.u32"), offsets)?;
+            use super::write_le;
+            let points = curves.points().iter().flat_map(|p| p.to_array());
+            write_le(&case.join("points.f32"), points.map(f32::to_le_bytes))?;
+            let widths = curves.widths().iter().map(|w| w.to_le_bytes());
+            write_le(&case.join("widths.f32"), widths)?;
+            let offsets = curves.offsets().iter().map(|o| o.to_le_bytes());
+            write_le(&case.join("offsets.u32"), offsets)?;
             let uvs = curves.root_uvs().context("the groom has root UVs")?;
-            std::fs::write(
-                case.join("root_uvs.f32"),
-                f32s(&uvs.iter().flat_map(|u| u.to_array()).collect::<Vec<_>>()),
-            )?;
+            let uvs = uvs.iter().flat_map(|u| u.to_array());
+            write_le(&case.join("root_uvs.f32"), uvs.map(f32::to_le_bytes))?;
             let ids = curves.ids().context("the groom has ids")?;
-            let ids: Vec<u8> = ids.iter().flat_map(|i| i.to_le_bytes()).collect();
-            std::fs::write(case.join("ids.u64"), ids)?;
+            write_le(&case.join("ids.u64"), ids.iter().map(|i| i.to_le_bytes()))?;
             pelage::io::write_curves(
                 &case.join("groom.usdc"),
                 [("fur".to_string(), &curves)],
                 &pelage::io::CurvesExport::default(),
             )?;
-            let addon_dir = addon
-                .canonicalize()
-                .with_context(|| format!("the add-on is not at {}", addon.display()))?;
-            let json = serde_json::json!({ "addon_dir": addon_dir, "hairs": curves.curve_count() });
+            let json = serde_json::json!({
+                "addon_dir": super::addon_dir()?,
+                "hairs": curves.curve_count(),
+            });
             std::fs::write(case.join("case.json"), json.to_string())?;
             Ok(())
         },
