@@ -46,7 +46,14 @@ enum Command {
 
 fn main() -> ExitCode {
     quiet_vulkan_device_select();
+    remove_temporary_files_on_signals();
     let cli = Cli::parse();
+    // A run's outputs never replace its inputs (`sample -o in.ply`, a
+    // groom's `[output] path` naming its mesh). The benchmarks write and
+    // read back their own scratch files, over and over.
+    if !matches!(cli.command, Command::Bench(_)) {
+        pelage::io::protect_inputs();
+    }
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
         Command::Sample(args) => commands::sample::run(&args),
@@ -66,6 +73,27 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// On Ctrl-C (SIGINT), SIGTERM or SIGHUP: removes the temporary files of
+/// the outputs being written, so an interrupted run leaves every target as
+/// it was (absent, or its earlier complete version), then exits with the
+/// shell's code for the signal (128 + its number). Runs on a thread of its
+/// own (signal-hook's self-pipe), where removing files is safe.
+fn remove_temporary_files_on_signals() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return;
+    };
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            pelage::io::remove_temporary_files();
+            eprintln!(
+                "\ninterrupted: the files being written were removed; finished ones are complete"
+            );
+            std::process::exit(128 + signal);
+        }
+    });
 }
 
 /// The error and its causes on one line, "a: b: c", each cause left out

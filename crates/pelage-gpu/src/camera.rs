@@ -19,7 +19,11 @@ impl Camera {
     /// front: the camera backs off until all eight corners of the box fit a
     /// view of `aspect` (width / height), with a 6 % margin.
     pub fn framing(lo: Vec3, hi: Vec3, aspect: f32) -> Self {
-        let fov_y_degrees = 30.0f32;
+        Self::framing_with_fov(lo, hi, aspect, 30.0)
+    }
+
+    /// [`Self::framing`] for a vertical field of view of `fov_y_degrees`.
+    pub fn framing_with_fov(lo: Vec3, hi: Vec3, aspect: f32, fov_y_degrees: f32) -> Self {
         let center = 0.5 * (lo + hi);
         let direction = Vec3::new(1.0, 0.25, 0.35).normalize();
         let forward = -direction;
@@ -60,8 +64,40 @@ impl Camera {
             near,
             far,
         );
-        let view = glam::camera::rh::view::look_at_mat4(self.eye, self.target, Vec3::Y);
+        let view = glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.up());
         proj * view
+    }
+
+    /// The view's up direction: world +y, or, looking straight down or up
+    /// (where +y is the view direction and says nothing about roll), the
+    /// world −z or +z, so a top-down view shows +x to the right and −z up,
+    /// as Blender's and Houdini's top views do.
+    pub fn up(&self) -> Vec3 {
+        let forward = (self.target - self.eye).normalize_or_zero();
+        if forward.cross(Vec3::Y).length_squared() > 1e-8 {
+            Vec3::Y
+        } else if forward.y < 0.0 {
+            Vec3::NEG_Z
+        } else {
+            Vec3::Z
+        }
+    }
+
+    /// A scene file's camera: what it places by hand, the rest framed on
+    /// the box `(lo, hi)` at its field of view.
+    pub fn from_scene(
+        placed: &pelage::shell::SceneCamera,
+        lo: Vec3,
+        hi: Vec3,
+        aspect: f32,
+    ) -> Self {
+        let framed = Self::framing_with_fov(lo, hi, aspect, placed.fov_y_degrees);
+        let target = placed.target.unwrap_or(framed.target);
+        Self {
+            eye: placed.eye.unwrap_or(target + (framed.eye - framed.target)),
+            target,
+            fov_y_degrees: placed.fov_y_degrees,
+        }
     }
 }
 

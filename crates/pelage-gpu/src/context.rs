@@ -1,6 +1,7 @@
 //! The GPU connection: instance, adapter, device and queue.
 
 use crate::GpuError;
+use std::sync::{Arc, Mutex};
 
 /// An open GPU device. One per process is enough; renderers share it.
 #[derive(Debug)]
@@ -11,6 +12,11 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     adapter: wgpu::AdapterInfo,
     raw_adapter: wgpu::Adapter,
+    /// The first error wgpu reported outside an error scope (out of
+    /// memory, a limit passed), kept for [`Self::check`]. wgpu's default
+    /// is to panic, which would end the program with a backtrace instead
+    /// of a message.
+    errors: Arc<Mutex<Option<String>>>,
 }
 
 impl GpuContext {
@@ -58,12 +64,41 @@ impl GpuContext {
             adapter: info.name.clone(),
             message: e.to_string(),
         })?;
+        let errors = Arc::new(Mutex::new(None));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            let mut first = sink.lock().unwrap_or_else(|e| e.into_inner());
+            if first.is_none() {
+                *first = Some(match error {
+                    wgpu::Error::OutOfMemory { .. } => {
+                        "the GPU ran out of memory; draw a smaller image, or fewer layers, hairs or texels".to_string()
+                    }
+                    error => error.to_string(),
+                });
+            }
+        }));
         Ok(Self {
             device,
             queue,
             adapter: info,
             raw_adapter: adapter,
+            errors,
         })
+    }
+
+    /// The first error the GPU reported since the last check (an
+    /// allocation that failed, a limit passed), as a [`GpuError`]. Every
+    /// read-back checks it, so a picture drawn with a failed resource is
+    /// an error, never a blank image.
+    pub fn check(&self) -> Result<(), GpuError> {
+        let mut first = self.errors.lock().unwrap_or_else(|e| e.into_inner());
+        match first.take() {
+            Some(message) => Err(GpuError::Failed {
+                adapter: self.adapter_name(),
+                message,
+            }),
+            None => Ok(()),
+        }
     }
 
     /// The adapter, e.g. for a surface's capabilities.

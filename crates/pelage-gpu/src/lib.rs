@@ -51,6 +51,14 @@ pub enum GpuError {
         /// wgpu's message.
         message: String,
     },
+    /// The GPU reported an error while drawing (out of memory, a limit).
+    #[error("the GPU ({adapter}) failed: {message}")]
+    Failed {
+        /// The adapter in words.
+        adapter: String,
+        /// What it reported.
+        message: String,
+    },
     /// Reading the rendered image back failed.
     #[error("reading the rendered image back from the GPU failed: {0}")]
     Readback(String),

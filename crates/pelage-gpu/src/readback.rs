@@ -69,9 +69,13 @@ pub(crate) fn map_read<T>(
     buffer.map_async(wgpu::MapMode::Read, .., move |result| {
         let _ = sender.send(result);
     });
-    ctx.device
+    let waited = ctx
+        .device
         .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
+        .map_err(|e| GpuError::Readback(e.to_string()));
+    // A resource that could not be made explains everything after it.
+    ctx.check()?;
+    waited?;
     receiver
         .recv()
         .map_err(|e| GpuError::Readback(e.to_string()))?

@@ -12,11 +12,6 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-/// Most triangles a subdivided mesh may have: `subdivide` multiplies the
-/// count by 4 a level, and a typo (`subdivide=12`) should be an error, not
-/// an exhausted machine.
-const MAX_SUBDIVIDED_TRIANGLES: u64 = 1 << 28;
-
 /// A triangle mesh: positions, triangles, normals and optional UVs
 /// (per vertex or per corner). Immutable; build a new one to change it.
 #[pyclass(name = "Mesh", module = "pelage", frozen)]
@@ -232,12 +227,6 @@ fn subdivide_checked(py: Python<'_>, mesh: Mesh, levels: u32) -> PyResult<Mesh> 
     if levels == 0 {
         return Ok(mesh);
     }
-    let triangles = (mesh.triangle_count() as u64).saturating_mul(4u64.saturating_pow(levels));
-    if triangles > MAX_SUBDIVIDED_TRIANGLES {
-        return Err(PyValueError::new_err(format!(
-            "subdivide = {levels} would make {triangles} triangles from {}; at most {MAX_SUBDIVIDED_TRIANGLES} are allowed",
-            mesh.triangle_count()
-        )));
-    }
-    Ok(py.detach(|| mesh.subdivided(levels)))
+    py.detach(|| mesh.subdivided_within_limits(levels))
+        .map_err(|e| PyValueError::new_err(e.to_string()))
 }

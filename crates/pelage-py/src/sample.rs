@@ -12,9 +12,9 @@ use pelage::sample::{DensitySampler, DensitySamplerOptions, sample_range};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-/// Most roots one call samples: a `(n, 3)` float array of this many rows
-/// is 3 GB already; sample in batches (`first=`) for more.
-const MAX_SAMPLES: u64 = 1 << 28;
+/// Most roots one call samples (the CLI's `sample -n` ceiling); sample in
+/// batches (`first=`) for more.
+const MAX_SAMPLES: u64 = pelage::limits::MAX_SAMPLE_POINTS;
 
 /// Sampled roots: `positions` and `normals` (n, 3), `uvs` (n, 2) or
 /// `None` on a mesh without UVs, `triangles` (n,) and `barycentrics`

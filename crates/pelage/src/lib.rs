@@ -39,6 +39,7 @@ pub mod groom;
 pub mod guides;
 pub mod interp;
 pub mod io;
+pub mod limits;
 pub mod map;
 pub mod mesh;
 pub mod sample;

@@ -30,15 +30,55 @@ pub struct Place {
 impl SettingsSource {
     /// Reads a settings file.
     pub fn read(path: &Path) -> std::io::Result<Self> {
+        if path.is_dir() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "it is a folder; give a settings file (TOML)",
+            ));
+        }
+        crate::io::note_input(path);
+        let text = std::fs::read_to_string(path)?;
         Ok(Self {
             path: path.to_path_buf(),
-            text: std::fs::read_to_string(path)?,
+            // A byte-order mark (Windows editors) is not TOML.
+            text: match text.strip_prefix('\u{feff}') {
+                Some(rest) => rest.to_string(),
+                None => text,
+            },
         })
     }
 
     /// The folder relative paths are resolved against.
     pub fn folder(&self) -> &Path {
         self.path.parent().unwrap_or(Path::new(""))
+    }
+
+    /// A `[NAME]` header for one of `lists`, the tables written as arrays
+    /// (`[[ops]]`, `[[droplets]]`): TOML then reads it as one table and
+    /// serde's complaint ("invalid type: map, expected a sequence", or
+    /// "duplicate key" for the second) does not say what to write.
+    pub fn single_bracket_list(&self, lists: &[&str]) -> Option<(Place, String)> {
+        let mut offset = 0;
+        for line in self.text.split_inclusive('\n') {
+            let code = line.split('#').next().unwrap_or("").trim();
+            if let Some(name) = code.strip_prefix('[').and_then(|c| c.strip_suffix(']'))
+                && !name.starts_with('[')
+                && lists.contains(&name.trim())
+            {
+                let name = name.trim();
+                let start = offset + line.find('[').unwrap_or(0);
+                let mut place = self.place(start..start + code.len());
+                place.key = Some(format!("[{name}]"));
+                return Some((
+                    place,
+                    format!(
+                        "[{name}] holds a list: write [[{name}]] (two brackets) above each entry"
+                    ),
+                ));
+            }
+            offset += line.len();
+        }
+        None
     }
 
     /// Parses the text with serde; a failure comes with its place (unknown
@@ -93,13 +133,47 @@ impl SettingsSource {
     }
 }
 
+/// `line` with every byte inside a quoted string replaced by `x`: the same
+/// length and the same character boundaries outside strings.
+fn mask_strings(line: &str) -> String {
+    let mut out = Vec::with_capacity(line.len());
+    let mut quote = None;
+    let mut escaped = false;
+    for &b in line.as_bytes() {
+        match quote {
+            Some(q) => {
+                if escaped {
+                    escaped = false;
+                } else if b == b'\\' && q == b'"' {
+                    escaped = true;
+                } else if b == q {
+                    quote = None;
+                    out.push(b);
+                    continue;
+                }
+                out.push(b'x');
+            }
+            None => {
+                if b == b'"' || b == b'\'' {
+                    quote = Some(b);
+                }
+                out.push(b);
+            }
+        }
+    }
+    String::from_utf8(out).expect("only ASCII bytes were replaced, and by ASCII")
+}
+
 /// The dotted key at `offset` on the line starting at `line_start`, with
 /// its table: `roots.count`, `ops[2].clump.rate`.
 fn key_at(text: &str, line_start: usize, offset: usize) -> Option<String> {
     let line_end = text[line_start..]
         .find('\n')
         .map_or(text.len(), |i| line_start + i);
-    let line = &text[line_start..line_end];
+    // Strings' contents masked: a `=` or `{` inside a value such as
+    // "noise:frequency=6" is not TOML's.
+    let masked = mask_strings(&text[line_start..line_end]);
+    let line = masked.as_str();
     let in_line = offset - line_start;
     let trimmed = line.trim_start();
     if trimmed.starts_with('[') {
@@ -165,4 +239,136 @@ fn key_at(text: &str, line_start: usize, offset: usize) -> Option<String> {
         Some(t) => format!("{t}.{key}"),
         None => key,
     })
+}
+
+/// What a numeric setting must be: a range, each end open or closed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Bound {
+    /// `min ≤ value ≤ max`.
+    Within(f64, f64),
+    /// `min < value ≤ max`.
+    Above(f64, f64),
+}
+
+impl Bound {
+    /// `value ≥ min`, no ceiling.
+    pub const fn at_least(min: f64) -> Self {
+        Self::Within(min, f64::INFINITY)
+    }
+
+    /// `value > min`, no ceiling.
+    pub const fn more_than(min: f64) -> Self {
+        Self::Above(min, f64::INFINITY)
+    }
+
+    fn admits(self, v: f64) -> bool {
+        match self {
+            Self::Within(lo, hi) => v >= lo && v <= hi,
+            Self::Above(lo, hi) => v > lo && v <= hi,
+        }
+    }
+}
+
+impl std::fmt::Display for Bound {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let number = |v: f64| crate::limits::grouped(v);
+        match *self {
+            Self::Within(lo, hi) if hi.is_infinite() => write!(f, "use at least {}", number(lo)),
+            Self::Above(lo, hi) if hi.is_infinite() => write!(f, "use more than {}", number(lo)),
+            Self::Within(lo, hi) => write!(f, "use {} to {}", number(lo), number(hi)),
+            Self::Above(lo, hi) => {
+                write!(f, "use more than {} and at most {}", number(lo), number(hi))
+            }
+        }
+    }
+}
+
+/// A documented range of a numeric setting: `key` is its dotted path with
+/// array indices left out (`ops.clump.count` holds for every clump
+/// operator; an array value such as `gravity = [0, -9.8, 0]` holds for each
+/// element), and `why` is said when the value is refused.
+#[derive(Debug, Clone, Copy)]
+pub struct Rule {
+    /// Dotted key without indices.
+    pub key: &'static str,
+    /// The values allowed.
+    pub bound: Bound,
+    /// What the bound protects, said after it ("" for nothing).
+    pub why: &'static str,
+}
+
+impl SettingsSource {
+    /// Checks every number in the file: each must be finite and fit an
+    /// `f32` where it is a float (settings are single precision, and a NaN
+    /// would otherwise surface far away, blamed on another setting), and
+    /// those `rules` name must lie in their bounds. Call after
+    /// [`Self::deserialize`] succeeded; the error is the first offending
+    /// value's place and what is wrong with it.
+    pub fn check(&self, rules: &[Rule]) -> Result<(), (Place, String)> {
+        use toml::de::{DeTable, DeValue};
+        let Ok(table) = DeTable::parse(&self.text) else {
+            // Serde parsed the same text: nothing to check here.
+            return Ok(());
+        };
+        fn walk(
+            source: &SettingsSource,
+            rules: &[Rule],
+            path: &str,
+            value: &toml::Spanned<DeValue<'_>>,
+        ) -> Result<(), (Place, String)> {
+            let refuse = |message: String| Err((source.place(value.span()), message));
+            let number = match value.get_ref() {
+                DeValue::Table(table) => {
+                    for (key, value) in table {
+                        let path = match path {
+                            "" => key.get_ref().to_string(),
+                            _ => format!("{path}.{}", key.get_ref()),
+                        };
+                        walk(source, rules, &path, value)?;
+                    }
+                    return Ok(());
+                }
+                DeValue::Array(items) => {
+                    for item in items.iter() {
+                        walk(source, rules, path, item)?;
+                    }
+                    return Ok(());
+                }
+                DeValue::Float(f) => {
+                    let text = f.as_str();
+                    let v: f64 = text.replace('_', "").parse().unwrap_or(f64::NAN);
+                    if !v.is_finite() {
+                        return refuse(format!("{text} is not a finite number"));
+                    }
+                    if v.abs() > f32::MAX as f64 {
+                        return refuse(format!(
+                            "{text} is too large: settings are 32-bit floats, at most ±3.4e38"
+                        ));
+                    }
+                    v
+                }
+                DeValue::Integer(i) => {
+                    let digits = i.as_str().replace('_', "");
+                    match i128::from_str_radix(&digits, i.radix()) {
+                        Ok(v) => v as f64,
+                        Err(_) => return Ok(()),
+                    }
+                }
+                _ => return Ok(()),
+            };
+            for rule in rules.iter().filter(|r| r.key == path) {
+                if !rule.bound.admits(number) {
+                    let shown = source.text[value.span()].trim().to_string();
+                    let why = match rule.why {
+                        "" => String::new(),
+                        why => format!(" ({why})"),
+                    };
+                    return refuse(format!("{shown}: {}{why}", rule.bound));
+                }
+            }
+            Ok(())
+        }
+        let root = toml::Spanned::new(table.span(), DeValue::Table(table.into_inner()));
+        walk(self, rules, "", &root)
+    }
 }

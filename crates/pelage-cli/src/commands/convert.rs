@@ -29,7 +29,7 @@ pub struct ConvertArgs {
     #[arg(long, value_enum, default_value_t = UpAxisArg::Y)]
     pub up_axis: UpAxisArg,
     /// USD metersPerUnit.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = super::args::positive)]
     pub meters_per_unit: f64,
     /// Also write this mesh (or `spot`, the embedded one) into the USD file
     /// as the skin, so it opens complete in usdview or Blender.

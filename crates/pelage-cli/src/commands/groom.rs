@@ -35,9 +35,9 @@ pub struct GroomArgs {
     /// layer is text: name OUTPUT .usda).
     #[arg(long, conflicts_with = "part")]
     pub assemble: bool,
-    /// Worker threads (default: all cores). The output is identical for
-    /// any number.
-    #[arg(long)]
+    /// Worker threads (default: all cores; more than the machine runs at
+    /// once are capped). The output is identical for any number.
+    #[arg(long, value_parser = super::args::threads)]
     pub threads: Option<usize>,
     /// Override the groom file's seed.
     #[arg(long)]
@@ -84,9 +84,15 @@ fn parse_part(s: &str) -> Result<(usize, usize), String> {
 }
 
 pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
-    if let Some(threads) = args.threads {
+    if let Some(wanted) = args.threads {
+        let (threads, capped) = super::args::worker_threads(wanted);
+        if capped {
+            eprintln!(
+                "note: --threads {wanted}: this machine runs {threads} at once; using {threads}"
+            );
+        }
         rayon::ThreadPoolBuilder::new()
-            .num_threads(threads.max(1))
+            .num_threads(threads)
             .build_global()
             .context("cannot set up the worker threads")?;
     }
@@ -134,6 +140,9 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         .iter()
         .map(|p| p.hair_count)
         .sum();
+    // Positions alone (12 bytes a point) are a floor of any format's size.
+    let points = *file.finish.points.get_ref() as u64;
+    pelage::io::check_free_space(&path, planned.saturating_mul(points).saturating_mul(12))?;
     let bar = if args.quiet {
         ProgressBar::hidden()
     } else {

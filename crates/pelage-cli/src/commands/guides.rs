@@ -20,7 +20,8 @@ pub struct GuidesArgs {
     /// The mesh (.obj, .ply, .gltf, .glb); without it, the embedded Spot.
     pub mesh: Option<PathBuf>,
     /// Number of guides to grow.
-    #[arg(short = 'n', long = "count", default_value_t = 500)]
+    #[arg(short = 'n', long = "count", default_value_t = 500,
+          value_parser = super::args::count_up_to::<usize>(pelage::limits::MAX_GUIDES, "guides"))]
     pub count: usize,
     /// Guide length, a map (`0.1`, `length.png:r`, `noise:…`).
     #[arg(long, default_value = "0.1")]
@@ -38,13 +39,14 @@ pub struct GuidesArgs {
     #[arg(long, value_name = "IMAGE", conflicts_with = "comb")]
     pub comb_map: Option<String>,
     /// Multiplies the comb map's direction.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = super::args::finite)]
     pub comb_strength: f32,
     /// Gravity's pull (world −Y) relative to the normal.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = super::args::finite)]
     pub gravity: f32,
     /// Points per guide.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 8,
+          value_parser = super::args::count_up_to::<usize>(pelage::limits::MAX_CURVE_POINTS, "points"))]
     pub points: usize,
     /// Seed of the roots.
     #[arg(long, default_value_t = 1)]
@@ -54,7 +56,7 @@ pub struct GuidesArgs {
     #[arg(long, value_name = "CURVES")]
     pub from: Option<PathBuf>,
     /// With --from: the farthest a root may be from the surface.
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = 1e-3, value_parser = super::args::positive_f32)]
     pub tolerance: f32,
     /// Output: .usdc (or .usd), .usda, .hair, .ply, .rib or .pbrt.
     #[arg(short, long)]

@@ -32,10 +32,10 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_vec3)]
     pub target: Option<[f32; 3]>,
     /// Vertical field of view in degrees.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, value_parser = super::args::field_of_view)]
     pub fov: f32,
     /// Point radius in pixels.
-    #[arg(long, default_value_t = 1.5)]
+    #[arg(long, default_value_t = 1.5, value_parser = super::args::positive_f32)]
     pub point_radius: f32,
     /// A colour texture (PNG) for the mesh, read at its UVs. The embedded
     /// Spot uses its own unless `--no-texture`.
@@ -51,7 +51,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "RANGE", value_parser = parse_frames)]
     pub frames: Option<pelage::anim::FrameRange>,
     /// Frames per second of the GIF.
-    #[arg(long, default_value_t = 24.0)]
+    #[arg(long, default_value_t = 24.0, value_parser = super::args::positive)]
     pub fps: f64,
 }
 
@@ -59,29 +59,7 @@ fn parse_frames(s: &str) -> Result<pelage::anim::FrameRange, String> {
     pelage::anim::FrameRange::parse(s).map_err(|e| e.to_string())
 }
 
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("{s:?} is not WIDTHxHEIGHT, e.g. 1280x720"))?;
-    let parse = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("{v:?} is not a whole number"))
-    };
-    Ok((parse(w)?, parse(h)?))
-}
-
-pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
-    let parts: Vec<f32> = s
-        .split(',')
-        .map(|v| {
-            v.trim()
-                .parse::<f32>()
-                .map_err(|_| format!("{v:?} is not a number"))
-        })
-        .collect::<Result<_, _>>()?;
-    <[f32; 3]>::try_from(parts).map_err(|_| format!("{s:?} is not X,Y,Z"))
-}
+pub use super::args::{size as parse_size, vec3 as parse_vec3};
 
 /// What a file given to `pelage render` holds.
 #[derive(Debug, PartialEq)]
@@ -182,7 +160,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
 
 /// The skin's colour texture (`--texture`).
 fn load_texture(path: &Path) -> anyhow::Result<image::RgbaImage> {
-    Ok(image::open(path)
+    Ok(pelage::map::open_image(path)
         .with_context(|| format!("cannot read the texture {}", path.display()))?
         .to_rgba8())
 }

@@ -28,7 +28,8 @@ pub struct SampleArgs {
     #[arg(long, default_value = "1")]
     pub density: String,
     /// Number of points.
-    #[arg(short = 'n', long = "count")]
+    #[arg(short = 'n', long = "count",
+          value_parser = super::args::count_up_to::<u64>(pelage::limits::MAX_SAMPLE_POINTS, "points"))]
     pub count: u64,
     /// Seed: the same seed gives the same points, on any number of threads.
     #[arg(long, default_value_t = 0)]

@@ -21,13 +21,13 @@ pub struct ShellsArgs {
     pub output: PathBuf,
     /// Draw a sequence of this many frames (overrides the scene's
     /// `[animation] frames`) into the output folder, with `shells.gif`.
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::count_up_to::<u32>(pelage::limits::MAX_FRAMES, "frames"))]
     pub frames: Option<u32>,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Draw this moment of the scene (seconds) for a single frame.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = super::args::finite)]
     pub time: f32,
     /// Also write the wetness mask (as Silva Fig. 11's insets) next to each
     /// image, as `*-mask.png`.

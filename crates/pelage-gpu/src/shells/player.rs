@@ -40,10 +40,10 @@ impl<'s> ShellScenePlayer<'s> {
         let renderer = ShellRenderer::new(ctx, features);
         let model = renderer.upload_scene(ctx, scene)?;
         let target = ShellTarget::new(ctx, &renderer, width, height)?;
-        let camera = scene.camera.map(|c| Camera {
-            eye: c.eye,
-            target: c.target,
-            fov_y_degrees: c.fov_y_degrees,
+        let camera = scene.camera.map(|c| {
+            let (lo, hi) = scene.mesh.bounds();
+            let l = Vec3::splat(scene.fur.length);
+            Camera::from_scene(&c, lo - l, hi + l, width as f32 / height as f32)
         });
         let view = ShellView::new(
             camera,

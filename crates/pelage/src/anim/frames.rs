@@ -6,7 +6,7 @@ use std::fmt;
 
 /// The most frames one range may hold: a range is expanded into a list,
 /// and a typo such as `1-10000000` should be an error, not minutes of work.
-pub const MAX_FRAMES: usize = 100_000;
+pub const MAX_FRAMES: usize = crate::limits::MAX_FRAMES as usize;
 
 /// A sorted list of distinct whole frames.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -50,7 +50,12 @@ impl FrameRange {
                 return Err(fail(format!("step {step}: it must be at least 1")));
             }
             // A leading '-' is a negative frame, not a range.
-            let (first, last) = match span[1..].find('-').map(|i| i + 1) {
+            let dash = span
+                .char_indices()
+                .skip(1)
+                .find(|&(_, c)| c == '-')
+                .map(|(i, _)| i);
+            let (first, last) = match dash {
                 Some(i) => (number(&span[..i])?, number(&span[i + 1..])?),
                 None => {
                     let f = number(span)?;

@@ -102,6 +102,7 @@ impl AnimatedSkin {
     /// mesh moves by its `points` samples; anything else stands still.
     pub fn load(path: &Path, options: &SkinOptions) -> Result<Self, MeshError> {
         let name = path.display().to_string();
+        crate::io::note_input(path);
         if !(options.fps.is_finite() && options.fps > 0.0) {
             return Err(MeshError::whole(
                 name,

@@ -161,10 +161,10 @@ impl MeshSection {
             "spot" => crate::assets::spot(),
             path => crate::Mesh::load(folder.join(path))?,
         };
-        Ok(match self.subdivide {
-            0 => mesh,
-            n => mesh.subdivided(n),
-        })
+        match self.subdivide {
+            0 => Ok(mesh),
+            n => mesh.subdivided_within_limits(n),
+        }
     }
 }
 

@@ -18,6 +18,7 @@ use super::spec::{
 use crate::curves::{CurveArrays, Curves};
 use crate::guides::Guides;
 use crate::interp::Interpolator;
+use crate::limits;
 use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
 use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, salts, sample_range};
@@ -115,6 +116,36 @@ impl Generator {
                 "finish.points",
                 GroomErrorKind::Invalid("hairs need at least 2 points".into()),
             ));
+        }
+        // Groom files are checked as they are read; grooms built in code
+        // (the Python package, tests) meet the same ceilings here.
+        let ceiling = |key: &str, value: u64, max: u64, what: &str| {
+            limits::check_count(value, max, false, what)
+                .map_err(|m| spec.error(key, GroomErrorKind::Invalid(m)))
+        };
+        ceiling("roots.count", count, limits::MAX_HAIRS, "hairs")?;
+        ceiling(
+            "finish.points",
+            points as u64,
+            limits::MAX_CURVE_POINTS,
+            "points",
+        )?;
+        for (k, op) in spec.ops.iter().enumerate() {
+            match op {
+                GroomOp::Clump(c) => ceiling(
+                    &format!("ops[{k}].clump.count"),
+                    c.count,
+                    limits::MAX_CLUMPS,
+                    "clumps",
+                )?,
+                GroomOp::Strands(s) => ceiling(
+                    &format!("ops[{k}].strands.count"),
+                    u64::from(s.count),
+                    limits::MAX_STRANDS,
+                    "hairs a strand",
+                )?,
+                _ => {}
+            }
         }
         let (sampler, layout, interpolator) = match shared {
             Some(g) => {

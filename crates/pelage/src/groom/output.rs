@@ -207,9 +207,15 @@ pub fn write_assembly(
     part_files: &[PathBuf],
     options: &UsdOptions,
 ) -> Result<(Vec3, Vec3), WriteError> {
+    // Named after the layer being written, the message after the file at
+    // fault (a part file that cannot be read, or the layer's own name).
     let fail = |file: &Path, message: String| WriteError {
-        path: file.to_path_buf(),
-        error: std::io::Error::other(message),
+        path: path.to_path_buf(),
+        error: std::io::Error::other(if file == path {
+            message
+        } else {
+            format!("{}: {message}", file.display())
+        }),
     };
     if CurvesFormat::from_path(path) != Some(CurvesFormat::Usda) {
         return Err(fail(
@@ -227,7 +233,7 @@ pub fn write_assembly(
             })
             .map_err(|e| fail(file, format!("cannot read the part file: {e}")))?;
         if binary {
-            let bounds = read_usd_extent(file).map_err(|e| fail(file, e.to_string()))?;
+            let bounds = read_usd_extent(file).map_err(|e| fail(path, e.to_string()))?;
             extents.push(bounds);
             continue;
         }
@@ -235,8 +241,25 @@ pub fn write_assembly(
             .map(std::io::BufReader::new)
             .map_err(|e| fail(file, format!("cannot read the part file: {e}")))?;
         let mut bounds: Option<(Vec3, Vec3)> = None;
+        // A part file cut short (a run killed while copying it, a full
+        // disk) or not USD at all must not be referenced as if whole: its
+        // extent would be silently missing from the assembly's.
+        let (mut header, mut depth, mut lines) = (false, 0i64, 0usize);
         for line in reader.lines() {
             let line = line.map_err(|e| fail(file, format!("cannot read the part file: {e}")))?;
+            if lines == 0 {
+                header = line.starts_with("#usda ");
+            }
+            lines += 1;
+            let mut quoted = false;
+            for c in line.chars() {
+                match c {
+                    '"' => quoted = !quoted,
+                    '{' | '(' if !quoted => depth += 1,
+                    '}' | ')' if !quoted => depth -= 1,
+                    _ => {}
+                }
+            }
             let Some(values) = line.trim_start().strip_prefix("float3[] extent = ") else {
                 continue;
             };
@@ -252,6 +275,20 @@ pub fn write_assembly(
                     None => (lo, hi),
                 });
             }
+        }
+        if !header {
+            return Err(fail(
+                file,
+                "not a USD part file (it does not start with `#usda`); grow its run again".into(),
+            ));
+        }
+        if depth != 0 {
+            return Err(fail(
+                file,
+                format!(
+                    "the part file is incomplete (cut short after {lines} lines); grow its run again"
+                ),
+            ));
         }
         // A run whose parts all grew nothing has no prims and no extent;
         // it is still referenced, so the layer lists every run.

@@ -3,9 +3,102 @@
 
 use super::error::{GroomError, GroomErrorKind};
 use super::file::{GroomFile, MapText, MapValue};
+use crate::limits::*;
 use crate::map::Map;
-use crate::settings::SettingsSource;
+use crate::settings::{Bound, Rule, SettingsSource};
 use std::path::Path;
+
+/// The documented range of every numeric groom setting that has one
+/// (docs/groom-format.md, docs/limits.md), checked when the file is read.
+/// Map-valued settings are checked here when written as numbers.
+const GROOM_RULES: &[Rule] = &[
+    rule(
+        "mesh.subdivide",
+        Bound::Within(0.0, MAX_SUBDIVIDE as f64),
+        "each step makes 4 triangles of 1",
+    ),
+    rule(
+        "roots.count",
+        Bound::Within(1.0, MAX_HAIRS as f64),
+        "pelage's hair limit, docs/limits.md",
+    ),
+    rule("roots.parts", Bound::Within(1.0, MAX_PARTS as f64), ""),
+    rule(
+        "guides.points",
+        Bound::Within(2.0, MAX_CURVE_POINTS as f64),
+        "points per guide",
+    ),
+    rule("guides.tolerance", Bound::at_least(0.0), "a distance"),
+    rule(
+        "guides.generate.count",
+        Bound::Within(1.0, MAX_GUIDES as f64),
+        "pelage's guide limit",
+    ),
+    rule("guides.generate.length", Bound::at_least(0.0), "a length"),
+    rule("guides.generate.density", Bound::at_least(0.0), "a density"),
+    rule(
+        "interpolation.k",
+        Bound::Within(1.0, 1024.0),
+        "guides per hair",
+    ),
+    rule(
+        "interpolation.power",
+        Bound::more_than(0.0),
+        "Shepard's distance exponent",
+    ),
+    rule("interpolation.radius", Bound::more_than(0.0), "a distance"),
+    rule("roots.density", Bound::at_least(0.0), "a density"),
+    rule(
+        "finish.points",
+        Bound::Within(2.0, MAX_CURVE_POINTS as f64),
+        "points per hair",
+    ),
+    rule("finish.width.root", Bound::at_least(0.0), "a width"),
+    rule("finish.width.tip", Bound::at_least(0.0), "a width"),
+    rule("finish.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
+    rule("finish.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
+    rule("ops.width.root", Bound::at_least(0.0), "a width"),
+    rule("ops.width.tip", Bound::at_least(0.0), "a width"),
+    rule("ops.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
+    rule("ops.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
+    rule(
+        "ops.clump.count",
+        Bound::Within(1.0, MAX_CLUMPS as f64),
+        "pelage's clump limit",
+    ),
+    rule("ops.clump.density", Bound::at_least(0.0), "a density"),
+    rule(
+        "ops.strands.count",
+        Bound::Within(1.0, MAX_STRANDS as f64),
+        "hairs per strand",
+    ),
+    rule(
+        "ops.noise.vectors",
+        Bound::Within(0.0, MAX_CURVE_POINTS as f64),
+        "noise vectors per hair",
+    ),
+    rule(
+        "ops.noise.frequency",
+        Bound::at_least(0.0),
+        "cycles per unit",
+    ),
+    rule(
+        "ops.frizz.frequency",
+        Bound::at_least(0.0),
+        "cycles per unit",
+    ),
+    rule(
+        "ops.frizz.fraction",
+        Bound::Within(0.0, 1.0),
+        "a fraction of the hairs",
+    ),
+    rule("ops.length.scale", Bound::at_least(0.0), "a factor"),
+    rule("animation.fps", Bound::more_than(0.0), "frames per second"),
+];
+
+const fn rule(key: &'static str, bound: Bound, why: &'static str) -> Rule {
+    Rule { key, bound, why }
+}
 
 impl SettingsSource {
     /// Reads a groom (or other settings) file, the error a [`GroomError`].
@@ -16,7 +109,24 @@ impl SettingsSource {
 
     /// Parses the text as a groom file.
     pub fn parse(&self) -> Result<GroomFile, GroomError> {
-        self.parse_as()
+        if let Some((place, message)) = self.single_bracket_list(&["ops"]) {
+            return Err(GroomError::new(
+                self.path.clone(),
+                place.line,
+                place.key,
+                GroomErrorKind::Syntax(message),
+            ));
+        }
+        let file = self.parse_as()?;
+        self.check(GROOM_RULES).map_err(|(place, message)| {
+            GroomError::new(
+                self.path.clone(),
+                place.line,
+                place.key,
+                GroomErrorKind::Invalid(message),
+            )
+        })?;
+        Ok(file)
     }
 
     /// Parses the text as `T`, the error a [`GroomError`] at its line and

@@ -1,9 +1,214 @@
 //! Atomic file output: temporary file in the target's folder, then rename.
+//!
+//! Around that core, what keeps an interrupted or mistaken run from
+//! leaving damage behind:
+//!
+//! - every temporary file being written is listed, so a signal handler can
+//!   remove them all ([`remove_temporary_files`]; the CLI calls it on
+//!   SIGINT, SIGTERM and SIGHUP);
+//! - temporary files that a killed process left beside a target (`kill
+//!   -9`, a power cut) are removed by the next write to that target: their
+//!   names carry the host and process id, and a process that no longer
+//!   runs on this host will not come back for them;
+//! - a program can mark the files it read as inputs
+//!   ([`protect_inputs`]), and writing over one is then an error instead
+//!   of a silently destroyed mesh or groom file;
+//! - [`check_free_space`] refuses work whose output cannot fit the disk
+//!   before the work starts.
 
 use super::WriteError;
+use std::collections::HashSet;
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// The temporary files being written now, by any thread.
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Whether [`note_input`] records inputs, and the inputs it recorded
+/// (canonical paths).
+static PROTECTING: AtomicBool = AtomicBool::new(false);
+static INPUTS: Mutex<Option<HashSet<PathBuf>>> = Mutex::new(None);
+
+/// From now on, the files this process reads (meshes, guides, maps,
+/// groom and scene files: every loader calls [`note_input`]) cannot be
+/// written over by it: [`AtomicFile::create`] refuses them. For programs
+/// whose outputs must never replace their inputs, such as the CLI; off by
+/// default, since a long-lived program may mean to rewrite a file it read
+/// earlier.
+pub fn protect_inputs() {
+    PROTECTING.store(true, Ordering::SeqCst);
+}
+
+/// Records `path` as an input of this process, when [`protect_inputs`] is
+/// on. Loaders call it; a path that does not exist is ignored.
+pub fn note_input(path: &Path) {
+    if !PROTECTING.load(Ordering::Relaxed) {
+        return;
+    }
+    if let Ok(canonical) = path.canonicalize() {
+        let mut inputs = INPUTS.lock().unwrap_or_else(|e| e.into_inner());
+        inputs.get_or_insert_with(HashSet::new).insert(canonical);
+    }
+}
+
+/// Whether `path` names a file recorded by [`note_input`].
+fn is_input(path: &Path) -> bool {
+    if !PROTECTING.load(Ordering::Relaxed) {
+        return false;
+    }
+    let Ok(canonical) = path.canonicalize() else {
+        return false;
+    };
+    let inputs = INPUTS.lock().unwrap_or_else(|e| e.into_inner());
+    inputs.as_ref().is_some_and(|i| i.contains(&canonical))
+}
+
+/// Removes every temporary file this process is writing now. For signal
+/// handlers (run from an ordinary thread, as `signal-hook`'s iterator
+/// does, not from the handler itself): afterwards the process should exit,
+/// since the writers' files are gone.
+pub fn remove_temporary_files() {
+    let live = LIVE.lock().unwrap_or_else(|e| e.into_inner());
+    for temp in live.iter() {
+        let _ = std::fs::remove_file(temp);
+    }
+}
+
+/// This host's name, for temporary file names (a folder may be shared by
+/// several machines of a farm: only this host's dead processes are
+/// known to be dead).
+fn host_name() -> String {
+    #[cfg(unix)]
+    {
+        let mut buffer = [0u8; 256];
+        // SAFETY: the buffer is valid for its length; gethostname writes
+        // at most that many bytes.
+        let ok = unsafe { libc::gethostname(buffer.as_mut_ptr().cast(), buffer.len()) } == 0;
+        if ok {
+            let end = buffer.iter().position(|&b| b == 0).unwrap_or(buffer.len());
+            let name: String = String::from_utf8_lossy(&buffer[..end])
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '.' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            if !name.is_empty() {
+                return name;
+            }
+        }
+    }
+    "host".to_string()
+}
+
+/// Whether process `pid` runs on this host.
+fn process_alive(pid: u32) -> bool {
+    #[cfg(unix)]
+    {
+        let Ok(pid) = libc::pid_t::try_from(pid) else {
+            return false;
+        };
+        // SAFETY: signal 0 only checks that the process exists.
+        if unsafe { libc::kill(pid, 0) } == 0 {
+            return true;
+        }
+        std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        true
+    }
+}
+
+/// Removes the temporary files beside `path` that processes of this host
+/// which no longer run left behind: `.NAME.tmp-HOST-PID`, and the
+/// `.NAME.tmp-PID` of earlier versions.
+fn remove_stale_temporary_files(path: &Path, name: &str, host: &str) {
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let Ok(entries) = std::fs::read_dir(folder) else {
+        return;
+    };
+    let prefix = format!(".{name}.tmp-");
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(rest) = file_name.to_str().and_then(|n| n.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let (owner, pid) = match rest.rsplit_once('-') {
+            Some((owner, pid)) => (owner, pid),
+            None => (host, rest),
+        };
+        let Ok(pid) = pid.parse::<u32>() else {
+            continue;
+        };
+        if owner == host && pid != std::process::id() && !process_alive(pid) {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Refuses work whose output, at least `bytes` long, cannot fit the free
+/// space of the disk that holds `path` (its folder when it does not exist
+/// yet). Where free space cannot be asked (not Unix, no such folder yet),
+/// nothing is refused.
+pub fn check_free_space(path: &Path, bytes: u64) -> Result<(), WriteError> {
+    let Some(free) = free_space(path) else {
+        return Ok(());
+    };
+    if bytes <= free {
+        return Ok(());
+    }
+    let gb = |b: u64| b as f64 / 1e9;
+    Err(WriteError {
+        path: path.to_path_buf(),
+        error: std::io::Error::new(
+            std::io::ErrorKind::StorageFull,
+            format!(
+                "the output needs at least {:.1} GB and the disk has {:.1} GB free; free some space, write elsewhere, or ask for fewer hairs, points or frames",
+                gb(bytes),
+                gb(free)
+            ),
+        ),
+    })
+}
+
+/// Bytes free for an unprivileged user on the disk of `path`.
+fn free_space(path: &Path) -> Option<u64> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let folder = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let folder = if path.is_dir() { path } else { folder };
+        let c_path = std::ffi::CString::new(folder.as_os_str().as_bytes()).ok()?;
+        let mut stats = std::mem::MaybeUninit::<libc::statvfs>::uninit();
+        // SAFETY: a valid C string and a buffer of the right type.
+        if unsafe { libc::statvfs(c_path.as_ptr(), stats.as_mut_ptr()) } != 0 {
+            return None;
+        }
+        // SAFETY: statvfs succeeded and filled it.
+        let stats = unsafe { stats.assume_init() };
+        #[allow(clippy::unnecessary_cast)] // the fields' types differ by platform
+        Some((stats.f_bavail as u64).saturating_mul(stats.f_frsize as u64))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = path;
+        None
+    }
+}
 
 /// A file being written atomically, for writers that hold their output
 /// (several files open at once): a buffered temporary file beside the
@@ -16,7 +221,8 @@ pub struct AtomicFile {
 }
 
 impl AtomicFile {
-    /// Starts writing `path`.
+    /// Starts writing `path`. Refused when `path` is a folder or, under
+    /// [`protect_inputs`], a file this process read.
     pub fn create(path: &Path) -> Result<Self, WriteError> {
         let fail = |error| WriteError {
             path: path.to_path_buf(),
@@ -24,13 +230,36 @@ impl AtomicFile {
         };
         let name = path
             .file_name()
-            .ok_or_else(|| fail(std::io::Error::other("the path names no file")))?;
-        let temp = path.with_file_name(format!(
-            ".{}.tmp-{}",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
-        let file = File::create(&temp).map_err(fail)?;
+            .ok_or_else(|| fail(std::io::Error::other("the path names no file")))?
+            .to_string_lossy()
+            .into_owned();
+        if path.is_dir() {
+            return Err(fail(std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "it is a folder; give a file name",
+            )));
+        }
+        if is_input(path) {
+            return Err(fail(std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                "it is an input of this run; writing over it would destroy it: choose another output",
+            )));
+        }
+        let host = host_name();
+        remove_stale_temporary_files(path, &name, &host);
+        let temp = path.with_file_name(format!(".{name}.tmp-{host}-{}", std::process::id()));
+        // Listed before it exists, so a signal arriving in between still
+        // finds it.
+        LIVE.lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push(temp.clone());
+        let file = match File::create(&temp) {
+            Ok(file) => file,
+            Err(error) => {
+                unlist(&temp);
+                return Err(fail(error));
+            }
+        };
         Ok(Self {
             path: path.to_path_buf(),
             temp,
@@ -52,6 +281,10 @@ impl AtomicFile {
             drop(file);
             std::fs::rename(&self.temp, &self.path)
         })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&self.temp);
+        }
+        unlist(&self.temp);
         result.map_err(|error| WriteError {
             path: self.path.clone(),
             error,
@@ -62,6 +295,14 @@ impl AtomicFile {
         self.out
             .as_mut()
             .expect("an uncommitted file has its writer")
+    }
+}
+
+/// Takes `temp` off the list of temporary files being written.
+fn unlist(temp: &Path) {
+    let mut live = LIVE.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(i) = live.iter().position(|t| t == temp) {
+        live.swap_remove(i);
     }
 }
 
@@ -87,12 +328,13 @@ impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.out.take().is_some() {
             let _ = std::fs::remove_file(&self.temp);
+            unlist(&self.temp);
         }
     }
 }
 
 /// Writes `path` by calling `write` on a buffered temporary file in the
-/// same folder (`.NAME.tmp-PID`), flushing and syncing it, and renaming it
+/// same folder (`.NAME.tmp-HOST-PID`), flushing and syncing it, and renaming it
 /// over `path`. On any error the temporary file is removed and `path` is
 /// left as it was.
 pub fn write_atomically(

@@ -28,7 +28,10 @@ mod usda;
 mod usdc;
 
 pub use abc::{AbcWriter, read_abc_curves, read_abc_curves_at};
-pub use atomic::{AtomicFile, write_atomically};
+pub use atomic::{
+    AtomicFile, check_free_space, note_input, protect_inputs, remove_temporary_files,
+    write_atomically,
+};
 pub use curves_file::{
     CurvesExport, CurvesFormat, join, read_curves, write_curves, write_streamed,
 };

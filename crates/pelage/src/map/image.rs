@@ -137,6 +137,96 @@ impl Filter {
     }
 }
 
+/// Opens and decodes an image file (PNG, EXR, …, by its contents) as
+/// pelage reads every map and texture: the size in its header is checked
+/// against [`crate::limits::MAX_IMAGE_PIXELS`] before any pixel memory is
+/// allocated, so a small file declaring 20000 × 20000 pixels is an error,
+/// not an abort; and under [`crate::io::protect_inputs`] the file is an
+/// input no output may replace.
+pub fn open_image(path: &Path) -> Result<image::DynamicImage, image::ImageError> {
+    if path.is_dir() {
+        return Err(image::ImageError::IoError(std::io::Error::new(
+            std::io::ErrorKind::IsADirectory,
+            "it is a folder; give an image file",
+        )));
+    }
+    crate::io::note_input(path);
+    let reader = || image::ImageReader::open(path)?.with_guessed_format();
+    let (width, height) = reader()?.into_dimensions()?;
+    let pixels = u64::from(width) * u64::from(height);
+    let limit = crate::limits::MAX_IMAGE_PIXELS;
+    if pixels > limit {
+        return Err(image::ImageError::IoError(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "the image is {width} × {height} pixels ({:.0} M); pelage reads at most {} M pixels (8192 × 8192): scale it down (docs/limits.md)",
+                pixels as f64 / 1e6,
+                limit >> 20
+            ),
+        )));
+    }
+    let mut reader = reader()?;
+    // The header was checked above; the decoder's own allocation limit
+    // (512 MB by default) would refuse 8192² 16-bit RGBA.
+    reader.no_limits();
+    reader.decode()
+}
+
+/// Whether `path` is an OpenEXR file (by its magic number).
+fn is_exr(path: &Path) -> bool {
+    let mut magic = [0u8; 4];
+    std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic))
+        .is_ok_and(|()| magic == [0x76, 0x2f, 0x31, 0x01])
+}
+
+/// One channel of an EXR's first layer, for files the image crate does
+/// not decode (no R, G and B): `Y` stands in for each colour channel and
+/// luminance, `A` is 1 where absent. Width, height, texels.
+fn exr_channel(path: &Path, channel: Channel) -> Result<(u32, u32, Vec<f32>), String> {
+    use exr::prelude::*;
+    let meta = MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
+    let header = meta.headers.first().ok_or("the EXR has no layer")?;
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    let limit = crate::limits::MAX_IMAGE_PIXELS;
+    if (w as u64) * (h as u64) > limit || w == 0 || h == 0 {
+        return Err(format!(
+            "the image is {w} × {h} pixels; pelage reads 1 to {} M pixels (docs/limits.md)",
+            limit >> 20
+        ));
+    }
+    let image = read_first_flat_layer_from_file(path).map_err(|e| e.to_string())?;
+    let channels = &image.layer_data.channel_data.list;
+    let named = |wanted: &str| {
+        channels.iter().find(|c| {
+            let name = c.name.to_string();
+            let last = name.rsplit('.').next().unwrap_or(&name).to_string();
+            last.eq_ignore_ascii_case(wanted)
+        })
+    };
+    let names: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
+    let source = match channel {
+        Channel::A => named("A"),
+        Channel::R => named("R").or_else(|| named("Y")),
+        Channel::G => named("G").or_else(|| named("Y")),
+        Channel::B => named("B").or_else(|| named("Y")),
+        Channel::Luminance => named("Y"),
+    };
+    let texels: Vec<f32> = match source {
+        Some(c) => (0..w * h)
+            .map(|i| c.sample_data.value_by_flat_index(i).to_f32())
+            .collect(),
+        None if channel == Channel::A => vec![1.0; w * h],
+        None => {
+            return Err(format!(
+                "the EXR has channels {}: no {channel:?} and no Y to read",
+                names.join(", ")
+            ));
+        }
+    };
+    Ok((w as u32, h as u32, texels))
+}
+
 /// One channel of an image as f32 texels, rows from the top.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImageMap {
@@ -153,13 +243,23 @@ impl ImageMap {
     pub fn load(path: impl AsRef<Path>, channel: Channel, wrap: Wrap) -> Result<Self, MapError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let reader = image::ImageReader::open(path)
-            .map_err(|e| MapError::new(&name, MapErrorKind::Io(e)))?
-            .with_guessed_format()
-            .map_err(|e| MapError::new(&name, MapErrorKind::Io(e)))?;
-        let decoded = reader
-            .decode()
-            .map_err(|e| MapError::new(&name, MapErrorKind::Decode(e.to_string())))?;
+        let decoded = match open_image(path) {
+            Ok(decoded) => decoded,
+            // Masks are often single-channel EXRs (Y, or A alone), which
+            // the image crate does not decode.
+            Err(image::ImageError::Decoding(_) | image::ImageError::Unsupported(_))
+                if is_exr(path) =>
+            {
+                let texels = exr_channel(path, channel)
+                    .map_err(|e| MapError::new(&name, MapErrorKind::Decode(e)))?;
+                let (width, height, texels) = texels;
+                return Self::checked(&name, width, height, texels, wrap);
+            }
+            Err(image::ImageError::IoError(e)) => {
+                return Err(MapError::new(&name, MapErrorKind::Io(e)));
+            }
+            Err(e) => return Err(MapError::new(&name, MapErrorKind::Decode(e.to_string()))),
+        };
         Self::from_image(&name, &decoded, channel, wrap)
     }
 
@@ -184,6 +284,17 @@ impl ImageMap {
         let rgba = decoded.to_rgba32f();
         let (width, height) = rgba.dimensions();
         let texels: Vec<f32> = rgba.pixels().map(|p| channel.pick(p.0)).collect();
+        Self::checked(name, width, height, texels, wrap)
+    }
+
+    /// A map of decoded texels, refused where one is not finite.
+    fn checked(
+        name: &str,
+        width: u32,
+        height: u32,
+        texels: Vec<f32>,
+        wrap: Wrap,
+    ) -> Result<Self, MapError> {
         if let Some(i) = texels.iter().position(|t| !t.is_finite()) {
             let (x, y) = ((i % width as usize) as u32, (i / width as usize) as u32);
             return Err(MapError::new(name, MapErrorKind::NonFiniteTexel { x, y }));
@@ -348,5 +459,49 @@ mod tests {
             .unwrap();
         let m = ImageMap::from_bytes("f.exr", &bytes, Channel::R, Wrap::Clamp).unwrap();
         assert_eq!(m.texel(0, 0), 3.5);
+    }
+
+    /// Writes a one-channel EXR (`name` is the channel) to `path`.
+    fn one_channel_exr(path: &Path, name: &str, values: Vec<f32>, width: usize) {
+        use exr::prelude::*;
+        let height = values.len() / width;
+        let channels = AnyChannels::sort(SmallVec::from_vec(vec![AnyChannel::new(
+            name,
+            FlatSamples::F32(values),
+        )]));
+        Image::from_channels((width, height), channels)
+            .write()
+            .to_file(path)
+            .unwrap();
+    }
+
+    #[test]
+    fn single_channel_exr_masks_are_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let y = dir.path().join("mask_y.exr");
+        one_channel_exr(&y, "Y", vec![0.25, 0.75], 2);
+        for channel in [Channel::Luminance, Channel::R, Channel::G] {
+            let m = ImageMap::load(&y, channel, Wrap::Clamp).unwrap();
+            assert_eq!((m.texel(0, 0), m.texel(1, 0)), (0.25, 0.75), "{channel:?}");
+        }
+        // No A channel: opaque.
+        assert_eq!(
+            ImageMap::load(&y, Channel::A, Wrap::Clamp)
+                .unwrap()
+                .texel(1, 0),
+            1.0
+        );
+        let a = dir.path().join("mask_a.exr");
+        one_channel_exr(&a, "A", vec![0.5, 1.0, 0.0, 0.125], 2);
+        let m = ImageMap::load(&a, Channel::A, Wrap::Clamp).unwrap();
+        assert_eq!((m.width(), m.height(), m.texel(1, 1)), (2, 2, 0.125));
+        // An alpha-only mask has no colour to read.
+        let err = ImageMap::load(&a, Channel::R, Wrap::Clamp)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("mask_a.exr") && err.contains("channels A"),
+            "{err}"
+        );
     }
 }

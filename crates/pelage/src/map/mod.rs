@@ -15,7 +15,7 @@ mod image;
 mod noise;
 mod spec;
 
-pub use self::image::{Channel, Filter, ImageMap, Wrap};
+pub use self::image::{Channel, Filter, ImageMap, Wrap, open_image};
 pub use self::noise::NoiseMap;
 
 use crate::mesh::{Mesh, SurfacePoint};

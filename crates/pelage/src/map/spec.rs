@@ -58,10 +58,20 @@ impl Map {
             }
             path = head;
         }
-        let full = match base {
+        let resolve = |path: &str| match base {
             Some(dir) if Path::new(path).is_relative() => dir.join(path),
             _ => Path::new(path).to_path_buf(),
         };
+        let full = resolve(path);
+        // `spot.png:q`: the file is there, the suffix is not one we know.
+        if let Some((head, suffix)) = path.rsplit_once(':')
+            && !full.exists()
+            && resolve(head).exists()
+        {
+            return Err(fail(format!(
+                "unknown suffix \":{suffix}\"; an image map takes :CHANNEL (r, g, b, a or luminance), :WRAP (repeat or clamp) and :FILTER (bilinear or nearest)"
+            )));
+        }
         ImageMap::load(&full, channel.unwrap_or_default(), wrap.unwrap_or_default())
             .map(|image| Map::Image(image.with_filter(filter.unwrap_or_default())))
     }

@@ -44,6 +44,50 @@ pub(crate) struct VertexSource {
     pub vertex: u32,
 }
 
+/// Checks a glTF document against the specification before anything reads
+/// it. The gltf crate's own validation indexes a primitive's `POSITION`
+/// accessor without checking it exists (it panics on a file whose POSITION
+/// names a missing accessor), so references are checked here first.
+fn validate(document: &gltf::Document) -> Result<(), String> {
+    let root = document.as_json();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, accessor) in &primitive.attributes {
+                if accessor.value() >= root.accessors.len() {
+                    return Err(format!(
+                        "mesh {m} primitive {p}: attribute {} names accessor {}, and the file has {} accessors",
+                        semantic_name(semantic),
+                        accessor.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
+    // Unknown problems in the crate's validation are still errors, not a
+    // crash of the whole program.
+    let checked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        use gltf::json::validation::Validate;
+        let mut errors = Vec::new();
+        root.validate(root, gltf::json::Path::new, &mut |path, error| {
+            errors.push(format!("{}: {error}", path()))
+        });
+        errors
+    }));
+    match checked {
+        Ok(errors) if errors.is_empty() => Ok(()),
+        Ok(errors) => Err(format!("not a valid glTF file: {}", errors.join("; "))),
+        Err(_) => Err("not a valid glTF file (its validation failed)".into()),
+    }
+}
+
+fn semantic_name(semantic: &gltf::json::validation::Checked<gltf::json::mesh::Semantic>) -> String {
+    match semantic {
+        gltf::json::validation::Checked::Valid(s) => s.to_string(),
+        gltf::json::validation::Checked::Invalid => "(unknown)".into(),
+    }
+}
+
 /// [`parse`], keeping the document and the vertices' sources.
 pub(crate) fn parse_with_sources(
     name: &str,
@@ -51,8 +95,9 @@ pub(crate) fn parse_with_sources(
     base: Option<&Path>,
 ) -> Result<ParsedGltf, MeshError> {
     let whole = |msg: String| MeshError::whole(name, MeshErrorKind::Syntax(msg));
-    let gltf = gltf::Gltf::from_slice(bytes)
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| whole(format!("not a readable glTF file: {e}")))?;
+    validate(&gltf.document).map_err(whole)?;
     let buffers = gltf::import_buffers(&gltf.document, base, gltf.blob.clone())
         .map_err(|e| whole(format!("cannot load the glTF's buffers: {e}")))?;
     let doc = &gltf.document;
@@ -66,9 +111,22 @@ pub(crate) fn parse_with_sources(
     if scenes.is_empty() {
         instances.extend(doc.meshes().map(|m| (m, Mat4::IDENTITY, None)));
     }
-    // A node reached twice on one path is a cycle (a malformed file that
-    // would otherwise be walked forever); the depth bounds the walk.
+    // glTF's nodes form trees: a node with two parents (a file that would
+    // be walked once per path, exponentially many in a lattice) is refused,
+    // and a node reached twice on one path is a cycle (a malformed file
+    // that would otherwise be walked forever); the depth bounds the walk.
     let node_count = doc.nodes().len();
+    let mut has_parent = vec![false; node_count];
+    for node in doc.nodes() {
+        for child in node.children() {
+            if std::mem::replace(&mut has_parent[child.index()], true) {
+                return Err(whole(format!(
+                    "node {} has two parents; glTF's node hierarchy must be a tree",
+                    child.index()
+                )));
+            }
+        }
+    }
     for scene in scenes {
         let mut stack: Vec<(gltf::Node, Mat4, usize)> =
             scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();

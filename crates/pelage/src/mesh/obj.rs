@@ -13,6 +13,9 @@ use glam::{Vec2, Vec3};
 
 /// Parses OBJ text. `name` is what errors call the file.
 pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    // Editors on Windows may start the text with a UTF-8 byte-order mark;
+    // left in place it would hide the first statement.
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     // First pass: count vertices, UVs and normals, so that every face index
     // can be checked at its own line even when it refers forwards.
     let (mut v_total, mut vt_total, mut vn_total) = (0usize, 0usize, 0usize);
@@ -191,9 +194,17 @@ fn numbers<'a, const N: usize>(
 }
 
 fn number(token: &str) -> Result<f32, MeshErrorKind> {
-    token
+    let value = token
         .parse::<f32>()
-        .map_err(|_| MeshErrorKind::Syntax(format!("cannot read {token:?} as a number")))
+        .map_err(|_| MeshErrorKind::Syntax(format!("cannot read {token:?} as a number")))?;
+    // A finite number beyond f32's range parses as infinity: say so, rather
+    // than call the file's 1e39 "NaN or infinity".
+    if value.is_infinite() && token.parse::<f64>().is_ok_and(f64::is_finite) {
+        return Err(MeshErrorKind::Syntax(format!(
+            "{token} is too large: coordinates are 32-bit floats, at most ±3.4e38"
+        )));
+    }
+    Ok(value)
 }
 
 /// One face corner, `v`, `v/vt`, `v//vn` or `v/vt/vn`, resolved to 0-based

@@ -24,6 +24,27 @@ impl Mesh {
         mesh
     }
 
+    /// [`Self::subdivided`], refused when the result would pass
+    /// [`crate::limits::MAX_TRIANGLES`] (`subdivide` multiplies the count
+    /// by 4 a level: a typo such as `subdivide = 20` would otherwise run
+    /// the machine out of memory).
+    pub fn subdivided_within_limits(&self, levels: u32) -> Result<Mesh, super::MeshError> {
+        let limit = crate::limits::MAX_TRIANGLES;
+        let triangles = (self.triangle_count() as u64).saturating_mul(4u64.saturating_pow(levels));
+        if triangles > limit {
+            return Err(super::MeshError::whole(
+                self.name(),
+                super::MeshErrorKind::Unsupported(format!(
+                    "subdivide = {levels} would make {} triangles of its {}; pelage's limit is {} (docs/limits.md)",
+                    crate::limits::grouped(triangles as f64),
+                    crate::limits::grouped(self.triangle_count() as f64),
+                    crate::limits::grouped(limit as f64),
+                )),
+            ));
+        }
+        Ok(self.subdivided(levels))
+    }
+
     fn subdivide_once(&self) -> Mesh {
         let edges = self.edges();
         let n = self.vertex_count() as u32;

@@ -22,6 +22,6 @@ pub mod wetness;
 
 pub use error::{SceneError, SceneErrorDetails, SceneErrorKind};
 pub use math::{ClumpParams, Coupling, CurlParams, KajiyaKay, Strand, WetTexel};
-pub use scene::ShellScene;
+pub use scene::{SceneCamera, ShellScene};
 pub use textures::{ShellTextureParams, ShellTextures, TextureStyle};
 pub use wetness::{Droplet, DropletStyle, WetnessMask};

@@ -22,7 +22,8 @@ use super::wetness::{
 };
 use crate::Mesh;
 use crate::dynamics::{DynamicsParams, Solver, Topology, Wind};
-use crate::settings::SettingsSource;
+use crate::limits::*;
+use crate::settings::{Bound, Rule, SettingsSource};
 use glam::{Vec2, Vec3};
 use std::f32::consts::TAU;
 use std::path::Path;
@@ -47,13 +48,13 @@ pub struct ShadingSettings {
     pub kajiya_kay: KajiyaKay,
 }
 
-/// A camera placed by hand.
+/// A camera placed by hand; what is not given is framed on the mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SceneCamera {
-    /// Where the camera is.
-    pub eye: Vec3,
-    /// What it looks at.
-    pub target: Vec3,
+    /// Where the camera is (`None`: backed off until the mesh fits).
+    pub eye: Option<Vec3>,
+    /// What it looks at (`None`: the centre of the mesh).
+    pub target: Option<Vec3>,
     /// Vertical field of view, degrees.
     pub fov_y_degrees: f32,
 }
@@ -186,8 +187,18 @@ impl ShellScene {
 
     /// Builds a scene from a file's text (relative paths against its folder).
     pub fn from_source(source: &SettingsSource) -> Result<Self, SceneError> {
+        if let Some((place, message)) = source.single_bracket_list(&["droplets"]) {
+            return Err(SceneError::new(
+                source.path.clone(),
+                place,
+                SceneErrorKind::Syntax(message),
+            ));
+        }
         let file: SceneFile = source.deserialize().map_err(|(place, message)| {
             SceneError::new(source.path.clone(), place, SceneErrorKind::Syntax(message))
+        })?;
+        source.check(SCENE_RULES).map_err(|(place, message)| {
+            SceneError::new(source.path.clone(), place, SceneErrorKind::Invalid(message))
         })?;
         let (mesh, color) = mesh_and_color(source, &file)?;
         let (lo, hi) = mesh.bounds();
@@ -231,8 +242,8 @@ impl ShellScene {
             shading,
             light: file.light.map(|l| Vec3::from(l).normalize_or(Vec3::Y)),
             camera: file.camera.map(|c| SceneCamera {
-                eye: Vec3::from(c.eye),
-                target: Vec3::from(c.target),
+                eye: c.eye.map(Vec3::from),
+                target: c.target.map(Vec3::from),
                 fov_y_degrees: c.fov.unwrap_or(30.0),
             }),
             wetness_resolution,
@@ -254,6 +265,162 @@ impl ShellScene {
             next: 0,
         }
     }
+}
+
+/// The documented range of every numeric scene setting
+/// (docs/shells-format.md, docs/limits.md), checked when the file is read.
+const SCENE_RULES: &[Rule] = &[
+    rule(
+        "mesh.subdivide",
+        Bound::Within(0.0, MAX_SUBDIVIDE as f64),
+        "each step makes 4 triangles of 1",
+    ),
+    rule("fur.tiles", Bound::more_than(0.0), "texture repeats"),
+    rule("texture.density", Bound::at_least(0.0), "hairs per texel"),
+    rule(
+        "texture.thickness",
+        Bound::more_than(0.0),
+        "a radius in texels",
+    ),
+    rule(
+        "texture.length_variance",
+        Bound::Within(0.0, 1.0),
+        "a fraction of the length",
+    ),
+    rule(
+        "texture.bend",
+        Bound::at_least(0.0),
+        "the exponent's bending",
+    ),
+    rule(
+        "texture.undercoat_ratio",
+        Bound::at_least(0.0),
+        "hairs per guard hair",
+    ),
+    rule(
+        "texture.undercoat_length",
+        Bound::Within(0.0, 1.0),
+        "a fraction of the length",
+    ),
+    rule(
+        "curl.radius",
+        Bound::at_least(0.0),
+        "a fraction of the shell length",
+    ),
+    rule("clump.w", Bound::Within(0.0, 1.0), "a blend"),
+    rule("clump.strength", Bound::at_least(0.0), "a squeeze"),
+    rule("shading.specular", Bound::at_least(0.0), "a colour"),
+    rule("shading.exponent", Bound::at_least(0.0), "a Phong exponent"),
+    rule(
+        "shading.shadow",
+        Bound::at_least(1.0),
+        "K_shadow of γ = (K_shadow − 1 + h) / K_shadow",
+    ),
+    rule("wetness.drying_rate", Bound::at_least(0.0), "per second"),
+    rule(
+        "droplets.time",
+        Bound::at_least(0.0),
+        "seconds into the sequence",
+    ),
+    rule(
+        "droplets.count",
+        Bound::Within(1.0, MAX_DROPLETS as f64),
+        "pelage's droplet limit",
+    ),
+    rule(
+        "droplets.radius",
+        Bound::Above(0.0, 1.0),
+        "mask units, the UV square is 1",
+    ),
+    rule(
+        "droplets.spacing",
+        Bound::Above(0.0, 1.0),
+        "mask units, the UV square is 1",
+    ),
+    rule("droplets.wetness", Bound::Within(0.0, 1.0), "ρ_drop"),
+    rule(
+        "camera.fov",
+        Bound::Above(0.0, 179.0),
+        "vertical field of view, degrees",
+    ),
+    rule(
+        "animation.frames",
+        Bound::Within(1.0, MAX_FRAMES as f64),
+        "pelage's frame limit",
+    ),
+    rule("animation.fps", Bound::more_than(0.0), "frames per second"),
+    rule(
+        "dynamics.substeps",
+        Bound::Within(0.0, MAX_DYNAMICS_STEPS as f64),
+        "substeps per step, 0: automatic",
+    ),
+    rule(
+        "dynamics.iterations",
+        Bound::Within(1.0, MAX_SOLVER_ITERATIONS as f64),
+        "conjugate-gradient iterations",
+    ),
+    rule(
+        "dynamics.steps_per_frame",
+        Bound::Within(1.0, MAX_DYNAMICS_STEPS as f64),
+        "steps per frame",
+    ),
+    rule(
+        "dynamics.exponent",
+        Bound::at_least(1.0),
+        "k of Banisch Eq. 4",
+    ),
+    rule(
+        "dynamics.mass",
+        Bound::more_than(0.0),
+        "a tip without mass cannot be moved by a force",
+    ),
+    rule(
+        "dynamics.stiffness",
+        Bound::at_least(0.0),
+        "a spring constant",
+    ),
+    rule(
+        "dynamics.lateral_stiffness",
+        Bound::at_least(0.0),
+        "a spring constant",
+    ),
+    rule(
+        "dynamics.damping",
+        Bound::at_least(0.0),
+        "a damping constant",
+    ),
+    rule("dynamics.drag", Bound::at_least(0.0), "air drag"),
+    rule(
+        "dynamics.restoring",
+        Bound::at_least(0.0),
+        "w of Banisch Eq. 5",
+    ),
+    rule(
+        "dynamics.wind.gust",
+        Bound::at_least(0.0),
+        "a fraction of the mean",
+    ),
+    rule(
+        "dynamics.wind.gust_frequency",
+        Bound::at_least(0.0),
+        "per second",
+    ),
+    rule("dynamics.wind.turbulence", Bound::at_least(0.0), "a speed"),
+    rule(
+        "dynamics.wind.scale",
+        Bound::more_than(0.0),
+        "features per unit length",
+    ),
+    rule(
+        "dynamics.shake.frequency",
+        Bound::more_than(0.0),
+        "per second",
+    ),
+    rule("dynamics.shake.duration", Bound::at_least(0.0), "seconds"),
+];
+
+const fn rule(key: &'static str, bound: Bound, why: &'static str) -> Rule {
+    Rule { key, bound, why }
 }
 
 /// An error at a span of the scene file: a value that cannot be used.
@@ -325,7 +492,7 @@ fn mesh_and_color(
     let color = match &file.color {
         Some(path) => {
             let full = source.folder().join(path.get_ref());
-            image::open(&full)
+            crate::map::open_image(&full)
                 .map_err(unreadable_image(source, path.span(), full.clone()))?
                 .to_rgba8()
         }
@@ -432,7 +599,7 @@ fn droplets(
             }
             (None, None, Some(path)) => {
                 let full = source.folder().join(path.get_ref());
-                let image = image::open(&full)
+                let image = crate::map::open_image(&full)
                     .map_err(unreadable_image(source, path.span(), full.clone()))?
                     .to_luma32f();
                 let (w, h) = (image.width() as f32, image.height() as f32);

@@ -178,8 +178,8 @@ pub(super) enum RadiusText {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct CameraSection {
-    pub(super) eye: [f32; 3],
-    pub(super) target: [f32; 3],
+    pub(super) eye: Option<[f32; 3]>,
+    pub(super) target: Option<[f32; 3]>,
     pub(super) fov: Option<f32>,
 }
 

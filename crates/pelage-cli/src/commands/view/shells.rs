@@ -192,10 +192,10 @@ impl ShellSession {
                 let (lo, hi) = self.scene.mesh.bounds();
                 pelage_gpu::Camera::framing(lo - l, hi + l, aspect)
             },
-            |c| pelage_gpu::Camera {
-                eye: c.eye,
-                target: c.target,
-                fov_y_degrees: c.fov_y_degrees,
+            |c| {
+                let l = Vec3::splat(self.scene.fur.length);
+                let (lo, hi) = self.scene.mesh.bounds();
+                pelage_gpu::Camera::from_scene(&c, lo - l, hi + l, aspect)
             },
         );
         OrbitCamera::from_camera(camera)
