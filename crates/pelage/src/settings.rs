@@ -372,3 +372,72 @@ impl SettingsSource {
         walk(self, rules, "", &root)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn source(text: &str) -> SettingsSource {
+        SettingsSource {
+            path: "s.toml".into(),
+            text: text.into(),
+        }
+    }
+
+    const RULES: &[Rule] = &[
+        Rule {
+            key: "roots.count",
+            bound: Bound::Within(1.0, 100.0),
+            why: "a test ceiling",
+        },
+        Rule {
+            key: "ops.clump.rate",
+            bound: Bound::Within(0.0, 1.0),
+            why: "",
+        },
+    ];
+
+    #[test]
+    fn numbers_outside_their_rule_are_refused_at_their_place() {
+        let (place, message) = source("[roots]\ncount = 101\n").check(RULES).unwrap_err();
+        assert_eq!(place.line, Some((2, 9)));
+        assert_eq!(place.key.as_deref(), Some("roots.count"));
+        assert_eq!(message, "101: use 1 to 100 (a test ceiling)");
+        // Array tables: the rule holds for every entry.
+        let text = "[[ops]]\nclump = { rate = 0.5 }\n[[ops]]\nclump = { rate = 1.5 }\n";
+        let (place, message) = source(text).check(RULES).unwrap_err();
+        assert_eq!(place.key.as_deref(), Some("ops[1].clump.rate"));
+        assert_eq!(message, "1.5: use 0 to 1");
+        source("[roots]\ncount = 100\n").check(RULES).unwrap();
+    }
+
+    #[test]
+    fn every_float_must_be_finite_and_fit_f32() {
+        for (text, expected) in [
+            ("a = nan\n", "nan is not a finite number"),
+            ("[t]\nv = [1.0, -inf]\n", "-inf is not a finite number"),
+            ("b = 1e39\n", "1e39 is too large"),
+        ] {
+            let (_, message) = source(text).check(&[]).unwrap_err();
+            assert!(message.starts_with(expected), "{text}: {message}");
+        }
+        source("a = 3.0e38\nb = 1_000.5\n").check(&[]).unwrap();
+    }
+
+    #[test]
+    fn a_key_is_found_outside_the_strings_of_its_line() {
+        let text = "[roots]\ndensity = \"noise:frequency=6,octaves=3\"\n";
+        let start = text.find("noise").unwrap();
+        let place = source(text).place(start..start + 5);
+        assert_eq!(place.key.as_deref(), Some("roots.density"));
+    }
+
+    #[test]
+    fn a_list_written_as_one_table_says_how_to_write_it() {
+        let text = "[mesh]\npath = \"spot\"\n[ops]  # operators\nclump = {}\n";
+        let (place, message) = source(text).single_bracket_list(&["ops"]).unwrap();
+        assert_eq!(place.line, Some((3, 1)));
+        assert!(message.contains("write [[ops]]"), "{message}");
+        assert!(source("[[ops]]\n").single_bracket_list(&["ops"]).is_none());
+    }
+}

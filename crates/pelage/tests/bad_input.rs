@@ -49,7 +49,7 @@ const CASES: &[(&str, &str, &str)] = &[
     (
         "obj_inf_vertex.obj",
         ":2: ",
-        "vertex position has a non-finite value",
+        "1e39 is too large: coordinates are 32-bit floats",
     ),
     (
         "obj_bad_number.obj",

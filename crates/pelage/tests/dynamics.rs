@@ -238,3 +238,73 @@ fn the_same_step_gives_the_same_bits_on_one_and_two_threads() {
     };
     assert_eq!(run(1), run(2));
 }
+
+/// The soak: 10⁵ steps of every topology × solver under the strongest
+/// wind, gravity and push the viewer offers (its sliders' ends: wind 10,
+/// gravity 20, push strength 4 over the whole patch, pressed and released
+/// every 500 steps; damping at its end, 0.5). Nothing may turn NaN, no tip
+/// may pass through the skin, and the energy stays within what the springs
+/// stretched to ten fur lengths would hold.
+///
+/// Half a minute in a release build, many minutes in a debug one: CI runs
+/// it with `cargo test --release -p pelage --test dynamics -- --ignored`.
+#[test]
+#[ignore = "a soak: run in a release build (--release -- --ignored)"]
+fn a_soak_under_the_strongest_wind_gravity_and_push_never_breaks_the_fur() {
+    let started = std::time::Instant::now();
+    let mesh = patch(2);
+    let params = DynamicsParams {
+        damping: 0.5,
+        gravity: Vec3::new(0.0, -20.0, 0.0),
+        wind: Some(Wind::new(Vec3::new(10.0, 0.0, 3.0), 0.8, 1.5, 4.0, 3.0, 11)),
+        ..Default::default()
+    };
+    let pushed = DynamicsParams {
+        brush: Some(pelage::dynamics::Brush {
+            centre: Vec3::ZERO,
+            radius: 0.5,
+            force: Vec3::new(4.0, -4.0, 0.0),
+        }),
+        ..params.clone()
+    };
+    let stiffness = f64::from(params.stiffness.max(params.lateral_stiffness));
+    for topology in Topology::ALL {
+        // The scene files' explicit default: as many substeps as
+        // stability needs (a fixed count can be too few for the strongest
+        // damping, as implicit_stays_stable_where_explicit_diverges shows).
+        for solver in [
+            Solver::Explicit { substeps: 0 },
+            Solver::Implicit { iterations: 30 },
+        ] {
+            let mut system = MassSpringSystem::new(&mesh, topology, LENGTH);
+            let mut peak = 0.0f64;
+            for k in 0..100_000 {
+                let p = if (k / 500) % 2 == 1 { &pushed } else { &params };
+                system.step(1.0 / 60.0, p, solver, k as f32 / 60.0);
+                if k % 100 == 99 {
+                    let e = system.energy(&params);
+                    assert!(e.is_finite(), "{topology:?} {solver:?}: NaN at step {k}");
+                    peak = peak.max(e);
+                    for i in 0..system.mass_count() {
+                        let offset = system.tips()[i] - system.roots()[i];
+                        assert!(
+                            offset.dot(system.normals()[i]) >= -1e-6,
+                            "{topology:?} {solver:?}: tip {i} went through the skin at step {k}"
+                        );
+                    }
+                }
+            }
+            let bound =
+                system.mass_count() as f64 * 0.5 * stiffness * (10.0 * LENGTH as f64).powi(2);
+            assert!(
+                peak < bound,
+                "{topology:?} {solver:?}: energy {peak} (bound {bound})"
+            );
+        }
+    }
+    eprintln!(
+        "soak: {} topologies × 2 solvers × 100,000 steps in {:.1} s",
+        Topology::ALL.len(),
+        started.elapsed().as_secs_f64()
+    );
+}

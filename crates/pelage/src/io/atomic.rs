@@ -71,8 +71,17 @@ fn is_input(path: &Path) -> bool {
 /// does, not from the handler itself): afterwards the process should exit,
 /// since the writers' files are gone.
 pub fn remove_temporary_files() {
+    remove_temporary_files_under(None);
+}
+
+/// [`remove_temporary_files`] for the files under `folder` only (`None`:
+/// all of them).
+fn remove_temporary_files_under(folder: Option<&Path>) {
     let live = LIVE.lock().unwrap_or_else(|e| e.into_inner());
-    for temp in live.iter() {
+    for temp in live
+        .iter()
+        .filter(|t| folder.is_none_or(|f| t.starts_with(f)))
+    {
         let _ = std::fs::remove_file(temp);
     }
 }
@@ -383,6 +392,82 @@ mod tests {
         file.commit().unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"whole");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn temporary_files_of_dead_processes_are_removed_by_the_next_write() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.usdc");
+        let host = host_name();
+        // No process has a pid this large (Linux's ceiling is 2^22).
+        let dead = [
+            format!(".out.usdc.tmp-{host}-2147483647"),
+            ".out.usdc.tmp-2147483646".to_string(),
+        ];
+        // Pid 1 runs; another host's processes are not ours to judge.
+        let kept = [
+            format!(".out.usdc.tmp-{host}-1"),
+            ".out.usdc.tmp-elsewhere-2147483647".to_string(),
+            ".other.usdc.tmp-2147483647".to_string(),
+        ];
+        for name in dead.iter().chain(&kept) {
+            std::fs::write(dir.path().join(name), b"debris").unwrap();
+        }
+        write_atomically(&target, |w| w.write_all(b"new")).unwrap();
+        for name in &dead {
+            assert!(!dir.path().join(name).exists(), "{name} was left");
+        }
+        for name in &kept {
+            assert!(dir.path().join(name).exists(), "{name} was removed");
+        }
+    }
+
+    #[test]
+    fn a_signal_handler_can_remove_the_files_being_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("sequence.usdc");
+        let mut file = AtomicFile::create(&target).unwrap();
+        file.write_all(b"half").unwrap();
+        let temporary = || {
+            std::fs::read_dir(dir.path())
+                .unwrap()
+                .filter(|e| {
+                    e.as_ref()
+                        .unwrap()
+                        .file_name()
+                        .to_string_lossy()
+                        .contains(".tmp-")
+                })
+                .count()
+        };
+        assert_eq!(temporary(), 1);
+        // Only this test's: other tests of this process write beside it.
+        remove_temporary_files_under(Some(dir.path()));
+        assert_eq!(temporary(), 0);
+        // The writer's commit then fails: its file is gone.
+        assert!(file.commit().is_err());
+        assert!(!target.exists());
+    }
+
+    #[test]
+    fn output_that_cannot_fit_the_disk_is_refused_before_it_starts() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("huge.usdc");
+        check_free_space(&target, 0).unwrap();
+        let err = check_free_space(&target, u64::MAX).unwrap_err().to_string();
+        assert!(
+            err.contains("huge.usdc") && err.contains("GB free"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_folder_is_not_a_file_to_write() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = write_atomically(dir.path(), |_| Ok(()))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("it is a folder"), "{err}");
     }
 
     #[test]

@@ -151,8 +151,26 @@ pub fn open_image(path: &Path) -> Result<image::DynamicImage, image::ImageError>
         )));
     }
     crate::io::note_input(path);
-    let reader = || image::ImageReader::open(path)?.with_guessed_format();
-    let (width, height) = reader()?.into_dimensions()?;
+    decode_within_limits(|| image::ImageReader::open(path)?.with_guessed_format())
+}
+
+/// Decodes an image from `reader` (made twice: once for the header, once
+/// for the pixels), refusing more than [`crate::limits::MAX_IMAGE_PIXELS`]
+/// before decoding.
+fn decode_within_limits<R: std::io::BufRead + std::io::Seek>(
+    reader: impl Fn() -> std::io::Result<image::ImageReader<R>>,
+) -> Result<image::DynamicImage, image::ImageError> {
+    // A header cut short is a broken image, not a failure to read a file.
+    let broken = |e: image::ImageError| match e {
+        image::ImageError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+            image::ImageError::Decoding(image::error::DecodingError::new(
+                image::error::ImageFormatHint::Unknown,
+                e,
+            ))
+        }
+        e => e,
+    };
+    let (width, height) = reader()?.into_dimensions().map_err(broken)?;
     let pixels = u64::from(width) * u64::from(height);
     let limit = crate::limits::MAX_IMAGE_PIXELS;
     if pixels > limit {
@@ -270,8 +288,10 @@ impl ImageMap {
         channel: Channel,
         wrap: Wrap,
     ) -> Result<Self, MapError> {
-        let decoded = image::load_from_memory(bytes)
-            .map_err(|e| MapError::new(name, MapErrorKind::Decode(e.to_string())))?;
+        let decoded = decode_within_limits(|| {
+            image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format()
+        })
+        .map_err(|e| MapError::new(name, MapErrorKind::Decode(e.to_string())))?;
         Self::from_image(name, &decoded, channel, wrap)
     }
 

@@ -64,6 +64,169 @@ fn validate(document: &gltf::Document) -> Result<(), String> {
             }
         }
     }
+    validate_with_crate(root)?;
+    validate_accessors(root)
+}
+
+/// What a reader of the gltf crate assumes of the accessors it reads and
+/// does not check (it asserts, or reaches `unreachable!`): each accessor's
+/// elements fit its buffer view at the view's stride, and each use has
+/// the type and component type the specification gives it.
+fn validate_accessors(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::accessor::{ComponentType as C, Type as T};
+    use gltf::json::mesh::Semantic as S;
+    use gltf::json::validation::Checked::Valid;
+    let component = |a: &gltf::json::Accessor| match a.component_type {
+        Valid(c) => Some(c.0),
+        _ => None,
+    };
+    for (i, accessor) in root.accessors.iter().enumerate() {
+        let (Some(c), Valid(t)) = (component(accessor), accessor.type_) else {
+            continue;
+        };
+        if accessor.sparse.is_some() {
+            return Err(format!("accessor {i}: sparse accessors are not supported"));
+        }
+        let Some(view) = accessor
+            .buffer_view
+            .and_then(|v| root.buffer_views.get(v.value()))
+        else {
+            continue;
+        };
+        let element = (c.size() * t.multiplicity()) as u64;
+        let stride = view.byte_stride.map_or(element, |s| s.0 as u64);
+        let count = accessor.count.0;
+        let offset = accessor.byte_offset.map_or(0, |o| o.0);
+        let end = match count {
+            0 => offset,
+            n => offset + stride * (n - 1) + element,
+        };
+        if stride < element || end > view.byte_length.0 {
+            return Err(format!(
+                "accessor {i}: {count} elements of {element} bytes at offset {offset}, stride {stride}, do not fit buffer view {} ({} bytes)",
+                accessor.buffer_view.map_or(0, |v| v.value()),
+                view.byte_length.0
+            ));
+        }
+        let buffer = root.buffers.get(view.buffer.value());
+        if buffer.is_none_or(|b| {
+            view.byte_offset.map_or(0, |o| o.0) + view.byte_length.0 > b.byte_length.0
+        }) {
+            return Err(format!(
+                "buffer view {} runs past the end of its buffer",
+                accessor.buffer_view.map_or(0, |v| v.value())
+            ));
+        }
+    }
+    let expect = |what: &str, index: usize, types: &[T], components: &[C]| {
+        let Some(a) = root.accessors.get(index) else {
+            return Err(format!(
+                "{what} names accessor {index}, which does not exist"
+            ));
+        };
+        let list = |names: Vec<String>| names.join(" or ");
+        let type_name = |t: &T| format!("{t:?}").to_uppercase();
+        let component_name = |c: &C| format!("{c:?}").to_lowercase();
+        match (a.type_, component(a)) {
+            (Valid(t), Some(c)) if types.contains(&t) && components.contains(&c) => Ok(()),
+            (t, c) => Err(format!(
+                "{what}: accessor {index} holds {} of {}; glTF allows {} of {}",
+                match t {
+                    Valid(t) => type_name(&t),
+                    _ => "an unknown type".into(),
+                },
+                c.map_or("an unknown component type".into(), |c| component_name(&c)),
+                list(types.iter().map(type_name).collect()),
+                list(components.iter().map(component_name).collect()),
+            )),
+        }
+    };
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let at = |what: &str| format!("mesh {m} primitive {p}: {what}");
+            if let Some(indices) = primitive.indices {
+                expect(
+                    &at("indices"),
+                    indices.value(),
+                    &[T::Scalar],
+                    &[C::U8, C::U16, C::U32],
+                )?;
+            }
+            for (semantic, accessor) in &primitive.attributes {
+                let (types, components): (&[T], &[C]) = match semantic {
+                    Valid(S::Positions | S::Normals) => (&[T::Vec3], &[C::F32]),
+                    Valid(S::Tangents) => (&[T::Vec4], &[C::F32]),
+                    Valid(S::TexCoords(_)) => (&[T::Vec2], &[C::F32, C::U8, C::U16]),
+                    Valid(S::Colors(_)) => (&[T::Vec3, T::Vec4], &[C::F32, C::U8, C::U16]),
+                    Valid(S::Joints(_)) => (&[T::Vec4], &[C::U8, C::U16]),
+                    Valid(S::Weights(_)) => (&[T::Vec4], &[C::F32, C::U8, C::U16]),
+                    _ => continue,
+                };
+                expect(
+                    &at(&semantic_name(semantic)),
+                    accessor.value(),
+                    types,
+                    components,
+                )?;
+            }
+        }
+    }
+    for (s, skin) in root.skins.iter().enumerate() {
+        if let Some(matrices) = skin.inverse_bind_matrices {
+            expect(
+                &format!("skin {s}: inverse bind matrices"),
+                matrices.value(),
+                &[T::Mat4],
+                &[C::F32],
+            )?;
+        }
+    }
+    for (a, animation) in root.animations.iter().enumerate() {
+        for (k, sampler) in animation.samplers.iter().enumerate() {
+            let at = format!("animation {a} sampler {k}");
+            expect(
+                &format!("{at} input"),
+                sampler.input.value(),
+                &[T::Scalar],
+                &[C::F32],
+            )?;
+            expect(
+                &format!("{at} output"),
+                sampler.output.value(),
+                &[T::Scalar, T::Vec3, T::Vec4],
+                &[C::F32, C::I8, C::U8, C::I16, C::U16],
+            )?;
+        }
+        for (k, channel) in animation.channels.iter().enumerate() {
+            let Some(sampler) = animation.samplers.get(channel.sampler.value()) else {
+                continue;
+            };
+            let (types, components): (&[T], &[C]) = match channel.target.path {
+                Valid(
+                    gltf::json::animation::Property::Translation
+                    | gltf::json::animation::Property::Scale,
+                ) => (&[T::Vec3], &[C::F32]),
+                Valid(gltf::json::animation::Property::Rotation) => {
+                    (&[T::Vec4], &[C::F32, C::I8, C::U8, C::I16, C::U16])
+                }
+                Valid(gltf::json::animation::Property::MorphTargetWeights) => {
+                    (&[T::Scalar], &[C::F32, C::I8, C::U8, C::I16, C::U16])
+                }
+                _ => continue,
+            };
+            expect(
+                &format!("animation {a} channel {k}"),
+                sampler.output.value(),
+                types,
+                components,
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// The gltf crate's own validation of references and enums.
+fn validate_with_crate(root: &gltf::json::Root) -> Result<(), String> {
     // Unknown problems in the crate's validation are still errors, not a
     // crash of the whole program.
     let checked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {

@@ -185,8 +185,13 @@ impl ShellScene {
         .expect("the default scene is valid")
     }
 
-    /// Builds a scene from a file's text (relative paths against its folder).
-    pub fn from_source(source: &SettingsSource) -> Result<Self, SceneError> {
+    /// Checks a scene file's text without building the scene (no mesh or
+    /// image is read): its syntax, keys and the range of every number.
+    pub fn check_text(source: &SettingsSource) -> Result<(), SceneError> {
+        Self::parse(source).map(|_| ())
+    }
+
+    fn parse(source: &SettingsSource) -> Result<SceneFile, SceneError> {
         if let Some((place, message)) = source.single_bracket_list(&["droplets"]) {
             return Err(SceneError::new(
                 source.path.clone(),
@@ -200,6 +205,12 @@ impl ShellScene {
         source.check(SCENE_RULES).map_err(|(place, message)| {
             SceneError::new(source.path.clone(), place, SceneErrorKind::Invalid(message))
         })?;
+        Ok(file)
+    }
+
+    /// Builds a scene from a file's text (relative paths against its folder).
+    pub fn from_source(source: &SettingsSource) -> Result<Self, SceneError> {
+        let file = Self::parse(source)?;
         let (mesh, color) = mesh_and_color(source, &file)?;
         let (lo, hi) = mesh.bounds();
         let fur = fur_settings(source, &file.fur, (hi - lo).length())?;

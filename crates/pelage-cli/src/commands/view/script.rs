@@ -123,7 +123,15 @@ impl Script {
     /// Reads a script; errors name the file, line and key. Screenshot
     /// paths are made relative to the script's folder.
     pub fn load(path: &Path) -> Result<Self, GroomError> {
-        Self::parse(&SettingsSource::read_groom(path)?)
+        let source = SettingsSource::read(path).map_err(|e| {
+            GroomError::new(
+                path.to_path_buf(),
+                None,
+                None,
+                pelage::groom::GroomErrorKind::Invalid(format!("cannot read the script: {e}")),
+            )
+        })?;
+        Self::parse(&source)
     }
 
     /// Parses a script's text.
