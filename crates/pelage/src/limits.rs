@@ -71,6 +71,11 @@ pub const MAX_DROPLETS: u64 = 1_000_000;
 /// Texels per side of a generated texture or wetness mask.
 pub const MAX_TEXTURE_SIDE: u64 = 4096;
 
+/// Texels of a shell texture, `resolution² × layers` (4 bytes each, on
+/// the CPU while it is generated and on the GPU: 1 GB at the ceiling,
+/// e.g. 2048² × 64 or 4096² × 16).
+pub const MAX_SHELL_TEXELS: u64 = 1 << 28;
+
 /// Pixels per side of a rendered image (further bounded by the GPU's own
 /// texture limit, which the renderer checks).
 pub const MAX_IMAGE_SIDE: u64 = 16384;

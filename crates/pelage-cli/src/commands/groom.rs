@@ -140,6 +140,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         .iter()
         .map(|p| p.hair_count)
         .sum();
+    pelage::io::check_output(&path)?;
     // Positions alone (12 bytes a point) are a floor of any format's size.
     let points = *file.finish.points.get_ref() as u64;
     pelage::io::check_free_space(&path, planned.saturating_mul(points).saturating_mul(12))?;

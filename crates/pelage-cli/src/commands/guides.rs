@@ -64,6 +64,8 @@ pub struct GuidesArgs {
 }
 
 pub fn run(args: &GuidesArgs) -> anyhow::Result<()> {
+    let points = (args.count as u64).saturating_mul(args.points as u64);
+    pelage::io::check_free_space(&args.output, points.saturating_mul(12))?;
     let mesh = load_mesh(args.mesh.as_deref())?;
     let guides = match &args.from {
         Some(file) => {

@@ -103,8 +103,11 @@ impl SampledBatch {
 const BATCH: u64 = 1 << 20;
 
 pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
+    // A point's position alone is 12 bytes in any of the formats.
+    pelage::io::check_free_space(&args.output, args.count.saturating_mul(12))?;
     let mesh = load_mesh(args.mesh.as_deref())?;
     let density = Map::parse(&args.density).context("cannot read the density map")?;
+    pelage::io::check_output(&args.output)?;
     let start = Instant::now();
     let sampler: Box<dyn SurfaceSampler + '_> = match args.method {
         Method::Rejection => Box::new(RejectionSampler::new(&mesh, &density)?),

@@ -219,6 +219,30 @@ fn free_space(path: &Path) -> Option<u64> {
     }
 }
 
+/// Whether `path` may be written: not a folder, and (under
+/// [`protect_inputs`]) not a file this process read. [`AtomicFile::create`]
+/// checks it; long work checks it before it starts, so a mistaken output
+/// is refused at once rather than after minutes of growing.
+pub fn check_output(path: &Path) -> Result<(), WriteError> {
+    let fail = |kind, message: &str| WriteError {
+        path: path.to_path_buf(),
+        error: std::io::Error::new(kind, message),
+    };
+    if path.is_dir() {
+        return Err(fail(
+            std::io::ErrorKind::IsADirectory,
+            "it is a folder; give a file name",
+        ));
+    }
+    if is_input(path) {
+        return Err(fail(
+            std::io::ErrorKind::AlreadyExists,
+            "it is an input of this run; writing over it would destroy it: choose another output",
+        ));
+    }
+    Ok(())
+}
+
 /// A file being written atomically, for writers that hold their output
 /// (several files open at once): a buffered temporary file beside the
 /// target, renamed over it by [`Self::commit`]; dropped uncommitted, the
@@ -242,18 +266,7 @@ impl AtomicFile {
             .ok_or_else(|| fail(std::io::Error::other("the path names no file")))?
             .to_string_lossy()
             .into_owned();
-        if path.is_dir() {
-            return Err(fail(std::io::Error::new(
-                std::io::ErrorKind::IsADirectory,
-                "it is a folder; give a file name",
-            )));
-        }
-        if is_input(path) {
-            return Err(fail(std::io::Error::new(
-                std::io::ErrorKind::AlreadyExists,
-                "it is an input of this run; writing over it would destroy it: choose another output",
-            )));
-        }
+        check_output(path)?;
         let host = host_name();
         remove_stale_temporary_files(path, &name, &host);
         let temp = path.with_file_name(format!(".{name}.tmp-{host}-{}", std::process::id()));

@@ -29,7 +29,7 @@ mod usdc;
 
 pub use abc::{AbcWriter, read_abc_curves, read_abc_curves_at};
 pub use atomic::{
-    AtomicFile, check_free_space, note_input, protect_inputs, remove_temporary_files,
+    AtomicFile, check_free_space, check_output, note_input, protect_inputs, remove_temporary_files,
     write_atomically,
 };
 pub use curves_file::{

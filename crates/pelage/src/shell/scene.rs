@@ -287,11 +287,15 @@ const SCENE_RULES: &[Rule] = &[
         "each step makes 4 triangles of 1",
     ),
     rule("fur.tiles", Bound::more_than(0.0), "texture repeats"),
-    rule("texture.density", Bound::at_least(0.0), "hairs per texel"),
+    rule(
+        "texture.density",
+        Bound::Within(0.0, 1.0),
+        "guard hairs per texel: each is a blade drawn through every layer",
+    ),
     rule(
         "texture.thickness",
-        Bound::more_than(0.0),
-        "a radius in texels",
+        Bound::Above(0.0, 64.0),
+        "a radius in texels: each blade stamps a disk this wide on every layer",
     ),
     rule(
         "texture.length_variance",
@@ -305,7 +309,7 @@ const SCENE_RULES: &[Rule] = &[
     ),
     rule(
         "texture.undercoat_ratio",
-        Bound::at_least(0.0),
+        Bound::Within(0.0, 100.0),
         "hairs per guard hair",
     ),
     rule(
@@ -340,13 +344,13 @@ const SCENE_RULES: &[Rule] = &[
     ),
     rule(
         "droplets.radius",
-        Bound::Above(0.0, 1.0),
+        Bound::more_than(0.0),
         "mask units, the UV square is 1",
     ),
     rule(
         "droplets.spacing",
-        Bound::Above(0.0, 1.0),
-        "mask units, the UV square is 1",
+        Bound::at_least(1e-3),
+        "mask units: a grid of at most a million droplets over the mask",
     ),
     rule("droplets.wetness", Bound::Within(0.0, 1.0), "ρ_drop"),
     rule(
@@ -557,6 +561,19 @@ fn texture_params(
         "texels",
         defaults.resolution,
     )?;
+    let texels = u64::from(resolution).pow(2) * u64::from(layers);
+    if texels > MAX_SHELL_TEXELS {
+        let span = t.resolution.as_ref().map_or(0..0, |r| r.span());
+        return Err(invalid(
+            source,
+            span,
+            format!(
+                "{resolution}² texels × {layers} layers is {} texels; pelage's limit is {} (4 bytes each): lower the resolution or the layers (docs/limits.md)",
+                grouped(texels as f64),
+                grouped(MAX_SHELL_TEXELS as f64)
+            ),
+        ));
+    }
     let texture = ShellTextureParams {
         resolution,
         layers,
@@ -619,7 +636,10 @@ fn droplets(
                     let y = (p.y * h).clamp(0.0, h - 1.0) as u32;
                     image.get_pixel(x, y).0[0]
                 };
-                droplets_from_image(brightness, d.spacing.unwrap_or(radius_max), style, seed)
+                // The default spacing follows the radius, kept to the
+                // coarsest grid `spacing` itself may ask for.
+                let spacing = d.spacing.unwrap_or(radius_max.max(1e-3));
+                droplets_from_image(brightness, spacing, style, seed)
             }
             _ => {
                 let span = d.image.as_ref().map_or(0..0, |p| p.span());
