@@ -73,6 +73,10 @@ for level in range(40):
 write("gltf_node_lattice.gltf", json.dumps(triangle_gltf(
     nodes=nodes, scenes=[{"nodes": [0, 1]}])))
 
+# Within the pixel ceiling (60 M pixels) but wider than most GPUs' texture
+# limit (16384 on lavapipe).
+write("wide_20000x3000.png", png(20000, 3000, 1, 0, [bytes(20000 // 8)] * 3000))
+
 # A mesh as a PLY, for outputs that would overwrite it.
 write("tri.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
       "property float y\nproperty float z\nelement face 1\n"

@@ -169,6 +169,10 @@ fn run_case(case: &Case) -> Vec<String> {
             Some(2) if !stderr.starts_with("error: ") => {
                 problems.push("exit 2 without an `error: …` message".into())
             }
+            // clap's own errors end with a hint line; pelage's are one line.
+            Some(2) if stderr.trim_end().lines().count() > 1 && !stderr.contains("--help") => {
+                problems.push("the error spans more than one line".into())
+            }
             Some(_) => {}
         },
     }

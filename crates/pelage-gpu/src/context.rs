@@ -73,7 +73,15 @@ impl GpuContext {
                     wgpu::Error::OutOfMemory { .. } => {
                         "the GPU ran out of memory; draw a smaller image, or fewer layers, hairs or texels".to_string()
                     }
-                    error => error.to_string(),
+                    // wgpu's message spans lines ("Caused by: …"); errors
+                    // print on one.
+                    error => error
+                        .to_string()
+                        .lines()
+                        .map(str::trim)
+                        .filter(|l| !l.is_empty() && *l != "Caused by:")
+                        .collect::<Vec<_>>()
+                        .join(": "),
                 });
             }
         }));

@@ -297,6 +297,13 @@ pub struct Rule {
     pub why: &'static str,
 }
 
+impl Rule {
+    /// A rule for `key`.
+    pub const fn new(key: &'static str, bound: Bound, why: &'static str) -> Self {
+        Self { key, bound, why }
+    }
+}
+
 impl SettingsSource {
     /// Checks every number in the file: each must be finite and fit an
     /// `f32` where it is a float (settings are single precision, and a NaN

@@ -12,93 +12,89 @@ use std::path::Path;
 /// (docs/groom-format.md, docs/limits.md), checked when the file is read.
 /// Map-valued settings are checked here when written as numbers.
 const GROOM_RULES: &[Rule] = &[
-    rule(
+    Rule::new(
         "mesh.subdivide",
         Bound::Within(0.0, MAX_SUBDIVIDE as f64),
         "each step makes 4 triangles of 1",
     ),
-    rule(
+    Rule::new(
         "roots.count",
         Bound::Within(1.0, MAX_HAIRS as f64),
         "pelage's hair limit, docs/limits.md",
     ),
-    rule("roots.parts", Bound::Within(1.0, MAX_PARTS as f64), ""),
-    rule(
+    Rule::new("roots.parts", Bound::Within(1.0, MAX_PARTS as f64), ""),
+    Rule::new(
         "guides.points",
         Bound::Within(2.0, MAX_CURVE_POINTS as f64),
         "points per guide",
     ),
-    rule("guides.tolerance", Bound::at_least(0.0), "a distance"),
-    rule(
+    Rule::new("guides.tolerance", Bound::at_least(0.0), "a distance"),
+    Rule::new(
         "guides.generate.count",
         Bound::Within(1.0, MAX_GUIDES as f64),
         "pelage's guide limit",
     ),
-    rule("guides.generate.length", Bound::at_least(0.0), "a length"),
-    rule("guides.generate.density", Bound::at_least(0.0), "a density"),
-    rule(
+    Rule::new("guides.generate.length", Bound::at_least(0.0), "a length"),
+    Rule::new("guides.generate.density", Bound::at_least(0.0), "a density"),
+    Rule::new(
         "interpolation.k",
         Bound::Within(1.0, 1024.0),
         "guides per hair",
     ),
-    rule(
+    Rule::new(
         "interpolation.power",
         Bound::more_than(0.0),
         "Shepard's distance exponent",
     ),
-    rule("interpolation.radius", Bound::more_than(0.0), "a distance"),
-    rule("roots.density", Bound::at_least(0.0), "a density"),
-    rule(
+    Rule::new("interpolation.radius", Bound::more_than(0.0), "a distance"),
+    Rule::new("roots.density", Bound::at_least(0.0), "a density"),
+    Rule::new(
         "finish.points",
         Bound::Within(2.0, MAX_CURVE_POINTS as f64),
         "points per hair",
     ),
-    rule("finish.width.root", Bound::at_least(0.0), "a width"),
-    rule("finish.width.tip", Bound::at_least(0.0), "a width"),
-    rule("finish.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
-    rule("finish.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
-    rule("ops.width.root", Bound::at_least(0.0), "a width"),
-    rule("ops.width.tip", Bound::at_least(0.0), "a width"),
-    rule("ops.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
-    rule("ops.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
-    rule(
+    Rule::new("finish.width.root", Bound::at_least(0.0), "a width"),
+    Rule::new("finish.width.tip", Bound::at_least(0.0), "a width"),
+    Rule::new("finish.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
+    Rule::new("finish.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
+    Rule::new("ops.width.root", Bound::at_least(0.0), "a width"),
+    Rule::new("ops.width.tip", Bound::at_least(0.0), "a width"),
+    Rule::new("ops.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
+    Rule::new("ops.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
+    Rule::new(
         "ops.clump.count",
         Bound::Within(1.0, MAX_CLUMPS as f64),
         "pelage's clump limit",
     ),
-    rule("ops.clump.density", Bound::at_least(0.0), "a density"),
-    rule(
+    Rule::new("ops.clump.density", Bound::at_least(0.0), "a density"),
+    Rule::new(
         "ops.strands.count",
         Bound::Within(1.0, MAX_STRANDS as f64),
         "hairs per strand",
     ),
-    rule(
+    Rule::new(
         "ops.noise.vectors",
         Bound::Within(0.0, MAX_CURVE_POINTS as f64),
         "noise vectors per hair",
     ),
-    rule(
+    Rule::new(
         "ops.noise.frequency",
         Bound::at_least(0.0),
         "cycles per unit",
     ),
-    rule(
+    Rule::new(
         "ops.frizz.frequency",
         Bound::at_least(0.0),
         "cycles per unit",
     ),
-    rule(
+    Rule::new(
         "ops.frizz.fraction",
         Bound::Within(0.0, 1.0),
         "a fraction of the hairs",
     ),
-    rule("ops.length.scale", Bound::at_least(0.0), "a factor"),
-    rule("animation.fps", Bound::more_than(0.0), "frames per second"),
+    Rule::new("ops.length.scale", Bound::at_least(0.0), "a factor"),
+    Rule::new("animation.fps", Bound::more_than(0.0), "frames per second"),
 ];
-
-const fn rule(key: &'static str, bound: Bound, why: &'static str) -> Rule {
-    Rule { key, bound, why }
-}
 
 impl SettingsSource {
     /// Reads a groom (or other settings) file, the error a [`GroomError`].

@@ -281,162 +281,158 @@ impl ShellScene {
 /// The documented range of every numeric scene setting
 /// (docs/shells-format.md, docs/limits.md), checked when the file is read.
 const SCENE_RULES: &[Rule] = &[
-    rule(
+    Rule::new(
         "mesh.subdivide",
         Bound::Within(0.0, MAX_SUBDIVIDE as f64),
         "each step makes 4 triangles of 1",
     ),
-    rule("fur.tiles", Bound::more_than(0.0), "texture repeats"),
-    rule(
+    Rule::new("fur.tiles", Bound::more_than(0.0), "texture repeats"),
+    Rule::new(
         "texture.density",
         Bound::Within(0.0, 1.0),
         "guard hairs per texel: each is a blade drawn through every layer",
     ),
-    rule(
+    Rule::new(
         "texture.thickness",
         Bound::Above(0.0, 64.0),
         "a radius in texels: each blade stamps a disk this wide on every layer",
     ),
-    rule(
+    Rule::new(
         "texture.length_variance",
         Bound::Within(0.0, 1.0),
         "a fraction of the length",
     ),
-    rule(
+    Rule::new(
         "texture.bend",
         Bound::at_least(0.0),
         "the exponent's bending",
     ),
-    rule(
+    Rule::new(
         "texture.undercoat_ratio",
         Bound::Within(0.0, 100.0),
         "hairs per guard hair",
     ),
-    rule(
+    Rule::new(
         "texture.undercoat_length",
         Bound::Within(0.0, 1.0),
         "a fraction of the length",
     ),
-    rule(
+    Rule::new(
         "curl.radius",
         Bound::at_least(0.0),
         "a fraction of the shell length",
     ),
-    rule("clump.w", Bound::Within(0.0, 1.0), "a blend"),
-    rule("clump.strength", Bound::at_least(0.0), "a squeeze"),
-    rule("shading.specular", Bound::at_least(0.0), "a colour"),
-    rule("shading.exponent", Bound::at_least(0.0), "a Phong exponent"),
-    rule(
+    Rule::new("clump.w", Bound::Within(0.0, 1.0), "a blend"),
+    Rule::new("clump.strength", Bound::at_least(0.0), "a squeeze"),
+    Rule::new("shading.specular", Bound::at_least(0.0), "a colour"),
+    Rule::new("shading.exponent", Bound::at_least(0.0), "a Phong exponent"),
+    Rule::new(
         "shading.shadow",
         Bound::at_least(1.0),
         "K_shadow of γ = (K_shadow − 1 + h) / K_shadow",
     ),
-    rule("wetness.drying_rate", Bound::at_least(0.0), "per second"),
-    rule(
+    Rule::new("wetness.drying_rate", Bound::at_least(0.0), "per second"),
+    Rule::new(
         "droplets.time",
         Bound::at_least(0.0),
         "seconds into the sequence",
     ),
-    rule(
+    Rule::new(
         "droplets.count",
         Bound::Within(1.0, MAX_DROPLETS as f64),
         "pelage's droplet limit",
     ),
-    rule(
+    Rule::new(
         "droplets.radius",
         Bound::more_than(0.0),
         "mask units, the UV square is 1",
     ),
-    rule(
+    Rule::new(
         "droplets.spacing",
         Bound::at_least(1e-3),
         "mask units: a grid of at most a million droplets over the mask",
     ),
-    rule("droplets.wetness", Bound::Within(0.0, 1.0), "ρ_drop"),
-    rule(
+    Rule::new("droplets.wetness", Bound::Within(0.0, 1.0), "ρ_drop"),
+    Rule::new(
         "camera.fov",
         Bound::Above(0.0, 179.0),
         "vertical field of view, degrees",
     ),
-    rule(
+    Rule::new(
         "animation.frames",
         Bound::Within(1.0, MAX_FRAMES as f64),
         "pelage's frame limit",
     ),
-    rule("animation.fps", Bound::more_than(0.0), "frames per second"),
-    rule(
+    Rule::new("animation.fps", Bound::more_than(0.0), "frames per second"),
+    Rule::new(
         "dynamics.substeps",
         Bound::Within(0.0, MAX_DYNAMICS_STEPS as f64),
         "substeps per step, 0: automatic",
     ),
-    rule(
+    Rule::new(
         "dynamics.iterations",
         Bound::Within(1.0, MAX_SOLVER_ITERATIONS as f64),
         "conjugate-gradient iterations",
     ),
-    rule(
+    Rule::new(
         "dynamics.steps_per_frame",
         Bound::Within(1.0, MAX_DYNAMICS_STEPS as f64),
         "steps per frame",
     ),
-    rule(
+    Rule::new(
         "dynamics.exponent",
         Bound::at_least(1.0),
         "k of Banisch Eq. 4",
     ),
-    rule(
+    Rule::new(
         "dynamics.mass",
         Bound::more_than(0.0),
         "a tip without mass cannot be moved by a force",
     ),
-    rule(
+    Rule::new(
         "dynamics.stiffness",
         Bound::at_least(0.0),
         "a spring constant",
     ),
-    rule(
+    Rule::new(
         "dynamics.lateral_stiffness",
         Bound::at_least(0.0),
         "a spring constant",
     ),
-    rule(
+    Rule::new(
         "dynamics.damping",
         Bound::at_least(0.0),
         "a damping constant",
     ),
-    rule("dynamics.drag", Bound::at_least(0.0), "air drag"),
-    rule(
+    Rule::new("dynamics.drag", Bound::at_least(0.0), "air drag"),
+    Rule::new(
         "dynamics.restoring",
         Bound::at_least(0.0),
         "w of Banisch Eq. 5",
     ),
-    rule(
+    Rule::new(
         "dynamics.wind.gust",
         Bound::at_least(0.0),
         "a fraction of the mean",
     ),
-    rule(
+    Rule::new(
         "dynamics.wind.gust_frequency",
         Bound::at_least(0.0),
         "per second",
     ),
-    rule("dynamics.wind.turbulence", Bound::at_least(0.0), "a speed"),
-    rule(
+    Rule::new("dynamics.wind.turbulence", Bound::at_least(0.0), "a speed"),
+    Rule::new(
         "dynamics.wind.scale",
         Bound::more_than(0.0),
         "features per unit length",
     ),
-    rule(
+    Rule::new(
         "dynamics.shake.frequency",
         Bound::more_than(0.0),
         "per second",
     ),
-    rule("dynamics.shake.duration", Bound::at_least(0.0), "seconds"),
+    Rule::new("dynamics.shake.duration", Bound::at_least(0.0), "seconds"),
 ];
-
-const fn rule(key: &'static str, bound: Bound, why: &'static str) -> Rule {
-    Rule { key, bound, why }
-}
 
 /// An error at a span of the scene file: a value that cannot be used.
 fn invalid(source: &SettingsSource, span: std::ops::Range<usize>, message: String) -> SceneError {
