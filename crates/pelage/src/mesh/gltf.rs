@@ -101,9 +101,14 @@ fn validate_accessors(root: &gltf::json::Root) -> Result<(), String> {
             0 => offset,
             n => offset + stride * (n - 1) + element,
         };
-        if stride < element || end > view.byte_length.0 {
+        if stride < element {
             return Err(format!(
-                "accessor {i}: {count} elements of {element} bytes at offset {offset}, stride {stride}, do not fit buffer view {} ({} bytes)",
+                "accessor {i}: its buffer view's stride {stride} is shorter than one element ({element} bytes)"
+            ));
+        }
+        if end > view.byte_length.0 {
+            return Err(format!(
+                "accessor {i} reaches past the end of its buffer view {}: {count} elements of {element} bytes at offset {offset}, stride {stride}, need {end} of its {} bytes",
                 accessor.buffer_view.map_or(0, |v| v.value()),
                 view.byte_length.0
             ));
