@@ -15,6 +15,13 @@
 //! once fixed, copy it into the parser's seed folder so every later run
 //! starts from it.
 //!
+//! An input that makes a parser allocate without bound cannot be caught:
+//! the process is limited to 8 GB of address space, so the allocation
+//! fails and the process aborts. With `PELAGE_FUZZ_TRACE=1` every input is
+//! written to `target/fuzz-crashes/PARSER/in-flight` before it is parsed,
+//! so the one that aborted is there afterwards (slower: a file write an
+//! input).
+//!
 //! There is no coverage feedback (that needs a nightly compiler); the
 //! mutations are structured instead: numbers replaced by the values that
 //! break parsers (0, −1, 2³² + 1, 1e39, NaN), lines and tokens of the
@@ -256,6 +263,17 @@ thread_local! {
 fn fuzz(parser: &str, tokens: &[&str], text: bool, parse: impl Fn(&[u8])) {
     static HOOK: std::sync::Once = std::sync::Once::new();
     HOOK.call_once(|| {
+        // An unbounded allocation then fails here rather than bringing the
+        // machine's out-of-memory killer.
+        #[cfg(unix)]
+        {
+            let limit = libc::rlimit {
+                rlim_cur: 8 << 30,
+                rlim_max: 8 << 30,
+            };
+            // SAFETY: setrlimit with a valid struct.
+            unsafe { libc::setrlimit(libc::RLIMIT_AS, &limit) };
+        }
         let default = std::panic::take_hook();
         std::panic::set_hook(Box::new(move |info| {
             if IN_PARSER.with(|p| p.get()) {
@@ -288,6 +306,10 @@ fn fuzz(parser: &str, tokens: &[&str], text: bool, parse: impl Fn(&[u8])) {
     let crash_folder = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../target/fuzz-crashes")
         .join(parser);
+    let trace = std::env::var_os("PELAGE_FUZZ_TRACE").is_some();
+    if trace {
+        std::fs::create_dir_all(&crash_folder).unwrap();
+    }
     let start = Instant::now();
     let budget = Duration::from_secs(seconds);
     let (mut execs, mut crashes, mut slowest) = (0u64, Vec::new(), Duration::ZERO);
@@ -295,6 +317,9 @@ fn fuzz(parser: &str, tokens: &[&str], text: bool, parse: impl Fn(&[u8])) {
     let mut pending: Vec<Vec<u8>> = seeds.clone();
     while execs < max_execs && (start.elapsed() < budget || !pending.is_empty()) {
         let input = pending.pop().unwrap_or_else(|| mutator.input());
+        if trace {
+            std::fs::write(crash_folder.join("in-flight"), &input).unwrap();
+        }
         let began = Instant::now();
         IN_PARSER.with(|p| p.set(true));
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| parse(&input)));

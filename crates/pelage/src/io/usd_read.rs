@@ -728,7 +728,17 @@ fn read_widths(
 /// The prim's transform to world space: its own and its ancestors'
 /// `xformOpOrder`, composed parent first.
 fn world_transform(data: &dyn AbstractData, prim: &sdf::Path) -> Result<DMat4, String> {
-    let mut chain: Vec<sdf::Path> = prim.ancestors().filter(|p| !p.is_abs_root()).collect();
+    // A path has one ancestor a `/`. openusd's walk up a malformed name
+    // (a `}` in it, say) never reaches the root: bound it.
+    let depth = prim.as_str().matches('/').count() + 1;
+    let mut chain: Vec<sdf::Path> = prim
+        .ancestors()
+        .take(depth + 1)
+        .filter(|p| !p.is_abs_root())
+        .collect();
+    if chain.len() > depth {
+        return Err("not a valid prim path (its ancestors never reach the root)".into());
+    }
     chain.sort_by_key(|p| p.as_str().len());
     let mut world = DMat4::IDENTITY;
     for path in chain {
