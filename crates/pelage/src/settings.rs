@@ -30,13 +30,7 @@ pub struct Place {
 impl SettingsSource {
     /// Reads a settings file.
     pub fn read(path: &Path) -> std::io::Result<Self> {
-        if path.is_dir() {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::IsADirectory,
-                "it is a folder; give a settings file (TOML)",
-            ));
-        }
-        crate::io::note_input(path);
+        crate::io::check_input(path, "a settings file (TOML)")?;
         let text = std::fs::read_to_string(path)?;
         Ok(Self {
             path: path.to_path_buf(),

@@ -54,6 +54,28 @@ pub fn note_input(path: &Path) {
     }
 }
 
+/// What every reader of a file does first: refuses a folder (`what` names
+/// the file wanted, "a mesh file (.obj, …)"), and records the file with
+/// [`note_input`]. Each reader wraps the error in its own type.
+pub fn check_input(path: &Path, what: &str) -> std::io::Result<()> {
+    if path.is_dir() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::IsADirectory,
+            format!("it is a folder; give {what}"),
+        ));
+    }
+    note_input(path);
+    Ok(())
+}
+
+/// The folder a file of `path` lives in (`.` for a bare name).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
 /// Whether `path` names a file recorded by [`note_input`].
 fn is_input(path: &Path) -> bool {
     if !PROTECTING.load(Ordering::Relaxed) {
@@ -89,7 +111,12 @@ fn remove_temporary_files_under(folder: Option<&Path>) {
 /// This host's name, for temporary file names (a folder may be shared by
 /// several machines of a farm: only this host's dead processes are
 /// known to be dead).
-fn host_name() -> String {
+fn host_name() -> &'static str {
+    static NAME: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    NAME.get_or_init(read_host_name)
+}
+
+fn read_host_name() -> String {
     #[cfg(unix)]
     {
         let mut buffer = [0u8; 256];
@@ -140,11 +167,7 @@ fn process_alive(pid: u32) -> bool {
 /// which no longer run left behind: `.NAME.tmp-HOST-PID`, and the
 /// `.NAME.tmp-PID` of earlier versions.
 fn remove_stale_temporary_files(path: &Path, name: &str, host: &str) {
-    let folder = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let Ok(entries) = std::fs::read_dir(folder) else {
+    let Ok(entries) = std::fs::read_dir(folder_of(path)) else {
         return;
     };
     let prefix = format!(".{name}.tmp-");
@@ -196,11 +219,7 @@ fn free_space(path: &Path) -> Option<u64> {
     #[cfg(unix)]
     {
         use std::os::unix::ffi::OsStrExt;
-        let folder = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        let folder = if path.is_dir() { path } else { folder };
+        let folder = if path.is_dir() { path } else { folder_of(path) };
         let c_path = std::ffi::CString::new(folder.as_os_str().as_bytes()).ok()?;
         let mut stats = std::mem::MaybeUninit::<libc::statvfs>::uninit();
         // SAFETY: a valid C string and a buffer of the right type.
@@ -268,7 +287,7 @@ impl AtomicFile {
             .into_owned();
         check_output(path)?;
         let host = host_name();
-        remove_stale_temporary_files(path, &name, &host);
+        remove_stale_temporary_files(path, &name, host);
         let temp = path.with_file_name(format!(".{name}.tmp-{host}-{}", std::process::id()));
         // Listed before it exists, so a signal arriving in between still
         // finds it.

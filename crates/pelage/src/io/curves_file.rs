@@ -64,16 +64,11 @@ impl CurvesFormat {
 /// Reads curves from a `.usda`, `.usdc`, `.usd`, `.abc`, `.hair` or `.ply`
 /// file.
 pub fn read_curves(path: &Path) -> Result<Curves, CurvesReadError> {
-    if path.is_dir() {
-        return Err(CurvesReadError::whole(
-            path,
-            CurvesReadErrorKind::Io(std::io::Error::new(
-                std::io::ErrorKind::IsADirectory,
-                "it is a folder; give a curves file (.usd, .usda, .usdc, .abc, .hair, .ply)",
-            )),
-        ));
-    }
-    super::note_input(path);
+    super::check_input(
+        path,
+        "a curves file (.usd, .usda, .usdc, .abc, .hair, .ply)",
+    )
+    .map_err(|e| CurvesReadError::whole(path, CurvesReadErrorKind::Io(e)))?;
     let unknown = || {
         let extension = path
             .extension()

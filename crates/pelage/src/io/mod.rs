@@ -29,8 +29,8 @@ mod usdc;
 
 pub use abc::{AbcWriter, read_abc_curves, read_abc_curves_at};
 pub use atomic::{
-    AtomicFile, check_free_space, check_output, note_input, protect_inputs, remove_temporary_files,
-    write_atomically,
+    AtomicFile, check_free_space, check_input, check_output, note_input, protect_inputs,
+    remove_temporary_files, write_atomically,
 };
 pub use curves_file::{
     CurvesExport, CurvesFormat, join, read_curves, write_curves, write_streamed,

@@ -144,13 +144,7 @@ impl Filter {
 /// not an abort; and under [`crate::io::protect_inputs`] the file is an
 /// input no output may replace.
 pub fn open_image(path: &Path) -> Result<image::DynamicImage, image::ImageError> {
-    if path.is_dir() {
-        return Err(image::ImageError::IoError(std::io::Error::new(
-            std::io::ErrorKind::IsADirectory,
-            "it is a folder; give an image file",
-        )));
-    }
-    crate::io::note_input(path);
+    crate::io::check_input(path, "an image file")?;
     decode_within_limits(|| image::ImageReader::open(path)?.with_guessed_format())
 }
 
@@ -171,23 +165,32 @@ fn decode_within_limits<R: std::io::BufRead + std::io::Seek>(
         e => e,
     };
     let (width, height) = reader()?.into_dimensions().map_err(broken)?;
-    let pixels = u64::from(width) * u64::from(height);
-    let limit = crate::limits::MAX_IMAGE_PIXELS;
-    if pixels > limit {
-        return Err(image::ImageError::IoError(std::io::Error::new(
+    check_image_size(width.into(), height.into()).map_err(|message| {
+        image::ImageError::IoError(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
-            format!(
-                "the image is {width} × {height} pixels ({:.0} M); pelage reads at most {} M pixels (8192 × 8192): scale it down (docs/limits.md)",
-                pixels as f64 / 1e6,
-                limit >> 20
-            ),
-        )));
-    }
+            message,
+        ))
+    })?;
     let mut reader = reader()?;
     // The header was checked above; the decoder's own allocation limit
     // (512 MB by default) would refuse 8192² 16-bit RGBA.
     reader.no_limits();
     reader.decode()
+}
+
+/// Refuses an image of more than [`crate::limits::MAX_IMAGE_PIXELS`],
+/// from the size in its header.
+fn check_image_size(width: u64, height: u64) -> Result<(), String> {
+    let pixels = width * height;
+    let limit = crate::limits::MAX_IMAGE_PIXELS;
+    if pixels <= limit {
+        return Ok(());
+    }
+    Err(format!(
+        "the image is {width} × {height} pixels ({:.0} M); pelage reads at most {} M pixels (8192 × 8192): scale it down (docs/limits.md)",
+        pixels as f64 / 1e6,
+        limit >> 20
+    ))
 }
 
 /// Whether `path` is an OpenEXR file (by its magic number).
@@ -206,13 +209,7 @@ fn exr_channel(path: &Path, channel: Channel) -> Result<(u32, u32, Vec<f32>), St
     let meta = MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
     let header = meta.headers.first().ok_or("the EXR has no layer")?;
     let (w, h) = (header.layer_size.width(), header.layer_size.height());
-    let limit = crate::limits::MAX_IMAGE_PIXELS;
-    if (w as u64) * (h as u64) > limit || w == 0 || h == 0 {
-        return Err(format!(
-            "the image is {w} × {h} pixels; pelage reads 1 to {} M pixels (docs/limits.md)",
-            limit >> 20
-        ));
-    }
+    check_image_size(w as u64, h as u64)?;
     let image = read_first_flat_layer_from_file(path).map_err(|e| e.to_string())?;
     let channels = &image.layer_data.channel_data.list;
     let named = |wanted: &str| {
@@ -268,9 +265,8 @@ impl ImageMap {
             Err(image::ImageError::Decoding(_) | image::ImageError::Unsupported(_))
                 if is_exr(path) =>
             {
-                let texels = exr_channel(path, channel)
+                let (width, height, texels) = exr_channel(path, channel)
                     .map_err(|e| MapError::new(&name, MapErrorKind::Decode(e)))?;
-                let (width, height, texels) = texels;
                 return Self::checked(&name, width, height, texels, wrap);
             }
             Err(image::ImageError::IoError(e)) => {

@@ -37,16 +37,8 @@ impl Mesh {
     pub fn load(path: impl AsRef<Path>) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        if path.is_dir() {
-            return Err(MeshError::whole(
-                &name,
-                MeshErrorKind::Io(std::io::Error::new(
-                    std::io::ErrorKind::IsADirectory,
-                    "it is a folder; give a mesh file (.obj, .ply, .gltf, .glb, .usd)",
-                )),
-            ));
-        }
-        crate::io::note_input(path);
+        crate::io::check_input(path, "a mesh file (.obj, .ply, .gltf, .glb, .usd)")
+            .map_err(|e| MeshError::whole(&name, MeshErrorKind::Io(e)))?;
         let format = MeshFormat::from_path(path).ok_or_else(|| {
             let extension = path
                 .extension()
