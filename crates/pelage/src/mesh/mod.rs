@@ -7,6 +7,11 @@
 //! once built, so derived data (triangle areas at construction, the edge list
 //! on first use, the edge graph) is cached without invalidation.
 //!
+//! A mesh may also carry named per-vertex scalars ([`VertexAttribute`]:
+//! PLY properties, OBJ vertex colours), which per-vertex maps read, and
+//! named sets of faces ([`FaceGroups`]: OBJ `g` and `usemtl`), which
+//! groom regions read.
+//!
 //! Degenerate triangles (a repeated vertex index, or an area that is zero
 //! relative to the triangle's size) are kept so indices stay as in the file,
 //! counted in [`Mesh::degenerate_triangle_count`], and given an area of
@@ -35,7 +40,34 @@ pub use surface_point::{SurfacePoint, TangentFrame};
 pub use topology::{EdgeList, TopologyReport, VertexAdjacency};
 
 use glam::{Vec2, Vec3};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
+
+/// A named scalar per vertex: a PLY vertex property other than position,
+/// normal and UV (`red`, `green`, `blue` and `alpha` scaled to 0–1 when
+/// stored as integers), or an OBJ vertex colour (`v x y z r g b`:
+/// `red`, `green`, `blue`). Per-vertex maps (`vertex:NAME`) read it,
+/// interpolated barycentrically.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VertexAttribute {
+    /// The name maps refer to it by.
+    pub name: String,
+    /// One value a vertex.
+    pub values: Arc<[f32]>,
+}
+
+/// Named sets of triangles of one kind: OBJ groups (`g`, or `o` in a
+/// file without `g`) or OBJ materials (`usemtl`). Each triangle is in
+/// exactly one set; triangles before the first statement are in a set
+/// named `default`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FaceGroups {
+    /// `"groups"` or `"materials"`.
+    pub kind: String,
+    /// The set names, in order of first appearance.
+    pub names: Vec<String>,
+    /// For each triangle, the index of its set in `names`.
+    pub of_triangle: Vec<u32>,
+}
 
 /// Texture coordinates of a mesh.
 #[derive(Debug, Clone, PartialEq)]
@@ -83,6 +115,8 @@ pub struct Mesh {
     uvs: Option<Uvs>,
     areas: Vec<f32>,
     degenerate_count: usize,
+    vertex_attributes: Vec<VertexAttribute>,
+    face_groups: Vec<FaceGroups>,
     edges: OnceLock<EdgeList>,
     edge_graph: OnceLock<EdgeGraph>,
 }
@@ -97,6 +131,8 @@ impl Clone for Mesh {
             uvs: self.uvs.clone(),
             areas: self.areas.clone(),
             degenerate_count: self.degenerate_count,
+            vertex_attributes: self.vertex_attributes.clone(),
+            face_groups: self.face_groups.clone(),
             edges: OnceLock::new(),
             edge_graph: OnceLock::new(),
         }
@@ -184,9 +220,105 @@ impl Mesh {
             uvs,
             areas,
             degenerate_count,
+            vertex_attributes: Vec::new(),
+            face_groups: Vec::new(),
             edges: OnceLock::new(),
             edge_graph: OnceLock::new(),
         })
+    }
+
+    /// The mesh with a per-vertex scalar `name` (replacing one of that
+    /// name). Fails, naming the mesh, unless there is one finite value a
+    /// vertex.
+    pub fn with_vertex_attribute(
+        mut self,
+        name: impl Into<String>,
+        values: Vec<f32>,
+    ) -> Result<Self, MeshError> {
+        let name = name.into();
+        if values.len() != self.positions.len() {
+            let msg = format!(
+                "vertex attribute '{name}' has {} values for {} vertices",
+                values.len(),
+                self.positions.len()
+            );
+            return Err(MeshError::whole(
+                &self.name,
+                MeshErrorKind::Inconsistent(msg),
+            ));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            let kind = MeshErrorKind::NonFinite {
+                what: "vertex attribute value",
+            };
+            return Err(MeshError::at_element(&self.name, "vertex", i, kind));
+        }
+        self.vertex_attributes.retain(|a| a.name != name);
+        self.vertex_attributes.push(VertexAttribute {
+            name,
+            values: values.into(),
+        });
+        Ok(self)
+    }
+
+    /// The per-vertex scalars, in the order they were added.
+    pub fn vertex_attributes(&self) -> &[VertexAttribute] {
+        &self.vertex_attributes
+    }
+
+    /// The per-vertex scalar called `name`, if the mesh has one.
+    pub fn vertex_attribute(&self, name: &str) -> Option<&VertexAttribute> {
+        self.vertex_attributes.iter().find(|a| a.name == name)
+    }
+
+    /// The mesh with named sets of faces (replacing sets of the same
+    /// kind). Fails, naming the mesh, unless every triangle is in one of
+    /// the sets.
+    pub fn with_face_groups(mut self, groups: FaceGroups) -> Result<Self, MeshError> {
+        if groups.of_triangle.len() != self.triangles.len() {
+            let msg = format!(
+                "{} '{}' entries for {} triangles",
+                groups.of_triangle.len(),
+                groups.kind,
+                self.triangles.len()
+            );
+            return Err(MeshError::whole(
+                &self.name,
+                MeshErrorKind::Inconsistent(msg),
+            ));
+        }
+        if let Some(t) = groups
+            .of_triangle
+            .iter()
+            .position(|&g| g as usize >= groups.names.len())
+        {
+            let msg = format!(
+                "is in {} set {} of {}",
+                groups.kind,
+                groups.of_triangle[t],
+                groups.names.len()
+            );
+            return Err(MeshError::at_element(
+                &self.name,
+                "triangle",
+                t,
+                MeshErrorKind::Inconsistent(msg),
+            ));
+        }
+        self.face_groups.retain(|g| g.kind != groups.kind);
+        self.face_groups.push(groups);
+        Ok(self)
+    }
+
+    /// The sets of faces of kind `kind` (`"groups"`, `"materials"`), if
+    /// the mesh has them.
+    pub fn face_groups(&self, kind: &str) -> Option<&FaceGroups> {
+        self.face_groups.iter().find(|g| g.kind == kind)
+    }
+
+    /// Every kind of face set the mesh has.
+    pub fn face_group_kinds(&self) -> Vec<&str> {
+        self.face_groups.iter().map(|g| g.kind.as_str()).collect()
     }
 
     /// What errors and reports call this mesh: its path, or a name such as

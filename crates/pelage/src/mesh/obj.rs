@@ -1,6 +1,9 @@
 //! Wavefront OBJ reader: `v`, `vt`, `vn` and `f` (any polygon, fan
 //! triangulated; `v`, `v/vt`, `v//vn`, `v/vt/vn`; negative = relative
-//! indices). Other statements (groups, materials, smoothing, lines) are
+//! indices). Vertex colours (`v x y z r g b`) become the vertex
+//! attributes `red`, `green`, `blue`; groups (`g`, or `o` in a file
+//! without `g`) and materials (`usemtl`) become [`super::FaceGroups`],
+//! which groom regions read. Other statements (smoothing, lines) are
 //! ignored.
 //!
 //! Hand-written rather than tobj (a departure from DESIGN.md, recorded in
@@ -8,7 +11,7 @@
 //! here names its line. It also keeps position and UV indices apart, so UV
 //! seams do not split vertices and topology stays as modelled.
 
-use super::{Mesh, MeshError, MeshErrorKind, Uvs};
+use super::{FaceGroups, Mesh, MeshError, MeshErrorKind, Uvs};
 use glam::{Vec2, Vec3};
 
 /// Parses OBJ text. `name` is what errors call the file.
@@ -41,6 +44,14 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
     let mut face_layout: Option<(bool, bool, usize)> = None;
     let mut normals_on_all_faces = true;
     let mut corners: Vec<[Option<u32>; 3]> = Vec::with_capacity(8);
+    // Vertex colours: present on every `v` line or on none.
+    let mut colours: Vec<Vec3> = Vec::new();
+    let mut coloured: Option<bool> = None;
+    // Face sets: each kind's names and the current set of faces to come.
+    let uses_g = bytes
+        .split(|&b| b == b'\n')
+        .any(|l| matches!(l.trim_ascii_start(), [b'g', b' ' | b'\t', ..]));
+    let mut sets = [FaceSets::new("groups"), FaceSets::new("materials")];
 
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
         let line_no = i + 1;
@@ -65,6 +76,28 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
                     }));
                 }
                 positions.push(p);
+                let rest: Vec<&str> = tokens.collect();
+                let has_colour = rest.len() >= 3;
+                match coloured {
+                    None => coloured = Some(has_colour),
+                    Some(before) if before != has_colour => {
+                        return Err(err(MeshErrorKind::Unsupported(
+                            "some vertices have colours (v x y z r g b) and some do not; pelage needs colours on all vertices or on none".into(),
+                        )));
+                    }
+                    Some(_) => {}
+                }
+                if has_colour {
+                    let mut rgb = rest[..3].iter().map(|t| number(t));
+                    let mut next = || rgb.next().expect("three tokens").map_err(err);
+                    let c = Vec3::new(next()?, next()?, next()?);
+                    if !c.is_finite() {
+                        return Err(err(MeshErrorKind::NonFinite {
+                            what: "vertex colour",
+                        }));
+                    }
+                    colours.push(c);
+                }
             }
             Some("vt") => {
                 let [u] =
@@ -90,6 +123,14 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
                     }));
                 }
                 file_normals.push(n);
+            }
+            Some(kind @ ("g" | "o" | "usemtl")) => {
+                let set = if kind == "usemtl" { 1 } else { 0 };
+                if kind == "o" && uses_g {
+                    continue;
+                }
+                let name = tokens.collect::<Vec<_>>().join(" ");
+                sets[set].enter(if name.is_empty() { "default" } else { &name });
             }
             Some("f") => {
                 corners.clear();
@@ -126,6 +167,9 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
                 normals_on_all_faces &= has_normal;
                 // Fan triangulation, as most OBJ readers do for convex polygons.
                 for k in 1..corners.len() - 1 {
+                    for set in &mut sets {
+                        set.add_triangle();
+                    }
                     let tri = [corners[0], corners[k], corners[k + 1]];
                     triangles.push(tri.map(|c| c[0].expect("position index is required")));
                     if has_uv {
@@ -174,7 +218,68 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
             .map(|(s, c)| s.try_normalize().unwrap_or(c))
             .collect()
     });
-    Mesh::new(name, positions, triangles, normals, uvs)
+    let mut mesh = Mesh::new(name, positions, triangles, normals, uvs)?;
+    if coloured == Some(true) {
+        for (channel, get) in [
+            ("red", (|c: &Vec3| c.x) as fn(&Vec3) -> f32),
+            ("green", |c| c.y),
+            ("blue", |c| c.z),
+        ] {
+            mesh = mesh.with_vertex_attribute(channel, colours.iter().map(get).collect())?;
+        }
+    }
+    for set in sets {
+        if let Some(groups) = set.finish() {
+            mesh = mesh.with_face_groups(groups)?;
+        }
+    }
+    Ok(mesh)
+}
+
+/// One kind of face set as the file names them: the set each triangle
+/// was in when read.
+struct FaceSets {
+    kind: &'static str,
+    names: Vec<String>,
+    current: u32,
+    of_triangle: Vec<u32>,
+    /// Whether the file named any set of this kind.
+    named: bool,
+}
+
+impl FaceSets {
+    fn new(kind: &'static str) -> Self {
+        Self {
+            kind,
+            names: vec!["default".into()],
+            current: 0,
+            of_triangle: Vec::new(),
+            named: false,
+        }
+    }
+
+    fn enter(&mut self, name: &str) {
+        self.named = true;
+        self.current = match self.names.iter().position(|n| n == name) {
+            Some(i) => i as u32,
+            None => {
+                self.names.push(name.to_string());
+                self.names.len() as u32 - 1
+            }
+        };
+    }
+
+    fn add_triangle(&mut self) {
+        self.of_triangle.push(self.current);
+    }
+
+    fn finish(self) -> Option<FaceGroups> {
+        self.named.then(|| FaceGroups {
+            kind: self.kind.to_string(),
+            names: self.names,
+            of_triangle: self.of_triangle,
+        })
+    }
 }
 
 /// Parses `N` numbers from `tokens`; `what` describes the statement for the
@@ -267,6 +372,33 @@ mod tests {
         assert_eq!(m.triangles(), &[[0, 1, 2], [0, 2, 3]]);
         assert_eq!(m.triangle_uvs(1).unwrap()[2], Vec2::new(0.0, 1.0));
         assert!((m.surface_area() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn vertex_colours_and_face_sets_are_kept() {
+        let text = "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 1 1 0 0 0 1\nv 0 1 0 1 1 1\nf 1 2 3\ng left side\nusemtl fur\nf 1 3 4\ng right\nf 1 2 4\n";
+        let m = parse("c.obj", text.as_bytes()).unwrap();
+        assert_eq!(
+            &m.vertex_attribute("green").unwrap().values[..],
+            &[0.0, 1.0, 0.0, 1.0]
+        );
+        let g = m.face_groups("groups").unwrap();
+        assert_eq!(g.names, ["default", "left side", "right"]);
+        assert_eq!(g.of_triangle, [0, 1, 2]);
+        let mtl = m.face_groups("materials").unwrap();
+        assert_eq!(mtl.names, ["default", "fur"]);
+        assert_eq!(mtl.of_triangle, [0, 1, 1]);
+        // Subdivision keeps both: children in their parent's set.
+        let s = m.subdivided(1);
+        assert_eq!(s.face_groups("groups").unwrap().of_triangle[4..8], [1; 4]);
+        assert_eq!(
+            s.vertex_attribute("red").unwrap().values.len(),
+            s.vertex_count()
+        );
+        let err = parse("c.obj", b"v 0 0 0 1 0 0\nv 1 0 0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("c.obj:2:"), "{err}");
     }
 
     #[test]

@@ -45,6 +45,28 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
         .into_iter()
         .find(|[a, b]| has(a) && has(b));
 
+    let mut reserved: Vec<&str> = vec!["x", "y", "z"];
+    reserved.extend(normal_keys.iter().flatten());
+    reserved.extend(uv_keys.iter().flatten());
+    let attribute_keys: Vec<(&str, f32)> = vertex_props
+        .iter()
+        .filter(|(key, _)| !reserved.contains(&key.as_str()))
+        .filter_map(|(key, def)| {
+            use ply_rs_bw::ply::{PropertyType, ScalarType};
+            let PropertyType::Scalar(kind) = &def.data_type else {
+                return None;
+            };
+            let colour = matches!(key.as_str(), "red" | "green" | "blue" | "alpha");
+            let scale = match kind {
+                ScalarType::UChar if colour => 1.0 / 255.0,
+                ScalarType::UShort if colour => 1.0 / 65535.0,
+                _ => 1.0,
+            };
+            Some((key.as_str(), scale))
+        })
+        .collect();
+    let mut attributes: Vec<Vec<f32>> =
+        vec![Vec::with_capacity(vertices.len()); attribute_keys.len()];
     let mut positions = Vec::with_capacity(vertices.len());
     let mut normals = normal_keys.map(|_| Vec::with_capacity(vertices.len()));
     let mut vertex_uvs = uv_keys.map(|_| Vec::with_capacity(vertices.len()));
@@ -63,6 +85,9 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
         }
         if let (Some([s, t]), Some(out)) = (uv_keys, vertex_uvs.as_mut()) {
             out.push(Vec2::new(get(s)?, get(t)?));
+        }
+        for ((key, scale), out) in attribute_keys.iter().zip(&mut attributes) {
+            out.push(get(key)? * scale);
         }
     }
 
@@ -158,7 +183,11 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
             })
             .collect()
     });
-    Mesh::new(name, positions, triangles, normals, uvs)
+    let mut mesh = Mesh::new(name, positions, triangles, normals, uvs)?;
+    for ((key, _), values) in attribute_keys.into_iter().zip(attributes) {
+        mesh = mesh.with_vertex_attribute(key, values)?;
+    }
+    Ok(mesh)
 }
 
 fn parse_error(name: &str, e: ply_rs_bw::parser::ParseError) -> MeshError {
@@ -245,6 +274,27 @@ mod tests {
         assert_eq!(m.triangle_count(), 2);
         assert!(matches!(m.uvs(), Some(Uvs::PerVertex(_))));
         assert!((m.surface_area() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn other_vertex_properties_become_attributes_and_colours_are_scaled() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty float density\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 255 0.5\n1 0 0 0 2\n0 1 0 51 1\n3 0 1 2\n";
+        let m = parse("painted.ply", text.as_bytes()).unwrap();
+        let red = m.vertex_attribute("red").unwrap();
+        let expected = [1.0, 0.0, 0.2];
+        assert!(
+            red.values
+                .iter()
+                .zip(expected)
+                .all(|(a, b)| (a - b).abs() < 1e-6),
+            "{:?}",
+            red.values
+        );
+        assert_eq!(
+            &m.vertex_attribute("density").unwrap().values[..],
+            &[0.5, 2.0, 1.0]
+        );
+        assert!(m.vertex_attribute("x").is_none());
     }
 
     #[test]

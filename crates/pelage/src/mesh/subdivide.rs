@@ -107,8 +107,27 @@ impl Mesh {
             }
         });
 
-        Mesh::new(self.name(), positions, triangles, Some(normals), uvs)
-            .expect("subdividing a valid mesh gives a valid mesh")
+        let mut mesh = Mesh::new(self.name(), positions, triangles, Some(normals), uvs)
+            .expect("subdividing a valid mesh gives a valid mesh");
+        // Per-vertex scalars interpolate linearly, as the UVs do; a child
+        // triangle is in its parent's face set.
+        for attribute in self.vertex_attributes() {
+            let mut values = attribute.values.to_vec();
+            values.extend(edges.edges.iter().map(|&[a, b]| {
+                0.5 * (attribute.values[a as usize] + attribute.values[b as usize])
+            }));
+            mesh = mesh
+                .with_vertex_attribute(attribute.name.clone(), values)
+                .expect("midpoints of finite values are finite");
+        }
+        for groups in &self.face_groups {
+            let mut children = groups.clone();
+            children.of_triangle = groups.of_triangle.iter().flat_map(|&g| [g; 4]).collect();
+            mesh = mesh
+                .with_face_groups(children)
+                .expect("four children a triangle");
+        }
+        mesh
     }
 }
 
