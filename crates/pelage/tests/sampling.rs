@@ -10,6 +10,7 @@
 //! centroid rule is exact. The expected probabilities are computed here
 //! independently, by clipping each triangle against each texel.
 
+mod support;
 use glam::{Vec2, Vec3};
 use pelage::map::{Filter, ImageMap, Map, NoiseMap, Wrap};
 use pelage::mesh::{Mesh, SurfacePoint, Uvs};
@@ -17,6 +18,7 @@ use pelage::sample::{
     DensitySampler, DensitySamplerOptions, RejectionSampler, SampleError, SampleRng, Selector,
     SurfaceSampler, sample_range,
 };
+use support::chi_square::{assert_fits, chi_square, chi_square_limit};
 
 const TEXELS: u32 = 32;
 const SAMPLES: u64 = 1_000_000;
@@ -169,53 +171,6 @@ fn exact_texel_probabilities(map: &Map) -> Vec<f64> {
         .collect();
     let total: f64 = values.iter().sum();
     values.iter().map(|v| v / total).collect()
-}
-
-/// Pearson's chi-square of `counts` against `probabilities`. Bins expected
-/// to hold fewer than 5 samples are pooled. A bin of probability zero that
-/// received a sample fails at once (returned as infinity).
-fn chi_square(counts: &[u64], probabilities: &[f64]) -> (f64, usize) {
-    let n: u64 = counts.iter().sum();
-    let (mut chi2, mut bins) = (0.0, 0usize);
-    let (mut pooled_count, mut pooled_expected) = (0.0, 0.0);
-    for (&c, &p) in counts.iter().zip(probabilities) {
-        let e = p * n as f64;
-        if p == 0.0 {
-            if c > 0 {
-                return (f64::INFINITY, bins);
-            }
-            continue;
-        }
-        if e < 5.0 {
-            pooled_count += c as f64;
-            pooled_expected += e;
-            continue;
-        }
-        chi2 += (c as f64 - e).powi(2) / e;
-        bins += 1;
-    }
-    if pooled_expected > 0.0 {
-        chi2 += (pooled_count - pooled_expected).powi(2) / pooled_expected;
-        bins += 1;
-    }
-    (chi2, bins.saturating_sub(1))
-}
-
-/// The 0.999 quantile of chi-square with `dof` degrees of freedom
-/// (Wilson–Hilferty).
-fn chi_square_limit(dof: usize) -> f64 {
-    let k = dof as f64;
-    let z = 3.0902;
-    k * (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3)
-}
-
-fn assert_fits(what: &str, counts: &[u64], probabilities: &[f64]) {
-    let (chi2, dof) = chi_square(counts, probabilities);
-    let limit = chi_square_limit(dof);
-    assert!(
-        chi2 < limit,
-        "{what}: chi-square {chi2:.1} ≥ {limit:.1} ({dof} degrees of freedom)"
-    );
 }
 
 fn counts_per_triangle(mesh: &Mesh, points: &[SurfacePoint]) -> Vec<u64> {
@@ -607,18 +562,18 @@ fn unusable_densities_are_errors_naming_the_mesh() {
         None,
     )
     .unwrap();
-    let err = DensitySampler::new(
-        &no_uvs,
-        &Map::Noise(NoiseMap::default()),
-        Default::default(),
-    )
-    .unwrap_err()
-    .to_string();
+    let image = Map::Image(ImageMap::from_texels(1, 1, vec![1.0], Wrap::Repeat).unwrap());
+    let err = DensitySampler::new(&no_uvs, &image, Default::default())
+        .unwrap_err()
+        .to_string();
     assert!(
         err.starts_with("plain triangle: this map is evaluated at UVs, and the mesh has no UVs"),
         "{err}"
     );
     assert!(DensitySampler::new(&no_uvs, &Map::Constant(1.0), Default::default()).is_ok());
+    // Noise needs no UVs: it is read at the position instead.
+    let noise = Map::Noise(NoiseMap::default());
+    assert!(DensitySampler::new(&no_uvs, &noise, Default::default()).is_ok());
 }
 
 #[test]

@@ -128,9 +128,9 @@ pub struct CombMap {
 impl CombMap {
     /// The comb at `root` (in world space, tangent to the surface).
     pub fn at(&self, mesh: &Mesh, root: SurfacePoint) -> Vec3 {
-        let uv = root.uv(mesh).unwrap_or_default();
+        let site = crate::map::MapSite::on(mesh, root);
         let frame = root.tangent_frame(mesh);
-        let (a, b) = (2.0 * self.u.eval(uv) - 1.0, 2.0 * self.v.eval(uv) - 1.0);
+        let (a, b) = (2.0 * self.u.at(&site) - 1.0, 2.0 * self.v.at(&site) - 1.0);
         self.strength * (a * frame.tangent + b * frame.bitangent)
     }
 }
@@ -220,16 +220,21 @@ impl Guides {
         let sampler = DensitySampler::new(mesh, &growth.density, DensitySamplerOptions::default())?;
         let roots = sample_range(&sampler, growth.seed, 0..growth.count as u64);
         let length = growth.length.on_mesh(mesh)?;
-        if let Some(map) = &growth.comb_map {
-            // Both need UVs to be read; refuse a mesh without them here.
-            map.u.on_mesh(mesh)?;
-            map.v.on_mesh(mesh)?;
-        }
+        // Refuse maps the mesh cannot serve here, and take per-vertex
+        // maps' values.
+        let comb_map = match &growth.comb_map {
+            Some(map) => Some(CombMap {
+                u: map.u.bound(mesh)?.into_owned(),
+                v: map.v.bound(mesh)?.into_owned(),
+                strength: map.strength,
+            }),
+            None => None,
+        };
         let n = growth.points.max(2);
         let (mut points, mut widths) = (Vec::new(), Vec::new());
         for root in &roots {
             let (p0, normal) = (root.position(mesh), root.normal(mesh));
-            let comb = match &growth.comb_map {
+            let comb = match &comb_map {
                 Some(map) => map.at(mesh, *root),
                 None => growth.comb,
             };
@@ -268,6 +273,27 @@ impl Guides {
             curves,
             points_per_guide: self.points_per_guide,
         })
+    }
+
+    /// The guides at `indices` (in that order), as guides of their own.
+    pub fn subset(&self, indices: &[u32]) -> Self {
+        let n = self.points_per_guide;
+        let mut points = Vec::with_capacity(indices.len() * n);
+        let mut widths = Vec::with_capacity(indices.len() * n);
+        let mut roots = Vec::with_capacity(indices.len());
+        for &i in indices {
+            points.extend_from_slice(self.guide(i as usize));
+            widths.extend_from_slice(self.widths(i as usize));
+            roots.push(self.roots()[i as usize]);
+        }
+        let offsets = (0..=indices.len() as u32).map(|i| i * n as u32).collect();
+        let curves = Curves::new(points, widths, offsets)
+            .and_then(|c| c.with_roots(roots))
+            .expect("a subset of valid guides is valid");
+        Self {
+            curves,
+            points_per_guide: n,
+        }
     }
 
     /// The guides as curves (with their roots).

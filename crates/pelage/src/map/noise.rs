@@ -1,6 +1,9 @@
 //! Procedural noise maps: 2D Perlin gradient noise (Perlin 2002, "Improving
 //! Noise": quintic fade, hashed gradients) summed in octaves (fBm), as the
 //! Stubble generator uses for density and displacement (Sik, section 4.3).
+//! On a mesh without UVs (or with `space=object`) the same fBm is summed
+//! over 3D Perlin noise at the point's rest position, so a noise map needs
+//! no texture coordinates.
 
 use glam::Vec2;
 
@@ -20,6 +23,9 @@ pub struct NoiseMap {
     pub offset: f32,
     /// Multiplies the noise.
     pub scale: f32,
+    /// Where the noise is read: UV, object space, or UV when the mesh has
+    /// UVs and object space when it has none.
+    pub space: NoiseSpace,
     permutation: Box<[u8; 512]>,
     /// The permutation table widened to `u32`, for SIMD gathers.
     permutation32: Box<[u32; 512]>,
@@ -29,6 +35,30 @@ pub struct NoiseMap {
     /// 0–3 from `h`, 4–7 from `perm[h + 101]`, 8–11 from `perm[h + 203]`.
     /// The SIMD path reads a corner's three gradients with one gather.
     corner_gradients: Box<[u32; 512]>,
+}
+
+/// Where a noise map is read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum NoiseSpace {
+    /// UV on a mesh with UVs, object space on one without (the default).
+    #[default]
+    Auto,
+    /// Always at the UV (the mesh needs UVs).
+    Uv,
+    /// Always at the rest position, `frequency` cells per world unit.
+    Object,
+}
+
+impl NoiseSpace {
+    /// `auto`, `uv` or `object`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "auto" => Some(Self::Auto),
+            "uv" => Some(Self::Uv),
+            "object" => Some(Self::Object),
+            _ => None,
+        }
+    }
 }
 
 impl Default for NoiseMap {
@@ -52,6 +82,7 @@ impl NoiseMap {
             seed,
             offset,
             scale,
+            space: NoiseSpace::Auto,
             permutation32: Box::new(permutation.map(u32::from)),
             corner_gradients,
             permutation,
@@ -77,6 +108,49 @@ impl NoiseMap {
             p *= 2.0;
         }
         self.offset + self.scale * sum / total
+    }
+
+    /// The noise read at `space`.
+    pub fn with_space(mut self, space: NoiseSpace) -> Self {
+        self.space = space;
+        self
+    }
+
+    /// The map's value at object-space position `p`: the same fBm over 3D
+    /// Perlin noise.
+    pub fn eval3(&self, p: glam::Vec3) -> f32 {
+        let mut sum = 0.0;
+        let mut amplitude = 1.0;
+        let mut total = 0.0;
+        let mut p = p * self.frequency;
+        for _ in 0..self.octaves {
+            sum += amplitude * self.perlin3(p);
+            total += amplitude;
+            amplitude *= 0.5;
+            p *= 2.0;
+        }
+        self.offset + self.scale * sum / total
+    }
+
+    /// One octave of 3D Perlin noise (Perlin 2002), in about [−1, 1].
+    pub fn perlin3(&self, p: glam::Vec3) -> f32 {
+        let cell = p.floor();
+        let f = p - cell;
+        let [xi, yi, zi] = [cell.x, cell.y, cell.z].map(|c| (c as i64 & 255) as usize);
+        let perm = &self.permutation;
+        let at = |i: usize| perm[i & 511] as usize;
+        let fade = |t: f32| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+        let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
+        let corner = |dx: usize, dy: usize, dz: usize| {
+            let h = at(at(at(xi + dx) + yi + dy) + zi + dz);
+            gradient3(h as u8, f.x - dx as f32, f.y - dy as f32, f.z - dz as f32)
+        };
+        let lerp = |a: f32, b: f32, t: f32| a + t * (b - a);
+        let x00 = lerp(corner(0, 0, 0), corner(1, 0, 0), u);
+        let x10 = lerp(corner(0, 1, 0), corner(1, 1, 0), u);
+        let x01 = lerp(corner(0, 0, 1), corner(1, 0, 1), u);
+        let x11 = lerp(corner(0, 1, 1), corner(1, 1, 1), u);
+        lerp(lerp(x00, x10, v), lerp(x01, x11, v), w)
     }
 
     /// One octave of 2D Perlin noise, in about [−1, 1].

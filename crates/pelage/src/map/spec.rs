@@ -4,10 +4,15 @@
 //! - an image: `density.png`, with optional `:channel` (`luminance`, `r`,
 //!   `g`, `b`, `a`), `:wrap` (`repeat`, `clamp`) and `:filter` (`bilinear`,
 //!   `nearest`) suffixes in any order, e.g. `mask.exr:a:clamp:nearest`;
-//! - noise: `noise` or `noise:frequency=8,octaves=4,seed=3,offset=0.5,scale=0.5`
-//!   (any subset of the keys; `freq` is accepted for `frequency`).
+//! - noise: `noise` or `noise:frequency=8,octaves=4,seed=3,offset=0.5,scale=0.5,space=object`
+//!   (any subset of the keys; `freq` is accepted for `frequency`);
+//! - UDIM tiles: an image path holding `<UDIM>` (`fur.<UDIM>.png:r`);
+//! - a per-vertex scalar of the mesh: `vertex:NAME` (`vertex:red`).
 
-use super::{Channel, Filter, ImageMap, Map, MapError, MapErrorKind, NoiseMap, Wrap};
+use super::{
+    Channel, Filter, ImageMap, Map, MapError, MapErrorKind, NoiseMap, NoiseSpace, UDIM_TOKEN,
+    UdimMap, VertexMap, Wrap,
+};
 use std::path::Path;
 
 impl Map {
@@ -31,6 +36,16 @@ impl Map {
                 return Err(fail("a constant map must be a finite number".into()));
             }
             return Ok(Map::Constant(value));
+        }
+        if let Some(name) = spec.strip_prefix("vertex:") {
+            let name = name.trim();
+            if name.is_empty() {
+                return Err(fail(
+                    "a per-vertex map names the attribute: vertex:NAME (vertex:red, vertex:density)"
+                        .into(),
+                ));
+            }
+            return Ok(Map::Vertex(VertexMap::new(name)));
         }
         if spec == "noise" || spec.starts_with("noise:") {
             return parse_noise(
@@ -63,6 +78,14 @@ impl Map {
             _ => Path::new(path).to_path_buf(),
         };
         let full = resolve(path);
+        if path.contains(UDIM_TOKEN) {
+            return UdimMap::load(
+                &full,
+                channel.unwrap_or_default(),
+                filter.unwrap_or_default(),
+            )
+            .map(Map::Udim);
+        }
         // `spot.png:q`: the file is there, the suffix is not one we know.
         if let Some((head, suffix)) = path.rsplit_once(':')
             && !full.exists()
@@ -79,6 +102,7 @@ impl Map {
 
 fn parse_noise(params: &str) -> Result<NoiseMap, String> {
     let defaults = NoiseMap::default();
+    let mut space = NoiseSpace::Auto;
     let (mut frequency, mut octaves, mut seed, mut offset, mut scale) = (
         defaults.frequency,
         defaults.octaves,
@@ -105,9 +129,10 @@ fn parse_noise(params: &str) -> Result<NoiseMap, String> {
             "seed" => seed = value.parse().map_err(|_| bad("a whole number"))?,
             "offset" => offset = float()?,
             "scale" => scale = float()?,
+            "space" => space = NoiseSpace::parse(value).ok_or_else(|| bad("auto, uv or object"))?,
             _ => {
                 return Err(format!(
-                    "unknown noise parameter {key:?}; the parameters are frequency, octaves, seed, offset, scale"
+                    "unknown noise parameter {key:?}; the parameters are frequency, octaves, seed, offset, scale, space"
                 ));
             }
         }
@@ -115,7 +140,7 @@ fn parse_noise(params: &str) -> Result<NoiseMap, String> {
     if !(1..=16).contains(&octaves) {
         return Err(format!("noise octaves must be 1 to 16, not {octaves}"));
     }
-    Ok(NoiseMap::new(frequency, octaves, seed, offset, scale))
+    Ok(NoiseMap::new(frequency, octaves, seed, offset, scale).with_space(space))
 }
 
 #[cfg(test)]

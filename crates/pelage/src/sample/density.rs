@@ -12,9 +12,9 @@ use super::cdf::CdfGrid;
 use super::rng::{PairDraws, open_unit_pair};
 use super::subtriangle::{MAX_LEVEL, PositionTable, SubTriangle, WHOLE_TRIANGLE, child_index};
 use super::{SampleError, SurfaceSampler, prefetch, warp};
-use crate::map::Map;
+use crate::map::{Map, MapSite};
 use crate::mesh::{Mesh, SurfacePoint};
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::sync::Arc;
 
@@ -153,10 +153,15 @@ impl SubTriangleRecords {
     /// UVs on a mesh without them, a negative or NaN density (with the
     /// triangle and UV), a density that is zero everywhere.
     pub(crate) fn build(mesh: &Mesh, density: &Map, max_level: u32) -> Result<Self, SampleError> {
-        // Refuses maps that need UVs on meshes without them.
-        density.on_mesh(mesh)?;
+        // Refuses maps that need UVs on meshes without them; takes a
+        // per-vertex map's values.
+        let density = &*density.bound(mesh)?;
         let max_level = max_level.min(MAX_LEVEL);
-        let texels = density.resolution();
+        let texels = Resolution {
+            uv: density.resolution(),
+            object: density.object_resolution(mesh.has_uvs()),
+            linear: density.varies_within_triangles(),
+        };
 
         // Triangles are independent: build in parallel, in fixed chunks
         // concatenated in order, so the records never depend on threads.
@@ -272,6 +277,56 @@ impl DensitySampler {
         })
     }
 
+    /// The same distribution restricted to a few `triangles` (any order)
+    /// and renormalised, as a small sampler that borrows this one: where
+    /// one cell of [`super::RootCells`] places its roots. Building it costs
+    /// the cell's records, not the mesh's triangles (as
+    /// [`Self::restricted`] does). `None` if the density is zero on all
+    /// of them.
+    pub fn cell_sampler(&self, triangles: &[u32]) -> Option<CellSampler<'_>> {
+        let mut entries = Vec::new();
+        let mut weights = Vec::new();
+        for &t in triangles {
+            let range =
+                self.first_record[t as usize] as usize..self.first_record[t as usize + 1] as usize;
+            for r in &self.records[range] {
+                entries.push(AliasedRecord {
+                    threshold: u32::MAX,
+                    alias: entries.len() as u32,
+                    triangle: r.triangle,
+                    position: r.position,
+                });
+                weights.push(f64::from(r.probability));
+            }
+        }
+        let total: f64 = weights.iter().sum();
+        if entries.is_empty() || total <= 0.0 {
+            return None;
+        }
+        build_alias_bins(weights, entries.as_mut_slice());
+        Some(CellSampler {
+            whole: self,
+            entries,
+            share: total / self.total,
+        })
+    }
+
+    /// The probability that a sample lands in `triangles` (any order).
+    pub fn probability_of(&self, triangles: &[u32]) -> f64 {
+        triangles
+            .iter()
+            .map(|&t| {
+                let range = self.first_record[t as usize] as usize
+                    ..self.first_record[t as usize + 1] as usize;
+                self.records[range]
+                    .iter()
+                    .map(|r| f64::from(r.probability))
+                    .sum::<f64>()
+            })
+            .sum::<f64>()
+            / self.total
+    }
+
     fn from_records(
         areas: Arc<[f32]>,
         records: Vec<SubTriangleRecord>,
@@ -362,6 +417,37 @@ impl DensitySampler {
             tri: triangle,
             bary: [b.x, b.y],
         }
+    }
+}
+
+/// A [`DensitySampler`] restricted to a few triangles: an alias table
+/// over their records (see [`DensitySampler::cell_sampler`]).
+#[derive(Debug, Clone)]
+pub struct CellSampler<'a> {
+    whole: &'a DensitySampler,
+    entries: Vec<AliasedRecord>,
+    /// The cell's share of the whole distribution.
+    share: f64,
+}
+
+impl SurfaceSampler for CellSampler<'_> {
+    /// As [`DensitySampler::sample`], among the cell's records.
+    #[inline]
+    fn sample(&self, seed: u64, index: u64) -> SurfacePoint {
+        let [select, place] = PairDraws::new(seed).draws(index);
+        let e = self.entries[alias_bin(select, self.entries.len())];
+        let e = if (select as u32) < e.threshold {
+            e
+        } else {
+            self.entries[e.alias as usize]
+        };
+        self.whole.point_in(e.triangle, e.position, place)
+    }
+
+    /// The whole sampler's density renormalised to the cell (for points
+    /// in the cell's triangles).
+    fn pdf(&self, point: SurfacePoint) -> f64 {
+        self.whole.pdf(point) / self.share
     }
 }
 
@@ -479,14 +565,34 @@ impl SurfaceSampler for DensitySampler {
     }
 }
 
+/// How finely a density varies: the texel grid over UV, the samples a
+/// world unit of object-space noise, or linearly inside triangles.
+#[derive(Debug, Clone, Copy)]
+struct Resolution {
+    uv: Option<(u32, u32)>,
+    object: Option<f32>,
+    linear: bool,
+}
+
+/// Levels a triangle is subdivided to for a per-vertex density: the
+/// triangle's probability is exact at level 0 (a linear function's mean
+/// is its centroid value); two levels follow the gradient inside it.
+const LINEAR_LEVELS: u32 = 2;
+
 /// Subdivision level of a triangle: the smallest level at which each
-/// sub-triangle covers at most one texel (Sik §3.1), capped.
-fn level_for(mesh: &Mesh, texels: Option<(u32, u32)>, max_level: u32, t: usize) -> u32 {
-    let (Some((w, h)), Some([t0, t1, t2])) = (texels, mesh.triangle_uvs(t)) else {
+/// sub-triangle covers at most one texel (Sik §3.1), capped. Object-space
+/// noise counts its samples over the triangle's area instead.
+fn level_for(mesh: &Mesh, texels: Resolution, max_level: u32, t: usize) -> u32 {
+    let footprint = if let Some(per_unit) = texels.object {
+        mesh.triangle_areas()[t] * per_unit * per_unit
+    } else if let (Some((w, h)), Some([t0, t1, t2])) = (texels.uv, mesh.triangle_uvs(t)) {
+        let (d1, d2) = (t1 - t0, t2 - t0);
+        0.5 * (d1.x * d2.y - d2.x * d1.y).abs() * w as f32 * h as f32
+    } else if texels.linear {
+        return LINEAR_LEVELS.min(max_level);
+    } else {
         return 0;
     };
-    let (d1, d2) = (t1 - t0, t2 - t0);
-    let footprint = 0.5 * (d1.x * d2.y - d2.x * d1.y).abs() * w as f32 * h as f32;
     let mut level = 0;
     let mut per_sub = footprint;
     while per_sub > 1.0 && level < max_level {
@@ -509,13 +615,16 @@ fn subdivide_triangle(
     if area == 0.0 {
         return Ok(()); // degenerate: zero probability, no records
     }
-    // UV corners once per triangle; a map without UV needs is constant.
+    // UV and position corners once per triangle.
     let uv_frame = mesh
         .triangle_uvs(t)
         .map(|[t0, t1, t2]| (t0, t1 - t0, t2 - t0));
+    let [p0, p1, p2] = mesh.triangle_positions(t);
     let leaf = Leaf {
         map,
         uv_frame,
+        position_frame: (p0, p1 - p0, p2 - p0),
+        corners: mesh.triangles()[t],
         t: t as u32,
         area,
         level,
@@ -540,6 +649,10 @@ struct Leaf<'a> {
     map: &'a Map,
     /// UV of corner 0 and the UV edges to corners 1 and 2.
     uv_frame: Option<(Vec2, Vec2, Vec2)>,
+    /// The same for positions (object-space noise reads them).
+    position_frame: (Vec3, Vec3, Vec3),
+    /// The triangle's vertices (per-vertex maps read them).
+    corners: [u32; 3],
     t: u32,
     area: f32,
     level: u32,
@@ -552,15 +665,18 @@ impl Leaf<'_> {
     /// The density at parent barycentrics `b`.
     #[inline]
     fn density_at(&self, b: Vec2) -> (f32, Option<Vec2>) {
-        match (self.map, self.uv_frame) {
-            (Map::Constant(c), _) => (*c, None),
-            (map, Some((t0, e1, e2))) => {
-                let uv = t0 + b.x * e1 + b.y * e2;
-                (map.eval(uv), Some(uv))
-            }
-            // Map::on_mesh refused maps that need UVs on meshes without.
-            (map, None) => (map.eval(Vec2::ZERO), None),
+        if let Map::Constant(c) = self.map {
+            return (*c, None);
         }
+        let uv = self.uv_frame.map(|(t0, e1, e2)| t0 + b.x * e1 + b.y * e2);
+        let (p0, e1, e2) = self.position_frame;
+        let site = MapSite {
+            uv,
+            position: p0 + b.x * e1 + b.y * e2,
+            corners: self.corners,
+            weights: [1.0 - b.x - b.y, b.x, b.y],
+        };
+        (self.map.at(&site), uv)
     }
 
     /// Returns `Some(probability)` when the node is uniform (a leaf, or four

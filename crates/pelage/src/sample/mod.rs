@@ -15,6 +15,7 @@
 
 mod alias;
 mod cdf;
+mod cells;
 mod density;
 mod rejection;
 mod rng;
@@ -24,7 +25,10 @@ pub mod warp;
 
 pub use alias::{AliasBin, AliasBins, AliasTable, build_alias_bins};
 pub use cdf::CdfGrid;
-pub use density::{DensitySampler, DensitySamplerOptions, Selector, SubTriangleRecord};
+pub use cells::RootCells;
+pub use density::{
+    CellSampler, DensitySampler, DensitySamplerOptions, Selector, SubTriangleRecord,
+};
 pub use rejection::RejectionSampler;
 pub use rng::{PairDraws, SampleRng, mix64, open_unit_pair};
 

@@ -26,8 +26,15 @@ pub const CURL_PHASE: u64 = 0xC0_11;
 /// Shell fur: droplets scattered over a mesh.
 pub const DROPLETS: u64 = 0x5EED_D201;
 
+/// Cell `c`'s hair arrivals (stable ids): `mix64(seed ^ mix64(CELL_ARRIVALS + c))`.
+pub const CELL_ARRIVALS: u64 = 0x0CE1_1A77;
+/// Cell `c`'s roots (stable ids): `mix64(seed ^ mix64(CELL_ROOTS + c))`.
+pub const CELL_ROOTS: u64 = 0xCE11_2007;
+/// Blue-noise roots: the candidates a part's roots are chosen from.
+pub const BLUE_NOISE: u64 = 0xB10E_2015;
+
 /// Every salt above, with its name.
-pub const ALL: [(&str, u64); 10] = [
+pub const ALL: [(&str, u64); 13] = [
     ("PART_ROOTS", PART_ROOTS),
     ("WIDTH_JITTER", WIDTH_JITTER),
     ("OPACITY_JITTER", OPACITY_JITTER),
@@ -38,6 +45,9 @@ pub const ALL: [(&str, u64); 10] = [
     ("FRIZZ_HAIR", FRIZZ_HAIR),
     ("CURL_PHASE", CURL_PHASE),
     ("DROPLETS", DROPLETS),
+    ("CELL_ARRIVALS", CELL_ARRIVALS),
+    ("CELL_ROOTS", CELL_ROOTS),
+    ("BLUE_NOISE", BLUE_NOISE),
 ];
 
 #[cfg(test)]

@@ -6,6 +6,8 @@
 
 #![allow(dead_code)] // each test binary uses its own share
 
+pub mod chi_square;
+
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
