@@ -240,6 +240,7 @@ fn on_a_thin_plate_the_style_mesh_keeps_each_side_to_its_guides_and_shepard_does
                 HairRoot {
                     position: root,
                     triangle: Some(triangle),
+                    region: 0,
                 },
                 HairRoot::at(root),
             ] {

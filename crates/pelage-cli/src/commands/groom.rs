@@ -56,6 +56,10 @@ pub struct GroomArgs {
     /// most 300,000 hairs, evenly chosen).
     #[arg(long, value_name = "PNG")]
     pub preview: Option<PathBuf>,
+    /// Also write a JSON report: per-part hair counts, the guides left
+    /// out and why, the regions with their guides and hairs, timings.
+    #[arg(long, value_name = "JSON")]
+    pub report: Option<PathBuf>,
     /// Do not print the progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -111,10 +115,19 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         }
     }
     if let Some(animated) = groom.animated(args.seed)? {
+        if args.report.is_some() {
+            bail!(
+                "--report describes still grooms; grow this one without --frames (or without [animation]) to get its report"
+            );
+        }
         return run_animated(args, &groom, &animated, &output, start);
     }
     let generator = groom.generator(args.seed)?;
     let prepared = start.elapsed();
+    let lost = generator.lost_guides();
+    for guide in &lost {
+        eprintln!("warning: style mesh: {guide}");
+    }
     let parts = generator.parts().len();
     let (range, path) = match args.part {
         Some((k, n)) => (run_parts(args, k, n, parts)?, part_file(&output, k, n)),
@@ -172,9 +185,13 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     // Hairs kept for the preview: every `stride`-th of each part.
     let stride = planned.div_ceil(PREVIEW_HAIRS).max(1) as usize;
     let mut shown = Vec::new();
-    let summary = generator.write(&path, range.clone(), &export, |_, curves| {
+    let mut report = args.report.as_ref().map(|_| GroomReport::new(&generator));
+    let summary = generator.write(&path, range.clone(), &export, |p, curves| {
         if args.preview.is_some() {
             shown.push(curves.every_nth(stride));
+        }
+        if let Some(report) = &mut report {
+            report.add_part(&generator, p, curves);
         }
         done += curves.curve_count() as u64;
         bar.set_message(format!("{} hairs", thousands(done)));
@@ -192,6 +209,19 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         summary.hairs as f64 / seconds / 1e6,
         prepared.as_secs_f64()
     );
+    if let Some(report) = &report {
+        for warning in report.borrowed_regions() {
+            eprintln!("warning: regions: {warning}");
+        }
+    }
+    if let (Some(report), Some(json)) = (report, &args.report) {
+        let value = report.finish(&groom, &path, prepared.as_secs_f64(), seconds, &lost);
+        pelage::io::write_atomically(json, |w| {
+            serde_json::to_writer_pretty(&mut *w, &value)?;
+            std::io::Write::write_all(w, b"\n")
+        })?;
+        println!("report → {}", json.display());
+    }
     if let Some(png) = &args.preview {
         let curves = pelage::io::join(shown.iter())?;
         let scene = pelage_gpu::PreviewScene {
@@ -501,4 +531,129 @@ fn assemble(output: &Path, options: &UsdOptions) -> anyhow::Result<()> {
         hi.z
     );
     Ok(())
+}
+
+/// What `--report` gathers while a groom grows.
+struct GroomReport {
+    /// Per part: index, hairs planned, hairs and points grown, triangles.
+    parts: Vec<serde_json::Value>,
+    /// Per region id: guides, hairs grown.
+    regions: std::collections::BTreeMap<u32, (usize, u64)>,
+    /// Each region's name (face sets) or number.
+    names: std::collections::BTreeMap<u32, String>,
+    split: bool,
+}
+
+impl GroomReport {
+    fn new(generator: &pelage::groom::Generator) -> Self {
+        let mut regions = std::collections::BTreeMap::new();
+        let split = generator.regions().is_some();
+        if split {
+            for root in generator.guides().roots() {
+                regions
+                    .entry(generator.region_of(*root))
+                    .or_insert((0, 0))
+                    .0 += 1;
+            }
+        }
+        Self {
+            parts: Vec::new(),
+            regions,
+            names: Default::default(),
+            split,
+        }
+    }
+
+    fn add_part(
+        &mut self,
+        generator: &pelage::groom::Generator,
+        p: usize,
+        curves: &pelage::Curves,
+    ) {
+        let part = &generator.parts()[p];
+        self.parts.push(serde_json::json!({
+            "part": p,
+            "hairs_planned": part.hair_count,
+            "hairs": curves.curve_count(),
+            "points": curves.points().len(),
+            "triangles": part.triangles.len(),
+        }));
+        if self.split
+            && let Some(roots) = curves.roots()
+        {
+            for root in roots {
+                self.regions
+                    .entry(generator.region_of(*root))
+                    .or_insert((0, 0))
+                    .1 += 1;
+            }
+            if let Some(lookup) = generator.regions() {
+                for id in self.regions.keys() {
+                    self.names.entry(*id).or_insert_with(|| lookup.name(*id));
+                }
+            }
+        }
+    }
+
+    /// Regions whose hairs had no guide of their own (they borrowed from
+    /// every guide).
+    fn borrowed_regions(&self) -> Vec<String> {
+        self.regions
+            .iter()
+            .filter(|(_, (guides, hairs))| *guides == 0 && *hairs > 0)
+            .map(|(id, (_, hairs))| {
+                let id = self.names.get(id).cloned().unwrap_or_else(|| id.to_string());
+                format!("region {id} has no guides: its {} hairs took their shape from all guides; add guides there", thousands(*hairs))
+            })
+            .collect()
+    }
+
+    fn finish(
+        self,
+        groom: &Groom,
+        output: &Path,
+        setup_s: f64,
+        grow_s: f64,
+        lost: &[pelage::interp::LostGuide],
+    ) -> serde_json::Value {
+        let dropped: Vec<serde_json::Value> = groom
+            .bind_report()
+            .map(|r| {
+                r.dropped
+                    .iter()
+                    .map(|d| serde_json::json!({ "guide": d.index, "why": d.to_string() }))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let lost: Vec<serde_json::Value> = lost
+            .iter()
+            .map(|l| serde_json::json!({ "guide": l.guide, "kept_by": l.kept_by, "vertex": l.vertex, "why": l.to_string() }))
+            .collect();
+        let regions: Vec<serde_json::Value> = self
+            .regions
+            .iter()
+            .map(|(id, (guides, hairs))| {
+                let name = self
+                    .names
+                    .get(id)
+                    .cloned()
+                    .unwrap_or_else(|| id.to_string());
+                serde_json::json!({ "region": id, "name": name, "guides": guides, "hairs": hairs })
+            })
+            .collect();
+        let hairs: u64 = self.parts.iter().filter_map(|p| p["hairs"].as_u64()).sum();
+        serde_json::json!({
+            "groom": groom.path().display().to_string(),
+            "output": output.display().to_string(),
+            "hairs": hairs,
+            "parts": self.parts,
+            "guides": {
+                "kept": groom.guides().len(),
+                "dropped": dropped,
+                "unused_by_style_mesh": lost,
+            },
+            "regions": regions,
+            "seconds": { "setup": setup_s, "grow_and_write": grow_s },
+        })
+    }
 }

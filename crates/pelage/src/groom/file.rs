@@ -97,6 +97,26 @@ pub struct GroomFile {
     pub output: OutputSection,
     /// Frames of an animated skin (absent: a still groom).
     pub animation: Option<AnimationSection>,
+    /// Regions of the skin that do not share guides or clumps (absent:
+    /// one region).
+    pub regions: Option<RegionsSection>,
+}
+
+/// `[regions]`: the skin split into regions. Hairs take their shape only
+/// from guides of their own region and clump only with centres of it; a
+/// parting is the two-region case. Exactly one of `map` or `faces`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionsSection {
+    /// A map whose value, times `scale` and rounded, is the region id.
+    pub map: Option<MapValue>,
+    /// Multiplies the map's value before rounding (255 for ids painted as
+    /// 8-bit grey levels).
+    #[serde(default = "one_f32")]
+    pub scale: f32,
+    /// The mesh's face sets: `"groups"` (OBJ `g`/`o`) or `"materials"`
+    /// (OBJ `usemtl`).
+    pub faces: Option<Spanned<String>>,
 }
 
 /// `[animation]`: the groom follows an animated skin (the `[mesh]` path:
@@ -182,6 +202,32 @@ pub struct RootsSection {
     pub seed: u64,
     /// Number of parts (default: one per 100,000 hairs).
     pub parts: Option<Spanned<u32>>,
+    /// `stable` (default) or `sequential` hair ids.
+    #[serde(default, deserialize_with = "hair_ids")]
+    pub ids: super::spec::HairIds,
+    /// `random` (default) or `blue-noise` roots.
+    #[serde(default, deserialize_with = "root_distribution")]
+    pub distribution: super::spec::RootDistribution,
+}
+
+fn hair_ids<'de, D: Deserializer<'de>>(d: D) -> Result<super::spec::HairIds, D::Error> {
+    let s = String::deserialize(d)?;
+    super::spec::HairIds::parse(&s).ok_or_else(|| {
+        de::Error::custom(format!(
+            "unknown ids {s:?}; use \"stable\" (hairs keep their ids and roots as the count changes) or \"sequential\""
+        ))
+    })
+}
+
+fn root_distribution<'de, D: Deserializer<'de>>(
+    d: D,
+) -> Result<super::spec::RootDistribution, D::Error> {
+    let s = String::deserialize(d)?;
+    super::spec::RootDistribution::parse(&s).ok_or_else(|| {
+        de::Error::custom(format!(
+            "unknown distribution {s:?}; use \"random\" or \"blue-noise\""
+        ))
+    })
 }
 
 /// `[guides]`: from a file, or grown.
@@ -286,6 +332,23 @@ fn default_power() -> f32 {
     2.0
 }
 
+impl OpSpec {
+    /// The operator's `mask`, if it has one.
+    pub fn mask(&self) -> Option<&MapValue> {
+        match self {
+            OpSpec::Noise(s) => s.mask.as_ref(),
+            OpSpec::Frizz(s) => s.mask.as_ref(),
+            OpSpec::Clump(s) => s.mask.as_ref(),
+            OpSpec::Curl(s) => s.mask.as_ref(),
+            OpSpec::Cut(s) => s.mask.as_ref(),
+            OpSpec::Length(s) => s.mask.as_ref(),
+            OpSpec::Strands(s) => s.mask.as_ref(),
+            OpSpec::Width(s) | OpSpec::Opacity(s) => s.mask.as_ref(),
+            OpSpec::Color(s) => s.mask.as_ref(),
+        }
+    }
+}
+
 impl Default for InterpolationSection {
     fn default() -> Self {
         Self {
@@ -343,6 +406,9 @@ pub struct NoiseSpec {
     /// Seed of the noise field.
     #[serde(default)]
     pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
 }
 
 fn default_noise_vectors() -> usize {
@@ -371,6 +437,9 @@ pub struct FrizzSpec {
     /// Seed.
     #[serde(default)]
     pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
 }
 
 fn default_frizz_frequency() -> MapValue {
@@ -398,6 +467,9 @@ pub struct ClumpSpec {
     /// Seed of the clump centres.
     #[serde(default)]
     pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
 }
 
 fn default_clump_rate() -> MapValue {
@@ -418,6 +490,9 @@ pub struct CurlSpec {
     /// Seed of each hair's phase.
     #[serde(default)]
     pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
 }
 
 /// `cut`: see [`crate::groom::ops::Cut`].
@@ -426,6 +501,9 @@ pub struct CurlSpec {
 pub struct CutSpec {
     /// Curve parameter (0 to 1) at which each hair is cut; 0 removes it.
     pub at: MapValue,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
 }
 
 /// `length`: see [`crate::groom::ops::Length`].
@@ -440,6 +518,9 @@ pub struct LengthSpec {
     /// Seed of the variation.
     #[serde(default)]
     pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
 }
 
 /// `strands`: see [`crate::groom::ops::Strands`].
@@ -459,6 +540,9 @@ pub struct StrandsSpec {
     /// Seed.
     #[serde(default)]
     pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
 }
 
 /// A quantity from root to tip: `width` and `opacity` (and
@@ -479,6 +563,9 @@ pub struct RootToTipSpec {
     /// Seed of the variation.
     #[serde(default)]
     pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
 }
 
 /// `color` (and `[finish.color]`): see [`crate::groom::ops::Color`].
@@ -498,6 +585,9 @@ pub struct ColorSpec {
     /// Seed of the variation.
     #[serde(default)]
     pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
 }
 
 /// `[finish]`.
@@ -532,6 +622,7 @@ fn default_width() -> RootToTipSpec {
         ramp: Ramp::default(),
         jitter: zero(),
         seed: 0,
+        mask: None,
     }
 }
 

@@ -6,14 +6,17 @@
 //! one hair.
 
 use super::error::{GroomError, GroomErrorKind};
-use super::grow::{Workspace, sorted_by_triangle};
+use super::grow::{Workspace, sorted_by_triangle, sorted_by_triangle_with_ids};
 use super::load::part_count;
 use super::ops::{
-    Clump, ClumpCentres, Curl, Frizz, Length, Noise, Opacity, Operator, Resampling, Strands, Width,
+    Clump, ClumpCentres, Curl, Frizz, Length, Masked, Noise, Opacity, Operator, Resampling,
+    Strands, Width,
 };
 use super::parts::{Part, PartLayout};
+use super::regions::RegionLookup;
 use super::spec::{
-    ClumpParams, GroomOp, GroomSpec, SpecOrigin, color_maps, root_to_tip_maps, setting_error,
+    ClumpParams, GroomOp, GroomSpec, HairIds, RootDistribution, SpecOrigin, color_maps_mut,
+    root_to_tip_maps_mut, setting_error,
 };
 use crate::curves::{CurveArrays, Curves};
 use crate::guides::Guides;
@@ -21,7 +24,7 @@ use crate::interp::Interpolator;
 use crate::limits;
 use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
-use crate::sample::{DensitySampler, DensitySamplerOptions, mix64, salts, sample_range};
+use crate::sample::{DensitySampler, DensitySamplerOptions, RootCells, mix64, salts, sample_range};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -48,8 +51,13 @@ pub struct Generator {
     name: PathBuf,
     origin: Option<Arc<SpecOrigin>>,
     pub(super) sampler: Arc<DensitySampler>,
+    /// With stable ids: the root cells parts are made of.
+    pub(super) cells: Option<Arc<RootCells>>,
+    pub(super) distribution: RootDistribution,
     pub(super) layout: Arc<PartLayout>,
     pub(super) interpolator: Interpolator,
+    /// The skin's regions, when it is split.
+    pub(super) regions: Option<Arc<RegionLookup>>,
     pub(super) ops: Vec<Operator>,
     /// The finish's width, colour and opacity, before the operators.
     pub(super) base: Vec<Operator>,
@@ -68,8 +76,11 @@ pub struct Generator {
     /// The part asked for last (`usize::MAX`: none yet), and the roots of
     /// the one after it, sampled ahead.
     last_part: AtomicUsize,
-    prefetched: Mutex<Option<(usize, Vec<SurfacePoint>)>>,
+    prefetched: Mutex<Option<(usize, PartRoots)>>,
 }
+
+/// A part's roots, ordered by triangle, and their hairs' ids.
+pub(super) type PartRoots = (Vec<SurfacePoint>, Vec<u64>);
 
 /// Parts' arrays kept for reuse: a writer holds one part while the next
 /// grows, so two cover the stream.
@@ -102,7 +113,7 @@ impl Generator {
         Self::build(spec, Some(self))
     }
 
-    fn build(spec: GroomSpec, shared: Option<&Generator>) -> Result<Self, GroomError> {
+    fn build(mut spec: GroomSpec, shared: Option<&Generator>) -> Result<Self, GroomError> {
         let count = spec.roots.count;
         if count == 0 {
             return Err(spec.error(
@@ -131,7 +142,7 @@ impl Generator {
             "points",
         )?;
         for (k, op) in spec.ops.iter().enumerate() {
-            match op {
+            match op.unmasked() {
                 GroomOp::Clump(c) => ceiling(
                     &format!("ops[{k}].clump.count"),
                     c.count,
@@ -147,7 +158,17 @@ impl Generator {
                 _ => {}
             }
         }
-        let (sampler, layout, interpolator) = match shared {
+        bind_maps(&mut spec)?;
+        let regions = match (shared, &spec.regions) {
+            (Some(g), _) => g.regions.clone(),
+            (None, Some(r)) => {
+                Some(Arc::new(r.lookup(&spec.mesh).map_err(|m| {
+                    spec.error("regions", GroomErrorKind::Invalid(m))
+                })?))
+            }
+            (None, None) => None,
+        };
+        let (sampler, cells, layout, interpolator) = match shared {
             Some(g) => {
                 if g.guides.len() != spec.guides.len() {
                     return Err(spec.error(
@@ -161,24 +182,51 @@ impl Generator {
                 }
                 (
                     g.sampler.clone(),
+                    g.cells.clone(),
                     g.layout.clone(),
                     g.interpolator.reshaped(&spec.mesh, spec.guides.clone()),
                 )
             }
             None => {
-                check_maps_on_mesh(&spec)?;
                 let mesh = &spec.mesh;
                 let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
                     .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
-                let layout = PartLayout::new(
-                    mesh,
-                    |t| sampler.triangle_probability(t),
-                    count,
-                    part_count(mesh, count, spec.roots.parts),
-                );
-                let interpolator =
-                    Interpolator::new(mesh, spec.guides.clone(), &spec.interpolation);
-                (Arc::new(sampler), Arc::new(layout), interpolator)
+                let parts = part_count(mesh, count, spec.roots.parts);
+                let (cells, layout) = match spec.roots.ids {
+                    HairIds::Stable => {
+                        let cells = RootCells::new(mesh, &sampler);
+                        let counts = cells.counts(spec.roots.seed, count);
+                        let layout = PartLayout::from_cells(&cells, &counts, parts);
+                        (Some(Arc::new(cells)), layout)
+                    }
+                    HairIds::Sequential => {
+                        let layout = PartLayout::new(
+                            mesh,
+                            |t| sampler.triangle_probability(t),
+                            count,
+                            parts,
+                        );
+                        (None, layout)
+                    }
+                };
+                let interpolator = match &regions {
+                    Some(lookup) => {
+                        let guide_regions: Vec<u32> = spec
+                            .guides
+                            .roots()
+                            .iter()
+                            .map(|r| lookup.of(mesh, *r))
+                            .collect();
+                        Interpolator::with_regions(
+                            mesh,
+                            spec.guides.clone(),
+                            &spec.interpolation,
+                            &guide_regions,
+                        )
+                    }
+                    None => Interpolator::new(mesh, spec.guides.clone(), &spec.interpolation),
+                };
+                (Arc::new(sampler), cells, Arc::new(layout), interpolator)
             }
         };
         let GroomSpec {
@@ -203,8 +251,11 @@ impl Generator {
             name,
             origin,
             sampler,
+            cells,
+            distribution: roots.distribution,
             layout,
             interpolator,
+            regions,
             ops: Vec::with_capacity(ops.len()),
             base,
             points,
@@ -220,9 +271,9 @@ impl Generator {
         };
         for (k, op) in ops.into_iter().enumerate() {
             let op = generator.operator(k, op)?;
-            generator.colors |= matches!(op, Operator::Color(_));
-            generator.opacities |= matches!(op, Operator::Opacity(_));
-            generator.clumps |= matches!(op, Operator::Clump(_));
+            generator.colors |= matches!(op.unmasked(), Operator::Color(_));
+            generator.opacities |= matches!(op.unmasked(), Operator::Opacity(_));
+            generator.clumps |= matches!(op.unmasked(), Operator::Clump(_));
             generator.ops.push(op);
         }
         Ok(generator)
@@ -241,6 +292,9 @@ impl Generator {
             )
         };
         Ok(match op {
+            GroomOp::Masked(op, mask) => {
+                Operator::Masked(Masked::new(self.operator(k, *op)?, mask))
+            }
             GroomOp::Noise(s) => Operator::Noise(Noise::new(
                 s.amplitude,
                 s.frequency,
@@ -328,13 +382,31 @@ impl Generator {
             })
             .collect();
         let positions = roots.iter().map(|r| r.position(mesh)).collect();
-        ClumpCentres::new(positions, shapes.concat(), self.points)
+        let normals = roots.iter().map(|r| r.normal(mesh)).collect();
+        let regions: Vec<u32> = roots.iter().map(|r| self.region_of(*r)).collect();
+        ClumpCentres::on_surface(positions, normals, &regions, shapes.concat(), self.points)
     }
 
     /// An error about the setting `key`, at its line when the groom came
     /// from a file.
     pub(super) fn error(&self, key: &str, kind: GroomErrorKind) -> GroomError {
         setting_error(&self.name, self.origin.as_deref(), key, kind)
+    }
+
+    /// The region of a point of the skin (0 when it is not split).
+    pub fn region_of(&self, point: SurfacePoint) -> u32 {
+        self.regions.as_ref().map_or(0, |r| r.of(&self.mesh, point))
+    }
+
+    /// The skin's regions, when it is split.
+    pub fn regions(&self) -> Option<&RegionLookup> {
+        self.regions.as_deref()
+    }
+
+    /// Guides the interpolation never uses, and why (the style mesh's
+    /// guides that share a vertex with a nearer one).
+    pub fn lost_guides(&self) -> Vec<crate::interp::LostGuide> {
+        self.interpolator.weighting().lost_guides()
     }
 
     /// The mesh hairs grow on.
@@ -367,20 +439,70 @@ impl Generator {
         self.points
     }
 
-    /// Roots of part `p`: sampled in the part's triangles with the part's
-    /// own stream, ordered by triangle (so neighbouring hairs are grown
-    /// together), numbered from the part's first hair id.
-    pub fn part_roots(&self, p: usize) -> Vec<SurfacePoint> {
+    /// Roots of part `p`, ordered by triangle (so neighbouring hairs are
+    /// grown together), and their hairs' ids. With stable ids each of the
+    /// part's root cells samples its own hairs from its own stream;
+    /// otherwise the part samples its hairs in its triangles with its own
+    /// stream, numbered from the part's first hair id. Blue-noise roots
+    /// are then thinned from four times as many ([`super::blue_noise`]).
+    pub fn part_roots(&self, p: usize) -> (Vec<SurfacePoint>, Vec<u64>) {
         let part = &self.layout.parts()[p];
         if part.hair_count == 0 {
-            return Vec::new();
+            return (Vec::new(), Vec::new());
         }
-        let Some(sampler) = self.sampler.restricted(&part.triangles) else {
-            return Vec::new();
-        };
-        let stream = mix64(self.seed ^ mix64(salts::PART_ROOTS + p as u64));
-        let roots = sample_range(&sampler, stream, 0..part.hair_count);
-        sorted_by_triangle(roots)
+        if self.distribution == RootDistribution::BlueNoise {
+            return super::blue_noise::part_roots(self, p);
+        }
+        self.regular_part_roots(p)
+    }
+
+    /// [`Self::part_roots`] before any blue-noise thinning.
+    pub(super) fn regular_part_roots(&self, p: usize) -> (Vec<SurfacePoint>, Vec<u64>) {
+        let part = &self.layout.parts()[p];
+        if part.hair_count == 0 {
+            return (Vec::new(), Vec::new());
+        }
+        match &self.cells {
+            Some(cells) => {
+                let grown: Vec<(Vec<SurfacePoint>, Vec<u64>)> = part
+                    .cells
+                    .par_iter()
+                    .with_max_len(8)
+                    .map(|&(c, n)| {
+                        let roots = cells.roots(&self.sampler, self.seed, c as usize, n);
+                        let ids = (0..roots.len() as u64)
+                            .map(|k| cells.id(c as usize, k))
+                            .collect();
+                        (roots, ids)
+                    })
+                    .collect();
+                let (mut roots, mut ids) = (Vec::new(), Vec::new());
+                for (r, i) in grown {
+                    roots.extend(r);
+                    ids.extend(i);
+                }
+                sorted_by_triangle_with_ids(roots, ids)
+            }
+            None => {
+                let Some(sampler) = self.sampler.restricted(&part.triangles) else {
+                    return (Vec::new(), Vec::new());
+                };
+                let stream = mix64(self.seed ^ mix64(salts::PART_ROOTS + p as u64));
+                let roots = sorted_by_triangle(sample_range(&sampler, stream, 0..part.hair_count));
+                let ids = (part.first_hair..part.first_hair + roots.len() as u64).collect();
+                (roots, ids)
+            }
+        }
+    }
+
+    /// The root cells hairs are numbered by (stable ids).
+    pub fn root_cells(&self) -> Option<&RootCells> {
+        self.cells.as_deref()
+    }
+
+    /// The root sampler over the whole mesh.
+    pub fn sampler(&self) -> &DensitySampler {
+        &self.sampler
     }
 
     /// Grows part `p`: its curves with per-point widths, normals (unless
@@ -394,7 +516,7 @@ impl Generator {
     /// the error names the operator in the groom file, from growing that
     /// hair again one operator at a time.
     pub fn part(&self, p: usize) -> Result<Curves, GroomError> {
-        let roots = self
+        let (roots, ids) = self
             .take_prefetched(p)
             .unwrap_or_else(|| self.part_roots(p));
         // Parts asked for in order (a whole groom, a farm task's range):
@@ -403,7 +525,7 @@ impl Generator {
         let previous = self.last_part.swap(p, Ordering::Relaxed);
         let prefetch = p + 1 < self.layout.len() && (p == 0 || previous == p - 1);
         let (curves, next) = rayon::join(
-            || self.grow_part(p, roots),
+            || self.grow_part(roots, ids),
             || prefetch.then(|| self.part_roots(p + 1)),
         );
         if let Some(next) = next {
@@ -413,7 +535,7 @@ impl Generator {
     }
 
     /// The roots of part `p` if they were sampled ahead.
-    fn take_prefetched(&self, p: usize) -> Option<Vec<SurfacePoint>> {
+    fn take_prefetched(&self, p: usize) -> Option<PartRoots> {
         let mut prefetched = self.prefetched.lock().unwrap_or_else(|e| e.into_inner());
         match prefetched.take() {
             Some((q, roots)) if q == p => Some(roots),
@@ -438,29 +560,49 @@ impl Generator {
     }
 }
 
-/// Every map of the groom can be read on its mesh (image and noise maps
-/// need UVs): an error naming the setting otherwise.
-fn check_maps_on_mesh(spec: &GroomSpec) -> Result<(), GroomError> {
-    let finish = &spec.finish;
-    let mut maps: Vec<(String, &Map)> = vec![("roots.density".into(), &spec.roots.density)];
-    fn add<'m>(maps: &mut Vec<(String, &'m Map)>, prefix: &str, named: Vec<(&str, &'m Map)>) {
-        for (key, map) in named {
-            maps.push((format!("{prefix}.{key}"), map));
+/// Binds every map of the groom to its mesh (per-vertex maps take their
+/// values), or fails naming the setting whose map the mesh cannot serve
+/// (image maps need UVs, per-vertex maps their attribute).
+fn bind_maps(spec: &mut GroomSpec) -> Result<(), GroomError> {
+    let mesh = spec.mesh.clone();
+    let mut failed = None;
+    {
+        let mut bind = |key: String, map: &mut Map| {
+            if failed.is_none()
+                && let Err(e) = map.bind(&mesh)
+            {
+                failed = Some((key, e));
+            }
+        };
+        bind("roots.density".into(), &mut spec.roots.density);
+        let finish = &mut spec.finish;
+        for (key, map) in root_to_tip_maps_mut(&mut finish.width) {
+            bind(format!("finish.width.{key}"), map);
+        }
+        if let Some(color) = &mut finish.color {
+            for (key, map) in color_maps_mut(color) {
+                bind(format!("finish.color.{key}"), map);
+            }
+        }
+        if let Some(opacity) = &mut finish.opacity {
+            for (key, map) in root_to_tip_maps_mut(opacity) {
+                bind(format!("finish.opacity.{key}"), map);
+            }
+        }
+        for (k, op) in spec.ops.iter_mut().enumerate() {
+            let name = op.name();
+            for (key, map) in op.maps_mut() {
+                bind(format!("ops[{k}].{name}.{key}"), map);
+            }
+        }
+        if let Some(regions) = &mut spec.regions {
+            for map in regions.maps_mut() {
+                bind("regions.map".into(), map);
+            }
         }
     }
-    add(&mut maps, "finish.width", root_to_tip_maps(&finish.width));
-    if let Some(color) = &finish.color {
-        add(&mut maps, "finish.color", color_maps(color));
+    match failed {
+        Some((key, e)) => Err(spec.error(&key, GroomErrorKind::Map(e))),
+        None => Ok(()),
     }
-    if let Some(opacity) = &finish.opacity {
-        add(&mut maps, "finish.opacity", root_to_tip_maps(opacity));
-    }
-    for (k, op) in spec.ops.iter().enumerate() {
-        add(&mut maps, &format!("ops[{k}].{}", op.name()), op.maps());
-    }
-    for (key, map) in maps {
-        map.on_mesh(&spec.mesh)
-            .map_err(|e| spec.error(&key, GroomErrorKind::Map(e)))?;
-    }
-    Ok(())
 }

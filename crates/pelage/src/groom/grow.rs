@@ -13,8 +13,9 @@ use crate::curves::frames::{
 };
 use crate::curves::{Curves, Values, vectors_finite};
 use crate::interp::{HairRoot, HairScratch, QueryRegion};
+use crate::map::MapSite;
 use crate::mesh::SurfacePoint;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// Hairs a worker grows between hand-overs (fixed, so results never depend
@@ -67,7 +68,7 @@ impl Generator {
     /// every operator side by side, into `ws.group` with their roots in
     /// `ws.contexts`: hair for hair what [`Self::grow`] makes, for grooms
     /// whose operators keep one hair a root.
-    fn grow_group(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) {
+    fn grow_group(&self, roots: &[SurfacePoint], ids: &[u64], ws: &mut Workspace) {
         if ws.group.len() < roots.len() {
             ws.group.resize_with(roots.len(), Hair::default);
         }
@@ -75,8 +76,7 @@ impl Generator {
         for (i, root) in roots.iter().enumerate() {
             let context = self.root_context(*root);
             let hair = &mut ws.group[i];
-            let id = first_id + i as u64;
-            self.interpolated(&context, id, &mut ws.interpolation, &mut ws.shape, hair);
+            self.interpolated(&context, ids[i], &mut ws.interpolation, &mut ws.shape, hair);
             ws.contexts.push(context);
         }
         let hairs = &mut ws.group[..roots.len()];
@@ -88,11 +88,14 @@ impl Generator {
     /// Where a hair grows: its root's position, skin normal and UV.
     pub(super) fn root_context(&self, root: SurfacePoint) -> RootContext {
         let mesh = &self.mesh;
+        let position = root.position(mesh);
+        let site = MapSite::with_position(mesh, root, position);
         RootContext {
             point: root,
-            position: root.position(mesh),
+            position,
             normal: root.normal(mesh),
-            uv: root.uv(mesh).unwrap_or(Vec2::ZERO),
+            region: self.regions.as_ref().map_or(0, |r| r.at(root, &site)),
+            site,
             skin_triangle: self
                 .clumps
                 .then(|| QueryRegion::around_triangle(mesh.triangle_positions(root.tri as usize))),
@@ -113,6 +116,7 @@ impl Generator {
         let hair_root = HairRoot {
             position: context.position,
             triangle: Some(context.point.tri),
+            region: context.region,
         };
         self.interpolator
             .hair_at(hair_root, context.normal, scratch, shape);
@@ -129,22 +133,20 @@ impl Generator {
         self.resampling.apply(shape, out);
     }
 
-    /// Part `p` grown from its `roots`.
+    /// A part grown from its `roots`, root `i` growing hair `ids[i]`.
     pub(super) fn grow_part(
         &self,
-        p: usize,
         roots: Vec<SurfacePoint>,
+        ids: Vec<u64>,
     ) -> Result<Curves, GroomError> {
-        let part = &self.layout.parts()[p];
         if self.one_hair_per_root() {
-            return self.part_in_place(roots, part.first_hair);
+            return self.part_in_place(roots, ids);
         }
         let chunks: Vec<PartChunk> = roots
             .par_chunks(CHUNK)
-            .enumerate()
-            .map_init(Workspace::default, |ws, (c, chunk)| {
-                let first = part.first_hair + (c * CHUNK) as u64;
-                self.grow_chunk(chunk, first, ws)
+            .zip(ids.par_chunks(CHUNK))
+            .map_init(Workspace::default, |ws, (chunk, ids)| {
+                self.grow_chunk(chunk, ids, ws)
             })
             .collect();
         // The first root, in the part's order, that grew a value that is
@@ -154,7 +156,7 @@ impl Generator {
             .enumerate()
             .find_map(|(c, chunk)| chunk.first_non_finite.map(|i| c * CHUNK + i));
         if let Some(i) = bad {
-            return Err(self.non_finite_error(roots[i], part.first_hair + i as u64));
+            return Err(self.non_finite_error(roots[i], ids[i]));
         }
         Ok(self.assemble(concat(chunks)))
     }
@@ -172,7 +174,7 @@ impl Generator {
     fn part_in_place(
         &self,
         roots: Vec<SurfacePoint>,
-        first_hair: u64,
+        hair_ids: Vec<u64>,
     ) -> Result<Curves, GroomError> {
         let n = self.points;
         let total = roots.len() * n;
@@ -214,8 +216,8 @@ impl Generator {
                 let (c0, c1) = std::mem::take(&mut c).split_at_mut(take(self.colors));
                 let (o0, o1) = std::mem::take(&mut o).split_at_mut(take(self.opacities));
                 (p, w, nr, c, o) = (p1, w1, n1, c1, o1);
-                let first = first_hair + (k * CHUNK) as u64;
-                jobs.push((k, chunk, first, p0, w0, n0, c0, o0));
+                let chunk_ids = &hair_ids[k * CHUNK..k * CHUNK + chunk.len()];
+                jobs.push((k, chunk, chunk_ids, p0, w0, n0, c0, o0));
             }
             // Each job answers with its first hair whose values are not all
             // finite, if any (checked as it is copied, while in cache).
@@ -223,12 +225,14 @@ impl Generator {
                 .into_par_iter()
                 .map_init(
                     Workspace::default,
-                    |ws, (job, chunk, first, p, w, nr, c, o)| {
+                    |ws, (job, chunk, chunk_ids, p, w, nr, c, o)| {
                         ws.skin_normals.clear();
                         let mut bad = None;
                         for (g, group) in chunk.chunks(GROUP).enumerate() {
                             let first_in_group = g * GROUP;
-                            self.grow_group(group, first + first_in_group as u64, ws);
+                            let group_ids =
+                                &chunk_ids[first_in_group..first_in_group + group.len()];
+                            self.grow_group(group, group_ids, ws);
                             for (k, (hair, root)) in ws.group.iter().zip(&ws.contexts).enumerate() {
                                 let i = first_in_group + k;
                                 if bad.is_none() && hair.non_finite().is_some() {
@@ -260,14 +264,14 @@ impl Generator {
             bad.into_iter().flatten().next()
         };
         if let Some(i) = bad {
-            return Err(self.non_finite_error(roots[i], first_hair + i as u64));
+            return Err(self.non_finite_error(roots[i], hair_ids[i]));
         }
         let mut offsets = spare.offsets;
         offsets.clear();
         offsets.extend((0..=roots.len() as u32).map(|i| i * n as u32));
         let mut ids = spare.ids;
         ids.clear();
-        ids.extend(first_hair..first_hair + roots.len() as u64);
+        ids.extend_from_slice(&hair_ids);
         Ok(self.assemble(PartArrays {
             points,
             widths,
@@ -296,13 +300,13 @@ impl Generator {
         curves.with_root_uvs(uvs).expect("one UV a curve")
     }
 
-    fn grow_chunk(&self, roots: &[SurfacePoint], first_id: u64, ws: &mut Workspace) -> PartChunk {
+    fn grow_chunk(&self, roots: &[SurfacePoint], ids: &[u64], ws: &mut Workspace) -> PartChunk {
         let n = self.points;
         let mut out = PartChunk::default();
         let mut tangents = vec![Vec3::ZERO; n];
         let mut frame = vec![Vec3::ZERO; n];
         for (i, root) in roots.iter().enumerate() {
-            let normal = self.grow(*root, first_id + i as u64, &self.ops, ws);
+            let normal = self.grow(*root, ids[i], &self.ops, ws);
             let finite = ws.batch.hairs().iter().all(|h| h.non_finite().is_none());
             if !finite && out.first_non_finite.is_none() {
                 out.first_non_finite = Some(i);
@@ -411,6 +415,43 @@ fn concat(chunks: Vec<PartChunk>) -> PartArrays {
         all.roots.extend_from_slice(&a.roots);
     }
     all
+}
+
+/// [`sorted_by_triangle`] carrying each root's id along (equal roots keep
+/// their order).
+pub(super) fn sorted_by_triangle_with_ids(
+    roots: Vec<SurfacePoint>,
+    ids: Vec<u64>,
+) -> (Vec<SurfacePoint>, Vec<u64>) {
+    let (Some(lo), Some(hi)) = (
+        roots.iter().map(|r| r.tri).min(),
+        roots.iter().map(|r| r.tri).max(),
+    ) else {
+        return (roots, ids);
+    };
+    // The counting sort of `sorted_by_triangle`, moving pairs.
+    let mut starts = vec![0u32; (hi - lo) as usize + 2];
+    for r in &roots {
+        starts[(r.tri - lo) as usize + 1] += 1;
+    }
+    for t in 1..starts.len() {
+        starts[t] += starts[t - 1];
+    }
+    let mut next = starts.clone();
+    let mut sorted = vec![(SurfacePoint::default(), 0u64); roots.len()];
+    for (r, id) in roots.iter().zip(&ids) {
+        let slot = &mut next[(r.tri - lo) as usize];
+        sorted[*slot as usize] = (*r, *id);
+        *slot += 1;
+    }
+    for range in starts.windows(2) {
+        let triangle = &mut sorted[range[0] as usize..range[1] as usize];
+        if triangle.len() > 1 {
+            triangle
+                .sort_unstable_by_key(|(r, id)| (r.bary[0].to_bits(), r.bary[1].to_bits(), *id));
+        }
+    }
+    sorted.into_iter().unzip()
 }
 
 /// `roots` ordered by (triangle, first barycentric, second barycentric),

@@ -13,7 +13,7 @@ use super::generator::Generator;
 use super::ops::{Color, Cut, RootToTip};
 use super::spec::{
     ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, LengthParams,
-    NoiseParams, RootsSpec, SpecOrigin, StrandsParams,
+    NoiseParams, RegionsSpec, RootsSpec, SpecOrigin, StrandsParams,
 };
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
@@ -268,6 +268,11 @@ impl Groom {
         &self.mesh
     }
 
+    /// The groom file's path.
+    pub fn path(&self) -> &Path {
+        &self.source.path
+    }
+
     /// The guides, bound to the mesh.
     pub fn guides(&self) -> &Guides {
         &self.guides
@@ -339,6 +344,8 @@ impl Groom {
             density: map(&file.roots.density)?,
             seed: file.roots.seed,
             parts: file.roots.parts.as_ref().map(|p| *p.get_ref()),
+            ids: file.roots.ids,
+            distribution: file.roots.distribution,
         };
         let method = &file.interpolation;
         let interpolation = match method.method {
@@ -433,7 +440,75 @@ impl Groom {
                 }
             };
             mark(format!("ops[{k}].{}", op.name()), source.line_of_op(k));
+            let op = match spec.mask() {
+                Some(mask) => {
+                    mark(
+                        format!("ops[{k}].{}.mask", op.name()),
+                        source.line_of(mask.span()),
+                    );
+                    op.masked(map(mask)?)
+                }
+                None => op,
+            };
             ops.push(op);
+        }
+        let regions = match &file.regions {
+            None => None,
+            Some(r) => {
+                let invalid = |span: std::ops::Range<usize>, m: &str| {
+                    source.error_at(span, GroomErrorKind::Invalid(m.into()))
+                };
+                match (&r.map, &r.faces) {
+                    (Some(m), None) => {
+                        mark("regions".into(), source.line_of(m.span()));
+                        Some(RegionsSpec::from_map(map(m)?, r.scale))
+                    }
+                    (None, Some(kind)) => {
+                        mark("regions".into(), source.line_of(kind.span()));
+                        if !matches!(kind.get_ref().as_str(), "groups" | "materials") {
+                            return Err(invalid(
+                                kind.span(),
+                                "faces is \"groups\" (OBJ g/o) or \"materials\" (OBJ usemtl)",
+                            ));
+                        }
+                        Some(RegionsSpec::from_faces(kind.get_ref().clone()))
+                    }
+                    (Some(m), Some(_)) => {
+                        return Err(invalid(
+                            m.span(),
+                            "[regions] takes a map or faces, not both",
+                        ));
+                    }
+                    (None, None) => {
+                        return Err(source.error_at(
+                            0..0,
+                            GroomErrorKind::Invalid(
+                                "[regions] needs map = \"…\" or faces = \"groups\"".into(),
+                            ),
+                        ));
+                    }
+                }
+            }
+        };
+        for (key, mask) in [
+            ("finish.width.mask", file.finish.width.mask.as_ref()),
+            (
+                "finish.opacity.mask",
+                file.finish.opacity.as_ref().and_then(|o| o.mask.as_ref()),
+            ),
+            (
+                "finish.color.mask",
+                file.finish.color.as_ref().and_then(|c| c.mask.as_ref()),
+            ),
+        ] {
+            if let Some(mask) = mask {
+                return Err(source.error_at(
+                    mask.span(),
+                    GroomErrorKind::Invalid(format!(
+                        "{key}: masks fade operators; [finish] sets every hair's starting values (add a masked width, color or opacity operator instead)"
+                    )),
+                ));
+            }
         }
         Ok(GroomSpec {
             name: source.path.clone(),
@@ -443,6 +518,7 @@ impl Groom {
             interpolation,
             ops,
             finish,
+            regions,
             origin: Some(Arc::new(SpecOrigin { lines })),
         })
     }
@@ -468,11 +544,11 @@ pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>) -> usize {
     wanted.min(mesh.triangle_count()).max(1)
 }
 
-/// Resolves a map value and checks it can be read on `mesh` (UVs), both
-/// errors at the value's line.
+/// Resolves a map value and binds it to `mesh` (UVs, vertex
+/// attributes), both errors at the value's line.
 fn map_on_mesh(source: &SettingsSource, mesh: &Mesh, value: &MapValue) -> Result<Map, GroomError> {
-    let map = source.map(value)?;
-    map.on_mesh(mesh)
+    let mut map = source.map(value)?;
+    map.bind(mesh)
         .map_err(|e| source.error_at(value.span(), GroomErrorKind::Map(e)))?;
     Ok(map)
 }

@@ -24,6 +24,7 @@
 //! part generated alone equals that part of the full run.
 
 pub mod animate;
+mod blue_noise;
 mod clips;
 mod diagnose;
 mod error;
@@ -35,6 +36,7 @@ pub mod ops;
 mod output;
 pub mod parts;
 mod ramp;
+pub mod regions;
 mod source;
 mod spec;
 
@@ -51,6 +53,6 @@ pub use parts::{Part, PartLayout};
 pub use ramp::Ramp;
 
 pub use spec::{
-    ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, LengthParams,
-    NoiseParams, RootsSpec, StrandsParams,
+    ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, HairIds, LengthParams,
+    NoiseParams, RegionSource, RegionsSpec, RootDistribution, RootsSpec, StrandsParams,
 };

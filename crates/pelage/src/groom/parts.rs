@@ -9,7 +9,9 @@
 //! and the part count — never on threads or machines — and part `p`'s
 //! hairs are numbered from `⌊N·C(p)⌋` to `⌊N·C(p+1)⌋`, `C` the cumulative
 //! probability at the part boundaries, so the parts' hair ids tile
-//! `0..N` exactly.
+//! `0..N` exactly. With stable ids ([`PartLayout::from_cells`]) parts are
+//! runs of root cells ([`crate::sample::RootCells`]) of about equal hair
+//! counts, and each cell numbers its own hairs.
 
 use crate::mesh::{Mesh, morton};
 use glam::Vec3;
@@ -23,6 +25,9 @@ pub struct Part {
     pub first_hair: u64,
     /// Number of hairs it grows.
     pub hair_count: u64,
+    /// With stable ids: its root cells and each one's hair count
+    /// (empty: hairs `first_hair..first_hair + hair_count`).
+    pub cells: Vec<(u32, u64)>,
 }
 
 /// The parts of a groom.
@@ -86,8 +91,50 @@ impl PartLayout {
                 triangles,
                 first_hair,
                 hair_count: last_hair - first_hair,
+                cells: Vec::new(),
             });
             first_hair = last_hair;
+            start = end;
+        }
+        Self { parts }
+    }
+
+    /// Parts as runs of root cells (in their Morton order) with about
+    /// equal hair counts: `counts[c]` hairs grow in cell `c`. `first_hair`
+    /// counts the hairs of the parts before (hair ids are the cells' own).
+    pub fn from_cells(cells: &crate::sample::RootCells, counts: &[u64], part_count: usize) -> Self {
+        let part_count = part_count.clamp(1, cells.len());
+        let total: u64 = counts.iter().sum();
+        let mut parts = Vec::with_capacity(part_count);
+        let mut start = 0usize;
+        let mut cumulative = 0u64;
+        for p in 0..part_count {
+            let target = (total as u128 * (p + 1) as u128 / part_count as u128) as u64;
+            let first_hair = cumulative;
+            // Leave a cell for each part to come.
+            let last_end = cells.len() - (part_count - p - 1);
+            let mut end = start;
+            if p + 1 == part_count {
+                end = cells.len();
+            } else {
+                while end < last_end && (end == start || cumulative + counts[end] / 2 < target) {
+                    cumulative += counts[end];
+                    end += 1;
+                }
+            }
+            let part_cells: Vec<(u32, u64)> = (start..end).map(|c| (c as u32, counts[c])).collect();
+            let hair_count = part_cells.iter().map(|&(_, n)| n).sum();
+            cumulative = first_hair + hair_count;
+            let mut triangles: Vec<u32> = (start..end)
+                .flat_map(|c| cells.triangles(c).iter().copied())
+                .collect();
+            triangles.sort_unstable();
+            parts.push(Part {
+                triangles,
+                first_hair,
+                hair_count,
+                cells: part_cells,
+            });
             start = end;
         }
         Self { parts }

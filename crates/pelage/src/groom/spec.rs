@@ -36,6 +36,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use super::ramp::Ramp;
+pub use super::regions::{RegionSource, RegionsSpec};
 
 /// A whole groom, as values. Build one with [`GroomSpec::new`] and the
 /// `with_*` methods (or set the public fields), then call
@@ -56,6 +57,8 @@ pub struct GroomSpec {
     pub ops: Vec<GroomOp>,
     /// Points, widths, colours, opacities and normals.
     pub finish: FinishSpec,
+    /// Regions that share no guides and no clumps (`None`: one region).
+    pub regions: Option<RegionsSpec>,
     /// Where the settings were written, for a groom read from a file.
     pub(crate) origin: Option<Arc<SpecOrigin>>,
 }
@@ -82,8 +85,15 @@ impl GroomSpec {
             },
             ops: Vec::new(),
             finish: FinishSpec::default(),
+            regions: None,
             origin: None,
         }
+    }
+
+    /// Splits the skin into regions.
+    pub fn with_regions(mut self, regions: RegionsSpec) -> Self {
+        self.regions = Some(regions);
+        self
     }
 
     /// Sets the interpolation method.
@@ -161,17 +171,85 @@ pub struct RootsSpec {
     pub seed: u64,
     /// Number of parts (`None`: one per 100,000 hairs).
     pub parts: Option<u32>,
+    /// How hairs are numbered when the count or the density changes.
+    pub ids: HairIds,
+    /// Independent random roots, or roots spread apart (blue noise).
+    pub distribution: RootDistribution,
+}
+
+/// How hairs are numbered and placed as the count or density changes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum HairIds {
+    /// Root cells ([`crate::sample::RootCells`]): raising the count keeps
+    /// every hair (id, root, shape) and adds new ones, lowering it removes
+    /// hairs without moving the rest, and a local density edit moves only
+    /// the hairs near it. Ids are `k · cells + cell`, not contiguous.
+    #[default]
+    Stable,
+    /// Ids `0..N` over the parts in order, each part sampled on its own:
+    /// any change of the count or density moves every root.
+    Sequential,
+}
+
+impl HairIds {
+    /// `stable` or `sequential`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "stable" => Some(Self::Stable),
+            "sequential" => Some(Self::Sequential),
+            _ => None,
+        }
+    }
+}
+
+/// How roots are spread.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum RootDistribution {
+    /// Independent random roots following the density (Sik §3).
+    #[default]
+    Random,
+    /// Blue-noise-like roots: drawn four times over and thinned by
+    /// weighted sample elimination (Yuksel 2015) with radii that follow
+    /// the density, so neighbours keep their distance and the density
+    /// still matches the map.
+    BlueNoise,
+}
+
+impl RootDistribution {
+    /// `random` or `blue-noise`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "random" => Some(Self::Random),
+            "blue-noise" | "blue_noise" => Some(Self::BlueNoise),
+            _ => None,
+        }
+    }
 }
 
 impl RootsSpec {
-    /// `count` hairs, uniform density, seed 1, the default parts.
+    /// `count` hairs, uniform density, seed 1, the default parts, stable
+    /// ids, random roots.
     pub fn new(count: u64) -> Self {
         Self {
             count,
             density: Map::Constant(1.0),
             seed: 1,
             parts: None,
+            ids: HairIds::default(),
+            distribution: RootDistribution::default(),
         }
+    }
+
+    /// Sets how hairs are numbered.
+    pub fn with_ids(mut self, ids: HairIds) -> Self {
+        self.ids = ids;
+        self
+    }
+
+    /// Sets how roots are spread.
+    pub fn with_distribution(mut self, distribution: RootDistribution) -> Self {
+        self.distribution = distribution;
+        self
     }
 
     /// Sets the density map.
@@ -251,12 +329,30 @@ pub enum GroomOp {
     Color(Color),
     /// Opacities root to tip (seed as given).
     Opacity(RootToTip),
+    /// An operator whose effect is faded by a map ([`super::ops::Masked`]):
+    /// build one with [`GroomOp::masked`].
+    Masked(Box<GroomOp>, Map),
 }
 
 impl GroomOp {
+    /// The operator with its effect faded by `mask` (0: none, 1: full),
+    /// read at each hair's root.
+    pub fn masked(self, mask: Map) -> GroomOp {
+        GroomOp::Masked(Box::new(self), mask)
+    }
+
+    /// The operator under any mask.
+    pub fn unmasked(&self) -> &GroomOp {
+        match self {
+            GroomOp::Masked(op, _) => op.unmasked(),
+            op => op,
+        }
+    }
+
     /// The operator's name in groom files (`noise`, `clump`, …).
     pub fn name(&self) -> &'static str {
         match self {
+            GroomOp::Masked(op, _) => op.name(),
             GroomOp::Noise(_) => "noise",
             GroomOp::Frizz(_) => "frizz",
             GroomOp::Clump(_) => "clump",
@@ -273,6 +369,11 @@ impl GroomOp {
     /// Every map the operator reads, with its setting's name.
     pub fn maps(&self) -> Vec<(&'static str, &Map)> {
         match self {
+            GroomOp::Masked(op, mask) => {
+                let mut maps = op.maps();
+                maps.push(("mask", mask));
+                maps
+            }
             GroomOp::Noise(s) => vec![("amplitude", &s.amplitude), ("frequency", &s.frequency)],
             GroomOp::Frizz(s) => vec![
                 ("amplitude", &s.amplitude),
@@ -296,6 +397,63 @@ impl GroomOp {
             GroomOp::Color(s) => color_maps(s),
         }
     }
+}
+
+impl GroomOp {
+    /// Every map the operator reads, to change (binding them to a mesh).
+    pub fn maps_mut(&mut self) -> Vec<(&'static str, &mut Map)> {
+        match self {
+            GroomOp::Masked(op, mask) => {
+                let mut maps = op.maps_mut();
+                maps.push(("mask", mask));
+                maps
+            }
+            GroomOp::Noise(s) => vec![
+                ("amplitude", &mut s.amplitude),
+                ("frequency", &mut s.frequency),
+            ],
+            GroomOp::Frizz(s) => vec![
+                ("amplitude", &mut s.amplitude),
+                ("frequency", &mut s.frequency),
+                ("fraction", &mut s.fraction),
+            ],
+            GroomOp::Clump(s) => {
+                let mut maps = vec![("density", &mut s.density), ("rate", &mut s.rate)];
+                maps.extend(s.size.as_mut().map(|m| ("size", m)));
+                maps
+            }
+            GroomOp::Curl(s) => vec![("radius", &mut s.radius), ("turns", &mut s.turns)],
+            GroomOp::Cut(s) => vec![("at", s.at_mut())],
+            GroomOp::Length(s) => vec![("scale", &mut s.scale), ("jitter", &mut s.jitter)],
+            GroomOp::Strands(s) => vec![
+                ("root_spread", &mut s.root_spread),
+                ("tip_spread", &mut s.tip_spread),
+                ("twist", &mut s.twist),
+            ],
+            GroomOp::Width(s) | GroomOp::Opacity(s) => root_to_tip_maps_mut(s),
+            GroomOp::Color(s) => color_maps_mut(s),
+        }
+    }
+}
+
+/// The maps of a root-to-tip setting, to change.
+pub(crate) fn root_to_tip_maps_mut(s: &mut RootToTip) -> Vec<(&'static str, &mut Map)> {
+    vec![
+        ("root", &mut s.root),
+        ("tip", &mut s.tip),
+        ("jitter", &mut s.jitter),
+    ]
+}
+
+/// The maps of a colour setting, to change.
+pub(crate) fn color_maps_mut(s: &mut Color) -> Vec<(&'static str, &mut Map)> {
+    let Color {
+        root, tip, jitter, ..
+    } = s;
+    let mut maps: Vec<(&'static str, &mut Map)> = root.iter_mut().map(|m| ("root", m)).collect();
+    maps.extend(tip.iter_mut().map(|m| ("tip", m)));
+    maps.push(("jitter", jitter));
+    maps
 }
 
 /// The maps of a root-to-tip setting, by name.

@@ -19,10 +19,12 @@
 //! rotation between two normals has no seams.)
 
 mod nearest;
+mod regional;
 mod shepard;
 mod style_mesh;
 
 pub use nearest::{NearestPoints, Neighbour, NeighbourCache, QueryRegion};
+pub use regional::RegionWeights;
 pub use shepard::Shepard;
 pub use style_mesh::{LostGuide, StyleMesh, StyleMeshOptions};
 
@@ -49,6 +51,9 @@ pub struct HairRoot {
     pub position: Vec3,
     /// The skin triangle under the root, if known.
     pub triangle: Option<u32>,
+    /// The root's region (0 when the skin is not split;
+    /// [`RegionWeights`] reads it).
+    pub region: u32,
 }
 
 impl HairRoot {
@@ -57,6 +62,7 @@ impl HairRoot {
         Self {
             position: point.position(mesh),
             triangle: Some(point.tri),
+            region: 0,
         }
     }
 
@@ -65,6 +71,7 @@ impl HairRoot {
         Self {
             position,
             triangle: None,
+            region: 0,
         }
     }
 }
@@ -82,6 +89,12 @@ pub trait GuideWeights: Send + Sync {
     fn weights_near(&self, root: HairRoot, near: &mut NeighbourCache, out: &mut Vec<GuideWeight>) {
         let _ = near;
         self.weights(root, out);
+    }
+
+    /// Guides this weighting never uses, and why (the style mesh's guides
+    /// that share a vertex with a nearer one). Empty by default.
+    fn lost_guides(&self) -> Vec<LostGuide> {
+        Vec::new()
     }
 }
 
@@ -154,6 +167,21 @@ impl Interpolator {
             }
         };
         Self::with_weights(mesh, guides, weights)
+    }
+
+    /// Prepares `guides` for interpolation by `method` within regions:
+    /// guide `i` is in region `guide_regions[i]`, and a hair takes its
+    /// shape only from the guides of its own region
+    /// ([`HairRoot::region`]); see [`RegionWeights`].
+    pub fn with_regions(
+        mesh: &Mesh,
+        guides: impl Into<Arc<Guides>>,
+        method: &InterpolationMethod,
+        guide_regions: &[u32],
+    ) -> Self {
+        let guides = guides.into();
+        let weights = RegionWeights::new(mesh, &guides, method, guide_regions);
+        Self::with_weights(mesh, guides, Box::new(weights))
     }
 
     /// Prepares `guides` with a weighting of your own.

@@ -441,6 +441,10 @@ impl GuideWeights for StyleMesh {
         }
         normalise(out);
     }
+
+    fn lost_guides(&self) -> Vec<LostGuide> {
+        self.lost.clone()
+    }
 }
 
 /// Guides whose vertex a nearer guide also marks (ties: the lower index

@@ -2,7 +2,11 @@
 //! clump operators do. Centres are roots sampled with their own density;
 //! each centre hair is grown through every operator before this one, so a
 //! second `clump` clumps the first level's clumps (multi-level clumping by
-//! stacking). Each hair follows the centre whose root is nearest its own.
+//! stacking). Each hair follows the centre whose root is nearest its own
+//! among the centres that respect the surface: in the hair's region, and
+//! on the hair's side of thin parts (a centre whose skin normal faces
+//! away from the hair's, as on the other side of an ear, is passed over
+//! for the next nearest).
 
 use super::{Hair, RampTables, RootContext};
 use crate::groom::file::Ramp;
@@ -10,22 +14,64 @@ use crate::interp::{NearestPoints, NeighbourCache, QueryRegion};
 use crate::map::Map;
 use glam::Vec3;
 
-/// The centre hairs of one clump level: roots in a kd-tree, shapes with
-/// the hairs' point count.
+/// The centre hairs of one clump level: roots in a kd-tree a region,
+/// shapes with the hairs' point count, and each root's skin normal.
 #[derive(Debug)]
 pub struct ClumpCentres {
-    roots: NearestPoints,
+    roots: Vec<Vec3>,
+    /// Indexed by region: a kd-tree over the region's centres and their
+    /// indices among all (`None`: no centre there).
+    by_region: Vec<Option<(NearestPoints, Vec<u32>)>>,
+    /// Each centre's skin normal (empty: no side test).
+    normals: Vec<Vec3>,
     shapes: Vec<Vec3>,
     points: usize,
 }
 
+/// Centres looked at first past the nearest when it lies on the other
+/// side of a thin part; four times as many each time none of them is on
+/// the hair's side, up to the whole region (a hair left with none there is
+/// not clumped).
+const SIDE_CANDIDATES: usize = 8;
+
 impl ClumpCentres {
     /// Centres rooted at `roots`, centre `i` shaped
-    /// `shapes[i * points..(i + 1) * points]`.
+    /// `shapes[i * points..(i + 1) * points]`; one region, no side test.
     pub fn new(roots: Vec<Vec3>, shapes: Vec<Vec3>, points: usize) -> Self {
+        let regions = vec![0; roots.len()];
+        Self::on_surface(roots, Vec::new(), &regions, shapes, points)
+    }
+
+    /// Centres that respect the surface: centre `i` is in region
+    /// `regions[i]` with skin normal `normals[i]` (empty: no side test).
+    pub fn on_surface(
+        roots: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        regions: &[u32],
+        shapes: Vec<Vec3>,
+        points: usize,
+    ) -> Self {
         assert_eq!(roots.len() * points, shapes.len());
+        assert_eq!(roots.len(), regions.len());
+        assert!(normals.is_empty() || normals.len() == roots.len());
+        let top = regions.iter().copied().max().map_or(0, |m| m as usize + 1);
+        let mut members: Vec<Vec<u32>> = vec![Vec::new(); top];
+        for (i, &r) in regions.iter().enumerate() {
+            members[r as usize].push(i as u32);
+        }
+        let by_region = members
+            .into_iter()
+            .map(|indices| {
+                (!indices.is_empty()).then(|| {
+                    let points = indices.iter().map(|&i| roots[i as usize]).collect();
+                    (NearestPoints::new(points), indices)
+                })
+            })
+            .collect();
         Self {
-            roots: NearestPoints::new(roots),
+            roots,
+            by_region,
+            normals,
             shapes,
             points,
         }
@@ -33,33 +79,62 @@ impl ClumpCentres {
 
     /// Number of centres.
     pub fn len(&self) -> usize {
-        self.roots.points().len()
+        self.roots.len()
     }
 
     /// Whether there are none.
     pub fn is_empty(&self) -> bool {
-        self.roots.points().is_empty()
+        self.roots.is_empty()
     }
 
-    /// The centre nearest `position` and its distance (ties: the lower
-    /// index).
+    /// The centre nearest `position` in region 0 and its distance (ties:
+    /// the lower index), without a side test.
     pub fn nearest(&self, position: Vec3) -> Option<(usize, f32)> {
-        self.nearest_near(position, &mut NeighbourCache::default(), None)
+        self.nearest_near(position, None, 0, &mut NeighbourCache::default(), None)
     }
 
-    /// [`Self::nearest`] for one of a run of nearby positions, `near`
-    /// kept between them, `region` a ball around `position` that likely
-    /// holds the next ones too (faster, same result).
+    /// The centre a hair at `position` (skin normal `normal`, in
+    /// `region`) follows, and its distance: the nearest of its region on
+    /// its side of the surface. `near` is kept between a run of nearby
+    /// positions, `ball` a ball around `position` that likely holds the
+    /// next ones too (faster, same result).
     pub fn nearest_near(
         &self,
         position: Vec3,
+        normal: Option<Vec3>,
+        region: u32,
         near: &mut NeighbourCache,
-        region: Option<QueryRegion>,
+        ball: Option<QueryRegion>,
     ) -> Option<(usize, f32)> {
-        self.roots
-            .nearest_cached_in(position, 1, near, region)
+        let (tree, indices) = self.by_region.get(region as usize)?.as_ref()?;
+        let found = |n: crate::interp::Neighbour| {
+            (
+                indices[n.index as usize] as usize,
+                n.distance_squared.sqrt(),
+            )
+        };
+        let first = tree
+            .nearest_cached_in(position, 1, near, ball)
             .next()
-            .map(|n| (n.index as usize, n.distance_squared.sqrt()))
+            .map(found)?;
+        let (Some(normal), false) = (normal, self.normals.is_empty()) else {
+            return Some(first);
+        };
+        let same_side = |c: usize| self.normals[c].dot(normal) > 0.0;
+        if same_side(first.0) {
+            return Some(first);
+        }
+        let mut k = SIDE_CANDIDATES;
+        loop {
+            let hit = tree
+                .nearest_cached_in(position, k, near, ball)
+                .map(found)
+                .find(|&(c, _)| same_side(c));
+            if hit.is_some() || k >= indices.len() {
+                return hit;
+            }
+            k *= 4;
+        }
     }
 
     /// Centre `i`'s points.
@@ -69,7 +144,7 @@ impl ClumpCentres {
 
     /// Every centre's root.
     pub fn roots(&self) -> &[Vec3] {
-        self.roots.points()
+        &self.roots
     }
 }
 
@@ -108,15 +183,18 @@ impl Clump {
         near: &mut NeighbourCache,
         ramps: &mut RampTables,
     ) {
-        let Some((centre, distance)) =
-            self.centres
-                .nearest_near(root.position, near, root.skin_triangle)
-        else {
+        let Some((centre, distance)) = self.centres.nearest_near(
+            root.position,
+            Some(root.normal),
+            root.region,
+            near,
+            root.skin_triangle,
+        ) else {
             return;
         };
-        let mut w = self.rate.eval(root.uv);
+        let mut w = self.rate.at(&root.site);
         if let Some(size) = &self.size {
-            let size = size.eval(root.uv);
+            let size = size.at(&root.site);
             w *= if size > 0.0 {
                 (1.0 - distance / size).max(0.0)
             } else {
@@ -163,6 +241,37 @@ mod tests {
         assert!(
             (hair.points[3].x - 0.1 * 3.0 / 7.0).abs() < 1e-6,
             "linear profile"
+        );
+    }
+
+    #[test]
+    fn centres_across_a_region_border_or_a_thin_part_are_passed_over() {
+        // Three centres: 0 close but in region 1, 1 close but facing
+        // away (the other side of a thin fin), 2 farther, on the hair's side.
+        let mut shapes = centre_at(0.01).shapes;
+        shapes.extend(centre_at(0.02).shapes);
+        shapes.extend(centre_at(0.3).shapes);
+        let roots = vec![Vec3::X * 0.01, Vec3::X * 0.02, Vec3::X * 0.3];
+        let normals = vec![Vec3::Z, -Vec3::Z, Vec3::Z];
+        let c = ClumpCentres::on_surface(roots, normals, &[1, 0, 0], shapes, 8);
+        let mut near = NeighbourCache::default();
+        let hit = |region| {
+            c.nearest_near(
+                Vec3::ZERO,
+                Some(Vec3::Z),
+                region,
+                &mut NeighbourCache::default(),
+                None,
+            )
+        };
+        assert_eq!(hit(0).map(|h| h.0), Some(2));
+        assert_eq!(hit(1).map(|h| h.0), Some(0));
+        assert_eq!(hit(5), None, "a region without centres");
+        // Without a normal: the nearest of the region.
+        assert_eq!(
+            c.nearest_near(Vec3::ZERO, None, 0, &mut near, None)
+                .map(|h| h.0),
+            Some(1)
         );
     }
 

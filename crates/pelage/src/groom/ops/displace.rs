@@ -103,13 +103,13 @@ impl Noise {
         at.clear();
         per_hair.clear();
         for (hair, root) in hairs.iter().zip(roots) {
-            let amplitude = self.amplitude.eval(root.uv);
+            let amplitude = self.amplitude.at(&root.site);
             let n = hair.points.len();
             if amplitude == 0.0 || n == 0 {
                 per_hair.push((0.0, 0));
                 continue;
             }
-            let frequency = self.frequency.eval(root.uv);
+            let frequency = self.frequency.at(&root.site);
             let m = self.vectors_along(n);
             per_hair.push((amplitude, m));
             if m == n {
@@ -234,11 +234,11 @@ impl Frizz {
 
     pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
         let mut rng = SampleRng::new(self.seed ^ salts::FRIZZ_HAIR, hair.id);
-        if rng.uniform_f32() >= self.fraction.eval(root.uv) {
+        if rng.uniform_f32() >= self.fraction.at(&root.site) {
             return;
         }
-        let amplitude = self.amplitude.eval(root.uv);
-        let frequency = self.frequency.eval(root.uv);
+        let amplitude = self.amplitude.at(&root.site);
+        let frequency = self.frequency.at(&root.site);
         let [a, b] = rng.uniform_f32_pair();
         let phase = Vec3::new(a, b, rng.uniform_f32()) * 256.0;
         let n = hair.points.len();
@@ -276,11 +276,11 @@ impl Curl {
     }
 
     pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
-        let radius = self.radius.eval(root.uv);
+        let radius = self.radius.at(&root.site);
         if radius == 0.0 {
             return;
         }
-        let turns = self.turns.eval(root.uv);
+        let turns = self.turns.at(&root.site);
         let phase = TAU * SampleRng::new(self.seed ^ salts::CURL_PHASE, hair.id).uniform_f32();
         let n = hair.points.len();
         scratch.frame_along(&hair.points, root.normal);

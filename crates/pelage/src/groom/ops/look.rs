@@ -21,8 +21,8 @@ fn root_to_tip(
     ramps: &mut RampTables,
 ) {
     let ramp = ramps.along(&spec.ramp, n);
-    let factor = varied(spec.jitter.eval(root.uv), spec.seed ^ salt, hair_id);
-    let (a, b) = (spec.root.eval(root.uv), spec.tip.eval(root.uv));
+    let factor = varied(spec.jitter.at(&root.site), spec.seed ^ salt, hair_id);
+    let (a, b) = (spec.root.at(&root.site), spec.tip.at(&root.site));
     out.clear();
     out.extend(ramp.iter().map(|&r| factor * (a + r * (b - a))));
 }
@@ -100,11 +100,11 @@ pub struct Color {
 impl Color {
     pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
         let factor = varied(
-            self.jitter.eval(root.uv),
+            self.jitter.at(&root.site),
             self.seed ^ salts::COLOR_JITTER,
             hair.id,
         );
-        let rgb = |m: &[Map; 3]| Vec3::from(m.each_ref().map(|c| c.eval(root.uv)));
+        let rgb = |m: &[Map; 3]| Vec3::from(m.each_ref().map(|c| c.at(&root.site)));
         let (a, b) = (rgb(&self.root), rgb(&self.tip));
         let ramp = ramps.along(&self.ramp, hair.points.len());
         hair.colors.clear();

@@ -16,12 +16,14 @@
 mod clump;
 mod displace;
 mod look;
+mod mask;
 mod strands;
 mod trim;
 
 pub use clump::{Clump, ClumpCentres};
 pub use displace::{Curl, Frizz, Noise, NoiseScratch};
 pub use look::{Color, Opacity, Width};
+pub use mask::Masked;
 pub use strands::Strands;
 pub use trim::{Cut, Length};
 
@@ -29,10 +31,10 @@ use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
 use crate::curves::{floats_finite, vectors_finite};
 use crate::groom::file::Ramp;
 use crate::interp::QueryRegion;
-use crate::map::Map;
+use crate::map::{Map, MapSite};
 use crate::mesh::SurfacePoint;
 use crate::sample::SampleRng;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 /// One hair while operators shape it.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -152,9 +154,10 @@ pub struct RootContext {
     pub position: Vec3,
     /// The skin normal there.
     pub normal: Vec3,
-    /// The UV maps are read at (zero on meshes without UVs, where only
-    /// constant maps are allowed).
-    pub uv: Vec2,
+    /// Where the operators' maps are read (UV, rest position, corners).
+    pub site: MapSite,
+    /// The root's region (0 when the skin is not split).
+    pub region: u32,
     /// A ball around the root's skin triangle, when an operator searches
     /// for nearest points (`clump`): one candidate list serves all the
     /// roots in it.
@@ -174,6 +177,8 @@ pub struct Scratch {
     pub(crate) noise: NoiseScratch,
     /// Root-to-tip profiles at the hairs' point counts.
     pub(crate) ramps: RampTables,
+    /// The hairs before a masked operator.
+    pub(crate) masked: HairBatch,
 }
 
 /// `ramp(t_j)` for the points `j` of an `n`-point hair, kept per (ramp,
@@ -254,6 +259,8 @@ pub enum Operator {
     Color(Color),
     /// Opacity.
     Opacity(Opacity),
+    /// An operator faded by a mask.
+    Masked(Masked),
 }
 
 impl Operator {
@@ -262,6 +269,7 @@ impl Operator {
         match self {
             Operator::Strands(op) => op.apply(batch, root, scratch),
             Operator::Cut(op) => op.apply(batch, root, scratch),
+            Operator::Masked(op) => op.apply(batch, root, scratch),
             _ => {
                 for hair in batch.hairs_mut() {
                     self.apply_to_hair(hair, root, scratch);
@@ -282,7 +290,10 @@ impl Operator {
             Operator::Noise(op) => {
                 op.apply_each(hairs, roots, &mut scratch.noise, &mut scratch.ramps)
             }
-            Operator::Strands(_) | Operator::Cut(_) => {
+            Operator::Masked(op) if op.operator().keeps_one_hair_a_root() => {
+                op.apply_each(hairs, roots, scratch)
+            }
+            Operator::Strands(_) | Operator::Cut(_) | Operator::Masked(_) => {
                 panic!("{} changes the number of hairs a root grows", self.name())
             }
             _ => {
@@ -296,7 +307,18 @@ impl Operator {
     /// Whether every root still grows exactly one hair after this operator
     /// (all but `strands` and `cut`, which may remove a hair).
     pub fn keeps_one_hair_a_root(&self) -> bool {
-        !matches!(self, Operator::Strands(_) | Operator::Cut(_))
+        match self {
+            Operator::Masked(op) => op.operator().keeps_one_hair_a_root(),
+            op => !matches!(op, Operator::Strands(_) | Operator::Cut(_)),
+        }
+    }
+
+    /// The operator under any mask.
+    pub fn unmasked(&self) -> &Operator {
+        match self {
+            Operator::Masked(op) => op.operator().unmasked(),
+            op => op,
+        }
     }
 
     /// An operator that works hair by hair, on one hair.
@@ -310,8 +332,8 @@ impl Operator {
             Operator::Width(op) => op.apply(hair, root, &mut scratch.ramps),
             Operator::Color(op) => op.apply(hair, root, &mut scratch.ramps),
             Operator::Opacity(op) => op.apply(hair, root, &mut scratch.ramps),
-            Operator::Strands(_) | Operator::Cut(_) => {
-                unreachable!("strands and cut work on the whole batch")
+            Operator::Strands(_) | Operator::Cut(_) | Operator::Masked(_) => {
+                unreachable!("strands, cut and masks work on the whole batch")
             }
         }
     }
@@ -329,6 +351,7 @@ impl Operator {
             Operator::Width(_) => "width",
             Operator::Color(_) => "color",
             Operator::Opacity(_) => "opacity",
+            Operator::Masked(op) => op.operator().name(),
         }
     }
 }
@@ -443,7 +466,8 @@ pub(crate) mod test_hairs {
             point: SurfacePoint::new(0, [0.3, 0.3]),
             position: Vec3::ZERO,
             normal: Vec3::Z,
-            uv: Vec2::new(0.5, 0.5),
+            site: MapSite::at_uv(glam::Vec2::new(0.5, 0.5)),
+            region: 0,
             skin_triangle: None,
         }
     }

@@ -46,10 +46,10 @@ impl Strands {
             bases.push().copy_from(hair);
         }
         let (s0, s1) = (
-            self.root_spread.eval(root.uv),
-            self.tip_spread.eval(root.uv),
+            self.root_spread.at(&root.site),
+            self.tip_spread.at(&root.site),
         );
-        let twist = self.twist.eval(root.uv);
+        let twist = self.twist.at(&root.site);
         batch.len = 0;
         for base in bases.hairs() {
             let n = base.points.len();

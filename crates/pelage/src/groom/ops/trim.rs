@@ -26,8 +26,17 @@ impl Cut {
         &self.at
     }
 
+    /// The curve parameter map, to change.
+    pub fn at_mut(&mut self) -> &mut Map {
+        &mut self.at
+    }
+
     pub(super) fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
-        let at = self.at.eval(root.uv);
+        self.apply_at(batch, self.at.at(&root.site), scratch);
+    }
+
+    /// Cuts every hair of `batch` at curve parameter `at`.
+    pub(super) fn apply_at(&self, batch: &mut HairBatch, at: f32, scratch: &mut Scratch) {
         if at >= 1.0 {
             return;
         }
@@ -89,7 +98,7 @@ impl Length {
     pub(super) fn apply(&self, hair: &mut super::Hair, root: &RootContext) {
         let mut rng = SampleRng::new(self.seed ^ salts::LENGTH_JITTER, hair.id);
         let factor =
-            (self.scale.eval(root.uv) * jittered(self.jitter.eval(root.uv), &mut rng)).max(0.0);
+            (self.scale.at(&root.site) * jittered(self.jitter.at(&root.site), &mut rng)).max(0.0);
         let Some(&origin) = hair.points.first() else {
             return;
         };
