@@ -1206,3 +1206,49 @@ fn regrow_follows_time_sampled_guides_from_usd_and_alembic_alike() {
         "regrown from usdc ≠ from Alembic at frame 4"
     );
 }
+
+#[test]
+fn groom_reports_unused_guides_regions_and_part_counts() {
+    // Style mesh with guides denser than spot's vertices: some share a
+    // vertex and go unused; a parting map splits the skin in two.
+    let dir = tempfile::tempdir().unwrap();
+    let toml = dir.path().join("g.toml");
+    std::fs::write(
+        &toml,
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 3000\nparts = 3\n[guides]\ngenerate = { count = 3000, length = 0.04 }\n[interpolation]\nmethod = \"style-mesh\"\n[regions]\nmap = \"noise:frequency=1,offset=0.5,scale=1\"\n[[ops]]\nnoise = { amplitude = 0.002, mask = \"noise:frequency=4\" }\n[output]\npath = \"g.usdc\"\n",
+    )
+    .unwrap();
+    let report = dir.path().join("report.json");
+    let out = pelage(&[
+        "groom",
+        toml.to_str().unwrap(),
+        "-q",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let warnings = stderr(&out);
+    assert!(
+        warnings.contains("warning: style mesh: guide "),
+        "{warnings}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["hairs"], 3000);
+    let parts = json["parts"].as_array().unwrap();
+    assert_eq!(parts.len(), 3);
+    let hairs: u64 = parts.iter().map(|p| p["hairs"].as_u64().unwrap()).sum();
+    assert_eq!(hairs, 3000);
+    let unused = json["guides"]["unused_by_style_mesh"].as_array().unwrap();
+    assert_eq!(
+        unused.len(),
+        warnings.matches("warning: style mesh:").count(),
+        "each unused guide printed once"
+    );
+    let regions = json["regions"].as_array().unwrap();
+    assert!(regions.len() >= 2, "{regions:?}");
+    let guides: u64 = regions.iter().map(|r| r["guides"].as_u64().unwrap()).sum();
+    assert_eq!(guides, json["guides"]["kept"].as_u64().unwrap());
+    let region_hairs: u64 = regions.iter().map(|r| r["hairs"].as_u64().unwrap()).sum();
+    assert_eq!(region_hairs, 3000);
+}

@@ -122,24 +122,40 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         }
         return run_animated(args, &groom, &animated, &output, start);
     }
-    let generator = groom.generator(args.seed)?;
-    let prepared = start.elapsed();
-    let lost = generator.lost_guides();
-    for guide in &lost {
-        eprintln!("warning: style mesh: {guide}");
-    }
-    let parts = generator.parts().len();
+    // What to grow and where, known from the file: refuse an output
+    // pelage cannot write, or a disk too small for it, before preparing
+    // anything (preparing a billion hairs' roots takes seconds).
+    let parts = groom.part_count();
     let (range, path) = match args.part {
         Some((k, n)) => (run_parts(args, k, n, parts)?, part_file(&output, k, n)),
         None => (0..parts, output.clone()),
     };
-    // Refuse an output pelage cannot write before growing anything.
     if CurvesFormat::from_path(&path).is_none() {
         bail!(
             "{}: unknown curves format; pelage writes .usdc (or .usd), .usda, .hair, .ply, .rib and .pbrt",
             path.display()
         );
     }
+    pelage::io::check_output(&path)?;
+    let count = *groom.file().roots.count.get_ref();
+    let share = count as u128 * range.len() as u128 / parts.max(1) as u128;
+    // Positions alone (12 bytes a point) are a floor of any format's size.
+    let points = *groom.file().finish.points.get_ref() as u64;
+    pelage::io::check_free_space(
+        &path,
+        (share as u64).saturating_mul(points).saturating_mul(12),
+    )?;
+    let generator = groom.generator(args.seed)?;
+    let prepared = start.elapsed();
+    let lost = generator.lost_guides();
+    for guide in &lost {
+        eprintln!("warning: style mesh: {guide}");
+    }
+    debug_assert_eq!(
+        generator.parts().len(),
+        parts,
+        "the file and the generator agree on parts"
+    );
     let file = groom.file();
     let basis = file.output.basis;
     let export = CurvesExport {
@@ -153,10 +169,6 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         .iter()
         .map(|p| p.hair_count)
         .sum();
-    pelage::io::check_output(&path)?;
-    // Positions alone (12 bytes a point) are a floor of any format's size.
-    let points = *file.finish.points.get_ref() as u64;
-    pelage::io::check_free_space(&path, planned.saturating_mul(points).saturating_mul(12))?;
     let bar = if args.quiet {
         ProgressBar::hidden()
     } else {

@@ -191,7 +191,7 @@ impl Generator {
                 let mesh = &spec.mesh;
                 let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
                     .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
-                let parts = part_count(mesh, count, spec.roots.parts);
+                let parts = part_count(mesh, count, spec.roots.parts, spec.roots.ids);
                 let (cells, layout) = match spec.roots.ids {
                     HairIds::Stable => {
                         let cells = RootCells::new(mesh, &sampler);

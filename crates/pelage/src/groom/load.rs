@@ -12,7 +12,7 @@ use super::file::{
 use super::generator::Generator;
 use super::ops::{Color, Cut, RootToTip};
 use super::spec::{
-    ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, LengthParams,
+    ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, HairIds, LengthParams,
     NoiseParams, RegionsSpec, RootsSpec, SpecOrigin, StrandsParams,
 };
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
@@ -294,12 +294,14 @@ impl Groom {
     }
 
     /// The number of parts: `[roots] parts`, or one per 100,000 hairs;
-    /// never more than the mesh has triangles.
+    /// never more than the mesh has triangles (root cells, with stable
+    /// ids). Known before the generator is built.
     pub fn part_count(&self) -> usize {
         part_count(
             &self.mesh,
             *self.file.roots.count.get_ref(),
             self.file.roots.parts.as_ref().map(|p| *p.get_ref()),
+            self.file.roots.ids,
         )
     }
 
@@ -535,13 +537,18 @@ impl Groom {
 }
 
 /// The number of parts of `count` hairs: `parts` if given, or one per
-/// [`HAIRS_PER_PART`] hairs; at least one, at most one a triangle.
-pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>) -> usize {
+/// [`HAIRS_PER_PART`] hairs; at least one, at most one a triangle (a root
+/// cell, with stable ids: a part is a run of cells).
+pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>, ids: HairIds) -> usize {
     let wanted = match parts {
         Some(p) => p.max(1) as usize,
         None => count.div_ceil(HAIRS_PER_PART).max(1) as usize,
     };
-    wanted.min(mesh.triangle_count()).max(1)
+    let most = match ids {
+        HairIds::Stable => crate::sample::RootCells::count_for(mesh.triangle_count()),
+        HairIds::Sequential => mesh.triangle_count(),
+    };
+    wanted.min(most).max(1)
 }
 
 /// Resolves a map value and binds it to `mesh` (UVs, vertex

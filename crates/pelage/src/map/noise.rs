@@ -134,7 +134,7 @@ impl NoiseMap {
 
     /// One octave of 3D Perlin noise (Perlin 2002), in about [−1, 1].
     pub fn perlin3(&self, p: glam::Vec3) -> f32 {
-        let cell = p.floor();
+        let cell = glam::Vec3::new(floor(p.x), floor(p.y), floor(p.z));
         let f = p - cell;
         let [xi, yi, zi] = [cell.x, cell.y, cell.z].map(|c| (c as i64 & 255) as usize);
         let perm = &self.permutation;
@@ -155,7 +155,7 @@ impl NoiseMap {
 
     /// One octave of 2D Perlin noise, in about [−1, 1].
     pub fn perlin(&self, p: Vec2) -> f32 {
-        let cell = p.floor();
+        let cell = Vec2::new(floor(p.x), floor(p.y));
         let f = p - cell;
         let (xi, yi) = (
             (cell.x as i64 & 255) as usize,
@@ -408,6 +408,15 @@ mod avx2 {
             }
         }
     }
+}
+
+/// `x.floor()` without a libm call (baseline x86-64 has no SSE4.1
+/// rounding instruction, so `f32::floor` is a function call): exact for
+/// |x| < 2³¹, where the noise lattice lives.
+#[inline]
+fn floor(x: f32) -> f32 {
+    let i = x as i32 as f32;
+    if i > x { i - 1.0 } else { i }
 }
 
 /// Dot product of the offset with one of Perlin's twelve gradients (the

@@ -256,6 +256,60 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
     json.insert("samples_per_s_all_threads".into(), rate_all.round().into());
     json.insert("threads".into(), threads.into());
 
+    // Stable hair ids: the same roots drawn cell by cell (counts from each
+    // cell's arrivals, then each cell's own alias table), against the
+    // whole-mesh alias sampler above, same samples, all threads.
+    let cells = pelage::sample::RootCells::new(&blub, &sampler);
+    let (cells_s, drawn) = median_seconds(plan.runs, true, || {
+        let counts = cells.counts(1, plan.samples as u64);
+        let drawn: u64 = (0..cells.len())
+            .into_par_iter()
+            .map(|c| cells.roots(&sampler, 1, c, counts[c]).len() as u64)
+            .sum();
+        drawn
+    });
+    anyhow::ensure!(drawn == plan.samples as u64, "the cells drew {drawn} roots");
+    let (counts_s, _) = median_seconds(plan.runs, true, || cells.counts(1, plan.samples as u64));
+    let cells_rate = plan.samples as f64 / cells_s;
+    let stable_ratio = rate_all / cells_rate;
+    report += &table(
+        &format!(
+            "Stable hair ids: root cells ({} cells) against the alias sampler, {threads} threads",
+            thousands(cells.len() as u64)
+        ),
+        &["", "samples/s", "time ratio", "target"],
+        &[
+            Row {
+                cells: vec![
+                    "alias sampler (whole mesh)".into(),
+                    mega(rate_all),
+                    "1.00".into(),
+                    "".into(),
+                ],
+            },
+            Row {
+                cells: vec![
+                    "root cells (counts + per-cell tables)".into(),
+                    mega(cells_rate),
+                    format!("{stable_ratio:.2}"),
+                    "≤ 1.5".into(),
+                ],
+            },
+            Row {
+                cells: vec![
+                    "  of which counting the arrivals".into(),
+                    format!("{:.1} ms", counts_s * 1e3),
+                    format!("{:.2}", counts_s * rate_all / plan.samples as f64),
+                    "".into(),
+                ],
+            },
+        ],
+    );
+    json.insert("stable_ids_samples_per_s".into(), cells_rate.round().into());
+    json.insert("stable_ids_time_ratio".into(), stable_ratio.into());
+    json.insert("root_cells".into(), cells.len().into());
+    json.insert("stable_ids_counting_s".into(), counts_s.into());
+
     // The selectors alone against a peer, rand_distr's WeightedAliasIndex,
     // on the same weights, in plain loops (no prefetching on either side).
     let weights: Vec<f64> = sampler
