@@ -418,40 +418,14 @@ fn concat(chunks: Vec<PartChunk>) -> PartArrays {
 }
 
 /// [`sorted_by_triangle`] carrying each root's id along (equal roots keep
-/// their order).
+/// ascending ids).
 pub(super) fn sorted_by_triangle_with_ids(
     roots: Vec<SurfacePoint>,
     ids: Vec<u64>,
 ) -> (Vec<SurfacePoint>, Vec<u64>) {
-    let (Some(lo), Some(hi)) = (
-        roots.iter().map(|r| r.tri).min(),
-        roots.iter().map(|r| r.tri).max(),
-    ) else {
-        return (roots, ids);
-    };
-    // The counting sort of `sorted_by_triangle`, moving pairs.
-    let mut starts = vec![0u32; (hi - lo) as usize + 2];
-    for r in &roots {
-        starts[(r.tri - lo) as usize + 1] += 1;
-    }
-    for t in 1..starts.len() {
-        starts[t] += starts[t - 1];
-    }
-    let mut next = starts.clone();
-    let mut sorted = vec![(SurfacePoint::default(), 0u64); roots.len()];
-    for (r, id) in roots.iter().zip(&ids) {
-        let slot = &mut next[(r.tri - lo) as usize];
-        sorted[*slot as usize] = (*r, *id);
-        *slot += 1;
-    }
-    for range in starts.windows(2) {
-        let triangle = &mut sorted[range[0] as usize..range[1] as usize];
-        if triangle.len() > 1 {
-            triangle
-                .sort_unstable_by_key(|(r, id)| (r.bary[0].to_bits(), r.bary[1].to_bits(), *id));
-        }
-    }
-    sorted.into_iter().unzip()
+    sorted_with(roots.into_iter().zip(ids).collect())
+        .into_iter()
+        .unzip()
 }
 
 /// `roots` ordered by (triangle, first barycentric, second barycentric),
@@ -461,31 +435,42 @@ pub(super) fn sorted_by_triangle_with_ids(
 /// two) are then sorted among themselves. A comparison sort of the whole
 /// part took a tenth of a groom's time on one core.
 pub(super) fn sorted_by_triangle(roots: Vec<SurfacePoint>) -> Vec<SurfacePoint> {
+    // A zero-sized payload: the pairs are the roots' own size.
+    sorted_with(roots.into_iter().map(|r| (r, ())).collect())
+        .into_iter()
+        .map(|(r, ())| r)
+        .collect()
+}
+
+/// Roots with a payload each, sorted by (triangle, barycentrics, payload).
+fn sorted_with<T: Copy + Default + Ord>(roots: Vec<(SurfacePoint, T)>) -> Vec<(SurfacePoint, T)> {
     let (Some(lo), Some(hi)) = (
-        roots.iter().map(|r| r.tri).min(),
-        roots.iter().map(|r| r.tri).max(),
+        roots.iter().map(|r| r.0.tri).min(),
+        roots.iter().map(|r| r.0.tri).max(),
     ) else {
         return roots;
     };
     // starts[t − lo] .. starts[t − lo + 1]: where triangle t's roots go.
     let mut starts = vec![0u32; (hi - lo) as usize + 2];
     for r in &roots {
-        starts[(r.tri - lo) as usize + 1] += 1;
+        starts[(r.0.tri - lo) as usize + 1] += 1;
     }
     for t in 1..starts.len() {
         starts[t] += starts[t - 1];
     }
     let mut next = starts.clone();
-    let mut sorted = vec![SurfacePoint::default(); roots.len()];
+    let mut sorted = vec![(SurfacePoint::default(), T::default()); roots.len()];
     for r in &roots {
-        let slot = &mut next[(r.tri - lo) as usize];
+        let slot = &mut next[(r.0.tri - lo) as usize];
         sorted[*slot as usize] = *r;
         *slot += 1;
     }
     for range in starts.windows(2) {
         let triangle = &mut sorted[range[0] as usize..range[1] as usize];
         if triangle.len() > 1 {
-            triangle.sort_unstable_by_key(|r| (r.bary[0].to_bits(), r.bary[1].to_bits()));
+            triangle.sort_unstable_by_key(|(r, payload)| {
+                (r.bary[0].to_bits(), r.bary[1].to_bits(), *payload)
+            });
         }
     }
     sorted
