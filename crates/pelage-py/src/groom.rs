@@ -112,7 +112,7 @@ impl PyGroom {
 #[pymethods]
 impl PyGroom {
     #[new]
-    #[pyo3(signature = (*, mesh, guides, roots, ops = None, interpolation = None, finish = None, output = None, animation = None, base_dir = None))]
+    #[pyo3(signature = (*, mesh, guides, roots, ops = None, interpolation = None, finish = None, output = None, animation = None, regions = None, base_dir = None))]
     #[allow(
         clippy::too_many_arguments,
         reason = "one keyword argument a groom-file table"
@@ -127,6 +127,7 @@ impl PyGroom {
         finish: Option<&Bound<'_, PyAny>>,
         output: Option<&Bound<'_, PyAny>>,
         animation: Option<&Bound<'_, PyAny>>,
+        regions: Option<&Bound<'_, PyAny>>,
         base_dir: Option<PathBuf>,
     ) -> PyResult<Self> {
         let mut table = toml::Table::new();
@@ -176,6 +177,7 @@ impl PyGroom {
             ("finish", finish),
             ("output", output),
             ("animation", animation),
+            ("regions", regions),
         ] {
             if let Some(value) = value.filter(|v| !v.is_none()) {
                 table.insert(key.into(), to_toml(value, key)?);

@@ -192,3 +192,25 @@ def test_a_mesh_value_replaces_the_files_mesh(tmp_path):
     assert groom.mesh.vertex_count == blub.vertex_count
     curves = groom.grow()
     assert curves.root_triangles.max() >= pelage.Mesh.spot().triangle_count, "roots on blub's triangles"
+
+
+def test_regions_masks_and_stable_ids_from_python(spot):
+    # A parting along a noise contour, a masked noise, stable ids: raising
+    # the count keeps every hair of the smaller groom.
+    def grown(count):
+        return small_groom(
+            spot,
+            count=count,
+            regions={"map": "noise:frequency=1,offset=0.5,scale=1"},
+            ops=[pelage.ops.noise(amplitude=0.002, mask="noise:frequency=4")],
+        ).grow()
+    small, large = grown(2_000), grown(3_000)
+    at = {int(i): k for k, i in enumerate(large.ids)}
+    offsets = large.offsets
+    for k, i in enumerate(small.ids):
+        j = at[int(i)]
+        a = small.points[small.offsets[k]:small.offsets[k + 1]]
+        b = large.points[offsets[j]:offsets[j + 1]]
+        assert np.array_equal(a, b), f"hair {i} changed"
+    with pytest.raises(pelage.PelageError, match="regions: the mesh has no face sets"):
+        small_groom(spot, regions={"faces": "groups"}).grow()

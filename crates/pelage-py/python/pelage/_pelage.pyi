@@ -139,6 +139,7 @@ class Groom:
         finish: Optional[Dict[str, Any]] = None,
         output: Optional[Dict[str, Any]] = None,
         animation: Optional[Dict[str, Any]] = None,
+        regions: Optional[Dict[str, Any]] = None,
         base_dir: Optional[_Path] = None,
     ) -> None: ...
     @staticmethod
