@@ -446,10 +446,6 @@ impl Generator {
     /// stream, numbered from the part's first hair id. Blue-noise roots
     /// are then thinned from four times as many ([`super::blue_noise`]).
     pub fn part_roots(&self, p: usize) -> (Vec<SurfacePoint>, Vec<u64>) {
-        let part = &self.layout.parts()[p];
-        if part.hair_count == 0 {
-            return (Vec::new(), Vec::new());
-        }
         if self.distribution == RootDistribution::BlueNoise {
             return super::blue_noise::part_roots(self, p);
         }

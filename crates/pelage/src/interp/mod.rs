@@ -25,6 +25,7 @@ mod style_mesh;
 
 pub use nearest::{NearestPoints, Neighbour, NeighbourCache, QueryRegion};
 pub use regional::RegionWeights;
+pub(crate) use regional::indices_by_region;
 pub use shepard::Shepard;
 pub use style_mesh::{LostGuide, StyleMesh, StyleMeshOptions};
 

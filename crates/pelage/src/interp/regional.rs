@@ -41,16 +41,7 @@ impl RegionWeights {
                 }
             }
         };
-        let top = guide_regions
-            .iter()
-            .copied()
-            .max()
-            .map_or(0, |m| m as usize + 1);
-        let mut members: Vec<Vec<u32>> = vec![Vec::new(); top];
-        for (i, &r) in guide_regions.iter().enumerate() {
-            members[r as usize].push(i as u32);
-        }
-        let regions = members
+        let regions = indices_by_region(guide_regions)
             .into_iter()
             .map(|indices| {
                 (!indices.is_empty()).then(|| (build(&guides.subset(&indices)), indices))
@@ -60,14 +51,6 @@ impl RegionWeights {
             regions,
             all: build(guides),
         }
-    }
-
-    /// The regions that have guides.
-    pub fn regions_with_guides(&self) -> impl Iterator<Item = u32> + '_ {
-        self.regions
-            .iter()
-            .enumerate()
-            .filter_map(|(r, w)| w.as_ref().map(|_| r as u32))
     }
 
     /// The region's weighting and guide indices, if it has guides.
@@ -112,6 +95,17 @@ impl GuideWeights for RegionWeights {
         lost.sort_by_key(|l| l.guide);
         lost
     }
+}
+
+/// For each region id up to the largest in `regions`, the indices of the
+/// items in it, ascending (empty for an id no item has).
+pub(crate) fn indices_by_region(regions: &[u32]) -> Vec<Vec<u32>> {
+    let top = regions.iter().copied().max().map_or(0, |m| m as usize + 1);
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); top];
+    for (i, &r) in regions.iter().enumerate() {
+        members[r as usize].push(i as u32);
+    }
+    members
 }
 
 /// Renumbers a region's guide weights to indices among all guides.

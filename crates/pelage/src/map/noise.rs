@@ -97,15 +97,22 @@ impl NoiseMap {
 
     /// The map's value at `uv`.
     pub fn eval(&self, uv: Vec2) -> f32 {
+        self.fbm(|octave| self.perlin(uv * (self.frequency * octave)))
+    }
+
+    /// `offset + scale · Σ 2⁻ᵏ noise(2ᵏ p) / Σ 2⁻ᵏ` over the octaves
+    /// `k`, `noise(2ᵏ)` given the octave's frequency factor `2ᵏ`.
+    #[inline]
+    fn fbm(&self, noise: impl Fn(f32) -> f32) -> f32 {
         let mut sum = 0.0;
         let mut amplitude = 1.0;
         let mut total = 0.0;
-        let mut p = uv * self.frequency;
+        let mut octave = 1.0;
         for _ in 0..self.octaves {
-            sum += amplitude * self.perlin(p);
+            sum += amplitude * noise(octave);
             total += amplitude;
             amplitude *= 0.5;
-            p *= 2.0;
+            octave *= 2.0;
         }
         self.offset + self.scale * sum / total
     }
@@ -119,17 +126,7 @@ impl NoiseMap {
     /// The map's value at object-space position `p`: the same fBm over 3D
     /// Perlin noise.
     pub fn eval3(&self, p: glam::Vec3) -> f32 {
-        let mut sum = 0.0;
-        let mut amplitude = 1.0;
-        let mut total = 0.0;
-        let mut p = p * self.frequency;
-        for _ in 0..self.octaves {
-            sum += amplitude * self.perlin3(p);
-            total += amplitude;
-            amplitude *= 0.5;
-            p *= 2.0;
-        }
-        self.offset + self.scale * sum / total
+        self.fbm(|octave| self.perlin3(p * (self.frequency * octave)))
     }
 
     /// One octave of 3D Perlin noise (Perlin 2002), in about [−1, 1].

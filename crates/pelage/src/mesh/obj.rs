@@ -20,14 +20,18 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
     // left in place it would hide the first statement.
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     // First pass: count vertices, UVs and normals, so that every face index
-    // can be checked at its own line even when it refers forwards.
+    // can be checked at its own line even when it refers forwards; and note
+    // whether the file has groups (`g`), which then take precedence over
+    // objects (`o`).
     let (mut v_total, mut vt_total, mut vn_total) = (0usize, 0usize, 0usize);
+    let mut uses_g = false;
     for line in bytes.split(|&b| b == b'\n') {
         let line = line.trim_ascii_start();
         match line {
             [b'v', b' ' | b'\t', ..] => v_total += 1,
             [b'v', b't', b' ' | b'\t', ..] => vt_total += 1,
             [b'v', b'n', b' ' | b'\t', ..] => vn_total += 1,
+            [b'g', b' ' | b'\t', ..] => uses_g = true,
             _ => {}
         }
     }
@@ -48,9 +52,6 @@ pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
     let mut colours: Vec<Vec3> = Vec::new();
     let mut coloured: Option<bool> = None;
     // Face sets: each kind's names and the current set of faces to come.
-    let uses_g = bytes
-        .split(|&b| b == b'\n')
-        .any(|l| matches!(l.trim_ascii_start(), [b'g', b' ' | b'\t', ..]));
     let mut sets = [FaceSets::new("groups"), FaceSets::new("materials")];
 
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {

@@ -54,12 +54,7 @@ impl ClumpCentres {
         assert_eq!(roots.len() * points, shapes.len());
         assert_eq!(roots.len(), regions.len());
         assert!(normals.is_empty() || normals.len() == roots.len());
-        let top = regions.iter().copied().max().map_or(0, |m| m as usize + 1);
-        let mut members: Vec<Vec<u32>> = vec![Vec::new(); top];
-        for (i, &r) in regions.iter().enumerate() {
-            members[r as usize].push(i as u32);
-        }
-        let by_region = members
+        let by_region = crate::interp::indices_by_region(regions)
             .into_iter()
             .map(|indices| {
                 (!indices.is_empty()).then(|| {
