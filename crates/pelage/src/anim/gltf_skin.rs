@@ -7,6 +7,7 @@
 //! Vertices are those of pelage's welded glTF mesh (`mesh/gltf.rs`): each
 //! is skinned as the first file vertex it was welded from.
 
+use super::rig::{Influence, SkinRig};
 use crate::mesh::gltf::{ParsedGltf, check_accessor};
 use glam::{Mat4, Quat, Vec3, Vec4};
 use gltf::animation::{Interpolation, Property, util::ReadOutputs};
@@ -23,7 +24,7 @@ pub(crate) struct GltfAnimation {
     order: Vec<usize>,
     channels: Vec<Channel>,
     skins: Vec<Skin>,
-    vertices: Vec<PosedVertex>,
+    rig: SkinRig,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -49,19 +50,6 @@ struct Channel {
 struct Skin {
     joints: Vec<usize>,
     inverse_bind: Vec<Mat4>,
-}
-
-#[derive(Debug, Clone, Copy)]
-enum PosedVertex {
-    /// Follows `node`'s global transform.
-    Rigid { node: Option<usize>, local: Vec3 },
-    /// Blended from up to four joints of `skin`.
-    Skinned {
-        skin: usize,
-        local: Vec3,
-        joints: [u16; 4],
-        weights: [f32; 4],
-    },
 }
 
 /// The names of a file's animations, for messages.
@@ -195,7 +183,7 @@ impl GltfAnimation {
             });
         }
 
-        let vertices = posed_vertices(parsed, &skins)?;
+        let rig = skin_rig(parsed, &skins, nodes.len())?;
         Ok(Self {
             name: animation
                 .name()
@@ -205,12 +193,26 @@ impl GltfAnimation {
             order,
             channels,
             skins,
-            vertices,
+            rig,
         })
     }
 
-    /// Every vertex at `seconds` into the animation (clamped to its keys).
+    /// Every vertex at `seconds` into the animation (clamped to its keys):
+    /// [`Self::rig`] posed by [`Self::palette_at`].
     pub fn positions_at(&self, seconds: f32) -> Vec<Vec3> {
+        self.rig.pose(&self.palette_at(seconds))
+    }
+
+    /// The skinning of every vertex, over the palette of
+    /// [`Self::palette_at`].
+    pub fn rig(&self) -> &SkinRig {
+        &self.rig
+    }
+
+    /// The palette at `seconds`: the identity (vertices of no node), each
+    /// node's global transform (vertices that follow a node), then each
+    /// skin's joint matrices `G(joint) · IBM`, skin after skin.
+    pub fn palette_at(&self, seconds: f32) -> Vec<Mat4> {
         let mut local: Vec<NodeRest> = self.nodes.clone();
         for channel in &self.channels {
             let v = channel.sample(seconds);
@@ -234,40 +236,18 @@ impl GltfAnimation {
                 None => own,
             };
         }
-        let joint_matrices: Vec<Vec<Mat4>> = self
-            .skins
-            .iter()
-            .map(|s| {
+        let mut palette = Vec::with_capacity(self.rig.palette_len());
+        palette.push(Mat4::IDENTITY);
+        palette.extend_from_slice(&global);
+        for s in &self.skins {
+            palette.extend(
                 s.joints
                     .iter()
                     .zip(&s.inverse_bind)
-                    .map(|(&j, ibm)| global[j] * *ibm)
-                    .collect()
-            })
-            .collect();
-        self.vertices
-            .iter()
-            .map(|v| match *v {
-                PosedVertex::Rigid { node, local } => {
-                    node.map_or(local, |n| global[n].transform_point3(local))
-                }
-                PosedVertex::Skinned {
-                    skin,
-                    local,
-                    joints,
-                    weights,
-                } => {
-                    let matrices = &joint_matrices[skin];
-                    let mut blended = Mat4::ZERO;
-                    for (j, w) in joints.iter().zip(weights) {
-                        if w != 0.0 {
-                            blended += matrices[*j as usize] * w;
-                        }
-                    }
-                    blended.transform_point3(local)
-                }
-            })
-            .collect()
+                    .map(|(&j, ibm)| global[j] * *ibm),
+            );
+        }
+        palette
     }
 }
 
@@ -358,14 +338,23 @@ fn parents_first(nodes: &[NodeRest]) -> Result<Vec<usize>, String> {
     Ok(order)
 }
 
-/// Each welded vertex's local position and what moves it.
-fn posed_vertices(parsed: &ParsedGltf, skins: &[Skin]) -> Result<Vec<PosedVertex>, String> {
+/// Each welded vertex's local position and what moves it, over the
+/// palette of [`GltfAnimation::palette_at`] (`node_count` nodes).
+fn skin_rig(parsed: &ParsedGltf, skins: &[Skin], node_count: usize) -> Result<SkinRig, String> {
+    // Where each skin's joints start in the palette.
+    let mut skin_base = Vec::with_capacity(skins.len());
+    let mut palette_len = 1 + node_count;
+    for s in skins {
+        skin_base.push(palette_len as u32);
+        palette_len += s.joints.len();
+    }
     let doc = &parsed.document;
     let data = |b: gltf::Buffer| parsed.buffers.get(b.index()).map(|d| &d.0[..]);
     // Per (mesh, primitive): local positions, joints, weights.
     type Attributes = (Vec<Vec3>, Option<Vec<[u16; 4]>>, Option<Vec<[f32; 4]>>);
     let mut read: std::collections::HashMap<(usize, usize), Attributes> = Default::default();
-    let mut out = Vec::with_capacity(parsed.sources.len());
+    let mut rest = Vec::with_capacity(parsed.sources.len());
+    let mut influences = Vec::with_capacity(parsed.sources.len());
     for source in &parsed.sources {
         let key = (source.mesh, source.primitive);
         if let std::collections::hash_map::Entry::Vacant(slot) = read.entry(key) {
@@ -390,7 +379,8 @@ fn posed_vertices(parsed: &ParsedGltf, skins: &[Skin]) -> Result<Vec<PosedVertex
         let local = positions[k];
         let node = source.node.and_then(|n| doc.nodes().nth(n));
         let skin = node.as_ref().and_then(|n| n.skin());
-        out.push(match (skin, joints, weights) {
+        rest.push(local);
+        influences.push(match (skin, joints, weights) {
             (Some(skin), Some(j), Some(w)) => {
                 let (joints, mut weights) = (j[k], w[k]);
                 let count = skins[skin.index()].joints.len();
@@ -408,20 +398,16 @@ fn posed_vertices(parsed: &ParsedGltf, skins: &[Skin]) -> Result<Vec<PosedVertex
                     ));
                 }
                 weights.iter_mut().for_each(|w| *w /= total);
-                PosedVertex::Skinned {
-                    skin: skin.index(),
-                    local,
-                    joints,
+                let base = skin_base[skin.index()];
+                Influence {
+                    joints: joints.map(|j| base + u32::from(j)),
                     weights,
                 }
             }
-            _ => PosedVertex::Rigid {
-                node: source.node,
-                local,
-            },
+            _ => Influence::rigid(source.node.map_or(0, |n| 1 + n as u32)),
         });
     }
-    Ok(out)
+    Ok(SkinRig::new(rest, influences, palette_len))
 }
 
 fn list_or_none(names: &[String]) -> String {

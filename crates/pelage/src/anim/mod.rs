@@ -8,8 +8,10 @@
 mod binding;
 mod frames;
 mod gltf_skin;
+mod rig;
 mod skin;
 
 pub use binding::{RestFrames, SkinBinding, SkinPose};
 pub use frames::{FrameRange, FrameRangeError, MAX_FRAMES};
+pub use rig::{Influence, PosedFrames, SkinRig};
 pub use skin::{AnimatedSkin, SkinOptions, sequence_file};

@@ -5,9 +5,10 @@
 //! program ([`AnimatedSkin::from_fn`]).
 
 use super::gltf_skin::GltfAnimation;
+use super::rig::SkinRig;
 use crate::io::UsdSkin;
 use crate::mesh::{Mesh, MeshError, MeshErrorKind, Uvs};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -66,6 +67,20 @@ impl std::fmt::Debug for AnimatedSkin {
             .field("animated", &self.is_animated())
             .finish()
     }
+}
+
+/// `seconds` into a looping clip: a walk cycle walks on. The clip's end
+/// is shown at its end, not folded back to its start.
+fn clip_seconds(animation: &GltfAnimation, seconds: f64) -> f32 {
+    let duration = f64::from(animation.duration);
+    let mut s = seconds;
+    if duration > 0.0 {
+        s = seconds.rem_euclid(duration);
+        if s == 0.0 && seconds > 0.0 {
+            s = duration;
+        }
+    }
+    s as f32
 }
 
 /// The `#` run of a sequence pattern: where it starts and how many digits.
@@ -214,6 +229,37 @@ impl AnimatedSkin {
         }
     }
 
+    /// A glTF skin's linear-blend skinning, over the base mesh's vertices
+    /// (before `subdivide`; [`SkinRig::subdivided`] follows it), with
+    /// rest positions in the space its palette maps from.
+    pub fn rig(&self) -> Option<&SkinRig> {
+        match &self.motion {
+            Motion::Gltf(a) => Some(a.rig()),
+            _ => None,
+        }
+    }
+
+    /// The palette of [`Self::rig`] at `seconds` into the clip (clips
+    /// loop, as frames do).
+    pub fn palette_at_seconds(&self, seconds: f64) -> Option<Vec<Mat4>> {
+        match &self.motion {
+            Motion::Gltf(a) => Some(a.palette_at(clip_seconds(a, seconds))),
+            _ => None,
+        }
+    }
+
+    /// The base mesh's triangles and UVs at the positions `positions` (as
+    /// many as its vertices), not subdivided.
+    pub fn base_mesh_at(&self, positions: Vec<Vec3>) -> Result<Mesh, MeshError> {
+        Mesh::new(
+            &self.name,
+            positions,
+            self.triangles.clone(),
+            None,
+            self.uvs.clone(),
+        )
+    }
+
     /// The time codes a USD skin is sampled at (empty for other skins).
     pub fn sample_times(&self) -> &[f64] {
         match &self.motion {
@@ -234,16 +280,7 @@ impl AnimatedSkin {
             Motion::Still(p) => p.clone(),
             Motion::Program(f) => f(frame),
             Motion::Gltf(animation) => {
-                let mut seconds = (frame - 1.0) / self.fps;
-                let duration = f64::from(animation.duration);
-                // Clips loop: a walk cycle walks on.
-                if duration > 0.0 {
-                    seconds = seconds.rem_euclid(duration);
-                    if seconds == 0.0 && frame > 1.0 {
-                        seconds = duration;
-                    }
-                }
-                animation.positions_at(seconds as f32)
+                animation.positions_at(clip_seconds(animation, (frame - 1.0) / self.fps))
             }
             Motion::Usd(skin) => skin.positions_at(frame).map_err(at_frame)?,
             Motion::ObjSequence(pattern) => {

@@ -129,41 +129,16 @@ impl MassSpringSystem {
     /// vertex normals (the face normal for Silva strands), at rest.
     pub fn new(mesh: &Mesh, topology: Topology, length: f32) -> Self {
         let tri_count = mesh.triangle_count();
-        let (roots, normals, corner_sticks): (Vec<Vec3>, Vec<Vec3>, Vec<u32>) = match topology {
-            Topology::SpringSticks | Topology::Prisms => (
-                mesh.positions().to_vec(),
-                mesh.normals().to_vec(),
-                mesh.triangles().iter().flatten().copied().collect(),
-            ),
-            Topology::SeparableSpringSticks | Topology::SeparablePrisms => {
-                let corners: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
-                (
-                    corners
-                        .iter()
-                        .map(|&v| mesh.positions()[v as usize])
-                        .collect(),
-                    corners
-                        .iter()
-                        .map(|&v| mesh.normals()[v as usize])
-                        .collect(),
-                    (0..corners.len() as u32).collect(),
-                )
+        let (roots, normals) =
+            Self::sticks_on(topology, mesh.triangles(), mesh.positions(), mesh.normals());
+        let corner_sticks: Vec<u32> = match topology {
+            Topology::SpringSticks | Topology::Prisms => {
+                mesh.triangles().iter().flatten().copied().collect()
             }
-            Topology::SilvaStrands => (
-                (0..tri_count)
-                    .map(|t| {
-                        let [a, b, c] = mesh.triangle_positions(t);
-                        (a + b + c) / 3.0
-                    })
-                    .collect(),
-                (0..tri_count)
-                    .map(|t| {
-                        let n = mesh.face_normal(t);
-                        if n == Vec3::ZERO { Vec3::Y } else { n }
-                    })
-                    .collect(),
-                (0..tri_count as u32).flat_map(|t| [t, t, t]).collect(),
-            ),
+            Topology::SeparableSpringSticks | Topology::SeparablePrisms => {
+                (0..3 * tri_count as u32).collect()
+            }
+            Topology::SilvaStrands => (0..tri_count as u32).flat_map(|t| [t, t, t]).collect(),
         };
         let normals: Vec<Vec3> = normals.iter().map(|n| n.normalize_or(Vec3::Y)).collect();
         let tips: Vec<Vec3> = roots
@@ -224,6 +199,35 @@ impl MassSpringSystem {
             corner_sticks,
             scratch_tips: Vec::new(),
             scratch_velocities: Vec::new(),
+        }
+    }
+
+    /// Each stick's root and rest direction on a skin with `positions` and
+    /// unit `normals` (one a vertex) over `triangles`: a vertex's
+    /// (spring-sticks, prisms), a triangle corner's (the separable
+    /// topologies) or a triangle's centre and face normal (Silva strands).
+    /// What [`Self::move_roots`] takes when the skin deforms.
+    pub fn sticks_on(
+        topology: Topology,
+        triangles: &[[u32; 3]],
+        positions: &[Vec3],
+        normals: &[Vec3],
+    ) -> (Vec<Vec3>, Vec<Vec3>) {
+        match topology {
+            Topology::SpringSticks | Topology::Prisms => (positions.to_vec(), normals.to_vec()),
+            Topology::SeparableSpringSticks | Topology::SeparablePrisms => triangles
+                .iter()
+                .flatten()
+                .map(|&v| (positions[v as usize], normals[v as usize]))
+                .unzip(),
+            Topology::SilvaStrands => triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|v| positions[v as usize]);
+                    let n = (b - a).cross(c - a).normalize_or_zero();
+                    ((a + b + c) / 3.0, if n == Vec3::ZERO { Vec3::Y } else { n })
+                })
+                .unzip(),
         }
     }
 

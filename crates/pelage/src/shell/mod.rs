@@ -11,17 +11,22 @@
 //!   Alg. 2), one function each — the reference `pelage-gpu`'s WGSL mirrors
 //!   and is tested against.
 //! - [`scene`]: shell scene files (TOML): mesh, textures, curl, clumping,
-//!   droplets, light and camera (docs/shells-format.md).
+//!   droplets, light and camera, fins, level of detail
+//!   (docs/shells-format.md).
+//! - [`ShellAnimation`]: a skinned glTF character playing a clip, posed by
+//!   linear-blend skinning for the GPU and the fur's dynamics.
 
 mod error;
 pub mod math;
 pub mod scene;
 mod scene_file;
+mod skinned;
 pub mod textures;
 pub mod wetness;
 
 pub use error::{SceneError, SceneErrorDetails, SceneErrorKind};
 pub use math::{ClumpParams, Coupling, CurlParams, KajiyaKay, Strand, WetTexel};
 pub use scene::{SceneCamera, ShellScene};
+pub use skinned::ShellAnimation;
 pub use textures::{ShellTextureParams, ShellTextures, TextureStyle};
 pub use wetness::{Droplet, DropletStyle, WetnessMask};

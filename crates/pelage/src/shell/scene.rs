@@ -118,6 +118,25 @@ impl Default for DynamicsSettings {
     }
 }
 
+/// Fins (Lengyel et al. 2001): quads on the mesh's edges, drawn where an
+/// edge is seen edge-on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FinSettings {
+    /// Opacity of a fin seen exactly edge-on.
+    pub opacity: f32,
+    /// `|n · e|` at which a fin has faded out.
+    pub width: f32,
+}
+
+/// Level of detail by projected size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LodSettings {
+    /// The largest spacing between layers on screen, pixels.
+    pub max_gap_px: f32,
+    /// Never fewer layers than this.
+    pub min_layers: u32,
+}
+
 /// A droplet and when it falls.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TimedDroplet {
@@ -161,6 +180,13 @@ pub struct ShellScene {
     pub fps: f32,
     /// Moving fur, if the scene has a `[dynamics]` section.
     pub dynamics: Option<DynamicsSettings>,
+    /// Fins, if on.
+    pub fins: Option<FinSettings>,
+    /// Level of detail, if on.
+    pub lod: Option<LodSettings>,
+    /// The skinned character and its clip, when `[animation] clip` names
+    /// one; [`Self::mesh`] is then its pose at time 0.
+    pub animation: Option<super::ShellAnimation>,
 }
 
 impl ShellScene {
@@ -211,7 +237,7 @@ impl ShellScene {
     /// Builds a scene from a file's text (relative paths against its folder).
     pub fn from_source(source: &SettingsSource) -> Result<Self, SceneError> {
         let file = Self::parse(source)?;
-        let (mesh, color) = mesh_and_color(source, &file)?;
+        let (mesh, color, animation) = mesh_and_color(source, &file)?;
         let (lo, hi) = mesh.bounds();
         let fur = fur_settings(source, &file.fur, (hi - lo).length())?;
         let length = fur.length;
@@ -263,6 +289,26 @@ impl ShellScene {
             frames: file.animation.frames.unwrap_or(1).max(1),
             fps: file.animation.fps.unwrap_or(12.0).max(1e-3),
             dynamics,
+            fins: file
+                .fins
+                .as_ref()
+                .filter(|f| f.enabled != Some(false))
+                .map(|f| FinSettings {
+                    opacity: f.opacity.unwrap_or(1.0),
+                    width: f.width.unwrap_or(0.3),
+                }),
+            lod: file
+                .lod
+                .as_ref()
+                .filter(|l| l.enabled != Some(false))
+                .map(|l| {
+                    Ok::<_, SceneError>(LodSettings {
+                        max_gap_px: l.max_gap.unwrap_or(0.75),
+                        min_layers: count_in(source, &l.min_layers, 1..=256, "layers", 4)?,
+                    })
+                })
+                .transpose()?,
+            animation,
         })
     }
 
@@ -364,6 +410,17 @@ const SCENE_RULES: &[Rule] = &[
         "pelage's frame limit",
     ),
     Rule::new("animation.fps", Bound::more_than(0.0), "frames per second"),
+    Rule::new("fins.opacity", Bound::Within(0.0, 1.0), "an opacity"),
+    Rule::new(
+        "fins.width",
+        Bound::Above(0.0, 1.0),
+        "|n · e| at which a fin fades out",
+    ),
+    Rule::new(
+        "lod.max_gap",
+        Bound::more_than(0.0),
+        "pixels between layers on screen",
+    ),
     Rule::new(
         "dynamics.substeps",
         Bound::Within(0.0, MAX_DYNAMICS_STEPS as f64),
@@ -478,10 +535,30 @@ fn unreadable_image(
 fn mesh_and_color(
     source: &SettingsSource,
     file: &SceneFile,
-) -> Result<(Mesh, image::RgbaImage), SceneError> {
-    let (mesh, default_color) = match &file.mesh {
-        None => (crate::assets::spot(), Some(spot_color())),
-        Some(section) => {
+) -> Result<(Mesh, image::RgbaImage, Option<super::ShellAnimation>), SceneError> {
+    let mut animation = None;
+    let (mesh, default_color) = match (&file.mesh, &file.animation.clip) {
+        (None, None) => (crate::assets::spot(), Some(spot_color())),
+        (None, Some(clip)) => {
+            return Err(invalid(
+                source,
+                clip.span(),
+                "a clip is played by a skinned mesh: add [mesh] path = \"character.gltf\"".into(),
+            ));
+        }
+        (Some(section), Some(clip)) => {
+            let path = source.folder().join(section.path.get_ref());
+            let skinned = super::ShellAnimation::load(&path, clip.get_ref(), section.subdivide)
+                .map_err(|e| {
+                    SceneError::at(source, section.path.span(), SceneErrorKind::Mesh(e))
+                })?;
+            let mesh = skinned.mesh_at(0.0).map_err(|e| {
+                SceneError::at(source, section.path.span(), SceneErrorKind::Mesh(e))
+            })?;
+            animation = Some(skinned);
+            (mesh, None)
+        }
+        (Some(section), None) => {
             let mesh = section.load(source.folder()).map_err(|e| {
                 SceneError::at(source, section.path.span(), SceneErrorKind::Mesh(e))
             })?;
@@ -511,7 +588,7 @@ fn mesh_and_color(
             image::RgbaImage::from_pixel(1, 1, image::Rgba([150, 110, 70, 255]))
         }),
     };
-    Ok((mesh, color))
+    Ok((mesh, color, animation))
 }
 
 /// `[fur]`: layers (1 to 256) and length (by default 2.5 % of the mesh's

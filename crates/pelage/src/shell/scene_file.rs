@@ -34,6 +34,8 @@ pub(super) struct SceneFile {
     #[serde(default)]
     pub(super) animation: AnimationSection,
     pub(super) dynamics: Option<DynamicsSection>,
+    pub(super) fins: Option<FinsSection>,
+    pub(super) lod: Option<LodSection>,
 }
 
 #[derive(Debug, Clone, Deserialize, Default)]
@@ -188,4 +190,22 @@ pub(super) struct CameraSection {
 pub(super) struct AnimationSection {
     pub(super) frames: Option<u32>,
     pub(super) fps: Option<f32>,
+    /// A glTF skin's animation to play (by name or `#index`).
+    pub(super) clip: Option<Spanned<String>>,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FinsSection {
+    pub(super) enabled: Option<bool>,
+    pub(super) opacity: Option<f32>,
+    pub(super) width: Option<f32>,
+}
+
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct LodSection {
+    pub(super) enabled: Option<bool>,
+    pub(super) max_gap: Option<f32>,
+    pub(super) min_layers: Option<Spanned<u32>>,
 }
