@@ -100,6 +100,8 @@ fn grass() -> Grass {
             k_shadow: 1.6,
         },
         background: [0.62, 0.66, 0.72],
+        fins: None,
+        lod: None,
     };
     Grass {
         mesh,

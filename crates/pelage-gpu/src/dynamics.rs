@@ -313,6 +313,7 @@ impl GpuMassSpring {
                 entry(7, read, false),
                 entry(11, read, false),
                 entry(12, write, false),
+                entry(13, read, false),
             ],
         });
         let coupling = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -533,10 +534,10 @@ impl GpuMassSpring {
     /// uploads from the CPU — so the renderer draws the GPU's state with no
     /// read-back. `model` must be of the mesh this system was built on.
     pub fn write_tip_offsets(&self, ctx: &GpuContext, model: &ShellModel) -> Result<(), GpuError> {
-        if model.vertex_count != self.corners {
+        if model.corner_count != self.corners {
             return Err(GpuError::Mismatch(format!(
                 "the shell model has {} triangle corners; the mass-spring system follows {}",
-                model.vertex_count, self.corners
+                model.corner_count, self.corners
             )));
         }
         if self.corners == 0 {
@@ -552,6 +553,7 @@ impl GpuMassSpring {
                 (7, tips),
                 (11, &self.corner_sticks),
                 (12, &model.tip_offsets),
+                (13, &model.vertex_corners),
             ]
             .map(|(binding, buffer)| wgpu::BindGroupEntry {
                 binding,
@@ -566,7 +568,7 @@ impl GpuMassSpring {
             });
             pass.set_pipeline(&self.coupling);
             pass.set_bind_group(0, &bind_group, &[]);
-            let (x, y) = workgroups(self.corners);
+            let (x, y) = workgroups(model.vertex_count);
             pass.dispatch_workgroups(x, y, 1);
         }
         ctx.queue.submit([encoder.finish()]);

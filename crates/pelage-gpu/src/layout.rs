@@ -128,7 +128,7 @@ pub(crate) struct UniformRing<T> {
 
 impl<T: bytemuck::Pod> UniformRing<T> {
     /// Slots in the ring.
-    pub(crate) const SLOTS: u64 = 64;
+    pub(crate) const SLOTS: u64 = 1024;
     /// Bytes a slot: the largest uniform offset alignment wgpu allows.
     const SLOT_BYTES: u64 = 256;
 
@@ -304,7 +304,7 @@ mod tests {
     #[test]
     fn rust_vertex_structs_match_their_wgsl_inputs() {
         use crate::renderer::{MeshVertex, PointInstance, SegmentInstance};
-        use crate::shells::{ShellVertex, TipOffset};
+        use crate::shells::{PoseVertex, SurfaceVertex, TipOffset};
         let cases: [(&str, &str, Vec<Input>); 4] = [
             (
                 "mesh.wgsl",
@@ -325,7 +325,8 @@ mod tests {
                 "shells.wgsl",
                 "VertexIn",
                 inputs(&[
-                    (ShellVertex::FIELDS, ShellVertex::ATTRIBUTES),
+                    (PoseVertex::FIELDS, PoseVertex::ATTRIBUTES),
+                    (SurfaceVertex::FIELDS, SurfaceVertex::ATTRIBUTES),
                     (TipOffset::FIELDS, TipOffset::ATTRIBUTES),
                 ]),
             ),

@@ -23,13 +23,13 @@ mod shells;
 pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
 pub use dynamics::GpuMassSpring;
-pub use motion::FurMotion;
+pub use motion::{FurMotion, SkinMotion};
 pub use pelage::Curves;
 pub use readback::read_texture;
 pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer};
 pub use shells::{
-    ShellFeatures, ShellModel, ShellParams, ShellRenderer, ShellScenePlayer, ShellTarget,
-    ShellView, vertex_tangents,
+    FinParams, ShellFeatures, ShellLevel, ShellLod, ShellModel, ShellParams, ShellRenderer,
+    ShellScenePlayer, ShellTarget, ShellTargetFormats, ShellUpload, ShellView, vertex_tangents,
 };
 /// wgpu itself, so callers (a window, the viewer) build surfaces with the same version.
 pub use wgpu;
@@ -113,6 +113,8 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("shells.wgsl", include_str!("shaders/shells.wgsl")),
     // The explicit mass-spring substep (compute).
     ("dynamics.wgsl", include_str!("shaders/dynamics.wgsl")),
+    // Linear-blend skinning of shell models (compute).
+    ("skin.wgsl", include_str!("shaders/skin.wgsl")),
 ];
 
 /// The WGSL source of the named shader (with its prelude).

@@ -6,6 +6,24 @@ use glam::Vec3;
 use pelage::dynamics::{MassSpringSystem, Solver, Topology};
 use pelage::shell::scene::DynamicsSettings;
 
+/// Where the skin under the fur is at the end of a step.
+#[derive(Debug, Clone, Copy)]
+pub enum SkinMotion<'a> {
+    /// The skin at rest, moved whole by an offset (a shake).
+    Offset(Vec3),
+    /// The skin posed (a skinned character): each vertex's position and
+    /// unit normal, of the mesh the motion was built on, then moved by
+    /// `offset`.
+    Posed {
+        /// Vertex positions.
+        positions: &'a [Vec3],
+        /// Unit vertex normals.
+        normals: &'a [Vec3],
+        /// Added to every position.
+        offset: Vec3,
+    },
+}
+
 /// A scene's moving fur as the renderer uses it: the mass-spring system
 /// stepped on the CPU, or on the GPU where the settings say `gpu` (and,
 /// for the implicit solver, no springs join the tips); the skin's rest
@@ -20,6 +38,9 @@ pub struct FurMotion {
     on_gpu: Option<GpuMassSpring>,
     rest_roots: Vec<Vec3>,
     rest_normals: Vec<Vec3>,
+    /// The skin's triangles: a posed skin's vertices become the sticks'
+    /// roots through them.
+    triangles: Vec<[u32; 3]>,
     /// The skin's offset at the last step, and whether that step moved it
     /// (root velocities not zero): the GPU's copy of the roots is
     /// refreshed only while either changes.
@@ -35,6 +56,7 @@ impl FurMotion {
         Self {
             rest_roots: system.roots().to_vec(),
             rest_normals: system.normals().to_vec(),
+            triangles: mesh.triangles().to_vec(),
             system,
             on_gpu: None,
             skin_offset: Vec3::ZERO,
@@ -53,15 +75,15 @@ impl FurMotion {
         self.time
     }
 
-    /// One step of `dt` seconds with the whole skin moved by `skin_offset`
-    /// from rest (its velocity taken from the move, so the tips lag). The
-    /// step runs where `settings` says; a change of place carries the
-    /// state over (back to the CPU: copied down).
+    /// One step of `dt` seconds with the skin where `skin` says at its end
+    /// (the roots' velocities are taken from the move, so the tips lag by
+    /// inertia). The step runs where `settings` says; a change of place
+    /// carries the state over (back to the CPU: copied down).
     pub fn step(
         &mut self,
         ctx: &GpuContext,
         dt: f32,
-        skin_offset: Vec3,
+        skin: SkinMotion<'_>,
         settings: &DynamicsSettings,
     ) -> Result<(), GpuError> {
         let explicit = match settings.solver {
@@ -76,9 +98,31 @@ impl FurMotion {
             (false, Some(gpu)) => gpu.download_into(ctx, &mut self.system)?,
             (_, kept) => self.on_gpu = kept,
         }
-        let roots: Vec<Vec3> = self.rest_roots.iter().map(|&r| r + skin_offset).collect();
-        self.system.move_roots(&roots, &self.rest_normals, dt);
-        let moving = skin_offset != self.skin_offset;
+        let (skin_offset, posed) = match skin {
+            SkinMotion::Offset(offset) => (offset, false),
+            SkinMotion::Posed { offset, .. } => (offset, true),
+        };
+        match skin {
+            SkinMotion::Offset(offset) => {
+                let roots: Vec<Vec3> = self.rest_roots.iter().map(|&r| r + offset).collect();
+                self.system.move_roots(&roots, &self.rest_normals, dt);
+            }
+            SkinMotion::Posed {
+                positions,
+                normals,
+                offset,
+            } => {
+                let (mut roots, normals) = MassSpringSystem::sticks_on(
+                    self.topology(),
+                    &self.triangles,
+                    positions,
+                    normals,
+                );
+                roots.iter_mut().for_each(|r| *r += offset);
+                self.system.move_roots(&roots, &normals, dt);
+            }
+        }
+        let moving = posed || skin_offset != self.skin_offset;
         match &mut self.on_gpu {
             Some(gpu) => {
                 if moving || self.skin_moving {

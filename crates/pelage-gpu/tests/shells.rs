@@ -255,6 +255,8 @@ fn params(layers: u32) -> ShellParams {
             k_shadow: 2.0,
         },
         background: [0.0, 0.0, 1.0],
+        fins: None,
+        lod: None,
     }
 }
 

@@ -297,24 +297,26 @@ fn implicit_unjoined_step(
 
 // ---- coupling to the shells: MassSpringSystem::corner_tip_offsets ----
 
-// For each triangle corner, the stick it follows; and the renderer's
-// per-corner tip offsets p − p0 (three floats a corner, its vertex buffer).
+// For each triangle corner, the stick it follows; for each vertex of the
+// shell model, a triangle corner it stands for; and the renderer's
+// per-vertex tip offsets p − p0 (three floats a vertex, its vertex buffer).
 @group(0) @binding(11) var<storage, read> corner_sticks: array<u32>;
-@group(0) @binding(12) var<storage, read_write> corner_offsets: array<f32>;
+@group(0) @binding(12) var<storage, read_write> vertex_offsets: array<f32>;
+@group(0) @binding(13) var<storage, read> vertex_corners: array<u32>;
 
 @compute @workgroup_size(64)
 fn corner_tip_offsets(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let c = flat_index(id, groups);
-    if c >= arrayLength(&corner_sticks) {
+    let r = flat_index(id, groups);
+    if r >= arrayLength(&vertex_corners) {
         return;
     }
-    let s = corner_sticks[c];
+    let s = corner_sticks[vertex_corners[r]];
     let rest_tip = roots[s].xyz + roots[s].w * normals[s].xyz;
     let offset = tips_in[s].xyz - rest_tip;
-    corner_offsets[3u * c] = offset.x;
-    corner_offsets[3u * c + 1u] = offset.y;
-    corner_offsets[3u * c + 2u] = offset.z;
+    vertex_offsets[3u * r] = offset.x;
+    vertex_offsets[3u * r + 1u] = offset.y;
+    vertex_offsets[3u * r + 2u] = offset.z;
 }

@@ -38,6 +38,13 @@ struct Shell {
     clump_strength: f32,
     // The wetness mask's size in texels.
     wetness_size: vec2<f32>,
+    // L: this level of detail's layers, continuous (N: full detail).
+    lod_layers: f32,
+    // The fur texture's mip level.
+    fur_mip: f32,
+    // Fins: opacity edge-on, and the |n·e| where they have faded out.
+    fin_opacity: f32,
+    fin_width: f32,
     pad0: vec2<f32>,
 };
 
@@ -52,15 +59,15 @@ struct Shell {
 override CURL: bool = true;
 override CLUMP: bool = true;
 
-// Mirrors ShellVertex (locations 0-3) and TipOffset (4) in shells/mod.rs
-// (a test checks names and locations).
+// Mirrors PoseVertex (locations 0-2), SurfaceVertex (3) and TipOffset (4)
+// in shells/mod.rs (a test checks names and locations).
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
-    // Mask (image) coordinates: (u, 1 − v).
-    @location(2) uv: vec2<f32>,
     // dP/du, the texture's x direction on the surface.
-    @location(3) tangent: vec3<f32>,
+    @location(2) tangent: vec3<f32>,
+    // Mask (image) coordinates: (u, 1 − v).
+    @location(3) uv: vec2<f32>,
     // p − p0: how far the strand's tip particle has moved (0 at rest).
     @location(4) tip_offset: vec3<f32>,
 };
@@ -231,15 +238,35 @@ struct LayerOut {
     @location(2) tangent: vec3<f32>,
     @location(3) normal: vec3<f32>,
     @location(4) u_axis: vec3<f32>,
-    @location(5) @interpolate(flat) layer: u32,
+    // h of this layer.
+    @location(5) @interpolate(flat) h: f32,
     // clump_profile(h, w, N) of this layer.
     @location(6) @interpolate(flat) clump_profile: f32,
+    // The shell texture slice at h: layer n at full detail, between two
+    // slices otherwise.
+    @location(7) @interpolate(flat) slice: f32,
+    // Opacity: the faded-in innermost layer of a level of detail, and the
+    // exponent N / L that gives L layers the coverage of N.
+    @location(8) @interpolate(flat) fade: f32,
+    @location(9) @interpolate(flat) coverage: f32,
 };
+
+// The height of layer n of the ⌈L⌉ drawn (n = 0 innermost): layer_height at
+// full detail; with L < N layers they stand 1/L apart down from the tip,
+// so as L grows they slide apart and a new innermost one fades in.
+fn lod_height(n: u32, layers: u32, lod_layers: f32) -> f32 {
+    if lod_layers >= f32(layers) {
+        return layer_height(n, layers);
+    }
+    let drawn = u32(ceil(lod_layers));
+    return 1.0 - f32(drawn - 1u - n) / lod_layers;
+}
 
 @vertex
 fn vs_layer(v: VertexIn, @builtin(instance_index) layer: u32) -> LayerOut {
     let layers = shell.layers;
-    let h = layer_height(layer, layers);
+    let full = shell.lod_layers >= f32(layers);
+    let h = lod_height(layer, layers, shell.lod_layers);
     let n = normalize(v.normal);
     let u = normalize(v.tangent - n * dot(n, v.tangent));
     let w = cross(n, u);
@@ -267,18 +294,41 @@ fn vs_layer(v: VertexIn, @builtin(instance_index) layer: u32) -> LayerOut {
     out.tangent = t;
     out.normal = n;
     out.u_axis = u;
-    out.layer = layer;
+    out.h = h;
     out.clump_profile = 0.0;
     if CLUMP {
         out.clump_profile = clump_profile(h, shell.clump_w, layers);
     }
+    out.slice = f32(layer);
+    out.fade = 1.0;
+    out.coverage = 1.0;
+    if !full {
+        let last = f32(textureNumLayers(fur_layers) - 1);
+        out.slice = clamp(h * f32(layers) - 1.0, 0.0, last);
+        if layer == 0u {
+            out.fade = shell.lod_layers - floor(shell.lod_layers - 1e-6);
+        }
+        out.coverage = f32(layers) / shell.lod_layers;
+    }
     return out;
+}
+
+// The shell texture at a continuous slice: one lookup on a slice, two
+// blended between slices.
+fn fur_at(uv: vec2<f32>, slice: f32) -> vec4<f32> {
+    let below = floor(slice);
+    let a = textureSampleLevel(fur_layers, fur_sampler, uv, i32(below), shell.fur_mip);
+    let s = slice - below;
+    if s == 0.0 {
+        return a;
+    }
+    let b = textureSampleLevel(fur_layers, fur_sampler, uv, i32(below) + 1, shell.fur_mip);
+    return mix(a, b, s);
 }
 
 @fragment
 fn fs_layer(v: LayerOut) -> @location(0) vec4<f32> {
-    let layers = shell.layers;
-    let h = layer_height(v.layer, layers);
+    let h = v.h;
     var uv_color = v.uv;
     var uv_geo = v.uv * shell.tiles;
     // Alg. 2.
@@ -296,10 +346,15 @@ fn fs_layer(v: LayerOut) -> @location(0) vec4<f32> {
             uv_geo += d * shell.tiles;
         }
     }
-    let fur = textureSampleLevel(fur_layers, fur_sampler, uv_geo, v.layer, 0.0);
+    let fur = fur_at(uv_geo, v.slice);
     if fur.a == 0.0 {
         discard;
     }
+    var alpha = fur.a;
+    if v.coverage != 1.0 {
+        alpha = 1.0 - pow(1.0 - alpha, v.coverage);
+    }
+    alpha *= v.fade;
     let color = textureSampleLevel(color_texture, color_sampler, uv_color, 0.0).rgb;
     // The strand tangent, leaning with the texel's own hair: its direction
     // in the texture plane (x along dP/du, y down the image, i.e. −v).
@@ -308,5 +363,131 @@ fn fs_layer(v: LayerOut) -> @location(0) vec4<f32> {
     let lean = (2.0 * fur.r - 1.0) * u - (2.0 * fur.g - 1.0) * cross(n, u);
     let t = normalize(normalize(v.tangent) + lean);
     let e = normalize(shell.eye - v.world);
-    return vec4<f32>(shade(color, fur.b, t, n, shell.light_dir, e, h), fur.a);
+    return vec4<f32>(shade(color, fur.b, t, n, shell.light_dir, e, h), alpha);
+}
+
+// ---- the fins (Lengyel et al. 2001) ----
+
+// Mirrors FinRecord in shells/fins.rs: the edge's two vertices.
+@group(2) @binding(0) var<storage, read> fins: array<vec2<u32>>;
+// PoseVertex, SurfaceVertex and TipOffset as storage: 9, 2 and 3 floats.
+@group(2) @binding(1) var<storage, read> pose: array<f32>;
+@group(2) @binding(2) var<storage, read> surface: array<vec2<f32>>;
+@group(2) @binding(3) var<storage, read> tips: array<f32>;
+
+fn pose_position(i: u32) -> vec3<f32> {
+    return vec3<f32>(pose[9u * i], pose[9u * i + 1u], pose[9u * i + 2u]) + shell.motion;
+}
+
+fn pose_normal(i: u32) -> vec3<f32> {
+    return normalize(vec3<f32>(pose[9u * i + 3u], pose[9u * i + 4u], pose[9u * i + 5u]));
+}
+
+fn tip_offset(i: u32) -> vec3<f32> {
+    return vec3<f32>(tips[3u * i], tips[3u * i + 1u], tips[3u * i + 2u]);
+}
+
+struct FinOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) uv: vec2<f32>,
+    // The strand's direction.
+    @location(2) tangent: vec3<f32>,
+    // Height up the fin, 0 at the skin.
+    @location(3) h: f32,
+    // Across the fin in texture units: a step between the parallel cuts.
+    @location(4) @interpolate(flat) across: vec2<f32>,
+    @location(5) @interpolate(flat) opacity: f32,
+};
+
+// How much of a fin shows (Lengyel et al. §4): fading in as the edge
+// comes edge-on (|n · e| below fin_width, n the smooth normal of the
+// edge's two vertices), and as the fin's own plane turns towards the eye
+// (a fin seen edge-on would draw a line).
+fn fin_visibility(n: vec3<f32>, along: vec3<f32>, e: vec3<f32>) -> f32 {
+    let edge_on = 1.0 - smoothstep(0.0, shell.fin_width, abs(dot(n, e)));
+    let plane = cross(along, n);
+    if dot(plane, plane) == 0.0 {
+        return 0.0;
+    }
+    let facing = smoothstep(0.3, 0.8, abs(dot(normalize(plane), e)));
+    return edge_on * facing;
+}
+
+@vertex
+fn vs_fin(@builtin(vertex_index) index: u32) -> FinOut {
+    let fin = fins[index / 6u];
+    // Two triangles: (a, b, b top), (a, b top, a top).
+    let corner = index % 6u;
+    let at_b = corner == 1u || corner == 2u || corner == 4u;
+    let top = corner == 2u || corner == 4u || corner == 5u;
+    let a = fin.x;
+    let b = fin.y;
+    var i = a;
+    if at_b {
+        i = b;
+    }
+    let middle = 0.5 * (pose_position(a) + pose_position(b));
+    let e = normalize(shell.eye - middle);
+    var edge_normal = pose_normal(a) + pose_normal(b);
+    if dot(edge_normal, edge_normal) == 0.0 {
+        edge_normal = pose_normal(a);
+    }
+    let edge = pose_position(b) - pose_position(a);
+    let visible = fin_visibility(normalize(edge_normal), edge, e) * shell.fin_opacity;
+    var out: FinOut;
+    if visible <= 0.0 {
+        // Outside the clip volume: the fin is not drawn.
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
+    }
+    let root = pose_position(i);
+    let n = pose_normal(i);
+    let rest_tip = root + shell.shell_length * n;
+    let tip = rest_tip + tip_offset(i);
+    let coupling = shell.coupling;
+    var h = 0.0;
+    if top {
+        h = 1.0;
+    }
+    out.world = root + coupled_offset(coupling, shell.coupling_exponent, root, rest_tip, tip, h);
+    out.clip = shell.view_proj * vec4<f32>(out.world, 1.0);
+    out.uv = surface[i];
+    out.tangent = coupled_tangent(coupling, shell.coupling_exponent, root, rest_tip, tip, 0.5);
+    out.h = h;
+    let along = (surface[b] - surface[a]) * shell.tiles;
+    let texel = 1.0 / f32(textureDimensions(fur_layers).x);
+    var across = vec2<f32>(-along.y, along.x);
+    if dot(across, across) > 0.0 {
+        across = normalize(across) * 3.0 * texel;
+    }
+    out.across = across;
+    out.opacity = visible;
+    return out;
+}
+
+@fragment
+fn fs_fin(v: FinOut) -> @location(0) vec4<f32> {
+    // A fin shows the fur seen side-on: four parallel vertical cuts
+    // through the blade volume, a few texels apart, over each other.
+    let layers = textureNumLayers(fur_layers);
+    let slice = clamp(v.h * f32(layers) - 1.0, 0.0, f32(layers - 1));
+    let uv = v.uv * shell.tiles;
+    var clear = 1.0;
+    var fur = vec4<f32>(0.0);
+    for (var k = 0; k < 4; k++) {
+        let sample = fur_at(uv + f32(k) * v.across, slice);
+        clear *= 1.0 - sample.a;
+        if sample.a > fur.a {
+            fur = sample;
+        }
+    }
+    let alpha = (1.0 - clear) * v.opacity;
+    if alpha <= 0.0 {
+        discard;
+    }
+    let color = textureSampleLevel(color_texture, color_sampler, v.uv, 0.0).rgb;
+    let t = normalize(v.tangent);
+    let e = normalize(shell.eye - v.world);
+    return vec4<f32>(shade(color, fur.b, t, t, shell.light_dir, e, v.h), alpha);
 }

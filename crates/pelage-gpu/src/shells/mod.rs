@@ -15,13 +15,14 @@
 //!   [`ShellTarget`] (the images drawn into);
 //! - `player.rs`: [`ShellScenePlayer`], a scene file drawn frame by frame.
 
+mod fins;
 mod model;
 mod player;
 mod renderer;
 
-pub use model::{ShellModel, ShellTarget, vertex_tangents};
+pub use model::{ShellModel, ShellTarget, ShellUpload, vertex_tangents};
 pub use player::ShellScenePlayer;
-pub use renderer::ShellRenderer;
+pub use renderer::{ShellRenderer, ShellTargetFormats};
 
 use crate::Camera;
 use crate::layout::{gpu_struct, gpu_vertex};
@@ -76,6 +77,111 @@ pub struct ShellParams {
     pub kajiya_kay: KajiyaKay,
     /// Behind the fur (linear RGB).
     pub background: [f32; 3],
+    /// Fins at the silhouette (Lengyel et al. 2001), if drawn.
+    pub fins: Option<FinParams>,
+    /// Level of detail by projected size, if on (else every layer, mip 0).
+    pub lod: Option<ShellLod>,
+}
+
+/// Fins: quads standing on the mesh's edges, textured with a vertical
+/// slice through the same blades as the layers, drawn where an edge is
+/// seen edge-on — where layers show as stacked lines.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FinParams {
+    /// Opacity of a fin seen exactly edge-on.
+    pub opacity: f32,
+    /// A fin fades out as `|n · e|` (edge normal, unit direction to the
+    /// eye) grows to this; silhouette edges (one face towards the eye, one
+    /// away) are drawn however far they are from edge-on.
+    pub width: f32,
+}
+
+impl Default for FinParams {
+    fn default() -> Self {
+        Self {
+            opacity: 1.0,
+            width: 0.3,
+        }
+    }
+}
+
+/// Level of detail: how many layers an object gets from its size on
+/// screen. The layers' spacing on screen (the fur length in pixels over
+/// the layer count) is the screen-space error: layers are dropped while
+/// they stay at most `max_gap_px` apart.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShellLod {
+    /// The largest spacing between layers on screen, in pixels.
+    pub max_gap_px: f32,
+    /// Never fewer layers than this.
+    pub min_layers: u32,
+}
+
+impl Default for ShellLod {
+    fn default() -> Self {
+        Self {
+            max_gap_px: 0.75,
+            min_layers: 4,
+        }
+    }
+}
+
+/// The level of detail an object is drawn at.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShellLevel {
+    /// Layers, continuous: ⌈layers⌉ are drawn, the innermost faded in by
+    /// the fraction, so a change of distance never pops a layer in or out.
+    pub layers: f32,
+    /// The fur texture's mip level.
+    pub mip: f32,
+    /// The fur length on screen, pixels.
+    pub fur_px: f32,
+}
+
+impl ShellLevel {
+    /// Every layer, mip 0.
+    pub fn full(layers: u32) -> Self {
+        Self {
+            layers: layers as f32,
+            mip: 0.0,
+            fur_px: f32::INFINITY,
+        }
+    }
+
+    /// Layers drawn: ⌈layers⌉.
+    pub fn drawn(&self) -> u32 {
+        self.layers.ceil() as u32
+    }
+}
+
+impl ShellLod {
+    /// The level for fur `fur_px` pixels long on screen, of `layers` at
+    /// most, its texture `texels` wide and repeated `tiles` times, the
+    /// object `object_px` wide on screen.
+    pub fn level(
+        &self,
+        layers: u32,
+        fur_px: f32,
+        texels: u32,
+        tiles: f32,
+        object_px: f32,
+    ) -> ShellLevel {
+        let most = layers as f32;
+        let least = (self.min_layers.max(1) as f32).min(most);
+        let wanted = fur_px / self.max_gap_px.max(1e-3);
+        // Texels across the object over pixels across it: the UV square
+        // wraps around the object, about half of it in view.
+        let texels_per_px = 0.5 * texels as f32 * tiles / object_px.max(1.0);
+        ShellLevel {
+            layers: if wanted.is_finite() {
+                wanted.clamp(least, most)
+            } else {
+                most
+            },
+            mip: texels_per_px.max(1.0).log2(),
+            fur_px,
+        }
+    }
 }
 
 /// Where the fur is seen from, and lit from.
@@ -90,6 +196,23 @@ pub struct ShellView {
 }
 
 impl ShellView {
+    /// How long `length` (world units) at `point` looks on screen, in
+    /// pixels of an image `height` pixels high, measured across the line
+    /// of sight.
+    pub fn projected_length(&self, point: Vec3, length: f32, height: f32) -> f32 {
+        let sight = (point - self.eye).normalize_or(Vec3::Z);
+        let across = sight.any_orthonormal_vector();
+        let ndc = |p: Vec3| {
+            let c = self.clip_from_world * p.extend(1.0);
+            (c.w > 1e-9).then(|| glam::Vec2::new(c.x, c.y) / c.w)
+        };
+        match (ndc(point), ndc(point + length * across)) {
+            (Some(a), Some(b)) => 0.5 * height * a.distance(b),
+            // Behind the eye: treat as huge, so nothing is dropped.
+            _ => f32::INFINITY,
+        }
+    }
+
     /// A perspective view through `camera` (framed on the mesh's bounds
     /// grown by the shell length when `None`), with a key light above and
     /// beside the camera unless `light` is given.
@@ -118,21 +241,28 @@ impl ShellView {
 }
 
 gpu_vertex! {
-    /// A skin vertex, one a triangle corner (`VertexIn` of `shells.wgsl`,
-    /// locations 0 to 3).
-    pub(crate) struct ShellVertex at location 0 {
+    /// Where a skin vertex is and how it is oriented (`VertexIn` of
+    /// `shells.wgsl`, locations 0 to 2): written once for a still mesh,
+    /// by the skinning pass (`skin.wgsl`) every frame for a skinned one.
+    pub(crate) struct PoseVertex at location 0 {
         position: [f32; 3],
         normal: [f32; 3],
-        /// Mask (image) coordinates: (u, 1 − v).
-        uv: [f32; 2],
         /// dP/du, the texture's x direction on the surface.
         tangent: [f32; 3],
     }
 }
 
 gpu_vertex! {
-    /// `p − p0`: how far a corner's strand tip has moved (0 at rest), from
-    /// a second buffer rewritten as the fur moves (location 4).
+    /// What does not move with the skin (location 3).
+    pub(crate) struct SurfaceVertex at location 3 {
+        /// Mask (image) coordinates: (u, 1 − v).
+        uv: [f32; 2],
+    }
+}
+
+gpu_vertex! {
+    /// `p − p0`: how far a vertex's strand tip has moved (0 at rest), from
+    /// a buffer rewritten as the fur moves (location 4).
     pub(crate) struct TipOffset at location 4 {
         tip_offset: [f32; 3],
     }
@@ -171,6 +301,15 @@ gpu_struct! {
         clump_strength: f32,
         /// The wetness mask's size in texels.
         wetness_size: [f32; 2],
+        /// L: the layers of this level of detail, continuous (N for full
+        /// detail); ⌈L⌉ are drawn, the innermost faded by L's fraction.
+        lod_layers: f32,
+        /// The fur texture's mip level for this object.
+        fur_mip: f32,
+        /// Fins: opacity at the silhouette (0: no fins).
+        fin_opacity: f32,
+        /// Fins: how far from edge-on (|n·e|) a fin fades out.
+        fin_width: f32,
         pad0: [f32; 2],
     }
 }
@@ -193,6 +332,14 @@ impl ShellParams {
             mode: scene.shading.mode,
             kajiya_kay: scene.shading.kajiya_kay,
             background: [0.62, 0.66, 0.72],
+            fins: scene.fins.map(|f| FinParams {
+                opacity: f.opacity,
+                width: f.width,
+            }),
+            lod: scene.lod.map(|l| ShellLod {
+                max_gap_px: l.max_gap_px,
+                min_layers: l.min_layers,
+            }),
         }
     }
 }

@@ -3,33 +3,68 @@
 //! texture and the wetness mask; and [`ShellTarget`], the images a frame
 //! is drawn into.
 
-use crate::renderer::{DEPTH_FORMAT, SAMPLES, check_size};
+use crate::renderer::check_size;
 use crate::{GpuContext, GpuError};
 use glam::Vec3;
 use pelage::Mesh;
 
 use super::ShellRenderer;
-use super::{ShellVertex, TipOffset};
+use super::{PoseVertex, SurfaceVertex, TipOffset};
+use pelage::anim::SkinRig;
 use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
 use wgpu::util::DeviceExt;
 
-/// A furry mesh on the GPU: skin vertices with their frames, the shell
-/// texture layers, the colour texture and the wetness mask.
+/// A furry mesh on the GPU: indexed skin vertices with their frames (posed
+/// every frame by the skinning pass for a skinned mesh), the shell texture
+/// layers with their mip chain, the colour texture, the wetness mask and
+/// the fins on its edges.
 #[derive(Debug)]
 pub struct ShellModel {
-    pub(super) vertices: wgpu::Buffer,
-    /// p − p0 per triangle corner; `GpuMassSpring` writes it in place.
+    /// [`PoseVertex`] per vertex: written once, or by the skinning pass.
+    pub(crate) pose: wgpu::Buffer,
+    /// [`SurfaceVertex`] per vertex.
+    pub(super) surface: wgpu::Buffer,
+    /// p − p0 per vertex; `GpuMassSpring` writes it in place.
     pub(crate) tip_offsets: wgpu::Buffer,
+    pub(super) indices: wgpu::Buffer,
+    pub(super) index_count: u32,
+    /// Vertices: triangle corners welded where the mesh vertex, its UV
+    /// and the stick it follows agree.
     pub(crate) vertex_count: u32,
+    /// Triangle corners of the mesh (3 × triangles).
+    pub(crate) corner_count: u32,
+    /// For each vertex, a triangle corner `3t + k` it stands for (CPU copy
+    /// and GPU buffer, which the dynamics' coupling pass reads).
+    pub(super) corners_of_vertices: Vec<u32>,
+    pub(crate) vertex_corners: wgpu::Buffer,
+    /// For each vertex, the mesh vertex it is.
+    pub(super) mesh_vertices: Vec<u32>,
+    /// Fins: their records and the bind group the fin pass reads them
+    /// (and the pose, UVs and tips) through; none on a mesh without
+    /// interior edges.
+    pub(super) fins: Option<(wgpu::BindGroup, u32)>,
+    /// The skinning pass's inputs, for a skinned mesh.
+    pub(super) skin: Option<GpuSkin>,
     pub(super) wetness: wgpu::Texture,
     pub(super) wetness_size: (u32, u32),
     pub(super) textures: wgpu::BindGroup,
     pub(super) layers: u32,
+    pub(super) texture_resolution: u32,
+    pub(super) mip_levels: u32,
     pub(super) bounds: (Vec3, Vec3),
 }
 
+/// A skinned model's rest frames, influences and palette on the GPU, and
+/// the bind group of the pass that poses it.
+#[derive(Debug)]
+pub(super) struct GpuSkin {
+    pub(super) palette: wgpu::Buffer,
+    pub(super) palette_len: usize,
+    pub(super) bind: wgpu::BindGroup,
+}
+
 impl ShellModel {
-    /// The skin's bounds.
+    /// The skin's bounds (at rest for a skinned mesh: the pose moves it).
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.bounds
     }
@@ -37,6 +72,55 @@ impl ShellModel {
     /// The number of layers in the shell texture.
     pub fn texture_layers(&self) -> u32 {
         self.layers
+    }
+
+    /// Vertices drawn per layer (after welding triangle corners).
+    pub fn vertex_count(&self) -> u32 {
+        self.vertex_count
+    }
+
+    /// Triangle corners of the mesh.
+    pub fn corner_count(&self) -> u32 {
+        self.corner_count
+    }
+
+    /// Fins on the mesh's edges.
+    pub fn fin_count(&self) -> u32 {
+        self.fins.as_ref().map_or(0, |f| f.1)
+    }
+
+    /// Whether the model is posed by a skin ([`ShellRenderer::pose`]).
+    pub fn is_skinned(&self) -> bool {
+        self.skin.is_some()
+    }
+
+    /// For each vertex, the mesh vertex it was welded from.
+    pub fn mesh_vertices(&self) -> &[u32] {
+        &self.mesh_vertices
+    }
+
+    /// Every vertex's position, normal and tangent as the GPU has them
+    /// now (after the skinning pass of a skinned model), read back — in
+    /// the model's vertex order ([`Self::mesh_vertices`] maps them).
+    pub fn read_pose(&self, ctx: &GpuContext) -> Result<pelage::anim::PosedFrames, GpuError> {
+        let size = self.pose.size();
+        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shell pose readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.pose, 0, &readback, 0, size);
+        ctx.queue.submit([encoder.finish()]);
+        crate::readback::map_read(ctx, &readback, |mapped| {
+            let vertices: &[PoseVertex] = bytemuck::cast_slice(mapped);
+            pelage::anim::PosedFrames {
+                positions: vertices.iter().map(|v| Vec3::from(v.position)).collect(),
+                normals: vertices.iter().map(|v| Vec3::from(v.normal)).collect(),
+                tangents: vertices.iter().map(|v| Vec3::from(v.tangent)).collect(),
+            }
+        })
     }
 }
 
@@ -75,10 +159,11 @@ impl ShellTarget {
             })
         };
         let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let formats = renderer.formats;
         Ok(Self {
-            color: texture(SAMPLES, renderer.format, attach).create_view(&Default::default()),
-            depth: texture(SAMPLES, DEPTH_FORMAT, attach).create_view(&Default::default()),
-            resolved: texture(1, renderer.format, attach | wgpu::TextureUsages::COPY_SRC),
+            color: texture(formats.samples, formats.color, attach).create_view(&Default::default()),
+            depth: texture(formats.samples, formats.depth, attach).create_view(&Default::default()),
+            resolved: texture(1, formats.color, attach | wgpu::TextureUsages::COPY_SRC),
             size: (width, height),
         })
     }
@@ -89,11 +174,21 @@ impl ShellTarget {
     }
 }
 
+/// How a mesh is uploaded ([`ShellRenderer::upload_with`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ShellUpload<'a> {
+    /// Skinning: the mesh is then the rig's rest pose, and
+    /// [`ShellRenderer::pose`] poses it each frame.
+    pub rig: Option<&'a SkinRig>,
+    /// One vertex per triangle corner, never welded: for fur whose
+    /// sticks stand per corner or per triangle (the separable topologies,
+    /// Silva strands), whose layers part at every edge.
+    pub per_corner: bool,
+}
+
 impl ShellRenderer {
-    /// Copies a furry mesh to the GPU: one vertex per triangle corner (UVs
-    /// may be per corner) with its strand frame, the shell layers, the
-    /// colour texture (sRGB) and a dry wetness mask of `mask_size`².
-    /// Meshes without UVs are refused: the fur is textured by UV.
+    /// Copies a furry mesh to the GPU ([`Self::upload_with`], still and
+    /// welded).
     pub fn upload(
         &self,
         ctx: &GpuContext,
@@ -102,53 +197,109 @@ impl ShellRenderer {
         textures: &ShellTextures,
         mask_size: u32,
     ) -> Result<ShellModel, GpuError> {
+        self.upload_with(
+            ctx,
+            mesh,
+            color,
+            textures,
+            mask_size,
+            ShellUpload::default(),
+        )
+    }
+
+    /// Copies a furry mesh to the GPU: its triangle corners welded into
+    /// indexed vertices wherever vertex and UV agree (a UV seam keeps two),
+    /// each with its strand frame; the shell layers with a mip chain; the
+    /// colour texture (sRGB); a dry wetness mask of `mask_size`²; the fins
+    /// on its edges; and, with a rig, what the skinning pass reads.
+    /// Meshes without UVs are refused: the fur is textured by UV.
+    pub fn upload_with(
+        &self,
+        ctx: &GpuContext,
+        mesh: &Mesh,
+        color: &image::RgbaImage,
+        textures: &ShellTextures,
+        mask_size: u32,
+        options: ShellUpload<'_>,
+    ) -> Result<ShellModel, GpuError> {
         if !mesh.has_uvs() {
             return Err(GpuError::NoUvs(mesh.name().to_string()));
         }
-        let device = &ctx.device;
-        let tangents = vertex_tangents(mesh);
-        let mut vertices = Vec::with_capacity(mesh.triangle_count() * 3);
-        for t in 0..mesh.triangle_count() {
-            let uvs = mesh.triangle_uvs(t).expect("checked: the mesh has UVs");
-            for (k, &v) in mesh.triangles()[t].iter().enumerate() {
-                let (p, n, u) = (
-                    mesh.positions()[v as usize],
-                    mesh.normals()[v as usize],
-                    tangents[v as usize],
-                );
-                let uv = pelage::shell::wetness::mask_coordinates(uvs[k]);
-                vertices.push(ShellVertex {
-                    position: p.to_array(),
-                    normal: n.to_array(),
-                    uv: uv.to_array(),
-                    tangent: u.to_array(),
-                });
-            }
+        if let Some(rig) = options.rig
+            && rig.vertex_count() != mesh.vertex_count()
+        {
+            return Err(GpuError::Mismatch(format!(
+                "a rig of {} vertices for a mesh of {}",
+                rig.vertex_count(),
+                mesh.vertex_count()
+            )));
         }
-        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("shell skin"),
-            contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-        let tip_offsets = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("shell tip offsets"),
-            contents: bytemuck::cast_slice(&vec![TipOffset::default(); mesh.triangle_count() * 3]),
-            usage: wgpu::BufferUsages::VERTEX
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::STORAGE,
-        });
+        let device = &ctx.device;
+        let welded = WeldedCorners::new(mesh, options.per_corner);
+        let tangents = vertex_tangents(mesh);
+        let pose: Vec<PoseVertex> = welded
+            .mesh_vertices
+            .iter()
+            .map(|&v| PoseVertex {
+                position: mesh.positions()[v as usize].to_array(),
+                normal: mesh.normals()[v as usize].to_array(),
+                tangent: tangents[v as usize].to_array(),
+            })
+            .collect();
+        let surface: Vec<SurfaceVertex> = welded
+            .uvs
+            .iter()
+            .map(|&uv| SurfaceVertex {
+                uv: pelage::shell::wetness::mask_coordinates(uv).to_array(),
+            })
+            .collect();
+        let storage = wgpu::BufferUsages::STORAGE;
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let pose_usage = wgpu::BufferUsages::VERTEX
+            | storage
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC;
+        let pose_buffer = buffer("shell pose", bytemuck::cast_slice(&pose), pose_usage);
+        let surface_buffer = buffer(
+            "shell surface",
+            bytemuck::cast_slice(&surface),
+            wgpu::BufferUsages::VERTEX | storage,
+        );
+        let vertex_count = welded.mesh_vertices.len();
+        let tip_offsets = buffer(
+            "shell tip offsets",
+            bytemuck::cast_slice(&vec![TipOffset::default(); vertex_count]),
+            wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST | storage,
+        );
+        let indices = buffer(
+            "shell indices",
+            bytemuck::cast_slice(&welded.indices),
+            wgpu::BufferUsages::INDEX,
+        );
+        let vertex_corners = buffer(
+            "shell vertex corners",
+            bytemuck::cast_slice(&welded.corners),
+            storage,
+        );
+
         let size = |w, h, layers| wgpu::Extent3d {
             width: w,
             height: h,
             depth_or_array_layers: layers,
         };
-        let texture = |label, extent, format, data: &[u8]| {
+        let texture = |label, extent, format, data: &[u8], mips: u32| {
             device.create_texture_with_data(
                 &ctx.queue,
                 &wgpu::TextureDescriptor {
                     label: Some(label),
                     size: extent,
-                    mip_level_count: 1,
+                    mip_level_count: mips,
                     sample_count: 1,
                     dimension: wgpu::TextureDimension::D2,
                     format,
@@ -160,17 +311,20 @@ impl ShellRenderer {
             )
         };
         let r = textures.resolution();
+        let (mip_data, mip_levels) = fur_mip_chain(textures);
         let fur = texture(
             "shell layers",
             size(r, r, textures.layers()),
             wgpu::TextureFormat::Rgba8Unorm,
-            bytemuck::cast_slice(textures.texels()),
+            &mip_data,
+            mip_levels,
         );
         let color_texture = texture(
             "fur colour",
             size(color.width(), color.height(), 1),
             wgpu::TextureFormat::Rgba8UnormSrgb,
             color.as_raw(),
+            1,
         );
         let mask_size = mask_size.max(1);
         let dry = WetnessMask::dry_mask(mask_size, mask_size);
@@ -179,6 +333,7 @@ impl ShellRenderer {
             size(mask_size, mask_size, 1),
             wgpu::TextureFormat::Rgba32Float,
             bytemuck::cast_slice(&dry.to_rgba()),
+            1,
         );
         let fur_view = fur.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -212,32 +367,126 @@ impl ShellRenderer {
                 },
             ],
         });
+
+        let fin_records = super::fins::fin_records(mesh, &welded);
+        let fins = (!fin_records.is_empty()).then(|| {
+            let records = buffer("shell fins", bytemuck::cast_slice(&fin_records), storage);
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shell fins"),
+                layout: &self.fin_layout,
+                entries: &[
+                    (0, &records),
+                    (1, &pose_buffer),
+                    (2, &surface_buffer),
+                    (3, &tip_offsets),
+                ]
+                .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: buffer.as_entire_binding(),
+                }),
+            });
+            (group, fin_records.len() as u32)
+        });
+
+        let skin = options.rig.map(|rig| {
+            let rest = buffer("shell rest pose", bytemuck::cast_slice(&pose), storage);
+            let influences: Vec<[u32; 8]> = welded
+                .mesh_vertices
+                .iter()
+                .map(|&v| {
+                    let i = rig.influences()[v as usize];
+                    let w = i.weights.map(f32::to_bits);
+                    [
+                        i.joints[0],
+                        i.joints[1],
+                        i.joints[2],
+                        i.joints[3],
+                        w[0],
+                        w[1],
+                        w[2],
+                        w[3],
+                    ]
+                })
+                .collect();
+            let influences = buffer(
+                "shell skin influences",
+                bytemuck::cast_slice(&influences),
+                storage,
+            );
+            let palette = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shell skin palette"),
+                size: (64 * rig.palette_len().max(1)) as u64,
+                usage: storage | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shell skinning"),
+                layout: &self.skin_layout,
+                entries: &[
+                    (0, &palette),
+                    (1, &rest),
+                    (2, &influences),
+                    (3, &pose_buffer),
+                ]
+                .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: buffer.as_entire_binding(),
+                }),
+            });
+            GpuSkin {
+                palette,
+                palette_len: rig.palette_len(),
+                bind,
+            }
+        });
+
         Ok(ShellModel {
-            vertices: vertex_buffer,
+            pose: pose_buffer,
+            surface: surface_buffer,
             tip_offsets,
-            vertex_count: (mesh.triangle_count() * 3) as u32,
+            indices,
+            index_count: welded.indices.len() as u32,
+            vertex_count: vertex_count as u32,
+            corner_count: (mesh.triangle_count() * 3) as u32,
+            corners_of_vertices: welded.corners,
+            mesh_vertices: welded.mesh_vertices,
+            vertex_corners,
+            fins,
+            skin,
             wetness,
             wetness_size: (mask_size, mask_size),
             textures: bind,
             layers: textures.layers(),
+            texture_resolution: r,
+            mip_levels,
             bounds: mesh.bounds(),
         })
     }
 
     /// Generates a scene's shell texture and uploads the scene
-    /// ([`Self::upload`] with the scene's mesh, colour and mask size).
+    /// ([`Self::upload_with`] with the scene's mesh — its rest pose and
+    /// rig when skinned —, colour and mask size; per corner when its
+    /// dynamics' sticks are).
     pub fn upload_scene(
         &self,
         ctx: &GpuContext,
         scene: &ShellScene,
     ) -> Result<ShellModel, GpuError> {
         let textures = ShellTextures::generate(&scene.texture);
-        self.upload(
+        let per_corner = scene.dynamics.as_ref().is_some_and(|d| {
+            d.topology.is_per_corner() || d.topology == pelage::dynamics::Topology::SilvaStrands
+        });
+        let (mesh, rig) = match &scene.animation {
+            Some(a) => (a.rest_mesh(), Some(a.rig())),
+            None => (&scene.mesh, None),
+        };
+        self.upload_with(
             ctx,
-            &scene.mesh,
+            mesh,
             &scene.color,
             &textures,
             scene.wetness_resolution,
+            ShellUpload { rig, per_corner },
         )
     }
 
@@ -250,17 +499,18 @@ impl ShellRenderer {
         model: &ShellModel,
         offsets: &[Vec3],
     ) -> Result<(), GpuError> {
-        if offsets.len() != model.vertex_count as usize {
+        if offsets.len() != model.corner_count as usize {
             return Err(GpuError::Mismatch(format!(
                 "{} tip offsets for a model with {} triangle corners",
                 offsets.len(),
-                model.vertex_count
+                model.corner_count
             )));
         }
-        let tips: Vec<TipOffset> = offsets
+        let tips: Vec<TipOffset> = model
+            .corners_of_vertices
             .iter()
-            .map(|o| TipOffset {
-                tip_offset: o.to_array(),
+            .map(|&c| TipOffset {
+                tip_offset: offsets[c as usize].to_array(),
             })
             .collect();
         ctx.queue
@@ -338,4 +588,116 @@ pub fn vertex_tangents(mesh: &Mesh) -> Vec<Vec3> {
                 .unwrap_or_else(|| n.any_orthonormal_vector())
         })
         .collect()
+}
+
+/// A mesh's triangle corners welded into indexed vertices.
+#[derive(Debug)]
+pub(super) struct WeldedCorners {
+    /// Per vertex: the mesh vertex, its UV and a corner `3t + k` it
+    /// stands for.
+    pub(super) mesh_vertices: Vec<u32>,
+    pub(super) uvs: Vec<glam::Vec2>,
+    pub(super) corners: Vec<u32>,
+    /// Three per triangle.
+    pub(super) indices: Vec<u32>,
+}
+
+impl WeldedCorners {
+    /// Corners that share a mesh vertex and a UV become one vertex (all of
+    /// them, on a mesh with UVs per vertex); `per_corner` keeps every
+    /// corner its own.
+    pub(super) fn new(mesh: &Mesh, per_corner: bool) -> Self {
+        let corners = mesh.triangle_count() * 3;
+        let mut out = Self {
+            mesh_vertices: Vec::new(),
+            uvs: Vec::new(),
+            corners: Vec::new(),
+            indices: Vec::with_capacity(corners),
+        };
+        let mut index: std::collections::HashMap<(u32, [u32; 2]), u32> =
+            std::collections::HashMap::with_capacity(if per_corner { 0 } else { corners / 2 });
+        for t in 0..mesh.triangle_count() {
+            let uvs = mesh.triangle_uvs(t).expect("checked: the mesh has UVs");
+            for (k, &v) in mesh.triangles()[t].iter().enumerate() {
+                let corner = (3 * t + k) as u32;
+                let add = |out: &mut Self| {
+                    out.mesh_vertices.push(v);
+                    out.uvs.push(uvs[k]);
+                    out.corners.push(corner);
+                    out.mesh_vertices.len() as u32 - 1
+                };
+                let i = if per_corner {
+                    add(&mut out)
+                } else {
+                    let key = (v, uvs[k].to_array().map(f32::to_bits));
+                    match index.get(&key) {
+                        Some(&i) => i,
+                        None => {
+                            let i = add(&mut out);
+                            index.insert(key, i);
+                            i
+                        }
+                    }
+                };
+                out.indices.push(i);
+            }
+        }
+        out
+    }
+}
+
+/// The shell texture's layers with a mip chain, layer by layer, each
+/// layer's levels in turn (wgpu's layer-major order): each
+/// level a box filter of the one above, colour weighted by alpha (a
+/// transparent texel's direction must not leak into its neighbours).
+fn fur_mip_chain(textures: &ShellTextures) -> (Vec<u8>, u32) {
+    let r = textures.resolution() as usize;
+    let layers = textures.layers() as usize;
+    let levels = (usize::BITS - r.leading_zeros()) as usize;
+    let texels: &[u8] = bytemuck::cast_slice(textures.texels());
+    let mut per_layer: Vec<Vec<Vec<u8>>> = (0..layers)
+        .map(|l| vec![texels[l * r * r * 4..(l + 1) * r * r * 4].to_vec()])
+        .collect();
+    for chain in &mut per_layer {
+        let mut size = r;
+        while size > 1 {
+            let half = size / 2;
+            let above = chain.last().expect("level 0 is there");
+            let mut next = vec![0u8; half * half * 4];
+            for y in 0..half {
+                for x in 0..half {
+                    let mut rgb = [0.0f32; 3];
+                    let mut alpha = 0.0f32;
+                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                        let i = ((2 * y + dy) * size + 2 * x + dx) * 4;
+                        let a = f32::from(above[i + 3]);
+                        for c in 0..3 {
+                            rgb[c] += a * f32::from(above[i + c]);
+                        }
+                        alpha += a;
+                    }
+                    let o = (y * half + x) * 4;
+                    for c in 0..3 {
+                        next[o + c] = if alpha > 0.0 {
+                            (rgb[c] / alpha).round() as u8
+                        } else {
+                            128
+                        };
+                    }
+                    next[o + 3] = (alpha / 4.0).round() as u8;
+                }
+            }
+            chain.push(next);
+            size = half;
+        }
+    }
+    // A texture that is not a power of two gets what levels halving gives.
+    let levels = levels.min(per_layer.first().map_or(1, Vec::len));
+    let mut data = Vec::new();
+    for chain in &per_layer {
+        for level in chain.iter().take(levels) {
+            data.extend_from_slice(level);
+        }
+    }
+    (data, levels as u32)
 }

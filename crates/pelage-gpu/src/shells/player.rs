@@ -1,6 +1,6 @@
 //! [`ShellScenePlayer`]: a shell scene file drawn frame by frame.
 
-use crate::{Camera, FurMotion, GpuContext, GpuError};
+use crate::{Camera, FurMotion, GpuContext, GpuError, SkinMotion};
 use glam::Vec3;
 
 use super::{ShellFeatures, ShellModel, ShellParams, ShellRenderer, ShellTarget, ShellView};
@@ -38,7 +38,10 @@ impl<'s> ShellScenePlayer<'s> {
             clump: scene.clump.is_some(),
         };
         let renderer = ShellRenderer::new(ctx, features);
-        let model = renderer.upload_scene(ctx, scene)?;
+        let mut model = renderer.upload_scene(ctx, scene)?;
+        // A skinned model is uploaded in its bind pose; the level of detail
+        // measures it where it stands.
+        model.bounds = scene.mesh.bounds();
         let target = ShellTarget::new(ctx, &renderer, width, height)?;
         let camera = scene.camera.map(|c| {
             let (lo, hi) = scene.mesh.bounds();
@@ -68,7 +71,8 @@ impl<'s> ShellScenePlayer<'s> {
     }
 
     /// Runs the scene's mass-spring system up to `time`, in steps of
-    /// `1 / (fps · steps_per_frame)`, moving the skin as the shake says.
+    /// `1 / (fps · steps_per_frame)`, the skin posed by its animation at
+    /// each step and moved as the shake says.
     fn simulate_to(&mut self, ctx: &GpuContext, time: f32) -> Result<(), GpuError> {
         let (Some(motion), Some(settings)) = (&mut self.motion, &self.scene.dynamics) else {
             return Ok(());
@@ -76,8 +80,19 @@ impl<'s> ShellScenePlayer<'s> {
         let dt = 1.0 / (self.scene.fps * settings.steps_per_frame as f32);
         let shake = |t: f32| settings.shake.map_or(Vec3::ZERO, |s| s.offset(t));
         while motion.time() + 0.5 * dt < time {
-            let offset = shake(motion.time() + dt);
-            motion.step(ctx, dt, offset, settings)?;
+            let t = motion.time() + dt;
+            match &self.scene.animation {
+                Some(animation) => {
+                    let posed = animation.posed(t);
+                    let skin = SkinMotion::Posed {
+                        positions: &posed.positions,
+                        normals: &posed.normals,
+                        offset: shake(t),
+                    };
+                    motion.step(ctx, dt, skin, settings)?;
+                }
+                None => motion.step(ctx, dt, SkinMotion::Offset(shake(t)), settings)?,
+            }
         }
         self.params.coupling = settings.coupling;
         self.params.offset = shake(motion.time());
@@ -86,6 +101,10 @@ impl<'s> ShellScenePlayer<'s> {
 
     /// The frame at `time` seconds (not before the last one drawn).
     pub fn render_at(&mut self, ctx: &GpuContext, time: f32) -> Result<image::RgbaImage, GpuError> {
+        if let Some(animation) = &self.scene.animation {
+            self.renderer
+                .pose_now(ctx, &self.model, &animation.palette_at(time))?;
+        }
         self.simulate_to(ctx, time)?;
         let mask = self.timeline.advance_to(time);
         self.renderer.set_wetness(ctx, &self.model, mask)?;

@@ -1,25 +1,60 @@
 //! [`ShellRenderer`]: the pipelines (specialised per [`ShellFeatures`]) and
-//! the frame they record: the skin once with depth write, then the N
-//! layers in one instanced draw.
+//! what they record: the skinning pass of a skinned model, then the skin
+//! once with depth write, the layers in one instanced indexed draw and the
+//! fins. [`ShellRenderer::record`] records into a render pass of the
+//! caller's (docs/embedding.md); [`ShellRenderer::draw`] and
+//! [`ShellRenderer::render`] into pelage's own [`ShellTarget`].
 
 use crate::layout::UniformRing;
 use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES};
 use crate::{GpuContext, GpuError};
+use glam::Mat4;
 
 use super::model::{ShellModel, ShellTarget};
-use super::{ShellFeatures, ShellParams, ShellUniforms, ShellVertex, ShellView, TipOffset};
+use super::{
+    PoseVertex, ShellFeatures, ShellLevel, ShellParams, ShellUniforms, ShellView, SurfaceVertex,
+    TipOffset,
+};
+
+/// The render targets a [`ShellRenderer`]'s pipelines draw into: the
+/// caller's colour format (use an sRGB one: the shaders write linear
+/// colour), depth format and sample count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShellTargetFormats {
+    /// Colour attachment format.
+    pub color: wgpu::TextureFormat,
+    /// Depth attachment format (the skin writes depth, the fur tests it).
+    pub depth: wgpu::TextureFormat,
+    /// Samples per pixel of both.
+    pub samples: u32,
+}
+
+impl ShellTargetFormats {
+    /// pelage's own: `format`, 32-bit float depth, 4× multisampling.
+    pub fn pelage(color: wgpu::TextureFormat) -> Self {
+        Self {
+            color,
+            depth: DEPTH_FORMAT,
+            samples: SAMPLES,
+        }
+    }
+}
 
 /// Draws shell fur. Build once per feature set, draw many frames.
 #[derive(Debug)]
 pub struct ShellRenderer {
-    /// The frame's [`ShellUniforms`], made once, rewritten for each frame.
+    /// The frame's [`ShellUniforms`], made once, rewritten for each draw.
     pub(super) uniforms: UniformRing<ShellUniforms>,
     pub(super) texture_layout: wgpu::BindGroupLayout,
+    pub(super) fin_layout: wgpu::BindGroupLayout,
+    pub(super) skin_layout: wgpu::BindGroupLayout,
     pub(super) fur_sampler: wgpu::Sampler,
     pub(super) color_sampler: wgpu::Sampler,
     pub(super) skin_pipeline: wgpu::RenderPipeline,
     pub(super) layer_pipeline: wgpu::RenderPipeline,
-    pub(super) format: wgpu::TextureFormat,
+    pub(super) fin_pipeline: wgpu::RenderPipeline,
+    pub(super) skinning: wgpu::ComputePipeline,
+    pub(super) formats: ShellTargetFormats,
     pub(super) features: ShellFeatures,
 }
 
@@ -29,19 +64,26 @@ impl ShellRenderer {
         Self::for_format(ctx, COLOR_FORMAT, features)
     }
 
-    /// Pipelines for targets of `format` (use an sRGB format).
+    /// Pipelines for targets of `format` (use an sRGB format) with
+    /// pelage's depth format and multisampling ([`ShellTarget`]).
     pub fn for_format(
         ctx: &GpuContext,
         format: wgpu::TextureFormat,
         features: ShellFeatures,
     ) -> Self {
-        let device = &ctx.device;
-        let uniform_layout = UniformRing::<ShellUniforms>::layout(
-            device,
-            "shell uniforms",
-            wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
-        );
+        Self::for_targets(&ctx.device, ShellTargetFormats::pelage(format), features)
+    }
+
+    /// Pipelines for the caller's render targets, on the caller's device:
+    /// what an engine embedding pelage's shells builds once
+    /// (docs/embedding.md).
+    pub fn for_targets(
+        device: &wgpu::Device,
+        formats: ShellTargetFormats,
+        features: ShellFeatures,
+    ) -> Self {
         let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let uniform_layout = UniformRing::<ShellUniforms>::layout(device, "shell uniforms", both);
         let texture_entry = |binding, dimension, filterable| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: both,
@@ -68,21 +110,59 @@ impl ShellRenderer {
                 texture_entry(4, wgpu::TextureViewDimension::D2, false),
             ],
         });
-        let sampler = |mode| {
+        let storage_entry = |binding, visibility, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let vertex = wgpu::ShaderStages::VERTEX;
+        let fin_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shell fins"),
+            entries: &[0, 1, 2, 3].map(|b| storage_entry(b, vertex, true)),
+        });
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let skin_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shell skinning"),
+            entries: &[
+                storage_entry(0, compute, true),
+                storage_entry(1, compute, true),
+                storage_entry(2, compute, true),
+                storage_entry(3, compute, false),
+            ],
+        });
+        let sampler = |mode, mips| {
             device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("shell"),
                 address_mode_u: mode,
                 address_mode_v: mode,
                 mag_filter: wgpu::FilterMode::Linear,
                 min_filter: wgpu::FilterMode::Linear,
+                mipmap_filter: mips,
                 ..Default::default()
             })
         };
-        let fur_sampler = sampler(wgpu::AddressMode::Repeat);
-        let color_sampler = sampler(wgpu::AddressMode::ClampToEdge);
+        let fur_sampler = sampler(wgpu::AddressMode::Repeat, wgpu::MipmapFilterMode::Linear);
+        let color_sampler = sampler(
+            wgpu::AddressMode::ClampToEdge,
+            wgpu::MipmapFilterMode::Nearest,
+        );
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shells"),
             bind_group_layouts: &[Some(&uniform_layout), Some(&texture_layout)],
+            immediate_size: 0,
+        });
+        let fin_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shell fins"),
+            bind_group_layouts: &[
+                Some(&uniform_layout),
+                Some(&texture_layout),
+                Some(&fin_layout),
+            ],
             immediate_size: 0,
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -93,22 +173,41 @@ impl ShellRenderer {
             ("CURL", f64::from(u8::from(features.curl))),
             ("CLUMP", f64::from(u8::from(features.clump))),
         ];
-        let pipeline = |vs: &str, fs: &str, layers: bool| {
+        let vertex_buffers = [
+            Some(PoseVertex::layout(wgpu::VertexStepMode::Vertex)),
+            Some(SurfaceVertex::layout(wgpu::VertexStepMode::Vertex)),
+            Some(TipOffset::layout(wgpu::VertexStepMode::Vertex)),
+        ];
+        #[derive(PartialEq)]
+        enum Kind {
+            Skin,
+            Layers,
+            Fins,
+        }
+        let pipeline = |kind: Kind| {
             let compilation_options = wgpu::PipelineCompilationOptions {
                 constants: &constants,
                 ..Default::default()
             };
+            let (label, vs, fs, layout, buffers): (_, _, _, _, &[_]) = match kind {
+                Kind::Skin => ("shell skin", "vs_skin", "fs_skin", &layout, &vertex_buffers),
+                Kind::Layers => (
+                    "shell layers",
+                    "vs_layer",
+                    "fs_layer",
+                    &layout,
+                    &vertex_buffers,
+                ),
+                Kind::Fins => ("shell fins", "vs_fin", "fs_fin", &fin_pipeline_layout, &[]),
+            };
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(if layers { "shell layers" } else { "shell skin" }),
-                layout: Some(&layout),
+                label: Some(label),
+                layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module: &module,
                     entry_point: Some(vs),
                     compilation_options: compilation_options.clone(),
-                    buffers: &[
-                        Some(ShellVertex::layout(wgpu::VertexStepMode::Vertex)),
-                        Some(TipOffset::layout(wgpu::VertexStepMode::Vertex)),
-                    ],
+                    buffers,
                 },
                 primitive: wgpu::PrimitiveState {
                     topology: wgpu::PrimitiveTopology::TriangleList,
@@ -116,14 +215,14 @@ impl ShellRenderer {
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(!layers),
+                    format: formats.depth,
+                    depth_write_enabled: Some(kind == Kind::Skin),
                     depth_compare: Some(wgpu::CompareFunction::Less),
                     stencil: Default::default(),
                     bias: Default::default(),
                 }),
                 multisample: wgpu::MultisampleState {
-                    count: SAMPLES,
+                    count: formats.samples,
                     mask: !0,
                     alpha_to_coverage_enabled: false,
                 },
@@ -132,8 +231,8 @@ impl ShellRenderer {
                     entry_point: Some(fs),
                     compilation_options,
                     targets: &[Some(wgpu::ColorTargetState {
-                        format,
-                        blend: layers.then_some(wgpu::BlendState::ALPHA_BLENDING),
+                        format: formats.color,
+                        blend: (kind != Kind::Skin).then_some(wgpu::BlendState::ALPHA_BLENDING),
                         write_mask: wgpu::ColorWrites::ALL,
                     })],
                 }),
@@ -141,15 +240,37 @@ impl ShellRenderer {
                 cache: None,
             })
         };
+        let skin_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("skin.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(crate::shader_source("skin.wgsl").into()),
+        });
+        let skinning = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("shell skinning"),
+            layout: Some(
+                &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("shell skinning"),
+                    bind_group_layouts: &[Some(&skin_layout)],
+                    immediate_size: 0,
+                }),
+            ),
+            module: &skin_module,
+            entry_point: Some("skin"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
         let uniforms = UniformRing::new(device, "shell uniforms", &uniform_layout);
         Self {
-            skin_pipeline: pipeline("vs_skin", "fs_skin", false),
-            layer_pipeline: pipeline("vs_layer", "fs_layer", true),
+            skin_pipeline: pipeline(Kind::Skin),
+            layer_pipeline: pipeline(Kind::Layers),
+            fin_pipeline: pipeline(Kind::Fins),
+            skinning,
             uniforms,
             texture_layout,
+            fin_layout,
+            skin_layout,
             fur_sampler,
             color_sampler,
-            format,
+            formats,
             features,
         }
     }
@@ -161,13 +282,18 @@ impl ShellRenderer {
 
     /// The colour format it draws into.
     pub fn format(&self) -> wgpu::TextureFormat {
-        self.format
+        self.formats.color
+    }
+
+    /// The targets it draws into.
+    pub fn target_formats(&self) -> ShellTargetFormats {
+        self.formats
     }
 }
 
 impl ShellRenderer {
     /// Draws one frame into `target` and waits for the GPU to finish (the
-    /// benchmark times this); read the image with [`read`](Self::read).
+    /// benchmark times this); read the image with [`render`](Self::render).
     pub fn draw(
         &self,
         ctx: &GpuContext,
@@ -201,9 +327,10 @@ impl ShellRenderer {
         crate::readback::read_texture(ctx, encoder, &target.resolved)
     }
 
-    /// Records a frame: the skin, then the layers, resolved into
-    /// `resolve` (a view of `target`'s size: the target's own resolve
-    /// texture, or a window's surface texture).
+    /// Records a frame into pelage's own `target`: a pass cleared to the
+    /// background with [`Self::record`] in it, resolved into `resolve` (a
+    /// view of `target`'s size: the target's own resolve texture, or a
+    /// window's surface texture).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -214,37 +341,27 @@ impl ShellRenderer {
         view: &ShellView,
         target: &ShellTarget,
         resolve: &wgpu::TextureView,
-    ) -> Result<(), GpuError> {
-        if params.layers > model.layers {
-            return Err(GpuError::Mismatch(format!(
-                "{} layers drawn from a shell texture of {}",
-                params.layers, model.layers
-            )));
-        }
-        let k = params.kajiya_kay;
-        let uniforms = ShellUniforms {
-            view_proj: view.clip_from_world.to_cols_array_2d(),
-            eye: view.eye.to_array(),
-            shell_length: params.length,
-            light_dir: view.light.normalize().to_array(),
-            layers: params.layers,
-            specular: k.specular.to_array(),
-            specular_exponent: k.exponent,
-            motion: params.offset.to_array(),
-            coupling_exponent: params.coupling.exponent(),
-            tiles: params.tiles,
-            k_shadow: k.k_shadow,
-            curl_radius: params.curl.radius,
-            curl_frequency: params.curl.frequency,
-            shading_mode: params.mode.index(),
-            coupling: params.coupling.index(),
-            clump_w: params.clump.w,
-            clump_strength: params.clump.strength,
-            wetness_size: [model.wetness_size.0 as f32, model.wetness_size.1 as f32],
-            pad0: [0.0; 2],
-        };
-        let uniform_offset = self.uniforms.write(&ctx.queue, &uniforms);
-        let [r, g, b] = params.background.map(f64::from);
+    ) -> Result<ShellLevel, GpuError> {
+        self.encode_all(ctx, encoder, &[(model, *params)], view, target, resolve)
+    }
+
+    /// [`Self::encode`] for several objects (a crowd) in one pass, each
+    /// with its own parameters (its `offset` places it); the levels of
+    /// detail chosen, one an object.
+    pub fn encode_all(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        objects: &[(&ShellModel, ShellParams)],
+        view: &ShellView,
+        target: &ShellTarget,
+        resolve: &wgpu::TextureView,
+    ) -> Result<ShellLevel, GpuError> {
+        let background = objects
+            .first()
+            .map_or([0.0; 3], |(_, p)| p.background)
+            .map(f64::from);
+        let [r, g, b] = background;
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("shells"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -268,14 +385,157 @@ impl ShellRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        let height = target.size.1 as f32;
+        let mut level = ShellLevel::full(0);
+        for (model, params) in objects {
+            level = self.record(&ctx.queue, &mut pass, model, params, view, height)?;
+        }
+        Ok(level)
+    }
+
+    /// The level of detail `model` is drawn at with `params` from `view`,
+    /// in an image `height` pixels high.
+    pub fn level(
+        &self,
+        model: &ShellModel,
+        params: &ShellParams,
+        view: &ShellView,
+        height: f32,
+    ) -> ShellLevel {
+        let Some(lod) = params.lod else {
+            return ShellLevel::full(params.layers);
+        };
+        let (lo, hi) = model.bounds;
+        let centre = 0.5 * (lo + hi) + params.offset;
+        let fur_px = view.projected_length(centre, params.length, height);
+        let object_px = view.projected_length(centre, (hi - lo).length(), height);
+        let mut level = lod.level(
+            params.layers,
+            fur_px,
+            model.texture_resolution,
+            params.tiles,
+            object_px,
+        );
+        level.mip = level.mip.min(model.mip_levels.saturating_sub(1) as f32);
+        level
+    }
+
+    /// Records one furry object into the caller's render pass, which must
+    /// draw into targets of [`Self::target_formats`] with a depth
+    /// attachment: the skin (writing depth), the layers of its level of
+    /// detail, and its fins. `height` is the target's height in pixels
+    /// (for the level of detail). The uniforms are written through
+    /// `queue`, so submit after this call; up to 1,024 objects a
+    /// submission.
+    pub fn record(
+        &self,
+        queue: &wgpu::Queue,
+        pass: &mut wgpu::RenderPass<'_>,
+        model: &ShellModel,
+        params: &ShellParams,
+        view: &ShellView,
+        height: f32,
+    ) -> Result<ShellLevel, GpuError> {
+        if params.layers > model.layers {
+            return Err(GpuError::Mismatch(format!(
+                "{} layers drawn from a shell texture of {}",
+                params.layers, model.layers
+            )));
+        }
+        let level = self.level(model, params, view, height);
+        let k = params.kajiya_kay;
+        let fins = params.fins.filter(|f| f.opacity > 0.0);
+        let uniforms = ShellUniforms {
+            view_proj: view.clip_from_world.to_cols_array_2d(),
+            eye: view.eye.to_array(),
+            shell_length: params.length,
+            light_dir: view.light.normalize().to_array(),
+            layers: params.layers,
+            specular: k.specular.to_array(),
+            specular_exponent: k.exponent,
+            motion: params.offset.to_array(),
+            coupling_exponent: params.coupling.exponent(),
+            tiles: params.tiles,
+            k_shadow: k.k_shadow,
+            curl_radius: params.curl.radius,
+            curl_frequency: params.curl.frequency,
+            shading_mode: params.mode.index(),
+            coupling: params.coupling.index(),
+            clump_w: params.clump.w,
+            clump_strength: params.clump.strength,
+            wetness_size: [model.wetness_size.0 as f32, model.wetness_size.1 as f32],
+            lod_layers: level.layers,
+            fur_mip: level.mip,
+            fin_opacity: fins.map_or(0.0, |f| f.opacity),
+            fin_width: fins.map_or(1.0, |f| f.width.max(1e-3)),
+            pad0: [0.0; 2],
+        };
+        let uniform_offset = self.uniforms.write(queue, &uniforms);
         pass.set_bind_group(0, self.uniforms.group(), &[uniform_offset]);
         pass.set_bind_group(1, &model.textures, &[]);
-        pass.set_vertex_buffer(0, model.vertices.slice(..));
-        pass.set_vertex_buffer(1, model.tip_offsets.slice(..));
+        pass.set_vertex_buffer(0, model.pose.slice(..));
+        pass.set_vertex_buffer(1, model.surface.slice(..));
+        pass.set_vertex_buffer(2, model.tip_offsets.slice(..));
+        pass.set_index_buffer(model.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.set_pipeline(&self.skin_pipeline);
-        pass.draw(0..model.vertex_count, 0..1);
+        pass.draw_indexed(0..model.index_count, 0, 0..1);
         pass.set_pipeline(&self.layer_pipeline);
-        pass.draw(0..model.vertex_count, 0..params.layers);
+        pass.draw_indexed(0..model.index_count, 0, 0..level.drawn());
+        if let (Some(_), Some((group, count))) = (fins, &model.fins) {
+            pass.set_pipeline(&self.fin_pipeline);
+            pass.set_bind_group(2, group, &[]);
+            pass.draw(0..6 * count, 0..1);
+        }
+        Ok(level)
+    }
+
+    /// Records the skinning pass of a skinned `model` into the caller's
+    /// encoder: every vertex posed by `palette` (the rig's, e.g.
+    /// [`pelage::shell::ShellAnimation::palette_at`]). Record it before the
+    /// frame that draws the model.
+    pub fn pose(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        model: &ShellModel,
+        palette: &[Mat4],
+    ) -> Result<(), GpuError> {
+        let Some(skin) = &model.skin else {
+            return Err(GpuError::Mismatch(
+                "a palette for a model uploaded without a rig".into(),
+            ));
+        };
+        if palette.len() != skin.palette_len {
+            return Err(GpuError::Mismatch(format!(
+                "a palette of {} matrices for a rig of {}",
+                palette.len(),
+                skin.palette_len
+            )));
+        }
+        let columns: Vec<[f32; 16]> = palette.iter().map(Mat4::to_cols_array).collect();
+        queue.write_buffer(&skin.palette, 0, bytemuck::cast_slice(&columns));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("shell skinning"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.skinning);
+        pass.set_bind_group(0, &skin.bind, &[]);
+        let groups = model.vertex_count.div_ceil(64).max(1);
+        let x = groups.min(65_535);
+        pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
+        Ok(())
+    }
+
+    /// [`Self::pose`] submitted on its own.
+    pub fn pose_now(
+        &self,
+        ctx: &GpuContext,
+        model: &ShellModel,
+        palette: &[Mat4],
+    ) -> Result<(), GpuError> {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.pose(&ctx.queue, &mut encoder, model, palette)?;
+        ctx.queue.submit([encoder.finish()]);
         Ok(())
     }
 }

@@ -12,7 +12,7 @@ use pelage::shell::wetness::{Droplet, DropletStyle, droplets_on_mesh, mask_coord
 use pelage::shell::{ShellScene, WetnessMask};
 use pelage_gpu::{
     FurMotion, GpuContext, GpuError, OrbitCamera, ShellFeatures, ShellModel, ShellParams,
-    ShellRenderer, ShellTarget, ShellView,
+    ShellRenderer, ShellTarget, ShellView, SkinMotion,
 };
 use std::time::Instant;
 
@@ -347,7 +347,7 @@ impl ShellSession {
         let h = dt / steps as f32;
         if h > 0.0 {
             for _ in 0..steps {
-                motion.step(ctx, h, offset, settings)?;
+                motion.step(ctx, h, SkinMotion::Offset(offset), settings)?;
             }
         }
         self.params.coupling = settings.coupling;
@@ -423,6 +423,7 @@ impl ShellSession {
         let target = self.target.as_ref().expect("made above");
         self.renderer
             .encode(ctx, encoder, &self.model, &params, &view, target, resolve)
+            .map(|_| ())
     }
 
     /// The control panel.
