@@ -47,6 +47,7 @@ fn render(ctx: &GpuContext, panel: &Panel) -> image::RgbaImage {
     let features = ShellFeatures {
         curl: panel.params.curl.radius != 0.0,
         clump: panel.mask.wet_fraction() > 0.0,
+        cull_back: false,
     };
     let renderer = ShellRenderer::new(ctx, features);
     let model = renderer

@@ -363,7 +363,7 @@ fn curl_moves_the_layer_by_the_reference_offset_and_wetness_straightens_it() {
     let case = Case {
         features: ShellFeatures {
             curl: true,
-            clump: false,
+            ..ShellFeatures::PLAIN
         },
         params: p,
         textures: textures(1),

@@ -459,7 +459,7 @@ fn vs_fin(@builtin(vertex_index) index: u32) -> FinOut {
     let texel = 1.0 / f32(textureDimensions(fur_layers).x);
     var across = vec2<f32>(-along.y, along.x);
     if dot(across, across) > 0.0 {
-        across = normalize(across) * 3.0 * texel;
+        across = normalize(across) * 4.0 * texel;
     }
     out.across = across;
     out.opacity = visible;
@@ -468,19 +468,17 @@ fn vs_fin(@builtin(vertex_index) index: u32) -> FinOut {
 
 @fragment
 fn fs_fin(v: FinOut) -> @location(0) vec4<f32> {
-    // A fin shows the fur seen side-on: four parallel vertical cuts
+    // A fin shows the fur seen side-on: two parallel vertical cuts
     // through the blade volume, a few texels apart, over each other.
     let layers = textureNumLayers(fur_layers);
     let slice = clamp(v.h * f32(layers) - 1.0, 0.0, f32(layers - 1));
     let uv = v.uv * shell.tiles;
-    var clear = 1.0;
-    var fur = vec4<f32>(0.0);
-    for (var k = 0; k < 4; k++) {
-        let sample = fur_at(uv + f32(k) * v.across, slice);
-        clear *= 1.0 - sample.a;
-        if sample.a > fur.a {
-            fur = sample;
-        }
+    let near = fur_at(uv, slice);
+    let far = fur_at(uv + v.across, slice);
+    let clear = (1.0 - near.a) * (1.0 - far.a);
+    var fur = near;
+    if far.a > near.a {
+        fur = far;
     }
     let alpha = (1.0 - clear) * v.opacity;
     if alpha <= 0.0 {

@@ -38,6 +38,11 @@ pub struct ShellFeatures {
     pub curl: bool,
     /// Clumping (Alg. 2) in the fragment shader: reads the mask per fragment.
     pub clump: bool,
+    /// Skin and layers drawn only where they face the camera (closed
+    /// meshes wound counter-clockwise seen from outside): the far side's
+    /// layers are hidden behind the near side's skin anyway, and fins
+    /// cover the silhouette.
+    pub cull_back: bool,
 }
 
 impl ShellFeatures {
@@ -45,11 +50,13 @@ impl ShellFeatures {
     pub const PLAIN: Self = Self {
         curl: false,
         clump: false,
+        cull_back: false,
     };
     /// Curl and clumps.
     pub const ALL: Self = Self {
         curl: true,
         clump: true,
+        cull_back: false,
     };
 }
 
@@ -100,7 +107,7 @@ impl Default for FinParams {
     fn default() -> Self {
         Self {
             opacity: 1.0,
-            width: 0.3,
+            width: 0.15,
         }
     }
 }
@@ -196,6 +203,19 @@ pub struct ShellView {
 }
 
 impl ShellView {
+    /// Whether a sphere may be in view: not wholly outside any of the six
+    /// planes of the view's frustum (Gribb & Hartmann's planes from the
+    /// rows of `clip_from_world`, wgpu's depth 0..1).
+    pub fn sees_sphere(&self, centre: Vec3, radius: f32) -> bool {
+        let m = self.clip_from_world;
+        let (x, y, z, w) = (m.row(0), m.row(1), m.row(2), m.row(3));
+        let p = centre.extend(1.0);
+        [w + x, w - x, w + y, w - y, z, w - z].iter().all(|plane| {
+            let length = plane.truncate().length();
+            length == 0.0 || plane.dot(p) / length >= -radius
+        })
+    }
+
     /// How long `length` (world units) at `point` looks on screen, in
     /// pixels of an image `height` pixels high, measured across the line
     /// of sight.

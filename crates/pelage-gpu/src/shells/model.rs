@@ -64,9 +64,18 @@ pub(super) struct GpuSkin {
 }
 
 impl ShellModel {
-    /// The skin's bounds (at rest for a skinned mesh: the pose moves it).
+    /// The skin's bounds: the mesh's as uploaded, or as set by
+    /// [`Self::set_bounds`]. Objects outside the view are not drawn and
+    /// the level of detail measures them by these.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.bounds
+    }
+
+    /// Sets the bounds (before `offset`) every pose stays within: a
+    /// skinned model is uploaded in its bind pose, which may lie elsewhere
+    /// (and at another scale) than where its animation takes it.
+    pub fn set_bounds(&mut self, lo: Vec3, hi: Vec3) {
+        self.bounds = (lo, hi);
     }
 
     /// The number of layers in the shell texture.
@@ -171,6 +180,12 @@ impl ShellTarget {
     /// The image size.
     pub fn size(&self) -> (u32, u32) {
         self.size
+    }
+
+    /// A view of the resolved image, to resolve a pass into (the `resolve`
+    /// of [`ShellRenderer::encode`]).
+    pub fn resolve_view(&self) -> wgpu::TextureView {
+        self.resolved.create_view(&Default::default())
     }
 }
 

@@ -36,12 +36,14 @@ impl<'s> ShellScenePlayer<'s> {
         let features = ShellFeatures {
             curl: scene.curl.radius != 0.0,
             clump: scene.clump.is_some(),
+            cull_back: scene.fur.cull_back,
         };
         let renderer = ShellRenderer::new(ctx, features);
         let mut model = renderer.upload_scene(ctx, scene)?;
-        // A skinned model is uploaded in its bind pose; the level of detail
-        // measures it where it stands.
-        model.bounds = scene.mesh.bounds();
+        if let Some(animation) = &scene.animation {
+            let (lo, hi) = animation.bounds();
+            model.set_bounds(lo, hi);
+        }
         let target = ShellTarget::new(ctx, &renderer, width, height)?;
         let camera = scene.camera.map(|c| {
             let (lo, hi) = scene.mesh.bounds();

@@ -211,7 +211,8 @@ impl ShellRenderer {
                 },
                 primitive: wgpu::PrimitiveState {
                     topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: None,
+                    cull_mode: (features.cull_back && kind != Kind::Fins)
+                        .then_some(wgpu::Face::Back),
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
@@ -423,7 +424,8 @@ impl ShellRenderer {
     /// Records one furry object into the caller's render pass, which must
     /// draw into targets of [`Self::target_formats`] with a depth
     /// attachment: the skin (writing depth), the layers of its level of
-    /// detail, and its fins. `height` is the target's height in pixels
+    /// detail, and its fins — or nothing, when its bounds
+    /// ([`ShellModel::set_bounds`]) grown by the fur are outside the view. `height` is the target's height in pixels
     /// (for the level of detail). The uniforms are written through
     /// `queue`, so submit after this call; up to 1,024 objects a
     /// submission.
@@ -441,6 +443,15 @@ impl ShellRenderer {
                 "{} layers drawn from a shell texture of {}",
                 params.layers, model.layers
             )));
+        }
+        let (lo, hi) = model.bounds;
+        let radius = 0.5 * (hi - lo).length() + params.length;
+        if !view.sees_sphere(0.5 * (lo + hi) + params.offset, radius) {
+            // Outside the frustum: nothing recorded.
+            return Ok(ShellLevel {
+                layers: 0.0,
+                ..ShellLevel::full(0)
+            });
         }
         let level = self.level(model, params, view, height);
         let k = params.kajiya_kay;

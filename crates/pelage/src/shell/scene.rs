@@ -37,6 +37,8 @@ pub struct FurSettings {
     pub length: f32,
     /// How many times the shell texture repeats across the UV square.
     pub tiles: f32,
+    /// Draw only the skin and layers that face the camera.
+    pub cull_back: bool,
 }
 
 /// Shading parameters.
@@ -614,6 +616,7 @@ fn fur_settings(
         layers,
         length,
         tiles: fur.tiles.unwrap_or(8.0).max(1e-3),
+        cull_back: fur.cull_back.unwrap_or(false),
     };
 
     Ok(fur)

@@ -85,6 +85,7 @@ pub(super) struct FurSection {
     pub(super) layers: Option<Spanned<u32>>,
     pub(super) length: Option<Spanned<f32>>,
     pub(super) tiles: Option<f32>,
+    pub(super) cull_back: Option<bool>,
 }
 
 #[derive(Debug, Clone, Deserialize, Default)]

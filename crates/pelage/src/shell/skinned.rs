@@ -7,7 +7,7 @@
 use crate::Mesh;
 use crate::anim::{AnimatedSkin, PosedFrames, SkinOptions, SkinRig};
 use crate::mesh::{MeshError, MeshErrorKind};
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 use std::path::Path;
 
 /// A skinned mesh playing one animation, looped.
@@ -79,6 +79,23 @@ impl ShellAnimation {
     pub fn posed(&self, seconds: f32) -> PosedFrames {
         self.rig
             .pose_frames(&self.palette_at(seconds), self.rest.normals(), &[])
+    }
+
+    /// Bounds of every pose of the clip, sampled 32 times over its length
+    /// and grown by a tenth for the poses between the samples.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let samples = 32;
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for k in 0..=samples {
+            let palette = self.palette_at(self.duration * k as f32 / samples as f32);
+            for p in self.rig.pose(&palette) {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        let margin = 0.1 * (hi - lo);
+        (lo - margin, hi + margin)
     }
 
     /// The whole mesh at `seconds`, its normals those the rig carries

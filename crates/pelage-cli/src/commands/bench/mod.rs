@@ -14,6 +14,7 @@ pub mod python;
 pub mod render;
 pub mod sampler;
 pub mod shells;
+mod shells_game;
 
 use clap::{Args, Subcommand};
 use std::time::Instant;

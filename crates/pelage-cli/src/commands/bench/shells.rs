@@ -31,6 +31,10 @@ pub struct ShellsBenchArgs {
     /// Frames per median.
     #[arg(long, default_value_t = 5)]
     pub frames: usize,
+    /// Only the rows for game characters (indexed layers, culling and
+    /// level of detail; skinned; a crowd; fins), not Table 1's matrix.
+    #[arg(long)]
+    pub game: bool,
 }
 
 /// Silva Table 1: (model, triangles, fps at 16 layers 800×600, 1680×1050,
@@ -56,11 +60,28 @@ struct Row {
 
 pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::headless()?;
+    if args.game {
+        let game = super::shells_game::measure(&ctx, args.quick, args.frames)?;
+        if args.json {
+            let mut report = game_json(&game);
+            report["adapter"] = ctx.adapter_name().into();
+            report["software_adapter"] = ctx.is_software().into();
+            println!("{report}");
+        } else {
+            println!(
+                "pelage bench shells --game — median of {} frames, on {}\n",
+                args.frames.max(1),
+                ctx.adapter_name()
+            );
+            print_game(&game);
+        }
+        return Ok(());
+    }
     let renderers = [
         ShellFeatures::PLAIN,
         ShellFeatures {
             curl: true,
-            clump: false,
+            ..ShellFeatures::PLAIN
         },
         ShellFeatures::ALL,
     ]
@@ -162,6 +183,7 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         }
     }
 
+    let game = super::shells_game::measure(&ctx, args.quick, args.frames)?;
     let headline = rows
         .iter()
         .find(|r| r.model == "spot ×2" && r.layers == 16 && r.size == (800, 600))
@@ -182,16 +204,19 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
                 })
             })
             .collect();
-        let report = serde_json::json!({
-            "adapter": ctx.adapter_name(),
-            "software_adapter": ctx.is_software(),
-            "plain_ms": headline.ms[0],
-            "curl_ms": headline.ms[1],
-            "curl_clump_ms": headline.ms[2],
-            "overhead_ratio": headline.ms[2] / headline.ms[0],
-            "target_overhead_ratio": 1.15,
-            "rows": list,
-        });
+        let mut report = game_json(&game);
+        for (key, value) in [
+            ("adapter", ctx.adapter_name().into()),
+            ("software_adapter", ctx.is_software().into()),
+            ("plain_ms", headline.ms[0].into()),
+            ("curl_ms", headline.ms[1].into()),
+            ("curl_clump_ms", headline.ms[2].into()),
+            ("overhead_ratio", (headline.ms[2] / headline.ms[0]).into()),
+            ("target_overhead_ratio", 1.15.into()),
+            ("rows", list.into()),
+        ] {
+            report[key] = value;
+        }
         println!("{report}");
         return Ok(());
     }
@@ -225,6 +250,8 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         "\ntarget (spot ×2, 16 layers, 800×600): curl + clump ≤ 1.15 × plain — measured {ratio:.2}× ({})",
         if ratio <= 1.15 { "met" } else { "missed" }
     );
+    println!();
+    print_game(&game);
     println!(
         "\nSilva et al. Table 1 (GeForce 8800 GTS, with curl and clumps), ms per frame (fps):"
     );
@@ -245,4 +272,61 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The game rows as JSON: each row's configurations in ms, and the ratios
+/// the targets are on.
+fn game_json(game: &super::shells_game::GameFigures) -> serde_json::Value {
+    let rows = [
+        ("geometry", &game.geometry),
+        ("skinned", &game.skinned),
+        ("crowd", &game.crowd),
+        ("fins", &game.fins),
+    ]
+    .map(|(key, row)| {
+        let timed: serde_json::Map<String, serde_json::Value> = row
+            .timed
+            .iter()
+            .map(|t| (t.name.to_string(), t.ms.into()))
+            .collect();
+        (key, serde_json::json!({ "what": row.what, "ms": timed }))
+    });
+    let last = game.geometry.timed.len() - 1;
+    serde_json::json!({
+        "game_rows": serde_json::Map::from_iter(rows.map(|(k, v)| (k.to_string(), v))),
+        "indexed_speedup": game.geometry.speedup(1),
+        "geometry_speedup": game.geometry.speedup(last),
+        "target_geometry_speedup": 4.0,
+        "skinned_ratio": game.skinned.ratio(1),
+        "target_skinned_ratio": 1.2,
+        "lod_speedup": game.crowd.speedup(1),
+        "target_lod_speedup": 3.0,
+        "fins_overhead_ratio": game.fins.ratio(1),
+        "target_fins_overhead_ratio": 1.1,
+    })
+}
+
+/// The game rows as a table, each configuration beside its peer (the
+/// row's first), with the targets.
+fn print_game(game: &super::shells_game::GameFigures) {
+    println!(
+        "shells for games (each row's first configuration is its peer, measured in the same run):"
+    );
+    for (row, target) in [
+        (&game.geometry, "the last ≥ 4× faster than the first"),
+        (&game.skinned, "running ≤ 1.2× standing"),
+        (&game.crowd, "level of detail ≥ 3× faster"),
+        (&game.fins, "fins ≤ 1.1× shells alone"),
+    ] {
+        println!("\n  {}", row.what);
+        for (k, t) in row.timed.iter().enumerate() {
+            println!(
+                "    {:<22} {:>9.1} ms  {:>6.2}× the time",
+                t.name,
+                t.ms,
+                row.ratio(k)
+            );
+        }
+        println!("    target: {target}");
+    }
 }
