@@ -257,3 +257,47 @@ fn a_groom_file_is_grown_and_drawn_with_its_guides_in_orange() {
         guides.len()
     );
 }
+
+#[test]
+fn the_fox_runs_furred_and_its_timeline_moves_it() {
+    if !has_display() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // examples/shells/fox.toml, its paths made absolute.
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../pelage/assets/fox");
+    let scene = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/shells/fox.toml"),
+    )
+    .unwrap()
+    .replace("../../crates/pelage/assets/fox", assets.to_str().unwrap());
+    let stdout = view_scripted(
+        dir.path(),
+        &scene,
+        "ui = false\n\
+         [[step]]\ntime = 0.1\n\
+         [[step]]\nwait = 2\n\
+         [[step]]\nscreenshot = \"early.png\"\n\
+         [[step]]\ntime = 0.4\n\
+         [[step]]\nwait = 2\n\
+         [[step]]\nscreenshot = \"late.png\"\n",
+    );
+    eprintln!("{stdout}");
+    let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
+    let (early, late) = (read("early.png"), read("late.png"));
+    // The fox: orange-brown fur covering a good part of the picture.
+    let furred = |image: &image::RgbImage| {
+        image
+            .pixels()
+            .filter(|p| u16::from(p.0[0]) > u16::from(p.0[2]) + 40 && p.0[0] > 80)
+            .count()
+    };
+    let total = (SIZE.0 * SIZE.1) as usize;
+    let (a, b) = (furred(&early), furred(&late));
+    eprintln!("fox pixels: {a} at 0.1 s, {b} at 0.4 s, of {total}");
+    assert!(a > total / 20 && b > total / 20, "{a} {b}");
+    // Its legs and body are elsewhere 0.3 s later.
+    let (near, far) = changed_near_and_far(&early, &late, (0.0, 0.0), 0.0);
+    let changed = near + far;
+    assert!(changed > total / 50, "{changed} pixels changed");
+}

@@ -297,7 +297,7 @@ impl ShellScene {
                 .filter(|f| f.enabled != Some(false))
                 .map(|f| FinSettings {
                     opacity: f.opacity.unwrap_or(1.0),
-                    width: f.width.unwrap_or(0.3),
+                    width: f.width.unwrap_or(0.15),
                 }),
             lod: file
                 .lod

@@ -529,6 +529,11 @@ impl WindowState {
                             s.shake();
                         }
                     }
+                    Step::Time(seconds) => {
+                        if let Some(s) = self.session.shells() {
+                            s.set_clip_time(seconds);
+                        }
+                    }
                     Step::Show(show) => match &mut self.session {
                         Session::Curves(c) => {
                             let t = &mut c.controls;

@@ -18,6 +18,8 @@
 //! push = { from = [400, 300], to = [460, 300], frames = 10 } # drag the fur
 //! [[step]]
 //! show = { skin = false, guides = true, percent = 10 }       # groom views
+//! [[step]]
+//! time = 0.4                         # hold a skinned scene's clip at 0.4 s
 //! ```
 
 use pelage::groom::GroomError;
@@ -53,6 +55,8 @@ pub enum Step {
     Push(PushStep),
     /// Shake the object (the scene's shake, or a default one).
     Shake(bool),
+    /// Hold a skinned scene's clip at this many seconds.
+    Time(f32),
     /// What a groom view draws: the panel's toggles.
     Show(ShowStep),
     /// Close the window.

@@ -11,8 +11,8 @@ use pelage::shell::scene::DynamicsSettings;
 use pelage::shell::wetness::{Droplet, DropletStyle, droplets_on_mesh, mask_coordinates};
 use pelage::shell::{ShellScene, WetnessMask};
 use pelage_gpu::{
-    FurMotion, GpuContext, GpuError, OrbitCamera, ShellFeatures, ShellModel, ShellParams,
-    ShellRenderer, ShellTarget, ShellView, SkinMotion,
+    FinParams, FurMotion, GpuContext, GpuError, OrbitCamera, ShellFeatures, ShellLevel, ShellLod,
+    ShellModel, ShellParams, ShellRenderer, ShellTarget, ShellView, SkinMotion,
 };
 use std::time::Instant;
 
@@ -66,6 +66,10 @@ pub struct ShellControls {
     pub brush_radius: f32,
     /// Brush force per pixel dragged.
     pub brush_strength: f32,
+    /// A skinned scene's clip plays (else it holds at `clip_time`).
+    pub playing: bool,
+    /// Seconds into the clip.
+    pub clip_time: f32,
 }
 
 /// A shell scene being looked at.
@@ -96,6 +100,11 @@ pub struct ShellSession {
     splashes: u64,
     /// Milliseconds the last frame's simulation (dynamics + mask) took.
     pub last_simulation_ms: f64,
+    /// The level of detail the last frame was drawn at.
+    level: Option<ShellLevel>,
+    /// The fins and level of detail the panel turns on (kept while off).
+    fins: FinParams,
+    lod: ShellLod,
 }
 
 impl ShellSession {
@@ -108,7 +117,11 @@ impl ShellSession {
         // Curl and clumps are always compiled in, so the sliders can turn
         // them on; at zero they cost little (see `pelage bench shells`).
         let renderer = ShellRenderer::for_format(ctx, format, ShellFeatures::ALL);
-        let model = renderer.upload_scene(ctx, &scene)?;
+        let mut model = renderer.upload_scene(ctx, &scene)?;
+        if let Some(animation) = &scene.animation {
+            let (lo, hi) = animation.bounds();
+            model.set_bounds(lo, hi);
+        }
         let mut params = ShellParams::from_scene(&scene);
         let clump = scene.clump.is_some();
         if !clump {
@@ -145,6 +158,8 @@ impl ShellSession {
             gravity: -dynamics.params.gravity.y,
             brush_radius: 0.12,
             brush_strength: 0.4,
+            playing: true,
+            clip_time: 0.0,
         };
         let base_wind = dynamics
             .params
@@ -172,6 +187,9 @@ impl ShellSession {
             last_simulation_ms: 0.0,
             base_wind,
             splashes: 0,
+            level: None,
+            fins: params.fins.unwrap_or_default(),
+            lod: params.lod.unwrap_or_default(),
         };
         // The scene's own droplets at time 0 are the starting mask.
         let mut timeline = session.scene.wetness_timeline();
@@ -214,10 +232,11 @@ impl ShellSession {
         clump: f32,
     ) -> bool {
         let origin = origin - self.params.offset;
-        let Some(hit) = pelage::mesh::first_hit(&self.scene.mesh, origin, direction) else {
+        let mesh = self.posed_mesh();
+        let Some(hit) = pelage::mesh::first_hit(&mesh, origin, direction) else {
             return false;
         };
-        let Some(uv) = hit.point.uv(&self.scene.mesh) else {
+        let Some(uv) = hit.point.uv(&mesh) else {
             return false;
         };
         self.splashes += 1;
@@ -232,18 +251,39 @@ impl ShellSession {
     /// [`Self::release`]; turns the dynamics on if they were off.
     pub fn push(&mut self, origin: Vec3, direction: Vec3, force: Vec3) -> bool {
         let origin = origin - self.params.offset;
-        let Some(hit) = pelage::mesh::first_hit(&self.scene.mesh, origin, direction) else {
+        let mesh = self.posed_mesh();
+        let Some(hit) = pelage::mesh::first_hit(&mesh, origin, direction) else {
             self.brush = None;
             return false;
         };
-        self.controls.dynamics_on = true;
-        let (lo, hi) = self.scene.mesh.bounds();
-        self.brush = Some(Brush {
-            centre: hit.point.position(&self.scene.mesh),
+        let (lo, hi) = mesh.bounds();
+        let brush = Brush {
+            centre: hit.point.position(&mesh),
             radius: self.controls.brush_radius * (hi - lo).length(),
             force,
-        });
+        };
+        drop(mesh);
+        self.controls.dynamics_on = true;
+        self.brush = Some(brush);
         true
+    }
+
+    /// The skin where it is now: a skinned scene posed at the clip's
+    /// time, else the scene's mesh.
+    fn posed_mesh(&self) -> std::borrow::Cow<'_, pelage::Mesh> {
+        match &self.scene.animation {
+            Some(a) => a.mesh_at(self.controls.clip_time).map_or(
+                std::borrow::Cow::Borrowed(&self.scene.mesh),
+                std::borrow::Cow::Owned,
+            ),
+            None => std::borrow::Cow::Borrowed(&self.scene.mesh),
+        }
+    }
+
+    /// Sets the clip's clock (seconds) and holds it there.
+    pub fn set_clip_time(&mut self, seconds: f32) {
+        self.controls.clip_time = seconds.max(0.0);
+        self.controls.playing = false;
     }
 
     /// Ends a push.
@@ -263,6 +303,12 @@ impl ShellSession {
         let started = Instant::now();
         let dt = dt.clamp(0.0, 0.1);
         self.time += dt;
+        if let Some(animation) = &self.scene.animation
+            && self.controls.playing
+        {
+            let duration = animation.clip().1.max(1e-3);
+            self.controls.clip_time = (self.controls.clip_time + dt).rem_euclid(duration);
+        }
         if self.controls.rain {
             self.rain_owed += self.controls.rain_rate.max(0.0) * dt;
             while self.rain_owed >= 1.0 {
@@ -346,8 +392,21 @@ impl ShellSession {
         let steps = settings.steps_per_frame.max(1);
         let h = dt / steps as f32;
         if h > 0.0 {
-            for _ in 0..steps {
-                motion.step(ctx, h, SkinMotion::Offset(offset), settings)?;
+            for k in 0..steps {
+                match &self.scene.animation {
+                    Some(animation) => {
+                        // The clip's clock has moved on by dt already.
+                        let t = self.controls.clip_time - dt + (k + 1) as f32 * h;
+                        let posed = animation.posed(t);
+                        let skin = SkinMotion::Posed {
+                            positions: &posed.positions,
+                            normals: &posed.normals,
+                            offset,
+                        };
+                        motion.step(ctx, h, skin, settings)?;
+                    }
+                    None => motion.step(ctx, h, SkinMotion::Offset(offset), settings)?,
+                }
             }
         }
         self.params.coupling = settings.coupling;
@@ -421,9 +480,16 @@ impl ShellSession {
         let view = self.view(orbit, width as f32 / height.max(1) as f32);
         let params = self.draw_params();
         let target = self.target.as_ref().expect("made above");
-        self.renderer
-            .encode(ctx, encoder, &self.model, &params, &view, target, resolve)
-            .map(|_| ())
+        if let Some(animation) = &self.scene.animation {
+            let palette = animation.palette_at(self.controls.clip_time);
+            self.renderer
+                .pose(&ctx.queue, encoder, &self.model, &palette)?;
+        }
+        let level =
+            self.renderer
+                .encode(ctx, encoder, &self.model, &params, &view, target, resolve)?;
+        self.level = Some(level);
+        Ok(())
     }
 
     /// The control panel.
@@ -441,6 +507,46 @@ impl ShellSession {
         ui.checkbox(&mut c.clump, "wet clumps");
         ui.add(egui::Slider::new(&mut self.params.clump.w, 0.0..=1.0).text("clump w"));
         ui.add(egui::Slider::new(&mut self.params.clump.strength, 0.0..=8.0).text("clump squeeze"));
+        let mut fins = self.params.fins.is_some();
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut fins, "fins");
+            ui.add_enabled(
+                fins,
+                egui::Slider::new(&mut self.fins.width, 0.02..=0.6).text("edge-on |n·e| <"),
+            );
+        });
+        self.params.fins = fins.then_some(self.fins);
+        let mut lod = self.params.lod.is_some();
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut lod, "level of detail");
+            ui.add_enabled(
+                lod,
+                egui::Slider::new(&mut self.lod.max_gap_px, 0.25..=4.0)
+                    .logarithmic(true)
+                    .text("px between layers"),
+            );
+        });
+        self.params.lod = lod.then_some(self.lod);
+
+        if let Some(animation) = &self.scene.animation {
+            let (clip, duration) = animation.clip();
+            ui.separator();
+            ui.heading(format!("Animation: {clip}"));
+            ui.horizontal(|ui| {
+                let label = if c.playing { "Pause" } else { "Play" };
+                if ui.button(label).clicked() {
+                    c.playing = !c.playing;
+                }
+                let slider = ui.add(
+                    egui::Slider::new(&mut c.clip_time, 0.0..=duration)
+                        .text("s")
+                        .fixed_decimals(2),
+                );
+                if slider.dragged() {
+                    c.playing = false;
+                }
+            });
+        }
 
         ui.separator();
         ui.heading("Water");
@@ -541,6 +647,29 @@ impl ShellSession {
         if ui.button("Shake").clicked() {
             self.shake();
         }
+        self.level_overlay(ui.ctx());
+    }
+}
+
+impl ShellSession {
+    /// The level of detail of the last frame, in the top right corner of
+    /// the window: layers drawn of the scene's, the fur's length on screen
+    /// and the texture's mip level.
+    fn level_overlay(&self, ctx: &egui::Context) {
+        let (Some(level), Some(_)) = (self.level, self.params.lod) else {
+            return;
+        };
+        egui::Area::new(egui::Id::unique("level of detail"))
+            .anchor(egui::Align2::RIGHT_TOP, egui::vec2(-10.0, 10.0))
+            .interactable(false)
+            .show(ctx, |ui| {
+                egui::Frame::popup(ui.style()).show(ui, |ui| {
+                    ui.label(format!(
+                        "level of detail: {:.1} of {} layers\nfur {:.1} px on screen · mip {:.1}",
+                        level.layers, self.params.layers, level.fur_px, level.mip
+                    ));
+                });
+            });
     }
 }
 
