@@ -877,6 +877,32 @@ fn shells_with_dynamics_move_in_the_wind_and_still_fur_does_not() {
     );
 }
 
+#[test]
+fn shells_play_the_fox_running_from_the_example_scene() {
+    // Needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_none() {
+        eprintln!("SKIPPED: set PELAGE_REQUIRE_GPU=1 to run render tests through the CLI");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/shells/fox.toml");
+    let frames = dir.path().join("run");
+    shells_sequence(&scene, &frames, &[]);
+    let frame = |k: u32| {
+        image::open(frames.join(format!("frame-{k:04}.png")))
+            .unwrap()
+            .to_rgba8()
+    };
+    // Frames are 1/24 s apart: the legs and the fur have moved.
+    let changed = frame(0)
+        .pixels()
+        .zip(frame(2).pixels())
+        .filter(|(a, b)| (0..3).any(|c| a.0[c].abs_diff(b.0[c]) > 24))
+        .count();
+    assert!(changed > 160 * 120 / 100, "{changed} pixels changed");
+    assert!(frames.join("shells.gif").exists());
+}
+
 /// `pelage shells SCENE --frames 3 -o FRAMES --size 160x120 -q EXTRA…`,
 /// which must succeed.
 fn shells_sequence(scene: &Path, frames: &Path, extra: &[&str]) {

@@ -38,6 +38,21 @@ impl GpuContext {
         Self::open(instance, Some(surface))
     }
 
+    /// The caller's own adapter, device and queue (an engine's, a game's),
+    /// for uploading and drawing with pelage there (docs/embedding.md).
+    /// wgpu's handles are shared, not copied. Unlike [`Self::headless`] it
+    /// installs no handler for uncaptured errors on the device: that stays
+    /// the caller's, and [`Self::check`] reports nothing.
+    pub fn wrap(adapter: &wgpu::Adapter, device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        Self {
+            device: device.clone(),
+            queue: queue.clone(),
+            adapter: adapter.get_info(),
+            raw_adapter: adapter.clone(),
+            errors: Arc::new(Mutex::new(None)),
+        }
+    }
+
     fn open(
         instance: &wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,

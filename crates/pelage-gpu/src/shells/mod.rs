@@ -146,6 +146,13 @@ pub struct ShellLevel {
 }
 
 impl ShellLevel {
+    /// Not drawn: outside the view.
+    pub const CULLED: Self = Self {
+        layers: 0.0,
+        mip: 0.0,
+        fur_px: 0.0,
+    };
+
     /// Every layer, mip 0.
     pub fn full(layers: u32) -> Self {
         Self {

@@ -182,6 +182,11 @@ impl ShellTarget {
         self.size
     }
 
+    /// The resolved (single-sample) image, e.g. to read back.
+    pub fn resolved(&self) -> &wgpu::Texture {
+        &self.resolved
+    }
+
     /// A view of the resolved image, to resolve a pass into (the `resolve`
     /// of [`ShellRenderer::encode`]).
     pub fn resolve_view(&self) -> wgpu::TextureView {

@@ -343,12 +343,14 @@ impl ShellRenderer {
         target: &ShellTarget,
         resolve: &wgpu::TextureView,
     ) -> Result<ShellLevel, GpuError> {
-        self.encode_all(ctx, encoder, &[(model, *params)], view, target, resolve)
+        let levels = self.encode_all(ctx, encoder, &[(model, *params)], view, target, resolve)?;
+        Ok(levels[0])
     }
 
     /// [`Self::encode`] for several objects (a crowd) in one pass, each
-    /// with its own parameters (its `offset` places it); the levels of
-    /// detail chosen, one an object.
+    /// with its own parameters (its `offset` places it; the first's
+    /// background clears the image); the level of detail each was drawn
+    /// at.
     pub fn encode_all(
         &self,
         ctx: &GpuContext,
@@ -357,7 +359,7 @@ impl ShellRenderer {
         view: &ShellView,
         target: &ShellTarget,
         resolve: &wgpu::TextureView,
-    ) -> Result<ShellLevel, GpuError> {
+    ) -> Result<Vec<ShellLevel>, GpuError> {
         let background = objects
             .first()
             .map_or([0.0; 3], |(_, p)| p.background)
@@ -387,11 +389,10 @@ impl ShellRenderer {
             multiview_mask: None,
         });
         let height = target.size.1 as f32;
-        let mut level = ShellLevel::full(0);
-        for (model, params) in objects {
-            level = self.record(&ctx.queue, &mut pass, model, params, view, height)?;
-        }
-        Ok(level)
+        objects
+            .iter()
+            .map(|(model, params)| self.record(&ctx.queue, &mut pass, model, params, view, height))
+            .collect()
     }
 
     /// The level of detail `model` is drawn at with `params` from `view`,
@@ -447,11 +448,7 @@ impl ShellRenderer {
         let (lo, hi) = model.bounds;
         let radius = 0.5 * (hi - lo).length() + params.length;
         if !view.sees_sphere(0.5 * (lo + hi) + params.offset, radius) {
-            // Outside the frustum: nothing recorded.
-            return Ok(ShellLevel {
-                layers: 0.0,
-                ..ShellLevel::full(0)
-            });
+            return Ok(ShellLevel::CULLED);
         }
         let level = self.level(model, params, view, height);
         let k = params.kajiya_kay;

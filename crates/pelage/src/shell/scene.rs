@@ -549,6 +549,13 @@ fn mesh_and_color(
             ));
         }
         (Some(section), Some(clip)) => {
+            if section.path.get_ref() == "spot" {
+                return Err(invalid(
+                    source,
+                    clip.span(),
+                    "a clip is played from a glTF or GLB skin; the embedded spot has none".into(),
+                ));
+            }
             let path = source.folder().join(section.path.get_ref());
             let skinned = super::ShellAnimation::load(&path, clip.get_ref(), section.subdivide)
                 .map_err(|e| {

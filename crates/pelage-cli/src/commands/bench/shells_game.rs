@@ -313,10 +313,11 @@ fn crowd(ctx: &GpuContext, quick: bool, frames: usize) -> anyhow::Result<GameRow
     ))
 }
 
-/// The crowd's camera and the 100 objects' offsets: ten rows of ten, all
-/// in view, receding from 5 to 66 units (each row a third farther).
+/// The crowd's camera and the 100 objects' offsets: ten rows of ten
+/// (1.8 units apart; rows 3 units apart), seen from above the first row,
+/// from 8 to 35 units away; the near rows spill out of the view.
 pub fn crowd_layout() -> (ShellView, Vec<Vec3>) {
-    let eye = Vec3::new(0.0, 1.0, 0.0);
+    let eye = Vec3::new(0.0, 4.0, 6.0);
     let view = pelage_gpu::Camera {
         eye,
         target: Vec3::new(0.0, 0.0, -20.0),
@@ -326,8 +327,7 @@ pub fn crowd_layout() -> (ShellView, Vec<Vec3>) {
     let offsets = (0..100)
         .map(|i| {
             let (row, column) = ((i / 10) as f32, (i % 10) as f32);
-            let depth = 5.0 * 1.33f32.powf(row);
-            Vec3::new((column - 4.5) * 0.09 * depth, 0.0, -depth)
+            Vec3::new((column - 4.5) * 1.8, 0.0, -2.0 - 3.0 * row)
         })
         .collect();
     (
