@@ -1,8 +1,10 @@
 // Shell fur (Silva et al., Lengyel et al., Banisch & Wüthrich): the skin
-// drawn once with depth write, then all N layers in one instanced draw
+// drawn once with depth write, then the layers in one instanced draw
 // (instance n = layer n), depth test on and write off, blended in layer
-// order. Every formula mirrors a function of pelage::shell::math, named
-// the same; keep them in step (tests/shells.rs renders against the Rust).
+// order, then the fins. Every formula mirrors a function of
+// pelage::shell::math, named the same; keep them in step (tests/shells.rs
+// renders against the Rust; tests/shells_game.rs checks fins and the level
+// of detail).
 
 // Mirrors ShellUniforms in shells.rs (a test checks names and offsets).
 struct Shell {

@@ -1,18 +1,25 @@
-//! The shell-fur renderer (Silva §4, Lengyel et al.): the skin once with
-//! depth write, then the N layers in one instanced draw — depth test on,
-//! depth write off, blended in layer order. Layer displacement (Eq. 1,
-//! curl Eq. 4) runs in the vertex shader, clumping (Alg. 2) and shading
-//! (Eq. 6) in the fragment shader; `shaders/shells.wgsl` mirrors
-//! `pelage::shell::math` function by function.
+//! The shell-fur renderer (Silva §4, Lengyel et al.): a skinned model
+//! posed by a compute pass (`shaders/skin.wgsl`, `pelage::anim::SkinRig`'s
+//! copy), then the skin once with depth write, the layers in one instanced
+//! indexed draw — depth test on, depth write off, blended in layer order —
+//! and the fins on the edges seen edge-on (Lengyel et al. 2001). Layer
+//! displacement (Eq. 1, curl Eq. 4) runs in the vertex shader, clumping
+//! (Alg. 2) and shading (Eq. 6) in the fragment shader;
+//! `shaders/shells.wgsl` mirrors `pelage::shell::math` function by
+//! function. A [`ShellLod`] chooses the layers and the texture's mip level
+//! by size on screen; objects outside the view are not drawn.
 //!
 //! Pipelines are specialised with WGSL override constants — plain shells,
-//! with curl, with curl and clumps ([`ShellFeatures`]) — so the benchmark
-//! compares like with like.
+//! with curl, with curl and clumps, back faces culled ([`ShellFeatures`]) —
+//! so the benchmark compares like with like, and built for pelage's
+//! targets or a caller's ([`ShellTargetFormats`], docs/embedding.md).
 //!
-//! - `renderer.rs`: [`ShellRenderer`], its pipelines and the frame it
-//!   records;
-//! - `model.rs`: [`ShellModel`] (a furry mesh uploaded) and
-//!   [`ShellTarget`] (the images drawn into);
+//! - `renderer.rs`: [`ShellRenderer`], its pipelines, the skinning pass
+//!   and what a frame records;
+//! - `model.rs`: [`ShellModel`] (a furry mesh uploaded: welded vertices,
+//!   pose, textures with mips, rig) and [`ShellTarget`] (the images drawn
+//!   into);
+//! - `fins.rs`: the fin records of a mesh's edges;
 //! - `player.rs`: [`ShellScenePlayer`], a scene file drawn frame by frame.
 
 mod fins;
