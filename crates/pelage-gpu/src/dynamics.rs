@@ -528,8 +528,9 @@ impl GpuMassSpring {
         }
     }
 
-    /// Writes each triangle corner's tip offset `p − p0` straight into
-    /// `model`'s vertex buffer — what
+    /// Writes each model vertex's tip offset `p − p0` (its stick's, through
+    /// the model's vertex → corner map) straight into `model`'s vertex
+    /// buffer — what
     /// [`ShellRenderer::set_tip_offsets`](crate::ShellRenderer::set_tip_offsets)
     /// uploads from the CPU — so the renderer draws the GPU's state with no
     /// read-back. `model` must be of the mesh this system was built on.

@@ -485,8 +485,8 @@ impl ShellRenderer {
 
     /// Generates a scene's shell texture and uploads the scene
     /// ([`Self::upload_with`] with the scene's mesh — its rest pose and
-    /// rig when skinned —, colour and mask size; per corner when its
-    /// dynamics' sticks are).
+    /// rig when skinned, with the bounds of its whole clip —, colour and
+    /// mask size; per corner when its dynamics' sticks are).
     pub fn upload_scene(
         &self,
         ctx: &GpuContext,
@@ -500,14 +500,19 @@ impl ShellRenderer {
             Some(a) => (a.rest_mesh(), Some(a.rig())),
             None => (&scene.mesh, None),
         };
-        self.upload_with(
+        let mut model = self.upload_with(
             ctx,
             mesh,
             &scene.color,
             &textures,
             scene.wetness_resolution,
             ShellUpload { rig, per_corner },
-        )
+        )?;
+        if let Some(animation) = &scene.animation {
+            let (lo, hi) = animation.bounds();
+            model.set_bounds(lo, hi);
+        }
+        Ok(model)
     }
 
     /// Moves the strands' tips: one offset `p − p0` per triangle corner
@@ -720,4 +725,80 @@ fn fur_mip_chain(textures: &ShellTextures) -> (Vec<u8>, u32) {
         }
     }
     (data, levels as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec2;
+    use pelage::mesh::Uvs;
+
+    /// Two triangles over a square sharing the diagonal 0–2; vertex 2's
+    /// UV differs between them when `seam` (a UV seam along the diagonal's
+    /// end).
+    fn square(seam: bool) -> Mesh {
+        let values = vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(0.0, 1.0),
+            Vec2::new(0.5, 0.5),
+        ];
+        let second = if seam { [0, 4, 3] } else { [0, 2, 3] };
+        Mesh::new(
+            "square",
+            vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            vec![[0, 1, 2], [0, 2, 3]],
+            None,
+            Some(Uvs::PerCorner {
+                values,
+                indices: vec![[0, 1, 2], second],
+            }),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn corners_weld_where_vertex_and_uv_agree_and_a_seam_keeps_two() {
+        let welded = WeldedCorners::new(&square(false), false);
+        assert_eq!(welded.mesh_vertices.len(), 4);
+        assert_eq!(welded.indices, vec![0, 1, 2, 0, 2, 3]);
+        let seam = WeldedCorners::new(&square(true), false);
+        assert_eq!(seam.mesh_vertices.len(), 5);
+        assert_eq!(
+            seam.mesh_vertices[3], 2,
+            "vertex 2 again, with its other UV"
+        );
+        assert_eq!(seam.uvs[3], Vec2::new(0.5, 0.5));
+        assert_eq!(seam.indices, vec![0, 1, 2, 0, 3, 4]);
+        let corners = WeldedCorners::new(&square(false), true);
+        assert_eq!(corners.mesh_vertices.len(), 6);
+        // Every vertex stands for a corner of its own mesh vertex.
+        for (i, &c) in seam.corners.iter().enumerate() {
+            let (t, k) = (c as usize / 3, c as usize % 3);
+            assert_eq!(square(true).triangles()[t][k], seam.mesh_vertices[i]);
+        }
+    }
+
+    #[test]
+    fn the_mip_chain_halves_to_one_texel_and_keeps_coverage() {
+        let textures = ShellTextures::generate(&pelage::shell::ShellTextureParams {
+            resolution: 16,
+            layers: 2,
+            ..Default::default()
+        });
+        let (data, levels) = fur_mip_chain(&textures);
+        assert_eq!(levels, 5, "16, 8, 4, 2, 1");
+        let per_layer: usize = [16, 8, 4, 2, 1].iter().map(|s| s * s * 4).sum();
+        assert_eq!(data.len(), 2 * per_layer);
+        // The last level of layer 0 is the mean alpha of its 256 texels.
+        let texels: &[u8] = bytemuck::cast_slice(textures.texels());
+        let mean: f32 = texels[..16 * 16 * 4]
+            .chunks(4)
+            .map(|t| f32::from(t[3]))
+            .sum::<f32>()
+            / 256.0;
+        let last = data[per_layer - 1];
+        assert!((f32::from(last) - mean).abs() <= 2.0, "{last} vs {mean}");
+    }
 }

@@ -39,11 +39,7 @@ impl<'s> ShellScenePlayer<'s> {
             cull_back: scene.fur.cull_back,
         };
         let renderer = ShellRenderer::new(ctx, features);
-        let mut model = renderer.upload_scene(ctx, scene)?;
-        if let Some(animation) = &scene.animation {
-            let (lo, hi) = animation.bounds();
-            model.set_bounds(lo, hi);
-        }
+        let model = renderer.upload_scene(ctx, scene)?;
         let target = ShellTarget::new(ctx, &renderer, width, height)?;
         let camera = scene.camera.map(|c| {
             let (lo, hi) = scene.mesh.bounds();

@@ -117,11 +117,7 @@ impl ShellSession {
         // Curl and clumps are always compiled in, so the sliders can turn
         // them on; at zero they cost little (see `pelage bench shells`).
         let renderer = ShellRenderer::for_format(ctx, format, ShellFeatures::ALL);
-        let mut model = renderer.upload_scene(ctx, &scene)?;
-        if let Some(animation) = &scene.animation {
-            let (lo, hi) = animation.bounds();
-            model.set_bounds(lo, hi);
-        }
+        let model = renderer.upload_scene(ctx, &scene)?;
         let mut params = ShellParams::from_scene(&scene);
         let clump = scene.clump.is_some();
         if !clump {
