@@ -4,6 +4,7 @@
 use crate::{GpuContext, GpuError, GpuMassSpring, ShellModel};
 use glam::Vec3;
 use pelage::dynamics::{MassSpringSystem, Solver, Topology};
+use pelage::shell::ShellAnimation;
 use pelage::shell::scene::DynamicsSettings;
 
 /// Where the skin under the fur is at the end of a step.
@@ -99,13 +100,10 @@ impl FurMotion {
             (_, kept) => self.on_gpu = kept,
         }
         let (skin_offset, posed) = match skin {
-            SkinMotion::Offset(offset) => (offset, false),
-            SkinMotion::Posed { offset, .. } => (offset, true),
-        };
-        match skin {
             SkinMotion::Offset(offset) => {
                 let roots: Vec<Vec3> = self.rest_roots.iter().map(|&r| r + offset).collect();
                 self.system.move_roots(&roots, &self.rest_normals, dt);
+                (offset, false)
             }
             SkinMotion::Posed {
                 positions,
@@ -120,8 +118,9 @@ impl FurMotion {
                 );
                 roots.iter_mut().for_each(|r| *r += offset);
                 self.system.move_roots(&roots, &normals, dt);
+                (offset, true)
             }
-        }
+        };
         let moving = posed || skin_offset != self.skin_offset;
         match &mut self.on_gpu {
             Some(gpu) => {
@@ -146,6 +145,32 @@ impl FurMotion {
         self.skin_moving = moving;
         self.time += dt;
         Ok(())
+    }
+
+    /// [`Self::step`] with a scene's skin: its character posed at
+    /// `seconds` into the clip ([`ShellAnimation::posed`], the pose the GPU
+    /// draws), or without one the skin at rest; either moved by `offset`.
+    pub fn step_scene(
+        &mut self,
+        ctx: &GpuContext,
+        dt: f32,
+        animation: Option<&ShellAnimation>,
+        seconds: f32,
+        offset: Vec3,
+        settings: &DynamicsSettings,
+    ) -> Result<(), GpuError> {
+        match animation {
+            Some(animation) => {
+                let posed = animation.posed(seconds);
+                let skin = SkinMotion::Posed {
+                    positions: &posed.positions,
+                    normals: &posed.normals,
+                    offset,
+                };
+                self.step(ctx, dt, skin, settings)
+            }
+            None => self.step(ctx, dt, SkinMotion::Offset(offset), settings),
+        }
     }
 
     /// Hands the tips to `renderer` for `model`: written in place where the

@@ -677,17 +677,17 @@ impl WeldedCorners {
 /// transparent texel's direction must not leak into its neighbours).
 fn fur_mip_chain(textures: &ShellTextures) -> (Vec<u8>, u32) {
     let r = textures.resolution() as usize;
-    let layers = textures.layers() as usize;
-    let levels = (usize::BITS - r.leading_zeros()) as usize;
     let texels: &[u8] = bytemuck::cast_slice(textures.texels());
-    let mut per_layer: Vec<Vec<Vec<u8>>> = (0..layers)
-        .map(|l| vec![texels[l * r * r * 4..(l + 1) * r * r * 4].to_vec()])
-        .collect();
-    for chain in &mut per_layer {
+    // Halving to one texel: a texture that is not a power of two gets
+    // wgpu's sizes, max(1, r >> level).
+    let levels = usize::BITS - r.leading_zeros();
+    let mut data = Vec::with_capacity(texels.len() * 4 / 3 + 4 * textures.layers() as usize);
+    for layer in texels.chunks_exact(r * r * 4) {
+        data.extend_from_slice(layer);
+        let mut above = layer.to_vec();
         let mut size = r;
         while size > 1 {
             let half = size / 2;
-            let above = chain.last().expect("level 0 is there");
             let mut next = vec![0u8; half * half * 4];
             for y in 0..half {
                 for x in 0..half {
@@ -712,19 +712,12 @@ fn fur_mip_chain(textures: &ShellTextures) -> (Vec<u8>, u32) {
                     next[o + 3] = (alpha / 4.0).round() as u8;
                 }
             }
-            chain.push(next);
+            data.extend_from_slice(&next);
+            above = next;
             size = half;
         }
     }
-    // A texture that is not a power of two gets what levels halving gives.
-    let levels = levels.min(per_layer.first().map_or(1, Vec::len));
-    let mut data = Vec::new();
-    for chain in &per_layer {
-        for level in chain.iter().take(levels) {
-            data.extend_from_slice(level);
-        }
-    }
-    (data, levels as u32)
+    (data, levels)
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
 //! [`ShellScenePlayer`]: a shell scene file drawn frame by frame.
 
-use crate::{Camera, FurMotion, GpuContext, GpuError, SkinMotion};
+use crate::{Camera, FurMotion, GpuContext, GpuError};
 use glam::Vec3;
 
 use super::{ShellFeatures, ShellModel, ShellParams, ShellRenderer, ShellTarget, ShellView};
@@ -79,18 +79,8 @@ impl<'s> ShellScenePlayer<'s> {
         let shake = |t: f32| settings.shake.map_or(Vec3::ZERO, |s| s.offset(t));
         while motion.time() + 0.5 * dt < time {
             let t = motion.time() + dt;
-            match &self.scene.animation {
-                Some(animation) => {
-                    let posed = animation.posed(t);
-                    let skin = SkinMotion::Posed {
-                        positions: &posed.positions,
-                        normals: &posed.normals,
-                        offset: shake(t),
-                    };
-                    motion.step(ctx, dt, skin, settings)?;
-                }
-                None => motion.step(ctx, dt, SkinMotion::Offset(shake(t)), settings)?,
-            }
+            let animation = self.scene.animation.as_ref();
+            motion.step_scene(ctx, dt, animation, t, shake(t), settings)?;
         }
         self.params.coupling = settings.coupling;
         self.params.offset = shake(motion.time());

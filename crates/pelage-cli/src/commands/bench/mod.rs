@@ -175,6 +175,32 @@ pub fn median_seconds<T>(runs: usize, warm_up: bool, mut f: impl FnMut() -> T) -
     (times[times.len() / 2], last.expect("at least one run"))
 }
 
+/// Medians of `frames` runs of each of `runs`, interleaved (one warm-up
+/// each first), in ms.
+pub fn interleaved(
+    frames: usize,
+    runs: &mut [&mut dyn FnMut() -> anyhow::Result<()>],
+) -> anyhow::Result<Vec<f64>> {
+    for run in runs.iter_mut() {
+        run()?;
+    }
+    let mut times = vec![Vec::new(); runs.len()];
+    for _ in 0..frames.max(1) {
+        for (k, run) in runs.iter_mut().enumerate() {
+            let start = Instant::now();
+            run()?;
+            times[k].push(start.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    Ok(times
+        .into_iter()
+        .map(|mut t| {
+            t.sort_by(f64::total_cmp);
+            t[t.len() / 2]
+        })
+        .collect())
+}
+
 /// Runs `f` on a rayon pool of `threads` threads.
 pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> anyhow::Result<T> {
     let pool = rayon::ThreadPoolBuilder::new()

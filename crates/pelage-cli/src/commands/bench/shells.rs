@@ -10,7 +10,6 @@
 //! i.e. with curl and clumps) are printed beside ours for scale; the
 //! target is on the ratio measured here: curl + clump ≤ 1.15 × plain.
 
-use super::median_seconds;
 use crate::format::thousands;
 use clap::Args;
 use pelage::Mesh;
@@ -155,23 +154,16 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
                     },
                     ..ShellParams::from_scene(&scene)
                 };
-                let mut ms = [0.0; 3];
                 // Interleaved: each feature set's frames alternate with the
                 // others', so drift on a noisy machine hits all three alike.
-                let mut times: [Vec<f64>; 3] = Default::default();
-                for _ in 0..args.frames.max(1) {
-                    for k in 0..3 {
-                        let (s, result) = median_seconds(1, times[k].is_empty(), || {
-                            renderers[k].draw(&ctx, &models[k], &params, &view, &targets[k])
-                        });
-                        result?;
-                        times[k].push(s);
-                    }
-                }
-                for k in 0..3 {
-                    times[k].sort_by(f64::total_cmp);
-                    ms[k] = 1e3 * times[k][times[k].len() / 2];
-                }
+                let draw = |k: usize| -> anyhow::Result<()> {
+                    Ok(renderers[k].draw(&ctx, &models[k], &params, &view, &targets[k])?)
+                };
+                let medians = super::interleaved(
+                    args.frames,
+                    &mut [&mut || draw(0), &mut || draw(1), &mut || draw(2)],
+                )?;
+                let ms = [medians[0], medians[1], medians[2]];
                 rows.push(Row {
                     model: name.clone(),
                     triangles: mesh.triangle_count(),

@@ -6,6 +6,7 @@
 //! and fins against shells alone. Every figure is a median of frames
 //! interleaved with its peers', so a noisy machine's drift hits them alike.
 
+use super::interleaved;
 use glam::Vec3;
 use pelage::shell::scene::DynamicsSettings;
 use pelage::shell::{ShellAnimation, ShellScene, ShellTextureParams, ShellTextures};
@@ -13,7 +14,6 @@ use pelage_gpu::{
     FinParams, FurMotion, GpuContext, ShellFeatures, ShellLod, ShellParams, ShellRenderer,
     ShellTarget, ShellUpload, ShellView, SkinMotion,
 };
-use std::time::Instant;
 
 /// One measured configuration: a name and its median frame in ms.
 pub struct Timed {
@@ -48,32 +48,6 @@ pub struct GameFigures {
     pub fins: GameRow,
 }
 
-/// Medians of `frames` runs of each of `runs`, interleaved (one warm-up
-/// each first), in ms.
-fn interleaved(
-    frames: usize,
-    runs: &mut [&mut dyn FnMut() -> anyhow::Result<()>],
-) -> anyhow::Result<Vec<f64>> {
-    for run in runs.iter_mut() {
-        run()?;
-    }
-    let mut times = vec![Vec::new(); runs.len()];
-    for _ in 0..frames.max(1) {
-        for (k, run) in runs.iter_mut().enumerate() {
-            let start = Instant::now();
-            run()?;
-            times[k].push(start.elapsed().as_secs_f64() * 1e3);
-        }
-    }
-    Ok(times
-        .into_iter()
-        .map(|mut t| {
-            t.sort_by(f64::total_cmp);
-            t[t.len() / 2]
-        })
-        .collect())
-}
-
 fn row(what: String, names: &[&'static str], ms: Vec<f64>) -> GameRow {
     GameRow {
         what,
@@ -91,7 +65,7 @@ pub fn measure(ctx: &GpuContext, quick: bool, frames: usize) -> anyhow::Result<G
         geometry: geometry(ctx, quick, frames)?,
         skinned: skinned(ctx, quick, frames)?,
         crowd: crowd(ctx, quick, frames)?,
-        fins: fins(ctx, quick, frames)?,
+        fins: fins(ctx, frames)?,
     })
 }
 
@@ -235,13 +209,7 @@ fn skinned(ctx: &GpuContext, quick: bool, frames: usize) -> anyhow::Result<GameR
     let mut frame_of_run = || -> anyhow::Result<()> {
         for _ in 0..2 {
             let t = moving.time() + dt;
-            let posed = fox.posed(t);
-            let skin = SkinMotion::Posed {
-                positions: &posed.positions,
-                normals: &posed.normals,
-                offset: Vec3::ZERO,
-            };
-            moving.step(ctx, dt, skin, &settings)?;
+            moving.step_scene(ctx, dt, Some(&fox), t, Vec3::ZERO, &settings)?;
         }
         renderer.pose_now(ctx, &skinned, &fox.palette_at(moving.time()))?;
         moving.show(ctx, &renderer, &skinned)?;
@@ -316,7 +284,7 @@ fn crowd(ctx: &GpuContext, quick: bool, frames: usize) -> anyhow::Result<GameRow
 /// The crowd's camera and the 100 objects' offsets: ten rows of ten
 /// (1.8 units apart; rows 3 units apart), seen from above the first row,
 /// from 8 to 35 units away; the near rows spill out of the view.
-pub fn crowd_layout() -> (ShellView, Vec<Vec3>) {
+fn crowd_layout() -> (ShellView, Vec<Vec3>) {
     let eye = Vec3::new(0.0, 4.0, 6.0);
     let view = pelage_gpu::Camera {
         eye,
@@ -340,9 +308,8 @@ pub fn crowd_layout() -> (ShellView, Vec<Vec3>) {
     )
 }
 
-/// spot ×2, 16 layers, 800×600: shells alone, and with fins.
-fn fins(ctx: &GpuContext, quick: bool, frames: usize) -> anyhow::Result<GameRow> {
-    let _ = quick;
+/// spot ×2, 16 layers, 800×600 (quick or not): shells alone, and with fins.
+fn fins(ctx: &GpuContext, frames: usize) -> anyhow::Result<GameRow> {
     let scene = ShellScene::spot();
     let mesh = pelage::assets::spot().subdivided(2);
     let textures = textures(16);

@@ -12,7 +12,7 @@ use pelage::shell::wetness::{Droplet, DropletStyle, droplets_on_mesh, mask_coord
 use pelage::shell::{ShellScene, WetnessMask};
 use pelage_gpu::{
     FinParams, FurMotion, GpuContext, GpuError, OrbitCamera, ShellFeatures, ShellLevel, ShellLod,
-    ShellModel, ShellParams, ShellRenderer, ShellTarget, ShellView, SkinMotion,
+    ShellModel, ShellParams, ShellRenderer, ShellTarget, ShellView,
 };
 use std::time::Instant;
 
@@ -389,20 +389,10 @@ impl ShellSession {
         let h = dt / steps as f32;
         if h > 0.0 {
             for k in 0..steps {
-                match &self.scene.animation {
-                    Some(animation) => {
-                        // The clip's clock has moved on by dt already.
-                        let t = self.controls.clip_time - dt + (k + 1) as f32 * h;
-                        let posed = animation.posed(t);
-                        let skin = SkinMotion::Posed {
-                            positions: &posed.positions,
-                            normals: &posed.normals,
-                            offset,
-                        };
-                        motion.step(ctx, h, skin, settings)?;
-                    }
-                    None => motion.step(ctx, h, SkinMotion::Offset(offset), settings)?,
-                }
+                // The clip's clock has moved on by dt already.
+                let t = self.controls.clip_time - dt + (k + 1) as f32 * h;
+                let animation = self.scene.animation.as_ref();
+                motion.step_scene(ctx, h, animation, t, offset, settings)?;
             }
         }
         self.params.coupling = settings.coupling;
