@@ -97,7 +97,7 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
         wm = context.window_manager
         wm.progress_begin(0, 1)
         try:
-            obj, grown = fur.grow_on_object(
+            obj, grown, warnings = fur.grow_on_object(
                 context, surface, settings, progress=lambda done, total: wm.progress_update(done / total)
             )
         except PelageError as error:
@@ -105,6 +105,8 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
             return {"CANCELLED"}
         finally:
             wm.progress_end()
+        for warning in warnings:
+            self.report({"WARNING"}, f"pelage: {warning}")
         self.report({"INFO"}, f"pelage: {grown.curve_count:,} hairs, {grown.point_count:,} points on {surface.name}")
         return {"FINISHED"}
 
@@ -128,6 +130,9 @@ class _PelageExport(ExportHelper):
         except PelageError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
+        if summary["report"] is not None:
+            for warning in fur.guide_warnings(summary["report"]):
+                self.report({"WARNING"}, f"pelage: {warning}")
         self.report({"INFO"}, f"pelage: wrote {summary['hairs']:,} hairs to {summary['path']}")
         return {"FINISHED"}
 

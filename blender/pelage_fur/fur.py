@@ -164,9 +164,19 @@ def deform_on_surface_modifier(obj):
     return modifier
 
 
+def guide_warnings(report):
+    """The guides a groom leaves out, with why, from its report (the
+    library's: ``Groom.report()`` or ``Groom.write()["report"]``)."""
+    guides = report["guides"]
+    notes = [f"guide {d['guide']} left out: {d['why']}" for d in guides["dropped"]]
+    notes += [note["why"] for note in guides["unused_by_style_mesh"]]
+    return notes
+
+
 def grow_on_object(context, surface, settings, progress=None):
     """Grows fur on the mesh object ``surface`` and links a Curves object
-    parented to it. Returns ``(curves_object, pelage_curves)``."""
+    parented to it. Returns ``(curves_object, pelage_curves, warnings)``:
+    the guides the groom left out, with why."""
     import bpy
 
     depsgraph = context.evaluated_depsgraph_get()
@@ -188,4 +198,4 @@ def grow_on_object(context, surface, settings, progress=None):
         surface.add_rest_position_attribute = True
         deform_on_surface_modifier(obj)
     obj["pelage_settings"] = groom.settings
-    return obj, grown
+    return obj, grown, guide_warnings(groom.report())

@@ -179,4 +179,14 @@ with tempfile.TemporaryDirectory() as folder:
         assert pelage.read_curves(out).curve_count == 700
     print("export: USD and Alembic written, 700 curves each")
 
+    # 5. The guides a groom leaves out reach the user, from the library's report.
+    # The add-on's module, wherever Blender installed the extension.
+    fur = next(m for name, m in sys.modules.items() if name.endswith("pelage_fur.fur"))
+
+    report = pelage.Groom.load(good).report()
+    assert fur.guide_warnings(report) == [], report
+    report["guides"]["dropped"] = [{"guide": 3, "why": "its root is 0.2 from the surface"}]
+    assert fur.guide_warnings(report) == ["guide 3 left out: its root is 0.2 from the surface"]
+    print("guides left out: reported from the library's report")
+
 print("add-on: all checks passed")

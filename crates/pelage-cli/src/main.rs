@@ -5,7 +5,7 @@
 //! Errors print as `error: …` followed by their causes, and exit with 2.
 
 mod commands;
-mod format;
+use pelage_bench::format;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -96,23 +96,11 @@ fn remove_temporary_files_on_signals() {
     });
 }
 
-/// The error and its causes on one line, "a: b: c", each cause left out
-/// when the message so far already says it (pelage's errors name the
-/// error underneath in their message and also give it as their `source`,
-/// for programs that inspect it).
+/// The error and its causes on one line, "a: b: c": each error prints
+/// its cause or returns it as its `source`, never both, so every cause is
+/// said once.
 pub(crate) fn one_line(err: &anyhow::Error) -> String {
-    let mut line = String::new();
-    for cause in err.chain() {
-        let text = cause.to_string();
-        if line.contains(&text) {
-            continue;
-        }
-        if !line.is_empty() {
-            line.push_str(": ");
-        }
-        line.push_str(&text);
-    }
-    line
+    format!("{err:#}")
 }
 
 /// Mesa's `VK_LAYER_MESA_device_select` (an implicit Vulkan layer, there

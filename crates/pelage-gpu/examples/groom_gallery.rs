@@ -3,7 +3,7 @@
 //! grown once without operators and once with each operator alone, seen
 //! from the same camera; `groom-operators.png` puts them on one sheet in
 //! the order none, noise, frizz, clump, clump on two levels, curl, cut,
-//! length, strands, width, colour. Rendered by the preview renderer (lavapipe serves
+//! length, strands, width, colour, twist, flyaways. Rendered by the preview renderer (lavapipe serves
 //! without a GPU).
 //!
 //! ```sh
@@ -58,7 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..PreviewStyle::default()
     };
     let gallery = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/gallery");
-    let cases: [(&str, u32, &str); 11] = [
+    let cases: [(&str, u32, &str); 13] = [
         ("none", 2500, ""),
         (
             "noise",
@@ -109,6 +109,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "color",
             2500,
             "[[ops]]\ncolor = { root = [0.05, 0.03, 0.02], tip = [0.95, 0.8, 0.55], ramp = \"smooth\", jitter = 0.3 }\n",
+        ),
+        (
+            "twist",
+            900,
+            "[[ops]]\ntwist = { angle = 270, jitter = 0.2 }\n",
+        ),
+        (
+            "flyaways",
+            2500,
+            "[[ops]]\nclump = { count = 40, rate = 0.85 }\n[[ops]]\nflyaways = { spread = 0.12, fraction = 0.06, length = 1.35, frequency = 3 }\n",
         ),
     ];
     let mut index = String::new();

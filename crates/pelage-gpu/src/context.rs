@@ -64,8 +64,8 @@ impl GpuContext {
             compatible_surface: surface,
             ..Default::default()
         };
-        let adapter = pollster::block_on(instance.request_adapter(&options))
-            .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let adapter =
+            pollster::block_on(instance.request_adapter(&options)).map_err(GpuError::NoAdapter)?;
         let info = adapter.get_info();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("pelage"),
@@ -75,9 +75,9 @@ impl GpuContext {
             required_limits: adapter.limits(),
             ..Default::default()
         }))
-        .map_err(|e| GpuError::Device {
+        .map_err(|error| GpuError::Device {
             adapter: info.name.clone(),
-            message: e.to_string(),
+            error,
         })?;
         let errors = Arc::new(Mutex::new(None));
         let sink = errors.clone();

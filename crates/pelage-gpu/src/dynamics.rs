@@ -581,7 +581,7 @@ impl GpuMassSpring {
         ctx.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| GpuError::Readback(e.to_string()))
+            .map_err(|e| GpuError::Readback(e.into()))
     }
 
     /// The current tip positions and velocities, read back.

@@ -40,16 +40,17 @@ pub use wgpu;
 pub enum GpuError {
     /// No adapter: no GPU, and no software Vulkan driver either.
     #[error(
-        "no GPU adapter found ({0}); for a software renderer install Mesa's Vulkan drivers (Debian/Ubuntu: apt-get install mesa-vulkan-drivers), or choose a backend with WGPU_BACKEND=vulkan|gl"
+        "no GPU adapter found; for a software renderer install Mesa's Vulkan drivers (Debian/Ubuntu: apt-get install mesa-vulkan-drivers), or choose a backend with WGPU_BACKEND=vulkan|gl"
     )]
-    NoAdapter(String),
+    NoAdapter(#[source] wgpu::RequestAdapterError),
     /// The adapter refused to create a device.
-    #[error("the GPU adapter {adapter} could not open a device: {message}")]
+    #[error("the GPU adapter {adapter} could not open a device")]
     Device {
         /// The adapter's name.
         adapter: String,
-        /// wgpu's message.
-        message: String,
+        /// wgpu's error.
+        #[source]
+        error: wgpu::RequestDeviceError,
     },
     /// The GPU reported an error while drawing (out of memory, a limit).
     #[error("the GPU ({adapter}) failed: {message}")]
@@ -60,8 +61,8 @@ pub enum GpuError {
         message: String,
     },
     /// Reading the rendered image back failed.
-    #[error("reading the rendered image back from the GPU failed: {0}")]
-    Readback(String),
+    #[error("reading back from the GPU failed")]
+    Readback(#[source] Box<dyn std::error::Error + Send + Sync>),
     /// Images are read back only from 8-bit RGBA or BGRA targets.
     #[error("images can be read back from Rgba8/Bgra8 renderers only, not {0}")]
     Format(String),

@@ -72,17 +72,17 @@ pub(crate) fn map_read<T>(
     let waited = ctx
         .device
         .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| GpuError::Readback(e.to_string()));
+        .map_err(|e| GpuError::Readback(e.into()));
     // A resource that could not be made explains everything after it.
     ctx.check()?;
     waited?;
     receiver
         .recv()
-        .map_err(|e| GpuError::Readback(e.to_string()))?
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
+        .map_err(|e| GpuError::Readback(e.into()))?
+        .map_err(|e| GpuError::Readback(e.into()))?;
     let mapped = buffer
         .get_mapped_range(..)
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
+        .map_err(|e| GpuError::Readback(e.into()))?;
     let value = read(&mapped);
     drop(mapped);
     buffer.unmap();

@@ -333,13 +333,7 @@ fn write_one(
 }
 
 pub(crate) fn parse_basis(basis: &str) -> PyResult<CurveBasis> {
-    match basis {
-        "catmull-rom" | "catmullRom" => Ok(CurveBasis::CatmullRom),
-        "linear" => Ok(CurveBasis::Linear),
-        other => Err(PyValueError::new_err(format!(
-            "basis = {other:?}: use \"catmull-rom\" or \"linear\""
-        ))),
-    }
+    basis.parse().map_err(PyValueError::new_err)
 }
 
 /// Offsets: a 1-D integer column, checked to fit u32 before it narrows.

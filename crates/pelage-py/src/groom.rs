@@ -11,10 +11,9 @@ use crate::curves::PyCurves;
 use crate::mesh::PyMesh;
 use crate::to_py_err;
 use pelage::groom::{
-    AnimatedGroom, Generator, Groom, GroomError, GroomInputs, GroomWriteError, part_file,
-    part_slice,
+    AnimatedGroom, Assembly, FarmRun, Generator, Groom, GroomError, GroomInputs, GroomReport,
+    GroomWriteError, ReportBuilder, Timings,
 };
-use pelage::io::{CurvesExport, UsdOptions};
 use pelage::settings::SettingsSource;
 use pyo3::exceptions::{PyIndexError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -388,7 +387,9 @@ impl PyGroom {
     /// `part=(k, n)` writes run k of n of a farm (docs/farm.md) to the
     /// part file beside `path`. An animated groom writes every frame.
     /// `progress(done, total)` is called as parts (and frames) are
-    /// written. Returns `{"path", "hairs", "points"}`.
+    /// written. Returns `{"path", "hairs", "points", "report"}`:
+    /// `report` (a still groom's) is what `pelage groom --report` writes —
+    /// hairs per part and region, the guides left out and why, timings.
     #[pyo3(signature = (path = None, *, part = None, seed = None, progress = None))]
     fn write<'py>(
         &self,
@@ -399,7 +400,11 @@ impl PyGroom {
         progress: Option<Py<PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let output = path.unwrap_or_else(|| self.groom.output_path());
-        let file = self.groom.file();
+        let run = part
+            .map(|(k, n)| FarmRun::new(k, n))
+            .transpose()
+            .map_err(|e| PyValueError::new_err(format!("part = {part:?}: {e}")))?;
+        let started = std::time::Instant::now();
         // A progress callback runs Python: it re-attaches from the writer's
         // thread; its first exception is raised when the write returns.
         let callback_error: std::sync::Mutex<Option<PyErr>> = std::sync::Mutex::new(None);
@@ -424,41 +429,44 @@ impl PyGroom {
                 .map_err(|e| self.error(e))?
                 .map(Arc::new),
         };
-        let (summary, written) = if let Some(animated) = animated {
-            let parts = animated.generator().parts().len();
-            let (range, path) = farm_slice(&output, part, parts)?;
-            let options = UsdOptions {
-                basis: file.output.basis,
-                time_codes_per_second: self.groom.fps().unwrap_or(24.0),
-                ..UsdOptions::default()
-            };
-            let with_skin = file.output.with_mesh && part.is_none_or(|(k, _)| k == 1);
+        let farm = |parts: usize| match run {
+            None => Ok((0..parts, output.clone())),
+            Some(run) => run
+                .parts(parts)
+                .map(|range| (range, run.file(&output)))
+                .map_err(|e| PyValueError::new_err(format!("part = {part:?}: {e}"))),
+        };
+        let (summary, written, grown) = if let Some(animated) = animated {
+            let (range, path) = farm(animated.generator().parts().len())?;
+            let options = self.groom.usd_options();
+            let with_skin = self.groom.writes_skin_in(run);
             let summary = py.detach(|| {
                 animated.write(&path, range, &options, with_skin, |p| {
                     report(p.done, p.total)
                 })
             });
-            (summary, path)
+            (summary, path, None)
         } else {
             let generator = self.generator(py, seed)?;
-            let parts = generator.parts().len();
-            let (range, path) = farm_slice(&output, part, parts)?;
-            let export = CurvesExport {
-                usd: UsdOptions {
-                    basis: file.output.basis,
-                    ..UsdOptions::default()
-                },
-                mesh: file.output.with_mesh.then(|| self.groom.mesh()),
-            };
+            let (range, path) = farm(generator.parts().len())?;
+            let export = self.groom.export();
             let total = range.len();
             let mut done = 0;
+            let mut gathered = ReportBuilder::new(&generator);
+            let setup = started.elapsed().as_secs_f64();
             let summary = py.detach(|| {
-                generator.write(&path, range, &export, |_, _| {
+                generator.write(&path, range, &export, |p, curves| {
+                    gathered.add_part(&generator, p, curves);
                     done += 1;
                     report(done, total);
                 })
             });
-            (summary, path)
+            let timings = Timings {
+                setup,
+                grow_and_write: started.elapsed().as_secs_f64() - setup,
+            };
+            let grown = gathered.finish(&generator, Some(&self.groom), Some(&path), timings);
+            (summary, path, Some(grown))
         };
         if let Some(e) = callback_error.into_inner().expect("not poisoned") {
             return Err(e);
@@ -471,6 +479,56 @@ impl PyGroom {
         result.set_item("path", written)?;
         result.set_item("hairs", summary.hairs)?;
         result.set_item("points", summary.points)?;
+        let report = match grown {
+            Some(grown) => report_dict(py, &grown)?,
+            None => py.None().into_bound(py),
+        };
+        result.set_item("report", report)?;
+        Ok(result)
+    }
+
+    /// The groom's report before it grows: the guides kept, those left out
+    /// when binding and those the style mesh never uses, each with why,
+    /// and each region's guides (`write` returns the full report, with
+    /// hairs per part and region).
+    #[pyo3(signature = (*, seed = None))]
+    fn report<'py>(&self, py: Python<'py>, seed: Option<u64>) -> PyResult<Bound<'py, PyAny>> {
+        let generator = self.generator(py, seed)?;
+        let report = ReportBuilder::new(&generator).finish(
+            &generator,
+            Some(&self.groom),
+            None,
+            Timings::default(),
+        );
+        report_dict(py, &report)
+    }
+
+    /// Ties a farm's files beside `path` (default `output_path`) together,
+    /// as `pelage groom FILE --assemble` does: a still groom's part files
+    /// referenced from one USD layer (name it .usda), an animated groom's
+    /// frame files stitched with value clips. Returns `{"path", "files"}`
+    /// and, for a still groom, `"extent"` (lowest and highest corner).
+    #[pyo3(signature = (path = None))]
+    fn assemble<'py>(
+        &self,
+        py: Python<'py>,
+        path: Option<PathBuf>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let output = path.unwrap_or_else(|| self.groom.output_path());
+        let assembled = py
+            .detach(|| self.groom.assemble(&output))
+            .map_err(to_py_err)?;
+        let result = PyDict::new(py);
+        result.set_item("path", &output)?;
+        match assembled {
+            Assembly::Parts { files, extent } => {
+                result.set_item("files", files)?;
+                result.set_item("extent", (extent.0.to_array(), extent.1.to_array()))?;
+            }
+            Assembly::Frames(stitched) => {
+                result.set_item("files", stitched.files)?;
+            }
+        }
         Ok(result)
     }
 
@@ -530,22 +588,12 @@ fn check_part(p: usize, parts: usize) -> PyResult<()> {
     )))
 }
 
-/// The parts run `k` of `n` writes and the file it writes them to, or
-/// every part to `output`.
-fn farm_slice(
-    output: &Path,
-    part: Option<(usize, usize)>,
-    parts: usize,
-) -> PyResult<(std::ops::Range<usize>, PathBuf)> {
-    match part {
-        None => Ok((0..parts, output.to_path_buf())),
-        Some((k, n)) if n >= 1 && (1..=n).contains(&k) => {
-            Ok((part_slice(k, n, parts), part_file(output, k, n)))
-        }
-        Some((k, n)) => Err(PyValueError::new_err(format!(
-            "part = ({k}, {n}): run k of n, with 1 <= k <= n"
-        ))),
-    }
+/// A groom report as the dict `json.loads` makes of the CLI's `--report`
+/// (one schema: the library's).
+fn report_dict<'py>(py: Python<'py>, report: &GroomReport) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(report)
+        .map_err(|e| PyValueError::new_err(format!("the report: {e}")))?;
+    py.import("json")?.call_method1("loads", (text,))
 }
 
 /// A groom error as a `PelageError`. For a groom built from values, the

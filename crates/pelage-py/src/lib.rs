@@ -1,16 +1,17 @@
 //! pelage for Python: the `pelage._pelage` extension module.
 //!
-//! A thin layer over the library (DESIGN.md, "Bindings": it holds no logic
-//! the library lacks). Each Python class wraps one Rust value:
+//! A thin layer over the library (docs/design.md, "Library first, front
+//! ends thin": it holds no logic the library lacks). Each Python class
+//! wraps one Rust value, one file each:
 //!
-//! - [`mesh::PyMesh`] wraps [`pelage::Mesh`] (loaded, or built from numpy
+//! - `mesh.rs`: `PyMesh` wraps [`pelage::Mesh`] (loaded, or built from numpy
 //!   arrays);
-//! - [`sample::sample`] runs the density sampler (Sik §3) and hands back
+//! - `sample.rs`: `sample` runs the density sampler (Sik §3) and hands back
 //!   numpy arrays;
-//! - [`groom::PyGroom`] wraps a [`pelage::groom::Groom`]: a groom file, or
+//! - `groom.rs`: `PyGroom` wraps a [`pelage::groom::Groom`]: a groom file, or
 //!   Python dicts turned into the same settings and checked by the same
 //!   code, so errors name the same keys;
-//! - [`curves::PyCurves`] wraps [`pelage::Curves`], with read-only numpy
+//! - `curves.rs`: `PyCurves` wraps [`pelage::Curves`], with read-only numpy
 //!   views of its arrays (no copy) and every curves format in and out.
 //!
 //! Errors become `pelage.PelageError` carrying pelage's message (file,
@@ -33,24 +34,20 @@ pyo3::create_exception!(
 );
 
 /// Turns any pelage error into a `PelageError` carrying its message and
-/// the messages of its causes.
+/// the messages of its causes, "a: b: c" (each error prints its cause or
+/// returns it as its `source`, never both, so each is said once).
 pub(crate) fn to_py_err(error: impl std::error::Error) -> PyErr {
     PelageError::new_err(with_causes(error.to_string(), error.source()))
 }
 
-/// `message`, then the message of `cause` and of each cause under it,
-/// leaving out those the text already holds (errors that print their
-/// cause and also give it as their source).
+/// `message`, then the message of `cause` and of each cause under it.
 pub(crate) fn with_causes(
     mut message: String,
     mut cause: Option<&(dyn std::error::Error + 'static)>,
 ) -> String {
     while let Some(error) = cause {
-        let text = error.to_string();
-        if !message.contains(&text) {
-            message.push_str(": ");
-            message.push_str(&text);
-        }
+        message.push_str(": ");
+        message.push_str(&error.to_string());
         cause = error.source();
     }
     message
@@ -74,5 +71,25 @@ fn _pelage(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sample::sample, m)?)?;
     m.add_function(wrap_pyfunction!(curves::read_curves, m)?)?;
     m.add_function(wrap_pyfunction!(curves::write_curves, m)?)?;
+    m.add_function(wrap_pyfunction!(operator_schema, m)?)?;
     Ok(())
+}
+
+/// Every groom operator's settings as the library defines them: a list of
+/// dicts with `name`, `summary`, `fields` (every key, `mask` included)
+/// and `required`. `pelage.ops` builds these tables; a test holds its
+/// functions to this schema.
+#[pyfunction]
+fn operator_schema(py: Python<'_>) -> PyResult<Vec<Bound<'_, pyo3::types::PyDict>>> {
+    pelage::groom::ops::operator_schema()
+        .into_iter()
+        .map(|op| {
+            let d = pyo3::types::PyDict::new(py);
+            d.set_item("name", op.name)?;
+            d.set_item("summary", op.summary)?;
+            d.set_item("fields", op.fields)?;
+            d.set_item("required", op.required)?;
+            Ok(d)
+        })
+        .collect()
 }

@@ -125,8 +125,32 @@ def test_farm_runs_write_part_files(groom, tmp_path):
     assert [p.name for p in written] == ["fur.part-1-of-2.usda", "fur.part-2-of-2.usda"]
     total = sum(pelage.read_curves(p).curve_count for p in written)
     assert total == 5_000
-    with pytest.raises(ValueError, match="1 <= k <= n"):
+    with pytest.raises(ValueError, match="K must be 1 to N"):
         groom.write(out, part=(3, 2))
+    # The library's assembly, as `pelage groom --assemble` runs it.
+    assembled = groom.assemble(out)
+    assert [p.name for p in assembled["files"]] == [p.name for p in written]
+    layer = out.read_text()
+    assert "fur.part-1-of-2.usda" in layer and "fur.part-2-of-2.usda" in layer
+    lo, hi = assembled["extent"]
+    assert all(a < b for a, b in zip(lo, hi))
+
+
+def test_the_report_before_growing_has_the_guides_and_no_parts(groom):
+    report = groom.report()
+    assert report["guides"] == {"kept": 60, "dropped": [], "unused_by_style_mesh": []}
+    assert report["parts"] == [] and report["hairs"] == 0
+
+
+def test_write_returns_the_groom_report(groom, tmp_path):
+    report = groom.write(tmp_path / "fur.usdc")["report"]
+    assert report["hairs"] == 5_000
+    assert [p["part"] for p in report["parts"]] == [0, 1, 2, 3]
+    assert sum(p["hairs"] for p in report["parts"]) == 5_000
+    assert report["guides"]["kept"] == 60
+    assert report["guides"]["dropped"] == []
+    assert report["output"].endswith("fur.usdc")
+    assert report["seconds"]["grow_and_write"] > 0
 
 
 def test_growth_releases_the_interpreter(spot):
@@ -214,3 +238,25 @@ def test_regions_masks_and_stable_ids_from_python(spot):
         assert np.array_equal(a, b), f"hair {i} changed"
     with pytest.raises(pelage.PelageError, match="regions: the mesh has no face sets"):
         small_groom(spot, regions={"faces": "groups"}).grow()
+
+
+def test_the_ops_builders_match_the_librarys_operator_schema():
+    """`pelage.ops` is written by hand; this holds it to the operators the
+    library defines (their serde definitions), so a new operator or key
+    without its builder fails here."""
+    import inspect
+
+    schema = pelage._pelage.operator_schema()
+    builders = {
+        name: fn
+        for name, fn in vars(pelage.ops).items()
+        if inspect.isfunction(fn) and not name.startswith("_")
+    }
+    assert sorted(builders) == sorted(op["name"] for op in schema)
+    for op in schema:
+        params = inspect.signature(builders[op["name"]]).parameters
+        # Python puts required arguments first; the sets must agree.
+        assert sorted(params) == sorted(op["fields"]), op["name"]
+        required = [k for k, p in params.items() if p.default is inspect.Parameter.empty]
+        assert sorted(required) == sorted(op["required"]), op["name"]
+        assert builders[op["name"]].__doc__.strip() == op["summary"], op["name"]

@@ -17,13 +17,22 @@
 //! - [`interp`]: guide interpolation — Shepard over a kd-tree (Sik §4.2.2)
 //!   and the style mesh (Furtility).
 //! - [`groom`]: the groom generator: groom files (TOML), operators
-//!   (noise, frizz, clump, curl, cut, length, strands, width, colour),
-//!   parts, deterministic generation (Sik §4).
+//!   (one module each: noise, frizz, clump, curl, cut, length, strands,
+//!   width, colour, opacity, twist, flyaways), parts, deterministic
+//!   generation (Sik §4), animated grooms and farm output.
+//! - [`anim`]: animated skins (USD time samples, OBJ/PLY sequences, glTF
+//!   clips through [`anim::SkinRig`]) and hairs bound to them at rest.
+//! - [`dynamics`]: mass-spring systems for shell fur (Banisch, Silva):
+//!   four topologies, explicit and implicit solvers, wind and brushes.
 //! - [`shell`]: shell fur — shell textures (Banisch), the wetness mask and
 //!   the curl / clump / Kajiya-Kay reference math (Silva) that the GPU
 //!   shaders mirror, and shell scene files.
-//! - [`io`]: curves and points in and out (USD, .hair, PLY, RIB, pbrt),
-//!   every writer atomic (temporary file, then rename).
+//! - [`io`]: curves and points in and out (USD usda and usdc, Alembic,
+//!   .hair, PLY, RIB, pbrt), every writer atomic (temporary file, then
+//!   rename).
+//! - [`settings`]: TOML settings files read with every error at its line
+//!   and key, and numbers checked against documented ranges.
+//! - [`limits`]: every ceiling on a count or size read from a file.
 //! - [`assets`]: the embedded demo mesh (Spot), so every command works with
 //!   no files at hand.
 //!

@@ -281,10 +281,10 @@ impl std::fmt::Display for Bound {
 /// array indices left out (`ops.clump.count` holds for every clump
 /// operator; an array value such as `gravity = [0, -9.8, 0]` holds for each
 /// element), and `why` is said when the value is refused.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Rule {
     /// Dotted key without indices.
-    pub key: &'static str,
+    pub key: std::borrow::Cow<'static, str>,
     /// The values allowed.
     pub bound: Bound,
     /// What the bound protects, said after it ("" for nothing).
@@ -294,7 +294,21 @@ pub struct Rule {
 impl Rule {
     /// A rule for `key`.
     pub const fn new(key: &'static str, bound: Bound, why: &'static str) -> Self {
-        Self { key, bound, why }
+        Self {
+            key: std::borrow::Cow::Borrowed(key),
+            bound,
+            why,
+        }
+    }
+
+    /// A rule for a key made at run time (an operator's settings under
+    /// `ops.NAME`).
+    pub fn owned(key: String, bound: Bound, why: &'static str) -> Self {
+        Self {
+            key: std::borrow::Cow::Owned(key),
+            bound,
+            why,
+        }
     }
 }
 
@@ -386,16 +400,8 @@ mod tests {
     }
 
     const RULES: &[Rule] = &[
-        Rule {
-            key: "roots.count",
-            bound: Bound::Within(1.0, 100.0),
-            why: "a test ceiling",
-        },
-        Rule {
-            key: "ops.clump.rate",
-            bound: Bound::Within(0.0, 1.0),
-            why: "",
-        },
+        Rule::new("roots.count", Bound::Within(1.0, 100.0), "a test ceiling"),
+        Rule::new("ops.clump.rate", Bound::Within(0.0, 1.0), ""),
     ];
 
     #[test]

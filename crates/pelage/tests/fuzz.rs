@@ -529,7 +529,7 @@ fn fuzz_groom_toml() {
                 path: "fuzz.toml".into(),
                 text: text.to_string(),
             };
-            let _ = source.parse();
+            let _ = source.check_groom();
         }
     });
 }

@@ -6,11 +6,11 @@ use glam::Vec3;
 use pelage::Curves;
 use pelage::groom::ops::{Color, Cut, RootToTip};
 use pelage::groom::{
-    ClumpParams, CurlParams, FrizzParams, Groom, GroomError, GroomOp, GroomSpec, LengthParams,
-    NoiseParams, Ramp, RootsSpec, StrandsParams,
+    ClumpParams, CurlParams, FlyawaysParams, FrizzParams, Groom, GroomError, GroomErrorKind,
+    GroomOp, GroomSpec, LengthParams, NoiseParams, Ramp, RootsSpec, StrandsParams, TwistParams,
 };
 use pelage::guides::{GuideGrowth, Guides};
-use pelage::map::{Map, NoiseMap};
+use pelage::map::{Map, MapErrorKind, NoiseMap};
 use std::collections::HashSet;
 use std::sync::Arc;
 
@@ -42,6 +42,12 @@ noise = { amplitude = 0.003, frequency = "noise:frequency=2,offset=30,scale=10" 
 
 [[ops]]
 frizz = { amplitude = 0.002, fraction = 0.3 }
+
+[[ops]]
+twist = { angle = 60, jitter = 0.3 }
+
+[[ops]]
+flyaways = { spread = 0.01, fraction = 0.1 }
 
 [[ops]]
 length = { scale = 1.0, jitter = 0.2 }
@@ -163,6 +169,14 @@ fn every_operator_in_code() -> GroomSpec {
             fraction: c(0.3),
             ..FrizzParams::new(c(0.002))
         }))
+        .with_op(GroomOp::Twist(TwistParams {
+            jitter: c(0.3),
+            ..TwistParams::new(c(60.0))
+        }))
+        .with_op(GroomOp::Flyaways(FlyawaysParams {
+            fraction: c(0.1),
+            ..FlyawaysParams::new(c(0.01))
+        }))
         .with_op(GroomOp::Length(LengthParams {
             jitter: c(0.2),
             ..LengthParams::new(c(1.0))
@@ -198,32 +212,32 @@ fn a_groom_built_in_code_equals_the_same_groom_file() {
         "<groom>: roots.count: the hair count must be at least 1"
     );
     let mut no_strand = every_operator_in_code();
-    no_strand.ops[7] = GroomOp::Strands(StrandsParams::new(0, Map::Constant(0.1)));
+    no_strand.ops[9] = GroomOp::Strands(StrandsParams::new(0, Map::Constant(0.1)));
     let err = no_strand.generator().unwrap_err().to_string();
-    assert!(err.starts_with("<groom>: ops[7].strands.count: "), "{err}");
+    assert!(err.starts_with("<groom>: ops[9].strands.count: "), "{err}");
 }
 
 #[test]
-fn errors_keep_the_error_underneath_as_their_source() {
+fn errors_say_each_cause_once_and_keep_it_typed() {
     let text = "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\ndensity = \"missing.png:r\"\n[guides]\ngenerate = { count = 5, length = 0.1 }\n";
     let err = groom(text).generator(None).unwrap_err();
+    let message = err.to_string();
     assert!(
-        err.to_string()
-            .starts_with("test.toml:5:11: roots.density: "),
-        "{err}"
+        message.starts_with("test.toml:5:11: roots.density: "),
+        "{message}"
     );
-    let mut chain = Vec::new();
-    let mut cause = std::error::Error::source(&err);
-    while let Some(c) = cause {
-        chain.push(c);
-        cause = c.source();
-    }
-    assert!(chain[0].is::<pelage::MapError>(), "{chain:?}");
-    let io = chain.last().unwrap().downcast_ref::<std::io::Error>();
-    assert_eq!(
-        io.map(std::io::Error::kind),
-        Some(std::io::ErrorKind::NotFound)
-    );
+    // The message says the map's file once and the system's reason, and
+    // no cause is handed on to be said again.
+    assert_eq!(message.matches("missing.png").count(), 1, "{message}");
+    assert!(std::error::Error::source(&err).is_none());
+    // Programs still reach the cause, typed.
+    let GroomErrorKind::Map(map) = &err.kind else {
+        panic!("{:?}", err.kind)
+    };
+    let MapErrorKind::Io(io) = &map.kind else {
+        panic!("{:?}", map.kind)
+    };
+    assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
 }
 
 #[test]
@@ -485,4 +499,66 @@ fn a_mesh_and_guides_given_as_values_replace_the_files() {
     let e = Groom::from_source_with_inputs(source(no_guides), None, GroomInputs::default())
         .unwrap_err();
     assert_eq!(e.key.as_deref(), Some("mesh"), "{e}");
+}
+
+/// The groom's hairs, all parts joined.
+fn grown(text: &str) -> Curves {
+    let generator = groom(text).generator(None).unwrap();
+    let parts: Vec<Curves> = (0..generator.parts().len())
+        .map(|p| generator.part(p).unwrap())
+        .collect();
+    pelage::io::join(parts.iter()).unwrap()
+}
+
+#[test]
+fn flyaways_move_only_their_fraction_and_nothing_under_a_zero_mask() {
+    let base = "[mesh]\npath = \"spot\"\n[roots]\ncount = 4000\n[guides]\ngenerate = { count = 40, length = 0.05 }\n[finish]\npoints = 6\n[[ops]]\nclump = { count = 40 }\n";
+    let plain = grown(base);
+    let strays = grown(&format!(
+        "{base}[[ops]]\nflyaways = {{ spread = 0.02, fraction = 0.25 }}\n"
+    ));
+    assert_eq!(plain.ids(), strays.ids(), "the same hairs");
+    let moved = (0..plain.curve_count())
+        .filter(|&i| plain.points()[plain.range(i)] != strays.points()[strays.range(i)])
+        .count();
+    // Binomial(4000, 0.25): mean 1000, σ ≈ 27; ±5σ.
+    assert!((865..=1135).contains(&moved), "{moved} hairs moved");
+    let masked = grown(&format!(
+        "{base}[[ops]]\nflyaways = {{ spread = 0.02, fraction = 0.25, mask = 0 }}\n"
+    ));
+    assert_eq!(
+        masked.points(),
+        plain.points(),
+        "a zero mask keeps every hair"
+    );
+}
+
+#[test]
+fn twist_turns_hairs_about_their_chord_keeping_roots_and_tips() {
+    let base = "[mesh]\npath = \"spot\"\n[roots]\ncount = 500\n[guides]\ngenerate = { count = 40, length = 0.05, comb = [0, -0.6, -1], gravity = 0.3 }\n[finish]\npoints = 9\n";
+    let plain = grown(base);
+    let twisted = grown(&format!(
+        "{base}[[ops]]\ntwist = {{ angle = 90, ramp = \"constant\" }}\n"
+    ));
+    for i in 0..plain.curve_count() {
+        let (a, b) = (
+            &plain.points()[plain.range(i)],
+            &twisted.points()[twisted.range(i)],
+        );
+        let (root, tip) = (a[0], a[a.len() - 1]);
+        assert!((b[0] - root).length() < 1e-6 && (b[b.len() - 1] - tip).length() < 1e-5);
+        let axis = (tip - root).normalize();
+        for (p, q) in a.iter().zip(b) {
+            // A quarter turn about the chord: the same height along it and
+            // distance from it, and the offset from it turned by 90°.
+            let (u, v) = (*p - root, *q - root);
+            let (pu, pv) = (u - axis * u.dot(axis), v - axis * v.dot(axis));
+            assert!((u.dot(axis) - v.dot(axis)).abs() < 1e-5);
+            assert!((pu.length() - pv.length()).abs() < 1e-5);
+            if pu.length() > 1e-4 {
+                let cos = pu.dot(pv) / (pu.length() * pv.length());
+                assert!(cos.abs() < 1e-2, "hair {i}: cos {cos}");
+            }
+        }
+    }
 }

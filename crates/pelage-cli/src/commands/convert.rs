@@ -4,6 +4,7 @@
 
 use super::load_mesh;
 use anyhow::Context;
+use clap::builder::TypedValueParser;
 use clap::{Args, ValueEnum};
 use pelage::io::{
     CurveBasis, CurvesExport, UpAxis, UsdOptions, UsdWrap, read_curves, write_curves,
@@ -19,8 +20,13 @@ pub struct ConvertArgs {
     /// .hair, .ply, .rib or .pbrt.
     pub output: PathBuf,
     /// How the points are interpolated (USD, RIB, pbrt).
-    #[arg(long, value_enum, default_value_t = BasisArg::CatmullRom)]
-    pub basis: BasisArg,
+    #[arg(
+        long,
+        default_value_t = CurveBasis::CatmullRom,
+        value_parser = clap::builder::PossibleValuesParser::new(CurveBasis::NAMES)
+            .try_map(|s: String| s.parse::<CurveBasis>()),
+    )]
+    pub basis: CurveBasis,
     /// End treatment of Catmull-Rom curves in USD: pinned passes through the
     /// end points (Blender's choice), nonperiodic needs ≥ 4 points a curve.
     #[arg(long, value_enum, default_value_t = WrapArg::Pinned)]
@@ -35,15 +41,6 @@ pub struct ConvertArgs {
     /// as the skin, so it opens complete in usdview or Blender.
     #[arg(long, value_name = "MESH")]
     pub with_mesh: Option<String>,
-}
-
-/// `--basis`.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum BasisArg {
-    /// Straight segments.
-    Linear,
-    /// Catmull-Rom spline through the points.
-    CatmullRom,
 }
 
 /// `--wrap`.
@@ -68,10 +65,7 @@ impl ConvertArgs {
     /// The USD options these flags describe.
     pub fn usd_options(&self) -> UsdOptions {
         UsdOptions {
-            basis: match self.basis {
-                BasisArg::Linear => CurveBasis::Linear,
-                BasisArg::CatmullRom => CurveBasis::CatmullRom,
-            },
+            basis: self.basis,
             wrap: match self.wrap {
                 WrapArg::Pinned => UsdWrap::Pinned,
                 WrapArg::Nonperiodic => UsdWrap::Nonperiodic,

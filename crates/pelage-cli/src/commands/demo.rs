@@ -12,7 +12,7 @@ use anyhow::Context;
 use clap::Args;
 use pelage::Curves;
 use pelage::groom::Groom;
-use pelage::io::{CurvesExport, UsdOptions, write_atomically};
+use pelage::io::write_atomically;
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -105,10 +105,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     let prepared = Instant::now();
     let generator = groom.generator(None)?;
     let output = groom.output_path();
-    let export = CurvesExport {
-        usd: UsdOptions::default(),
-        mesh: groom.file().output.with_mesh.then(|| groom.mesh()),
-    };
+    let export = groom.export();
     println!(
         "\ngrowing {} hairs from {} guides in {} parts: {} …",
         thousands(generator.parts().iter().map(|p| p.hair_count).sum()),
@@ -206,10 +203,7 @@ fn run_fox(out: &std::path::Path) -> anyhow::Result<()> {
         thousands(groom.mesh().triangle_count() as u64),
         animation.frames,
     );
-    let options = UsdOptions {
-        time_codes_per_second: groom.fps().unwrap_or(24.0),
-        ..UsdOptions::default()
-    };
+    let options = groom.usd_options();
     let growing = Instant::now();
     let parts = 0..animated.generator().parts().len();
     let summary = animated.write(&output, parts, &options, true, |_| {})?;

@@ -8,11 +8,10 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use pelage::anim::FrameRange;
 use pelage::groom::{
-    AnimatedGroom, FrameFile, FrameOutput, Groom, find_frame_files, frames_file, part_file,
-    part_slice, write_assembly, write_clip_assembly,
+    AnimatedGroom, Assembly, FarmRun, FrameFile, FrameOutput, Groom, ReportBuilder, Timings,
+    frames_file, write_clip_assembly,
 };
-use pelage::io::{CurvesExport, CurvesFormat, UsdOptions};
-use std::ops::Range;
+use pelage::io::CurvesFormat;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -21,15 +20,15 @@ use std::time::Instant;
 pub struct GroomArgs {
     /// The groom file (TOML; see docs/groom-format.md).
     pub file: PathBuf,
-    /// Output (.usdc or .usd: binary USD; .usda: text USD; .hair, .ply,
-    /// .rib, .pbrt). Default: the file's `[output] path`, or the groom
+    /// Output (.usdc or .usd: binary USD; .usda: text USD; .abc: Alembic;
+    /// .hair, .ply, .rib, .pbrt). Default: the file's `[output] path`, or the groom
     /// file's name with .usdc.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Grow only run K of N (1-based): a contiguous share of the parts,
     /// written to OUTPUT with `.part-K-of-N` before the extension.
-    #[arg(long, value_name = "K/N", value_parser = parse_part)]
-    pub part: Option<(usize, usize)>,
+    #[arg(long, value_name = "K/N")]
+    pub part: Option<FarmRun>,
     /// Instead of growing: write OUTPUT as a USD layer referencing every
     /// part file `OUTPUT.part-K-of-N.EXT` beside it, with extents (the
     /// layer is text: name OUTPUT .usda).
@@ -45,7 +44,7 @@ pub struct GroomArgs {
     /// Frames of an animated skin, e.g. 1-24 (replaces `[animation]
     /// frames`; makes the groom animated when the file has no
     /// `[animation]`). Output: one .usdc or .abc with time samples.
-    #[arg(long, value_name = "RANGE", value_parser = parse_frames)]
+    #[arg(long, value_name = "RANGE")]
     pub frames: Option<FrameRange>,
     /// Animated grooms: write one .usdc a frame beside OUTPUT
     /// (`NAME.f0001.usdc`, …) and OUTPUT itself (.usda) as the layer that
@@ -65,28 +64,6 @@ pub struct GroomArgs {
     pub quiet: bool,
 }
 
-fn parse_frames(s: &str) -> Result<FrameRange, String> {
-    FrameRange::parse(s).map_err(|e| e.to_string())
-}
-
-fn parse_part(s: &str) -> Result<(usize, usize), String> {
-    let (k, n) = s
-        .split_once('/')
-        .ok_or_else(|| format!("{s:?}: write the part as K/N, e.g. 3/8"))?;
-    let (k, n): (usize, usize) = (
-        k.trim()
-            .parse()
-            .map_err(|_| format!("{k:?} is not a whole number"))?,
-        n.trim()
-            .parse()
-            .map_err(|_| format!("{n:?} is not a whole number"))?,
-    );
-    if n == 0 || k == 0 || k > n {
-        return Err(format!("{s}: K must be 1 to N (runs are numbered from 1)"));
-    }
-    Ok((k, n))
-}
-
 pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     if let Some(wanted) = args.threads {
         let (threads, capped) = super::args::worker_threads(wanted);
@@ -104,10 +81,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     let groom = Groom::load_with_frames(&args.file, args.frames.clone())?;
     let output = args.output.clone().unwrap_or_else(|| groom.output_path());
     if args.assemble {
-        if let Some(animation) = groom.animation() {
-            return assemble_frames(&output, &animation.frames);
-        }
-        return assemble(&output, &UsdOptions::default());
+        return assemble(&groom, &output);
     }
     if let Some(report) = groom.bind_report() {
         for dropped in &report.dropped {
@@ -126,21 +100,17 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     // pelage cannot write, or a disk too small for it, before preparing
     // anything (preparing a billion hairs' roots takes seconds).
     let parts = groom.part_count();
-    let (range, path) = match args.part {
-        Some((k, n)) => (run_parts(args, k, n, parts)?, part_file(&output, k, n)),
-        None => (0..parts, output.clone()),
-    };
+    let (range, path) = groom
+        .run_output(&output, args.part)
+        .with_context(|| format!("--part: {}", args.file.display()))?;
     if CurvesFormat::from_path(&path).is_none() {
-        bail!(
-            "{}: unknown curves format; pelage writes .usdc (or .usd), .usda, .hair, .ply, .rib and .pbrt",
-            path.display()
-        );
+        bail!("{}: {}", path.display(), CurvesFormat::UNKNOWN_FOR_WRITING);
     }
     pelage::io::check_output(&path)?;
-    let count = *groom.file().roots.count.get_ref();
+    let count = groom.hair_count();
     let share = count as u128 * range.len() as u128 / parts.max(1) as u128;
     // Positions alone (12 bytes a point) are a floor of any format's size.
-    let points = *groom.file().finish.points.get_ref() as u64;
+    let points = groom.points_per_hair() as u64;
     pelage::io::check_free_space(
         &path,
         (share as u64).saturating_mul(points).saturating_mul(12),
@@ -156,15 +126,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         parts,
         "the file and the generator agree on parts"
     );
-    let file = groom.file();
-    let basis = file.output.basis;
-    let export = CurvesExport {
-        usd: UsdOptions {
-            basis,
-            ..UsdOptions::default()
-        },
-        mesh: file.output.with_mesh.then(|| groom.mesh()),
-    };
+    let export = groom.export();
     let planned: u64 = generator.parts()[range.clone()]
         .iter()
         .map(|p| p.hair_count)
@@ -197,7 +159,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     // Hairs kept for the preview: every `stride`-th of each part.
     let stride = planned.div_ceil(PREVIEW_HAIRS).max(1) as usize;
     let mut shown = Vec::new();
-    let mut report = args.report.as_ref().map(|_| GroomReport::new(&generator));
+    let mut report = args.report.as_ref().map(|_| ReportBuilder::new(&generator));
     let summary = generator.write(&path, range.clone(), &export, |p, curves| {
         if args.preview.is_some() {
             shown.push(curves.every_nth(stride));
@@ -221,15 +183,21 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         summary.hairs as f64 / seconds / 1e6,
         prepared.as_secs_f64()
     );
-    if let Some(report) = &report {
-        for warning in report.borrowed_regions() {
-            eprintln!("warning: regions: {warning}");
-        }
-    }
     if let (Some(report), Some(json)) = (report, &args.report) {
-        let value = report.finish(&groom, &path, prepared.as_secs_f64(), seconds, &lost);
+        let timings = Timings {
+            setup: prepared.as_secs_f64(),
+            grow_and_write: seconds,
+        };
+        let report = report.finish(&generator, Some(&groom), Some(&path), timings);
+        for region in report.regions_without_guides() {
+            eprintln!(
+                "warning: regions: region {} has no guides: its {} hairs took their shape from all guides; add guides there",
+                region.name,
+                thousands(region.hairs)
+            );
+        }
         pelage::io::write_atomically(json, |w| {
-            serde_json::to_writer_pretty(&mut *w, &value)?;
+            serde_json::to_writer_pretty(&mut *w, &report)?;
             std::io::Write::write_all(w, b"\n")
         })?;
         println!("report → {}", json.display());
@@ -283,11 +251,13 @@ fn run_animated(
         _ => output.to_path_buf(),
     };
     let (range, outputs) = match args.part {
-        Some((k, n)) => {
-            let range = run_parts(args, k, n, parts)?;
+        Some(run) => {
+            let range = run
+                .parts(parts)
+                .with_context(|| format!("--part: {}", args.file.display()))?;
             let path = frames_file(
                 &data,
-                Some((k, n)),
+                Some((run.k, run.n)),
                 animation.frames.first(),
                 animation.frames.last(),
             );
@@ -358,14 +328,10 @@ fn run_animated(
         );
         bar
     };
-    let options = UsdOptions {
-        basis: groom.file().output.basis,
-        time_codes_per_second: groom.fps().unwrap_or(24.0),
-        ..UsdOptions::default()
-    };
+    let options = groom.usd_options();
     let growing = Instant::now();
     // In a farm, the first run writes the skin.
-    let with_skin = groom.file().output.with_mesh && args.part.is_none_or(|(k, _)| k == 1);
+    let with_skin = groom.writes_skin_in(args.part);
     let summary = animated.write_files(&outputs, range.clone(), &options, with_skin, |p| {
         bar.set_message(format!("part {} frame {}", p.part, p.time));
         bar.set_position(p.done as u64);
@@ -410,42 +376,6 @@ fn run_animated(
     Ok(())
 }
 
-/// `--assemble` for an animated groom: the farm's frame files beside
-/// OUTPUT stitched with value clips.
-fn assemble_frames(output: &Path, frames: &FrameRange) -> anyhow::Result<()> {
-    let found = find_frame_files(output)
-        .with_context(|| format!("cannot list the folder of {}", output.display()))?;
-    if found.is_empty() {
-        bail!(
-            "no frame files beside {} (NAME.part-K-of-N.fA-B.usdc); run `pelage groom FILE --part K/N` first",
-            output.display()
-        );
-    }
-    let stitched = write_clip_assembly(output, &found, frames)?;
-    println!(
-        "{} → {} files of {} runs stitched with value clips ({} prims, time codes {} to {})",
-        output.display(),
-        stitched.files,
-        stitched.runs,
-        stitched.prims,
-        stitched.time_range.0,
-        stitched.time_range.1
-    );
-    Ok(())
-}
-
-/// The parts run `k` of `n` grows, or an error when there are fewer parts
-/// than runs.
-fn run_parts(args: &GroomArgs, k: usize, n: usize, parts: usize) -> anyhow::Result<Range<usize>> {
-    if n > parts {
-        bail!(
-            "--part {k}/{n}: the groom has {parts} parts, so at most {parts} runs; set [roots] parts in {} for more",
-            args.file.display()
-        );
-    }
-    Ok(part_slice(k, n, parts))
-}
-
 /// "FILE: N hairs on MESH (T triangles) from G guides, P parts": what a
 /// run is about to grow.
 fn heading(args: &GroomArgs, groom: &Groom, planned: u64, parts: usize) -> String {
@@ -472,200 +402,34 @@ fn parts_text(n: usize) -> String {
 /// Hairs the preview draws at most.
 const PREVIEW_HAIRS: u64 = 300_000;
 
-/// Finds `OUTPUT.part-K-of-N.usda` for one N and every K, and writes the
-/// root layer.
-fn assemble(output: &Path, options: &UsdOptions) -> anyhow::Result<()> {
-    let folder = match output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let stem = output
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .context("the output needs a file name")?;
-    let mut runs: Option<usize> = None;
-    for entry in
-        std::fs::read_dir(&folder).with_context(|| format!("cannot list {}", folder.display()))?
-    {
-        let name = entry?.file_name();
-        let Some(name) = name.to_str() else { continue };
-        let Some(rest) = name.strip_prefix(&format!("{stem}.part-")) else {
-            continue;
-        };
-        let Some((_, n)) = rest.split_once("-of-") else {
-            continue;
-        };
-        let Some(n) = n.split('.').next().and_then(|n| n.parse::<usize>().ok()) else {
-            continue;
-        };
-        match runs {
-            Some(m) if m != n => bail!(
-                "{}: part files of two different farm runs (of {m} and of {n}); remove one set",
-                folder.display()
-            ),
-            _ => runs = Some(n),
-        }
+/// `--assemble`: ties the farm's files beside `output` together (part
+/// files referenced from one layer, or frame files stitched with value
+/// clips) and says what it tied.
+fn assemble(groom: &Groom, output: &Path) -> anyhow::Result<()> {
+    match groom.assemble(output)? {
+        Assembly::Parts {
+            files,
+            extent: (lo, hi),
+        } => println!(
+            "{} → {} part files referenced, extent ({:.4}, {:.4}, {:.4}) to ({:.4}, {:.4}, {:.4})",
+            output.display(),
+            files.len(),
+            lo.x,
+            lo.y,
+            lo.z,
+            hi.x,
+            hi.y,
+            hi.z
+        ),
+        Assembly::Frames(stitched) => println!(
+            "{} → {} files of {} runs stitched with value clips ({} prims, time codes {} to {})",
+            output.display(),
+            stitched.files,
+            stitched.runs,
+            stitched.prims,
+            stitched.time_range.0,
+            stitched.time_range.1
+        ),
     }
-    let n = runs.with_context(|| {
-        format!(
-            "no part files {stem}.part-K-of-N.* in {}; run `pelage groom FILE --part K/N` first",
-            folder.display()
-        )
-    })?;
-    // A run's file is text or binary USD, whatever the root layer's name.
-    let files: Vec<PathBuf> = (1..=n)
-        .map(|k| {
-            let named = part_file(output, k, n);
-            ["usda", "usdc", "usd"]
-                .iter()
-                .map(|ext| named.with_extension(ext))
-                .find(|f| f.exists())
-                .unwrap_or(named)
-        })
-        .collect();
-    if let Some(missing) = files.iter().find(|f| !f.exists()) {
-        bail!(
-            "{} is missing: run {} of {n} has not finished",
-            missing.display(),
-            { files.iter().position(|f| f == missing).unwrap_or(0) + 1 }
-        );
-    }
-    let (lo, hi) = write_assembly(output, &files, options)?;
-    println!(
-        "{} → {} part files referenced, extent ({:.4}, {:.4}, {:.4}) to ({:.4}, {:.4}, {:.4})",
-        output.display(),
-        n,
-        lo.x,
-        lo.y,
-        lo.z,
-        hi.x,
-        hi.y,
-        hi.z
-    );
     Ok(())
-}
-
-/// What `--report` gathers while a groom grows.
-struct GroomReport {
-    /// Per part: index, hairs planned, hairs and points grown, triangles.
-    parts: Vec<serde_json::Value>,
-    /// Per region id: guides, hairs grown.
-    regions: std::collections::BTreeMap<u32, (usize, u64)>,
-    /// Each region's name (face sets) or number.
-    names: std::collections::BTreeMap<u32, String>,
-    split: bool,
-}
-
-impl GroomReport {
-    fn new(generator: &pelage::groom::Generator) -> Self {
-        let mut regions = std::collections::BTreeMap::new();
-        let split = generator.regions().is_some();
-        if split {
-            for root in generator.guides().roots() {
-                regions
-                    .entry(generator.region_of(*root))
-                    .or_insert((0, 0))
-                    .0 += 1;
-            }
-        }
-        Self {
-            parts: Vec::new(),
-            regions,
-            names: Default::default(),
-            split,
-        }
-    }
-
-    fn add_part(
-        &mut self,
-        generator: &pelage::groom::Generator,
-        p: usize,
-        curves: &pelage::Curves,
-    ) {
-        let part = &generator.parts()[p];
-        self.parts.push(serde_json::json!({
-            "part": p,
-            "hairs_planned": part.hair_count,
-            "hairs": curves.curve_count(),
-            "points": curves.points().len(),
-            "triangles": part.triangles.len(),
-        }));
-        if self.split
-            && let Some(roots) = curves.roots()
-        {
-            for root in roots {
-                self.regions
-                    .entry(generator.region_of(*root))
-                    .or_insert((0, 0))
-                    .1 += 1;
-            }
-            if let Some(lookup) = generator.regions() {
-                for id in self.regions.keys() {
-                    self.names.entry(*id).or_insert_with(|| lookup.name(*id));
-                }
-            }
-        }
-    }
-
-    /// Regions whose hairs had no guide of their own (they borrowed from
-    /// every guide).
-    fn borrowed_regions(&self) -> Vec<String> {
-        self.regions
-            .iter()
-            .filter(|(_, (guides, hairs))| *guides == 0 && *hairs > 0)
-            .map(|(id, (_, hairs))| {
-                let id = self.names.get(id).cloned().unwrap_or_else(|| id.to_string());
-                format!("region {id} has no guides: its {} hairs took their shape from all guides; add guides there", thousands(*hairs))
-            })
-            .collect()
-    }
-
-    fn finish(
-        self,
-        groom: &Groom,
-        output: &Path,
-        setup_s: f64,
-        grow_s: f64,
-        lost: &[pelage::interp::LostGuide],
-    ) -> serde_json::Value {
-        let dropped: Vec<serde_json::Value> = groom
-            .bind_report()
-            .map(|r| {
-                r.dropped
-                    .iter()
-                    .map(|d| serde_json::json!({ "guide": d.index, "why": d.to_string() }))
-                    .collect()
-            })
-            .unwrap_or_default();
-        let lost: Vec<serde_json::Value> = lost
-            .iter()
-            .map(|l| serde_json::json!({ "guide": l.guide, "kept_by": l.kept_by, "vertex": l.vertex, "why": l.to_string() }))
-            .collect();
-        let regions: Vec<serde_json::Value> = self
-            .regions
-            .iter()
-            .map(|(id, (guides, hairs))| {
-                let name = self
-                    .names
-                    .get(id)
-                    .cloned()
-                    .unwrap_or_else(|| id.to_string());
-                serde_json::json!({ "region": id, "name": name, "guides": guides, "hairs": hairs })
-            })
-            .collect();
-        let hairs: u64 = self.parts.iter().filter_map(|p| p["hairs"].as_u64()).sum();
-        serde_json::json!({
-            "groom": groom.path().display().to_string(),
-            "output": output.display().to_string(),
-            "hairs": hairs,
-            "parts": self.parts,
-            "guides": {
-                "kept": groom.guides().len(),
-                "dropped": dropped,
-                "unused_by_style_mesh": lost,
-            },
-            "regions": regions,
-            "seconds": { "setup": setup_s, "grow_and_write": grow_s },
-        })
-    }
 }

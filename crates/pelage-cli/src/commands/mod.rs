@@ -1,7 +1,6 @@
 //! One module per subcommand: its arguments (clap) and its `run`.
 
 pub mod args;
-pub mod bench;
 pub mod convert;
 pub mod demo;
 pub mod groom;
@@ -11,6 +10,9 @@ pub mod render;
 pub mod sample;
 pub mod shells;
 pub mod view;
+
+/// `pelage bench`: the harness is its own crate, `pelage-bench`.
+pub use pelage_bench as bench;
 
 use anyhow::Context;
 use pelage::Mesh;

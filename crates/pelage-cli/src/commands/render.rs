@@ -48,15 +48,11 @@ pub struct RenderArgs {
     /// then a folder that gets one PNG a frame and an animated GIF. The
     /// file's time-sampled `skin` mesh (`[output] with_mesh`) is drawn
     /// under the curves, moving with them.
-    #[arg(long, value_name = "RANGE", value_parser = parse_frames)]
+    #[arg(long, value_name = "RANGE")]
     pub frames: Option<pelage::anim::FrameRange>,
     /// Frames per second of the GIF.
     #[arg(long, default_value_t = 24.0, value_parser = super::args::positive)]
     pub fps: f64,
-}
-
-fn parse_frames(s: &str) -> Result<pelage::anim::FrameRange, String> {
-    pelage::anim::FrameRange::parse(s).map_err(|e| e.to_string())
 }
 
 pub use super::args::{size as parse_size, vec3 as parse_vec3};

@@ -172,10 +172,9 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
                 write_streamed(out, format, &UsdOptions::default(), |usd| {
                     for (k, b) in batches.enumerate() {
                         let points = SampledBatch::of(&mesh, &b);
-                        usd.write_points(&format!("points_{k:04}"), &points.view())
-                            .map_err(std::io::Error::other)?;
+                        usd.write_points(&format!("points_{k:04}"), &points.view())?;
                     }
-                    Ok(())
+                    Ok::<(), std::io::Error>(())
                 })?;
             }
         }

@@ -309,7 +309,7 @@ impl ShellRenderer {
         ctx.queue.submit([encoder.finish()]);
         ctx.device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
+            .map_err(|e| GpuError::Readback(e.into()))?;
         Ok(())
     }
 

@@ -9,13 +9,28 @@ pub fn open_headless() -> Option<GpuContext> {
     match GpuContext::headless() {
         Ok(ctx) => Some(ctx),
         Err(e) if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() => {
-            panic!("PELAGE_REQUIRE_GPU is set and there is no adapter: {e}")
+            panic!(
+                "PELAGE_REQUIRE_GPU is set and there is no adapter: {}",
+                with_causes(&e)
+            )
         }
         Err(e) => {
-            eprintln!("SKIPPED: no GPU adapter ({e})");
+            eprintln!("SKIPPED: no GPU adapter ({})", with_causes(&e));
             None
         }
     }
+}
+
+/// An error and its causes, "a: b: c".
+pub fn with_causes(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut cause = error.source();
+    while let Some(e) = cause {
+        text.push_str(": ");
+        text.push_str(&e.to_string());
+        cause = e.source();
+    }
+    text
 }
 
 /// The test binary's one GPU context (see [`open_headless`]).

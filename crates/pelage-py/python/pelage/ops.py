@@ -63,14 +63,14 @@ def cut(at: Map,
     return _op("cut", at=at, mask=mask)
 
 
-def length(scale: Optional[Map] = None, jitter: Optional[Map] = None,
+def length(scale: Map, jitter: Optional[Map] = None,
            seed: Optional[int] = None,
         mask: Optional[Map] = None) -> Dict[str, Dict[str, Any]]:
     """Scales hair length by `scale`, ± `jitter` (a fraction) per hair."""
     return _op("length", scale=scale, jitter=jitter, seed=seed, mask=mask)
 
 
-def strands(count: int, root_spread: Optional[Map] = None, tip_spread: Optional[Map] = None,
+def strands(count: int, tip_spread: Map, root_spread: Optional[Map] = None,
             twist: Optional[Map] = None, seed: Optional[int] = None,
         mask: Optional[Map] = None) -> Dict[str, Dict[str, Any]]:
     """Each hair becomes a strand of `count` hairs."""
@@ -96,3 +96,19 @@ def opacity(root: Map, tip: Map, ramp: Optional[Ramp] = None, jitter: Optional[M
         mask: Optional[Map] = None) -> Dict[str, Dict[str, Any]]:
     """Opacities from `root` to `tip`."""
     return _op("opacity", root=root, tip=tip, ramp=ramp, jitter=jitter, seed=seed, mask=mask)
+
+
+def twist(angle: Map, ramp: Optional[Ramp] = None, jitter: Optional[Map] = None,
+          seed: Optional[int] = None,
+        mask: Optional[Map] = None) -> Dict[str, Dict[str, Any]]:
+    """Turns each hair about its root–tip axis, `angle` degrees at the tip."""
+    return _op("twist", angle=angle, ramp=ramp, jitter=jitter, seed=seed, mask=mask)
+
+
+def flyaways(spread: Map, fraction: Optional[Map] = None, length: Optional[Map] = None,
+             frequency: Optional[Map] = None, ramp: Optional[Ramp] = None,
+             seed: Optional[int] = None,
+        mask: Optional[Map] = None) -> Dict[str, Dict[str, Any]]:
+    """A `fraction` of the hairs lengthened and pushed `spread` off their clump, each its own way."""
+    return _op("flyaways", spread=spread, fraction=fraction, length=length, frequency=frequency,
+               ramp=ramp, seed=seed, mask=mask)

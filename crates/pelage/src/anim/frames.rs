@@ -24,6 +24,15 @@ pub struct FrameRangeError {
     pub message: String,
 }
 
+impl std::str::FromStr for FrameRange {
+    type Err = FrameRangeError;
+
+    /// [`FrameRange::parse`].
+    fn from_str(text: &str) -> Result<Self, FrameRangeError> {
+        Self::parse(text)
+    }
+}
+
 impl FrameRange {
     /// Parses `"1-24"`, `"5"`, `"1-48x2"` or comma-separated lists of them.
     pub fn parse(text: &str) -> Result<Self, FrameRangeError> {

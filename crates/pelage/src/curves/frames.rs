@@ -142,7 +142,7 @@ fn dot(ax: f32, ay: f32, az: f32, bx: f32, by: f32, bz: f32) -> f32 {
 /// Per-point normals of many hairs of `n` points each (`points` holds them
 /// one after another; hair `h` starts its frame from `first[h]`): the same
 /// values, to the bit, as [`catmull_rom_tangents`] and
-/// [`rotation_minimizing_normals`] hair by hair, computed [`LANES`] hairs at
+/// [`rotation_minimizing_normals`] hair by hair, computed `LANES` hairs at
 /// a time.
 ///
 /// On x86-64 CPUs with AVX the lanes are AVX registers (module `avx`; the same

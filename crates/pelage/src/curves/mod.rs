@@ -4,7 +4,7 @@
 //! sliced the same way.
 //!
 //! Besides positions and widths, curves carry the optional attributes
-//! renderers read (DESIGN.md's data model): per point a normal (ribbon
+//! renderers read (docs/design.md, "Data model"): per point a normal (ribbon
 //! orientation), a colour and an opacity; per curve its root on the mesh
 //! ([`SurfacePoint`]), the root's UV, and a stable id.
 //!

@@ -52,7 +52,7 @@ use super::spec::GroomSpec;
 use crate::Curves;
 use crate::anim::{AnimatedSkin, FrameRange, RestFrames, SkinBinding, SkinPose};
 use crate::guides::{Guides, resample_by_arc_length};
-use crate::io::{AbcWriter, AtomicFile, CurvesFormat, UsdOptions, UsdPrimWriter, UsdcWriter};
+use crate::io::{AbcWriter, AtomicFile, CurvesFormat, PrimWriter, UsdOptions, UsdcWriter};
 use glam::Vec3;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -606,14 +606,14 @@ enum TimeSampledLayer {
 }
 
 impl TimeSampledLayer {
-    fn prims(&mut self) -> &mut dyn UsdPrimWriter {
+    fn prims(&mut self) -> &mut dyn PrimWriter {
         match self {
             Self::Usdc(w) => w,
             Self::Abc(w) => w,
         }
     }
 
-    fn finish(self) -> Result<AtomicFile, crate::io::UsdWriteError> {
+    fn finish(self) -> Result<AtomicFile, crate::io::PrimWriteError> {
         match self {
             Self::Usdc(w) => w.finish(),
             Self::Abc(w) => w.finish(),

@@ -8,9 +8,9 @@ use std::path::PathBuf;
 /// A groom file could not be read, parsed or set up. Displays as
 /// `FILE:LINE:COLUMN: KEY: what is wrong`.
 ///
-/// Its [`source`](std::error::Error::source) is the error underneath, when
-/// there is one (a [`MapError`], a [`crate::mesh::MeshError`], an I/O
-/// error …), whose message the display already includes.
+/// The error underneath, when there is one (a [`MapError`], a
+/// [`crate::mesh::MeshError`], an I/O error …), is in its
+/// [`kind`](GroomErrorDetails::kind) and its message in this one's.
 #[derive(Debug)]
 pub struct GroomError(Box<GroomErrorDetails>);
 
@@ -20,11 +20,10 @@ impl fmt::Display for GroomError {
     }
 }
 
-impl std::error::Error for GroomError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        std::error::Error::source(&self.0.kind)
-    }
-}
+/// Prints its cause in its message and returns none as `source()`:
+/// front ends print each cause once by walking the chain. The cause stays
+/// in its kind for programs that inspect it.
+impl std::error::Error for GroomError {}
 
 /// Where and what a [`GroomError`] is.
 #[derive(Debug)]
@@ -77,13 +76,13 @@ impl fmt::Display for GroomErrorDetails {
 }
 
 /// What is wrong with a groom. The variants that wrap another error
-/// display its message and give it as their `source`.
+/// display its message (and hold it, typed).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum GroomErrorKind {
     /// The file could not be read.
     #[error("cannot read the groom file: {0}")]
-    Io(#[source] std::io::Error),
+    Io(std::io::Error),
     /// Not valid TOML, an unknown key, or a value of the wrong type.
     #[error("{0}")]
     Syntax(String),
@@ -92,19 +91,19 @@ pub enum GroomErrorKind {
     Invalid(String),
     /// A map that cannot be read or used.
     #[error("{0}")]
-    Map(#[source] MapError),
+    Map(MapError),
     /// The mesh could not be loaded.
     #[error("{0}")]
-    Mesh(#[source] crate::mesh::MeshError),
+    Mesh(crate::mesh::MeshError),
     /// The guides file could not be read.
     #[error("{0}")]
-    Guides(#[source] crate::io::CurvesReadError),
+    Guides(crate::io::CurvesReadError),
     /// Guides could not be grown.
     #[error("{0}")]
-    GuideGrowth(#[source] crate::guides::GuideError),
+    GuideGrowth(crate::guides::GuideError),
     /// Roots could not be sampled.
     #[error("{0}")]
-    Sample(#[source] crate::sample::SampleError),
+    Sample(crate::sample::SampleError),
     /// A hair grew values that are not finite numbers.
     #[error("{0}")]
     NotFinite(String),

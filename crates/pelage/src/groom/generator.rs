@@ -9,22 +9,19 @@ use super::error::{GroomError, GroomErrorKind};
 use super::grow::{Workspace, sorted_by_triangle, sorted_by_triangle_with_ids};
 use super::load::part_count;
 use super::ops::{
-    Clump, ClumpCentres, Curl, Frizz, Length, Masked, Noise, Opacity, Operator, Resampling,
-    Strands, Width,
+    ClumpCentres, OpKey, Opacity, Operator, Preparation, Resampling, Width, color_maps_mut,
+    root_to_tip_maps_mut,
 };
 use super::parts::{Part, PartLayout};
 use super::regions::RegionLookup;
-use super::spec::{
-    ClumpParams, GroomOp, GroomSpec, HairIds, RootDistribution, SpecOrigin, color_maps_mut,
-    root_to_tip_maps_mut, setting_error,
-};
+use super::spec::{GroomSpec, HairIds, RootDistribution, SpecOrigin, setting_error};
 use crate::curves::{CurveArrays, Curves};
 use crate::guides::Guides;
 use crate::interp::Interpolator;
 use crate::limits;
 use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
-use crate::sample::{DensitySampler, DensitySamplerOptions, RootCells, mix64, salts, sample_range};
+use crate::sample::{DensitySampler, RootCells, mix64, salts, sample_range};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -141,21 +138,13 @@ impl Generator {
             limits::MAX_CURVE_POINTS,
             "points",
         )?;
-        for (k, op) in spec.ops.iter().enumerate() {
-            match op.unmasked() {
-                GroomOp::Clump(c) => ceiling(
-                    &format!("ops[{k}].clump.count"),
-                    c.count,
-                    limits::MAX_CLUMPS,
-                    "clumps",
-                )?,
-                GroomOp::Strands(s) => ceiling(
-                    &format!("ops[{k}].strands.count"),
-                    u64::from(s.count),
-                    limits::MAX_STRANDS,
-                    "hairs a strand",
-                )?,
-                _ => {}
+        for (index, op) in spec.ops.iter().enumerate() {
+            let key = OpKey {
+                index,
+                name: op.name(),
+            };
+            for (field, value, most, what) in op.counts() {
+                ceiling(&key.field(field), value, most, what)?;
             }
         }
         bind_maps(&mut spec)?;
@@ -269,100 +258,29 @@ impl Generator {
             last_part: AtomicUsize::new(usize::MAX),
             prefetched: Mutex::new(None),
         };
-        for (k, op) in ops.into_iter().enumerate() {
-            let op = generator.operator(k, op)?;
-            generator.colors |= matches!(op.unmasked(), Operator::Color(_));
-            generator.opacities |= matches!(op.unmasked(), Operator::Opacity(_));
-            generator.clumps |= matches!(op.unmasked(), Operator::Clump(_));
+        for (index, op) in ops.into_iter().enumerate() {
+            let key = OpKey {
+                index,
+                name: op.name(),
+            };
+            // Clump centres are grown through the operators before this
+            // one, which are already in `generator.ops`.
+            let op = op.prepare(&Preparation {
+                generator: &generator,
+                key,
+            })?;
+            generator.colors |= op.adds_colors();
+            generator.opacities |= op.adds_opacities();
+            generator.clumps |= op.searches_neighbours();
             generator.ops.push(op);
         }
         Ok(generator)
     }
 
-    /// Builds operator `k` (clump centres are grown through the operators
-    /// before it, which are already in `self.ops`).
-    fn operator(&self, k: usize, op: GroomOp) -> Result<Operator, GroomError> {
-        // Each operator's own random streams: the groom's seed mixed with
-        // its position in the chain and its own seed.
-        let op_seed = |s: u64| mix64(self.seed ^ mix64((k as u64 + 1) << 32 ^ s));
-        let invalid = |key: &str, message: &str| {
-            self.error(
-                &format!("ops[{k}].{key}"),
-                GroomErrorKind::Invalid(message.into()),
-            )
-        };
-        Ok(match op {
-            GroomOp::Masked(op, mask) => {
-                Operator::Masked(Masked::new(self.operator(k, *op)?, mask))
-            }
-            GroomOp::Noise(s) => Operator::Noise(Noise::new(
-                s.amplitude,
-                s.frequency,
-                s.ramp,
-                op_seed(s.seed),
-                s.vectors,
-            )),
-            GroomOp::Frizz(s) => Operator::Frizz(Frizz::new(
-                s.amplitude,
-                s.frequency,
-                s.fraction,
-                s.ramp,
-                op_seed(s.seed),
-            )),
-            GroomOp::Curl(s) => {
-                Operator::Curl(Curl::new(s.radius, s.turns, s.ramp, op_seed(s.seed)))
-            }
-            GroomOp::Cut(s) => Operator::Cut(s),
-            GroomOp::Length(s) => Operator::Length(Length::new(s.scale, s.jitter, op_seed(s.seed))),
-            GroomOp::Strands(s) => {
-                if s.count == 0 {
-                    return Err(invalid("strands.count", "a strand needs at least 1 hair"));
-                }
-                Operator::Strands(Strands::new(
-                    s.count,
-                    s.root_spread,
-                    s.tip_spread,
-                    s.twist,
-                    op_seed(s.seed),
-                ))
-            }
-            GroomOp::Width(s) => Operator::Width(Width(s)),
-            GroomOp::Color(s) => Operator::Color(s),
-            GroomOp::Opacity(s) => Operator::Opacity(Opacity(s)),
-            GroomOp::Clump(s) => {
-                if s.count == 0 {
-                    return Err(invalid(
-                        "clump.count",
-                        "a clump operator needs at least 1 clump",
-                    ));
-                }
-                let ClumpParams {
-                    count,
-                    density,
-                    rate,
-                    ramp,
-                    size,
-                    seed,
-                } = s;
-                let sampler =
-                    DensitySampler::new(&self.mesh, &density, DensitySamplerOptions::default())
-                        .map_err(|e| {
-                            self.error(
-                                &format!("ops[{k}].clump.density"),
-                                GroomErrorKind::Sample(e),
-                            )
-                        })?;
-                let roots = sample_range(&sampler, op_seed(seed), 0..count);
-                let centres = self.clump_centres(k, &roots);
-                Operator::Clump(Clump::new(centres, rate, ramp, size))
-            }
-        })
-    }
-
     /// Grows the centre hairs of the clump operator at chain position `k`
     /// through the operators before it. Centre ids live apart from hair ids
     /// (top bits set), so their random numbers are their own.
-    fn clump_centres(&self, k: usize, roots: &[SurfacePoint]) -> ClumpCentres {
+    pub(super) fn clump_centres(&self, k: usize, roots: &[SurfacePoint]) -> ClumpCentres {
         let mesh = &self.mesh;
         let shapes: Vec<Vec<Vec3>> = roots
             .par_chunks(256)
@@ -444,7 +362,7 @@ impl Generator {
     /// part's root cells samples its own hairs from its own stream;
     /// otherwise the part samples its hairs in its triangles with its own
     /// stream, numbered from the part's first hair id. Blue-noise roots
-    /// are then thinned from four times as many ([`super::blue_noise`]).
+    /// are then thinned from four times as many (`blue_noise.rs`).
     pub fn part_roots(&self, p: usize) -> (Vec<SurfacePoint>, Vec<u64>) {
         if self.distribution == RootDistribution::BlueNoise {
             return super::blue_noise::part_roots(self, p);
@@ -585,10 +503,13 @@ fn bind_maps(spec: &mut GroomSpec) -> Result<(), GroomError> {
                 bind(format!("finish.opacity.{key}"), map);
             }
         }
-        for (k, op) in spec.ops.iter_mut().enumerate() {
-            let name = op.name();
-            for (key, map) in op.maps_mut() {
-                bind(format!("ops[{k}].{name}.{key}"), map);
+        for (index, op) in spec.ops.iter_mut().enumerate() {
+            let key = OpKey {
+                index,
+                name: op.name(),
+            };
+            for (field, map) in op.maps_mut() {
+                bind(key.field(field), map);
             }
         }
         if let Some(regions) = &mut spec.regions {

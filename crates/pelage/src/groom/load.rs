@@ -5,20 +5,13 @@
 
 use super::animate::{AnimatedGroom, AnimationMode, AnimationSpec, GuideMotion};
 use super::error::{GroomError, GroomErrorKind};
-use super::file::{
-    AnimationModeName, ColorSpec, GroomFile, InterpolationKind, MapValue, MeshSection, OpSpec,
-    RootToTipSpec,
-};
+use super::file::{AnimationModeName, GroomFile, InterpolationKind, MapValue, MeshSection};
 use super::generator::Generator;
-use super::ops::{Color, Cut, RootToTip};
-use super::spec::{
-    ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, HairIds, LengthParams,
-    NoiseParams, RegionsSpec, RootsSpec, SpecOrigin, StrandsParams,
-};
+use super::ops::{OpKey, SpecReader, map_on_mesh};
+use super::spec::{FinishSpec, GroomSpec, HairIds, RegionsSpec, RootsSpec, SpecOrigin};
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{InterpolationMethod, StyleMeshOptions};
-use crate::map::Map;
 use crate::mesh::Mesh;
 use crate::settings::SettingsSource;
 use glam::Vec3;
@@ -253,9 +246,26 @@ impl Groom {
         AnimatedGroom::new(spec, animation.skin.clone(), animation.spec.clone(), guides).map(Some)
     }
 
-    /// The parsed file.
-    pub fn file(&self) -> &GroomFile {
-        &self.file
+    /// The number of hairs `[roots] count` asks for (before `strands`
+    /// multiplies them).
+    pub fn hair_count(&self) -> u64 {
+        *self.file.roots.count.get_ref()
+    }
+
+    /// Points per hair (`[finish] points`).
+    pub fn points_per_hair(&self) -> usize {
+        *self.file.finish.points.get_ref()
+    }
+
+    /// The curves' basis (`[output] basis`).
+    pub fn curve_basis(&self) -> crate::io::CurveBasis {
+        self.file.output.basis
+    }
+
+    /// Whether the skin is written beside the curves (`[output]
+    /// with_mesh`).
+    pub fn writes_skin(&self) -> bool {
+        self.file.output.with_mesh
     }
 
     /// The file's path and text.
@@ -312,34 +322,42 @@ impl Groom {
         let source = &self.source;
         // Where the settings the generator checks were written.
         let mut lines = HashMap::new();
-        let mut mark = |key: String, line: Option<(usize, usize)>| {
+        fn mark(
+            lines: &mut HashMap<String, (usize, usize)>,
+            key: &str,
+            line: Option<(usize, usize)>,
+        ) {
             if let Some(line) = line {
-                lines.insert(key, line);
+                lines.insert(key.to_string(), line);
             }
-        };
+        }
         let map = |v: &MapValue| map_on_mesh(source, &self.mesh, v);
 
         mark(
-            "roots.count".into(),
+            &mut lines,
+            "roots.count",
             source.line_of(file.roots.count.span()),
         );
         mark(
-            "roots.density".into(),
+            &mut lines,
+            "roots.density",
             source.line_of(file.roots.density.span()),
         );
         mark(
-            "finish.points".into(),
+            &mut lines,
+            "finish.points",
             source.line_of(file.finish.points.span()),
         );
         mark(
-            "finish.width".into(),
+            &mut lines,
+            "finish.width",
             source.line_of(file.finish.width.root.span()),
         );
         if let Some(o) = &file.finish.opacity {
-            mark("finish.opacity".into(), source.line_of(o.root.span()));
+            mark(&mut lines, "finish.opacity", source.line_of(o.root.span()));
         }
         if let Some(c) = &file.finish.color {
-            mark("finish.color".into(), source.line_of(c.root[0].span()));
+            mark(&mut lines, "finish.color", source.line_of(c.root[0].span()));
         }
         let roots = RootsSpec {
             count: *file.roots.count.get_ref(),
@@ -360,99 +378,43 @@ impl Groom {
                 split_shared: method.split_shared,
             }),
         };
+        let width = SpecReader::new(source, &self.mesh, &mut lines, "finish.width".into())
+            .root_to_tip(&file.finish.width)?;
+        let color = file
+            .finish
+            .color
+            .as_ref()
+            .map(|c| {
+                SpecReader::new(source, &self.mesh, &mut lines, "finish.color".into()).color(c)
+            })
+            .transpose()?;
+        let opacity = file
+            .finish
+            .opacity
+            .as_ref()
+            .map(|o| {
+                SpecReader::new(source, &self.mesh, &mut lines, "finish.opacity".into())
+                    .root_to_tip(o)
+            })
+            .transpose()?;
         let finish = FinishSpec {
             points: *file.finish.points.get_ref(),
-            width: root_to_tip(source, &self.mesh, &file.finish.width)?,
-            color: file
-                .finish
-                .color
-                .as_ref()
-                .map(|c| color(source, &self.mesh, c))
-                .transpose()?,
-            opacity: file
-                .finish
-                .opacity
-                .as_ref()
-                .map(|o| root_to_tip(source, &self.mesh, o))
-                .transpose()?,
+            width,
+            color,
+            opacity,
             normals: file.finish.normals,
         };
         let mut ops = Vec::with_capacity(file.ops.len());
-        for (k, spec) in file.ops.iter().enumerate() {
-            let op = match spec {
-                OpSpec::Noise(s) => GroomOp::Noise(NoiseParams {
-                    amplitude: map(&s.amplitude)?,
-                    frequency: map(&s.frequency)?,
-                    ramp: s.ramp.clone(),
-                    vectors: s.vectors,
-                    seed: s.seed,
-                }),
-                OpSpec::Frizz(s) => GroomOp::Frizz(FrizzParams {
-                    amplitude: map(&s.amplitude)?,
-                    frequency: map(&s.frequency)?,
-                    fraction: map(&s.fraction)?,
-                    ramp: s.ramp.clone(),
-                    seed: s.seed,
-                }),
-                OpSpec::Curl(s) => GroomOp::Curl(CurlParams {
-                    radius: map(&s.radius)?,
-                    turns: map(&s.turns)?,
-                    ramp: s.ramp.clone(),
-                    seed: s.seed,
-                }),
-                OpSpec::Cut(s) => GroomOp::Cut(Cut::new(map(&s.at)?)),
-                OpSpec::Length(s) => GroomOp::Length(LengthParams {
-                    scale: map(&s.scale)?,
-                    jitter: map(&s.jitter)?,
-                    seed: s.seed,
-                }),
-                OpSpec::Strands(s) => {
-                    mark(
-                        format!("ops[{k}].strands.count"),
-                        source.line_of(s.count.span()),
-                    );
-                    GroomOp::Strands(StrandsParams {
-                        count: *s.count.get_ref(),
-                        root_spread: map(&s.root_spread)?,
-                        tip_spread: map(&s.tip_spread)?,
-                        twist: map(&s.twist)?,
-                        seed: s.seed,
-                    })
-                }
-                OpSpec::Width(s) => GroomOp::Width(root_to_tip(source, &self.mesh, s)?),
-                OpSpec::Color(s) => GroomOp::Color(color(source, &self.mesh, s)?),
-                OpSpec::Opacity(s) => GroomOp::Opacity(root_to_tip(source, &self.mesh, s)?),
-                OpSpec::Clump(s) => {
-                    mark(
-                        format!("ops[{k}].clump.count"),
-                        source.line_of(s.count.span()),
-                    );
-                    mark(
-                        format!("ops[{k}].clump.density"),
-                        source.line_of(s.density.span()),
-                    );
-                    GroomOp::Clump(ClumpParams {
-                        count: *s.count.get_ref(),
-                        density: map(&s.density)?,
-                        rate: map(&s.rate)?,
-                        ramp: s.ramp.clone(),
-                        size: s.size.as_ref().map(map).transpose()?,
-                        seed: s.seed,
-                    })
-                }
+        for (index, spec) in file.ops.iter().enumerate() {
+            let key = OpKey {
+                index,
+                name: spec.name(),
             };
-            mark(format!("ops[{k}].{}", op.name()), source.line_of_op(k));
-            let op = match spec.mask() {
-                Some(mask) => {
-                    mark(
-                        format!("ops[{k}].{}.mask", op.name()),
-                        source.line_of(mask.span()),
-                    );
-                    op.masked(map(mask)?)
-                }
-                None => op,
-            };
-            ops.push(op);
+            if let Some(line) = source.line_of_op(index) {
+                lines.insert(key.to_string(), line);
+            }
+            let mut reader = SpecReader::new(source, &self.mesh, &mut lines, key.to_string());
+            ops.push(spec.read(&mut reader)?);
         }
         let regions = match &file.regions {
             None => None,
@@ -462,11 +424,11 @@ impl Groom {
                 };
                 match (&r.map, &r.faces) {
                     (Some(m), None) => {
-                        mark("regions".into(), source.line_of(m.span()));
+                        mark(&mut lines, "regions", source.line_of(m.span()));
                         Some(RegionsSpec::from_map(map(m)?, r.scale))
                     }
                     (None, Some(kind)) => {
-                        mark("regions".into(), source.line_of(kind.span()));
+                        mark(&mut lines, "regions", source.line_of(kind.span()));
                         if !matches!(kind.get_ref().as_str(), "groups" | "materials") {
                             return Err(invalid(
                                 kind.span(),
@@ -549,44 +511,6 @@ pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>, ids: HairI
         HairIds::Sequential => mesh.triangle_count(),
     };
     wanted.min(most).max(1)
-}
-
-/// Resolves a map value and binds it to `mesh` (UVs, vertex
-/// attributes), both errors at the value's line.
-fn map_on_mesh(source: &SettingsSource, mesh: &Mesh, value: &MapValue) -> Result<Map, GroomError> {
-    let mut map = source.map(value)?;
-    map.bind(mesh)
-        .map_err(|e| source.error_at(value.span(), GroomErrorKind::Map(e)))?;
-    Ok(map)
-}
-
-fn root_to_tip(
-    source: &SettingsSource,
-    mesh: &Mesh,
-    s: &RootToTipSpec,
-) -> Result<RootToTip, GroomError> {
-    let map = |v: &MapValue| map_on_mesh(source, mesh, v);
-    Ok(RootToTip {
-        root: map(&s.root)?,
-        tip: map(&s.tip)?,
-        ramp: s.ramp.clone(),
-        jitter: map(&s.jitter)?,
-        seed: s.seed,
-    })
-}
-
-fn color(source: &SettingsSource, mesh: &Mesh, s: &ColorSpec) -> Result<Color, GroomError> {
-    let map = |v: &MapValue| map_on_mesh(source, mesh, v);
-    let three = |c: &[MapValue; 3]| -> Result<[Map; 3], GroomError> {
-        Ok([map(&c[0])?, map(&c[1])?, map(&c[2])?])
-    };
-    Ok(Color {
-        root: three(&s.root)?,
-        tip: three(&s.tip)?,
-        ramp: s.ramp.clone(),
-        jitter: map(&s.jitter)?,
-        seed: s.seed,
-    })
 }
 
 /// The mesh a `[mesh]` section names, subdivided as asked; a mesh that

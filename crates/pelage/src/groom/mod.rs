@@ -5,7 +5,7 @@
 //! - [`GroomSpec`] (`spec.rs`): the groom as plain Rust values: mesh,
 //!   guides, roots, interpolation, operators, finish. Programs and bindings
 //!   build one directly.
-//! - [`mod@file`], [`Groom`] (`load.rs`): the TOML groom file, one front end
+//! - [`Groom`] (`load.rs`, the schema in `file.rs`): the TOML groom file, one front end
 //!   that produces a `GroomSpec`; every error with file, line and key
 //!   ([`GroomError`], `error.rs`; `source.rs` finds lines and keys).
 //! - [`Generator`]: a spec prepared for generation (root sampler,
@@ -14,7 +14,11 @@
 //!   overflows is traced to its operator in `diagnose.rs`).
 //! - [`ops`]: the operators.
 //! - [`parts`]: the part layout; [`Generator::write`] streams parts to a
-//!   file, [`write_assembly`] ties a farm's part files together in USD.
+//!   file; [`FarmRun`] (`K/N`) is one run of a farm and
+//!   [`find_part_files`] finds the runs' files, which [`write_assembly`]
+//!   ties together in USD ([`Groom::assemble`] does both).
+//! - [`GroomReport`] (`report.rs`): what a groom grew and left out, for
+//!   every front end.
 //!
 //! One hair, as Sik's Fig. 14 draws it: a root sampled in its part → shape
 //! interpolated from the guides → resampled to the finishing point count →
@@ -28,7 +32,8 @@ mod blue_noise;
 mod clips;
 mod diagnose;
 mod error;
-pub mod file;
+mod farm;
+pub(crate) mod file;
 mod generator;
 mod grow;
 mod load;
@@ -37,22 +42,32 @@ mod output;
 pub mod parts;
 mod ramp;
 pub mod regions;
+mod report;
 mod source;
 mod spec;
+mod writing;
 
 pub use animate::{
     AnimatedGroom, AnimationMode, AnimationProgress, AnimationSpec, FrameOutput, GuideMotion,
 };
 pub use clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
 pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
-pub use file::{GroomFile, InterpolationKind};
+pub use farm::{FarmError, FarmRun, find_part_files};
 pub use generator::{Generator, GroomSummary, HAIRS_PER_PART};
 pub use load::{Groom, GroomInputs};
-pub use output::{GroomWriteError, part_file, part_name, part_slice, write_assembly};
+pub use output::{GroomWriteError, StreamError, part_file, part_name, part_slice, write_assembly};
 pub use parts::{Part, PartLayout};
 pub use ramp::Ramp;
+pub use report::{
+    GroomReport, GuideNote, GuidesReport, LostGuideNote, PartReport, RegionReport, ReportBuilder,
+    Timings,
+};
+pub use writing::{AssembleError, Assembly, DEFAULT_FPS};
 
+pub use ops::{
+    ClumpParams, CurlParams, FlyawaysParams, FrizzParams, GroomOp, LengthParams, NoiseParams,
+    StrandsParams, TwistParams,
+};
 pub use spec::{
-    ClumpParams, CurlParams, FinishSpec, FrizzParams, GroomOp, GroomSpec, HairIds, LengthParams,
-    NoiseParams, RegionSource, RegionsSpec, RootDistribution, RootsSpec, StrandsParams,
+    FinishSpec, GroomSpec, HairIds, RegionSource, RegionsSpec, RootDistribution, RootsSpec,
 };

@@ -1,4 +1,4 @@
-//! Writing a groom: parts stream to the writer as they are grown (DESIGN.md
+//! Writing a groom: parts stream to the writer as they are grown (docs/design.md,
 //! "Streaming"), and a farm's per-part files are tied together by a small
 //! root USD layer ([`write_assembly`]).
 
@@ -6,8 +6,9 @@ use super::error::GroomError;
 use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
-    CurvesExport, CurvesFormat, UpAxis, UsdOptions, UsdPrimWriter, UsdaWriter, WriteError,
-    read_usd_extent, write_atomically, write_curves, write_streamed,
+    CurvesExport, CurvesFormat, PrimWriteError, PrimWriter, UpAxis, UsdOptions, UsdaWriter,
+    WriteError, read_usd_extent, write_atomically, write_atomically_with, write_curves,
+    write_streamed,
 };
 use glam::Vec3;
 use std::io::{BufRead, Write};
@@ -81,7 +82,7 @@ impl Generator {
             write_curves(path, grown.iter().map(|(n, c)| (n.clone(), c)), export)?;
             return Ok(summary);
         }
-        write_atomically(path, |out| {
+        write_atomically_with(path, |out| {
             let on_part = |p, c: &Curves| {
                 on_part(p, c);
                 count(c);
@@ -91,14 +92,14 @@ impl Generator {
                 self.stream_parts(layer, parts, export, on_part)
             })
         })
-        .map_err(unwrap_groom_error)?;
+        .map_err(|e| e.at(path))?;
         Ok(summary)
     }
 
     /// Grows `parts` and streams them as USD text to `out`, one part
     /// written while the next grows (memory: about two parts). A part that
-    /// cannot grow ([`Generator::part`]) stops the stream with an I/O error
-    /// of kind `Other` wrapping its [`GroomError`].
+    /// cannot grow ([`Generator::part`]) stops the stream with its
+    /// [`GroomError`].
     ///
     /// ```
     /// use pelage::groom::{GroomSpec, RootsSpec};
@@ -123,10 +124,10 @@ impl Generator {
         parts: Range<usize>,
         export: &CurvesExport,
         on_part: impl FnMut(usize, &Curves) + Send,
-    ) -> std::io::Result<()> {
-        let mut usd = UsdaWriter::new(out, &export.usd).map_err(std::io::Error::other)?;
+    ) -> Result<(), StreamError> {
+        let mut usd = UsdaWriter::new(out, &export.usd)?;
         self.stream_parts(&mut usd, parts, export, on_part)?;
-        usd.finish().map_err(std::io::Error::other)?;
+        usd.finish()?;
         Ok(())
     }
 
@@ -134,14 +135,13 @@ impl Generator {
     /// thread and writes each as it arrives.
     fn stream_parts(
         &self,
-        usd: &mut dyn UsdPrimWriter,
+        usd: &mut dyn PrimWriter,
         parts: Range<usize>,
         export: &CurvesExport,
         mut on_part: impl FnMut(usize, &Curves) + Send,
-    ) -> std::io::Result<()> {
-        let other = std::io::Error::other;
+    ) -> Result<(), StreamError> {
         if let Some(mesh) = export.mesh {
-            usd.write_mesh("skin", mesh).map_err(other)?;
+            usd.write_mesh("skin", mesh)?;
         }
         std::thread::scope(|scope| {
             type Grown = (usize, Result<Curves, GroomError>);
@@ -156,33 +156,48 @@ impl Generator {
                 }
             });
             for (p, curves) in receive {
-                let curves = curves.map_err(std::io::Error::other)?;
+                let curves = curves?;
                 // A part that grew no hair (more parts than hairs, or a
                 // bald region) is left out: USD has no empty BasisCurves.
                 if curves.curve_count() > 0 {
-                    usd.write_part(&part_name(p), &curves).map_err(other)?;
+                    usd.write_part(&part_name(p), &curves)?;
                 }
                 on_part(p, &curves);
                 self.recycle(curves);
             }
             grower.join().expect("the part grower does not panic");
-            Ok::<(), std::io::Error>(())
+            Ok::<(), StreamError>(())
         })
     }
 }
 
-/// A part that could not grow comes back from a streamed write wrapped
-/// as an I/O error (see `write_usd`; the half-written file is gone): this
-/// unwraps it, and leaves real write errors as they are.
-pub(super) fn unwrap_groom_error(e: WriteError) -> GroomWriteError {
-    if e.error
-        .get_ref()
-        .is_some_and(|inner| inner.is::<GroomError>())
-    {
-        let inner = e.error.into_inner().expect("checked above");
-        GroomWriteError::Groom(*inner.downcast::<GroomError>().expect("checked above"))
-    } else {
-        GroomWriteError::Write(e)
+/// A groom could not be streamed into a layer: a part did not grow, the
+/// writer refused a prim, or the file itself failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum StreamError {
+    /// A hair could not be grown (the error names the groom file's line).
+    #[error(transparent)]
+    Groom(#[from] GroomError),
+    /// The writer refused a prim, or writing it failed.
+    #[error(transparent)]
+    Prim(#[from] PrimWriteError),
+    /// The output file could not be created, synced or renamed.
+    #[error(transparent)]
+    File(#[from] WriteError),
+}
+
+impl StreamError {
+    /// As a [`GroomWriteError`] of the file at `path`.
+    fn at(self, path: &Path) -> GroomWriteError {
+        match self {
+            StreamError::Groom(e) => GroomWriteError::Groom(e),
+            StreamError::File(e) => GroomWriteError::Write(e),
+            StreamError::Prim(e) => GroomWriteError::Write(WriteError {
+                path: path.to_path_buf(),
+                error: e.into(),
+            }),
+        }
     }
 }
 

@@ -1,6 +1,6 @@
 //! Parts: the mesh split into spatially compact groups of triangles, each
 //! generated on its own (Sik §4.2.1: "each of these calls is responsible
-//! for generating hair on one selected part of a triangular mesh"; DESIGN.md
+//! for generating hair on one selected part of a triangular mesh"; docs/design.md,
 //! "Parts").
 //!
 //! Triangles are ordered along a Morton (Z-order) curve through their

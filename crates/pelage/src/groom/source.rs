@@ -10,7 +10,8 @@ use std::path::Path;
 
 /// The documented range of every numeric groom setting that has one
 /// (docs/groom-format.md, docs/limits.md), checked when the file is read.
-/// Map-valued settings are checked here when written as numbers.
+/// Map-valued settings are checked here when written as numbers. Each
+/// operator's rules are its module's ([`super::ops::operator_rules`]).
 const GROOM_RULES: &[Rule] = &[
     Rule::new(
         "mesh.subdivide",
@@ -57,42 +58,6 @@ const GROOM_RULES: &[Rule] = &[
     Rule::new("finish.width.tip", Bound::at_least(0.0), "a width"),
     Rule::new("finish.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
     Rule::new("finish.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
-    Rule::new("ops.width.root", Bound::at_least(0.0), "a width"),
-    Rule::new("ops.width.tip", Bound::at_least(0.0), "a width"),
-    Rule::new("ops.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
-    Rule::new("ops.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
-    Rule::new(
-        "ops.clump.count",
-        Bound::Within(1.0, MAX_CLUMPS as f64),
-        "pelage's clump limit",
-    ),
-    Rule::new("ops.clump.density", Bound::at_least(0.0), "a density"),
-    Rule::new(
-        "ops.strands.count",
-        Bound::Within(1.0, MAX_STRANDS as f64),
-        "hairs per strand",
-    ),
-    Rule::new(
-        "ops.noise.vectors",
-        Bound::Within(0.0, MAX_CURVE_POINTS as f64),
-        "noise vectors per hair",
-    ),
-    Rule::new(
-        "ops.noise.frequency",
-        Bound::at_least(0.0),
-        "cycles per unit",
-    ),
-    Rule::new(
-        "ops.frizz.frequency",
-        Bound::at_least(0.0),
-        "cycles per unit",
-    ),
-    Rule::new(
-        "ops.frizz.fraction",
-        Bound::Within(0.0, 1.0),
-        "a fraction of the hairs",
-    ),
-    Rule::new("ops.length.scale", Bound::at_least(0.0), "a factor"),
     Rule::new("animation.fps", Bound::more_than(0.0), "frames per second"),
 ];
 
@@ -103,8 +68,14 @@ impl SettingsSource {
             .map_err(|e| GroomError::new(path.to_path_buf(), None, None, GroomErrorKind::Io(e)))
     }
 
+    /// Parses and checks the text as a groom file (every key known, every
+    /// number in its range), loading nothing it names.
+    pub fn check_groom(&self) -> Result<(), GroomError> {
+        self.parse().map(drop)
+    }
+
     /// Parses the text as a groom file.
-    pub fn parse(&self) -> Result<GroomFile, GroomError> {
+    pub(crate) fn parse(&self) -> Result<GroomFile, GroomError> {
         if let Some((place, message)) = self.single_bracket_list(&["ops"]) {
             return Err(GroomError::new(
                 self.path.clone(),
@@ -114,7 +85,9 @@ impl SettingsSource {
             ));
         }
         let file = self.parse_as()?;
-        self.check(GROOM_RULES).map_err(|(place, message)| {
+        let mut rules = GROOM_RULES.to_vec();
+        rules.extend(super::ops::operator_rules());
+        self.check(&rules).map_err(|(place, message)| {
             GroomError::new(
                 self.path.clone(),
                 place.line,
@@ -147,7 +120,7 @@ impl SettingsSource {
 
     /// Resolves a map value, reporting a bad spec or unreadable image at its
     /// line.
-    pub fn map(&self, value: &MapValue) -> Result<Map, GroomError> {
+    pub(crate) fn map(&self, value: &MapValue) -> Result<Map, GroomError> {
         match value.get_ref() {
             MapText::Number(n) if n.is_finite() => Ok(Map::Constant(*n)),
             MapText::Number(n) => Err(self.error_at(

@@ -26,7 +26,8 @@
 
 use super::error::{GroomError, GroomErrorKind};
 use super::generator::Generator;
-use super::ops::{Color, Cut, RootToTip};
+pub use super::ops::GroomOp;
+use super::ops::{Color, RootToTip};
 use crate::guides::Guides;
 use crate::interp::InterpolationMethod;
 use crate::map::Map;
@@ -202,6 +203,24 @@ impl HairIds {
     }
 }
 
+impl std::str::FromStr for HairIds {
+    type Err = String;
+
+    /// `stable` or `sequential`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::parse(s).ok_or_else(|| format!("ids {s:?}: use \"stable\" or \"sequential\""))
+    }
+}
+
+impl std::fmt::Display for HairIds {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            HairIds::Stable => "stable",
+            HairIds::Sequential => "sequential",
+        })
+    }
+}
+
 /// How roots are spread.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum RootDistribution {
@@ -296,340 +315,6 @@ impl Default for FinishSpec {
             color: None,
             opacity: None,
             normals: true,
-        }
-    }
-}
-
-/// One operator of the chain, with its settings. Seeds are the operator's
-/// own; the generator mixes them with the groom's seed and the operator's
-/// place in the chain, so two operators with the same seed still differ.
-#[derive(Debug, Clone)]
-#[allow(
-    clippy::large_enum_variant,
-    reason = "a groom holds a handful, built once; boxing would only add noise to building them"
-)]
-pub enum GroomOp {
-    /// Perlin displacement ([`super::ops::Noise`]).
-    Noise(NoiseParams),
-    /// Per-hair random high-frequency displacement ([`super::ops::Frizz`]).
-    Frizz(FrizzParams),
-    /// Pull hairs toward clump centre hairs ([`super::ops::Clump`]).
-    Clump(ClumpParams),
-    /// Helix around the hair's path ([`super::ops::Curl`]).
-    Curl(CurlParams),
-    /// Cut at a curve parameter.
-    Cut(Cut),
-    /// Scale the length ([`super::ops::Length`]).
-    Length(LengthParams),
-    /// Each hair becomes a strand of hairs ([`super::ops::Strands`]).
-    Strands(StrandsParams),
-    /// Widths root to tip (seed as given).
-    Width(RootToTip),
-    /// Colours root to tip (seed as given).
-    Color(Color),
-    /// Opacities root to tip (seed as given).
-    Opacity(RootToTip),
-    /// An operator whose effect is faded by a map ([`super::ops::Masked`]):
-    /// build one with [`GroomOp::masked`].
-    Masked(Box<GroomOp>, Map),
-}
-
-impl GroomOp {
-    /// The operator with its effect faded by `mask` (0: none, 1: full),
-    /// read at each hair's root.
-    pub fn masked(self, mask: Map) -> GroomOp {
-        GroomOp::Masked(Box::new(self), mask)
-    }
-
-    /// The operator under any mask.
-    pub fn unmasked(&self) -> &GroomOp {
-        match self {
-            GroomOp::Masked(op, _) => op.unmasked(),
-            op => op,
-        }
-    }
-
-    /// The operator's name in groom files (`noise`, `clump`, …).
-    pub fn name(&self) -> &'static str {
-        match self {
-            GroomOp::Masked(op, _) => op.name(),
-            GroomOp::Noise(_) => "noise",
-            GroomOp::Frizz(_) => "frizz",
-            GroomOp::Clump(_) => "clump",
-            GroomOp::Curl(_) => "curl",
-            GroomOp::Cut(_) => "cut",
-            GroomOp::Length(_) => "length",
-            GroomOp::Strands(_) => "strands",
-            GroomOp::Width(_) => "width",
-            GroomOp::Color(_) => "color",
-            GroomOp::Opacity(_) => "opacity",
-        }
-    }
-
-    /// Every map the operator reads, with its setting's name.
-    pub fn maps(&self) -> Vec<(&'static str, &Map)> {
-        match self {
-            GroomOp::Masked(op, mask) => {
-                let mut maps = op.maps();
-                maps.push(("mask", mask));
-                maps
-            }
-            GroomOp::Noise(s) => vec![("amplitude", &s.amplitude), ("frequency", &s.frequency)],
-            GroomOp::Frizz(s) => vec![
-                ("amplitude", &s.amplitude),
-                ("frequency", &s.frequency),
-                ("fraction", &s.fraction),
-            ],
-            GroomOp::Clump(s) => {
-                let mut maps = vec![("density", &s.density), ("rate", &s.rate)];
-                maps.extend(s.size.as_ref().map(|m| ("size", m)));
-                maps
-            }
-            GroomOp::Curl(s) => vec![("radius", &s.radius), ("turns", &s.turns)],
-            GroomOp::Cut(s) => vec![("at", s.at())],
-            GroomOp::Length(s) => vec![("scale", &s.scale), ("jitter", &s.jitter)],
-            GroomOp::Strands(s) => vec![
-                ("root_spread", &s.root_spread),
-                ("tip_spread", &s.tip_spread),
-                ("twist", &s.twist),
-            ],
-            GroomOp::Width(s) | GroomOp::Opacity(s) => root_to_tip_maps(s),
-            GroomOp::Color(s) => color_maps(s),
-        }
-    }
-}
-
-impl GroomOp {
-    /// Every map the operator reads, to change (binding them to a mesh).
-    pub fn maps_mut(&mut self) -> Vec<(&'static str, &mut Map)> {
-        match self {
-            GroomOp::Masked(op, mask) => {
-                let mut maps = op.maps_mut();
-                maps.push(("mask", mask));
-                maps
-            }
-            GroomOp::Noise(s) => vec![
-                ("amplitude", &mut s.amplitude),
-                ("frequency", &mut s.frequency),
-            ],
-            GroomOp::Frizz(s) => vec![
-                ("amplitude", &mut s.amplitude),
-                ("frequency", &mut s.frequency),
-                ("fraction", &mut s.fraction),
-            ],
-            GroomOp::Clump(s) => {
-                let mut maps = vec![("density", &mut s.density), ("rate", &mut s.rate)];
-                maps.extend(s.size.as_mut().map(|m| ("size", m)));
-                maps
-            }
-            GroomOp::Curl(s) => vec![("radius", &mut s.radius), ("turns", &mut s.turns)],
-            GroomOp::Cut(s) => vec![("at", s.at_mut())],
-            GroomOp::Length(s) => vec![("scale", &mut s.scale), ("jitter", &mut s.jitter)],
-            GroomOp::Strands(s) => vec![
-                ("root_spread", &mut s.root_spread),
-                ("tip_spread", &mut s.tip_spread),
-                ("twist", &mut s.twist),
-            ],
-            GroomOp::Width(s) | GroomOp::Opacity(s) => root_to_tip_maps_mut(s),
-            GroomOp::Color(s) => color_maps_mut(s),
-        }
-    }
-}
-
-/// The maps of a root-to-tip setting, to change.
-pub(crate) fn root_to_tip_maps_mut(s: &mut RootToTip) -> Vec<(&'static str, &mut Map)> {
-    vec![
-        ("root", &mut s.root),
-        ("tip", &mut s.tip),
-        ("jitter", &mut s.jitter),
-    ]
-}
-
-/// The maps of a colour setting, to change.
-pub(crate) fn color_maps_mut(s: &mut Color) -> Vec<(&'static str, &mut Map)> {
-    let Color {
-        root, tip, jitter, ..
-    } = s;
-    let mut maps: Vec<(&'static str, &mut Map)> = root.iter_mut().map(|m| ("root", m)).collect();
-    maps.extend(tip.iter_mut().map(|m| ("tip", m)));
-    maps.push(("jitter", jitter));
-    maps
-}
-
-/// The maps of a root-to-tip setting, by name.
-pub(crate) fn root_to_tip_maps(s: &RootToTip) -> Vec<(&'static str, &Map)> {
-    vec![("root", &s.root), ("tip", &s.tip), ("jitter", &s.jitter)]
-}
-
-/// The maps of a colour setting, by name.
-pub(crate) fn color_maps(s: &Color) -> Vec<(&'static str, &Map)> {
-    let root = s.root.iter().map(|m| ("root", m));
-    let tip = s.tip.iter().map(|m| ("tip", m));
-    root.chain(tip).chain([("jitter", &s.jitter)]).collect()
-}
-
-/// `noise`: see [`super::ops::Noise`].
-#[derive(Debug, Clone)]
-pub struct NoiseParams {
-    /// Largest displacement (world units).
-    pub amplitude: Map,
-    /// Noise cycles per world unit.
-    pub frequency: Map,
-    /// Root-to-tip profile of the amplitude.
-    pub ramp: Ramp,
-    /// Noise vectors sampled along each hair, interpolated between (0: one
-    /// at every point).
-    pub vectors: usize,
-    /// Seed of the noise field.
-    pub seed: u64,
-}
-
-impl NoiseParams {
-    /// Noise of `amplitude`; a groom file's defaults for the rest
-    /// (frequency 10, linear ramp, 5 vectors, seed 0).
-    pub fn new(amplitude: Map) -> Self {
-        Self {
-            amplitude,
-            frequency: Map::Constant(10.0),
-            ramp: Ramp::default(),
-            vectors: 5,
-            seed: 0,
-        }
-    }
-}
-
-/// `frizz`: see [`super::ops::Frizz`].
-#[derive(Debug, Clone)]
-pub struct FrizzParams {
-    /// Largest displacement (world units).
-    pub amplitude: Map,
-    /// Wiggles along one hair.
-    pub frequency: Map,
-    /// Share of hairs that frizz (0 to 1).
-    pub fraction: Map,
-    /// Root-to-tip profile.
-    pub ramp: Ramp,
-    /// Seed.
-    pub seed: u64,
-}
-
-impl FrizzParams {
-    /// Frizz of `amplitude` on every hair; frequency 6, linear ramp, seed 0.
-    pub fn new(amplitude: Map) -> Self {
-        Self {
-            amplitude,
-            frequency: Map::Constant(6.0),
-            fraction: Map::Constant(1.0),
-            ramp: Ramp::default(),
-            seed: 0,
-        }
-    }
-}
-
-/// `clump`: see [`super::ops::Clump`].
-#[derive(Debug, Clone)]
-pub struct ClumpParams {
-    /// Number of clumps over the whole mesh.
-    pub count: u64,
-    /// Density of clump centres.
-    pub density: Map,
-    /// How far hairs move to their centre hair (0 to 1).
-    pub rate: Map,
-    /// Root-to-tip profile of the rate.
-    pub ramp: Ramp,
-    /// Clump radius (`None`: no limit).
-    pub size: Option<Map>,
-    /// Seed of the clump centres.
-    pub seed: u64,
-}
-
-impl ClumpParams {
-    /// `count` clumps, uniform centres, rate 0.8, linear ramp, no size
-    /// limit, seed 0.
-    pub fn new(count: u64) -> Self {
-        Self {
-            count,
-            density: Map::Constant(1.0),
-            rate: Map::Constant(0.8),
-            ramp: Ramp::default(),
-            size: None,
-            seed: 0,
-        }
-    }
-}
-
-/// `curl`: see [`super::ops::Curl`].
-#[derive(Debug, Clone)]
-pub struct CurlParams {
-    /// Helix radius at the tip (world units): Silva's K_α.
-    pub radius: Map,
-    /// Turns along the hair: Silva's ω / 2π.
-    pub turns: Map,
-    /// Root-to-tip profile of the radius.
-    pub ramp: Ramp,
-    /// Seed of each hair's phase.
-    pub seed: u64,
-}
-
-impl CurlParams {
-    /// A curl of `radius` and `turns`, linear ramp, seed 0.
-    pub fn new(radius: Map, turns: Map) -> Self {
-        Self {
-            radius,
-            turns,
-            ramp: Ramp::default(),
-            seed: 0,
-        }
-    }
-}
-
-/// `length`: see [`super::ops::Length`].
-#[derive(Debug, Clone)]
-pub struct LengthParams {
-    /// Length factor.
-    pub scale: Map,
-    /// Per-hair random variation, a fraction (0.2 = ±20 %).
-    pub jitter: Map,
-    /// Seed of the variation.
-    pub seed: u64,
-}
-
-impl LengthParams {
-    /// Lengths times `scale`, no jitter, seed 0.
-    pub fn new(scale: Map) -> Self {
-        Self {
-            scale,
-            jitter: Map::Constant(0.0),
-            seed: 0,
-        }
-    }
-}
-
-/// `strands`: see [`super::ops::Strands`].
-#[derive(Debug, Clone)]
-pub struct StrandsParams {
-    /// Hairs per strand (at least 1).
-    pub count: u32,
-    /// Spread around the base hair at the root (world units).
-    pub root_spread: Map,
-    /// Spread at the tip.
-    pub tip_spread: Map,
-    /// Turns of the strand's hairs around the base hair, root to tip.
-    pub twist: Map,
-    /// Seed.
-    pub seed: u64,
-}
-
-impl StrandsParams {
-    /// Strands of `count` hairs spreading to `tip_spread`; no root spread,
-    /// no twist, seed 0.
-    pub fn new(count: u32, tip_spread: Map) -> Self {
-        Self {
-            count,
-            root_spread: Map::Constant(0.0),
-            tip_spread,
-            twist: Map::Constant(0.0),
-            seed: 0,
         }
     }
 }

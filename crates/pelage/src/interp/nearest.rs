@@ -23,7 +23,7 @@
 //! Results are ordered by (squared distance, index), computed here from
 //! the points, so they are the same whichever earlier query filled the
 //! list: a hair's neighbours never depend on the thread or the order that
-//! grew it (DESIGN.md, "Deterministic by hair id"), ties included.
+//! grew it (docs/design.md, "Deterministic by hair id"), ties included.
 
 use glam::Vec3;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};

@@ -374,6 +374,20 @@ impl Drop for AtomicFile {
     }
 }
 
+/// [`write_atomically`] for a body with errors of its own type `E` (a
+/// streamed groom's: a part that did not grow), kept as they are instead
+/// of flattened into I/O errors; the file's own errors (creating, syncing,
+/// renaming) become `E` through `From<WriteError>`.
+pub fn write_atomically_with<E: From<WriteError>>(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), E>,
+) -> Result<(), E> {
+    let mut file = AtomicFile::create(path)?;
+    // On an error the file is dropped uncommitted: its temporary is removed.
+    write(file.writer())?;
+    Ok(file.commit()?)
+}
+
 /// Writes `path` by calling `write` on a buffered temporary file in the
 /// same folder (`.NAME.tmp-HOST-PID`), flushing and syncing it, and renaming it
 /// over `path`. On any error the temporary file is removed and `path` is

@@ -2,8 +2,9 @@
 //! pelage understands, and one to write a finished groom in any format.
 
 use super::read_error::{CurvesReadError, CurvesReadErrorKind};
+use super::usda::PrimWriteError;
 use super::{
-    AbcWriter, HairFile, UsdOptions, UsdPrimWriter, UsdaWriter, UsdcWriter, WriteError,
+    AbcWriter, HairFile, PrimWriter, UsdOptions, UsdaWriter, UsdcWriter, WriteError,
     read_abc_curves, read_curves_ply, read_usd_curves, write_atomically, write_curves_ply,
     write_pbrt, write_rib,
 };
@@ -32,6 +33,10 @@ pub enum CurvesFormat {
 }
 
 impl CurvesFormat {
+    /// What to say of an output whose extension names no format pelage
+    /// writes (every front end says the same).
+    pub const UNKNOWN_FOR_WRITING: &'static str = "unknown curves format; pelage writes .usdc (or .usd), .usda, .abc, .hair, .ply, .rib and .pbrt";
+
     /// The extension files of this format are written with.
     pub fn extension(self) -> &'static str {
         match self {
@@ -106,12 +111,8 @@ pub fn write_curves<'c>(
         path: path.to_path_buf(),
         error: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
     };
-    let format = CurvesFormat::from_path(path).ok_or_else(|| {
-        fail(
-            "unknown curves format; pelage writes .usdc (or .usd), .usda, .abc, .hair, .ply, .rib and .pbrt"
-                .into(),
-        )
-    })?;
+    let format = CurvesFormat::from_path(path)
+        .ok_or_else(|| fail(CurvesFormat::UNKNOWN_FOR_WRITING.into()))?;
     let basis = export.usd.basis;
     match format {
         CurvesFormat::Usda | CurvesFormat::Usdc | CurvesFormat::Abc => {
@@ -145,36 +146,36 @@ pub fn write_curves<'c>(
 }
 
 /// Writes a streamed file of `format` (usdc, usda or Alembic) to `out`:
-/// starts it, lets `body` write prims, and finishes it. The other formats
-/// are refused (they are not streamed).
-pub fn write_streamed<W: Write + Seek>(
+/// starts it, lets `body` write prims, and finishes it. The body's errors
+/// are its own type `E` (a groom's part that did not grow stays a groom
+/// error); the writers' become `E` through `From<PrimWriteError>`. The
+/// other formats are refused (they are not streamed).
+pub fn write_streamed<W: Write + Seek, E: From<PrimWriteError>>(
     out: W,
     format: CurvesFormat,
     options: &UsdOptions,
-    body: impl FnOnce(&mut dyn UsdPrimWriter) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    use std::io::Error;
+    body: impl FnOnce(&mut dyn PrimWriter) -> Result<(), E>,
+) -> Result<(), E> {
     match format {
         CurvesFormat::Usdc => {
-            let mut usd = UsdcWriter::new(out, options).map_err(Error::other)?;
+            let mut usd = UsdcWriter::new(out, options)?;
             body(&mut usd)?;
-            usd.finish().map_err(Error::other)?;
+            usd.finish()?;
         }
         CurvesFormat::Usda => {
-            let mut usd = UsdaWriter::new(out, options).map_err(Error::other)?;
+            let mut usd = UsdaWriter::new(out, options)?;
             body(&mut usd)?;
-            usd.finish().map_err(Error::other)?;
+            usd.finish()?;
         }
         CurvesFormat::Abc => {
-            let mut abc = AbcWriter::new(out, options).map_err(Error::other)?;
+            let mut abc = AbcWriter::new(out, options)?;
             body(&mut abc)?;
-            abc.finish().map_err(Error::other)?;
+            abc.finish()?;
         }
         other => {
-            return Err(Error::new(
-                std::io::ErrorKind::InvalidInput,
-                format!("{other:?} is not written as a stream of prims"),
-            ));
+            return Err(E::from(PrimWriteError::BadSetting(format!(
+                "{other:?} is not written as a stream of prims"
+            ))));
         }
     }
     Ok(())
@@ -183,7 +184,7 @@ pub fn write_streamed<W: Write + Seek>(
 /// The skin (if exported) and then every part, as prims of one layer (or
 /// objects of one Alembic archive).
 fn write_usd_prims<'c>(
-    usd: &mut dyn UsdPrimWriter,
+    usd: &mut dyn PrimWriter,
     parts: impl IntoIterator<Item = (String, &'c Curves)>,
     export: &CurvesExport,
 ) -> std::io::Result<()> {

@@ -3,11 +3,14 @@
 //! ([`write_atomically`]), so an error or a kill never leaves a truncated
 //! file under the real name.
 //!
-//! - [`read_curves`] / [`write_curves`]: curves by extension (`.usda`,
-//!   `.usd`, `.usdc` read only, `.hair`, `.ply`, `.rib` and `.pbrt` write
+//! - [`read_curves`] / [`write_curves`]: curves by extension (`.usdc` and
+//!   `.usd`, `.usda`, `.abc`, `.hair`, `.ply`; `.rib` and `.pbrt` write
 //!   only).
-//! - USD: [`UsdaWriter`] streams usda (BasisCurves per part, optional skin
+//! - USD: [`UsdaWriter`] streams usda and [`UsdcWriter`] binary USD
+//!   (BasisCurves per part, time samples, optional skin
 //!   mesh); [`read_usd_curves`] reads usda and usdc (Blender's export too).
+//! - Alembic: [`AbcWriter`] streams Ogawa curves; [`read_abc_curves`]
+//!   reads them back.
 //! - [`HairFile`]: Cem Yuksel's `.hair`, byte for byte.
 //! - [`write_curves_ply`] / [`read_curves_ply`]: curves as PLY polylines.
 //! - [`write_rib`] / [`write_pbrt`]: RenderMan and pbrt-v4 scene text.
@@ -30,7 +33,7 @@ mod usdc;
 pub use abc::{AbcWriter, read_abc_curves, read_abc_curves_at};
 pub use atomic::{
     AtomicFile, check_free_space, check_input, check_output, note_input, protect_inputs,
-    remove_temporary_files, write_atomically,
+    remove_temporary_files, write_atomically, write_atomically_with,
 };
 pub use curves_file::{
     CurvesExport, CurvesFormat, join, read_curves, write_curves, write_streamed,
@@ -47,8 +50,8 @@ pub use usd_read::{
     read_usd_extent, read_usd_layer_info,
 };
 pub(crate) use usd_read::{UsdSkin, read_usd_skin};
-pub use usd_schema::{SurfacePoints, UsdPrimWriter};
-pub use usda::{CurveBasis, UpAxis, UsdOptions, UsdWrap, UsdWriteError, UsdaWriter};
+pub use usd_schema::{PrimWriter, SurfacePoints};
+pub use usda::{CurveBasis, PrimWriteError, UpAxis, UsdOptions, UsdWrap, UsdaWriter};
 pub use usdc::UsdcWriter;
 
 use std::path::PathBuf;

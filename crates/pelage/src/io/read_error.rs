@@ -12,7 +12,7 @@ use std::path::Path;
 pub enum CurvesReadErrorKind {
     /// The file could not be opened or read.
     #[error("cannot read the file: {0}")]
-    Io(#[source] std::io::Error),
+    Io(std::io::Error),
     /// The extension names no format pelage reads curves from.
     #[error(
         "unknown curves format {extension:?}; pelage reads curves from .usda, .usdc, .usd, .abc, .hair and .ply"
@@ -76,8 +76,7 @@ impl fmt::Display for CurvesReadError {
     }
 }
 
-impl std::error::Error for CurvesReadError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        std::error::Error::source(&self.0.2)
-    }
-}
+/// Prints its cause in its message and returns none as `source()`:
+/// front ends print each cause once by walking the chain. The cause stays
+/// in its kind for programs that inspect it.
+impl std::error::Error for CurvesReadError {}

@@ -10,24 +10,26 @@
 //! hair id are per curve (`uniform`), and every prim has an `extent`
 //! padded by half the widest hair, as `UsdGeomCurves::ComputeExtent` does.
 
-use super::usda::{CurveBasis, UsdOptions, UsdWrap, UsdWriteError};
+use super::usda::{CurveBasis, PrimWriteError, UsdOptions, UsdWrap};
 use crate::Curves;
 use crate::mesh::{Mesh, Uvs};
 use glam::{Vec2, Vec3};
 use std::borrow::Cow;
 
-/// A USD layer being written prim by prim, as text ([`UsdaWriter`]) or
-/// binary ([`UsdcWriter`]), so code that streams parts works with either.
+/// A file being written prim by prim: a USD layer as text ([`UsdaWriter`])
+/// or binary ([`UsdcWriter`]), or an Alembic archive ([`AbcWriter`]), so
+/// code that streams parts works with any of them.
 ///
 /// [`UsdaWriter`]: super::UsdaWriter
 /// [`UsdcWriter`]: super::UsdcWriter
-pub trait UsdPrimWriter {
+/// [`AbcWriter`]: super::AbcWriter
+pub trait PrimWriter {
     /// Writes one part as a `BasisCurves` prim named `name`.
-    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError>;
+    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError>;
     /// Writes the skin as a `Mesh` prim named `name`.
-    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError>;
+    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), PrimWriteError>;
     /// Writes sampled surface points as a `Points` prim named `name`.
-    fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), UsdWriteError>;
+    fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), PrimWriteError>;
     /// Writes one frame of an animated part (time code `time`): the first
     /// call for `name` writes the prim, later ones add time samples of
     /// points, normals and extent. Writers without time samples refuse.
@@ -36,18 +38,18 @@ pub trait UsdPrimWriter {
         name: &str,
         time: f64,
         curves: &Curves,
-    ) -> Result<(), UsdWriteError> {
+    ) -> Result<(), PrimWriteError> {
         let _ = (name, time, curves);
-        Err(UsdWriteError::BadSetting(
+        Err(PrimWriteError::BadSetting(
             "this format has no time samples; write animated grooms to .usdc or .abc".into(),
         ))
     }
     /// Writes one frame of an animated skin (time code `time`), as
     /// [`Self::write_part_at`] does for curves. Writers without animated
     /// meshes refuse.
-    fn write_mesh_at(&mut self, name: &str, time: f64, mesh: &Mesh) -> Result<(), UsdWriteError> {
+    fn write_mesh_at(&mut self, name: &str, time: f64, mesh: &Mesh) -> Result<(), PrimWriteError> {
         let _ = (name, time, mesh);
-        Err(UsdWriteError::BadSetting(
+        Err(PrimWriteError::BadSetting(
             "this format cannot write an animated skin; write it to .usdc".into(),
         ))
     }
@@ -173,7 +175,7 @@ pub(crate) fn basis_curves_attributes<'a>(
     part: &str,
     curves: &'a Curves,
     options: &UsdOptions,
-) -> Result<Vec<UsdAttribute<'a>>, UsdWriteError> {
+) -> Result<Vec<UsdAttribute<'a>>, PrimWriteError> {
     check_curve_lengths(part, curves, options)?;
     let mut attributes = Vec::with_capacity(12);
     match options.basis {
@@ -306,11 +308,11 @@ fn check_curve_lengths(
     part: &str,
     curves: &Curves,
     options: &UsdOptions,
-) -> Result<(), UsdWriteError> {
+) -> Result<(), PrimWriteError> {
     let min = options.min_points_per_curve();
     match (0..curves.curve_count()).find(|&i| curves.range(i).len() < min) {
         None => Ok(()),
-        Some(curve) => Err(UsdWriteError::ShortCurve {
+        Some(curve) => Err(PrimWriteError::ShortCurve {
             part: part.to_string(),
             curve,
             points: curves.range(curve).len(),
@@ -325,7 +327,7 @@ fn check_curve_lengths(
 }
 
 /// USD prim names: an identifier.
-pub(crate) fn check_name(name: &str) -> Result<(), UsdWriteError> {
+pub(crate) fn check_name(name: &str) -> Result<(), PrimWriteError> {
     let mut chars = name.chars();
     let ok = chars
         .next()
@@ -334,7 +336,7 @@ pub(crate) fn check_name(name: &str) -> Result<(), UsdWriteError> {
     if ok {
         Ok(())
     } else {
-        Err(UsdWriteError::BadName(name.to_string()))
+        Err(PrimWriteError::BadName(name.to_string()))
     }
 }
 

@@ -11,7 +11,7 @@
 
 use super::text::{put_f32, put_tuple2, put_tuple3, put_u64};
 use super::usd_schema::{
-    SurfacePoints, UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name,
+    PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes, check_name,
     mesh_attributes, points_attributes,
 };
 use crate::Curves;
@@ -32,6 +32,35 @@ pub enum CurveBasis {
     #[default]
     #[serde(alias = "catmullRom")]
     CatmullRom,
+}
+
+impl CurveBasis {
+    /// Every basis's name, as groom files, flags and Python spell it.
+    pub const NAMES: [&'static str; 2] = ["catmull-rom", "linear"];
+}
+
+impl std::fmt::Display for CurveBasis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            CurveBasis::Linear => "linear",
+            CurveBasis::CatmullRom => "catmull-rom",
+        })
+    }
+}
+
+impl std::str::FromStr for CurveBasis {
+    type Err = String;
+
+    /// `catmull-rom` (or USD's `catmullRom`) or `linear`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "catmull-rom" | "catmullRom" => Ok(CurveBasis::CatmullRom),
+            "linear" => Ok(CurveBasis::Linear),
+            other => Err(format!(
+                "basis {other:?}: use \"catmull-rom\" or \"linear\""
+            )),
+        }
+    }
 }
 
 /// How curve ends are treated (USD `wrap`; only meaningful for cubic
@@ -91,7 +120,7 @@ impl UsdOptions {
     /// Refuses options no file can hold: a root name USD does not accept,
     /// and a scale or frame rate that is not a positive number (a file
     /// with `metersPerUnit = NaN` would be written and then misread).
-    pub fn check(&self) -> Result<(), UsdWriteError> {
+    pub fn check(&self) -> Result<(), PrimWriteError> {
         check_name(&self.root)?;
         for (what, value) in [
             ("metersPerUnit", self.meters_per_unit),
@@ -101,7 +130,7 @@ impl UsdOptions {
             ),
         ] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(UsdWriteError::BadSetting(format!(
+                return Err(PrimWriteError::BadSetting(format!(
                     "{what} must be a positive number, not {value}"
                 )));
             }
@@ -118,10 +147,22 @@ impl UsdOptions {
     }
 }
 
-/// A part or mesh could not be written as USD.
+/// The I/O error underneath, or the writer's refusal as one (for callers
+/// whose writes are all I/O to them).
+impl From<PrimWriteError> for std::io::Error {
+    fn from(error: PrimWriteError) -> Self {
+        match error {
+            PrimWriteError::Io(e) => e,
+            other => std::io::Error::other(other),
+        }
+    }
+}
+
+/// A part or mesh could not be written as a prim (of a USD layer or an
+/// Alembic archive).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
-pub enum UsdWriteError {
+pub enum PrimWriteError {
     /// Writing failed.
     #[error(transparent)]
     Io(#[from] std::io::Error),
@@ -170,7 +211,7 @@ pub enum UsdWriteError {
     },
 }
 
-impl UsdWriteError {
+impl PrimWriteError {
     /// Refuses a frame time that is not a number.
     pub(crate) fn check_time(part: &str, time: f64) -> Result<(), Self> {
         if time.is_finite() {
@@ -218,7 +259,7 @@ pub struct UsdaWriter<W: Write> {
 
 impl<W: Write> UsdaWriter<W> {
     /// Writes the stage metadata and opens the default prim.
-    pub fn new(mut out: W, options: &UsdOptions) -> Result<Self, UsdWriteError> {
+    pub fn new(mut out: W, options: &UsdOptions) -> Result<Self, PrimWriteError> {
         options.check()?;
         let up = match options.up_axis {
             UpAxis::Y => "Y",
@@ -239,16 +280,16 @@ impl<W: Write> UsdaWriter<W> {
         })
     }
 
-    fn claim(&mut self, name: &str) -> Result<(), UsdWriteError> {
+    fn claim(&mut self, name: &str) -> Result<(), PrimWriteError> {
         check_name(name)?;
         if !self.names.insert(name.to_string()) {
-            return Err(UsdWriteError::DuplicateName(name.to_string()));
+            return Err(PrimWriteError::DuplicateName(name.to_string()));
         }
         Ok(())
     }
 
     /// Writes one part as a `BasisCurves` prim named `name`.
-    pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+    pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         let attributes = basis_curves_attributes(name, curves, &self.options)?;
         self.write_prim("BasisCurves", name, &attributes)
     }
@@ -258,14 +299,14 @@ impl<W: Write> UsdaWriter<W> {
         &mut self,
         name: &str,
         points: &SurfacePoints,
-    ) -> Result<(), UsdWriteError> {
+    ) -> Result<(), PrimWriteError> {
         self.write_prim("Points", name, &points_attributes(points))
     }
 
     /// Writes the skin as a `Mesh` prim named `name` (triangles, vertex
     /// normals, UVs as `st`), so the file opens complete in usdview or
     /// Blender.
-    pub fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
+    pub fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), PrimWriteError> {
         self.write_prim("Mesh", name, &mesh_attributes(mesh))
     }
 
@@ -274,7 +315,7 @@ impl<W: Write> UsdaWriter<W> {
         type_name: &str,
         name: &str,
         attributes: &[UsdAttribute],
-    ) -> Result<(), UsdWriteError> {
+    ) -> Result<(), PrimWriteError> {
         self.claim(name)?;
         let out = &mut self.out;
         writeln!(out, "    def {type_name} \"{name}\"\n    {{")?;
@@ -286,7 +327,7 @@ impl<W: Write> UsdaWriter<W> {
     }
 
     /// Closes the default prim and returns the output (not flushed).
-    pub fn finish(mut self) -> Result<W, UsdWriteError> {
+    pub fn finish(mut self) -> Result<W, PrimWriteError> {
         writeln!(self.out, "}}")?;
         Ok(self.out)
     }
@@ -328,16 +369,16 @@ fn write_array<T: Sync>(
     }
 }
 
-impl<W: Write> UsdPrimWriter for UsdaWriter<W> {
-    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+impl<W: Write> PrimWriter for UsdaWriter<W> {
+    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         UsdaWriter::write_part(self, name, curves)
     }
 
-    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
+    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), PrimWriteError> {
         UsdaWriter::write_mesh(self, name, mesh)
     }
 
-    fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), UsdWriteError> {
+    fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), PrimWriteError> {
         UsdaWriter::write_points(self, name, points)
     }
 }

@@ -89,7 +89,7 @@ impl MapSite {
 
 /// A map could not be read, parsed or used. Displays as `SOURCE: what is
 /// wrong`, where SOURCE is the image file, the spec string or the mesh.
-/// Its `source` is the error underneath its kind, if any.
+/// The error underneath, if any, is in its kind.
 #[derive(Debug)]
 pub struct MapError {
     /// The image path, the map spec as written, or the mesh name.
@@ -104,11 +104,10 @@ impl std::fmt::Display for MapError {
     }
 }
 
-impl std::error::Error for MapError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        std::error::Error::source(&self.kind)
-    }
-}
+/// Prints its cause in its message and returns none as `source()`:
+/// front ends print each cause once by walking the chain. The cause stays
+/// in its kind for programs that inspect it.
+impl std::error::Error for MapError {}
 
 /// What is wrong with a map.
 #[derive(Debug, thiserror::Error)]
@@ -116,7 +115,7 @@ impl std::error::Error for MapError {
 pub enum MapErrorKind {
     /// The image file could not be opened or read.
     #[error("cannot read the file: {0}")]
-    Io(#[source] std::io::Error),
+    Io(std::io::Error),
     /// The file is not an image pelage can decode.
     #[error("not a readable PNG or EXR image: {0}")]
     Decode(String),

@@ -35,7 +35,7 @@ impl fmt::Display for Location {
 pub enum MeshErrorKind {
     /// The file could not be opened or read.
     #[error("cannot read the file: {0}")]
-    Io(#[source] std::io::Error),
+    Io(std::io::Error),
     /// The extension names no format pelage reads.
     #[error(
         "unknown mesh format {extension:?}; pelage reads .obj, .ply, .gltf, .glb, .usda, .usdc and .usd"
@@ -161,8 +161,7 @@ impl fmt::Display for MeshError {
     }
 }
 
-impl std::error::Error for MeshError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        std::error::Error::source(&self.0.kind)
-    }
-}
+/// Prints its cause in its message and returns none as `source()`:
+/// front ends print each cause once by walking the chain. The cause stays
+/// in its kind for programs that inspect it.
+impl std::error::Error for MeshError {}

@@ -6,7 +6,7 @@
 //! which groom regions read. Other statements (smoothing, lines) are
 //! ignored.
 //!
-//! Hand-written rather than tobj (a departure from DESIGN.md, recorded in
+//! Hand-written rather than tobj (a departure from the starting design, recorded in
 //! ARCHITECTURE.md): tobj's errors carry no line numbers, and every error
 //! here names its line. It also keeps position and UV indices apart, so UV
 //! seams do not split vertices and topology stays as modelled.

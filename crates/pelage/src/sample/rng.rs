@@ -1,6 +1,6 @@
 //! Counter-based random streams: the random numbers of sample `i` depend on
 //! `(seed, i)` alone, so any range of samples can be generated on its own,
-//! on any number of threads, with identical results (DESIGN.md,
+//! on any number of threads, with identical results (docs/design.md,
 //! "Deterministic by hair id").
 //!
 //! Two forms, both SplitMix64 (Steele et al. 2014, "Fast splittable

@@ -3,26 +3,12 @@
 //! drawing with the same user seed and hair id still get unrelated numbers
 //! as long as their salts differ. The values are part of the output: a
 //! changed salt changes every groom that uses it, so they live here, named,
-//! and a test checks that no two are equal.
+//! and a test checks that no two are equal. Each groom operator keeps its
+//! own salts in its module (`groom/ops/<name>.rs`); the test compares
+//! those too.
 
 /// Part `p`'s roots: `mix64(seed ^ mix64(PART_ROOTS + p))`.
 pub const PART_ROOTS: u64 = 0x9A27;
-/// `width`'s per-hair jitter.
-pub const WIDTH_JITTER: u64 = 0x3D_7714;
-/// `opacity`'s per-hair jitter.
-pub const OPACITY_JITTER: u64 = 0x00BA_C17E;
-/// `color`'s per-hair brightness jitter.
-pub const COLOR_JITTER: u64 = 0xC0_10E;
-/// `length`'s per-hair jitter.
-pub const LENGTH_JITTER: u64 = 0x1E_4674;
-/// `strands`: where each strand hair sits around its base hair.
-pub const STRAND_SPREAD: u64 = 0x57_2A4D;
-/// `frizz`: the noise field it follows.
-pub const FRIZZ_FIELD: u64 = 0xF122;
-/// `frizz`: whether a hair frizzes, and its offset into the field.
-pub const FRIZZ_HAIR: u64 = 0xF122_F122;
-/// `curl`: each hair's phase.
-pub const CURL_PHASE: u64 = 0xC0_11;
 /// Shell fur: droplets scattered over a mesh.
 pub const DROPLETS: u64 = 0x5EED_D201;
 
@@ -34,16 +20,8 @@ pub const CELL_ROOTS: u64 = 0xCE11_2007;
 pub const BLUE_NOISE: u64 = 0xB10E_2015;
 
 /// Every salt above, with its name.
-pub const ALL: [(&str, u64); 13] = [
+pub const ALL: [(&str, u64); 5] = [
     ("PART_ROOTS", PART_ROOTS),
-    ("WIDTH_JITTER", WIDTH_JITTER),
-    ("OPACITY_JITTER", OPACITY_JITTER),
-    ("COLOR_JITTER", COLOR_JITTER),
-    ("LENGTH_JITTER", LENGTH_JITTER),
-    ("STRAND_SPREAD", STRAND_SPREAD),
-    ("FRIZZ_FIELD", FRIZZ_FIELD),
-    ("FRIZZ_HAIR", FRIZZ_HAIR),
-    ("CURL_PHASE", CURL_PHASE),
     ("DROPLETS", DROPLETS),
     ("CELL_ARRIVALS", CELL_ARRIVALS),
     ("CELL_ROOTS", CELL_ROOTS),
@@ -56,8 +34,11 @@ mod tests {
 
     #[test]
     fn no_two_streams_share_a_salt() {
-        for (i, (a, x)) in ALL.iter().enumerate() {
-            for (b, y) in &ALL[i + 1..] {
+        let mut all: Vec<(String, u64)> = ALL.iter().map(|(n, s)| (n.to_string(), *s)).collect();
+        all.extend(crate::groom::ops::operator_salts());
+        assert!(all.len() > ALL.len(), "the operators' salts are counted");
+        for (i, (a, x)) in all.iter().enumerate() {
+            for (b, y) in &all[i + 1..] {
                 assert_ne!(
                     x, y,
                     "{a} and {b} share a salt: their streams would coincide"

@@ -7,8 +7,8 @@ use std::ops::Range;
 use std::path::PathBuf;
 
 /// A shell scene could not be read, parsed or set up. Displays as
-/// `FILE:LINE:COLUMN: KEY: what is wrong`; its `source` is the error
-/// underneath, if any (whose message the display includes).
+/// `FILE:LINE:COLUMN: KEY: what is wrong`; the error underneath, if any,
+/// is in its kind and its message in this one's.
 ///
 /// Boxed inside, so results stay small on the happy path.
 #[derive(Debug)]
@@ -31,7 +31,7 @@ pub struct SceneErrorDetails {
 pub enum SceneErrorKind {
     /// The file could not be read.
     #[error("cannot read the scene file: {0}")]
-    Io(#[source] std::io::Error),
+    Io(std::io::Error),
     /// Not valid TOML, an unknown key, or a value of the wrong type (an
     /// unknown name lists the accepted ones).
     #[error("{0}")]
@@ -41,14 +41,13 @@ pub enum SceneErrorKind {
     Invalid(String),
     /// The mesh could not be loaded.
     #[error("{0}")]
-    Mesh(#[source] crate::mesh::MeshError),
+    Mesh(crate::mesh::MeshError),
     /// An image (colour texture, droplet mask) could not be read.
     #[error("{path}: {error}")]
     Image {
         /// The image file.
         path: PathBuf,
         /// Why.
-        #[source]
         error: image::ImageError,
     },
 }
@@ -85,8 +84,7 @@ impl fmt::Display for SceneError {
     }
 }
 
-impl std::error::Error for SceneError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        std::error::Error::source(&self.0.kind)
-    }
-}
+/// Prints its cause in its message and returns none as `source()`:
+/// front ends print each cause once by walking the chain. The cause stays
+/// in its kind for programs that inspect it.
+impl std::error::Error for SceneError {}

@@ -1,6 +1,6 @@
 //! The shell-fur formulas of Silva et al., one function per formula, as the
 //! reference the WGSL in `pelage-gpu/src/shaders/shells.wgsl` mirrors line
-//! by line (DESIGN.md, "One formula, two homes"):
+//! by line (docs/design.md, "One formula, two homes"):
 //!
 //! - layer height `h = (1 + n) / N` (§4),
 //! - the layer offset `v_offset(h) = β(h) + φ(h)` (Eq. 1), with `β` from the

@@ -962,9 +962,12 @@ mod tests {
             assert!(e.contains(&format!(": {key}: unknown variant")), "{e}");
             assert!(e.contains(accepted), "{e}");
         }
-        // The error underneath an unreadable image is its source.
+        // The error underneath an unreadable image is in the message once,
+        // and kept typed in the kind (not handed on to be said again).
         let e = scene("color = \"missing.png\"\n").unwrap_err();
-        assert!(std::error::Error::source(&e).is_some(), "{e}");
+        assert!(std::error::Error::source(&e).is_none(), "{e}");
+        assert!(matches!(e.kind, SceneErrorKind::Image { .. }), "{e}");
+        assert_eq!(e.to_string().matches("missing.png").count(), 1, "{e}");
     }
 
     #[test]

@@ -8,11 +8,85 @@
 //! away from the hair's, as on the other side of an ear, is passed over
 //! for the next nearest).
 
-use super::{Hair, RampTables, RootContext};
-use crate::groom::file::Ramp;
+use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::{Hair, RampTables, RootContext, Scratch};
+use crate::groom::error::{GroomError, GroomErrorKind};
+use crate::groom::file::MapValue;
+use crate::groom::ramp::Ramp;
 use crate::interp::{NearestPoints, NeighbourCache, QueryRegion};
+use crate::limits::MAX_CLUMPS;
 use crate::map::Map;
+use crate::sample::{DensitySampler, DensitySamplerOptions, sample_range};
+use crate::settings::{Bound, Rule};
 use glam::Vec3;
+use serde::Deserialize;
+use toml::Spanned;
+
+/// `clump` as a groom file writes it.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ClumpSpec {
+    /// Number of clumps over the whole mesh.
+    pub count: Spanned<u64>,
+    /// Density of clump centres.
+    #[serde(default = "uniform")]
+    pub density: MapValue,
+    /// How far hairs move to their centre hair (0 to 1).
+    #[serde(default = "default_rate")]
+    pub rate: MapValue,
+    /// Root-to-tip profile of the rate.
+    #[serde(default)]
+    pub ramp: Ramp,
+    /// Clump radius: hairs this far from their centre's root are not
+    /// pulled, nearer ones in proportion (default: no limit).
+    pub size: Option<MapValue>,
+    /// Seed of the clump centres.
+    #[serde(default)]
+    pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
+}
+
+fn uniform() -> MapValue {
+    default_map(1.0)
+}
+
+fn default_rate() -> MapValue {
+    default_map(0.8)
+}
+
+/// `clump`: see [`Clump`].
+#[derive(Debug, Clone)]
+pub struct ClumpParams {
+    /// Number of clumps over the whole mesh.
+    pub count: u64,
+    /// Density of clump centres.
+    pub density: Map,
+    /// How far hairs move to their centre hair (0 to 1).
+    pub rate: Map,
+    /// Root-to-tip profile of the rate.
+    pub ramp: Ramp,
+    /// Clump radius (`None`: no limit).
+    pub size: Option<Map>,
+    /// Seed of the clump centres.
+    pub seed: u64,
+}
+
+impl ClumpParams {
+    /// `count` clumps, uniform centres, rate 0.8, linear ramp, no size
+    /// limit, seed 0.
+    pub fn new(count: u64) -> Self {
+        Self {
+            count,
+            density: Map::Constant(1.0),
+            rate: Map::Constant(0.8),
+            ramp: Ramp::default(),
+            size: None,
+            seed: 0,
+        }
+    }
+}
 
 /// The centre hairs of one clump level: roots in a kd-tree a region,
 /// shapes with the hairs' point count, and each root's skin normal.
@@ -171,7 +245,8 @@ impl Clump {
         &self.centres
     }
 
-    pub(super) fn apply(
+    /// Pulls one hair toward its centre.
+    pub(super) fn pull(
         &self,
         hair: &mut Hair,
         root: &RootContext,
@@ -207,6 +282,70 @@ impl Clump {
     }
 }
 
+impl OperatorKind for Clump {
+    const NAME: &'static str = "clump";
+    const SUMMARY: &'static str = "Pulls hairs toward `count` clump centre hairs (`rate` 0 to 1).";
+    type Spec = ClumpSpec;
+    type Params = ClumpParams;
+    const RULES: &'static [Rule] = &[
+        Rule::new(
+            "count",
+            Bound::Within(1.0, MAX_CLUMPS as f64),
+            "pelage's clump limit",
+        ),
+        Rule::new("density", Bound::at_least(0.0), "a density"),
+    ];
+    const SEARCHES_NEIGHBOURS: bool = true;
+
+    fn mask(spec: &ClumpSpec) -> Option<&MapValue> {
+        spec.mask.as_ref()
+    }
+
+    fn read(s: &ClumpSpec, r: &mut SpecReader<'_>) -> Result<ClumpParams, GroomError> {
+        Ok(ClumpParams {
+            count: r.value("count", &s.count),
+            density: r.map("density", &s.density)?,
+            rate: r.map("rate", &s.rate)?,
+            ramp: s.ramp.clone(),
+            size: s.size.as_ref().map(|m| r.map("size", m)).transpose()?,
+            seed: s.seed,
+        })
+    }
+
+    fn maps(p: &ClumpParams) -> Vec<(&'static str, &Map)> {
+        let mut maps = vec![("density", &p.density), ("rate", &p.rate)];
+        maps.extend(p.size.as_ref().map(|m| ("size", m)));
+        maps
+    }
+
+    fn maps_mut(p: &mut ClumpParams) -> Vec<(&'static str, &mut Map)> {
+        let mut maps = vec![("density", &mut p.density), ("rate", &mut p.rate)];
+        maps.extend(p.size.as_mut().map(|m| ("size", m)));
+        maps
+    }
+
+    fn counts(p: &ClumpParams) -> Vec<(&'static str, u64, u64, &'static str)> {
+        vec![("count", p.count, MAX_CLUMPS, "clumps")]
+    }
+
+    fn prepare(p: ClumpParams, cx: &Preparation<'_>) -> Result<Self, GroomError> {
+        if p.count == 0 {
+            return Err(cx.error(
+                "count",
+                GroomErrorKind::Invalid("a clump operator needs at least 1 clump".into()),
+            ));
+        }
+        let sampler = DensitySampler::new(cx.mesh(), &p.density, DensitySamplerOptions::default())
+            .map_err(|e| cx.error("density", GroomErrorKind::Sample(e)))?;
+        let roots = sample_range(&sampler, cx.seed(p.seed), 0..p.count);
+        Ok(Clump::new(cx.centres(&roots), p.rate, p.ramp, p.size))
+    }
+
+    fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
+        self.pull(hair, root, &mut scratch.near, &mut scratch.ramps);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::test_hairs::{root, straight};
@@ -225,7 +364,7 @@ mod tests {
     fn full_rate_brings_the_tip_to_the_centre_and_keeps_the_root() {
         let op = Clump::new(centre_at(0.1), Map::Constant(1.0), Ramp::default(), None);
         let mut hair = straight(1, 8, 1.0);
-        op.apply(
+        op.pull(
             &mut hair,
             &root(),
             &mut NeighbourCache::default(),
@@ -279,7 +418,7 @@ mod tests {
             Some(Map::Constant(0.05)),
         );
         let mut hair = straight(1, 8, 1.0);
-        op.apply(
+        op.pull(
             &mut hair,
             &root(),
             &mut NeighbourCache::default(),

@@ -51,9 +51,8 @@ impl Masked {
         if m == 1.0 {
             return self.op.apply(batch, root, scratch);
         }
-        if let Operator::Cut(cut) = &*self.op {
-            let at = cut.at().at(&root.site);
-            return cut.apply_at(batch, 1.0 - m * (1.0 - at), scratch);
+        if self.op.apply_faded(batch, root, m, scratch) {
+            return;
         }
         let mut before = std::mem::take(&mut scratch.masked);
         before.len = 0;

@@ -7,29 +7,85 @@
 //! one hair, or several once [`Strands`] has split it. Every random number
 //! comes from a stream keyed by the operator's seed and the hair's id
 //! ([`SampleRng`]), so a hair is the same whichever thread, part or run
-//! makes it (DESIGN.md, "Deterministic by hair id"). Parameters are
+//! makes it (docs/design.md, "Deterministic by hair id"). Parameters are
 //! [`Map`]s read at the root's UV.
 //!
 //! Points are indexed root to tip; `t = j / (n − 1)` is point `j`'s curve
 //! parameter, the `t` of every root-to-tip [`Ramp`].
 
 mod clump;
-mod displace;
+mod color;
+mod curl;
+mod cut;
+mod flyaways;
+mod frizz;
+mod kind;
+mod length;
 mod look;
 mod mask;
+mod noise;
+mod opacity;
 mod strands;
-mod trim;
+mod twist;
+mod width;
 
-pub use clump::{Clump, ClumpCentres};
-pub use displace::{Curl, Frizz, Noise, NoiseScratch};
-pub use look::{Color, Opacity, Width};
+pub use clump::{Clump, ClumpCentres, ClumpParams};
+pub use color::Color;
+pub use curl::{Curl, CurlParams};
+pub use cut::Cut;
+pub use flyaways::{Flyaways, FlyawaysParams};
+pub use frizz::{Frizz, FrizzParams};
+pub use length::{Length, LengthParams};
 pub use mask::Masked;
-pub use strands::Strands;
-pub use trim::{Cut, Length};
+pub use noise::{Noise, NoiseParams, NoiseScratch};
+pub use opacity::Opacity;
+pub use strands::{Strands, StrandsParams};
+pub use twist::{Twist, TwistParams};
+pub use width::Width;
+
+pub(crate) use color::color_maps_mut;
+pub use kind::OperatorSchema;
+pub(crate) use kind::{OpKey, Preparation, SpecReader, map_on_mesh, schema_of};
+pub(crate) use look::root_to_tip_maps_mut;
+
+use crate::groom::error::GroomError;
+use crate::groom::file::MapValue;
+use crate::settings::Rule;
+use kind::{OperatorKind, operators};
+
+// The registry: every operator, one a line. The enums `OpSpec`, `GroomOp`
+// and `Operator` and their dispatch are derived from it (`kind.rs`).
+operators! {
+    /// Perlin displacement ([`Noise`]).
+    Noise(Noise, NoiseParams, noise::NoiseSpec),
+    /// Per-hair random high-frequency displacement ([`Frizz`]).
+    Frizz(Frizz, FrizzParams, frizz::FrizzSpec),
+    /// Pull hairs toward clump centre hairs ([`Clump`]).
+    Clump(Clump, ClumpParams, clump::ClumpSpec),
+    /// Helix around the hair's path ([`Curl`]).
+    Curl(Curl, CurlParams, curl::CurlSpec),
+    /// Cut at a curve parameter ([`Cut`]).
+    Cut(Cut, Cut, cut::CutSpec),
+    /// Scale the length ([`Length`]).
+    Length(Length, LengthParams, length::LengthSpec),
+    /// Each hair becomes a strand of hairs ([`Strands`]).
+    Strands(Strands, StrandsParams, strands::StrandsSpec),
+    /// Widths root to tip ([`Width`]).
+    Width(Width, RootToTip, crate::groom::file::RootToTipSpec),
+    /// Colours root to tip ([`Color`]).
+    Color(Color, Color, crate::groom::file::ColorSpec),
+    /// Opacities root to tip ([`Opacity`]).
+    Opacity(Opacity, RootToTip, crate::groom::file::RootToTipSpec),
+    /// Hairs turned about their root–tip axis ([`Twist`]).
+    Twist(Twist, TwistParams, twist::TwistSpec),
+    /// A fraction of the hairs lengthened and pushed off their clump
+    /// ([`Flyaways`]).
+    Flyaways(Flyaways, FlyawaysParams, flyaways::FlyawaysSpec),
+}
 
 use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
 use crate::curves::{floats_finite, vectors_finite};
-use crate::groom::file::Ramp;
+use crate::groom::ramp::Ramp;
 use crate::interp::QueryRegion;
 use crate::map::{Map, MapSite};
 use crate::mesh::SurfacePoint;
@@ -236,126 +292,6 @@ impl Scratch {
     }
 }
 
-/// One operator of the chain.
-#[derive(Debug)]
-pub enum Operator {
-    /// Perlin displacement.
-    Noise(Noise),
-    /// Per-hair random high-frequency displacement.
-    Frizz(Frizz),
-    /// Pull toward clump centre hairs.
-    Clump(Clump),
-    /// Helix around the path.
-    Curl(Curl),
-    /// Cut at a curve parameter.
-    Cut(Cut),
-    /// Scale the length.
-    Length(Length),
-    /// Split into strands.
-    Strands(Strands),
-    /// Widths.
-    Width(Width),
-    /// Colours.
-    Color(Color),
-    /// Opacity.
-    Opacity(Opacity),
-    /// An operator faded by a mask.
-    Masked(Masked),
-}
-
-impl Operator {
-    /// Applies the operator to every hair of `batch`.
-    pub fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
-        match self {
-            Operator::Strands(op) => op.apply(batch, root, scratch),
-            Operator::Cut(op) => op.apply(batch, root, scratch),
-            Operator::Masked(op) => op.apply(batch, root, scratch),
-            _ => {
-                for hair in batch.hairs_mut() {
-                    self.apply_to_hair(hair, root, scratch);
-                }
-            }
-        }
-    }
-
-    /// Applies the operator to hairs grown one a root (`hairs[i]` from
-    /// `roots[i]`): the same result as [`Self::apply`] root by root, with
-    /// the work of some operators (noise) shared across the hairs.
-    ///
-    /// # Panics
-    /// For operators that change the number of hairs ([`Self::keeps_one_hair_a_root`]).
-    pub fn apply_each(&self, hairs: &mut [Hair], roots: &[RootContext], scratch: &mut Scratch) {
-        assert_eq!(hairs.len(), roots.len(), "one root a hair");
-        match self {
-            Operator::Noise(op) => {
-                op.apply_each(hairs, roots, &mut scratch.noise, &mut scratch.ramps)
-            }
-            Operator::Masked(op) if op.operator().keeps_one_hair_a_root() => {
-                op.apply_each(hairs, roots, scratch)
-            }
-            Operator::Strands(_) | Operator::Cut(_) | Operator::Masked(_) => {
-                panic!("{} changes the number of hairs a root grows", self.name())
-            }
-            _ => {
-                for (hair, root) in hairs.iter_mut().zip(roots) {
-                    self.apply_to_hair(hair, root, scratch);
-                }
-            }
-        }
-    }
-
-    /// Whether every root still grows exactly one hair after this operator
-    /// (all but `strands` and `cut`, which may remove a hair).
-    pub fn keeps_one_hair_a_root(&self) -> bool {
-        match self {
-            Operator::Masked(op) => op.operator().keeps_one_hair_a_root(),
-            op => !matches!(op, Operator::Strands(_) | Operator::Cut(_)),
-        }
-    }
-
-    /// The operator under any mask.
-    pub fn unmasked(&self) -> &Operator {
-        match self {
-            Operator::Masked(op) => op.operator().unmasked(),
-            op => op,
-        }
-    }
-
-    /// An operator that works hair by hair, on one hair.
-    fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
-        match self {
-            Operator::Noise(op) => op.apply(hair, root, &mut scratch.noise, &mut scratch.ramps),
-            Operator::Frizz(op) => op.apply(hair, root, &mut scratch.ramps),
-            Operator::Clump(op) => op.apply(hair, root, &mut scratch.near, &mut scratch.ramps),
-            Operator::Curl(op) => op.apply(hair, root, scratch),
-            Operator::Length(op) => op.apply(hair, root),
-            Operator::Width(op) => op.apply(hair, root, &mut scratch.ramps),
-            Operator::Color(op) => op.apply(hair, root, &mut scratch.ramps),
-            Operator::Opacity(op) => op.apply(hair, root, &mut scratch.ramps),
-            Operator::Strands(_) | Operator::Cut(_) | Operator::Masked(_) => {
-                unreachable!("strands, cut and masks work on the whole batch")
-            }
-        }
-    }
-
-    /// The operator's name as groom files spell it.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Operator::Noise(_) => "noise",
-            Operator::Frizz(_) => "frizz",
-            Operator::Clump(_) => "clump",
-            Operator::Curl(_) => "curl",
-            Operator::Cut(_) => "cut",
-            Operator::Length(_) => "length",
-            Operator::Strands(_) => "strands",
-            Operator::Width(_) => "width",
-            Operator::Color(_) => "color",
-            Operator::Opacity(_) => "opacity",
-            Operator::Masked(op) => op.operator().name(),
-        }
-    }
-}
-
 /// Curve parameter of point `j` of `n`.
 #[inline]
 pub(crate) fn param(j: usize, n: usize) -> f32 {
@@ -477,5 +413,54 @@ pub(crate) mod test_hairs {
         let mut b = HairBatch::default();
         *b.reset() = hair;
         b
+    }
+}
+
+#[cfg(test)]
+mod registry_tests {
+    use super::*;
+
+    #[test]
+    fn the_schema_is_read_off_each_operators_spec() {
+        let schema = operator_schema();
+        let names: Vec<&str> = schema.iter().map(|s| s.name).collect();
+        assert_eq!(names, OPERATOR_NAMES);
+        let clump = schema.iter().find(|s| s.name == "clump").unwrap();
+        assert_eq!(
+            clump.fields,
+            ["count", "density", "rate", "ramp", "size", "seed", "mask"]
+        );
+        assert_eq!(clump.required, ["count"]);
+        let color = schema.iter().find(|s| s.name == "color").unwrap();
+        assert_eq!(color.required, ["root", "tip"]);
+        let twist = schema.iter().find(|s| s.name == "twist").unwrap();
+        assert_eq!(twist.required, ["angle"]);
+        assert!(schema.iter().all(|s| s.fields.contains(&"mask")));
+    }
+
+    #[test]
+    fn every_operator_reads_under_its_name_with_its_required_keys() {
+        for op in operator_schema() {
+            let keys: Vec<String> = op
+                .required
+                .iter()
+                .map(|k| match (op.name, *k) {
+                    ("color", _) => format!("{k} = [0.5, 0.5, 0.5]"),
+                    _ => format!("{k} = 1"),
+                })
+                .collect();
+            let text = format!(
+                "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[[ops]]\n{} = {{ {} }}\n",
+                op.name,
+                keys.join(", ")
+            );
+            let source = crate::settings::SettingsSource {
+                path: "ops.toml".into(),
+                text,
+            };
+            source
+                .check_groom()
+                .unwrap_or_else(|e| panic!("{}: {e}", op.name));
+        }
     }
 }

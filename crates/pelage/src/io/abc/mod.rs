@@ -23,7 +23,7 @@ mod read;
 pub use read::{read_abc_curves, read_abc_curves_at};
 
 use super::usd_schema::{check_name, curve_extent};
-use super::{CurveBasis, UsdOptions, UsdWriteError};
+use super::{CurveBasis, PrimWriteError, UsdOptions};
 use crate::Curves;
 use ogawa::{Child, EMPTY_DATA, EMPTY_GROUP, OgawaWriter, murmur3_128};
 use std::collections::HashSet;
@@ -137,7 +137,7 @@ impl<W: Write + Seek> AbcWriter<W> {
     /// Starts the file. The curve basis, the root name (unused: Alembic
     /// objects sit under the archive's top object) and the frames per
     /// second come from `options`.
-    pub fn new(out: W, options: &UsdOptions) -> Result<Self, UsdWriteError> {
+    pub fn new(out: W, options: &UsdOptions) -> Result<Self, PrimWriteError> {
         options.check()?;
         Ok(Self {
             ogawa: OgawaWriter::new(out)?,
@@ -148,7 +148,7 @@ impl<W: Write + Seek> AbcWriter<W> {
     }
 
     /// Writes one part as an `ICurves` object named `name`.
-    pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+    pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         self.start_part(name, curves, None)
     }
 
@@ -162,19 +162,19 @@ impl<W: Write + Seek> AbcWriter<W> {
         name: &str,
         time: f64,
         curves: &Curves,
-    ) -> Result<(), UsdWriteError> {
-        UsdWriteError::check_time(name, time)?;
+    ) -> Result<(), PrimWriteError> {
+        PrimWriteError::check_time(name, time)?;
         let Some(index) = self.parts.iter().position(|p| p.name == name) else {
             return self.start_part(name, curves, Some(time));
         };
         let part = &self.parts[index];
         if part.times.is_empty() {
-            return Err(UsdWriteError::DuplicateName(name.to_string()));
+            return Err(PrimWriteError::DuplicateName(name.to_string()));
         }
-        UsdWriteError::check_frame(name, time, &part.offsets, curves)?;
+        PrimWriteError::check_frame(name, time, &part.offsets, curves)?;
         let last = *part.times.last().expect("an animated part has a frame");
         if time <= last {
-            return Err(UsdWriteError::BadSetting(format!(
+            return Err(PrimWriteError::BadSetting(format!(
                 "part {name:?}: frame at {time} after the frame at {last}; write frames in increasing time"
             )));
         }
@@ -233,14 +233,14 @@ impl<W: Write + Seek> AbcWriter<W> {
         name: &str,
         curves: &Curves,
         time: Option<f64>,
-    ) -> Result<(), UsdWriteError> {
+    ) -> Result<(), PrimWriteError> {
         check_name(name)?;
         if !self.names.insert(name.to_string()) {
-            return Err(UsdWriteError::DuplicateName(name.to_string()));
+            return Err(PrimWriteError::DuplicateName(name.to_string()));
         }
         let min = self.options.min_points_per_curve();
         if let Some(curve) = (0..curves.curve_count()).find(|&i| curves.range(i).len() < min) {
-            return Err(UsdWriteError::ShortCurve {
+            return Err(PrimWriteError::ShortCurve {
                 part: name.to_string(),
                 curve,
                 points: curves.range(curve).len(),
@@ -394,7 +394,7 @@ impl<W: Write + Seek> AbcWriter<W> {
     /// Writes the groups of every part, the top object, the time
     /// samplings and the archive's metadata; returns the output (not
     /// flushed), positioned at its end.
-    pub fn finish(mut self) -> Result<W, UsdWriteError> {
+    pub fn finish(mut self) -> Result<W, PrimWriteError> {
         let frames = self.frame_times()?;
         let mut objects = Vec::with_capacity(self.parts.len());
         let mut headers = Vec::new();
@@ -463,14 +463,14 @@ impl<W: Write + Seek> AbcWriter<W> {
     }
 
     /// The frames every animated part shares, if any part is animated.
-    fn frame_times(&self) -> Result<Option<Vec<f64>>, UsdWriteError> {
+    fn frame_times(&self) -> Result<Option<Vec<f64>>, PrimWriteError> {
         let mut animated = self.parts.iter().filter(|p| !p.times.is_empty());
         let Some(first) = animated.next() else {
             return Ok(None);
         };
         for other in animated {
             if other.times != first.times {
-                return Err(UsdWriteError::BadSetting(format!(
+                return Err(PrimWriteError::BadSetting(format!(
                     "parts {:?} and {:?} have different frames; in Alembic every animated part has the same frames",
                     first.name, other.name
                 )));
@@ -655,14 +655,14 @@ fn object_digests(geom: &Property) -> [u8; 32] {
     out
 }
 
-impl<W: Write + Seek> super::UsdPrimWriter for AbcWriter<W> {
-    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+impl<W: Write + Seek> super::PrimWriter for AbcWriter<W> {
+    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         AbcWriter::write_part(self, name, curves)
     }
 
     /// Alembic files from pelage hold curves only.
-    fn write_mesh(&mut self, _name: &str, _mesh: &crate::Mesh) -> Result<(), UsdWriteError> {
-        Err(UsdWriteError::BadSetting(
+    fn write_mesh(&mut self, _name: &str, _mesh: &crate::Mesh) -> Result<(), PrimWriteError> {
+        Err(PrimWriteError::BadSetting(
             "pelage's Alembic files hold curves only: leave the skin out ([output] with_mesh = false, no --with-mesh) or write USD".into(),
         ))
     }
@@ -672,8 +672,8 @@ impl<W: Write + Seek> super::UsdPrimWriter for AbcWriter<W> {
         &mut self,
         _name: &str,
         _points: &super::SurfacePoints,
-    ) -> Result<(), UsdWriteError> {
-        Err(UsdWriteError::BadSetting(
+    ) -> Result<(), PrimWriteError> {
+        Err(PrimWriteError::BadSetting(
             "pelage's Alembic files hold curves only: write sampled points as .ply or USD".into(),
         ))
     }
@@ -683,7 +683,7 @@ impl<W: Write + Seek> super::UsdPrimWriter for AbcWriter<W> {
         name: &str,
         time: f64,
         curves: &Curves,
-    ) -> Result<(), UsdWriteError> {
+    ) -> Result<(), PrimWriteError> {
         AbcWriter::write_part_at(self, name, time, curves)
     }
 }

@@ -21,10 +21,10 @@ mod read;
 pub(crate) use read::read_usdc;
 
 use super::usd_schema::{
-    SurfacePoints, UsdAttribute, UsdPrimWriter, UsdValues, basis_curves_attributes, check_name,
+    PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes, check_name,
     curve_extent, mesh_attributes, points_attributes,
 };
-use super::{UpAxis, UsdOptions, UsdWriteError};
+use super::{PrimWriteError, UpAxis, UsdOptions};
 use crate::Curves;
 use crate::mesh::Mesh;
 use crate_file::{
@@ -66,7 +66,7 @@ pub struct UsdcWriter<W: Write + Seek> {
 
 impl<W: Write + Seek> UsdcWriter<W> {
     /// Reserves the bootstrap header; the rest of the file follows.
-    pub fn new(mut out: W, options: &UsdOptions) -> Result<Self, UsdWriteError> {
+    pub fn new(mut out: W, options: &UsdOptions) -> Result<Self, PrimWriteError> {
         options.check()?;
         let start = out.stream_position()?;
         out.write_all(&[0u8; BOOTSTRAP_SIZE])?;
@@ -88,7 +88,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
     }
 
     /// Writes one part as a `BasisCurves` prim named `name`.
-    pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+    pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         let attributes = basis_curves_attributes(name, curves, &self.options)?;
         self.write_prim("BasisCurves", name, &attributes, false)?;
         Ok(())
@@ -104,8 +104,8 @@ impl<W: Write + Seek> UsdcWriter<W> {
         name: &str,
         time: f64,
         curves: &Curves,
-    ) -> Result<(), UsdWriteError> {
-        UsdWriteError::check_time(name, time)?;
+    ) -> Result<(), PrimWriteError> {
+        PrimWriteError::check_time(name, time)?;
         if !self.animated.contains_key(name) {
             let attributes = basis_curves_attributes(name, curves, &self.options)?;
             let specs = self.write_prim("BasisCurves", name, &attributes, true)?;
@@ -120,7 +120,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
             self.animated.insert(name.to_string(), part);
         }
         let part = &self.animated[name];
-        UsdWriteError::check_frame(name, time, &part.offsets, curves)?;
+        PrimWriteError::check_frame(name, time, &part.offsets, curves)?;
         let (lo, hi) = curve_extent(curves);
         self.add_samples(name, time, curves.points(), [lo, hi], curves.normals())
     }
@@ -134,8 +134,8 @@ impl<W: Write + Seek> UsdcWriter<W> {
         name: &str,
         time: f64,
         mesh: &Mesh,
-    ) -> Result<(), UsdWriteError> {
-        UsdWriteError::check_time(name, time)?;
+    ) -> Result<(), PrimWriteError> {
+        PrimWriteError::check_time(name, time)?;
         let shape = vec![mesh.vertex_count() as u32, mesh.triangle_count() as u32];
         if !self.animated.contains_key(name) {
             let specs = self.write_prim("Mesh", name, &mesh_attributes(mesh), true)?;
@@ -151,7 +151,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
         }
         let first = &self.animated[name].offsets;
         if *first != shape {
-            return Err(UsdWriteError::BadSetting(format!(
+            return Err(PrimWriteError::BadSetting(format!(
                 "mesh {name:?} at time {time}: {} vertices and {} triangles where the first frame had {} and {}",
                 shape[0], shape[1], first[0], first[1]
             )));
@@ -169,11 +169,11 @@ impl<W: Write + Seek> UsdcWriter<W> {
         points: &[glam::Vec3],
         extent: [glam::Vec3; 2],
         normals: Option<&[glam::Vec3]>,
-    ) -> Result<(), UsdWriteError> {
+    ) -> Result<(), PrimWriteError> {
         let part = &self.animated[name];
         let seen = |(_, _, samples): &SampledAttribute| samples.iter().any(|&(t, _)| t == time);
         if part.samples.iter().any(seen) {
-            return Err(UsdWriteError::BadSetting(format!(
+            return Err(PrimWriteError::BadSetting(format!(
                 "part {name:?}: two frames at time {time}"
             )));
         }
@@ -203,14 +203,14 @@ impl<W: Write + Seek> UsdcWriter<W> {
         &mut self,
         name: &str,
         points: &SurfacePoints,
-    ) -> Result<(), UsdWriteError> {
+    ) -> Result<(), PrimWriteError> {
         self.write_prim("Points", name, &points_attributes(points), false)?;
         Ok(())
     }
 
     /// Writes the skin as a `Mesh` prim named `name` (triangles, vertex
     /// normals, UVs as `st`).
-    pub fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
+    pub fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), PrimWriteError> {
         self.write_prim("Mesh", name, &mesh_attributes(mesh), false)?;
         Ok(())
     }
@@ -224,10 +224,10 @@ impl<W: Write + Seek> UsdcWriter<W> {
         name: &str,
         attributes: &[UsdAttribute],
         animated: bool,
-    ) -> Result<Vec<(usize, &'static str)>, UsdWriteError> {
+    ) -> Result<Vec<(usize, &'static str)>, PrimWriteError> {
         check_name(name)?;
         if !self.names.insert(name.to_string()) {
-            return Err(UsdWriteError::DuplicateName(name.to_string()));
+            return Err(PrimWriteError::DuplicateName(name.to_string()));
         }
         let prim = self.structure.child_path(self.root, name, false);
         let mut sampled = Vec::new();
@@ -288,7 +288,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
 
     /// Writes an attribute's values where they are not inlined, and
     /// returns their representation.
-    fn pack(&mut self, values: &UsdValues) -> Result<ValueRep, UsdWriteError> {
+    fn pack(&mut self, values: &UsdValues) -> Result<ValueRep, PrimWriteError> {
         Ok(match values {
             UsdValues::Token(token) => {
                 ValueRep::inlined(ValueType::Token, self.structure.token(token))
@@ -420,7 +420,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
     /// Writes the time samples, the stage and default prim specs, the
     /// structure and the table of contents, then the header; returns the
     /// output (not flushed), positioned at the end.
-    pub fn finish(mut self) -> Result<W, UsdWriteError> {
+    pub fn finish(mut self) -> Result<W, PrimWriteError> {
         let mut range: Option<(f64, f64)> = None;
         let mut animated: Vec<_> = std::mem::take(&mut self.animated).into_values().collect();
         for part in &mut animated {
@@ -509,16 +509,16 @@ impl<W: Write + Seek> UsdcWriter<W> {
     }
 }
 
-impl<W: Write + Seek> UsdPrimWriter for UsdcWriter<W> {
-    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), UsdWriteError> {
+impl<W: Write + Seek> PrimWriter for UsdcWriter<W> {
+    fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         UsdcWriter::write_part(self, name, curves)
     }
 
-    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), UsdWriteError> {
+    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), PrimWriteError> {
         UsdcWriter::write_mesh(self, name, mesh)
     }
 
-    fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), UsdWriteError> {
+    fn write_points(&mut self, name: &str, points: &SurfacePoints) -> Result<(), PrimWriteError> {
         UsdcWriter::write_points(self, name, points)
     }
 
@@ -527,11 +527,11 @@ impl<W: Write + Seek> UsdPrimWriter for UsdcWriter<W> {
         name: &str,
         time: f64,
         curves: &Curves,
-    ) -> Result<(), UsdWriteError> {
+    ) -> Result<(), PrimWriteError> {
         UsdcWriter::write_part_at(self, name, time, curves)
     }
 
-    fn write_mesh_at(&mut self, name: &str, time: f64, mesh: &Mesh) -> Result<(), UsdWriteError> {
+    fn write_mesh_at(&mut self, name: &str, time: f64, mesh: &Mesh) -> Result<(), PrimWriteError> {
         UsdcWriter::write_mesh_at(self, name, time, mesh)
     }
 }

@@ -22,6 +22,7 @@ pub struct RenderBenchArgs {
     pub json: bool,
 }
 
+/// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &RenderBenchArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::headless()?;
     let renderer = Renderer::new(&ctx);

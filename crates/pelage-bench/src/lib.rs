@@ -1,12 +1,16 @@
-//! `pelage bench <what>`: the benchmarks. Each prints our figures beside
-//! the paper's (and, where there is one, a peer's measured in the same
-//! run) as a table, or as one JSON object with `--json`.
+//! pelage's benchmark harness: what `pelage bench <what>` runs. Each
+//! benchmark prints our figures beside the paper's (and, where there is
+//! one, a peer's measured in the same run) as a table, or as one JSON
+//! object with `--json`. One module a benchmark; the peers' Python scripts
+//! (Blender's, the Python package's) sit beside the module that runs them.
+//! The `pelage` command is a thin front end over [`run`].
 //!
 //! Machines here are small and noisy: every figure is the median of several
 //! runs, and comparisons are ratios taken within one run.
 
 pub mod animation;
 pub mod dynamics;
+pub mod format;
 pub mod groom;
 pub mod interp;
 pub mod io;
@@ -23,6 +27,7 @@ use std::time::Instant;
 #[derive(Debug, Args)]
 pub struct BenchArgs {
     #[command(subcommand)]
+    /// The benchmark to run.
     pub what: BenchWhat,
 }
 
@@ -50,6 +55,9 @@ pub enum BenchWhat {
     Python(python::PythonBenchArgs),
 }
 
+/// The demo groom file (`pelage demo`), which the I/O benchmark grows.
+pub const DEMO_GROOM: &str = include_str!("../../pelage-cli/src/demo.toml");
+
 /// The repository's test meshes (blub), where the benchmarks that go past
 /// the embedded Spot find them: `tests/data/meshes/` of the source tree
 /// this binary was built from.
@@ -63,6 +71,7 @@ pub fn tools_dir() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools")
 }
 
+/// Runs the benchmark `args` names.
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     match &args.what {
         BenchWhat::Sampler(a) => sampler::run(a),

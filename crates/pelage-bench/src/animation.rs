@@ -120,6 +120,7 @@ fn twist(p: Vec3, frame: f64) -> Vec3 {
     Mat3::from_rotation_y(angle) * p + Vec3::new(0.1 * t, 0.0, 0.0)
 }
 
+/// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
     let (hairs, runs) = if args.quick {
         (200_000u64, 3)

@@ -1,22 +1,146 @@
-//! Displacement operators: `noise` (Sik §4.2.2, Fig. 15: "random vectors
-//! generated from Perlin noise added to the hair curve's vertices"),
-//! `frizz` (per-hair random high-frequency wiggle) and `curl` (a helix
-//! around the hair's path, the shape of Silva et al. Eq. 4).
+//! `noise` (Sik §4.2.2, Fig. 15: "random vectors generated from Perlin
+//! noise added to the hair curve's vertices"): every hair displaced by one
+//! smooth vector field in space, so neighbouring hairs wave alike.
 
-use super::{Hair, RampTables, Resampling, RootContext, Scratch, param};
-use crate::groom::file::Ramp;
+use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::{Hair, RampTables, Resampling, RootContext, Scratch};
+use crate::groom::error::GroomError;
+use crate::groom::file::MapValue;
+use crate::groom::ramp::Ramp;
+use crate::limits::MAX_CURVE_POINTS;
 use crate::map::{Map, NoiseMap};
-use crate::sample::{SampleRng, salts};
+use crate::settings::{Bound, Rule};
 use glam::Vec3;
-use std::f32::consts::TAU;
+use serde::Deserialize;
+
+/// `noise` as a groom file writes it.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct NoiseSpec {
+    /// Largest displacement (world units).
+    pub amplitude: MapValue,
+    /// Noise cycles per world unit.
+    #[serde(default = "default_frequency")]
+    pub frequency: MapValue,
+    /// Root-to-tip profile of the amplitude.
+    #[serde(default)]
+    pub ramp: Ramp,
+    /// Noise vectors sampled along each hair, interpolated between (0:
+    /// one at every point).
+    #[serde(default = "default_vectors")]
+    pub vectors: usize,
+    /// Seed of the noise field.
+    #[serde(default)]
+    pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
+}
+
+fn default_frequency() -> MapValue {
+    default_map(10.0)
+}
+
+fn default_vectors() -> usize {
+    5
+}
+
+/// `noise`: see [`Noise`].
+#[derive(Debug, Clone)]
+pub struct NoiseParams {
+    /// Largest displacement (world units).
+    pub amplitude: Map,
+    /// Noise cycles per world unit.
+    pub frequency: Map,
+    /// Root-to-tip profile of the amplitude.
+    pub ramp: Ramp,
+    /// Noise vectors sampled along each hair, interpolated between (0: one
+    /// at every point).
+    pub vectors: usize,
+    /// Seed of the noise field.
+    pub seed: u64,
+}
+
+impl NoiseParams {
+    /// Noise of `amplitude`; a groom file's defaults for the rest
+    /// (frequency 10, linear ramp, 5 vectors, seed 0).
+    pub fn new(amplitude: Map) -> Self {
+        Self {
+            amplitude,
+            frequency: Map::Constant(10.0),
+            ramp: Ramp::default(),
+            vectors: default_vectors(),
+            seed: 0,
+        }
+    }
+}
+
+impl OperatorKind for Noise {
+    const NAME: &'static str = "noise";
+    const SUMMARY: &'static str =
+        "Perlin displacement of every point, `amplitude` world units at most.";
+    type Spec = NoiseSpec;
+    type Params = NoiseParams;
+    const RULES: &'static [Rule] = &[
+        Rule::new(
+            "vectors",
+            Bound::Within(0.0, MAX_CURVE_POINTS as f64),
+            "noise vectors per hair",
+        ),
+        Rule::new("frequency", Bound::at_least(0.0), "cycles per unit"),
+    ];
+
+    fn mask(spec: &NoiseSpec) -> Option<&MapValue> {
+        spec.mask.as_ref()
+    }
+
+    fn read(s: &NoiseSpec, r: &mut SpecReader<'_>) -> Result<NoiseParams, GroomError> {
+        Ok(NoiseParams {
+            amplitude: r.map("amplitude", &s.amplitude)?,
+            frequency: r.map("frequency", &s.frequency)?,
+            ramp: s.ramp.clone(),
+            vectors: s.vectors,
+            seed: s.seed,
+        })
+    }
+
+    fn maps(p: &NoiseParams) -> Vec<(&'static str, &Map)> {
+        vec![("amplitude", &p.amplitude), ("frequency", &p.frequency)]
+    }
+
+    fn maps_mut(p: &mut NoiseParams) -> Vec<(&'static str, &mut Map)> {
+        vec![
+            ("amplitude", &mut p.amplitude),
+            ("frequency", &mut p.frequency),
+        ]
+    }
+
+    fn prepare(p: NoiseParams, cx: &Preparation<'_>) -> Result<Self, GroomError> {
+        Ok(Noise::new(
+            p.amplitude,
+            p.frequency,
+            p.ramp,
+            cx.seed(p.seed),
+            p.vectors,
+        ))
+    }
+
+    fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
+        self.displace(hair, root, &mut scratch.noise, &mut scratch.ramps);
+    }
+
+    fn apply_each(&self, hairs: &mut [Hair], roots: &[RootContext], scratch: &mut Scratch) {
+        self.displace_each(hairs, roots, &mut scratch.noise, &mut scratch.ramps);
+    }
+}
 
 /// A smooth random vector field in space (three Perlin noises sharing
 /// their lattice, see [`NoiseMap::perlin3_vector`]).
 #[derive(Debug, Clone)]
-struct VectorNoise(NoiseMap);
+pub(super) struct VectorNoise(NoiseMap);
 
 impl VectorNoise {
-    fn new(seed: u64) -> Self {
+    pub(super) fn new(seed: u64) -> Self {
         Self(NoiseMap::new(1.0, 1, seed, 0.0, 1.0))
     }
 
@@ -24,7 +148,7 @@ impl VectorNoise {
     /// lattice; the offset keeps round coordinates (a hair along an axis)
     /// off it.
     #[inline]
-    fn at(&self, p: Vec3) -> Vec3 {
+    pub(super) fn at(&self, p: Vec3) -> Vec3 {
         self.0.perlin3_vector(p + Self::OFF_LATTICE)
     }
 
@@ -68,14 +192,14 @@ impl Noise {
     }
 
     /// Displaces one hair.
-    pub(super) fn apply(
+    pub(super) fn displace(
         &self,
         hair: &mut Hair,
         root: &RootContext,
         scratch: &mut NoiseScratch,
         ramps: &mut RampTables,
     ) {
-        self.apply_each(
+        self.displace_each(
             std::slice::from_mut(hair),
             std::slice::from_ref(root),
             scratch,
@@ -87,7 +211,7 @@ impl Noise {
     /// same values as one at a time, with the noise vectors of all of them
     /// read in one go, so the eight-lane noise runs full (a hair's handful
     /// of vectors leaves lanes idle).
-    pub(super) fn apply_each(
+    pub(super) fn displace_each(
         &self,
         hairs: &mut [Hair],
         roots: &[RootContext],
@@ -170,7 +294,7 @@ impl Noise {
     }
 }
 
-/// Buffers of [`Noise::apply_each`], reused.
+/// Buffers of the noise operator when it displaces many hairs at once, reused.
 #[derive(Debug, Default)]
 pub struct NoiseScratch {
     /// Where the noise is read (scaled and shifted), every hair's in turn.
@@ -205,97 +329,6 @@ impl VectorSpacing {
 /// interpolated).
 const MAX_VECTORS: usize = 64;
 
-/// `frizz`: a share of the hairs (`fraction`) each wiggle on their own:
-/// `p += amplitude · ramp(t) · N(φ + frequency · t · X)`, where `φ` is a
-/// random point of the noise field drawn per hair, so hairs side by side
-/// frizz differently (unlike `noise`), `frequency` wiggles along the hair.
-#[derive(Debug, Clone)]
-pub struct Frizz {
-    field: VectorNoise,
-    amplitude: Map,
-    frequency: Map,
-    fraction: Map,
-    ramp: Ramp,
-    seed: u64,
-}
-
-impl Frizz {
-    /// A frizz operator.
-    pub fn new(amplitude: Map, frequency: Map, fraction: Map, ramp: Ramp, seed: u64) -> Self {
-        Self {
-            field: VectorNoise::new(seed ^ salts::FRIZZ_FIELD),
-            amplitude,
-            frequency,
-            fraction,
-            ramp,
-            seed,
-        }
-    }
-
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, ramps: &mut RampTables) {
-        let mut rng = SampleRng::new(self.seed ^ salts::FRIZZ_HAIR, hair.id);
-        if rng.uniform_f32() >= self.fraction.at(&root.site) {
-            return;
-        }
-        let amplitude = self.amplitude.at(&root.site);
-        let frequency = self.frequency.at(&root.site);
-        let [a, b] = rng.uniform_f32_pair();
-        let phase = Vec3::new(a, b, rng.uniform_f32()) * 256.0;
-        let n = hair.points.len();
-        let ramp = ramps.along(&self.ramp, n);
-        for (j, (p, profile)) in hair.points.iter_mut().zip(ramp).enumerate() {
-            let t = param(j, n);
-            *p += amplitude * profile * self.field.at(phase + Vec3::X * (frequency * t));
-        }
-    }
-}
-
-/// `curl`: a helix around the hair's path, Silva et al. Eq. 4 with the
-/// curve parameter for `h`: `p += α(t) (cos(2π·turns·t + φ) r + sin(…) b)`
-/// with `α(t) = radius · ramp(t)` (Silva: `K_α h`, a linear ramp), `r` the
-/// rotation-minimizing normal along the hair and `b = T × r`, `φ` a random
-/// phase per hair. The frame does not twist, so the helix turns exactly
-/// `turns` times; resolve it with enough points per hair.
-#[derive(Debug, Clone)]
-pub struct Curl {
-    radius: Map,
-    turns: Map,
-    ramp: Ramp,
-    seed: u64,
-}
-
-impl Curl {
-    /// A curl operator.
-    pub fn new(radius: Map, turns: Map, ramp: Ramp, seed: u64) -> Self {
-        Self {
-            radius,
-            turns,
-            ramp,
-            seed,
-        }
-    }
-
-    pub(super) fn apply(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
-        let radius = self.radius.at(&root.site);
-        if radius == 0.0 {
-            return;
-        }
-        let turns = self.turns.at(&root.site);
-        let phase = TAU * SampleRng::new(self.seed ^ salts::CURL_PHASE, hair.id).uniform_f32();
-        let n = hair.points.len();
-        scratch.frame_along(&hair.points, root.normal);
-        let ramp = scratch.ramps.along(&self.ramp, n);
-        for (j, (p, profile)) in hair.points.iter_mut().zip(ramp).enumerate() {
-            let t = param(j, n);
-            let alpha = radius * profile;
-            let (s, c) = (TAU * turns * t + phase).sin_cos();
-            let r = scratch.frame[j];
-            let b = scratch.tangents[j].cross(r);
-            *p += alpha * (c * r + s * b);
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::test_hairs::{root, straight};
@@ -311,7 +344,7 @@ mod tests {
             0,
         );
         let mut a = straight(1, 16, 1.0);
-        op.apply(
+        op.displace(
             &mut a,
             &root(),
             &mut NoiseScratch::default(),
@@ -324,7 +357,7 @@ mod tests {
         // noise is a field in space, not per hair.
         let mut b = straight(2, 16, 1.0);
         b.points.iter_mut().for_each(|p| *p += Vec3::X * 1e-3);
-        op.apply(
+        op.displace(
             &mut b,
             &root(),
             &mut NoiseScratch::default(),
@@ -360,7 +393,7 @@ mod tests {
                 vectors,
             );
             let mut together = hairs.clone();
-            op.apply_each(
+            op.displace_each(
                 &mut together,
                 &roots,
                 &mut NoiseScratch::default(),
@@ -369,7 +402,7 @@ mod tests {
             let (mut scratch, mut ramps) = (NoiseScratch::default(), RampTables::default());
             for (i, (hair, root)) in hairs.iter().zip(&roots).enumerate() {
                 let mut alone = hair.clone();
-                op.apply(&mut alone, root, &mut scratch, &mut ramps);
+                op.displace(&mut alone, root, &mut scratch, &mut ramps);
                 let bits = |h: &Hair| -> Vec<[u32; 3]> {
                     h.points
                         .iter()
@@ -388,62 +421,5 @@ mod tests {
                 assert_ne!(together[0], hairs[0], "the noise moves hairs");
             }
         }
-    }
-
-    #[test]
-    fn frizz_differs_per_hair_and_respects_fraction() {
-        let op = Frizz::new(
-            Map::Constant(0.05),
-            Map::Constant(6.0),
-            Map::Constant(1.0),
-            Ramp::default(),
-            0,
-        );
-        let ramps = &mut RampTables::default();
-        let (mut a, mut b) = (straight(1, 16, 1.0), straight(2, 16, 1.0));
-        op.apply(&mut a, &root(), ramps);
-        op.apply(&mut b, &root(), ramps);
-        assert!((a.points[15] - b.points[15]).length() > 1e-3, "per hair");
-        let mut again = straight(1, 16, 1.0);
-        op.apply(&mut again, &root(), ramps);
-        assert_eq!(again, a, "same id, same frizz");
-        let none = Frizz::new(
-            Map::Constant(0.05),
-            Map::Constant(6.0),
-            Map::Constant(0.0),
-            Ramp::default(),
-            0,
-        );
-        let mut c = straight(3, 16, 1.0);
-        none.apply(&mut c, &root(), ramps);
-        assert_eq!(c, straight(3, 16, 1.0), "fraction 0 frizzes nothing");
-    }
-
-    #[test]
-    fn curl_is_a_helix_of_the_given_radius_and_turns() {
-        // Straight hair up Z, constant ramp: every point lies at exactly
-        // `radius` from the axis, at its own height, and the angle turns
-        // 2 full times root to tip.
-        let op = Curl::new(Map::Constant(0.05), Map::Constant(2.0), Ramp::Power(0.0), 9);
-        let n = 65;
-        let mut hair = straight(1, n, 1.0);
-        op.apply(&mut hair, &root(), &mut Scratch::default());
-        let mut angle = 0.0f32;
-        for j in 0..n {
-            let p = hair.points[j];
-            assert!((p.truncate().length() - 0.05).abs() < 1e-5, "{j}: {p}");
-            assert!((p.z - param(j, n)).abs() < 1e-6);
-            if j > 0 {
-                let q = hair.points[j - 1].truncate();
-                angle += q.angle_to(p.truncate());
-            }
-        }
-        assert!((angle.abs() - 2.0 * TAU).abs() < 1e-3, "{angle}");
-        // Silva's linear ramp: the radius grows from 0 at the root.
-        let linear = Curl::new(Map::Constant(0.05), Map::Constant(2.0), Ramp::default(), 9);
-        let mut hair = straight(1, n, 1.0);
-        linear.apply(&mut hair, &root(), &mut Scratch::default());
-        assert!(hair.points[0].length() < 1e-7);
-        assert!((hair.points[32].truncate().length() - 0.025).abs() < 1e-5);
     }
 }

@@ -1,9 +1,23 @@
 //! `cut` (Sik §4.2.2: "the texture value specifies a curve parameter at
-//! which the curve is cut") and `length` (scale about the root).
+//! which the curve is cut").
 
-use super::{HairBatch, RootContext, Scratch, jittered, param};
+use super::kind::{OperatorKind, Preparation, SpecReader};
+use super::{HairBatch, RootContext, Scratch, param};
+use crate::groom::error::GroomError;
+use crate::groom::file::MapValue;
 use crate::map::Map;
-use crate::sample::{SampleRng, salts};
+use serde::Deserialize;
+
+/// `cut` as a groom file writes it.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct CutSpec {
+    /// Curve parameter (0 to 1) at which each hair is cut; 0 removes it.
+    pub at: MapValue,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
+}
 
 /// `cut`: each hair ends at curve parameter `at` (0 to 1, read from the
 /// map at its root) and keeps its point count: the kept part is resampled
@@ -31,12 +45,8 @@ impl Cut {
         &mut self.at
     }
 
-    pub(super) fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
-        self.apply_at(batch, self.at.at(&root.site), scratch);
-    }
-
     /// Cuts every hair of `batch` at curve parameter `at`.
-    pub(super) fn apply_at(&self, batch: &mut HairBatch, at: f32, scratch: &mut Scratch) {
+    pub(super) fn cut_at(&self, batch: &mut HairBatch, at: f32, scratch: &mut Scratch) {
         if at >= 1.0 {
             return;
         }
@@ -76,35 +86,49 @@ impl Cut {
     }
 }
 
-/// `length`: points scale about the root by `scale · (1 ± jitter)`,
-/// the variation drawn per hair.
-#[derive(Debug, Clone)]
-pub struct Length {
-    scale: Map,
-    jitter: Map,
-    seed: u64,
-}
+impl OperatorKind for Cut {
+    const NAME: &'static str = "cut";
+    const SUMMARY: &'static str = "Cuts every hair at curve parameter `at` (0 to 1).";
+    type Spec = CutSpec;
+    type Params = Cut;
+    const KEEPS_ONE_HAIR: bool = false;
 
-impl Length {
-    /// A length operator.
-    pub fn new(scale: Map, jitter: Map, seed: u64) -> Self {
-        Self {
-            scale,
-            jitter,
-            seed,
-        }
+    fn mask(spec: &CutSpec) -> Option<&MapValue> {
+        spec.mask.as_ref()
     }
 
-    pub(super) fn apply(&self, hair: &mut super::Hair, root: &RootContext) {
-        let mut rng = SampleRng::new(self.seed ^ salts::LENGTH_JITTER, hair.id);
-        let factor =
-            (self.scale.at(&root.site) * jittered(self.jitter.at(&root.site), &mut rng)).max(0.0);
-        let Some(&origin) = hair.points.first() else {
-            return;
-        };
-        for p in &mut hair.points[1..] {
-            *p = origin + (*p - origin) * factor;
-        }
+    fn read(s: &CutSpec, r: &mut SpecReader<'_>) -> Result<Cut, GroomError> {
+        Ok(Cut::new(r.map("at", &s.at)?))
+    }
+
+    fn maps(p: &Cut) -> Vec<(&'static str, &Map)> {
+        vec![("at", &p.at)]
+    }
+
+    fn maps_mut(p: &mut Cut) -> Vec<(&'static str, &mut Map)> {
+        vec![("at", &mut p.at)]
+    }
+
+    fn prepare(p: Cut, _: &Preparation<'_>) -> Result<Self, GroomError> {
+        Ok(p)
+    }
+
+    fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
+        self.cut_at(batch, self.at.at(&root.site), scratch);
+    }
+
+    /// A half-masked cut is a cut half as deep (`1 − m(1 − at)`), so a
+    /// half-masked bald patch is half-length hair.
+    fn apply_faded(
+        &self,
+        batch: &mut HairBatch,
+        root: &RootContext,
+        m: f32,
+        scratch: &mut Scratch,
+    ) -> bool {
+        let at = self.at.at(&root.site);
+        self.cut_at(batch, 1.0 - m * (1.0 - at), scratch);
+        true
     }
 }
 
@@ -136,24 +160,5 @@ mod tests {
         assert_eq!(b.hairs()[0], straight(1, 8, 1.0));
         Cut::new(Map::Constant(0.0)).apply(&mut b, &root(), &mut Scratch::default());
         assert!(b.is_empty());
-    }
-
-    #[test]
-    fn length_scales_about_the_root_with_jitter_per_hair() {
-        let mut hair = straight(1, 8, 1.0);
-        Length::new(Map::Constant(2.0), Map::Constant(0.0), 0).apply(&mut hair, &root());
-        assert!((hair.points[7] - Vec3::Z * 2.0).length() < 1e-6);
-        assert_eq!(hair.points[0], Vec3::ZERO);
-        let lengths: Vec<f32> = (0..200)
-            .map(|id| {
-                let mut h = straight(id, 8, 1.0);
-                Length::new(Map::Constant(1.0), Map::Constant(0.2), 0).apply(&mut h, &root());
-                h.points[7].z
-            })
-            .collect();
-        assert!(lengths.iter().all(|l| (0.8..=1.2).contains(l)));
-        let spread = lengths.iter().cloned().fold(f32::MIN, f32::max)
-            - lengths.iter().cloned().fold(f32::MAX, f32::min);
-        assert!(spread > 0.3, "jitter varies per hair: {spread}");
     }
 }

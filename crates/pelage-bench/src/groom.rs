@@ -227,6 +227,7 @@ impl std::io::Write for CountingSink {
     }
 }
 
+/// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
     if let Some(hairs) = args.rss_child {
         return rss_child(hairs);

@@ -57,6 +57,7 @@ struct Row {
     ms: [f64; 3],
 }
 
+/// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::headless()?;
     if args.game {

@@ -92,6 +92,7 @@ const SOLVERS: [Solver; 2] = [
     Solver::Implicit { iterations: 10 },
 ];
 
+/// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
     let spot = pelage::assets::spot();
     let mut meshes: Vec<(String, Mesh)> = vec![("spot".into(), spot.subdivided(0))];
@@ -113,7 +114,7 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         match pelage_gpu::GpuContext::headless() {
             Ok(ctx) => Some(ctx),
             Err(e) => {
-                eprintln!("no GPU column: {e}");
+                eprintln!("no GPU column: {:#}", anyhow::Error::from(e));
                 None
             }
         }

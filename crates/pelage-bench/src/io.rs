@@ -18,7 +18,7 @@ use crate::format::thousands;
 use anyhow::Context;
 use clap::Args;
 use pelage::io::{
-    CurvesExport, CurvesFormat, UsdOptions, UsdPrimWriter, write_atomically, write_streamed,
+    CurvesExport, CurvesFormat, PrimWriter, UsdOptions, write_atomically, write_streamed,
 };
 use pelage::sample::{DensitySampler, DensitySamplerOptions, sample_range};
 use pelage::{Curves, Map};
@@ -116,7 +116,7 @@ fn write_groom(args: &IoBenchArgs, hairs: u64, format: CurvesFormat) -> anyhow::
     let start = Instant::now();
     write_atomically(&path, |out| {
         use std::io::Error as E;
-        let mut stream = |writer: &mut dyn UsdPrimWriter| {
+        let mut stream = |writer: &mut dyn PrimWriter| {
             let mut first = 0;
             let mut index = 0;
             while first < hairs {
@@ -192,7 +192,7 @@ fn blender_imports() -> anyhow::Result<BlenderImports> {
     let dir = std::env::temp_dir().join(format!("pelage-io-peer-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let result = (|| {
-        std::fs::write(dir.join("demo.toml"), crate::commands::demo::DEMO_GROOM)?;
+        std::fs::write(dir.join("demo.toml"), crate::DEMO_GROOM)?;
         std::fs::write(dir.join("spot.png"), pelage::assets::SPOT_TEXTURE_PNG)?;
         let groom = pelage::groom::Groom::load(&dir.join("demo.toml"))?;
         let generator = groom.generator(None)?;
@@ -258,6 +258,7 @@ fn blender_imports() -> anyhow::Result<BlenderImports> {
     result
 }
 
+/// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &IoBenchArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
     let sizes: Vec<u64> = if args.quick {

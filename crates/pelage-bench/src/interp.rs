@@ -45,6 +45,7 @@ fn ns_per_hair(method: &dyn GuideWeights, roots: &[HairRoot], runs: usize) -> f6
     seconds * 1e9 / roots.len() as f64
 }
 
+/// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
     let (levels, guide_count, hair_count, runs) = if args.quick {
         (2, 1_000, 100_000u64, 3)

@@ -162,6 +162,7 @@ fn median(values: &[f64]) -> f64 {
     sorted.get(sorted.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
+/// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &PythonBenchArgs) -> anyhow::Result<()> {
     let hairs: u64 = if args.quick { 200_000 } else { 1_600_000 };
     let (rounds, runs): (usize, usize) = if args.quick { (3, 3) } else { (5, 3) };

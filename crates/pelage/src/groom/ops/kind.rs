@@ -1,0 +1,620 @@
+//! What one operator module provides ([`OperatorKind`]), and the registry
+//! macro that derives the operator chain's three enums from the list of
+//! modules: [`super::OpSpec`] (the `[[ops]]` table as a groom file writes
+//! it), [`super::GroomOp`] (the operator as plain values, what programs
+//! build) and [`super::Operator`] (prepared, what the generator runs).
+//!
+//! An operator lives in one file, `groom/ops/<name>.rs`: its serde spec
+//! with defaults, its parameters, its prepared form, its name, its map
+//! fields, its range rules and its salts. Adding one is that file, one
+//! line of the registry in `ops/mod.rs`, its tests and its docs
+//! (docs/adding-an-operator.md).
+
+use super::{Hair, HairBatch, RootContext, Scratch};
+use crate::groom::error::{GroomError, GroomErrorKind};
+use crate::groom::file::{ColorSpec, MapText, MapValue, RootToTipSpec};
+use crate::groom::generator::Generator;
+use crate::map::Map;
+use crate::mesh::{Mesh, SurfacePoint};
+use crate::settings::{Rule, SettingsSource};
+use serde::Deserialize as _;
+use std::collections::HashMap;
+
+/// One operator: implemented by its prepared form (the value the
+/// generator runs), which names the operator's other two forms.
+pub(crate) trait OperatorKind: Sized {
+    /// The name groom files, errors and bindings use (`noise`, `clump`).
+    const NAME: &'static str;
+    /// One line saying what it does, for `--help`-like listings and the
+    /// Python builders' docstrings.
+    const SUMMARY: &'static str;
+    /// The `[[ops]]` table as written (serde, unknown keys refused).
+    type Spec: serde::de::DeserializeOwned + std::fmt::Debug + Clone;
+    /// The operator as plain values (maps read, not yet prepared).
+    type Params: std::fmt::Debug + Clone;
+
+    /// The documented ranges of the operator's numeric settings, keyed by
+    /// field name (`count`), checked when a groom file is read.
+    const RULES: &'static [Rule] = &[];
+    /// The salts of the operator's random streams (kept apart from every
+    /// other stream's: a test compares them all).
+    const SALTS: &'static [(&'static str, u64)] = &[];
+    /// Whether every root still grows exactly one hair after it (`false`
+    /// for operators that split or remove hairs).
+    const KEEPS_ONE_HAIR: bool = true;
+    /// Whether it gives hairs colours.
+    const ADDS_COLORS: bool = false;
+    /// Whether it gives hairs opacities.
+    const ADDS_OPACITIES: bool = false;
+    /// Whether it searches for hairs near the root (roots then carry the
+    /// ball around their skin triangle).
+    const SEARCHES_NEIGHBOURS: bool = false;
+
+    /// The spec's `mask`, if it has one.
+    fn mask(spec: &Self::Spec) -> Option<&MapValue>;
+
+    /// The parameters a groom file's spec says, maps read on the mesh.
+    fn read(spec: &Self::Spec, reader: &mut SpecReader<'_>) -> Result<Self::Params, GroomError>;
+
+    /// Every map the parameters hold, with its field name.
+    fn maps(params: &Self::Params) -> Vec<(&'static str, &Map)>;
+
+    /// Every map the parameters hold, to change (binding them to a mesh).
+    fn maps_mut(params: &mut Self::Params) -> Vec<(&'static str, &mut Map)>;
+
+    /// Counts with a ceiling (field, value, most, what is counted),
+    /// checked before anything is prepared.
+    fn counts(_params: &Self::Params) -> Vec<(&'static str, u64, u64, &'static str)> {
+        Vec::new()
+    }
+
+    /// The operator prepared: seeds mixed, anything it precomputes built.
+    fn prepare(params: Self::Params, cx: &Preparation<'_>) -> Result<Self, GroomError>;
+
+    /// Shapes one hair (operators that keep one hair a root).
+    fn apply_to_hair(&self, _hair: &mut Hair, _root: &RootContext, _scratch: &mut Scratch) {
+        unreachable!("{} works on the whole batch", Self::NAME)
+    }
+
+    /// Shapes every hair grown from one root.
+    fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
+        for hair in batch.hairs_mut() {
+            self.apply_to_hair(hair, root, scratch);
+        }
+    }
+
+    /// Shapes hairs grown one a root (`hairs[i]` from `roots[i]`); an
+    /// operator that can share work across hairs overrides it.
+    fn apply_each(&self, hairs: &mut [Hair], roots: &[RootContext], scratch: &mut Scratch) {
+        for (hair, root) in hairs.iter_mut().zip(roots) {
+            self.apply_to_hair(hair, root, scratch);
+        }
+    }
+
+    /// Applies the operator at strength `m` (0 to 1) its own way, instead
+    /// of the mask's blend of before and after; `false` when it has none.
+    fn apply_faded(
+        &self,
+        _batch: &mut HairBatch,
+        _root: &RootContext,
+        _m: f32,
+        _scratch: &mut Scratch,
+    ) -> bool {
+        false
+    }
+}
+
+/// Where an operator sits in a groom: its place in the chain and its
+/// name. Setting keys in errors are built from it (`ops[2].clump.count`),
+/// never spelled by hand.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct OpKey {
+    /// Place in the chain.
+    pub index: usize,
+    /// The operator's name.
+    pub name: &'static str,
+}
+
+impl OpKey {
+    /// The key of one of its settings.
+    pub fn field(&self, field: &str) -> String {
+        format!("{self}.{field}")
+    }
+}
+
+impl std::fmt::Display for OpKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ops[{}].{}", self.index, self.name)
+    }
+}
+
+/// Reads a spec's values from a groom file: maps resolved against the
+/// file's folder and bound to the mesh, and where each setting was written
+/// noted for errors the generator finds later.
+pub(crate) struct SpecReader<'a> {
+    source: &'a SettingsSource,
+    mesh: &'a Mesh,
+    lines: &'a mut HashMap<String, (usize, usize)>,
+    /// The setting's key: `ops[2].clump` or `finish.width`.
+    prefix: String,
+}
+
+impl<'a> SpecReader<'a> {
+    pub(crate) fn new(
+        source: &'a SettingsSource,
+        mesh: &'a Mesh,
+        lines: &'a mut HashMap<String, (usize, usize)>,
+        prefix: String,
+    ) -> Self {
+        Self {
+            source,
+            mesh,
+            lines,
+            prefix,
+        }
+    }
+
+    /// Notes where `field` was written.
+    pub fn mark(&mut self, field: &str, span: std::ops::Range<usize>) {
+        if let Some(line) = self.source.line_of(span) {
+            self.lines.insert(format!("{}.{field}", self.prefix), line);
+        }
+    }
+
+    /// A spanned number, its line noted.
+    pub fn value<T: Copy>(&mut self, field: &str, value: &toml::Spanned<T>) -> T {
+        self.mark(field, value.span());
+        *value.get_ref()
+    }
+
+    /// A map, read and bound to the mesh, both errors at its line.
+    pub fn map(&mut self, field: &str, value: &MapValue) -> Result<Map, GroomError> {
+        self.mark(field, value.span());
+        map_on_mesh(self.source, self.mesh, value)
+    }
+
+    /// Three maps (a colour's channels).
+    pub fn rgb(&mut self, field: &str, value: &[MapValue; 3]) -> Result<[Map; 3], GroomError> {
+        Ok([
+            self.map(field, &value[0])?,
+            self.map(field, &value[1])?,
+            self.map(field, &value[2])?,
+        ])
+    }
+
+    /// A root-to-tip quantity (`width`, `opacity`).
+    pub fn root_to_tip(&mut self, s: &RootToTipSpec) -> Result<super::RootToTip, GroomError> {
+        Ok(super::RootToTip {
+            root: self.map("root", &s.root)?,
+            tip: self.map("tip", &s.tip)?,
+            ramp: s.ramp.clone(),
+            jitter: self.map("jitter", &s.jitter)?,
+            seed: s.seed,
+        })
+    }
+
+    /// A colour from root to tip.
+    pub fn color(&mut self, s: &ColorSpec) -> Result<super::Color, GroomError> {
+        Ok(super::Color {
+            root: self.rgb("root", &s.root)?,
+            tip: self.rgb("tip", &s.tip)?,
+            ramp: s.ramp.clone(),
+            jitter: self.map("jitter", &s.jitter)?,
+            seed: s.seed,
+        })
+    }
+}
+
+/// Resolves a map value and binds it to `mesh` (UVs, vertex
+/// attributes), both errors at the value's line.
+pub(crate) fn map_on_mesh(
+    source: &SettingsSource,
+    mesh: &Mesh,
+    value: &MapValue,
+) -> Result<Map, GroomError> {
+    let mut map = source.map(value)?;
+    map.bind(mesh)
+        .map_err(|e| source.error_at(value.span(), GroomErrorKind::Map(e)))?;
+    Ok(map)
+}
+
+/// A constant map as a groom file's default (no line of its own).
+pub(crate) fn default_map(value: f32) -> MapValue {
+    toml::Spanned::new(0..0, MapText::Number(value))
+}
+
+/// What preparing operator `k` of a chain can use: the generator built so
+/// far (the operators before it are prepared), the operator's own random
+/// streams and its errors.
+pub(crate) struct Preparation<'a> {
+    pub(crate) generator: &'a Generator,
+    pub(crate) key: OpKey,
+}
+
+impl Preparation<'_> {
+    /// The operator's own random stream for its seed `s`: the groom's seed
+    /// mixed with the operator's place in the chain and `s`, so two
+    /// operators with the same seed still differ.
+    pub fn seed(&self, s: u64) -> u64 {
+        use crate::sample::mix64;
+        mix64(self.generator.seed() ^ mix64((self.key.index as u64 + 1) << 32 ^ s))
+    }
+
+    /// An error about one of the operator's settings, at its line.
+    pub fn error(&self, field: &str, kind: GroomErrorKind) -> GroomError {
+        self.generator.error(&self.key.field(field), kind)
+    }
+
+    /// The mesh hairs grow on.
+    pub fn mesh(&self) -> &Mesh {
+        self.generator.mesh()
+    }
+
+    /// Hairs grown from `roots` through the operators before this one: the
+    /// centre hairs of a clump level.
+    pub fn centres(&self, roots: &[SurfacePoint]) -> super::ClumpCentres {
+        self.generator.clump_centres(self.key.index, roots)
+    }
+}
+
+/// One operator's settings as a groom file spells them.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OperatorSchema {
+    /// The operator's name (`clump`).
+    pub name: &'static str,
+    /// One line saying what it does.
+    pub summary: &'static str,
+    /// Every key its table takes, `mask` included, in declaration order.
+    pub fields: Vec<&'static str>,
+    /// The keys it cannot do without.
+    pub required: Vec<&'static str>,
+}
+
+/// The schema of operator `K`, from its spec's serde definition: the keys
+/// are those serde asks a deserializer for; the required ones are found by
+/// reading tables that lack them, one missing key at a time.
+pub(crate) fn schema_of<K: OperatorKind>() -> OperatorSchema {
+    use serde::de::value::Error;
+    use serde::de::{Deserializer, Error as _, Visitor};
+    struct FieldNames(&'static [&'static str]);
+    impl<'de> Deserializer<'de> for &mut FieldNames {
+        type Error = Error;
+        fn deserialize_any<V: Visitor<'de>>(self, _: V) -> Result<V::Value, Error> {
+            Err(Error::custom("an operator's spec is a struct"))
+        }
+        fn deserialize_struct<V: Visitor<'de>>(
+            self,
+            _: &'static str,
+            fields: &'static [&'static str],
+            _: V,
+        ) -> Result<V::Value, Error> {
+            self.0 = fields;
+            Err(Error::custom("fields read"))
+        }
+        serde::forward_to_deserialize_any! {
+            bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string
+            bytes byte_buf option unit unit_struct newtype_struct seq tuple
+            tuple_struct map enum identifier ignored_any
+        }
+    }
+    let mut names = FieldNames(&[]);
+    let _ = K::Spec::deserialize(&mut names);
+    let fields = names.0.to_vec();
+    // Add what the last read said was missing, until a table reads.
+    let mut required: Vec<(&'static str, &'static str)> = Vec::new();
+    for _ in 0..=fields.len() {
+        let text = |extra: Option<(&str, &str)>| {
+            required
+                .iter()
+                .copied()
+                .chain(extra)
+                .map(|(k, v)| format!("{k} = {v}\n"))
+                .collect::<String>()
+        };
+        let missing = |text: &str| -> Option<&'static str> {
+            let message = toml::from_str::<K::Spec>(text).err()?.to_string();
+            fields
+                .iter()
+                .copied()
+                .find(|f| message.contains(&format!("missing field `{f}`")))
+        };
+        let Some(field) = missing(&text(None)) else {
+            break;
+        };
+        // A number stands for a map or a count, three for a colour: the
+        // first that reads past this key (a wrong type stops the read at it).
+        let reads_past = |t: &str| match toml::from_str::<K::Spec>(t) {
+            Ok(_) => true,
+            Err(e) => {
+                let message = e.to_string();
+                message.contains("missing field")
+                    && !message.contains(&format!("missing field `{field}`"))
+            }
+        };
+        let value = ["1", "[1, 1, 1]"]
+            .into_iter()
+            .find(|v| reads_past(&text(Some((field, v)))))
+            .unwrap_or("1");
+        required.push((field, value));
+    }
+    OperatorSchema {
+        name: K::NAME,
+        summary: K::SUMMARY,
+        fields,
+        required: required.into_iter().map(|(k, _)| k).collect(),
+    }
+}
+
+/// Derives the chain's enums and their dispatch from the list of
+/// operators: `Variant(Prepared, Params, Spec)`, one a line, in the
+/// registry (`ops/mod.rs`). The variant's name, in kebab case, is the
+/// operator's name in groom files.
+macro_rules! operators {
+    ($( $(#[$doc:meta])* $Variant:ident($Op:ty, $Params:ty, $Spec:ty) ),* $(,)?) => {
+        /// One operator as a groom file writes it: `[[ops]]` followed by
+        /// `NAME = { … }` or `[ops.NAME]`.
+        #[derive(Debug, Clone, serde::Deserialize)]
+        #[serde(rename_all = "kebab-case")]
+        pub(crate) enum OpSpec {
+            $( $(#[$doc])* $Variant($Spec), )*
+        }
+
+        /// One operator of the chain, with its settings, as plain values.
+        /// Seeds are the operator's own; the generator mixes them with the
+        /// groom's seed and the operator's place in the chain, so two
+        /// operators with the same seed still differ.
+        #[derive(Debug, Clone)]
+        #[allow(
+            clippy::large_enum_variant,
+            reason = "a groom holds a handful, built once; boxing would only add noise to building them"
+        )]
+        pub enum GroomOp {
+            $( $(#[$doc])* $Variant($Params), )*
+            /// An operator whose effect is faded by a map ([`Masked`]):
+            /// build one with [`GroomOp::masked`].
+            Masked(Box<GroomOp>, Map),
+        }
+
+        /// One operator of the chain, prepared.
+        #[derive(Debug)]
+        pub enum Operator {
+            $( $(#[$doc])* $Variant($Op), )*
+            /// An operator faded by a mask.
+            Masked(Masked),
+        }
+
+        /// Every operator's name, in the registry's order.
+        pub const OPERATOR_NAMES: &[&str] = &[$( <$Op as OperatorKind>::NAME ),*];
+
+        /// Every operator's settings as a groom file spells them, read off
+        /// their serde definitions: what front ends (the Python builders,
+        /// the Blender panel) must offer.
+        pub fn operator_schema() -> Vec<OperatorSchema> {
+            vec![$( schema_of::<$Op>() ),*]
+        }
+
+        /// Every operator's range rules, keyed as the groom file's
+        /// settings are (`ops.clump.count`).
+        pub(crate) fn operator_rules() -> Vec<Rule> {
+            let mut rules = Vec::new();
+            $(
+                for rule in <$Op as OperatorKind>::RULES {
+                    rules.push(Rule::owned(
+                        format!("ops.{}.{}", <$Op as OperatorKind>::NAME, rule.key),
+                        rule.bound,
+                        rule.why,
+                    ));
+                }
+            )*
+            rules
+        }
+
+        /// Every operator's salts, named `name.SALT`: the streams they
+        /// key must stay apart from each other and from every other
+        /// stream's (`crate::sample::salts`).
+        pub fn operator_salts() -> Vec<(String, u64)> {
+            let mut salts = Vec::new();
+            $(
+                for (name, salt) in <$Op as OperatorKind>::SALTS {
+                    salts.push((format!("{}.{name}", <$Op as OperatorKind>::NAME), *salt));
+                }
+            )*
+            salts
+        }
+
+        impl OpSpec {
+            /// The operator's name.
+            pub(crate) fn name(&self) -> &'static str {
+                match self {
+                    $( OpSpec::$Variant(_) => <$Op as OperatorKind>::NAME, )*
+                }
+            }
+
+            /// The operator's `mask`, if it has one.
+            pub(crate) fn mask(&self) -> Option<&MapValue> {
+                match self {
+                    $( OpSpec::$Variant(s) => <$Op as OperatorKind>::mask(s), )*
+                }
+            }
+
+            /// The operator as values, its mask included, maps read on the
+            /// mesh; `reader` notes where each setting was written.
+            pub(crate) fn read(
+                &self,
+                reader: &mut SpecReader<'_>,
+            ) -> Result<GroomOp, GroomError> {
+                let op = match self {
+                    $( OpSpec::$Variant(s) => GroomOp::$Variant(<$Op as OperatorKind>::read(s, reader)?), )*
+                };
+                Ok(match self.mask() {
+                    Some(mask) => op.masked(reader.map("mask", mask)?),
+                    None => op,
+                })
+            }
+        }
+
+        impl GroomOp {
+            /// The operator with its effect faded by `mask` (0: none, 1:
+            /// full), read at each hair's root.
+            pub fn masked(self, mask: Map) -> GroomOp {
+                GroomOp::Masked(Box::new(self), mask)
+            }
+
+            /// The operator under any mask.
+            pub fn unmasked(&self) -> &GroomOp {
+                match self {
+                    GroomOp::Masked(op, _) => op.unmasked(),
+                    op => op,
+                }
+            }
+
+            /// The operator's name in groom files (`noise`, `clump`, …).
+            pub fn name(&self) -> &'static str {
+                match self {
+                    GroomOp::Masked(op, _) => op.name(),
+                    $( GroomOp::$Variant(_) => <$Op as OperatorKind>::NAME, )*
+                }
+            }
+
+            /// Every map the operator reads, with its setting's name.
+            pub fn maps(&self) -> Vec<(&'static str, &Map)> {
+                match self {
+                    GroomOp::Masked(op, mask) => {
+                        let mut maps = op.maps();
+                        maps.push(("mask", mask));
+                        maps
+                    }
+                    $( GroomOp::$Variant(p) => <$Op as OperatorKind>::maps(p), )*
+                }
+            }
+
+            /// Every map the operator reads, to change (binding them to a
+            /// mesh).
+            pub fn maps_mut(&mut self) -> Vec<(&'static str, &mut Map)> {
+                match self {
+                    GroomOp::Masked(op, mask) => {
+                        let mut maps = op.maps_mut();
+                        maps.push(("mask", mask));
+                        maps
+                    }
+                    $( GroomOp::$Variant(p) => <$Op as OperatorKind>::maps_mut(p), )*
+                }
+            }
+
+            /// Counts with a ceiling: (field, value, most, what).
+            pub(crate) fn counts(&self) -> Vec<(&'static str, u64, u64, &'static str)> {
+                match self {
+                    GroomOp::Masked(op, _) => op.counts(),
+                    $( GroomOp::$Variant(p) => <$Op as OperatorKind>::counts(p), )*
+                }
+            }
+
+            /// The operator prepared for the generator.
+            pub(crate) fn prepare(self, cx: &Preparation<'_>) -> Result<Operator, GroomError> {
+                Ok(match self {
+                    GroomOp::Masked(op, mask) => {
+                        Operator::Masked(Masked::new(op.prepare(cx)?, mask))
+                    }
+                    $( GroomOp::$Variant(p) => Operator::$Variant(<$Op as OperatorKind>::prepare(p, cx)?), )*
+                })
+            }
+        }
+
+        impl Operator {
+            /// Applies the operator to every hair of `batch`.
+            pub fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
+                match self {
+                    Operator::Masked(op) => op.apply(batch, root, scratch),
+                    $( Operator::$Variant(op) => op.apply(batch, root, scratch), )*
+                }
+            }
+
+            /// Applies the operator to hairs grown one a root (`hairs[i]`
+            /// from `roots[i]`): the same result as [`Self::apply`] root by
+            /// root, with the work of some operators (noise) shared across
+            /// the hairs.
+            ///
+            /// # Panics
+            /// For operators that change the number of hairs
+            /// ([`Self::keeps_one_hair_a_root`]).
+            pub fn apply_each(&self, hairs: &mut [Hair], roots: &[RootContext], scratch: &mut Scratch) {
+                assert_eq!(hairs.len(), roots.len(), "one root a hair");
+                assert!(
+                    self.keeps_one_hair_a_root(),
+                    "{} changes the number of hairs a root grows",
+                    self.name()
+                );
+                match self {
+                    Operator::Masked(op) => op.apply_each(hairs, roots, scratch),
+                    $( Operator::$Variant(op) => op.apply_each(hairs, roots, scratch), )*
+                }
+            }
+
+            /// Applies the operator at strength `m` its own way (`false`:
+            /// it has none; a mask blends before and after instead).
+            pub(crate) fn apply_faded(
+                &self,
+                batch: &mut HairBatch,
+                root: &RootContext,
+                m: f32,
+                scratch: &mut Scratch,
+            ) -> bool {
+                match self {
+                    Operator::Masked(_) => false,
+                    $( Operator::$Variant(op) => op.apply_faded(batch, root, m, scratch), )*
+                }
+            }
+
+            /// Whether every root still grows exactly one hair after this
+            /// operator.
+            pub fn keeps_one_hair_a_root(&self) -> bool {
+                match self {
+                    Operator::Masked(op) => op.operator().keeps_one_hair_a_root(),
+                    $( Operator::$Variant(_) => <$Op as OperatorKind>::KEEPS_ONE_HAIR, )*
+                }
+            }
+
+            /// Whether it gives hairs colours.
+            pub fn adds_colors(&self) -> bool {
+                match self {
+                    Operator::Masked(op) => op.operator().adds_colors(),
+                    $( Operator::$Variant(_) => <$Op as OperatorKind>::ADDS_COLORS, )*
+                }
+            }
+
+            /// Whether it gives hairs opacities.
+            pub fn adds_opacities(&self) -> bool {
+                match self {
+                    Operator::Masked(op) => op.operator().adds_opacities(),
+                    $( Operator::$Variant(_) => <$Op as OperatorKind>::ADDS_OPACITIES, )*
+                }
+            }
+
+            /// Whether it searches for hairs near the root.
+            pub fn searches_neighbours(&self) -> bool {
+                match self {
+                    Operator::Masked(op) => op.operator().searches_neighbours(),
+                    $( Operator::$Variant(_) => <$Op as OperatorKind>::SEARCHES_NEIGHBOURS, )*
+                }
+            }
+
+            /// The operator under any mask.
+            pub fn unmasked(&self) -> &Operator {
+                match self {
+                    Operator::Masked(op) => op.operator().unmasked(),
+                    op => op,
+                }
+            }
+
+            /// The operator's name as groom files spell it.
+            pub fn name(&self) -> &'static str {
+                match self {
+                    Operator::Masked(op) => op.operator().name(),
+                    $( Operator::$Variant(_) => <$Op as OperatorKind>::NAME, )*
+                }
+            }
+        }
+    };
+}
+
+pub(crate) use operators;

@@ -1,0 +1,207 @@
+//! `twist`: each hair turned about its own root–tip axis, more toward the
+//! tip, as groomers twist locks (Houdini's guide twist, Ornatrix's
+//! rotate): point `j` turns by `angle · ramp(t_j) · (1 ± jitter)` about
+//! the line from the root through the tip. The root and the tip stay
+//! where they are; the hair's bends wind around its chord.
+
+use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::{Hair, RootContext, Scratch, jittered};
+use crate::groom::error::GroomError;
+use crate::groom::file::MapValue;
+use crate::groom::ramp::Ramp;
+use crate::map::Map;
+use crate::sample::SampleRng;
+use glam::{Quat, Vec3};
+use serde::Deserialize;
+
+/// The per-hair jitter of the angle.
+const JITTER_SALT: u64 = 0x7_3157;
+
+/// `twist` as a groom file writes it.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct TwistSpec {
+    /// Angle at the tip, in degrees (positive: counter-clockwise looking
+    /// from the tip down to the root).
+    pub angle: MapValue,
+    /// Root-to-tip profile of the angle.
+    #[serde(default)]
+    pub ramp: Ramp,
+    /// Per-hair random variation of the angle, a fraction (0.2 = ±20 %).
+    #[serde(default = "no_jitter")]
+    pub jitter: MapValue,
+    /// Seed of the variation.
+    #[serde(default)]
+    pub seed: u64,
+    /// Where the operator acts: its effect is faded by this map (0: none,
+    /// 1: full).
+    pub mask: Option<MapValue>,
+}
+
+fn no_jitter() -> MapValue {
+    default_map(0.0)
+}
+
+/// `twist`: see [`Twist`].
+#[derive(Debug, Clone)]
+pub struct TwistParams {
+    /// Angle at the tip, in degrees.
+    pub angle: Map,
+    /// Root-to-tip profile of the angle.
+    pub ramp: Ramp,
+    /// Per-hair random variation, a fraction.
+    pub jitter: Map,
+    /// Seed of the variation.
+    pub seed: u64,
+}
+
+impl TwistParams {
+    /// A twist of `angle` degrees at the tip, linear ramp, no jitter,
+    /// seed 0.
+    pub fn new(angle: Map) -> Self {
+        Self {
+            angle,
+            ramp: Ramp::default(),
+            jitter: Map::Constant(0.0),
+            seed: 0,
+        }
+    }
+}
+
+/// `twist`, prepared: see the module docs.
+#[derive(Debug, Clone)]
+pub struct Twist(TwistParams);
+
+impl OperatorKind for Twist {
+    const NAME: &'static str = "twist";
+    const SUMMARY: &'static str =
+        "Turns each hair about its root–tip axis, `angle` degrees at the tip.";
+    type Spec = TwistSpec;
+    type Params = TwistParams;
+    const SALTS: &'static [(&'static str, u64)] = &[("JITTER", JITTER_SALT)];
+
+    fn mask(spec: &TwistSpec) -> Option<&MapValue> {
+        spec.mask.as_ref()
+    }
+
+    fn read(s: &TwistSpec, r: &mut SpecReader<'_>) -> Result<TwistParams, GroomError> {
+        Ok(TwistParams {
+            angle: r.map("angle", &s.angle)?,
+            ramp: s.ramp.clone(),
+            jitter: r.map("jitter", &s.jitter)?,
+            seed: s.seed,
+        })
+    }
+
+    fn maps(p: &TwistParams) -> Vec<(&'static str, &Map)> {
+        vec![("angle", &p.angle), ("jitter", &p.jitter)]
+    }
+
+    fn maps_mut(p: &mut TwistParams) -> Vec<(&'static str, &mut Map)> {
+        vec![("angle", &mut p.angle), ("jitter", &mut p.jitter)]
+    }
+
+    fn prepare(mut p: TwistParams, cx: &Preparation<'_>) -> Result<Self, GroomError> {
+        p.seed = cx.seed(p.seed);
+        Ok(Twist(p))
+    }
+
+    fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
+        let p = &self.0;
+        let degrees = p.angle.at(&root.site);
+        let (Some(&origin), Some(&tip)) = (hair.points.first(), hair.points.last()) else {
+            return;
+        };
+        let axis = (tip - origin).normalize_or_zero();
+        if degrees == 0.0 || axis == Vec3::ZERO {
+            return;
+        }
+        let jitter = p.jitter.at(&root.site);
+        let factor = if jitter == 0.0 {
+            1.0
+        } else {
+            jittered(jitter, &mut SampleRng::new(p.seed ^ JITTER_SALT, hair.id))
+        };
+        let angle = degrees.to_radians() * factor;
+        let n = hair.points.len();
+        let ramp = scratch.ramps.along(&p.ramp, n);
+        for (point, profile) in hair.points.iter_mut().zip(ramp).skip(1) {
+            let turn = Quat::from_axis_angle(axis, angle * profile);
+            *point = origin + turn * (*point - origin);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_hairs::root;
+    use super::super::{Hair, param};
+    use super::*;
+
+    /// A hair bowed sideways (+X) between a root at the origin and a tip
+    /// on +Z: every point but the ends lies off the axis.
+    fn bowed(id: u64, n: usize) -> Hair {
+        Hair {
+            id,
+            points: (0..n)
+                .map(|j| {
+                    let t = param(j, n);
+                    Vec3::new(0.2 * (std::f32::consts::PI * t).sin(), 0.0, t)
+                })
+                .collect(),
+            widths: vec![0.01; n],
+            ..Hair::default()
+        }
+    }
+
+    /// The angle point `p` turned by about the Z axis, from +X.
+    fn turned(p: Vec3) -> f32 {
+        p.y.atan2(p.x)
+    }
+
+    #[test]
+    fn each_point_turns_by_the_ramps_angle_about_the_root_tip_axis() {
+        let n = 11;
+        for ramp in [Ramp::default(), Ramp::Smooth, Ramp::Power(0.0)] {
+            let op = Twist(TwistParams {
+                ramp: ramp.clone(),
+                ..TwistParams::new(Map::Constant(90.0))
+            });
+            let mut hair = bowed(1, n);
+            let before = hair.clone();
+            op.apply_to_hair(&mut hair, &root(), &mut Scratch::default());
+            assert_eq!(hair.points[0], before.points[0], "the root stays");
+            assert!((hair.points[n - 1] - before.points[n - 1]).length() < 1e-6);
+            for j in 1..n - 1 {
+                let (a, b) = (before.points[j], hair.points[j]);
+                let want = 90f32.to_radians() * ramp.at(param(j, n));
+                assert!((turned(b) - want).abs() < 1e-4, "{ramp:?} point {j}");
+                // A turn about the axis keeps the height and the distance
+                // from the axis.
+                assert!((a.z - b.z).abs() < 1e-6);
+                assert!((a.truncate().length() - b.truncate().length()).abs() < 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn jitter_varies_the_angle_per_hair_within_its_bounds() {
+        let op = Twist(TwistParams {
+            jitter: Map::Constant(0.5),
+            ramp: Ramp::Power(0.0),
+            ..TwistParams::new(Map::Constant(60.0))
+        });
+        let angles: Vec<f32> = (0..200)
+            .map(|id| {
+                let mut hair = bowed(id, 5);
+                op.apply_to_hair(&mut hair, &root(), &mut Scratch::default());
+                turned(hair.points[2]).to_degrees()
+            })
+            .collect();
+        assert!(angles.iter().all(|a| (29.9..=90.1).contains(a)));
+        let (lo, hi) = angles
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(lo, hi), a| (lo.min(*a), hi.max(*a)));
+        assert!(hi - lo > 40.0, "per-hair variation: {lo} to {hi}");
+    }
+}
