@@ -227,11 +227,51 @@ impl std::io::Write for CountingSink {
     }
 }
 
+/// Everything `pelage bench groom` measures, before it is printed.
+struct GroomFigures {
+    hairs: u64,
+    runs: usize,
+    rss_hairs: u64,
+    threads: usize,
+    triangles: usize,
+    prep_s: f64,
+    shepard_s: f64,
+    hair_count: u64,
+    point_count: u64,
+    blender_hairs: u64,
+    blender_s: f64,
+    blender_per_million: f64,
+    peer: Result<BlenderRun, String>,
+    sequential_s: f64,
+    parted_s: f64,
+    stable_ratio: f64,
+    parted_ratio: f64,
+    style_prep_s: f64,
+    style_s: f64,
+    grow_s: f64,
+    style_grow_s: f64,
+    rss: u64,
+    usd_bytes: u64,
+    rss_s: f64,
+}
+
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
     if let Some(hairs) = args.rss_child {
         return rss_child(hairs);
     }
+    let figures = measure(args)?;
+    if args.json {
+        println!("{}", figures.to_json());
+    } else {
+        figures.print();
+    }
+    Ok(())
+}
+
+/// Grows the benchmark's grooms (and Blender's case with `--peer
+/// blender`) and measures the memory of a large one in a child process.
+fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
     let (hairs, rss_hairs, runs) = if args.quick {
         (200_000u64, 1_000_000u64, 3)
     } else {
@@ -298,10 +338,64 @@ pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
         [a, b, c] => (a as u64, b as u64, c),
         _ => anyhow::bail!("unexpected memory measurement output {out:?}"),
     };
+    Ok(GroomFigures {
+        hairs,
+        runs,
+        rss_hairs,
+        threads,
+        triangles,
+        prep_s,
+        shepard_s,
+        hair_count,
+        point_count,
+        blender_hairs,
+        blender_s,
+        blender_per_million,
+        peer,
+        sequential_s,
+        parted_s,
+        stable_ratio,
+        parted_ratio,
+        style_prep_s,
+        style_s,
+        grow_s,
+        style_grow_s,
+        rss,
+        usd_bytes,
+        rss_s,
+    })
+}
 
-    let per_s = hair_count as f64 / shepard_s;
-    let paper_scaled = PAPER_SECONDS * hairs as f64 / 1.6e6;
-    if args.json {
+impl GroomFigures {
+    /// The figures as one JSON object (`--json`).
+    fn to_json(&self) -> serde_json::Value {
+        let &GroomFigures {
+            hairs,
+            rss_hairs,
+            threads,
+            triangles,
+            prep_s,
+            shepard_s,
+            hair_count,
+            point_count,
+            blender_hairs,
+            blender_s,
+            blender_per_million,
+            ref peer,
+            sequential_s,
+            parted_s,
+            stable_ratio,
+            parted_ratio,
+            style_prep_s,
+            style_s,
+            grow_s,
+            rss,
+            usd_bytes,
+            rss_s,
+            ..
+        } = self;
+        let per_s = hair_count as f64 / shepard_s;
+        let paper_scaled = PAPER_SECONDS * hairs as f64 / 1.6e6;
         let report = serde_json::json!({
             "hairs": hair_count,
             "points_per_hair": 16,
@@ -337,100 +431,128 @@ pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
             "rss_usd_bytes": usd_bytes,
             "rss_seconds": rss_s,
         });
-        println!("{report}");
-        return Ok(());
+        report
     }
-    println!(
-        "pelage bench groom — {} hairs × 16 points on spot ×2 ({} triangles), 1,000 guides, clump + noise + normals + widths; {threads} threads, median of {runs}\n",
-        thousands(hair_count),
-        thousands(triangles as u64)
-    );
-    println!(
-        "{:<40} {:>10} {:>12} {:>14}",
-        "", "seconds", "M hairs/s", "paper / peer"
-    );
-    println!(
-        "{:<40} {:>10.3} {:>12.2} {:>14}",
-        "Shepard k = 4, all of it",
-        shepard_s,
-        per_s / 1e6,
-        format!("{paper_scaled:.2} s")
-    );
-    println!(
-        "{:<40} {:>10.3} {:>12} {:>14}",
-        "  of which preparation (guides, kd-tree,", prep_s, "", ""
-    );
-    println!("{:<40}", "  sampler, clump centres)");
-    println!(
-        "{:<40} {:>10.3} {:>12.2} {:>14}",
-        "  growing the hairs",
-        grow_s,
-        hair_count as f64 / grow_s / 1e6,
-        ""
-    );
-    println!(
-        "{:<40} {:>10.3} {:>12.2} {:>14}",
-        "  ids part by part (the old numbering)",
-        sequential_s,
-        hair_count as f64 / sequential_s / 1e6,
-        format!("stable {stable_ratio:.2}×")
-    );
-    println!(
-        "{:<40} {:>10.3} {:>12.2} {:>14}",
-        "  with a parting and two masked ops",
-        parted_s,
-        hair_count as f64 / parted_s / 1e6,
-        format!("{parted_ratio:.2}× old")
-    );
-    println!(
-        "{:<40} {:>10.3} {:>12.2} {:>14}",
-        "style mesh, all of it",
-        style_s,
-        hair_count as f64 / style_s / 1e6,
-        "—"
-    );
-    println!(
-        "{:<40} {:>10.3} {:>12.2} {:>14}",
-        "  growing the hairs",
-        style_grow_s,
-        hair_count as f64 / style_grow_s / 1e6,
-        ""
-    );
-    println!(
-        "{:<40} {:>10.3} {:>12.2} {:>14}",
-        format!("{} × 8 points, no operators", thousands(blender_hairs)),
-        blender_s,
-        blender_hairs as f64 / blender_s / 1e6,
-        ""
-    );
-    match &peer {
-        Ok(b) => {
-            // Per hair, in case Blender's random distribution made a few
-            // more or fewer hairs than asked.
-            let ratio = b.seconds / blender_s * blender_hairs as f64 / b.hairs.max(1) as f64;
-            println!(
-                "{:<40} {:>10.3} {:>12.2} {:>14}",
-                format!(
-                    "  peer: Blender {} ({} hairs)",
-                    b.version,
-                    thousands(b.hairs)
-                ),
-                b.seconds,
-                b.hairs as f64 / b.seconds / 1e6,
-                format!("pelage {ratio:.1}× faster"),
-            );
+
+    /// The figures as a table beside the paper's and the peer's.
+    fn print(&self) {
+        let &GroomFigures {
+            hairs,
+            runs,
+            rss_hairs,
+            threads,
+            triangles,
+            prep_s,
+            shepard_s,
+            hair_count,
+            blender_hairs,
+            blender_s,
+            ref peer,
+            sequential_s,
+            parted_s,
+            stable_ratio,
+            parted_ratio,
+            style_s,
+            grow_s,
+            style_grow_s,
+            rss,
+            usd_bytes,
+            rss_s,
+            ..
+        } = self;
+        let per_s = hair_count as f64 / shepard_s;
+        let paper_scaled = PAPER_SECONDS * hairs as f64 / 1.6e6;
+        println!(
+            "pelage bench groom — {} hairs × 16 points on spot ×2 ({} triangles), 1,000 guides, clump + noise + normals + widths; {threads} threads, median of {runs}\n",
+            thousands(hair_count),
+            thousands(triangles as u64)
+        );
+        println!(
+            "{:<40} {:>10} {:>12} {:>14}",
+            "", "seconds", "M hairs/s", "paper / peer"
+        );
+        println!(
+            "{:<40} {:>10.3} {:>12.2} {:>14}",
+            "Shepard k = 4, all of it",
+            shepard_s,
+            per_s / 1e6,
+            format!("{paper_scaled:.2} s")
+        );
+        println!(
+            "{:<40} {:>10.3} {:>12} {:>14}",
+            "  of which preparation (guides, kd-tree,", prep_s, "", ""
+        );
+        println!("{:<40}", "  sampler, clump centres)");
+        println!(
+            "{:<40} {:>10.3} {:>12.2} {:>14}",
+            "  growing the hairs",
+            grow_s,
+            hair_count as f64 / grow_s / 1e6,
+            ""
+        );
+        println!(
+            "{:<40} {:>10.3} {:>12.2} {:>14}",
+            "  ids part by part (the old numbering)",
+            sequential_s,
+            hair_count as f64 / sequential_s / 1e6,
+            format!("stable {stable_ratio:.2}×")
+        );
+        println!(
+            "{:<40} {:>10.3} {:>12.2} {:>14}",
+            "  with a parting and two masked ops",
+            parted_s,
+            hair_count as f64 / parted_s / 1e6,
+            format!("{parted_ratio:.2}× old")
+        );
+        println!(
+            "{:<40} {:>10.3} {:>12.2} {:>14}",
+            "style mesh, all of it",
+            style_s,
+            hair_count as f64 / style_s / 1e6,
+            "—"
+        );
+        println!(
+            "{:<40} {:>10.3} {:>12.2} {:>14}",
+            "  growing the hairs",
+            style_grow_s,
+            hair_count as f64 / style_grow_s / 1e6,
+            ""
+        );
+        println!(
+            "{:<40} {:>10.3} {:>12.2} {:>14}",
+            format!("{} × 8 points, no operators", thousands(blender_hairs)),
+            blender_s,
+            blender_hairs as f64 / blender_s / 1e6,
+            ""
+        );
+        match &peer {
+            Ok(b) => {
+                // Per hair, in case Blender's random distribution made a few
+                // more or fewer hairs than asked.
+                let ratio = b.seconds / blender_s * blender_hairs as f64 / b.hairs.max(1) as f64;
+                println!(
+                    "{:<40} {:>10.3} {:>12.2} {:>14}",
+                    format!(
+                        "  peer: Blender {} ({} hairs)",
+                        b.version,
+                        thousands(b.hairs)
+                    ),
+                    b.seconds,
+                    b.hairs as f64 / b.seconds / 1e6,
+                    format!("pelage {ratio:.1}× faster"),
+                );
+            }
+            Err(why) => println!("{:<40} not measured: {why}", "  peer: Blender"),
         }
-        Err(why) => println!("{:<40} not measured: {why}", "  peer: Blender"),
+        println!(
+            "\ntarget: ≥ 5 M hairs/s (1.6 M in ≤ 0.32 s); stable ids ≤ 1.1× and a parting with two masked ops ≤ 1.3× the old numbering. Paper: 1.6 M hairs in 3.2 s on 2 cores (0.5 M hairs/s)."
+        );
+        println!(
+            "memory: {} hairs streamed to USD ({:.1} GB of text, {:.1} s): peak RSS {:.0} MB (limit 1,024 MB)",
+            thousands(rss_hairs),
+            usd_bytes as f64 / 1e9,
+            rss_s,
+            rss as f64 / 1e6
+        );
     }
-    println!(
-        "\ntarget: ≥ 5 M hairs/s (1.6 M in ≤ 0.32 s); stable ids ≤ 1.1× and a parting with two masked ops ≤ 1.3× the old numbering. Paper: 1.6 M hairs in 3.2 s on 2 cores (0.5 M hairs/s)."
-    );
-    println!(
-        "memory: {} hairs streamed to USD ({:.1} GB of text, {:.1} s): peak RSS {:.0} MB (limit 1,024 MB)",
-        thousands(rss_hairs),
-        usd_bytes as f64 / 1e9,
-        rss_s,
-        rss as f64 / 1e6
-    );
-    Ok(())
 }

@@ -17,7 +17,7 @@
 //! One file, past 600 lines: the explicit and implicit compute pipelines
 //! share buffers, bind groups and the uniform ring.
 
-use crate::layout::gpu_struct;
+use crate::layout::{entry, gpu_struct};
 use crate::{GpuContext, GpuError, ShellModel};
 use glam::Vec3;
 use pelage::dynamics::{DynamicsParams, MassSpringSystem, Topology};
@@ -228,22 +228,11 @@ impl GpuMassSpring {
             mapped_at_creation: false,
         });
 
-        let entry =
-            |binding: u32, ty: wgpu::BufferBindingType, dynamic: bool| wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty,
-                    has_dynamic_offset: dynamic,
-                    min_binding_size: None,
-                },
-                count: None,
-            };
-        let read = wgpu::BufferBindingType::Storage { read_only: true };
-        let write = wgpu::BufferBindingType::Storage { read_only: false };
-        let mut entries = vec![entry(0, wgpu::BufferBindingType::Uniform, true)];
-        entries.extend((1..=8).map(|b| entry(b, read, false)));
-        entries.extend((9..=10).map(|b| entry(b, write, false)));
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let uniform = wgpu::BufferBindingType::Uniform;
+        let mut entries = vec![entry::buffer(0, compute, uniform, true)];
+        entries.extend((1..=8).map(|b| entry::storage(b, compute, true)));
+        entries.extend((9..=10).map(|b| entry::storage(b, compute, false)));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dynamics"),
             entries: &entries,
@@ -308,12 +297,12 @@ impl GpuMassSpring {
         let coupling_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dynamics coupling"),
             entries: &[
-                entry(1, read, false),
-                entry(2, read, false),
-                entry(7, read, false),
-                entry(11, read, false),
-                entry(12, write, false),
-                entry(13, read, false),
+                entry::storage(1, compute, true),
+                entry::storage(2, compute, true),
+                entry::storage(7, compute, true),
+                entry::storage(11, compute, true),
+                entry::storage(12, compute, false),
+                entry::storage(13, compute, true),
             ],
         });
         let coupling = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

@@ -203,6 +203,74 @@ impl<T: bytemuck::Pod> UniformRing<T> {
     }
 }
 
+/// Bind-group layout entries, one constructor a kind of binding, so each
+/// pipeline lists its bindings instead of spelling wgpu's structs out.
+pub(crate) mod entry {
+    use wgpu::{BindGroupLayoutEntry, BindingType, ShaderStages};
+
+    /// A float texture of `dimension`, sampled (`filterable`) or loaded.
+    pub(crate) fn texture(
+        binding: u32,
+        visibility: ShaderStages,
+        dimension: wgpu::TextureViewDimension,
+        filterable: bool,
+    ) -> BindGroupLayoutEntry {
+        BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable },
+                view_dimension: dimension,
+                multisampled: false,
+            },
+            count: None,
+        }
+    }
+
+    /// A filtering sampler.
+    pub(crate) fn sampler(binding: u32, visibility: ShaderStages) -> BindGroupLayoutEntry {
+        BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        }
+    }
+
+    /// A buffer: uniform or storage (`ty`), at a dynamic offset or not.
+    pub(crate) fn buffer(
+        binding: u32,
+        visibility: ShaderStages,
+        ty: wgpu::BufferBindingType,
+        dynamic: bool,
+    ) -> BindGroupLayoutEntry {
+        BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: BindingType::Buffer {
+                ty,
+                has_dynamic_offset: dynamic,
+                min_binding_size: None,
+            },
+            count: None,
+        }
+    }
+
+    /// A storage buffer, read only or read-write.
+    pub(crate) fn storage(
+        binding: u32,
+        visibility: ShaderStages,
+        read_only: bool,
+    ) -> BindGroupLayoutEntry {
+        buffer(
+            binding,
+            visibility,
+            wgpu::BufferBindingType::Storage { read_only },
+            false,
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::dynamics::StepUniform;

@@ -4,7 +4,7 @@
 //! One file, past 600 lines: the three preview pipelines (skin, points,
 //! curves) share one frame uniform and one pass.
 
-use crate::layout::{UniformRing, gpu_struct, gpu_vertex};
+use crate::layout::{UniformRing, entry, gpu_struct, gpu_vertex};
 use crate::readback::{is_bgra, read_texture};
 use crate::{Camera, GpuContext, GpuError};
 use glam::Vec3;
@@ -185,22 +185,13 @@ impl Renderer {
         let texture_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("skin texture"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
+                entry::texture(
+                    0,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::TextureViewDimension::D2,
+                    true,
+                ),
+                entry::sampler(1, wgpu::ShaderStages::FRAGMENT),
             ],
         });
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {

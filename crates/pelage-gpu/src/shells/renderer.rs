@@ -5,7 +5,7 @@
 //! caller's (docs/embedding.md); [`ShellRenderer::draw`] and
 //! [`ShellRenderer::render`] into pelage's own [`ShellTarget`].
 
-use crate::layout::UniformRing;
+use crate::layout::{UniformRing, entry};
 use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES};
 use crate::{GpuContext, GpuError};
 use glam::Mat4;
@@ -84,55 +84,29 @@ impl ShellRenderer {
     ) -> Self {
         let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let uniform_layout = UniformRing::<ShellUniforms>::layout(device, "shell uniforms", both);
-        let texture_entry = |binding, dimension, filterable| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: both,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable },
-                view_dimension: dimension,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let sampler_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: both,
-            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-            count: None,
-        };
         let texture_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shell textures"),
             entries: &[
-                texture_entry(0, wgpu::TextureViewDimension::D2Array, true),
-                sampler_entry(1),
-                texture_entry(2, wgpu::TextureViewDimension::D2, true),
-                sampler_entry(3),
-                texture_entry(4, wgpu::TextureViewDimension::D2, false),
+                entry::texture(0, both, wgpu::TextureViewDimension::D2Array, true),
+                entry::sampler(1, both),
+                entry::texture(2, both, wgpu::TextureViewDimension::D2, true),
+                entry::sampler(3, both),
+                entry::texture(4, both, wgpu::TextureViewDimension::D2, false),
             ],
         });
-        let storage_entry = |binding, visibility, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let vertex = wgpu::ShaderStages::VERTEX;
         let fin_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shell fins"),
-            entries: &[0, 1, 2, 3].map(|b| storage_entry(b, vertex, true)),
+            entries: &[0, 1, 2, 3].map(|b| entry::storage(b, vertex, true)),
         });
         let compute = wgpu::ShaderStages::COMPUTE;
         let skin_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shell skinning"),
             entries: &[
-                storage_entry(0, compute, true),
-                storage_entry(1, compute, true),
-                storage_entry(2, compute, true),
-                storage_entry(3, compute, false),
+                entry::storage(0, compute, true),
+                entry::storage(1, compute, true),
+                entry::storage(2, compute, true),
+                entry::storage(3, compute, false),
             ],
         });
         let sampler = |mode, mips| {
