@@ -511,6 +511,8 @@ fn fuzz_groom_toml() {
         "count = ",
         "points = ",
         "clump = { count = 1 }\n",
+        "twist = { angle = 1e30 }\n",
+        "flyaways = { spread = 1, fraction = 2 }\n",
         "strands = { count = 4294967297 }\n",
         "subdivide = 20\n",
         "= nan\n",
