@@ -120,8 +120,38 @@ fn twist(p: Vec3, frame: f64) -> Vec3 {
     Mat3::from_rotation_y(angle) * p + Vec3::new(0.1 * t, 0.0, 0.0)
 }
 
+/// Everything `pelage bench animation` measures, before it is printed.
+struct AnimationFigures {
+    runs: usize,
+    threads: usize,
+    hair_count: u64,
+    point_count: u64,
+    times: Vec<f64>,
+    grow_s: f64,
+    deform_per_frame: f64,
+    regrow_per_frame: f64,
+    regrown: Vec<f64>,
+    scratch_s: f64,
+    paper_scaled: f64,
+    rss: u64,
+    peer: Result<BlenderDeform, String>,
+}
+
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
+    let figures = measure(args)?;
+    if args.json {
+        figures.print_json();
+    } else {
+        figures.print_table();
+    }
+    Ok(())
+}
+
+/// Grows the groom once, then deforms and regrows it frame by frame on
+/// the twisted skin, beside growing from scratch (and Blender with
+/// `--peer blender`).
+fn measure(args: &AnimationBenchArgs) -> anyhow::Result<AnimationFigures> {
     let (hairs, runs) = if args.quick {
         (200_000u64, 3)
     } else {
@@ -286,8 +316,41 @@ pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
         None => Err("run with --peer blender".to_string()),
     };
     let paper_scaled = PAPER_SECONDS * hairs as f64 / 1.6e6;
+    Ok(AnimationFigures {
+        runs,
+        threads,
+        hair_count,
+        point_count,
+        times,
+        grow_s,
+        deform_per_frame,
+        regrow_per_frame,
+        regrown,
+        scratch_s,
+        paper_scaled,
+        rss,
+        peer,
+    })
+}
 
-    if args.json {
+impl AnimationFigures {
+    /// The figures as one JSON object (`--json`).
+    fn print_json(&self) {
+        let AnimationFigures {
+            threads,
+            hair_count,
+            point_count,
+            ref times,
+            grow_s,
+            deform_per_frame,
+            regrow_per_frame,
+            ref regrown,
+            scratch_s,
+            paper_scaled,
+            rss,
+            ref peer,
+            ..
+        } = *self;
         let report = serde_json::json!({
             "hairs": hair_count,
             "points": point_count,
@@ -313,55 +376,72 @@ pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
             },
         });
         println!("{report}");
-        return Ok(());
     }
-    println!(
-        "pelage bench animation — the Stubble figure ({} hairs × 16 points on spot ×2, clump + noise) on a skin twisted over {} frames; {threads} threads\n",
-        thousands(hair_count),
-        times.len()
-    );
-    println!("{:<66} {:>12} {:>12}", "", "s / frame", "× growing");
-    let row = |name: &str, s: f64| {
-        println!("{name:<66} {s:>12.3} {:>12.2}", s / grow_s);
-    };
-    row(
-        &format!("growing the groom once (median of {runs})"),
-        grow_s,
-    );
-    row("deform: pose + every hair carried", deform_per_frame);
-    row(
-        &format!(
-            "regrow: guides to rest + regrown + carried ({} frames)",
-            regrown.len()
-        ),
-        regrow_per_frame,
-    );
-    row(
-        "peer: from scratch on the posed skin (Stubble's way)",
-        scratch_s,
-    );
-    row("paper: Stubble, 2 cores (Sik §4.2.2)", paper_scaled);
-    match &peer {
-        Ok(b) => {
-            row(
-                &format!(
-                    "peer: Blender {} Deform Curves on Surface ({} hairs)",
-                    b.version,
-                    thousands(b.hairs)
-                ),
-                b.seconds,
-            );
-            println!(
-                "{:66} pelage's deform {:.1}× faster",
-                "",
-                b.seconds / deform_per_frame
-            );
+
+    /// The figures as a table beside growing, the peers and the paper.
+    fn print_table(&self) {
+        let AnimationFigures {
+            runs,
+            threads,
+            hair_count,
+            ref times,
+            grow_s,
+            deform_per_frame,
+            regrow_per_frame,
+            ref regrown,
+            scratch_s,
+            paper_scaled,
+            rss,
+            ref peer,
+            ..
+        } = *self;
+        println!(
+            "pelage bench animation — the Stubble figure ({} hairs × 16 points on spot ×2, clump + noise) on a skin twisted over {} frames; {threads} threads\n",
+            thousands(hair_count),
+            times.len()
+        );
+        println!("{:<66} {:>12} {:>12}", "", "s / frame", "× growing");
+        let row = |name: &str, s: f64| {
+            println!("{name:<66} {s:>12.3} {:>12.2}", s / grow_s);
+        };
+        row(
+            &format!("growing the groom once (median of {runs})"),
+            grow_s,
+        );
+        row("deform: pose + every hair carried", deform_per_frame);
+        row(
+            &format!(
+                "regrow: guides to rest + regrown + carried ({} frames)",
+                regrown.len()
+            ),
+            regrow_per_frame,
+        );
+        row(
+            "peer: from scratch on the posed skin (Stubble's way)",
+            scratch_s,
+        );
+        row("paper: Stubble, 2 cores (Sik §4.2.2)", paper_scaled);
+        match &peer {
+            Ok(b) => {
+                row(
+                    &format!(
+                        "peer: Blender {} Deform Curves on Surface ({} hairs)",
+                        b.version,
+                        thousands(b.hairs)
+                    ),
+                    b.seconds,
+                );
+                println!(
+                    "{:66} pelage's deform {:.1}× faster",
+                    "",
+                    b.seconds / deform_per_frame
+                );
+            }
+            Err(why) => println!("{:<66} not measured: {why}", "peer: Blender"),
         }
-        Err(why) => println!("{:<66} not measured: {why}", "peer: Blender"),
+        println!(
+            "\ntargets: deform ≤ 0.25× growing, regrow ≤ 1.2× growing. Peak RSS {:.0} MB.",
+            rss as f64 / 1e6
+        );
     }
-    println!(
-        "\ntargets: deform ≤ 0.25× growing, regrow ≤ 1.2× growing. Peak RSS {:.0} MB.",
-        rss as f64 / 1e6
-    );
-    Ok(())
 }

@@ -20,6 +20,7 @@ use clap::Args;
 use glam::Vec3;
 use pelage::Mesh;
 use pelage::dynamics::{DynamicsParams, MassSpringSystem, Solver, Topology, Wind};
+use pelage_gpu::GpuContext;
 
 /// Arguments of `pelage bench dynamics`.
 #[derive(Debug, Args)]
@@ -94,6 +95,29 @@ const SOLVERS: [Solver; 2] = [
 
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
+    let gpu = if args.no_gpu {
+        None
+    } else {
+        match pelage_gpu::GpuContext::headless() {
+            Ok(ctx) => Some(ctx),
+            Err(e) => {
+                eprintln!("no GPU column: {:#}", anyhow::Error::from(e));
+                None
+            }
+        }
+    };
+    let rows = measure(args, gpu.as_ref())?;
+    if args.json {
+        print_json(&rows, gpu.as_ref());
+    } else {
+        print_table(args, &rows, gpu.as_ref());
+    }
+    Ok(())
+}
+
+/// Every topology × solver on each mesh, on the CPU and (where `gpu` is
+/// given) the GPU.
+fn measure(args: &DynamicsBenchArgs, gpu: Option<&GpuContext>) -> anyhow::Result<Vec<Row>> {
     let spot = pelage::assets::spot();
     let mut meshes: Vec<(String, Mesh)> = vec![("spot".into(), spot.subdivided(0))];
     if !args.quick {
@@ -108,17 +132,6 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         ..Default::default()
     };
     let dt = 1.0 / 60.0;
-    let gpu = if args.no_gpu {
-        None
-    } else {
-        match pelage_gpu::GpuContext::headless() {
-            Ok(ctx) => Some(ctx),
-            Err(e) => {
-                eprintln!("no GPU column: {:#}", anyhow::Error::from(e));
-                None
-            }
-        }
-    };
     let mut rows = Vec::new();
     for (name, mesh) in &meshes {
         let length = 0.025 * (mesh.bounds().1 - mesh.bounds().0).length();
@@ -127,7 +140,7 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
             let at_rest = MassSpringSystem::new(mesh, topology, length);
             let substeps = at_rest.stable_substeps(dt, &params);
             let mut gpu_ms = [None; 2];
-            if let Some(ctx) = &gpu {
+            if let Some(ctx) = gpu {
                 for (k, solver) in SOLVERS.into_iter().enumerate() {
                     // The prisms' implicit step has no GPU path.
                     if matches!(solver, Solver::Implicit { .. }) && at_rest.joins_tips() {
@@ -157,50 +170,63 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
             });
         }
     }
-    let threads = rayon::current_num_threads();
-    let headline = rows
-        .iter()
+    Ok(rows)
+}
+
+/// The row the targets are judged on: spring-sticks on the largest mesh.
+fn headline(rows: &[Row]) -> &Row {
+    rows.iter()
         .rev()
         .find(|r| r.topology == Topology::SpringSticks)
-        .expect("spring-sticks always run");
-    let gpu_name = gpu.as_ref().map(|ctx| ctx.adapter_name());
-    if args.json {
-        let list: Vec<serde_json::Value> = rows
-            .iter()
-            .map(|r| {
-                serde_json::json!({
-                    "model": r.model,
-                    "topology": r.topology.name(),
-                    "masses": r.masses,
-                    "springs": r.springs,
-                    "explicit_ms": r.ms[0],
-                    "explicit_substeps": r.substeps,
-                    "implicit_ms": r.ms[1],
-                    "gpu_explicit_ms": r.gpu_ms[0],
-                    "gpu_implicit_ms": r.gpu_ms[1],
-                })
+        .expect("spring-sticks always run")
+}
+
+/// The figures as one JSON object (`--json`).
+fn print_json(rows: &[Row], gpu: Option<&GpuContext>) {
+    let threads = rayon::current_num_threads();
+    let headline = headline(rows);
+    let gpu_name = gpu.map(|ctx| ctx.adapter_name());
+    let list: Vec<serde_json::Value> = rows
+        .iter()
+        .map(|r| {
+            serde_json::json!({
+                "model": r.model,
+                "topology": r.topology.name(),
+                "masses": r.masses,
+                "springs": r.springs,
+                "explicit_ms": r.ms[0],
+                "explicit_substeps": r.substeps,
+                "implicit_ms": r.ms[1],
+                "gpu_explicit_ms": r.gpu_ms[0],
+                "gpu_implicit_ms": r.gpu_ms[1],
             })
-            .collect();
-        let per_million = |ms: f64| ms * 1e6 / headline.masses as f64;
-        let report = serde_json::json!({
-            "model": headline.model,
-            "masses": headline.masses,
-            "explicit_ms": headline.ms[0],
-            "implicit_ms": headline.ms[1],
-            "explicit_ms_per_million": per_million(headline.ms[0]),
-            "implicit_ms_per_million": per_million(headline.ms[1]),
-            "threads": threads,
-            "gpu_adapter": gpu_name,
-            "gpu_software": gpu.as_ref().map(|ctx| ctx.is_software()),
-            "gpu_explicit_ms": headline.gpu_ms[0],
-            "gpu_explicit_ms_per_million": headline.gpu_ms[0].map(per_million),
-            "gpu_implicit_ms": headline.gpu_ms[1],
-            "gpu_implicit_ms_per_million": headline.gpu_ms[1].map(per_million),
-            "rows": list,
-        });
-        println!("{report}");
-        return Ok(());
-    }
+        })
+        .collect();
+    let per_million = |ms: f64| ms * 1e6 / headline.masses as f64;
+    let report = serde_json::json!({
+        "model": headline.model,
+        "masses": headline.masses,
+        "explicit_ms": headline.ms[0],
+        "implicit_ms": headline.ms[1],
+        "explicit_ms_per_million": per_million(headline.ms[0]),
+        "implicit_ms_per_million": per_million(headline.ms[1]),
+        "threads": threads,
+        "gpu_adapter": gpu_name,
+        "gpu_software": gpu.map(|ctx| ctx.is_software()),
+        "gpu_explicit_ms": headline.gpu_ms[0],
+        "gpu_explicit_ms_per_million": headline.gpu_ms[0].map(per_million),
+        "gpu_implicit_ms": headline.gpu_ms[1],
+        "gpu_implicit_ms_per_million": headline.gpu_ms[1].map(per_million),
+        "rows": list,
+    });
+    println!("{report}");
+}
+
+/// The figures as a table beside the targets and the paper's.
+fn print_table(args: &DynamicsBenchArgs, rows: &[Row], gpu: Option<&GpuContext>) {
+    let threads = rayon::current_num_threads();
+    let headline = headline(rows);
+    let gpu_name = gpu.map(|ctx| ctx.adapter_name());
     println!(
         "pelage bench dynamics — ms per step (median of {}), {threads} threads; gravity + gusting turbulent wind",
         args.steps.max(1)
@@ -228,7 +254,7 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         "GPU explicit",
         "GPU implicit"
     );
-    for r in &rows {
+    for r in rows {
         println!(
             "{:>8}  {:>24}  {:>10}  {:>10}  {:>4}  {:>8.2} ms  {:>8.2} ms  {:>18.2}  {:>12}  {:>12}",
             r.model,
@@ -261,7 +287,7 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
         },
     );
     if let Some(name) = &gpu_name {
-        let software = gpu.as_ref().is_some_and(|ctx| ctx.is_software());
+        let software = gpu.is_some_and(|ctx| ctx.is_software());
         let verdict = |ms: Option<f64>, target: f64| match ms {
             Some(ms) => format!(
                 "{:.2} ms ({})",
@@ -288,5 +314,4 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
     println!(
         "Banisch & Wüthrich (P4 1.7 GHz, 2006): 1,247–6,888 masses at 22–27 fps including rendering"
     );
-    Ok(())
 }

@@ -77,6 +77,18 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         }
         return Ok(());
     }
+    let rows = measure(&ctx, args)?;
+    let game = super::shells_game::measure(&ctx, args.quick, args.frames)?;
+    if args.json {
+        print_json(&ctx, &rows, &game);
+    } else {
+        print_table(&ctx, args, &rows, &game);
+    }
+    Ok(())
+}
+
+/// Plain, curl and curl + clump frames on each mesh, layer count and size.
+fn measure(ctx: &GpuContext, args: &ShellsBenchArgs) -> anyhow::Result<Vec<Row>> {
     let renderers = [
         ShellFeatures::PLAIN,
         ShellFeatures {
@@ -85,7 +97,7 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         },
         ShellFeatures::ALL,
     ]
-    .map(|f| ShellRenderer::new(&ctx, f));
+    .map(|f| ShellRenderer::new(ctx, f));
     let scene = ShellScene::spot();
     let spot = pelage::assets::spot();
     let mut meshes: Vec<(String, Mesh)> = vec![
@@ -123,15 +135,15 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         let models = renderers
             .iter()
             .map(|r| {
-                let model = r.upload(&ctx, mesh, &scene.color, &textures, 256)?;
-                r.set_wetness(&ctx, &model, &mask)?;
+                let model = r.upload(ctx, mesh, &scene.color, &textures, 256)?;
+                r.set_wetness(ctx, &model, &mask)?;
                 Ok(model)
             })
             .collect::<Result<Vec<_>, pelage_gpu::GpuError>>()?;
         for &size in sizes {
             let targets = renderers
                 .iter()
-                .map(|r| ShellTarget::new(&ctx, r, size.0, size.1))
+                .map(|r| ShellTarget::new(ctx, r, size.0, size.1))
                 .collect::<Result<Vec<_>, _>>()?;
             let length = 0.025 * (mesh.bounds().1 - mesh.bounds().0).length();
             let view = ShellView::new(
@@ -158,7 +170,7 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
                 // Interleaved: each feature set's frames alternate with the
                 // others', so drift on a noisy machine hits all three alike.
                 let draw = |k: usize| -> anyhow::Result<()> {
-                    Ok(renderers[k].draw(&ctx, &models[k], &params, &view, &targets[k])?)
+                    Ok(renderers[k].draw(ctx, &models[k], &params, &view, &targets[k])?)
                 };
                 let medians = super::interleaved(
                     args.frames,
@@ -175,44 +187,58 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
             }
         }
     }
+    Ok(rows)
+}
 
-    let game = super::shells_game::measure(&ctx, args.quick, args.frames)?;
-    let headline = rows
-        .iter()
+/// The row the target is judged on: spot ×2, 16 layers, 800×600.
+fn headline(rows: &[Row]) -> &Row {
+    rows.iter()
         .find(|r| r.model == "spot ×2" && r.layers == 16 && r.size == (800, 600))
-        .expect("spot ×2 at 16 layers, 800×600 is always measured");
-    if args.json {
-        let list: Vec<serde_json::Value> = rows
-            .iter()
-            .map(|r| {
-                serde_json::json!({
-                    "model": r.model,
-                    "triangles": r.triangles,
-                    "layers": r.layers,
-                    "width": r.size.0,
-                    "height": r.size.1,
-                    "plain_ms": r.ms[0],
-                    "curl_ms": r.ms[1],
-                    "curl_clump_ms": r.ms[2],
-                })
+        .expect("spot ×2 at 16 layers, 800×600 is always measured")
+}
+
+/// The figures as one JSON object (`--json`).
+fn print_json(ctx: &GpuContext, rows: &[Row], game: &super::shells_game::GameFigures) {
+    let headline = headline(rows);
+    let list: Vec<serde_json::Value> = rows
+        .iter()
+        .map(|r| {
+            serde_json::json!({
+                "model": r.model,
+                "triangles": r.triangles,
+                "layers": r.layers,
+                "width": r.size.0,
+                "height": r.size.1,
+                "plain_ms": r.ms[0],
+                "curl_ms": r.ms[1],
+                "curl_clump_ms": r.ms[2],
             })
-            .collect();
-        let mut report = game_json(&game);
-        for (key, value) in [
-            ("adapter", ctx.adapter_name().into()),
-            ("software_adapter", ctx.is_software().into()),
-            ("plain_ms", headline.ms[0].into()),
-            ("curl_ms", headline.ms[1].into()),
-            ("curl_clump_ms", headline.ms[2].into()),
-            ("overhead_ratio", (headline.ms[2] / headline.ms[0]).into()),
-            ("target_overhead_ratio", 1.15.into()),
-            ("rows", list.into()),
-        ] {
-            report[key] = value;
-        }
-        println!("{report}");
-        return Ok(());
+        })
+        .collect();
+    let mut report = game_json(game);
+    for (key, value) in [
+        ("adapter", ctx.adapter_name().into()),
+        ("software_adapter", ctx.is_software().into()),
+        ("plain_ms", headline.ms[0].into()),
+        ("curl_ms", headline.ms[1].into()),
+        ("curl_clump_ms", headline.ms[2].into()),
+        ("overhead_ratio", (headline.ms[2] / headline.ms[0]).into()),
+        ("target_overhead_ratio", 1.15.into()),
+        ("rows", list.into()),
+    ] {
+        report[key] = value;
     }
+    println!("{report}");
+}
+
+/// The figures as tables beside the target and Silva et al.'s Table 1.
+fn print_table(
+    ctx: &GpuContext,
+    args: &ShellsBenchArgs,
+    rows: &[Row],
+    game: &super::shells_game::GameFigures,
+) {
+    let headline = headline(rows);
     println!(
         "pelage bench shells — median of {} frames, on {}",
         args.frames.max(1),
@@ -225,7 +251,7 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         "{:>9}  {:>10}  {:>6}  {:>10}  {:>10}  {:>10}  {:>12}  {:>9}",
         "model", "triangles", "layers", "size", "plain", "+ curl", "+ curl+clump", "÷ plain"
     );
-    for r in &rows {
+    for r in rows {
         println!(
             "{:>9}  {:>10}  {:>6}  {:>10}  {:>7.1} ms  {:>7.1} ms  {:>9.1} ms  {:>8.2}×",
             r.model,
@@ -244,7 +270,7 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         if ratio <= 1.15 { "met" } else { "missed" }
     );
     println!();
-    print_game(&game);
+    print_game(game);
     println!(
         "\nSilva et al. Table 1 (GeForce 8800 GTS, with curl and clumps), ms per frame (fps):"
     );
@@ -264,7 +290,6 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
             cell(*d)
         );
     }
-    Ok(())
 }
 
 /// The game rows as JSON: each row's configurations in ms, and the ratios
