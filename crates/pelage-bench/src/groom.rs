@@ -229,7 +229,10 @@ impl std::io::Write for CountingSink {
 
 /// Everything `pelage bench groom` measures, before it is printed.
 struct GroomFigures {
-    hairs: u64,
+    /// Hairs a second, Shepard, all of it.
+    per_s: f64,
+    /// The paper's seconds scaled to this run's hair count.
+    paper_scaled: f64,
     runs: usize,
     rss_hairs: u64,
     threads: usize,
@@ -339,7 +342,8 @@ fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
         _ => anyhow::bail!("unexpected memory measurement output {out:?}"),
     };
     Ok(GroomFigures {
-        hairs,
+        per_s: hair_count as f64 / shepard_s,
+        paper_scaled: PAPER_SECONDS * hairs as f64 / 1.6e6,
         runs,
         rss_hairs,
         threads,
@@ -370,7 +374,8 @@ impl GroomFigures {
     /// The figures as one JSON object (`--json`).
     fn to_json(&self) -> serde_json::Value {
         let &GroomFigures {
-            hairs,
+            per_s,
+            paper_scaled,
             rss_hairs,
             threads,
             triangles,
@@ -394,8 +399,6 @@ impl GroomFigures {
             rss_s,
             ..
         } = self;
-        let per_s = hair_count as f64 / shepard_s;
-        let paper_scaled = PAPER_SECONDS * hairs as f64 / 1.6e6;
         let report = serde_json::json!({
             "hairs": hair_count,
             "points_per_hair": 16,
@@ -437,7 +440,8 @@ impl GroomFigures {
     /// The figures as a table beside the paper's and the peer's.
     fn print(&self) {
         let &GroomFigures {
-            hairs,
+            per_s,
+            paper_scaled,
             runs,
             rss_hairs,
             threads,
@@ -460,8 +464,6 @@ impl GroomFigures {
             rss_s,
             ..
         } = self;
-        let per_s = hair_count as f64 / shepard_s;
-        let paper_scaled = PAPER_SECONDS * hairs as f64 / 1.6e6;
         println!(
             "pelage bench groom — {} hairs × 16 points on spot ×2 ({} triangles), 1,000 guides, clump + noise + normals + widths; {threads} threads, median of {runs}\n",
             thousands(hair_count),

@@ -429,15 +429,13 @@ impl PyGroom {
                 .map_err(|e| self.error(e))?
                 .map(Arc::new),
         };
-        let farm = |parts: usize| match run {
-            None => Ok((0..parts, output.clone())),
-            Some(run) => run
-                .parts(parts)
-                .map(|range| (range, run.file(&output)))
-                .map_err(|e| PyValueError::new_err(format!("part = {part:?}: {e}"))),
+        let farm = || {
+            self.groom
+                .run_output(&output, run)
+                .map_err(|e| PyValueError::new_err(format!("part = {part:?}: {e}")))
         };
         let (summary, written, grown) = if let Some(animated) = animated {
-            let (range, path) = farm(animated.generator().parts().len())?;
+            let (range, path) = farm()?;
             let options = self.groom.usd_options();
             let with_skin = self.groom.writes_skin_in(run);
             let summary = py.detach(|| {
@@ -448,7 +446,7 @@ impl PyGroom {
             (summary, path, None)
         } else {
             let generator = self.generator(py, seed)?;
-            let (range, path) = farm(generator.parts().len())?;
+            let (range, path) = farm()?;
             let export = self.groom.export();
             let total = range.len();
             let mut done = 0;

@@ -56,13 +56,10 @@ pub struct FrameFile {
 /// Every `STEM[.part-K-of-N].fA[-B].EXT` beside `output` (STEM its file
 /// stem), sorted by run and frame.
 pub fn find_frame_files(output: &Path) -> std::io::Result<Vec<FrameFile>> {
-    let folder = match output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let folder = crate::io::folder_of(output);
     let stem = output.file_stem().and_then(|s| s.to_str()).unwrap_or("");
     let mut found = Vec::new();
-    for entry in std::fs::read_dir(&folder)? {
+    for entry in std::fs::read_dir(folder)? {
         let name = entry?.file_name();
         let Some(name) = name.to_str() else { continue };
         let Some(rest) = name.strip_prefix(stem).and_then(|r| r.strip_prefix('.')) else {

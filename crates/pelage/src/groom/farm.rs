@@ -132,10 +132,7 @@ pub enum FarmError {
 /// No part file, files of two farms of different sizes, a run's file
 /// missing, or a folder that cannot be listed.
 pub fn find_part_files(output: &Path) -> Result<Vec<PathBuf>, FarmError> {
-    let folder = match output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let folder = crate::io::folder_of(output).to_path_buf();
     let stem = output
         .file_stem()
         .and_then(|s| s.to_str())

@@ -65,7 +65,7 @@ impl Groom {
             Some(animation) => {
                 let found = find_frame_files(output).map_err(|error| {
                     AssembleError::Farm(FarmError::List {
-                        folder: output.parent().unwrap_or(Path::new(".")).to_path_buf(),
+                        folder: crate::io::folder_of(output).to_path_buf(),
                         error,
                     })
                 })?;

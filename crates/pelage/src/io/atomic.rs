@@ -69,7 +69,7 @@ pub fn check_input(path: &Path, what: &str) -> std::io::Result<()> {
 }
 
 /// The folder a file of `path` lives in (`.` for a bare name).
-fn folder_of(path: &Path) -> &Path {
+pub(crate) fn folder_of(path: &Path) -> &Path {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),

@@ -18,6 +18,7 @@
 
 mod abc;
 mod atomic;
+pub(crate) use atomic::folder_of;
 mod curves_file;
 mod curves_ply;
 mod hair;

@@ -5,12 +5,12 @@
 //! where they are; the hair's bends wind around its chord.
 
 use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
-use super::{Hair, RootContext, Scratch, jittered};
+use super::look::varied;
+use super::{Hair, RootContext, Scratch};
 use crate::groom::error::GroomError;
 use crate::groom::file::MapValue;
 use crate::groom::ramp::Ramp;
 use crate::map::Map;
-use crate::sample::SampleRng;
 use glam::{Quat, Vec3};
 use serde::Deserialize;
 
@@ -116,12 +116,7 @@ impl OperatorKind for Twist {
         if degrees == 0.0 || axis == Vec3::ZERO {
             return;
         }
-        let jitter = p.jitter.at(&root.site);
-        let factor = if jitter == 0.0 {
-            1.0
-        } else {
-            jittered(jitter, &mut SampleRng::new(p.seed ^ JITTER_SALT, hair.id))
-        };
+        let factor = varied(p.jitter.at(&root.site), p.seed ^ JITTER_SALT, hair.id);
         let angle = degrees.to_radians() * factor;
         let n = hair.points.len();
         let ramp = scratch.ramps.along(&p.ramp, n);
