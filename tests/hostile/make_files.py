@@ -73,6 +73,23 @@ for level in range(40):
 write("gltf_node_lattice.gltf", json.dumps(triangle_gltf(
     nodes=nodes, scenes=[{"nodes": [0, 1]}])))
 
+# Animation channels the gltf crate reads without checking: a target node
+# out of range (it panics), and a target path it does not know (it
+# unwraps). Times and values read from the triangle's own buffer.
+def animated_gltf(node, path):
+    doc = triangle_gltf()
+    doc["accessors"] += [
+        {"bufferView": 0, "componentType": 5126, "count": 1, "type": "SCALAR",
+         "min": [0], "max": [0]},
+        {"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC3"},
+    ]
+    doc["animations"] = [{"name": "Run",
+                          "samplers": [{"input": 1, "output": 2}],
+                          "channels": [{"sampler": 0, "target": {"node": node, "path": path}}]}]
+    return doc
+write("gltf_animation_missing_node.gltf", json.dumps(animated_gltf(999, "translation")))
+write("gltf_animation_unknown_path.gltf", json.dumps(animated_gltf(0, "wobble")))
+
 # Within the pixel ceiling (60 M pixels) but wider than most GPUs' texture
 # limit (16384 on lavapipe).
 write("wide_20000x3000.png", png(20000, 3000, 1, 0, [bytes(20000 // 8)] * 3000))

@@ -40,6 +40,12 @@ struct Case {
     not_blank: Vec<String>,
     #[serde(default)]
     allow_temporary: Vec<String>,
+    /// Text files and pieces each must contain.
+    #[serde(default)]
+    contains: BTreeMap<String, Vec<String>>,
+    /// The longest stderr allowed, in bytes.
+    #[serde(default)]
+    stderr_at_most: Option<usize>,
     #[serde(default)]
     gpu: bool,
 }
@@ -101,7 +107,13 @@ fn run_case(case: &Case) -> Vec<String> {
         .map(|f| (f, std::fs::read(dir.path().join(f)).unwrap()))
         .collect();
 
-    let mut command = Command::new(env!("CARGO_BIN_EXE_pelage"));
+    // Another binary can be tried (an older build, to see that new cases
+    // fail there).
+    let binary = std::env::var_os("PELAGE_HOSTILE_BINARY").map_or_else(
+        || PathBuf::from(env!("CARGO_BIN_EXE_pelage")),
+        PathBuf::from,
+    );
+    let mut command = Command::new(binary);
     command
         .args(&case.args)
         .current_dir(dir.path())
@@ -184,6 +196,22 @@ fn run_case(case: &Case) -> Vec<String> {
             problems.push(format!("stderr lacks {piece:?}"));
         }
     }
+    if let Some(most) = case.stderr_at_most
+        && stderr.len() > most
+    {
+        problems.push(format!(
+            "stderr is {} bytes, more than {most}",
+            stderr.len()
+        ));
+    }
+    for (file, pieces) in &case.contains {
+        let text = std::fs::read_to_string(dir.path().join(file)).unwrap_or_default();
+        for piece in pieces {
+            if !text.contains(piece.as_str()) {
+                problems.push(format!("{file} lacks {piece:?}"));
+            }
+        }
+    }
     for piece in &case.stdout {
         if !stdout.contains(piece.as_str()) {
             problems.push(format!("stdout lacks {piece:?}"));
@@ -224,7 +252,12 @@ fn run_case(case: &Case) -> Vec<String> {
         }
     }
     if !problems.is_empty() {
-        problems.push(format!("stdout: {stdout}\nstderr: {stderr}"));
+        let short = |s: &str| s.chars().take(2000).collect::<String>();
+        problems.push(format!(
+            "stdout: {}\nstderr: {}",
+            short(&stdout),
+            short(&stderr)
+        ));
     }
     problems
 }
@@ -251,7 +284,18 @@ fn hostile_inputs_end_in_clear_errors_or_correct_results() {
     if !gpu && std::env::var_os("PELAGE_REQUIRE_GPU").is_some() {
         panic!("PELAGE_REQUIRE_GPU is set and no GPU adapter was found");
     }
-    let cases: Vec<&Case> = manifest.case.iter().filter(|c| gpu || !c.gpu).collect();
+    // PELAGE_HOSTILE_ONLY=name,name runs only those cases.
+    let only = std::env::var("PELAGE_HOSTILE_ONLY").ok();
+    let chosen = |c: &&Case| {
+        only.as_ref()
+            .is_none_or(|o| o.split(',').any(|n| n == c.name))
+    };
+    let cases: Vec<&Case> = manifest
+        .case
+        .iter()
+        .filter(|c| gpu || !c.gpu)
+        .filter(chosen)
+        .collect();
     let skipped = manifest.case.len() - cases.len();
     // Two at a time: the cases are small, the machines have two cores.
     let next = std::sync::atomic::AtomicUsize::new(0);
@@ -283,7 +327,7 @@ fn hostile_inputs_end_in_clear_errors_or_correct_results() {
     });
     let failures = failures.into_inner().unwrap();
     eprintln!(
-        "{} hostile cases run, {skipped} skipped (no GPU), {} failed",
+        "{} hostile cases run, {skipped} skipped (no GPU, or not in PELAGE_HOSTILE_ONLY), {} failed",
         cases.len(),
         failures.len()
     );

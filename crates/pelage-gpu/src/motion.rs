@@ -66,6 +66,29 @@ impl FurMotion {
         }
     }
 
+    /// A warning when `settings` ask for automatic explicit substeps
+    /// (`substeps = 0`) and steps of `dt` would need more than the ceiling
+    /// ([`MassSpringSystem::stable_substeps`] stops there): the fur may
+    /// blow up, and the message says what to change.
+    pub fn substeps_warning(&self, dt: f32, settings: &DynamicsSettings) -> Option<String> {
+        let Solver::Explicit { substeps: 0 } = settings.solver else {
+            return None;
+        };
+        let needed = self.system.substeps_for_stability(dt, &settings.params);
+        let ceiling = pelage::limits::MAX_DYNAMICS_STEPS;
+        (needed > ceiling).then(|| {
+            format!(
+                "dynamics: a stable explicit step needs {} substeps at this stiffness and mass, more than pelage's limit of {}; it takes {} and the fur may blow up: use solver = \"implicit\", a lower stiffness or a higher mass",
+                match needed {
+                    u64::MAX => "endless".to_string(),
+                    n => pelage::limits::grouped(n as f64),
+                },
+                pelage::limits::grouped(ceiling as f64),
+                pelage::limits::grouped(ceiling as f64),
+            )
+        })
+    }
+
     /// The topology stepped.
     pub fn topology(&self) -> Topology {
         self.system.topology()

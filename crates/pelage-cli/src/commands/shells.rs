@@ -47,6 +47,9 @@ pub fn run(args: &ShellsArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::headless()?;
     let (width, height) = args.size;
     let mut player = ShellScenePlayer::new(&ctx, &scene, width, height)?;
+    for warning in player.warnings() {
+        eprintln!("warning: {warning}");
+    }
     let frames = args.frames.unwrap_or(scene.frames);
     println!(
         "{}: {} layers over {} ({} triangles), texture {}² × {}, on {}",

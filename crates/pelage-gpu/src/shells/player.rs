@@ -68,6 +68,17 @@ impl<'s> ShellScenePlayer<'s> {
         })
     }
 
+    /// Warnings about the scene as it will play (today: automatic
+    /// explicit substeps capped at pelage's ceiling), for the caller to
+    /// show.
+    pub fn warnings(&self) -> Vec<String> {
+        let (Some(motion), Some(settings)) = (&self.motion, &self.scene.dynamics) else {
+            return Vec::new();
+        };
+        let dt = 1.0 / (self.scene.fps * settings.steps_per_frame as f32);
+        motion.substeps_warning(dt, settings).into_iter().collect()
+    }
+
     /// Runs the scene's mass-spring system up to `time`, in steps of
     /// `1 / (fps · steps_per_frame)`, the skin posed by its animation at
     /// each step and moved as the shake says.

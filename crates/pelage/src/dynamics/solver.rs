@@ -406,7 +406,21 @@ impl MassSpringSystem {
     /// likewise plus drag. The substep is then kept to 80 % of the bound.
     /// Prisms on spot (`L0` = 0.08) at the defaults take 11 substeps at 24
     /// steps a second, where one diverges (tested).
+    ///
+    /// The count is at most [`MAX_DYNAMICS_STEPS`](crate::limits::MAX_DYNAMICS_STEPS),
+    /// the ceiling a scene's own `substeps` has: past it a step would take
+    /// as long as a thousand frames. [`Self::substeps_for_stability`] says
+    /// how many stability would need, so callers can warn that the cap
+    /// was hit (the fur may then blow up; the implicit solver would not).
     pub fn stable_substeps(&self, dt: f32, p: &DynamicsParams) -> u32 {
+        self.substeps_for_stability(dt, p)
+            .min(crate::limits::MAX_DYNAMICS_STEPS) as u32
+    }
+
+    /// The substeps an explicit step of `dt` needs to be stable, without
+    /// the ceiling of [`Self::stable_substeps`] (`u64::MAX` when nothing
+    /// finite is enough).
+    pub fn substeps_for_stability(&self, dt: f32, p: &DynamicsParams) -> u64 {
         let degree = self.max_tip_springs as f32;
         let shortest = self.lengths.iter().copied().fold(f32::INFINITY, f32::min);
         let restoring = if self.topology == Topology::SilvaStrands || !shortest.is_finite() {
@@ -420,13 +434,17 @@ impl MassSpringSystem {
         if k <= 0.0 {
             return 1;
         }
+        if !k.is_finite() || !c.is_finite() {
+            return u64::MAX;
+        }
         // The positive root of (k/m) h² + 2 (c/m) h − 4 = 0.
         let h = (-2.0 * c + (4.0 * c * c + 16.0 * k).sqrt()) / (2.0 * k);
-        let n = (dt / (0.8 * h)).ceil();
-        if n.is_finite() {
-            n.clamp(1.0, 1e6) as u32
-        } else {
+        let n = (f64::from(dt) / (0.8 * f64::from(h))).ceil();
+        if n.is_nan() {
             1
+        } else {
+            // Saturates: an infinite need is u64::MAX.
+            n.max(1.0) as u64
         }
     }
 
@@ -735,6 +753,34 @@ mod tests {
         assert!(
             run(Topology::Prisms, 1) > 100.0 * length,
             "prisms at one substep of 1/24 s diverge: the bound is needed"
+        );
+    }
+
+    /// A stiffness no explicit step can follow asks for more substeps
+    /// than the ceiling; the automatic choice stops at the ceiling instead
+    /// of hanging for a million substeps a step.
+    #[test]
+    fn automatic_substeps_stop_at_the_ceiling() {
+        let mesh = crate::assets::spot();
+        let params = DynamicsParams {
+            stiffness: 1e30,
+            ..DynamicsParams::default()
+        };
+        let system = MassSpringSystem::new(&mesh, Topology::Prisms, 0.08);
+        let dt = 1.0 / 24.0;
+        assert!(system.substeps_for_stability(dt, &params) > crate::limits::MAX_DYNAMICS_STEPS);
+        assert_eq!(
+            system.explicit_substeps(dt, &params, 0) as u64,
+            crate::limits::MAX_DYNAMICS_STEPS
+        );
+        let infinite = DynamicsParams {
+            stiffness: f32::INFINITY,
+            ..DynamicsParams::default()
+        };
+        assert_eq!(system.substeps_for_stability(dt, &infinite), u64::MAX);
+        assert_eq!(
+            system.stable_substeps(dt, &infinite) as u64,
+            crate::limits::MAX_DYNAMICS_STEPS
         );
     }
 

@@ -47,9 +47,13 @@ pub(crate) struct VertexSource {
 /// Checks a glTF document against the specification before anything reads
 /// it. The gltf crate's own validation indexes a primitive's `POSITION`
 /// accessor without checking it exists (it panics on a file whose POSITION
-/// names a missing accessor), so references are checked here first.
+/// names a missing accessor), and does not check animation channels at
+/// all (a channel's target node out of range, or a target path it does
+/// not know, panics when read), so those references are checked here
+/// first.
 fn validate(document: &gltf::Document) -> Result<(), String> {
     let root = document.as_json();
+    validate_animation_channels(root)?;
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             for (semantic, accessor) in &primitive.attributes {
@@ -231,6 +235,39 @@ fn validate_accessors(root: &gltf::json::Root) -> Result<(), String> {
 }
 
 /// The gltf crate's own validation of references and enums.
+/// Each animation channel's sampler, target node and target path exist.
+fn validate_animation_channels(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::validation::Checked;
+    for (a, animation) in root.animations.iter().enumerate() {
+        let name = match &animation.name {
+            Some(name) => format!("animation {a} ({name:?})"),
+            None => format!("animation {a}"),
+        };
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let node = channel.target.node.value();
+            if node >= root.nodes.len() {
+                return Err(format!(
+                    "{name} channel {c}: its target names node {node}, and the file has {} nodes",
+                    root.nodes.len()
+                ));
+            }
+            let sampler = channel.sampler.value();
+            if sampler >= animation.samplers.len() {
+                return Err(format!(
+                    "{name} channel {c}: it names sampler {sampler}, and the animation has {} samplers",
+                    animation.samplers.len()
+                ));
+            }
+            if let Checked::Invalid = channel.target.path {
+                return Err(format!(
+                    "{name} channel {c}: its target path is not translation, rotation, scale or weights"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 fn validate_with_crate(root: &gltf::json::Root) -> Result<(), String> {
     // Unknown problems in the crate's validation are still errors, not a
     // crash of the whole program.

@@ -6,9 +6,21 @@
 //! operator alone. `cut` fades its parameter instead (`1 − m(1 − at)`), so
 //! a half-masked bald patch is half-length hair, and `strands` fades each
 //! new hair toward its base hair.
+//!
+//! An operator that gives hairs an attribute they did not have (the first
+//! `color` or `opacity`) blends from what the hair shows without it: fully
+//! opaque ([`UNMASKED_OPACITY`]) and the mid grey renderers draw uncoloured
+//! curves in ([`UNMASKED_COLOR`]), so `mask = 0` leaves every hair as it
+//! would be without the operator.
 
 use super::{Hair, HairBatch, Operator, RootContext, Scratch};
 use crate::map::Map;
+use glam::Vec3;
+
+/// The opacity a masked `opacity` fades from where the hair had none.
+pub const UNMASKED_OPACITY: f32 = 1.0;
+/// The colour a masked `color` fades from where the hair had none.
+pub const UNMASKED_COLOR: Vec3 = Vec3::splat(0.5);
 
 /// An operator whose effect a map fades.
 #[derive(Debug)]
@@ -43,8 +55,23 @@ impl Masked {
         if m > 0.0 { m.min(1.0) } else { 0.0 }
     }
 
+    /// Gives `hair` the attributes the operator adds, at the values it
+    /// fades from, where it has none yet.
+    fn start_attributes(&self, hair: &mut Hair) {
+        let n = hair.points.len();
+        if self.op.adds_opacities() && hair.opacities.is_empty() {
+            hair.opacities.resize(n, UNMASKED_OPACITY);
+        }
+        if self.op.adds_colors() && hair.colors.is_empty() {
+            hair.colors.resize(n, UNMASKED_COLOR);
+        }
+    }
+
     pub(super) fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
         let m = self.weight(root);
+        for hair in batch.hairs_mut() {
+            self.start_attributes(hair);
+        }
         if m == 0.0 {
             return;
         }
@@ -80,7 +107,8 @@ impl Masked {
     ) {
         let mut before = std::mem::take(&mut scratch.masked);
         before.len = 0;
-        for hair in hairs.iter() {
+        for hair in hairs.iter_mut() {
+            self.start_attributes(hair);
             before.push().copy_from(hair);
         }
         self.op.apply_each(hairs, roots, scratch);
@@ -150,5 +178,28 @@ mod tests {
         op.apply(&mut b, &root(), &mut scratch);
         assert_eq!(b.len(), 1);
         assert!((b.hairs()[0].points[7].z - 0.5).abs() < 1e-5);
+    }
+
+    /// The first opacity or colour a hair gets under a mask fades from
+    /// what the hair shows without one: `mask = 0` is no operator, half a
+    /// mask is halfway, on both paths.
+    #[test]
+    fn a_masked_first_look_fades_from_the_unmasked_look() {
+        use super::super::Opacity;
+        use super::super::look::tests::spec;
+        let opacity = || Operator::Opacity(Opacity(spec(0.2, 0.2, 0.0)));
+        let mut scratch = Scratch::default();
+        for (m, want) in [(0.0, UNMASKED_OPACITY), (0.5, 0.6), (1.0, 0.2)] {
+            let op = Masked::new(opacity(), Map::Constant(m));
+            let mut b = batch(straight(1, 8, 1.0));
+            op.apply(&mut b, &root(), &mut scratch);
+            let o = &b.hairs()[0].opacities;
+            assert_eq!(o.len(), 8, "mask {m}");
+            assert!(o.iter().all(|v| (v - want).abs() < 1e-5), "mask {m}: {o:?}");
+            let mut hairs = vec![straight(1, 8, 1.0)];
+            op.apply_each(&mut hairs, &[root()], &mut scratch);
+            let o = &hairs[0].opacities;
+            assert!(o.iter().all(|v| (v - want).abs() < 1e-5), "mask {m}: {o:?}");
+        }
     }
 }

@@ -36,7 +36,7 @@ pub use cut::Cut;
 pub use flyaways::{Flyaways, FlyawaysParams};
 pub use frizz::{Frizz, FrizzParams};
 pub use length::{Length, LengthParams};
-pub use mask::Masked;
+pub use mask::{Masked, UNMASKED_COLOR, UNMASKED_OPACITY};
 pub use noise::{Noise, NoiseParams, NoiseScratch};
 pub use opacity::Opacity;
 pub use strands::{Strands, StrandsParams};
