@@ -117,3 +117,35 @@ doc = triangle_gltf()
 doc["bufferViews"][0]["byteStride"] = 4
 with open(os.path.join(fuzz, "crash_stride_below_element.gltf"), "w") as f:
     f.write(json.dumps(doc))
+
+
+# Alembic (Ogawa) objects that list themselves as their own child, under a
+# long name: each level's path is longer than the last (quadratic memory:
+# 300 KB names abort at 256 levels; 100 KB ones print a 25 MB error), and
+# a name just under the name ceiling nested until the path ceiling.
+def ogawa_self_listing(name_len):
+    name = b"n" * name_len
+    empty_data = 1 << 63
+    out = bytearray(b"Ogawa\xff\x00\x01" + bytes(8))
+    headers = len(out)
+    body = struct.pack("<I", len(name)) + name + b"\x00" + bytes(32)
+    out += struct.pack("<Q", len(body)) + body
+    obj = len(out)
+    out += struct.pack("<4Q", 3, 0, obj, headers | empty_data)
+    top = len(out)
+    out += struct.pack("<7Q", 6, empty_data, empty_data, obj, empty_data, empty_data, empty_data)
+    out[8:16] = struct.pack("<Q", top)
+    return bytes(out)
+write("abc_self_listing_300k.abc", ogawa_self_listing(300_000))
+write("abc_self_listing_100k.abc", ogawa_self_listing(100_000))
+write("abc_self_listing_4000.abc", ogawa_self_listing(4000))
+
+
+# Forty UDIM tiles of 8192 x 8192 one-bit pixels: each is within the
+# per-image ceiling, together they are 2.7 G pixels (10 GB as texels).
+udim = os.path.join(here, "udim_40_tiles")
+os.makedirs(udim, exist_ok=True)
+tile = png(8192, 8192, 1, 0, [bytes(1024)] * 8192)
+for k in range(40):
+    with open(os.path.join(udim, "density.%d.png" % (1001 + k)), "wb") as f:
+        f.write(tile)

@@ -92,9 +92,16 @@ fn run_case(case: &Case) -> Vec<String> {
     let dir = tempfile::tempdir().unwrap();
     for file in &case.files {
         let from = hostile_folder().join(file);
-        let name = Path::new(file).file_name().unwrap();
-        std::fs::copy(&from, dir.path().join(name))
-            .unwrap_or_else(|e| panic!("{}: {}: {e}", case.name, from.display()));
+        // A folder brings its files.
+        let sources = match std::fs::read_dir(&from) {
+            Ok(entries) => entries.map(|e| e.unwrap().path()).collect(),
+            Err(_) => vec![from],
+        };
+        for from in sources {
+            let name = from.file_name().unwrap();
+            std::fs::copy(&from, dir.path().join(name))
+                .unwrap_or_else(|e| panic!("{}: {}: {e}", case.name, from.display()));
+        }
     }
     for (name, text) in &case.write {
         let path = dir.path().join(name);

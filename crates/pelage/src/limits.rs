@@ -80,6 +80,38 @@ pub const MAX_SHELL_TEXELS: u64 = 1 << 28;
 /// texture limit, which the renderer checks).
 pub const MAX_IMAGE_SIDE: u64 = 16384;
 
+/// Bytes of one name read from a file (a USD token used as a path
+/// element, an Alembic object or property name). Real names are tens of
+/// bytes; a path is built of them level by level.
+pub const MAX_NAME_BYTES: usize = 4096;
+
+/// Bytes of one object or prim path read from a file. Without it, a
+/// chain of long names nested deep builds a path per level, each longer
+/// than the last (quadratic memory: a 60,000-deep chain under a 2 KB name
+/// is 3.6 TB of path text).
+pub const MAX_PATH_BYTES: usize = 65_536;
+
+/// Values decoded from one USD or Alembic file, in all: this floor plus
+/// [`DECODED_BYTES_PER_FILE_BYTE`] times the file's size. A file's
+/// counts are each checked against the bytes that remain, but compressed
+/// integers (two bits a value, then LZ4) and arrays that many fields share
+/// decode to far more than the file holds; past this budget the read is an
+/// error instead of an allocation the machine cannot make.
+pub const DECODED_BYTES_FLOOR: u64 = 1 << 30;
+
+/// See [`DECODED_BYTES_FLOOR`]: plain arrays decode to about their own
+/// size, so a file's real values stay well inside eight times its size.
+pub const DECODED_BYTES_PER_FILE_BYTE: u64 = 8;
+
+/// Pixels of all the tiles of one UDIM map together (each tile is
+/// further bounded by [`MAX_IMAGE_PIXELS`]): 256 M, 1 GB of texels.
+pub const MAX_UDIM_PIXELS: u64 = 1 << 28;
+
+/// Frame files a run keeps open at once while it writes an animation as
+/// one file a frame; the rest wait, so a long range stays under the usual
+/// limit of 1,024 open files.
+pub const MAX_OPEN_FRAME_FILES: usize = 64;
+
 /// A count that must lie in `1..=max` (or `0..=max` when `zero_ok`);
 /// the error says what is wrong without naming the setting, which the
 /// caller adds ("roots.count: …").

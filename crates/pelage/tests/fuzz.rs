@@ -356,19 +356,6 @@ fn hash(data: &[u8]) -> u64 {
     })
 }
 
-/// Parsers that read files by path get the input through a file of this
-/// thread's own.
-fn through_file(extension: &str, data: &[u8], read: impl FnOnce(&Path)) {
-    thread_local! {
-        static FOLDER: tempfile::TempDir = tempfile::tempdir().unwrap();
-    }
-    FOLDER.with(|folder| {
-        let path = folder.path().join(format!("input.{extension}"));
-        std::fs::write(&path, data).unwrap();
-        read(&path);
-    });
-}
-
 #[test]
 #[ignore = "fuzzing: run with --ignored (PELAGE_FUZZ_SECONDS sets the budget)"]
 fn fuzz_obj() {
@@ -463,10 +450,8 @@ fn fuzz_usda() {
         ", ",
     ];
     fuzz("usda", &tokens, true, |data| {
-        through_file("usda", data, |path| {
-            let _ = pelage::io::read_curves(path);
-            let _ = Mesh::load(path);
-        });
+        let _ = pelage::io::usd_curves_from_bytes(data, Path::new("fuzz.usda"));
+        let _ = Mesh::from_bytes("fuzz.usda", data, MeshFormat::Usd);
     });
 }
 
@@ -474,10 +459,8 @@ fn fuzz_usda() {
 #[ignore = "fuzzing: run with --ignored (PELAGE_FUZZ_SECONDS sets the budget)"]
 fn fuzz_usdc() {
     fuzz("usdc", &[], false, |data| {
-        through_file("usdc", data, |path| {
-            let _ = pelage::io::read_curves(path);
-            let _ = pelage::io::read_usd_extent(path);
-        });
+        let _ = pelage::io::usd_curves_from_bytes(data, Path::new("fuzz.usdc"));
+        let _ = Mesh::from_bytes("fuzz.usdc", data, MeshFormat::Usd);
     });
 }
 
@@ -485,9 +468,8 @@ fn fuzz_usdc() {
 #[ignore = "fuzzing: run with --ignored (PELAGE_FUZZ_SECONDS sets the budget)"]
 fn fuzz_abc() {
     fuzz("abc", &[], false, |data| {
-        through_file("abc", data, |path| {
-            let _ = pelage::io::read_curves(path);
-        });
+        let _ = pelage::io::abc_curves_from_bytes(data, Path::new("fuzz.abc"), None);
+        let _ = pelage::io::abc_curves_from_bytes(data, Path::new("fuzz.abc"), Some(0.5));
     });
 }
 

@@ -31,7 +31,7 @@ mod usd_schema;
 mod usda;
 mod usdc;
 
-pub use abc::{AbcWriter, read_abc_curves, read_abc_curves_at};
+pub use abc::{AbcWriter, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at};
 pub use atomic::{
     AtomicFile, check_free_space, check_input, check_output, note_input, protect_inputs,
     remove_temporary_files, write_atomically, write_atomically_with,
@@ -48,9 +48,9 @@ pub use read_error::{CurvesReadError, CurvesReadErrorKind};
 pub use render_text::{bezier_control_points, write_pbrt, write_rib};
 pub use usd_read::{
     DEFAULT_WIDTH, UsdCurvesSequence, UsdLayerInfo, read_usd_curves, read_usd_curves_at,
-    read_usd_extent, read_usd_layer_info,
+    read_usd_extent, read_usd_layer_info, usd_curves_from_bytes,
 };
-pub(crate) use usd_read::{UsdSkin, read_usd_skin};
+pub(crate) use usd_read::{UsdSkin, read_usd_skin, usd_skin_from_bytes};
 pub use usd_schema::{PrimWriter, SurfacePoints};
 pub use usda::{CurveBasis, PrimWriteError, UpAxis, UsdOptions, UsdWrap, UsdaWriter};
 pub use usdc::UsdcWriter;

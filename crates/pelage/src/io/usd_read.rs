@@ -35,6 +35,13 @@ pub fn read_usd_curves_at(path: &Path, time: Option<f64>) -> Result<Curves, Curv
     curves_from_layer(path, data.as_ref(), time)
 }
 
+/// [`read_usd_curves`] of a usda or usdc file's bytes held in memory (a
+/// network buffer, a fuzzer's input); `path` is what errors call it.
+pub fn usd_curves_from_bytes(bytes: &[u8], path: &Path) -> Result<Curves, CurvesReadError> {
+    let data = layer_from_bytes(bytes, path, false)?;
+    curves_from_layer(path, data.as_ref(), None)
+}
+
 /// A USD file's curves over time, parsed once with every time sample, for
 /// reading many frames (`pelage render --frames`).
 pub struct UsdCurvesSequence {
@@ -339,6 +346,29 @@ fn open_layer_with(
     }
 }
 
+/// A usda or usdc layer (by its first bytes) from bytes in memory.
+fn layer_from_bytes(
+    bytes: &[u8],
+    path: &Path,
+    all_samples: bool,
+) -> Result<Box<dyn AbstractData>, CurvesReadError> {
+    if bytes.starts_with(b"PXR-USDC") {
+        super::usdc::read_usdc_bytes(bytes, path, all_samples)
+    } else if bytes.starts_with(b"#usda") {
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            CurvesReadError::whole(path, Kind::Syntax(format!("not UTF-8 text: {e}")))
+        })?;
+        let data = openusd::usda::parse(text).map_err(|e| parse_error(path, &e))?;
+        Ok(Box::new(data))
+    } else {
+        Err(CurvesReadError::new(
+            path,
+            Location::Line(1),
+            Kind::Syntax("not a USD file: it starts with neither '#usda' nor 'PXR-USDC'".into()),
+        ))
+    }
+}
+
 /// Splits openusd's `PATH:LINE: COL: message` into a line location.
 fn parse_error(path: &Path, error: &dyn std::fmt::Display) -> CurvesReadError {
     let text = format!("{error:#}");
@@ -517,8 +547,15 @@ fn vec3_array(value: Option<Value>) -> Result<Vec<DVec3>, String> {
 /// Reads the `Mesh` prims of a usda or usdc file as one skin, keeping
 /// every time sample of their points.
 pub(crate) fn read_usd_skin(path: &Path) -> Result<UsdSkin, CurvesReadError> {
-    let layer = open_layer_with(path, true)?;
-    let data = layer.as_ref();
+    skin_from_layer(path, open_layer_with(path, true)?.as_ref())
+}
+
+/// [`read_usd_skin`] of a file's bytes (`path` names it in errors).
+pub(crate) fn usd_skin_from_bytes(bytes: &[u8], path: &Path) -> Result<UsdSkin, CurvesReadError> {
+    skin_from_layer(path, layer_from_bytes(bytes, path, true)?.as_ref())
+}
+
+fn skin_from_layer(path: &Path, data: &dyn AbstractData) -> Result<UsdSkin, CurvesReadError> {
     let mut prim_paths: Vec<sdf::Path> = data
         .spec_paths()
         .into_iter()

@@ -193,6 +193,25 @@ fn check_image_size(width: u64, height: u64) -> Result<(), String> {
     ))
 }
 
+/// An image file's width and height from its header alone (no pixel is
+/// decoded), for totals over many images (the tiles of a UDIM map).
+pub(crate) fn image_size(path: &Path) -> Result<(u64, u64), String> {
+    if is_exr(path) {
+        use exr::prelude::*;
+        let meta = MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
+        let header = meta.headers.first().ok_or("the EXR has no layer")?;
+        let size = header.layer_size;
+        return Ok((size.width() as u64, size.height() as u64));
+    }
+    let (w, h) = image::ImageReader::open(path)
+        .map_err(|e| e.to_string())?
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?
+        .into_dimensions()
+        .map_err(|e| e.to_string())?;
+    Ok((w.into(), h.into()))
+}
+
 /// Whether `path` is an OpenEXR file (by its magic number).
 fn is_exr(path: &Path) -> bool {
     let mut magic = [0u8; 4];

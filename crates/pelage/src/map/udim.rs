@@ -39,7 +39,7 @@ impl UdimMap {
         };
         let entries = std::fs::read_dir(&folder)
             .map_err(|e| MapError::new(folder.display().to_string(), MapErrorKind::Io(e)))?;
-        let mut tiles = Vec::new();
+        let mut found = Vec::new();
         for entry in entries.flatten() {
             let name = entry.file_name().to_string_lossy().to_string();
             let Some(number) = name
@@ -54,14 +54,36 @@ impl UdimMap {
             if number.len() != 4 || !(1001..=9999).contains(&tile) {
                 continue;
             }
-            let image = ImageMap::load(entry.path(), channel, Wrap::Clamp)?.with_filter(filter);
-            tiles.push((tile, image));
+            found.push((tile, entry.path()));
         }
-        if tiles.is_empty() {
+        if found.is_empty() {
             return Err(fail(format!(
                 "no tile of this UDIM map in {}: expected files such as {prefix}1001{suffix}",
                 folder.display()
             )));
+        }
+        // Each tile is within the one-image ceiling when loaded; the
+        // tiles together are bounded here, from their headers, before any
+        // is decoded.
+        let mut pixels = 0u64;
+        for (_, path) in &found {
+            let (w, h) = super::image::image_size(path)
+                .map_err(|e| MapError::new(path.display().to_string(), MapErrorKind::Spec(e)))?;
+            pixels = pixels.saturating_add(w.saturating_mul(h));
+        }
+        let limit = crate::limits::MAX_UDIM_PIXELS;
+        if pixels > limit {
+            return Err(fail(format!(
+                "its {} tiles hold {} M pixels together; pelage reads at most {} M pixels of one UDIM map (docs/limits.md): scale the tiles down",
+                found.len(),
+                pixels >> 20,
+                limit >> 20
+            )));
+        }
+        let mut tiles = Vec::with_capacity(found.len());
+        for (tile, path) in found {
+            let image = ImageMap::load(path, channel, Wrap::Clamp)?.with_filter(filter);
+            tiles.push((tile, image));
         }
         tiles.sort_by_key(|(tile, _)| *tile);
         Ok(Self { tiles })

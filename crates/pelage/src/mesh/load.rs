@@ -59,16 +59,26 @@ impl Mesh {
 
     /// Reads a mesh from bytes already in memory (an embedded asset, a
     /// network buffer). `name` is what errors call it. A `.gltf` with
-    /// external buffers cannot be read this way; use [`Mesh::load`].
+    /// external buffers cannot be read this way; use [`Mesh::load`]. USD
+    /// meshes (usda or usdc, by their first bytes) are read at their first
+    /// time sample, as [`Mesh::load`] reads them.
     pub fn from_bytes(name: &str, bytes: &[u8], format: MeshFormat) -> Result<Mesh, MeshError> {
         match format {
             MeshFormat::Obj => super::obj::parse(name, bytes),
             MeshFormat::Ply => super::ply::parse(name, bytes),
             MeshFormat::Gltf => super::gltf::parse(name, bytes, None),
-            MeshFormat::Usd => Err(MeshError::whole(
-                name,
-                MeshErrorKind::Unsupported("USD meshes are read from files; use Mesh::load".into()),
-            )),
+            MeshFormat::Usd => {
+                let path = Path::new(name);
+                let skin =
+                    crate::io::usd_skin_from_bytes(bytes, path).map_err(|e| usd_error(&e))?;
+                Mesh::new(
+                    name.to_string(),
+                    skin.positions,
+                    skin.triangles,
+                    None,
+                    skin.uvs,
+                )
+            }
         }
     }
 }

@@ -20,7 +20,7 @@
 mod ogawa;
 mod read;
 
-pub use read::{read_abc_curves, read_abc_curves_at};
+pub use read::{abc_curves_from_bytes, read_abc_curves, read_abc_curves_at};
 
 use super::usd_schema::{check_name, curve_extent};
 use super::{CurveBasis, PrimWriteError, UsdOptions};

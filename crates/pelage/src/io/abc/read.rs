@@ -10,12 +10,18 @@
 //! Every offset, count and size in the file is checked against the file
 //! before it is used, so a truncated or hostile file is an error naming
 //! the byte and the structure, never a panic or an allocation of a size
-//! the file claims but does not hold.
+//! the file claims but does not hold. Groups and blocks may be shared, so
+//! what is decoded from them (headers, values) is charged to one
+//! [`DecodeBudget`] for the read; names and paths have length ceilings
+//! ([`MAX_NAME_BYTES`], [`MAX_PATH_BYTES`]).
 
-use super::super::read_error::{CurvesReadError, CurvesReadErrorKind as Kind};
+use super::super::read_error::{
+    CurvesReadError, CurvesReadErrorKind as Kind, DecodeBudget, excerpt,
+};
 use super::super::usd_read::DEFAULT_WIDTH;
 use super::ogawa::{Child, EMPTY_DATA};
 use crate::Curves;
+use crate::limits::{MAX_NAME_BYTES, MAX_PATH_BYTES};
 use crate::mesh::Location;
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::cell::Cell;
@@ -32,6 +38,7 @@ struct Ogawa<'a> {
     bytes: &'a [u8],
     path: &'a Path,
     visited: Cell<usize>,
+    budget: DecodeBudget,
 }
 
 impl<'a> Ogawa<'a> {
@@ -46,12 +53,34 @@ impl<'a> Ogawa<'a> {
         )
     }
 
+    /// Takes `bytes` of decoded values from the read's budget.
+    fn charge(&self, at: u64, bytes: u64, what: &str) -> Result<(), CurvesReadError> {
+        self.budget
+            .charge(bytes)
+            .map_err(|e| self.fail(at, format!("{what}: {e}")))
+    }
+
+    /// A name read from the file, within [`MAX_NAME_BYTES`].
+    fn check_name(&self, at: u64, name: &str, what: &str) -> Result<(), CurvesReadError> {
+        if name.len() > MAX_NAME_BYTES {
+            return Err(self.fail(
+                at,
+                format!(
+                    "{what}: the name {} is longer than pelage's limit of {MAX_NAME_BYTES} bytes (docs/limits.md)",
+                    excerpt(name)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// The root group, after checking the header.
     fn open(bytes: &'a [u8], path: &'a Path) -> Result<(Self, Child), CurvesReadError> {
         let file = Self {
             bytes,
             path,
             visited: Cell::new(0),
+            budget: DecodeBudget::for_file(bytes.len()),
         };
         if bytes.len() < 16 || &bytes[..5] != b"Ogawa" {
             return Err(CurvesReadError::whole(
@@ -290,12 +319,16 @@ impl Compound {
             });
         };
         let block = file.data(last, &format!("{what}: property headers"))?;
+        file.charge(last & !EMPTY_DATA, 2 * block.len() as u64, what)?;
         let headers = property_headers(block, indexed).ok_or_else(|| {
             file.fail(
                 last & !EMPTY_DATA,
                 format!("{what}: property headers end in the middle of a header"),
             )
         })?;
+        for header in &headers {
+            file.check_name(last & !EMPTY_DATA, &header.name, what)?;
+        }
         if headers.len() > groups.len() {
             return Err(file.fail(
                 group,
@@ -363,6 +396,8 @@ fn sample<'a>(
         ));
     }
     let bytes = &block[16..];
+    // Decoded into pelage's arrays, through a copy of the components.
+    file.charge(first & !EMPTY_DATA, 2 * bytes.len() as u64, what)?;
     let size = pod_size(header.pod) * header.extent.max(1) as usize;
     if size == 0 || bytes.len() % size != 0 {
         return Err(file.fail(
@@ -403,7 +438,16 @@ pub fn read_abc_curves(path: &Path) -> Result<Curves, CurvesReadError> {
 /// sample.
 pub fn read_abc_curves_at(path: &Path, seconds: Option<f64>) -> Result<Curves, CurvesReadError> {
     let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
-    let (file, root) = Ogawa::open(&bytes, path)?;
+    abc_curves_from_bytes(&bytes, path, seconds)
+}
+
+/// [`read_abc_curves_at`] of a file's bytes (`path` names it in errors).
+pub fn abc_curves_from_bytes(
+    bytes: &[u8],
+    path: &Path,
+    seconds: Option<f64>,
+) -> Result<Curves, CurvesReadError> {
+    let (file, root) = Ogawa::open(bytes, path)?;
     let top = file.group(root, "the archive")?;
     if top.len() < 6 {
         return Err(file.fail(
@@ -479,6 +523,7 @@ fn collect_curves(
     }
     let last = children[children.len() - 1];
     let block = file.data(last, &format!("{what}: object headers"))?;
+    file.charge(last & !EMPTY_DATA, 2 * block.len() as u64, what)?;
     let headers = object_headers(block, indexed).ok_or_else(|| {
         file.fail(
             last & !EMPTY_DATA,
@@ -496,6 +541,17 @@ fn collect_curves(
         ));
     }
     for (i, (name, metadata)) in headers.iter().enumerate() {
+        file.check_name(last & !EMPTY_DATA, name, what)?;
+        let length = path.len() + 1 + name.len();
+        if length > MAX_PATH_BYTES {
+            return Err(file.fail(
+                object,
+                format!(
+                    "{}: a child's path of {length} bytes, longer than pelage's limit of {MAX_PATH_BYTES} (docs/limits.md)",
+                    excerpt(what)
+                ),
+            ));
+        }
         let child_path = format!("{path}/{name}");
         let group = children[i + 1];
         let schema = metadata_value(metadata, "schema");

@@ -18,7 +18,7 @@
 mod crate_file;
 mod read;
 
-pub(crate) use read::read_usdc;
+pub(crate) use read::{read_usdc, read_usdc_bytes};
 
 use super::usd_schema::{
     PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes, check_name,

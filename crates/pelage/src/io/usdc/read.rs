@@ -9,12 +9,17 @@
 //! A size in the file is believed only once the bytes it claims are there:
 //! a truncated, corrupted or hostile file is an error naming the byte and
 //! the structure, never a panic or an allocation of a size the file only
-//! claims. Fields of types pelage does not read (list ops, dictionaries,
+//! claims. Sizes the bytes cannot bound (compressed integers decode to up
+//! to 128 values a byte; many fields may point at one array) are charged
+//! to one [`DecodeBudget`] for the whole read, and paths have a length
+//! ceiling ([`MAX_PATH_BYTES`]); errors quote names and paths as short
+//! excerpts. Fields of types pelage does not read (list ops, dictionaries,
 //! …) are left out of the layer; of time samples only the earliest is
 //! decoded (pelage reads the first frame of an animation).
 
 use super::crate_file::MIN_COMPRESSED_ARRAY_SIZE;
-use crate::io::read_error::{CurvesReadError, CurvesReadErrorKind as Kind};
+use crate::io::read_error::{CurvesReadError, CurvesReadErrorKind as Kind, DecodeBudget, excerpt};
+use crate::limits::MAX_PATH_BYTES;
 use crate::mesh::Location;
 use openusd::gf;
 use openusd::sdf::{self, AbstractData, SpecType, Value};
@@ -29,6 +34,8 @@ struct Crate<'a> {
     minor: u8,
     /// Whether time-sampled values keep every sample or only the first.
     all_samples: bool,
+    /// What the read may still decode.
+    budget: DecodeBudget,
 }
 
 type Result<T> = std::result::Result<T, CurvesReadError>;
@@ -70,6 +77,13 @@ impl<'a> Crate<'a> {
         Ok(u32::from_le_bytes(
             self.take(at, 4, what)?.try_into().expect("4 bytes"),
         ))
+    }
+
+    /// Takes `bytes` of decoded values from the read's budget.
+    fn charge(&self, at: usize, bytes: u64, what: &str) -> Result<()> {
+        self.budget
+            .charge(bytes)
+            .map_err(|e| self.fail(at, format!("{what}: {e}")))
     }
 
     /// A count of `size`-byte items at `at` that must fit in the file.
@@ -143,6 +157,10 @@ impl<'a> Crate<'a> {
         } else {
             width + count.div_ceil(4) + width * count
         };
+        // The coding's buffer and the decoded values, before either is
+        // allocated.
+        let decoded = (coded_size as u64).saturating_add((count as u64).saturating_mul(8));
+        self.charge(at, decoded, what)?;
         let coded = if count == 0 {
             Vec::new()
         } else {
@@ -199,11 +217,21 @@ struct Structure {
 /// Reads a usdc file into openusd's in-memory layer.
 pub(crate) fn read_usdc(path: &Path, all_samples: bool) -> Result<Box<dyn AbstractData>> {
     let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
+    read_usdc_bytes(&bytes, path, all_samples)
+}
+
+/// [`read_usdc`] of a file's bytes (`path` names it in errors).
+pub(crate) fn read_usdc_bytes(
+    bytes: &[u8],
+    path: &Path,
+    all_samples: bool,
+) -> Result<Box<dyn AbstractData>> {
     let mut file = Crate {
-        bytes: &bytes,
+        bytes,
         path,
         minor: 0,
         all_samples,
+        budget: DecodeBudget::for_file(bytes.len()),
     };
     let head = file.take(0, 24, "the bootstrap header")?;
     if &head[..8] != b"PXR-USDC" {
@@ -242,7 +270,8 @@ pub(crate) fn read_usdc(path: &Path, all_samples: bool) -> Result<Box<dyn Abstra
     let structure = read_structure(&file, &section)?;
     let mut data = sdf::Data::new();
     for &(path_index, fieldset, kind) in &structure.specs {
-        let spec_path = structure.paths.get(path_index as usize).ok_or_else(|| {
+        let spec_path = structure.paths.get(path_index as usize).map(String::as_str);
+        let spec_path = spec_path.ok_or_else(|| {
             file.fail(
                 section("SPECS").unwrap_or(0),
                 format!(
@@ -254,18 +283,23 @@ pub(crate) fn read_usdc(path: &Path, all_samples: bool) -> Result<Box<dyn Abstra
         let kind = spec_type(kind).ok_or_else(|| {
             file.fail(
                 section("SPECS").unwrap_or(0),
-                format!("{spec_path}: spec type {kind}"),
+                format!("{}: spec type {kind}", excerpt(spec_path)),
             )
         })?;
-        let sdf_path =
-            sdf::Path::new(spec_path).map_err(|e| file.fail(0, format!("{spec_path}: {e}")))?;
+        let sdf_path = sdf::Path::new(spec_path).map_err(|e| {
+            file.fail(
+                0,
+                format!("{}: {}", excerpt(spec_path), excerpt(&e.to_string())),
+            )
+        })?;
+        let quoted = excerpt(spec_path);
         data.create_spec(sdf_path.clone(), kind);
         let mut i = fieldset as usize;
         loop {
             let field = *structure.fieldsets.get(i).ok_or_else(|| {
                 file.fail(
                     section("FIELDSETS").unwrap_or(0),
-                    format!("{spec_path}: its field set runs past the end"),
+                    format!("{quoted}: its field set runs past the end"),
                 )
             })?;
             if field == u32::MAX {
@@ -274,16 +308,16 @@ pub(crate) fn read_usdc(path: &Path, all_samples: bool) -> Result<Box<dyn Abstra
             let &(token, rep) = structure.fields.get(field as usize).ok_or_else(|| {
                 file.fail(
                     section("FIELDS").unwrap_or(0),
-                    format!("{spec_path}: field {field} of {}", structure.fields.len()),
+                    format!("{quoted}: field {field} of {}", structure.fields.len()),
                 )
             })?;
             let name = structure.tokens.get(token as usize).ok_or_else(|| {
                 file.fail(
                     section("FIELDS").unwrap_or(0),
-                    format!("{spec_path}: a field named by token {token}"),
+                    format!("{quoted}: a field named by token {token}"),
                 )
             })?;
-            let what = format!("{spec_path} {}", name.as_str());
+            let what = format!("{quoted} {}", excerpt(name.as_str()));
             if let Some(value) = read_value(&file, &structure, rep, &what)? {
                 data.set_field(&sdf_path, name.as_str(), value);
             }
@@ -317,6 +351,8 @@ fn read_structure(file: &Crate, section: &dyn Fn(&str) -> Result<usize>) -> Resu
     let size = file.u64_at(at + 8, "TOKENS")? as usize;
     let compressed = file.u64_at(at + 16, "TOKENS")?;
     let compressed = file.count(at + 24, compressed, 1, "TOKENS")?;
+    // The text, and the tokens made of it.
+    file.charge(at, (size as u64).saturating_mul(2), "TOKENS")?;
     let text = file.decompress(
         at + 24,
         file.take(at + 24, compressed, "TOKENS")?,
@@ -350,6 +386,7 @@ fn read_structure(file: &Crate, section: &dyn Fn(&str) -> Result<usize>) -> Resu
     let at = section("STRINGS")?;
     let n = file.u64_at(at, "STRINGS")?;
     let n = file.count(at + 8, n, 4, "STRINGS")?;
+    file.charge(at, 4 * n as u64, "STRINGS")?;
     let strings = (0..n)
         .map(|i| file.u32_at(at + 8 + 4 * i, "STRINGS"))
         .collect::<Result<Vec<_>>>()?;
@@ -360,6 +397,7 @@ fn read_structure(file: &Crate, section: &dyn Fn(&str) -> Result<usize>) -> Resu
     let (names, next) = file.integers(at + 8, n, false, "FIELDS: names")?;
     let size = file.u64_at(next, "FIELDS: values")?;
     let size = file.count(next + 8, size, 1, "FIELDS: values")?;
+    file.charge(next, 8 * n as u64, "FIELDS: values")?;
     let reps = file.decompress(
         next + 8,
         file.take(next + 8, size, "FIELDS: values")?,
@@ -454,6 +492,18 @@ fn build_paths(
                     let token = tokens
                         .get(element.unsigned_abs() as usize)
                         .ok_or_else(|| bad(i, "an element token past the tokens"))?;
+                    let length = p.len() + 1 + token.as_str().len();
+                    if length > MAX_PATH_BYTES {
+                        return Err(bad(
+                            i,
+                            &format!(
+                                "a path of {length} bytes under {}, longer than pelage's limit of {MAX_PATH_BYTES} (docs/limits.md)",
+                                excerpt(p)
+                            ),
+                        ));
+                    }
+                    // The path and the copy its slot keeps.
+                    file.charge(at, 2 * length as u64, "PATHS")?;
                     if element < 0 {
                         format!("{p}.{}", token.as_str())
                     } else if p == "/" {
@@ -473,6 +523,7 @@ fn build_paths(
             if has_child && has_sibling {
                 let sibling = usize::try_from(i as i64 + jump)
                     .map_err(|_| bad(i, "a jump before the start"))?;
+                file.charge(at, parent.as_ref().map_or(0, |p| p.len() as u64), "PATHS")?;
                 pending.push((sibling, parent.clone()));
             }
             if has_child {
@@ -577,6 +628,7 @@ fn read_value(file: &Crate, s: &Structure, rep: u64, what: &str) -> Result<Optio
         48 => {
             let n = file.u64_at(at, what)?;
             let n = file.count(at + 8, n, 8, what)?;
+            file.charge(at, 8 * n as u64, what)?;
             Value::DoubleVec(doubles(file.take(at + 8, 8 * n, what)?))
         }
         9 => Value::Double(f64::from_le_bytes(
@@ -604,6 +656,7 @@ fn read_value(file: &Crate, s: &Structure, rep: u64, what: &str) -> Result<Optio
         41 => {
             let n = file.u64_at(at, what)?;
             let n = file.count(at + 8, n, 4, what)?;
+            file.charge(at, 16 * n as u64, what)?;
             let tokens = (0..n)
                 .map(|k| {
                     file.u32_at(at + 8 + 4 * k, what)
@@ -721,6 +774,9 @@ fn read_array(
     };
     let integer = matches!(ty, 3 | 5);
     let floating = matches!(ty, 8 | 9);
+    // The values as pelage holds them (compressed ones are charged again
+    // for their decoding below).
+    file.charge(at, count.saturating_mul(element as u64), what)?;
     let compressed = compressed && count as usize >= MIN_COMPRESSED_ARRAY_SIZE;
     if compressed && integer && minor >= 5 {
         let count = usize::try_from(count).unwrap_or(usize::MAX);
@@ -734,15 +790,18 @@ fn read_array(
         let count = usize::try_from(count).unwrap_or(usize::MAX);
         let code = file.take(at, 1, what)?[0];
         let values: Vec<f64> = match code {
-            b'i' => file
-                .integers(at + 1, count, false, what)?
-                .0
-                .into_iter()
-                .map(|x| x as f64)
-                .collect(),
+            b'i' => {
+                file.charge(at, 8 * count as u64, what)?;
+                file.integers(at + 1, count, false, what)?
+                    .0
+                    .into_iter()
+                    .map(|x| x as f64)
+                    .collect()
+            }
             b't' => {
                 let n = file.u32_at(at + 1, what)? as u64;
                 let n = file.count(at + 5, n, element, what)?;
+                file.charge(at, 8 * n as u64 + 8 * count as u64, what)?;
                 let table = file.take(at + 5, n * element, what)?;
                 let table: Vec<f64> = if ty == 8 {
                     floats(table).into_iter().map(f64::from).collect()
@@ -821,4 +880,230 @@ fn element_size(ty: u8) -> Option<usize> {
         24 => 12,
         _ => return None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    //! Hand-made crate files of the shapes a hostile file takes: each is
+    //! small, and claims (or, decoded, would build) gigabytes. The ignored
+    //! test at the end writes them into the hostile suite's files.
+    use super::super::crate_file::{
+        BOOTSTRAP_SIZE, Counted, ROOT_PATH, Spec, SpecType, Structure, VERSION, ValueRep,
+        ValueType, encode_integers,
+    };
+    use super::*;
+    use std::io::Write;
+
+    /// A layer with one prim, `/root`, whose attributes `a0`, `a1`, … have
+    /// the `default` values `reps`, which point into `body` (written at
+    /// [`BOOTSTRAP_SIZE`]); `chain` more prims nested each in the last,
+    /// all named `name`.
+    fn crafted(body: &[u8], reps: &[ValueRep], chain: usize, name: &str) -> Vec<u8> {
+        let mut out = Counted {
+            inner: Vec::new(),
+            position: 0,
+        };
+        out.write_all(&[0u8; BOOTSTRAP_SIZE]).unwrap();
+        out.write_all(body).unwrap();
+        let mut s = Structure::new("root");
+        let prim = s.child_path(ROOT_PATH, "root", false);
+        for (k, &rep) in reps.iter().enumerate() {
+            let path = s.child_path(prim, &format!("a{k}"), true);
+            let fields = vec![
+                (
+                    s.token("typeName"),
+                    ValueRep::inlined(ValueType::Token, s.token("int[]")),
+                ),
+                (s.token("default"), rep),
+            ];
+            s.specs.push(Spec {
+                path,
+                kind: SpecType::Attribute,
+                fields,
+            });
+        }
+        let mut parent = prim;
+        for _ in 0..chain {
+            parent = s.child_path(parent, name, false);
+        }
+        let specifier = s.token("specifier");
+        s.specs.push(Spec {
+            path: prim,
+            kind: SpecType::Prim,
+            fields: vec![(specifier, ValueRep::inlined(ValueType::Specifier, 0))],
+        });
+        s.specs.push(Spec {
+            path: ROOT_PATH,
+            kind: SpecType::PseudoRoot,
+            fields: Vec::new(),
+        });
+        // The path tree is walked recursively: a deep chain needs a deep
+        // stack.
+        let toc = std::thread::scope(|scope| {
+            std::thread::Builder::new()
+                .stack_size(1 << 30)
+                .spawn_scoped(scope, || s.write_sections(&mut out).unwrap())
+                .unwrap()
+                .join()
+                .unwrap()
+        });
+        let mut bytes = out.inner;
+        bytes[..8].copy_from_slice(b"PXR-USDC");
+        bytes[8..11].copy_from_slice(&VERSION);
+        bytes[16..24].copy_from_slice(&toc.to_le_bytes());
+        bytes
+    }
+
+    /// A compressed `int[]` of `count` values 1, 2, 3, … whose coding is
+    /// real LZ4 (it decodes, to `count` values), or with `decodes` false,
+    /// the smallest body the compression ratio check lets through (a
+    /// literal run of zeros, not the coding).
+    fn integer_array(count: u64, decodes: bool) -> Vec<u8> {
+        let coded = if decodes {
+            encode_integers(std::iter::repeat_n(1i64, 1), false)
+                .into_iter()
+                .take(4)
+                .chain(std::iter::repeat_n(0u8, count.div_ceil(4) as usize))
+                .collect::<Vec<u8>>()
+        } else {
+            Vec::new()
+        };
+        let mut framed = vec![0u8];
+        if decodes {
+            framed.extend(lz4_flex::block::compress(&coded));
+        } else {
+            // One literal run: token, length bytes, the literals.
+            let literals = (count / 4).div_ceil(255) as usize + 1;
+            framed.push(0xf0);
+            let mut rest = literals - 15;
+            while rest >= 255 {
+                framed.push(255);
+                rest -= 255;
+            }
+            framed.push(rest as u8);
+            framed.extend(std::iter::repeat_n(0u8, literals));
+        }
+        let mut body = count.to_le_bytes().to_vec();
+        body.extend((framed.len() as u64).to_le_bytes());
+        body.extend(framed);
+        body
+    }
+
+    /// 60,000 prims nested each in the last, named `name`, the file padded
+    /// at its end so the path count fits the bytes after it.
+    fn deep_chain(name: &str) -> Vec<u8> {
+        let mut file = crafted(&[], &[], 60_000, name);
+        file.extend(std::iter::repeat_n(0u8, 70_000));
+        file
+    }
+
+    fn int_array_at(offset: usize) -> ValueRep {
+        ValueRep::array(ValueType::Int, offset as u64, true)
+    }
+
+    fn read(bytes: &[u8]) -> std::result::Result<Box<dyn AbstractData>, String> {
+        read_usdc_bytes(bytes, Path::new("bad.usdc"), false).map_err(|e| e.to_string())
+    }
+
+    fn read_err(bytes: &[u8]) -> String {
+        match read(bytes) {
+            Ok(_) => panic!("read a hostile file"),
+            Err(e) => e,
+        }
+    }
+
+    /// An array claiming 300 million integers in 300 KB: the compression
+    /// ratio allows it, the budget does not, and nothing is allocated.
+    #[test]
+    fn integers_claimed_past_the_budget_are_refused_before_decoding() {
+        let file = crafted(
+            &integer_array(300_000_000, false),
+            &[int_array_at(BOOTSTRAP_SIZE)],
+            0,
+            "",
+        );
+        let err = read_err(&file);
+        assert!(err.starts_with("bad.usdc: byte "), "{err}");
+        assert!(err.contains("/root.a0 default:"), "{err}");
+        assert!(err.contains("docs/limits.md"), "{err}");
+    }
+
+    /// Many fields may share one array, and each decode is its own
+    /// allocation: a 20-million-integer array decodes for three fields
+    /// and is refused at the fourth.
+    #[test]
+    fn a_shared_array_is_charged_at_each_decode() {
+        let body = integer_array(20_000_000, true);
+        let one = crafted(&body, &[int_array_at(BOOTSTRAP_SIZE)], 0, "");
+        let Ok(layer) = read(&one) else {
+            panic!("one array of 20 million integers is within the budget")
+        };
+        let path = sdf::Path::new("/root.a0").unwrap();
+        match layer.get_field(&path, "default").as_deref() {
+            Ok(Value::IntVec(v)) => {
+                assert_eq!(v.len(), 20_000_000);
+                assert_eq!((v[0], v[19_999_999]), (1, 20_000_000));
+            }
+            _ => panic!("/root.a0 is not the int array"),
+        }
+        let eight = crafted(&body, &[int_array_at(BOOTSTRAP_SIZE); 8], 0, "");
+        let err = read_err(&eight);
+        assert!(err.contains("/root.a3 default:"), "{err}");
+        assert!(err.contains("docs/limits.md"), "{err}");
+    }
+
+    /// A chain of prims nested 60,000 deep under a 2 KB name: the path
+    /// ceiling stops it at 32 levels, and the error quotes the path as an
+    /// excerpt.
+    #[test]
+    fn a_deep_chain_of_long_names_stops_at_the_path_ceiling() {
+        let name = "n".repeat(2048);
+        let file = deep_chain(&name);
+        let err = read_err(&file);
+        assert!(err.contains("longer than pelage's limit of 65536"), "{err}");
+        assert!(err.len() < 600, "{} bytes: {err}", err.len());
+    }
+
+    /// Writes the crafted files the hostile suite runs the binary on.
+    #[test]
+    #[ignore = "writes tests/hostile/files; run by hand after changing a crafted file"]
+    fn write_hostile_suite_files() {
+        let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/hostile/files");
+        let write = |name: &str, bytes: Vec<u8>| std::fs::write(folder.join(name), bytes).unwrap();
+        // 1.1 billion integers in 1.1 MB of real LZ4: 8.8 GB decoded.
+        let at = BOOTSTRAP_SIZE;
+        write(
+            "usdc_integer_bomb.usdc",
+            crafted(
+                &integer_array(1_100_000_000, true),
+                &[int_array_at(at)],
+                0,
+                "",
+            ),
+        );
+        // Eight fields at one array of 400 million integers: 1.6 GB each.
+        write(
+            "usdc_shared_array.usdc",
+            crafted(
+                &integer_array(400_000_000, true),
+                &[int_array_at(at); 8],
+                0,
+                "",
+            ),
+        );
+        write("usdc_deep_long_paths.usdc", deep_chain(&"n".repeat(2048)));
+        // The fuzz harness's seeds: the same shapes, small enough to
+        // mutate fast (a chain of 40 levels passes the path ceiling; eight
+        // fields share an array).
+        let seeds = folder.join("../fuzz/usdc");
+        let seed = |name: &str, bytes: Vec<u8>| std::fs::write(seeds.join(name), bytes).unwrap();
+        seed(
+            "deep_long_paths.usdc",
+            crafted(&[], &[], 40, &"n".repeat(2048)),
+        );
+        seed(
+            "shared_array.usdc",
+            crafted(&integer_array(100_000, true), &[int_array_at(at); 8], 0, ""),
+        );
+    }
 }
