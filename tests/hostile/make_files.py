@@ -1,6 +1,10 @@
 #!/usr/bin/env python3
 """Writes the hostile suite's binary and generated inputs into files/.
 
+Not from here: the crafted usdc files (`cargo test -p pelage --lib --
+--ignored write_hostile_suite_files`) and the farm folders `farm_*`
+(written by `pelage groom --part` itself).
+
 cases.toml names them; crates/pelage-cli/tests/hostile.rs copies each
 case's files into a fresh folder and runs pelage there. Run this again
 after adding a file here.

@@ -71,6 +71,9 @@ impl Exit {
 /// instead of exhausting the machine.
 const MEMORY_LIMIT: u64 = 8 << 30;
 const TIME_LIMIT: Duration = Duration::from_secs(60);
+/// Open files each run may hold: the usual default of Linux shells.
+#[cfg(unix)]
+const OPEN_FILES: libc::rlim_t = 1024;
 
 fn hostile_folder() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/hostile")
@@ -141,6 +144,14 @@ fn run_case(case: &Case) -> Vec<String> {
                     rlim_max: MEMORY_LIMIT as libc::rlim_t,
                 };
                 if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                // The usual limit of open files, whatever this machine's.
+                let files = libc::rlimit {
+                    rlim_cur: OPEN_FILES,
+                    rlim_max: OPEN_FILES,
+                };
+                if libc::setrlimit(libc::RLIMIT_NOFILE, &files) != 0 {
                     return Err(std::io::Error::last_os_error());
                 }
                 Ok(())

@@ -33,6 +33,10 @@ fn temporary_files(dir: &Path) -> Vec<String> {
         .collect()
 }
 
+/// The tests time their signals against a whole run's length: they run
+/// one at a time, so neither slows the other's runs.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// A deterministic spread of moments over `0..span`.
 fn moment(trial: u64, span: Duration) -> Duration {
     let mut x = trial.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
@@ -44,6 +48,7 @@ fn moment(trial: u64, span: Duration) -> Duration {
 
 #[test]
 fn killed_and_interrupted_grooms_leave_the_destination_whole() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("g.toml"), GROOM).unwrap();
     let out = dir.path().join("out.usdc");
@@ -124,4 +129,86 @@ fn killed_and_interrupted_grooms_leave_the_destination_whole() {
         killed_mid_write >= 20,
         "only {killed_mid_write} trials interrupted the run: the moments miss it"
     );
+}
+
+/// A `--frame-files` cache of 40 frames over seed 1, then rewritten over
+/// seed 2, interrupted early and late: the stitching layer never stitches
+/// frames of two runs (it is there only beside one run's frames), and
+/// after SIGINT no temporary file is left, however early it comes.
+#[test]
+fn an_interrupted_frame_cache_never_stitches_two_runs() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let frames = 40;
+    let text = |seed: u32| {
+        format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 3000\nseed = {seed}\n[guides]\ngenerate = {{ count = 20, length = 0.05 }}\n[animation]\nframes = \"1-{frames}\"\n"
+        )
+    };
+    let run = |dir: &Path| {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_pelage"));
+        command
+            .args(["groom", "g.toml", "-q", "-o", "out.usda", "--frame-files"])
+            .current_dir(dir)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped());
+        command
+    };
+    let frame = |dir: &Path, f: u32| std::fs::read(dir.join(format!("out.f{f:04}.usdc"))).ok();
+    // Each run's frames, whole.
+    let whole = |seed| {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("g.toml"), text(seed)).unwrap();
+        let started = Instant::now();
+        assert!(run(dir.path()).status().unwrap().success());
+        let took = started.elapsed();
+        let files: Vec<Vec<u8>> = (1..=frames)
+            .map(|f| frame(dir.path(), f).unwrap())
+            .collect();
+        (dir, files, took)
+    };
+    let (old_dir, old, _) = whole(1);
+    let (_, new, full) = whole(2);
+    assert!(old != new, "the two seeds write different frames");
+    eprintln!("a whole cache takes {:.2} s", full.as_secs_f64());
+
+    for trial in 0..16u64 {
+        let signal = if trial % 4 == 3 {
+            libc::SIGKILL
+        } else {
+            libc::SIGINT
+        };
+        // Each trial starts from the first run's complete cache.
+        let dir = tempfile::tempdir().unwrap();
+        for entry in std::fs::read_dir(old_dir.path()).unwrap() {
+            let entry = entry.unwrap();
+            std::fs::copy(entry.path(), dir.path().join(entry.file_name())).unwrap();
+        }
+        std::fs::write(dir.path().join("g.toml"), text(2)).unwrap();
+        let child = run(dir.path()).spawn().unwrap();
+        // Half the trials in the first tenth of the run (temporary files
+        // being created as the signal lands), half anywhere.
+        let span = if trial % 2 == 0 { full / 10 } else { full };
+        std::thread::sleep(moment(trial + 7, span));
+        // SAFETY: sending a signal to our own child.
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        if dir.path().join("out.usda").exists() {
+            let now: Vec<Option<Vec<u8>>> = (1..=frames).map(|f| frame(dir.path(), f)).collect();
+            let one_run = now.iter().zip(&old).all(|(n, o)| n.as_ref() == Some(o))
+                || now.iter().zip(&new).all(|(n, w)| n.as_ref() == Some(w));
+            assert!(
+                one_run,
+                "trial {trial}: the stitching layer is beside frames of two runs ({stderr})"
+            );
+        }
+        if signal == libc::SIGINT {
+            let debris = temporary_files(dir.path());
+            assert!(
+                debris.is_empty(),
+                "SIGINT trial {trial}: left {debris:?} ({stderr})"
+            );
+        }
+    }
 }

@@ -329,6 +329,21 @@ fn run_animated(
         bar
     };
     let options = groom.usd_options();
+    if args.frame_files {
+        // A stitching layer of an earlier run would stitch this run's
+        // frames with its own if this run stopped half-way: it goes first,
+        // and comes back, naming this run's frames only, once all of them
+        // are written.
+        match std::fs::remove_file(output) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                bail!(
+                    "{}: cannot remove the earlier stitching layer: {e}",
+                    output.display()
+                )
+            }
+            _ => {}
+        }
+    }
     let growing = Instant::now();
     // In a farm, the first run writes the skin.
     let with_skin = groom.writes_skin_in(args.part);

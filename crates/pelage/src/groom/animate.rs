@@ -53,6 +53,7 @@ use crate::Curves;
 use crate::anim::{AnimatedSkin, FrameRange, RestFrames, SkinBinding, SkinPose};
 use crate::guides::{Guides, resample_by_arc_length};
 use crate::io::{AbcWriter, AtomicFile, CurvesFormat, PrimWriter, UsdOptions, UsdcWriter};
+use crate::limits::MAX_OPEN_FRAME_FILES;
 use glam::Vec3;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -450,10 +451,13 @@ impl AnimatedGroom {
         self.write_files(&[output], parts, options, with_skin, progress)
     }
 
-    /// [`Self::write`] into several files at once, each with its own time
-    /// codes (one file a frame, or a farm task's frame range): every part
-    /// is grown once (deform) and carried to every file's frames. All the
-    /// files are written, or none.
+    /// [`Self::write`] into several files, each with its own time codes
+    /// (one file a frame, or a farm task's frame range). Files are written
+    /// in windows of at most [`MAX_OPEN_FRAME_FILES`] open at once (a long
+    /// range stays under the process's limit of open files, and its
+    /// buffers and poses in memory): within a window every part is grown
+    /// once (deform) and carried to every file's frames, and the window's
+    /// files are written all or none.
     pub fn write_files(
         &self,
         outputs: &[FrameOutput],
@@ -461,6 +465,41 @@ impl AnimatedGroom {
         options: &UsdOptions,
         with_skin: bool,
         mut progress: impl FnMut(AnimationProgress),
+    ) -> Result<GroomSummary, GroomWriteError> {
+        let total = parts.len() * outputs.iter().map(|o| o.times.len()).sum::<usize>();
+        let mut done = 0;
+        let mut summary = GroomSummary::default();
+        for (k, window) in outputs.chunks(MAX_OPEN_FRAME_FILES).enumerate() {
+            let counts = self.write_window(
+                window,
+                parts.clone(),
+                options,
+                with_skin,
+                &mut |p: AnimationProgress| {
+                    progress(AnimationProgress {
+                        done: done + p.done,
+                        total,
+                        ..p
+                    })
+                },
+            )?;
+            done += parts.len() * window.iter().map(|o| o.times.len()).sum::<usize>();
+            // Every window holds the same hairs: count them once.
+            if k == 0 {
+                summary = counts;
+            }
+        }
+        Ok(summary)
+    }
+
+    /// [`Self::write_files`] of one window of files, all open at once.
+    fn write_window(
+        &self,
+        outputs: &[FrameOutput],
+        parts: Range<usize>,
+        options: &UsdOptions,
+        with_skin: bool,
+        progress: &mut dyn FnMut(AnimationProgress),
     ) -> Result<GroomSummary, GroomWriteError> {
         let write_error = |path: &Path, e: &dyn std::fmt::Display| {
             GroomWriteError::Write(crate::io::WriteError {

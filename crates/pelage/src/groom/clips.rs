@@ -8,6 +8,7 @@
 
 use super::output::part_file;
 use crate::anim::FrameRange;
+use crate::io::asset_path;
 use crate::io::{UsdLayerInfo, WriteError, read_usd_layer_info, write_atomically};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -87,10 +88,10 @@ pub fn find_frame_files(output: &Path) -> std::io::Result<Vec<FrameFile>> {
         let Some(frames) = fields.last().and_then(|f| f.strip_prefix('f')) else {
             continue;
         };
-        let parsed = match frames.split_once('-') {
-            Some((a, b)) => a.parse().ok().zip(b.parse().ok()),
-            None => frames.parse().ok().map(|f| (f, f)),
+        let Some((first, last)) = frame_span(frames) else {
+            continue;
         };
+        let parsed = Some((first, last));
         let Some((first, last)) = parsed else {
             continue;
         };
@@ -103,6 +104,21 @@ pub fn find_frame_files(output: &Path) -> std::io::Result<Vec<FrameFile>> {
     }
     found.sort_by_key(|f| (f.run, f.first));
     Ok(found)
+}
+
+/// The frames of a file name's `fA` or `fA-B` field (without the `f`):
+/// either may be negative (`f-003`, `f-003-0004`, `f-010--001`), so the
+/// range's `-` is the first one after the first character.
+fn frame_span(frames: &str) -> Option<(i32, i32)> {
+    let split = frames
+        .char_indices()
+        .skip(1)
+        .find(|&(_, c)| c == '-')
+        .map(|(i, _)| i);
+    match split {
+        Some(i) => Some((frames[..i].parse().ok()?, frames[i + 1..].parse().ok()?)),
+        None => frames.parse().ok().map(|f| (f, f)),
+    }
 }
 
 /// What [`write_clip_assembly`] tied together.
@@ -234,7 +250,7 @@ pub fn write_clip_assembly(
             prims += 1;
             let assets: Vec<String> = run
                 .iter()
-                .map(|(f, _)| format!("@{}@", relative(&f.path)))
+                .map(|(f, _)| asset_path(&relative(&f.path)))
                 .collect();
             let active: Vec<String> = run
                 .iter()
@@ -246,10 +262,10 @@ pub fn write_clip_assembly(
                 .collect();
             let _ = write!(
                 text,
-                "    over \"{prim}\" (\n        clips = {{\n            dictionary default = {{\n                double2[] active = [{}]\n                asset[] assetPaths = [{}]\n                string primPath = \"/{root}/{prim}\"\n            }}\n        }}\n        prepend references = @{}@</{root}/{prim}>\n    )\n    {{\n    }}\n",
+                "    over \"{prim}\" (\n        clips = {{\n            dictionary default = {{\n                double2[] active = [{}]\n                asset[] assetPaths = [{}]\n                string primPath = \"/{root}/{prim}\"\n            }}\n        }}\n        prepend references = {}</{root}/{prim}>\n    )\n    {{\n    }}\n",
                 active.join(", "),
                 assets.join(", "),
-                relative(&first_file.path),
+                asset_path(&relative(&first_file.path)),
             );
         }
     }
@@ -261,4 +277,29 @@ pub fn write_clip_assembly(
         prims,
         time_range: (start, end),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Negative frames name files that are found again: the range's `-`
+    /// is told from a sign.
+    #[test]
+    fn frame_files_of_negative_frames_are_found_by_their_names() {
+        assert_eq!(frame_span("0007"), Some((7, 7)));
+        assert_eq!(frame_span("0001-0012"), Some((1, 12)));
+        assert_eq!(frame_span("-003"), Some((-3, -3)));
+        assert_eq!(frame_span("-003-0002"), Some((-3, 2)));
+        assert_eq!(frame_span("-010--001"), Some((-10, -1)));
+        assert_eq!(frame_span("x-1"), None);
+        let dir = tempfile::tempdir().unwrap();
+        let output = dir.path().join("g.usdc");
+        for (run, first, last) in [(Some((1, 2)), -3, 2), (Some((2, 2)), -3, 2), (None, -1, -1)] {
+            std::fs::write(frames_file(&output, run, first, last), b"").unwrap();
+        }
+        let found = find_frame_files(&output).unwrap();
+        let spans: Vec<_> = found.iter().map(|f| (f.run, f.first, f.last)).collect();
+        assert_eq!(spans, [((1, 1), -1, -1), ((1, 2), -3, 2), ((2, 2), -3, 2)]);
+    }
 }

@@ -114,6 +114,15 @@ pub enum FarmError {
         /// The other.
         b: usize,
     },
+    /// Part files that are Alembic: only USD parts are assembled (a USD
+    /// layer references them; Alembic has no references).
+    #[error(
+        "{path}: Alembic part files cannot be assembled (pelage assembles USD parts, referenced from one layer); write the parts as .usdc (`-o NAME.usdc --part K/N`), or use them one by one"
+    )]
+    AlembicParts {
+        /// One of the Alembic part files.
+        path: PathBuf,
+    },
     /// A run's file is missing.
     #[error("{path} is missing: run {run} has not finished")]
     Missing {
@@ -173,14 +182,19 @@ pub fn find_part_files(output: &Path) -> Result<Vec<PathBuf>, FarmError> {
     (1..=n)
         .map(|k| {
             let named = part_file(output, k, n);
-            ["usda", "usdc", "usd"]
+            let found = ["usda", "usdc", "usd"]
                 .iter()
                 .map(|ext| named.with_extension(ext))
-                .find(|f| f.exists())
-                .ok_or(FarmError::Missing {
+                .find(|f| f.exists());
+            let alembic = named.with_extension("abc");
+            match found {
+                Some(f) => Ok(f),
+                None if alembic.exists() => Err(FarmError::AlembicParts { path: alembic }),
+                None => Err(FarmError::Missing {
                     path: named,
                     run: FarmRun { k, n },
-                })
+                }),
+            }
         })
         .collect()
 }

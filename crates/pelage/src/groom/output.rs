@@ -345,8 +345,9 @@ pub fn write_assembly(
             };
             writeln!(
                 out,
-                "\n    def Xform \"run_{:04}\" (\n        prepend references = @{shown}@\n    )\n    {{{hint}\n    }}",
+                "\n    def Xform \"run_{:04}\" (\n        prepend references = {}\n    )\n    {{{hint}\n    }}",
                 k + 1,
+                crate::io::asset_path(&shown),
             )?;
         }
         writeln!(out, "}}")

@@ -27,6 +27,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// The temporary files being written now, by any thread.
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
+/// Set (under [`LIVE`]'s lock) once [`remove_temporary_files`] has swept:
+/// the process is on its way out, and no new temporary file may appear
+/// after the sweep.
+static CLOSED: AtomicBool = AtomicBool::new(false);
+
 /// Whether [`note_input`] records inputs, and the inputs it recorded
 /// (canonical paths).
 static PROTECTING: AtomicBool = AtomicBool::new(false);
@@ -100,6 +105,9 @@ pub fn remove_temporary_files() {
 /// all of them).
 fn remove_temporary_files_under(folder: Option<&Path>) {
     let live = LIVE.lock().unwrap_or_else(|e| e.into_inner());
+    if folder.is_none() {
+        CLOSED.store(true, Ordering::SeqCst);
+    }
     for temp in live
         .iter()
         .filter(|t| folder.is_none_or(|f| t.starts_with(f)))
@@ -289,17 +297,20 @@ impl AtomicFile {
         let host = host_name();
         remove_stale_temporary_files(path, &name, host);
         let temp = path.with_file_name(format!(".{name}.tmp-{host}-{}", std::process::id()));
-        // Listed before it exists, so a signal arriving in between still
-        // finds it.
-        LIVE.lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push(temp.clone());
-        let file = match File::create(&temp) {
-            Ok(file) => file,
-            Err(error) => {
-                unlist(&temp);
-                return Err(fail(error));
+        // Created and listed under the list's lock: a signal's sweep comes
+        // wholly before (and then no file is created) or after (and finds
+        // it), never between creating and listing.
+        let file = {
+            let mut live = LIVE.lock().unwrap_or_else(|e| e.into_inner());
+            if CLOSED.load(Ordering::SeqCst) {
+                return Err(fail(std::io::Error::new(
+                    std::io::ErrorKind::Interrupted,
+                    "the run was interrupted",
+                )));
             }
+            let file = File::create(&temp).map_err(fail)?;
+            live.push(temp.clone());
+            file
         };
         Ok(Self {
             path: path.to_path_buf(),

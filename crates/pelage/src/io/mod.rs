@@ -52,6 +52,7 @@ pub use usd_read::{
 };
 pub(crate) use usd_read::{UsdSkin, read_usd_skin, usd_skin_from_bytes};
 pub use usd_schema::{PrimWriter, SurfacePoints};
+pub(crate) use usda::asset_path;
 pub use usda::{CurveBasis, PrimWriteError, UpAxis, UsdOptions, UsdWrap, UsdaWriter};
 pub use usdc::UsdcWriter;
 

@@ -404,3 +404,14 @@ fn write_attribute(out: &mut impl Write, attribute: &UsdAttribute) -> std::io::R
         UsdValues::Vec3s(values) => write_array(out, &decl, values, interpolation, put_tuple3),
     }
 }
+
+/// `path` as a USD asset path in text USD: `@path@`, or where the path
+/// holds an `@` (a legal file name character), USD's escaped form
+/// `@@@path@@@`, so that a reader does not end the path at its `@`.
+pub(crate) fn asset_path(path: &str) -> String {
+    if path.contains('@') {
+        format!("@@@{path}@@@")
+    } else {
+        format!("@{path}@")
+    }
+}
