@@ -44,7 +44,7 @@ pub struct GroomArgs {
     /// Frames of an animated skin, e.g. 1-24 (replaces `[animation]
     /// frames`; makes the groom animated when the file has no
     /// `[animation]`). Output: one .usdc or .abc with time samples.
-    #[arg(long, value_name = "RANGE")]
+    #[arg(long, value_name = "RANGE", allow_hyphen_values = true)]
     pub frames: Option<FrameRange>,
     /// Animated grooms: write one .usdc a frame beside OUTPUT
     /// (`NAME.f0001.usdc`, …) and OUTPUT itself (.usda) as the layer that

@@ -48,7 +48,7 @@ pub struct RenderArgs {
     /// then a folder that gets one PNG a frame and an animated GIF. The
     /// file's time-sampled `skin` mesh (`[output] with_mesh`) is drawn
     /// under the curves, moving with them.
-    #[arg(long, value_name = "RANGE")]
+    #[arg(long, value_name = "RANGE", allow_hyphen_values = true)]
     pub frames: Option<pelage::anim::FrameRange>,
     /// Frames per second of the GIF.
     #[arg(long, default_value_t = 24.0, value_parser = super::args::positive)]

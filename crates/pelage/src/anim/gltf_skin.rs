@@ -64,6 +64,22 @@ pub(crate) fn animation_names(parsed: &ParsedGltf) -> Vec<String> {
         .collect()
 }
 
+/// Whether the file has the animation `wanted` (by name, or `#INDEX`);
+/// if not, the message naming the ones it has.
+pub(crate) fn check_clip(parsed: &ParsedGltf, wanted: &str) -> Result<(), String> {
+    let found = parsed
+        .document
+        .animations()
+        .any(|a| a.name() == Some(wanted) || format!("#{}", a.index()) == wanted);
+    if found {
+        return Ok(());
+    }
+    Err(format!(
+        "no animation called {wanted:?}; the file has {}",
+        list_or_none(&animation_names(parsed))
+    ))
+}
+
 impl GltfAnimation {
     /// The animation called `name` (or the first one when `None`) of the
     /// parsed file. Errors are messages for the mesh's error.

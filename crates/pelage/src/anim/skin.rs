@@ -133,6 +133,15 @@ impl AnimatedSkin {
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase)
             .unwrap_or_default();
+        let plays_clips = frame_digits(&text).is_none() && (ext == "gltf" || ext == "glb");
+        if let (Some(wanted), false) = (options.clip.as_deref(), plays_clips) {
+            return Err(MeshError::whole(
+                name,
+                MeshErrorKind::Clip(format!(
+                    "clip {wanted:?}: this skin has no clips to play; clips are glTF animations (a .gltf or .glb skin), and a USD skin or an OBJ/PLY sequence moves by its own frames: remove `clip`"
+                )),
+            ));
+        }
         let (base, motion) = if frame_digits(&text).is_some() {
             // The sequence's topology and UVs come from its first file
             // found; frames are read on demand.
@@ -148,6 +157,10 @@ impl AnimatedSkin {
                 std::fs::read(path).map_err(|e| MeshError::whole(&name, MeshErrorKind::Io(e)))?;
             let parsed = crate::mesh::gltf::parse_with_sources(&name, &bytes, path.parent())?;
             let has_animation = parsed.document.animations().next().is_some();
+            if let Some(wanted) = options.clip.as_deref() {
+                crate::anim::gltf_skin::check_clip(&parsed, wanted)
+                    .map_err(|m| MeshError::whole(&name, MeshErrorKind::Clip(m)))?;
+            }
             if !has_animation && options.clip.is_none() {
                 (parsed.mesh, Motion::Still(Vec::new()))
             } else {
@@ -315,6 +328,16 @@ impl AnimatedSkin {
     fn sequence_frame(&self, pattern: &Path, frame: f64) -> Result<Vec<Vec3>, MeshError> {
         let file = sequence_file(pattern, frame as i64);
         let mesh = Mesh::load(&file)?;
+        if mesh.positions().len() != self.vertex_count {
+            return Err(MeshError::whole(
+                file.display().to_string(),
+                MeshErrorKind::Inconsistent(format!(
+                    "frame {frame} has {} vertices, not the {} of the sequence's first file: the skin's topology must not change over time",
+                    mesh.positions().len(),
+                    self.vertex_count
+                )),
+            ));
+        }
         if mesh.triangles() != self.triangles.as_slice() {
             return Err(MeshError::whole(
                 file.display().to_string(),

@@ -140,7 +140,7 @@ pub struct AnimationSection {
     #[serde(default)]
     pub mode: AnimationModeName,
     /// The glTF animation to play, by name (default: the file's first).
-    pub clip: Option<String>,
+    pub clip: Option<Spanned<String>>,
     /// Shutter offsets in frames, e.g. `[-0.25, 0.25]`: every frame is
     /// also written at these sub-frame times (motion blur).
     #[serde(default)]

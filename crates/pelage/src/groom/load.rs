@@ -12,12 +12,13 @@ use super::spec::{FinishSpec, GroomSpec, HairIds, RegionsSpec, RootsSpec, SpecOr
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{InterpolationMethod, StyleMeshOptions};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshError, MeshErrorKind};
 use crate::settings::SettingsSource;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use toml::Spanned;
 
 /// Hairs per part when the groom does not say.
 pub const HAIRS_PER_PART: u64 = 100_000;
@@ -139,7 +140,7 @@ impl Groom {
             }
             (Some(section), None, None) => (Arc::new(load_mesh_section(&source, section)?), None),
             (Some(section), None, Some((spec, fps, clip))) => {
-                let skin = load_skin(&source, section, *fps, clip.clone())?;
+                let skin = load_skin(&source, section, *fps, clip.as_ref())?;
                 let mesh = skin
                     .mesh_at(spec.rest_frame)
                     .map_err(|e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e)))?;
@@ -538,7 +539,7 @@ fn animation_spec(
     source: &SettingsSource,
     file: &GroomFile,
     frames: Option<FrameRange>,
-) -> Result<Option<(AnimationSpec, f64, Option<String>)>, GroomError> {
+) -> Result<Option<(AnimationSpec, f64, Option<Spanned<String>>)>, GroomError> {
     let section = file.animation.as_ref();
     let frames = match (frames, section) {
         (Some(f), _) => f,
@@ -586,23 +587,39 @@ fn animation_spec(
     Ok(Some((spec, fps, section.and_then(|s| s.clip.clone()))))
 }
 
-/// The animated skin a `[mesh]` section names.
+/// The animated skin a `[mesh]` section names. A problem with the clip
+/// (one the file does not have, or a clip for a skin that plays none) is
+/// reported at `animation.clip`, anything else at `mesh.path`.
 fn load_skin(
     source: &SettingsSource,
     section: &MeshSection,
     fps: f64,
-    clip: Option<String>,
+    clip: Option<&Spanned<String>>,
 ) -> Result<AnimatedSkin, GroomError> {
-    let error = |e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e));
+    let error = |e: MeshError| match (e.kind(), clip) {
+        (MeshErrorKind::Clip(_), Some(clip)) => {
+            source.error_at(clip.span(), GroomErrorKind::Mesh(e))
+        }
+        _ => source.error_at(section.path.span(), GroomErrorKind::Mesh(e)),
+    };
     let options = SkinOptions {
         fps,
-        clip,
+        clip: clip.map(|c| c.get_ref().clone()),
         subdivide: section.subdivide,
     };
     match section.path.get_ref().as_str() {
-        "spot" => Ok(AnimatedSkin::still(
-            &crate::assets::spot().subdivided(section.subdivide),
-        )),
+        "spot" => match clip {
+            Some(clip) => Err(source.error_at(
+                clip.span(),
+                GroomErrorKind::Invalid(format!(
+                    "clip {:?}: the embedded spot has no clips to play; clips are glTF animations (a .gltf or .glb skin): remove `clip`",
+                    clip.get_ref()
+                )),
+            )),
+            None => Ok(AnimatedSkin::still(
+                &crate::assets::spot().subdivided(section.subdivide),
+            )),
+        },
         path => AnimatedSkin::load(&source.folder().join(path), &options).map_err(error),
     }
 }

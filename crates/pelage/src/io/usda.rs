@@ -195,7 +195,8 @@ pub enum PrimWriteError {
     },
     /// A curve too short for the basis.
     #[error(
-        "part {part:?}: curve {curve} has {points} points; {basis} curves need at least {min} (use linear curves or resample)"
+        "part {part:?}: curve {curve} has {points} points; {basis} curves need at least {min} ({})",
+        short_curve_hint(.basis)
     )]
     ShortCurve {
         /// The part.
@@ -209,6 +210,16 @@ pub enum PrimWriteError {
         /// The basis and wrap, in words.
         basis: &'static str,
     },
+}
+
+/// What to do about a curve too short for `basis`: a curve shorter than
+/// linear curves need has no basis to turn to.
+fn short_curve_hint(basis: &str) -> &'static str {
+    if basis == "linear" {
+        "remove the curve, or give it a second point"
+    } else {
+        "write linear curves (--basis linear), or resample to more points"
+    }
 }
 
 impl PrimWriteError {

@@ -73,6 +73,11 @@ pub enum MeshErrorKind {
     /// Something the format allows but pelage cannot use.
     #[error("{0}")]
     Unsupported(String),
+    /// An animation clip the skin does not have, or a clip asked of a
+    /// skin that plays none (only glTF skins have clips): the setting to
+    /// fix is the clip's, not the mesh's.
+    #[error("{0}")]
+    Clip(String),
     /// The file is inconsistent with itself (counts that do not add up, …).
     #[error("{0}")]
     Inconsistent(String),

@@ -559,7 +559,12 @@ fn mesh_and_color(
             let path = source.folder().join(section.path.get_ref());
             let skinned = super::ShellAnimation::load(&path, clip.get_ref(), section.subdivide)
                 .map_err(|e| {
-                    SceneError::at(source, section.path.span(), SceneErrorKind::Mesh(e))
+                    // A clip the file lacks is the clip's fault.
+                    let span = match e.kind() {
+                        crate::mesh::MeshErrorKind::Clip(_) => clip.span(),
+                        _ => section.path.span(),
+                    };
+                    SceneError::at(source, span, SceneErrorKind::Mesh(e))
                 })?;
             let mesh = skinned.mesh_at(0.0).map_err(|e| {
                 SceneError::at(source, section.path.span(), SceneErrorKind::Mesh(e))
