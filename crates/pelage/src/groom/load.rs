@@ -533,13 +533,16 @@ fn is_animatable(path: &Path) -> bool {
         Some("usda" | "usdc" | "usd" | "abc")
     )
 }
-/// The animation a groom file (or `--frames`) asks for: the spec, the
-/// frame rate and the glTF clip.
+/// What a groom file (or `--frames`) asks to animate: the spec, the frame
+/// rate and the glTF clip (where it is written, for errors).
+type AnimationRequest = (AnimationSpec, f64, Option<Spanned<String>>);
+
+/// The animation a groom file (or `--frames`) asks for.
 fn animation_spec(
     source: &SettingsSource,
     file: &GroomFile,
     frames: Option<FrameRange>,
-) -> Result<Option<(AnimationSpec, f64, Option<Spanned<String>>)>, GroomError> {
+) -> Result<Option<AnimationRequest>, GroomError> {
     let section = file.animation.as_ref();
     let frames = match (frames, section) {
         (Some(f), _) => f,
