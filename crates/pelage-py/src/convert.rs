@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 use numpy::ndarray::{ArrayView1, ArrayView2};
 use numpy::{Element, PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 /// `value` (anything `numpy.asarray` accepts) as a C-contiguous numpy
@@ -21,6 +21,27 @@ fn contiguous<'py, T: Element>(
         .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?
         .cast_into::<PyArrayDyn<T>>()
         .map_err(|_| PyValueError::new_err(format!("{what}: expected a numeric array")))
+}
+
+/// Refuses an array of indices (triangles, offsets, ids) whose values
+/// are not integers: numpy would cast floats by truncating them (1.7
+/// becomes 1) and bools to 0 and 1, silently. Empty input passes (an
+/// empty list is a float array to numpy).
+pub fn require_integers(value: &Bound<'_, PyAny>, what: &str) -> PyResult<()> {
+    let py = value.py();
+    let array = py
+        .import("numpy")?
+        .call_method1("asarray", (value,))
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    let size: usize = array.getattr("size")?.extract()?;
+    let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
+    if size == 0 || kind == "i" || kind == "u" {
+        return Ok(());
+    }
+    let dtype = array.getattr("dtype")?.str()?.to_string();
+    Err(PyTypeError::new_err(format!(
+        "{what}: expected integer indices, got an array of {dtype} (numpy would truncate or reinterpret them): convert deliberately, e.g. .astype(np.uint32)"
+    )))
 }
 
 /// `f` of the values of a contiguous array, in order.

@@ -102,6 +102,7 @@ impl PyCurves {
                 .map_err(to_py_err)?;
         }
         if let Some(i) = ids {
+            crate::convert::require_integers(i, "ids")?;
             curves = curves
                 .with_ids(column::<u64>(i, "ids")?)
                 .map_err(to_py_err)?;
@@ -338,6 +339,7 @@ pub(crate) fn parse_basis(basis: &str) -> PyResult<CurveBasis> {
 
 /// Offsets: a 1-D integer column, checked to fit u32 before it narrows.
 fn offsets_column(value: &Bound<'_, PyAny>) -> PyResult<Vec<u32>> {
+    crate::convert::require_integers(value, "offsets")?;
     let wide = column::<i64>(value, "offsets")?;
     wide.into_iter()
         .enumerate()

@@ -15,10 +15,11 @@ use pelage::groom::{
     GroomWriteError, ReportBuilder, Timings,
 };
 use pelage::settings::SettingsSource;
-use pyo3::exceptions::{PyIndexError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyIndexError, PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
 
 /// What errors call a groom built from Python values.
@@ -71,6 +72,22 @@ impl PyGroom {
 
     fn error(&self, error: GroomError) -> PyErr {
         groom_error(error, self.from_values)
+    }
+
+    /// Where `write` or `assemble` (`what`) goes: `path`, else the groom's
+    /// own output path, which a groom built from values has only when its
+    /// `output` table names one.
+    fn output(&self, path: Option<PathBuf>, what: &str) -> PyResult<PathBuf> {
+        if let Some(path) = path {
+            return Ok(path);
+        }
+        let own = self.groom.output_path();
+        if own.file_stem().and_then(|s| s.to_str()) == Some(PYTHON_GROOM) {
+            return Err(PyValueError::new_err(format!(
+                "{what}(): give a path, e.g. groom.{what}(\"fur.usdc\"): a groom built from values has no file to name its output after (or set output={{\"path\": \"fur.usdc\"}})"
+            )));
+        }
+        Ok(own)
     }
 
     /// The groom bound to its animated skin (cached); an error for a still
@@ -162,12 +179,29 @@ impl PyGroom {
         } else {
             table.insert("guides".into(), to_toml(guides, "guides")?);
         }
-        // `roots=200_000` is short for `roots={"count": 200_000}`.
-        let roots = match roots.extract::<u64>() {
-            Ok(count) if !roots.is_instance_of::<pyo3::types::PyBool>() => {
-                one_key("count", to_toml_int(count, "roots")?)
+        // `roots=200_000` is short for `roots={"count": 200_000}`; so is
+        // `roots=2e5`, a whole number written as a float.
+        let roots = if roots.is_instance_of::<pyo3::types::PyBool>() {
+            return Err(PyTypeError::new_err(
+                "roots: a number of hairs (roots=200_000) or a table (roots={\"count\": 200_000, \"seed\": 3}), not a bool",
+            ));
+        } else if let Ok(count) = roots.extract::<u64>() {
+            one_key("count", to_toml_int(count, "roots")?)
+        } else if roots.is_instance_of::<pyo3::types::PyFloat>() {
+            let x: f64 = roots.extract()?;
+            if !(x.is_finite() && x >= 0.0 && x.fract() == 0.0 && x <= u64::MAX as f64) {
+                return Err(PyValueError::new_err(format!(
+                    "roots = {x}: a whole number of hairs (roots=200_000) or a table (roots={{\"count\": 200_000}})"
+                )));
             }
-            _ => to_toml(roots, "roots")?,
+            one_key("count", to_toml_int(x as u64, "roots")?)
+        } else if roots.is_instance_of::<PyDict>() {
+            to_toml(roots, "roots")?
+        } else {
+            return Err(PyTypeError::new_err(format!(
+                "roots: a number of hairs (roots=200_000) or a table (roots={{\"count\": 200_000, \"seed\": 3}}), not a {}",
+                roots.get_type().name()?
+            )));
         };
         table.insert("roots".into(), roots);
         for (key, value) in [
@@ -320,15 +354,21 @@ impl PyGroom {
         let parts = generator.parts().len();
         if let Some(p) = part {
             check_part(p, parts)?;
+            let hairs = generator.parts()[p].hair_count;
+            check_memory(hairs, generator.points_per_hair(), "this part")?;
             let curves = py.detach(|| generator.part(p)).map_err(|e| self.error(e))?;
             return Ok(PyCurves::grown_by(curves, generator));
         }
+        let hairs: u64 = generator.parts().iter().map(|p| p.hair_count).sum();
+        check_memory(hairs, generator.points_per_hair(), "the whole groom")?;
         let mut grown = Vec::with_capacity(parts);
         for p in 0..parts {
             grown.push(py.detach(|| generator.part(p)).map_err(|e| self.error(e))?);
             if let Some(progress) = &progress {
                 progress.call1(py, (p + 1, parts))?;
             }
+            // Ctrl-C between parts (the interpreter only sees it here).
+            py.check_signals()?;
         }
         let joined = py
             .detach(|| pelage::io::join(grown.iter()))
@@ -399,26 +439,38 @@ impl PyGroom {
         seed: Option<u64>,
         progress: Option<Py<PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let output = path.unwrap_or_else(|| self.groom.output_path());
+        let output = self.output(path, "write")?;
         let run = part
             .map(|(k, n)| FarmRun::new(k, n))
             .transpose()
-            .map_err(|e| PyValueError::new_err(format!("part = {part:?}: {e}")))?;
+            .map_err(|e| {
+                PyValueError::new_err(format!(
+                    "part = ({}, {}): {e}",
+                    part.map_or(0, |p| p.0),
+                    part.map_or(0, |p| p.1)
+                ))
+            })?;
         let started = std::time::Instant::now();
-        // A progress callback runs Python: it re-attaches from the writer's
-        // thread; its first exception is raised when the write returns.
+        // After each part the writer re-attaches to Python: to call the
+        // progress callback, and to see a Ctrl-C (signals reach Python
+        // code only while it runs). An exception from either stops the
+        // write (the file is left as it was) and is raised when it returns.
         let callback_error: std::sync::Mutex<Option<PyErr>> = std::sync::Mutex::new(None);
+        let cancel = AtomicBool::new(false);
         let report = |done: usize, total: usize| {
-            if let Some(progress) = &progress {
-                Python::attach(|py| {
-                    if let Err(e) = progress.call1(py, (done, total)) {
-                        callback_error
-                            .lock()
-                            .expect("not poisoned")
-                            .get_or_insert(e);
-                    }
-                });
-            }
+            Python::attach(|py| {
+                let called = match &progress {
+                    Some(progress) => progress.call1(py, (done, total)).map(drop),
+                    None => Ok(()),
+                };
+                if let Err(e) = called.and_then(|()| py.check_signals()) {
+                    cancel.store(true, Ordering::Relaxed);
+                    callback_error
+                        .lock()
+                        .expect("not poisoned")
+                        .get_or_insert(e);
+                }
+            });
         };
         // An animated groom with its own seed is the one grow_frame uses.
         let animated = match (self.groom.animation(), seed) {
@@ -430,16 +482,21 @@ impl PyGroom {
                 .map(Arc::new),
         };
         let farm = || {
-            self.groom
-                .run_output(&output, run)
-                .map_err(|e| PyValueError::new_err(format!("part = {part:?}: {e}")))
+            self.groom.run_output(&output, run).map_err(|e| {
+                PyValueError::new_err(format!(
+                    "part = ({}, {}): {e}",
+                    part.map_or(0, |p| p.0),
+                    part.map_or(0, |p| p.1)
+                ))
+            })
         };
         let (summary, written, grown) = if let Some(animated) = animated {
             let (range, path) = farm()?;
+            create_folder(&path)?;
             let options = self.groom.usd_options();
             let with_skin = self.groom.writes_skin_in(run);
             let summary = py.detach(|| {
-                animated.write(&path, range, &options, with_skin, |p| {
+                animated.write_until(&path, range, &options, with_skin, &cancel, |p| {
                     report(p.done, p.total)
                 })
             });
@@ -447,13 +504,14 @@ impl PyGroom {
         } else {
             let generator = self.generator(py, seed)?;
             let (range, path) = farm()?;
+            create_folder(&path)?;
             let export = self.groom.export();
             let total = range.len();
             let mut done = 0;
             let mut gathered = ReportBuilder::new(&generator);
             let setup = started.elapsed().as_secs_f64();
             let summary = py.detach(|| {
-                generator.write(&path, range, &export, |p, curves| {
+                generator.write_until(&path, range, &export, &cancel, |p, curves| {
                     gathered.add_part(&generator, p, curves);
                     done += 1;
                     report(done, total);
@@ -471,7 +529,7 @@ impl PyGroom {
         }
         let summary = summary.map_err(|e| match e {
             GroomWriteError::Groom(e) => self.error(e),
-            GroomWriteError::Write(e) => to_py_err(e),
+            e => to_py_err(e),
         })?;
         let result = PyDict::new(py);
         result.set_item("path", written)?;
@@ -512,7 +570,7 @@ impl PyGroom {
         py: Python<'py>,
         path: Option<PathBuf>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let output = path.unwrap_or_else(|| self.groom.output_path());
+        let output = self.output(path, "assemble")?;
         let assembled = py
             .detach(|| self.groom.assemble(&output))
             .map_err(to_py_err)?;
@@ -575,6 +633,54 @@ impl PartIter {
     }
 }
 
+/// Bytes a grown hair point takes at most in memory (positions, normals,
+/// colours, widths, opacities) and a hair besides its points (offset, id,
+/// root UV, triangle and barycentrics).
+const BYTES_PER_POINT: u64 = 12 + 12 + 12 + 4 + 4;
+const BYTES_PER_HAIR: u64 = 4 + 8 + 8 + 4 + 8;
+
+/// Refuses to grow `hairs` hairs into memory where they cannot fit: an
+/// allocation that fails aborts the interpreter, a `MemoryError` does not.
+fn check_memory(hairs: u64, points: usize, what: &str) -> PyResult<()> {
+    let need =
+        hairs.saturating_mul((points as u64).saturating_mul(BYTES_PER_POINT) + BYTES_PER_HAIR);
+    let Some(available) = available_memory() else {
+        return Ok(());
+    };
+    if need <= available {
+        return Ok(());
+    }
+    let gb = |b: u64| b as f64 / 1e9;
+    Err(PyMemoryError::new_err(format!(
+        "growing {what} holds {} hairs of {points} points in memory, up to {:.1} GB, and this machine has {:.1} GB available: iterate over groom.parts() (one part in memory at a time) or groom.write() it (streamed)",
+        pelage::limits::grouped(hairs as f64),
+        gb(need),
+        gb(available)
+    )))
+}
+
+/// Memory the system can give this process now (`MemAvailable`), where
+/// it says.
+fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb.saturating_mul(1024))
+}
+
+/// Creates the folder `path` will be written in, as a user of `write()`
+/// expects of `groom.write("out/fur.usdc")`.
+fn create_folder(path: &Path) -> PyResult<()> {
+    match path.parent() {
+        Some(folder) if !folder.as_os_str().is_empty() => {
+            std::fs::create_dir_all(folder).map_err(|e| {
+                crate::PelageError::new_err(format!("cannot create {}: {e}", folder.display()))
+            })
+        }
+        _ => Ok(()),
+    }
+}
+
 /// An error unless `p` names one of `parts` parts.
 fn check_part(p: usize, parts: usize) -> PyResult<()> {
     if p < parts {
@@ -608,7 +714,27 @@ fn groom_error(error: GroomError, from_values: bool) -> PyErr {
     message.push_str(": ");
     message.push_str(&error.kind.to_string());
     let message = crate::with_causes(message, std::error::Error::source(&error.kind));
-    crate::PelageError::new_err(message)
+    crate::PelageError::new_err(in_python_terms(&message))
+}
+
+/// A groom-file reader's message about a value of the wrong type, in
+/// the words of the values the user gave: serde names the Rust struct a
+/// table becomes ("expected struct GuidesSection"), which a Python user
+/// never wrote.
+fn in_python_terms(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(at) = rest.find("expected struct ") {
+        out.push_str(&rest[..at]);
+        out.push_str("expected a table (a dict)");
+        let after = &rest[at + "expected struct ".len()..];
+        let end = after
+            .find(|c: char| !c.is_alphanumeric() && c != '_')
+            .unwrap_or(after.len());
+        rest = &after[end..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// A table of one setting, `{ key = value }`.

@@ -208,6 +208,7 @@ impl PyMesh {
 /// Triangles as (m, 3) indices: any integer array, checked non-negative
 /// and below 2³² before it narrows.
 fn triangle_rows(triangles: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
+    crate::convert::require_integers(triangles, "triangles")?;
     let wide = rows::<i64, 3>(triangles, "triangles")?;
     wide.into_iter()
         .enumerate()

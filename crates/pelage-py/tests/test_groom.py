@@ -1,5 +1,6 @@
 """Grooms from files and from Python values; growth part by part."""
 
+import pathlib
 import threading
 import time
 
@@ -260,3 +261,91 @@ def test_the_ops_builders_match_the_librarys_operator_schema():
         required = [k for k, p in params.items() if p.default is inspect.Parameter.empty]
         assert sorted(required) == sorted(op["required"]), op["name"]
         assert builders[op["name"]].__doc__.strip() == op["summary"], op["name"]
+
+
+def _interrupt_after(seconds):
+    """Sends this process SIGINT (Ctrl-C) after `seconds`, from a thread."""
+    import os
+    import signal
+    import threading
+
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+def test_ctrl_c_stops_write_and_grow_between_parts(spot, tmp_path):
+    """Ctrl-C during a long write() stops it at the next part (the file is
+    left absent, no temporary file stays), with or without a progress
+    callback; grow() without a callback stops too."""
+    import time
+
+    groom = small_groom(spot, count=60_000, roots={"count": 60_000, "seed": 3, "parts": 64})
+    out = tmp_path / "fur.usdc"
+    started = time.perf_counter()
+    groom.write(out)
+    whole = time.perf_counter() - started
+    out.unlink()
+    for progress in [None, lambda done, total: None]:
+        timer = _interrupt_after(whole / 8)
+        started = time.perf_counter()
+        with pytest.raises(KeyboardInterrupt):
+            groom.write(out, progress=progress)
+        stopped = time.perf_counter() - started
+        timer.join()
+        assert stopped < whole * 0.8, f"stopped after {stopped:.2f} s of {whole:.2f}"
+        assert not out.exists()
+        assert [p.name for p in tmp_path.iterdir()] == []
+    timer = _interrupt_after(whole / 8)
+    with pytest.raises(KeyboardInterrupt):
+        groom.grow()
+    timer.join()
+
+
+def test_an_exception_in_progress_stops_the_write(spot, tmp_path):
+    groom = small_groom(spot, count=20_000, roots={"count": 20_000, "seed": 3, "parts": 16})
+    calls = []
+
+    def progress(done, total):
+        calls.append(done)
+        if done == 2:
+            raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        groom.write(tmp_path / "fur.usdc", progress=progress)
+    assert calls == [1, 2], "the write went on after the callback failed"
+    assert not (tmp_path / "fur.usdc").exists()
+
+
+def test_python_values_of_the_wrong_kind_are_refused_in_python_terms(spot, tmp_path):
+    guides = {"generate": {"count": 20, "length": 0.05}}
+    # A whole number written as a float is a count; anything else is not.
+    assert pelage.Groom(mesh=spot, guides=guides, roots=1e3).part_hair_counts == [1000]
+    with pytest.raises(ValueError, match=r"roots = 1000.5: a whole number of hairs"):
+        pelage.Groom(mesh=spot, guides=guides, roots=1000.5)
+    with pytest.raises(TypeError, match="not a bool"):
+        pelage.Groom(mesh=spot, guides=guides, roots=True)
+    with pytest.raises(pelage.PelageError, match=r"guides: invalid type: integer `5`, expected a table \(a dict\)"):
+        pelage.Groom(mesh=spot, guides=5, roots=100)
+    # No file name to write beside: a path is needed.
+    groom = pelage.Groom(mesh=spot, guides=guides, roots=100)
+    with pytest.raises(ValueError, match=r"write\(\): give a path"):
+        groom.write()
+    assert not any(p.name.startswith("<python groom>") for p in pathlib.Path(".").iterdir())
+    # The folder of the output is made; more runs than parts is an error.
+    assert groom.write(tmp_path / "a" / "b" / "fur.usdc")["hairs"] == 100
+    with pytest.raises(ValueError, match=r"part = \(2, 5\): run 2/5: the groom has 1 parts"):
+        groom.write(tmp_path / "farm" / "fur.usdc", part=(2, 5))
+    assert not (tmp_path / "farm").exists() or not any((tmp_path / "farm").iterdir())
+
+
+def test_a_groom_too_large_for_memory_raises_memory_error(spot):
+    big = pelage.Groom(
+        mesh=spot, guides={"generate": {"count": 20, "length": 0.05}}, roots=1_000_000_000
+    )
+    with pytest.raises(MemoryError, match=r"1,000,000,000 hairs .* groom.parts\(\)"):
+        big.grow()
+
+
+def test_the_build_profile_is_exported():
+    assert pelage.__build_profile__ in ("debug", "release")

@@ -48,6 +48,15 @@ def test_from_arrays_checks_indices_and_shapes():
         pelage.Mesh.from_arrays(positions, [[0, 1, -2]])
     with pytest.raises(ValueError, match="one per vertex"):
         pelage.Mesh.from_arrays(positions, [[0, 1, 2]], uvs=np.zeros((5, 2)))
+    # Indices that are not integers are refused, not truncated or cast.
+    with pytest.raises(TypeError, match="triangles: expected integer indices, got an array of float64"):
+        pelage.Mesh.from_arrays(positions, [[0, 1.7, 2]])
+    with pytest.raises(TypeError, match="got an array of bool"):
+        pelage.Mesh.from_arrays(positions, np.array([[True, False, True]]))
+    with pytest.raises(TypeError, match="offsets: expected integer indices"):
+        pelage.Curves.from_arrays(positions, [0.0, 3.0])
+    # Integer arrays of any width still work.
+    assert pelage.Mesh.from_arrays(positions, np.array([[0, 1, 2]], dtype=np.int16)).triangle_count == 1
 
 
 def test_a_missing_file_is_an_error_naming_it():

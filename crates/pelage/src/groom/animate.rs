@@ -58,6 +58,7 @@ use glam::Vec3;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// How an animated groom follows its skin.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -444,11 +445,27 @@ impl AnimatedGroom {
         with_skin: bool,
         progress: impl FnMut(AnimationProgress),
     ) -> Result<GroomSummary, GroomWriteError> {
+        let cancel = AtomicBool::new(false);
+        self.write_until(path, parts, options, with_skin, &cancel, progress)
+    }
+
+    /// [`Self::write`] that stops after the part-frame during which
+    /// `cancel` was set (a front end's Ctrl-C): the output is left as it
+    /// was, and the error is [`GroomWriteError::Cancelled`].
+    pub fn write_until(
+        &self,
+        path: &Path,
+        parts: Range<usize>,
+        options: &UsdOptions,
+        with_skin: bool,
+        cancel: &AtomicBool,
+        progress: impl FnMut(AnimationProgress),
+    ) -> Result<GroomSummary, GroomWriteError> {
         let output = FrameOutput {
             path: path.to_path_buf(),
             times: self.animation.sample_times(),
         };
-        self.write_files(&[output], parts, options, with_skin, progress)
+        self.write_files_until(&[output], parts, options, with_skin, cancel, progress)
     }
 
     /// [`Self::write`] into several files, each with its own time codes
@@ -464,6 +481,21 @@ impl AnimatedGroom {
         parts: Range<usize>,
         options: &UsdOptions,
         with_skin: bool,
+        progress: impl FnMut(AnimationProgress),
+    ) -> Result<GroomSummary, GroomWriteError> {
+        let cancel = AtomicBool::new(false);
+        self.write_files_until(outputs, parts, options, with_skin, &cancel, progress)
+    }
+
+    /// [`Self::write_files`] that stops once `cancel` is set, as
+    /// [`Self::write_until`] does (windows already written stay).
+    pub fn write_files_until(
+        &self,
+        outputs: &[FrameOutput],
+        parts: Range<usize>,
+        options: &UsdOptions,
+        with_skin: bool,
+        cancel: &AtomicBool,
         mut progress: impl FnMut(AnimationProgress),
     ) -> Result<GroomSummary, GroomWriteError> {
         let total = parts.len() * outputs.iter().map(|o| o.times.len()).sum::<usize>();
@@ -475,6 +507,7 @@ impl AnimatedGroom {
                 parts.clone(),
                 options,
                 with_skin,
+                cancel,
                 &mut |p: AnimationProgress| {
                     progress(AnimationProgress {
                         done: done + p.done,
@@ -499,6 +532,7 @@ impl AnimatedGroom {
         parts: Range<usize>,
         options: &UsdOptions,
         with_skin: bool,
+        cancel: &AtomicBool,
         progress: &mut dyn FnMut(AnimationProgress),
     ) -> Result<GroomSummary, GroomWriteError> {
         let write_error = |path: &Path, e: &dyn std::fmt::Display| {
@@ -596,6 +630,9 @@ impl AnimatedGroom {
                         done,
                         total,
                     });
+                    if cancel.load(Ordering::Relaxed) {
+                        return Err(GroomWriteError::Cancelled);
+                    }
                 }
             }
             if let Some((rest, _)) = rest {

@@ -14,6 +14,7 @@ use glam::Vec3;
 use std::io::{BufRead, Write};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The parts run `k` of `n` (1-based `k`) grows: a contiguous slice of the
 /// layout, so the `n` runs together grow every part exactly once, in order.
@@ -57,6 +58,21 @@ impl Generator {
         path: &Path,
         parts: Range<usize>,
         export: &CurvesExport,
+        on_part: impl FnMut(usize, &Curves) + Send,
+    ) -> Result<GroomSummary, GroomWriteError> {
+        self.write_until(path, parts, export, &AtomicBool::new(false), on_part)
+    }
+
+    /// [`Self::write`] that stops between parts once `cancel` is set (by
+    /// `on_part`, or another thread: a front end's Ctrl-C). The output is
+    /// then left as it was before the write, and the error is
+    /// [`GroomWriteError::Cancelled`].
+    pub fn write_until(
+        &self,
+        path: &Path,
+        parts: Range<usize>,
+        export: &CurvesExport,
+        cancel: &AtomicBool,
         mut on_part: impl FnMut(usize, &Curves) + Send,
     ) -> Result<GroomSummary, GroomWriteError> {
         let mut summary = GroomSummary::default();
@@ -74,6 +90,9 @@ impl Generator {
             for p in parts {
                 let curves = self.part(p)?;
                 on_part(p, &curves);
+                if cancel.load(Ordering::Relaxed) {
+                    return Err(GroomWriteError::Cancelled);
+                }
                 count(&curves);
                 if curves.curve_count() > 0 {
                     grown.push((part_name(p), curves));
@@ -89,7 +108,7 @@ impl Generator {
             };
             let format = format.expect("a streamed format");
             write_streamed(out, format, &export.usd, |layer| {
-                self.stream_parts(layer, parts, export, on_part)
+                self.stream_parts(layer, parts, export, cancel, on_part)
             })
         })
         .map_err(|e| e.at(path))?;
@@ -126,7 +145,7 @@ impl Generator {
         on_part: impl FnMut(usize, &Curves) + Send,
     ) -> Result<(), StreamError> {
         let mut usd = UsdaWriter::new(out, &export.usd)?;
-        self.stream_parts(&mut usd, parts, export, on_part)?;
+        self.stream_parts(&mut usd, parts, export, &AtomicBool::new(false), on_part)?;
         usd.finish()?;
         Ok(())
     }
@@ -138,6 +157,7 @@ impl Generator {
         usd: &mut dyn PrimWriter,
         parts: Range<usize>,
         export: &CurvesExport,
+        cancel: &AtomicBool,
         mut on_part: impl FnMut(usize, &Curves) + Send,
     ) -> Result<(), StreamError> {
         if let Some(mesh) = export.mesh {
@@ -164,6 +184,10 @@ impl Generator {
                 }
                 on_part(p, &curves);
                 self.recycle(curves);
+                if cancel.load(Ordering::Relaxed) {
+                    // Hanging up stops the grower at its next part.
+                    return Err(StreamError::Cancelled);
+                }
             }
             grower.join().expect("the part grower does not panic");
             Ok::<(), StreamError>(())
@@ -185,6 +209,9 @@ pub enum StreamError {
     /// The output file could not be created, synced or renamed.
     #[error(transparent)]
     File(#[from] WriteError),
+    /// The write was cancelled between parts.
+    #[error("the write was cancelled")]
+    Cancelled,
 }
 
 impl StreamError {
@@ -193,6 +220,7 @@ impl StreamError {
         match self {
             StreamError::Groom(e) => GroomWriteError::Groom(e),
             StreamError::File(e) => GroomWriteError::Write(e),
+            StreamError::Cancelled => GroomWriteError::Cancelled,
             StreamError::Prim(e) => GroomWriteError::Write(WriteError {
                 path: path.to_path_buf(),
                 error: e.into(),
@@ -210,6 +238,9 @@ pub enum GroomWriteError {
     /// The output could not be written.
     #[error(transparent)]
     Write(#[from] WriteError),
+    /// The write was cancelled (`write_until`): the output is as it was.
+    #[error("the write was cancelled; the output is left as it was")]
+    Cancelled,
 }
 
 /// Writes a root USD layer at `path` that references every part file (each
