@@ -149,6 +149,7 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
     let mut run = SamplerRun::new(args)?;
     let (sampler, rate_all) = run.headline()?;
     run.stable_ids(&sampler, rate_all);
+    run.blue_noise(&sampler);
     run.selectors(&sampler);
     drop(sampler);
     run.table1()?;
@@ -314,6 +315,86 @@ impl SamplerRun {
             .insert("samples_per_s_all_threads".into(), rate_all.round().into());
         self.json.insert("threads".into(), self.threads.into());
         Ok((sampler, rate_all))
+    }
+
+    /// Blue-noise samples (weighted sample elimination over the whole
+    /// mesh) against random samples of the same count, mesh and density,
+    /// on every thread, with where the blue noise's time goes.
+    fn blue_noise(&mut self, sampler: &DensitySampler) {
+        // Elimination holds every candidate's neighbours: a count that
+        // runs in seconds, not the random rate's ten million.
+        let n: u64 = if self.quick { 200_000 } else { 1_000_000 };
+        let runs = self.plan.runs;
+        let (random_s, _) = median_seconds(runs, true, || {
+            pelage::sample::sample_range(sampler, 1, 0..n).len()
+        });
+        let (blue_s, (_, phases)) = median_seconds(runs, true, || {
+            pelage::sample::blue_noise::blue_noise_samples_timed(sampler, &self.blub, 1, n)
+        });
+        let ratio = blue_s / random_s;
+        let share = |s: f64| format!("{:.0} %", 100.0 * s / blue_s);
+        self.report += &table(
+            &format!(
+                "Blue noise: {} samples on blub ×1, 1024² Perlin, {} threads (last run's steps)",
+                thousands(n),
+                self.threads
+            ),
+            &["", "time", "time ratio", "target"],
+            &[
+                Row {
+                    cells: vec![
+                        "random (alias sampler)".into(),
+                        format!("{:.1} ms", random_s * 1e3),
+                        "1.00".into(),
+                        "".into(),
+                    ],
+                },
+                Row {
+                    cells: vec![
+                        "blue noise (4× candidates, eliminated)".into(),
+                        format!("{:.1} ms", blue_s * 1e3),
+                        format!("{ratio:.1}"),
+                        "≤ 3".into(),
+                    ],
+                },
+                Row {
+                    cells: vec![
+                        "  drawing candidates, positions, radii".into(),
+                        format!("{:.1} ms", phases.candidates * 1e3),
+                        share(phases.candidates),
+                        "".into(),
+                    ],
+                },
+                Row {
+                    cells: vec![
+                        "  kd-tree and neighbours within 2r".into(),
+                        format!("{:.1} ms", phases.neighbours * 1e3),
+                        share(phases.neighbours),
+                        "".into(),
+                    ],
+                },
+                Row {
+                    cells: vec![
+                        "  elimination (one at a time)".into(),
+                        format!("{:.1} ms", phases.elimination * 1e3),
+                        share(phases.elimination),
+                        "".into(),
+                    ],
+                },
+            ],
+        );
+        self.json
+            .insert("blue_noise_vs_random".into(), ratio.into());
+        self.json.insert(
+            "blue_noise_samples_per_s".into(),
+            (n as f64 / blue_s).round().into(),
+        );
+        self.json
+            .insert("blue_noise_candidates_s".into(), phases.candidates.into());
+        self.json
+            .insert("blue_noise_neighbours_s".into(), phases.neighbours.into());
+        self.json
+            .insert("blue_noise_elimination_s".into(), phases.elimination.into());
     }
 
     /// Stable hair ids: root cells against the whole-mesh alias sampler.

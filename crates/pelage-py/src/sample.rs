@@ -49,9 +49,11 @@ impl PySamples {
 /// `"noise:frequency=8"`), or a 2-D numpy array read like an image over
 /// the mesh's UVs (row 0 at the top, v = 1). Sample i depends only on (`seed`, `first` + i),
 /// so batches with `first=` add up to one big sample and any thread count
-/// gives the same roots.
+/// gives the same roots. `distribution="blue-noise"` thins four times as
+/// many to roots that keep their distance (the whole set at once: no
+/// `first=`, at most 20,000,000).
 #[pyfunction]
-#[pyo3(signature = (mesh, n, *, density = None, seed = 1, first = 0))]
+#[pyo3(signature = (mesh, n, *, density = None, seed = 1, first = 0, distribution = "random"))]
 pub fn sample(
     py: Python<'_>,
     mesh: &PyMesh,
@@ -59,7 +61,28 @@ pub fn sample(
     density: Option<&Bound<'_, PyAny>>,
     seed: u64,
     first: u64,
+    distribution: &str,
 ) -> PyResult<PySamples> {
+    let blue = match distribution {
+        "random" => false,
+        "blue-noise" | "blue_noise" => true,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "distribution = {other:?}: use \"random\" or \"blue-noise\""
+            )));
+        }
+    };
+    if blue && first != 0 {
+        return Err(PyValueError::new_err(
+            "first = … with distribution=\"blue-noise\": blue noise is thinned as one set and cannot be drawn in batches",
+        ));
+    }
+    let most = pelage::limits::MAX_BLUE_NOISE_POINTS;
+    if blue && n > most {
+        return Err(PyValueError::new_err(format!(
+            "n = {n}: blue noise thins at most {most} roots at once (docs/limits.md)"
+        )));
+    }
     if n > MAX_SAMPLES {
         return Err(PyValueError::new_err(format!(
             "n = {n}: at most {MAX_SAMPLES} roots a call; sample in batches with first="
@@ -73,7 +96,11 @@ pub fn sample(
     let (roots, positions, normals, uvs) = py
         .detach(|| {
             let sampler = DensitySampler::new(&mesh, &density, DensitySamplerOptions::default())?;
-            let roots: Vec<SurfacePoint> = sample_range(&sampler, seed, first..first + n);
+            let roots: Vec<SurfacePoint> = if blue {
+                pelage::sample::blue_noise_samples(&sampler, &mesh, seed, n)
+            } else {
+                sample_range(&sampler, seed, first..first + n)
+            };
             let positions: Vec<glam::Vec3> = roots.iter().map(|r| r.position(&mesh)).collect();
             let normals: Vec<glam::Vec3> = roots.iter().map(|r| r.normal(&mesh)).collect();
             let uvs: Option<Vec<glam::Vec2>> = mesh.has_uvs().then(|| {

@@ -121,3 +121,22 @@ def test_a_numpy_density_image_follows_the_uvs():
     assert right(painted) > right(uniform) + 0.15, (right(painted), right(uniform))
     with pytest.raises(ValueError, match="2-D"):
         pelage.sample(mesh, 10, density=np.zeros((2, 2, 2)))
+
+
+def test_blue_noise_roots_keep_their_distance(spot):
+    blue = pelage.sample(spot, 2000, seed=5, distribution="blue-noise")
+    random = pelage.sample(spot, 2000, seed=5)
+    assert len(blue) == 2000
+
+    def closest(points):
+        d = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=-1)
+        np.fill_diagonal(d, np.inf)
+        return np.percentile(d.min(axis=1), 1)
+
+    assert closest(blue.positions) > 2 * closest(random.positions)
+    again = pelage.sample(spot, 2000, seed=5, distribution="blue-noise")
+    assert np.array_equal(blue.positions, again.positions)
+    with pytest.raises(ValueError, match="cannot be drawn in batches"):
+        pelage.sample(spot, 10, first=10, distribution="blue-noise")
+    with pytest.raises(ValueError, match='use "random" or "blue-noise"'):
+        pelage.sample(spot, 10, distribution="poisson")

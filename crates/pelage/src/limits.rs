@@ -40,6 +40,12 @@ pub const MAX_PARTS: u64 = 1_000_000;
 /// each with their normals, UVs and triangles: 12 GB at the ceiling).
 pub const MAX_SAMPLE_POINTS: u64 = 200_000_000;
 
+/// Points `pelage sample --distribution blue-noise` (and Python's
+/// `sample(distribution="blue-noise")`) thins to at once: the whole set is
+/// thinned together, four candidates a point with their neighbour lists,
+/// about 1 KB a point kept (20 GB at the ceiling).
+pub const MAX_BLUE_NOISE_POINTS: u64 = 20_000_000;
+
 /// Triangles of a mesh after `subdivide` (each step makes four of one). A
 /// mesh costs about 100 bytes a triangle with its topology and sampler.
 pub const MAX_TRIANGLES: u64 = 100_000_000;

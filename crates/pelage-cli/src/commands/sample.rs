@@ -39,6 +39,11 @@ pub struct SampleArgs {
     /// rejection-sampling baseline (`rejection`).
     #[arg(long, value_enum, default_value_t = Method::Alias)]
     pub method: Method,
+    /// `random` (independent samples, streamed in batches) or
+    /// `blue-noise` (four times as many thinned to keep their distance:
+    /// the whole set at once, no seams; at most 20,000,000 points).
+    #[arg(long, value_enum, default_value_t = Distribution::Random)]
+    pub distribution: Distribution,
     /// Grid cells as a percentage of the CDF size, for `--method subdivision`.
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(0..=400))]
     pub grid: u32,
@@ -56,6 +61,16 @@ pub enum Method {
     Alias,
     /// Rejection sampling (Sik §3.4.1), for comparison.
     Rejection,
+}
+
+/// How the points are spread.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Distribution {
+    /// Independent samples of the density.
+    Random,
+    /// Samples of the density that keep their distance (Yuksel's weighted
+    /// sample elimination over the whole mesh).
+    BlueNoise,
 }
 
 /// What `--output`'s extension asks for.
@@ -109,6 +124,20 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
     let density = Map::parse(&args.density).context("cannot read the density map")?;
     pelage::io::check_output(&args.output)?;
     let start = Instant::now();
+    let blue = args.distribution == Distribution::BlueNoise;
+    if blue && args.method == Method::Rejection {
+        anyhow::bail!(
+            "--distribution blue-noise thins samples of the density sampler: use --method alias or subdivision"
+        );
+    }
+    if blue && args.count > pelage::limits::MAX_BLUE_NOISE_POINTS {
+        anyhow::bail!(
+            "--distribution blue-noise: {} points is more than pelage's limit of {} thinned at once (docs/limits.md); sample fewer, or use random points",
+            thousands(args.count),
+            thousands(pelage::limits::MAX_BLUE_NOISE_POINTS)
+        );
+    }
+    let mut blue_sampler = None;
     let sampler: Box<dyn SurfaceSampler + '_> = match args.method {
         Method::Rejection => Box::new(RejectionSampler::new(&mesh, &density)?),
         method => {
@@ -122,9 +151,17 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
                 selector,
                 ..Default::default()
             };
-            Box::new(DensitySampler::new(&mesh, &density, options)?)
+            let density_sampler = DensitySampler::new(&mesh, &density, options)?;
+            if blue {
+                blue_sampler = Some(density_sampler.clone());
+            }
+            Box::new(density_sampler)
         }
     };
+    // Blue noise is thinned whole, then written in batches like the rest.
+    let thinned = blue_sampler
+        .as_ref()
+        .map(|s| pelage::sample::blue_noise_samples(s, &mesh, args.seed, args.count));
     let preprocess = start.elapsed();
 
     let progress = if args.count >= 4 * BATCH {
@@ -159,7 +196,12 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
         let mut batch = vec![SurfacePoint::default(); BATCH.min(args.count) as usize];
         let mut batches = (0..args.count).step_by(BATCH as usize).map(|first| {
             let n = BATCH.min(args.count - first) as usize;
-            sample_into(sampler.as_ref(), args.seed, first, &mut batch[..n]);
+            match &thinned {
+                Some(points) => {
+                    batch[..n].copy_from_slice(&points[first as usize..first as usize + n])
+                }
+                None => sample_into(sampler.as_ref(), args.seed, first, &mut batch[..n]),
+            }
             progress.set_position(first + n as u64);
             batch[..n].to_vec()
         });

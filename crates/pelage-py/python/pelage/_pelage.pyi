@@ -66,6 +66,7 @@ def sample(
     density: Optional[Union[_Map, npt.NDArray[np.floating[Any]]]] = None,
     seed: int = 1,
     first: int = 0,
+    distribution: str = "random",
 ) -> Samples: ...
 
 class Curves:

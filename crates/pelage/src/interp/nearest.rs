@@ -325,7 +325,9 @@ impl NearestPoints {
         hits.last().map(|h| h.distance)
     }
 
-    fn visit_within(&self, p: Vec3, radius_squared: f32, mut visit: impl FnMut(u32)) {
+    /// Visits every point within `radius_squared` of `p` (squared distance
+    /// at most it), in the tree's order (the same for the same points).
+    pub(crate) fn visit_within(&self, p: Vec3, radius_squared: f32, mut visit: impl FnMut(u32)) {
         if let Some(tree) = &self.tree {
             tree.query(&p.to_array())
                 .within::<SquaredEuclidean<f32>>(radius_squared)

@@ -130,7 +130,8 @@ pub struct CurvesReadError(Box<(String, Location, CurvesReadErrorKind)>);
 
 impl CurvesReadError {
     /// An error at `location` of the file at `path`. A message that
-    /// quotes the file is [`shortened`]: a hostile name can be megabytes.
+    /// quotes the file is shortened to excerpts: a hostile name can be
+    /// megabytes.
     pub fn new(path: &Path, location: Location, kind: CurvesReadErrorKind) -> Self {
         use CurvesReadErrorKind as K;
         let kind = match kind {

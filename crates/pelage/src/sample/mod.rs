@@ -5,6 +5,8 @@
 //!   one texel, sibling merging, 12-byte records, and selection by CDF +
 //!   uniform grid or by an alias table.
 //! - [`RejectionSampler`]: the paper's baseline (§3.4.1).
+//! - [`blue_noise_samples`]: samples of a [`DensitySampler`] thinned to
+//!   blue noise (Yuksel's weighted sample elimination).
 //!
 //! Both implement [`SurfaceSampler`]: sample `i` is a pure function of
 //! `(seed, i)` ([`PairDraws`], [`SampleRng`]), and each sampler gives its probability
@@ -14,6 +16,7 @@
 //! [`Map`]: crate::Map
 
 mod alias;
+pub mod blue_noise;
 mod cdf;
 mod cells;
 mod density;
@@ -24,6 +27,7 @@ pub mod subtriangle;
 pub mod warp;
 
 pub use alias::{AliasBin, AliasBins, AliasTable, build_alias_bins};
+pub use blue_noise::{BlueNoiseTimes, blue_noise_samples};
 pub use cdf::CdfGrid;
 pub use cells::RootCells;
 pub use density::{
