@@ -91,8 +91,12 @@ def animated_gltf(node, path):
                           "samplers": [{"input": 1, "output": 2}],
                           "channels": [{"sampler": 0, "target": {"node": node, "path": path}}]}]
     return doc
-write("gltf_animation_missing_node.gltf", json.dumps(animated_gltf(999, "translation")))
-write("gltf_animation_unknown_path.gltf", json.dumps(animated_gltf(0, "wobble")))
+for name, doc in [("gltf_animation_missing_node.gltf", animated_gltf(999, "translation")),
+                  ("gltf_animation_unknown_path.gltf", animated_gltf(0, "wobble"))]:
+    write(name, json.dumps(doc))
+    # Seeds of the glTF fuzz harness too.
+    with open(os.path.join(os.path.dirname(here), "fuzz", "gltf", name), "w") as f:
+        f.write(json.dumps(doc))
 
 # Within the pixel ceiling (60 M pixels) but wider than most GPUs' texture
 # limit (16384 on lavapipe).

@@ -1155,17 +1155,15 @@ fn animated_grooms_refuse_what_they_cannot_write_with_a_reason() {
         "{}",
         stderr(&out)
     );
-    // A clip the file does not have names the ones it has, at its line.
-    std::fs::write(
-        &groom,
-        std::fs::read_to_string(&groom)
-            .unwrap()
-            .replace("\"Walk\"", "\"Dance\""),
-    )
-    .unwrap();
+    // A clip the file does not have names the ones it has, at the clip's
+    // line (the setting to fix), not the mesh's.
+    let text = std::fs::read_to_string(&groom).unwrap();
+    let clip_line = 1 + text.lines().position(|l| l.contains("\"Walk\"")).unwrap();
+    std::fs::write(&groom, text.replace("\"Walk\"", "\"Dance\"")).unwrap();
     let out = pelage(&["groom", g]);
     assert!(
-        stderr(&out).contains("fox.toml:2:")
+        stderr(&out).contains(&format!("fox.toml:{clip_line}:"))
+            && stderr(&out).contains("animation.clip")
             && stderr(&out).contains("no animation called \"Dance\""),
         "{}",
         stderr(&out)
