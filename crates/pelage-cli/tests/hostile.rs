@@ -46,6 +46,10 @@ struct Case {
     /// The longest stderr allowed, in bytes.
     #[serde(default)]
     stderr_at_most: Option<usize>,
+    /// Files that a second run of the command writes byte for byte the
+    /// same.
+    #[serde(default)]
+    reproducible: Vec<String>,
     #[serde(default)]
     gpu: bool,
 }
@@ -90,33 +94,9 @@ fn gpu_available() -> bool {
     pelage_gpu::GpuContext::headless().is_ok()
 }
 
-/// Runs one case; the problems found, empty when it passed.
-fn run_case(case: &Case) -> Vec<String> {
-    let dir = tempfile::tempdir().unwrap();
-    for file in &case.files {
-        let from = hostile_folder().join(file);
-        // A folder brings its files.
-        let sources = match std::fs::read_dir(&from) {
-            Ok(entries) => entries.map(|e| e.unwrap().path()).collect(),
-            Err(_) => vec![from],
-        };
-        for from in sources {
-            let name = from.file_name().unwrap();
-            std::fs::copy(&from, dir.path().join(name))
-                .unwrap_or_else(|e| panic!("{}: {}: {e}", case.name, from.display()));
-        }
-    }
-    for (name, text) in &case.write {
-        let path = dir.path().join(name);
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, text).unwrap();
-    }
-    let before: BTreeMap<&String, Vec<u8>> = case
-        .unchanged
-        .iter()
-        .map(|f| (f, std::fs::read(dir.path().join(f)).unwrap()))
-        .collect();
-
+/// Runs the case's command in `dir` under the limits: its exit status
+/// (`None`: it timed out and was killed), stdout and stderr.
+fn run_binary(case: &Case, dir: &Path) -> (Option<std::process::ExitStatus>, String, String) {
     // Another binary can be tried (an older build, to see that new cases
     // fail there).
     let binary = std::env::var_os("PELAGE_HOSTILE_BINARY").map_or_else(
@@ -126,7 +106,7 @@ fn run_case(case: &Case) -> Vec<String> {
     let mut command = Command::new(binary);
     command
         .args(&case.args)
-        .current_dir(dir.path())
+        .current_dir(dir)
         .env("NO_COLOR", "1")
         .env("RUST_BACKTRACE", "0")
         .stdin(Stdio::null())
@@ -185,8 +165,56 @@ fn run_case(case: &Case) -> Vec<String> {
         std::thread::sleep(Duration::from_millis(20));
     };
     let (stdout, stderr) = (out.join().unwrap(), err.join().unwrap());
+    (status, stdout, stderr)
+}
 
-    let mut problems = Vec::new();
+/// Runs one case; the problems found, empty when it passed.
+fn run_case(case: &Case) -> Vec<String> {
+    let dir = tempfile::tempdir().unwrap();
+    for file in &case.files {
+        let from = hostile_folder().join(file);
+        // A folder brings its files.
+        let sources = match std::fs::read_dir(&from) {
+            Ok(entries) => entries.map(|e| e.unwrap().path()).collect(),
+            Err(_) => vec![from],
+        };
+        for from in sources {
+            let name = from.file_name().unwrap();
+            std::fs::copy(&from, dir.path().join(name))
+                .unwrap_or_else(|e| panic!("{}: {}: {e}", case.name, from.display()));
+        }
+    }
+    for (name, text) in &case.write {
+        let path = dir.path().join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, text).unwrap();
+    }
+    let before: BTreeMap<&String, Vec<u8>> = case
+        .unchanged
+        .iter()
+        .map(|f| (f, std::fs::read(dir.path().join(f)).unwrap()))
+        .collect();
+
+    let (status, stdout, stderr) = run_binary(case, dir.path());
+    // Outputs that a second run must write byte for byte the same.
+    let mut again_problems = Vec::new();
+    if !case.reproducible.is_empty() {
+        let first: Vec<Option<Vec<u8>>> = case
+            .reproducible
+            .iter()
+            .map(|f| std::fs::read(dir.path().join(f)).ok())
+            .collect();
+        run_binary(case, dir.path());
+        for (file, bytes) in case.reproducible.iter().zip(first) {
+            match (bytes, std::fs::read(dir.path().join(file)).ok()) {
+                (Some(a), Some(b)) if a == b => {}
+                (None, _) | (_, None) => again_problems.push(format!("{file} was not written")),
+                _ => again_problems.push(format!("{file} differs between two runs")),
+            }
+        }
+    }
+
+    let mut problems = again_problems;
     match status {
         None => problems.push(format!("timed out after {TIME_LIMIT:?}")),
         Some(status) => match status.code() {
