@@ -197,6 +197,17 @@ pub fn write_clip_assembly(
             {
                 continue; // frames outside the range asked for
             }
+            // A file reaching past the frames asked for would carry its
+            // other frames into the stage (and move its end time code).
+            if f.first < frames.first() || f.last > frames.last() {
+                return Err(fail(
+                    &f.path,
+                    format!(
+                        "it holds frames {} to {}, past the frames asked for ({frames}): assemble those frames, or remove the file",
+                        f.first, f.last
+                    ),
+                ));
+            }
             let info = read_usd_layer_info(&f.path).map_err(|e| fail(&f.path, e.to_string()))?;
             infos.push((f, info));
         }
