@@ -137,9 +137,10 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
             thousands(pelage::limits::MAX_BLUE_NOISE_POINTS)
         );
     }
-    let mut blue_sampler = None;
-    let sampler: Box<dyn SurfaceSampler + '_> = match args.method {
-        Method::Rejection => Box::new(RejectionSampler::new(&mesh, &density)?),
+    // Blue noise is thinned whole here, then written in batches like the
+    // rest.
+    let (sampler, thinned): (Box<dyn SurfaceSampler + '_>, _) = match args.method {
+        Method::Rejection => (Box::new(RejectionSampler::new(&mesh, &density)?), None),
         method => {
             let selector = match method {
                 Method::Subdivision => Selector::CdfGrid {
@@ -151,17 +152,13 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
                 selector,
                 ..Default::default()
             };
-            let density_sampler = DensitySampler::new(&mesh, &density, options)?;
-            if blue {
-                blue_sampler = Some(density_sampler.clone());
-            }
-            Box::new(density_sampler)
+            let sampler = DensitySampler::new(&mesh, &density, options)?;
+            let thinned = blue.then(|| {
+                pelage::sample::blue_noise_samples(&sampler, &mesh, args.seed, args.count)
+            });
+            (Box::new(sampler), thinned)
         }
     };
-    // Blue noise is thinned whole, then written in batches like the rest.
-    let thinned = blue_sampler
-        .as_ref()
-        .map(|s| pelage::sample::blue_noise_samples(s, &mesh, args.seed, args.count));
     let preprocess = start.elapsed();
 
     let progress = if args.count >= 4 * BATCH {
@@ -228,12 +225,13 @@ pub fn run(args: &SampleArgs) -> anyhow::Result<()> {
         .map(|m| m.len())
         .unwrap_or(0);
     println!(
-        "wrote {} points on {} to {} ({:.1} MB) in {:.2} s: preprocess {:.1} ms, then {:.1} M points/s sampled and written",
+        "wrote {} points on {} to {} ({:.1} MB) in {:.2} s: preprocess{} {:.1} ms, then {:.1} M points/s sampled and written",
         thousands(args.count),
         mesh.name(),
         args.output.display(),
         bytes as f64 / 1e6,
         total.as_secs_f64(),
+        if blue { " and blue-noise thinning" } else { "" },
         preprocess.as_secs_f64() * 1e3,
         args.count as f64 / sampling.elapsed().as_secs_f64() / 1e6,
     );
