@@ -377,16 +377,21 @@ impl ShellSession {
         });
         settings.params.brush = self.brush;
         let topology = settings.topology;
-        let motion = match &mut self.motion {
-            Some(m) if m.topology() == topology => m,
-            slot => slot.insert(FurMotion::new(
-                &self.scene.mesh,
-                topology,
-                self.scene.fur.length,
-            )),
-        };
         let steps = settings.steps_per_frame.max(1);
         let h = dt / steps as f32;
+        let motion = match &mut self.motion {
+            Some(m) if m.topology() == topology => m,
+            slot => {
+                let motion = FurMotion::new(&self.scene.mesh, topology, self.scene.fur.length);
+                // Said once a system, as `pelage shells` says it.
+                if h > 0.0
+                    && let Some(warning) = motion.substeps_warning(h, settings)
+                {
+                    eprintln!("warning: {warning}");
+                }
+                slot.insert(motion)
+            }
+        };
         if h > 0.0 {
             for k in 0..steps {
                 // The clip's clock has moved on by dt already.
