@@ -238,7 +238,7 @@ fn morton_order(positions: &[glam::Vec3]) -> Vec<u32> {
     keyed.into_iter().map(|(_, i)| i).collect()
 }
 
-/// A max-heap of candidates by weight that knows where each candidate
+/// A max-heap (four-ary) of candidates by weight that knows where each candidate
 /// sits, so a weight that drops moves its candidate down in place (no
 /// stale entries to skip, as a heap of copies has). Ties go to the higher
 /// index.
@@ -256,7 +256,7 @@ impl WeightHeap {
             order: (0..m as u32).collect(),
             place: (0..m as u32).collect(),
         };
-        for k in (0..m / 2).rev() {
+        for k in (0..m.div_ceil(4)).rev() {
             heap.sift_down(k, weight);
         }
         heap
@@ -277,16 +277,18 @@ impl WeightHeap {
         self.place[self.order[y] as usize] = y as u32;
     }
 
+    /// Moves the candidate at `k` down past heavier children. Four
+    /// children a node: half the levels of a binary heap, and the
+    /// children side by side in memory.
     fn sift_down(&mut self, mut k: usize, weight: &[f32]) {
         let n = self.order.len();
         loop {
-            let (l, r) = (2 * k + 1, 2 * k + 2);
+            let first = 4 * k + 1;
             let mut top = k;
-            if l < n && Self::above(self.order[l], self.order[top], weight) {
-                top = l;
-            }
-            if r < n && Self::above(self.order[r], self.order[top], weight) {
-                top = r;
+            for c in first..(first + 4).min(n) {
+                if Self::above(self.order[c], self.order[top], weight) {
+                    top = c;
+                }
             }
             if top == k {
                 return;
