@@ -440,16 +440,14 @@ impl PyGroom {
         progress: Option<Py<PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let output = self.output(path, "write")?;
+        // The farm's errors, said of the argument as the user wrote it.
+        let (k, n) = part.unwrap_or_default();
+        let part_error =
+            |e: pelage::groom::FarmError| PyValueError::new_err(format!("part = ({k}, {n}): {e}"));
         let run = part
             .map(|(k, n)| FarmRun::new(k, n))
             .transpose()
-            .map_err(|e| {
-                PyValueError::new_err(format!(
-                    "part = ({}, {}): {e}",
-                    part.map_or(0, |p| p.0),
-                    part.map_or(0, |p| p.1)
-                ))
-            })?;
+            .map_err(part_error)?;
         let started = std::time::Instant::now();
         // After each part the writer re-attaches to Python: to call the
         // progress callback, and to see a Ctrl-C (signals reach Python
@@ -481,15 +479,7 @@ impl PyGroom {
                 .map_err(|e| self.error(e))?
                 .map(Arc::new),
         };
-        let farm = || {
-            self.groom.run_output(&output, run).map_err(|e| {
-                PyValueError::new_err(format!(
-                    "part = ({}, {}): {e}",
-                    part.map_or(0, |p| p.0),
-                    part.map_or(0, |p| p.1)
-                ))
-            })
-        };
+        let farm = || self.groom.run_output(&output, run).map_err(part_error);
         let (summary, written, grown) = if let Some(animated) = animated {
             let (range, path) = farm()?;
             create_folder(&path)?;

@@ -64,20 +64,22 @@ pub(crate) fn animation_names(parsed: &ParsedGltf) -> Vec<String> {
         .collect()
 }
 
-/// Whether the file has the animation `wanted` (by name, or `#INDEX`);
-/// if not, the message naming the ones it has.
-pub(crate) fn check_clip(parsed: &ParsedGltf, wanted: &str) -> Result<(), String> {
-    let found = parsed
+/// The file's animation `wanted` (by name, or `#INDEX`); if it has none
+/// such, the message naming the ones it has.
+pub(crate) fn find_clip<'a>(
+    parsed: &'a ParsedGltf,
+    wanted: &str,
+) -> Result<gltf::Animation<'a>, String> {
+    parsed
         .document
         .animations()
-        .any(|a| a.name() == Some(wanted) || format!("#{}", a.index()) == wanted);
-    if found {
-        return Ok(());
-    }
-    Err(format!(
-        "no animation called {wanted:?}; the file has {}",
-        list_or_none(&animation_names(parsed))
-    ))
+        .find(|a| a.name() == Some(wanted) || format!("#{}", a.index()) == wanted)
+        .ok_or_else(|| {
+            format!(
+                "no animation called {wanted:?}; the file has {}",
+                list_or_none(&animation_names(parsed))
+            )
+        })
 }
 
 impl GltfAnimation {
@@ -86,17 +88,8 @@ impl GltfAnimation {
     pub fn new(parsed: &ParsedGltf, name: Option<&str>) -> Result<Self, String> {
         let doc = &parsed.document;
         let buffers = &parsed.buffers;
-        let names = animation_names(parsed);
         let animation = match name {
-            Some(wanted) => doc
-                .animations()
-                .find(|a| a.name() == Some(wanted) || format!("#{}", a.index()) == wanted)
-                .ok_or_else(|| {
-                    format!(
-                        "no animation called {wanted:?}; the file has {}",
-                        list_or_none(&names)
-                    )
-                })?,
+            Some(wanted) => find_clip(parsed, wanted)?,
             None => doc.animations().next().ok_or("the file has no animation")?,
         };
         let data = |b: gltf::Buffer| buffers.get(b.index()).map(|d| &d.0[..]);

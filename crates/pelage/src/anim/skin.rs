@@ -158,7 +158,7 @@ impl AnimatedSkin {
             let parsed = crate::mesh::gltf::parse_with_sources(&name, &bytes, path.parent())?;
             let has_animation = parsed.document.animations().next().is_some();
             if let Some(wanted) = options.clip.as_deref() {
-                crate::anim::gltf_skin::check_clip(&parsed, wanted)
+                crate::anim::gltf_skin::find_clip(&parsed, wanted)
                     .map_err(|m| MeshError::whole(&name, MeshErrorKind::Clip(m)))?;
             }
             if !has_animation && options.clip.is_none() {

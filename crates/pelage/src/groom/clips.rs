@@ -91,10 +91,6 @@ pub fn find_frame_files(output: &Path) -> std::io::Result<Vec<FrameFile>> {
         let Some((first, last)) = frame_span(frames) else {
             continue;
         };
-        let parsed = Some((first, last));
-        let Some((first, last)) = parsed else {
-            continue;
-        };
         found.push(FrameFile {
             path: folder.join(name),
             run,
