@@ -172,6 +172,10 @@ pub struct MeshSection {
     /// Midpoint subdivision steps applied after loading.
     #[serde(default)]
     pub subdivide: u32,
+    /// A PLY mesh (the groom editor's `NAME.layers.ply`) whose vertex
+    /// properties become the mesh's paint layers (`vertex:NAME` maps),
+    /// after subdivision; it must have the same vertex count.
+    pub layers: Option<Spanned<String>>,
 }
 
 impl MeshSection {
@@ -182,10 +186,28 @@ impl MeshSection {
             "spot" => crate::assets::spot(),
             path => crate::Mesh::load(folder.join(path))?,
         };
-        match self.subdivide {
-            0 => Ok(mesh),
-            n => mesh.subdivided_within_limits(n),
+        let mut mesh = match self.subdivide {
+            0 => mesh,
+            n => mesh.subdivided_within_limits(n)?,
+        };
+        if let Some(layers) = &self.layers {
+            let path = folder.join(layers.get_ref());
+            let painted = crate::Mesh::load(&path)?;
+            if painted.vertex_count() != mesh.vertex_count() {
+                return Err(crate::mesh::MeshError::whole(
+                    path.display().to_string(),
+                    crate::mesh::MeshErrorKind::Inconsistent(format!(
+                        "the paint layers have {} vertices where the mesh has {}: they were painted on another mesh (or another subdivision)",
+                        painted.vertex_count(),
+                        mesh.vertex_count()
+                    )),
+                ));
+            }
+            for layer in painted.vertex_attributes() {
+                mesh = mesh.with_vertex_attribute(layer.name.clone(), layer.values.to_vec())?;
+            }
         }
+        Ok(mesh)
     }
 }
 

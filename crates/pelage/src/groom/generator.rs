@@ -76,6 +76,22 @@ pub struct Generator {
     prefetched: Mutex<Option<(usize, PartRoots)>>,
 }
 
+/// What [`Generator::rebuilt`] takes from an earlier generator instead of
+/// building again.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Reuse<'a> {
+    /// The earlier generator (`None`: build everything).
+    pub(crate) from: Option<&'a Generator>,
+    /// The root sampler, root cells and part layout (same mesh geometry,
+    /// density, count and seed).
+    pub(crate) roots: bool,
+    /// The region lookup (same regions map or face sets).
+    pub(crate) regions: bool,
+    /// The guide weighting (same guide roots and regions, same method);
+    /// only with `regions`.
+    pub(crate) weights: bool,
+}
+
 /// A part's roots, ordered by triangle, and their hairs' ids.
 pub(super) type PartRoots = (Vec<SurfacePoint>, Vec<u64>);
 
@@ -98,7 +114,7 @@ impl std::fmt::Debug for Generator {
 impl Generator {
     /// Prepares `spec` for growing; see [`GroomSpec::generator`].
     pub fn new(spec: GroomSpec) -> Result<Self, GroomError> {
-        Self::build(spec, None)
+        Self::build(spec, Reuse::default())
     }
 
     /// A generator for `spec`, which must be this generator's spec with
@@ -107,10 +123,30 @@ impl Generator {
     /// the shapes and what the operators grew from them (clump centres)
     /// are new. Animated grooms regrow each frame this way.
     pub fn reshaped(&self, spec: GroomSpec) -> Result<Self, GroomError> {
-        Self::build(spec, Some(self))
+        Self::build(
+            spec,
+            Reuse {
+                from: Some(self),
+                roots: true,
+                regions: true,
+                weights: true,
+            },
+        )
     }
 
-    fn build(mut spec: GroomSpec, shared: Option<&Generator>) -> Result<Self, GroomError> {
+    /// A generator for `spec` that takes from `reuse.from` what `reuse`
+    /// says is unchanged (an editable groom's edits: a guide added keeps
+    /// the roots, a painted length keeps roots and weights). The caller
+    /// answers for it: what is reused is not checked against `spec`.
+    pub(crate) fn rebuilt(spec: GroomSpec, reuse: Reuse<'_>) -> Result<Self, GroomError> {
+        Self::build(spec, reuse)
+    }
+
+    fn build(mut spec: GroomSpec, reuse: Reuse<'_>) -> Result<Self, GroomError> {
+        let from = reuse.from;
+        let shared_regions = from.filter(|_| reuse.regions);
+        let shared_roots = from.filter(|_| reuse.roots);
+        let shared_weights = from.filter(|_| reuse.weights && reuse.regions);
         let count = spec.roots.count;
         if count == 0 {
             return Err(spec.error(
@@ -148,7 +184,7 @@ impl Generator {
             }
         }
         bind_maps(&mut spec)?;
-        let regions = match (shared, &spec.regions) {
+        let regions = match (shared_regions, &spec.regions) {
             (Some(g), _) => g.regions.clone(),
             (None, Some(r)) => {
                 Some(Arc::new(r.lookup(&spec.mesh).map_err(|m| {
@@ -157,25 +193,8 @@ impl Generator {
             }
             (None, None) => None,
         };
-        let (sampler, cells, layout, interpolator) = match shared {
-            Some(g) => {
-                if g.guides.len() != spec.guides.len() {
-                    return Err(spec.error(
-                        "guides",
-                        GroomErrorKind::Invalid(format!(
-                            "{} guides where the groom has {}",
-                            spec.guides.len(),
-                            g.guides.len()
-                        )),
-                    ));
-                }
-                (
-                    g.sampler.clone(),
-                    g.cells.clone(),
-                    g.layout.clone(),
-                    g.interpolator.reshaped(&spec.mesh, spec.guides.clone()),
-                )
-            }
+        let (sampler, cells, layout) = match shared_roots {
+            Some(g) => (g.sampler.clone(), g.cells.clone(), g.layout.clone()),
             None => {
                 let mesh = &spec.mesh;
                 let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
@@ -198,7 +217,26 @@ impl Generator {
                         (None, layout)
                     }
                 };
-                let interpolator = match &regions {
+                (Arc::new(sampler), cells, Arc::new(layout))
+            }
+        };
+        let interpolator = match shared_weights {
+            Some(g) => {
+                if g.guides.len() != spec.guides.len() {
+                    return Err(spec.error(
+                        "guides",
+                        GroomErrorKind::Invalid(format!(
+                            "{} guides where the groom has {}",
+                            spec.guides.len(),
+                            g.guides.len()
+                        )),
+                    ));
+                }
+                g.interpolator.reshaped(&spec.mesh, spec.guides.clone())
+            }
+            None => {
+                let mesh = &spec.mesh;
+                match &regions {
                     Some(lookup) => {
                         let guide_regions: Vec<u32> = spec
                             .guides
@@ -214,8 +252,7 @@ impl Generator {
                         )
                     }
                     None => Interpolator::new(mesh, spec.guides.clone(), &spec.interpolation),
-                };
-                (Arc::new(sampler), cells, Arc::new(layout), interpolator)
+                }
             }
         };
         let GroomSpec {
@@ -254,7 +291,7 @@ impl Generator {
             normals: finish.normals,
             // A frame's generator (`reshaped`) grows parts of the same
             // sizes: it reuses its parent's arrays.
-            spare: shared.map_or_else(Default::default, |g| g.spare.clone()),
+            spare: shared_roots.map_or_else(Default::default, |g| g.spare.clone()),
             last_part: AtomicUsize::new(usize::MAX),
             prefetched: Mutex::new(None),
         };

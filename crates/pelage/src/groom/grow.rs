@@ -86,7 +86,7 @@ impl Generator {
     }
 
     /// Where a hair grows: its root's position, skin normal and UV.
-    pub(super) fn root_context(&self, root: SurfacePoint) -> RootContext {
+    pub(crate) fn root_context(&self, root: SurfacePoint) -> RootContext {
         let mesh = &self.mesh;
         let position = root.position(mesh);
         let site = MapSite::with_position(mesh, root, position);
@@ -139,8 +139,19 @@ impl Generator {
         roots: Vec<SurfacePoint>,
         ids: Vec<u64>,
     ) -> Result<Curves, GroomError> {
+        self.grow_roots(roots, ids).map(|(curves, _)| curves)
+    }
+
+    /// [`Self::grow_part`] that also says how many hairs each root grew
+    /// (`None`: one each), in the roots' order: an editable groom keeps
+    /// each root's hairs apart to replace them alone.
+    pub(crate) fn grow_roots(
+        &self,
+        roots: Vec<SurfacePoint>,
+        ids: Vec<u64>,
+    ) -> Result<(Curves, Option<Vec<u32>>), GroomError> {
         if self.one_hair_per_root() {
-            return self.part_in_place(roots, ids);
+            return self.part_in_place(roots, ids).map(|c| (c, None));
         }
         let chunks: Vec<PartChunk> = roots
             .par_chunks(CHUNK)
@@ -158,13 +169,17 @@ impl Generator {
         if let Some(i) = bad {
             return Err(self.non_finite_error(roots[i], ids[i]));
         }
-        Ok(self.assemble(concat(chunks)))
+        let per_root = chunks
+            .iter()
+            .flat_map(|c| c.per_root.iter().copied())
+            .collect();
+        Ok((self.assemble(concat(chunks)), Some(per_root)))
     }
 
     /// Whether every root grows exactly one hair (no `strands`, no `cut`):
     /// then a part's arrays have a known size and workers fill them in
     /// place.
-    fn one_hair_per_root(&self) -> bool {
+    pub(crate) fn one_hair_per_root(&self) -> bool {
         self.ops.iter().all(Operator::keeps_one_hair_a_root)
     }
 
@@ -307,6 +322,7 @@ impl Generator {
         let mut frame = vec![Vec3::ZERO; n];
         for (i, root) in roots.iter().enumerate() {
             let normal = self.grow(*root, ids[i], &self.ops, ws);
+            out.per_root.push(ws.batch.hairs().len() as u32);
             let finite = ws.batch.hairs().iter().all(|h| h.non_finite().is_none());
             if !finite && out.first_non_finite.is_none() {
                 out.first_non_finite = Some(i);
@@ -389,6 +405,8 @@ struct PartArrays {
 struct PartChunk {
     arrays: PartArrays,
     counts: Vec<u32>,
+    /// Hairs each root grew.
+    per_root: Vec<u32>,
     /// The first of the chunk's roots that grew a value that is not
     /// finite.
     first_non_finite: Option<usize>,

@@ -29,8 +29,10 @@
 
 pub mod animate;
 mod blue_noise;
+pub mod brush;
 mod clips;
 mod diagnose;
+pub mod edit;
 mod error;
 mod farm;
 pub(crate) mod file;

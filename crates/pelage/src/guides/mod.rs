@@ -275,6 +275,24 @@ impl Guides {
         })
     }
 
+    /// Guides from arrays already at one point count (`points_per_guide`
+    /// points and widths a root), roots bound.
+    pub(crate) fn from_resampled(
+        points: Vec<Vec3>,
+        widths: Vec<f32>,
+        roots: Vec<SurfacePoint>,
+        points_per_guide: usize,
+    ) -> Result<Self, CurvesError> {
+        let offsets = (0..=roots.len() as u32)
+            .map(|i| i * points_per_guide as u32)
+            .collect();
+        let curves = Curves::new(points, widths, offsets)?.with_roots(roots)?;
+        Ok(Self {
+            curves,
+            points_per_guide,
+        })
+    }
+
     /// The guides at `indices` (in that order), as guides of their own.
     pub fn subset(&self, indices: &[u32]) -> Self {
         let n = self.points_per_guide;

@@ -1,0 +1,536 @@
+//! Grooming by hand: brushes do what a groomer expects of them, undo and
+//! redo restore states bit for bit, and incremental regrowth equals a
+//! full regrow after random edits of every kind.
+
+use glam::Vec3;
+use pelage::groom::brush::{Brush, Dab, Falloff, height_above_skin};
+use pelage::groom::edit::{Edit, EditableGroom};
+use pelage::groom::{ClumpParams, GroomOp, GroomSpec, LengthParams, NoiseParams, RootsSpec};
+use pelage::guides::{GuideGrowth, Guides};
+use pelage::map::{Map, VertexMap};
+use pelage::mesh::Mesh;
+use pelage::{Curves, sample::mix64};
+use std::sync::Arc;
+
+/// Spot with a `len` layer, 60 guides, a clump level, a painted length
+/// and noise: every kind of dependence a hair can have.
+fn spec(hairs: u64) -> GroomSpec {
+    let spot = pelage::assets::spot();
+    let n = spot.vertex_count();
+    let mesh = Arc::new(spot.with_vertex_attribute("len", vec![1.0; n]).unwrap());
+    let growth = GuideGrowth {
+        count: 60,
+        length: Map::Constant(0.08),
+        comb: Vec3::new(0.0, -0.3, -0.6),
+        points: 8,
+        ..Default::default()
+    };
+    let guides = Guides::grow(&mesh, &growth).unwrap();
+    GroomSpec::new(mesh, guides, RootsSpec::new(hairs))
+        .with_op(GroomOp::Clump(ClumpParams::new(40)))
+        .with_op(GroomOp::Length(LengthParams::new(Map::Vertex(
+            VertexMap::new("len"),
+        ))))
+        .with_op(GroomOp::Noise(NoiseParams::new(Map::Constant(0.002))))
+}
+
+fn bits(c: &Curves) -> (Vec<u64>, Vec<[u32; 3]>, Vec<u32>, Vec<u32>) {
+    (
+        c.ids().unwrap().to_vec(),
+        c.points()
+            .iter()
+            .map(|p| p.to_array().map(f32::to_bits))
+            .collect(),
+        c.widths().iter().map(|w| w.to_bits()).collect(),
+        c.offsets().to_vec(),
+    )
+}
+
+/// A guide's root position (its first point).
+fn root(groom: &EditableGroom, g: usize) -> Vec3 {
+    groom.guides().guide(g)[0]
+}
+
+fn lengths(points: &[Vec3]) -> Vec<f32> {
+    points.windows(2).map(|s| s[0].distance(s[1])).collect()
+}
+
+fn dab(center: Vec3, radius: f32) -> Dab {
+    Dab::new(center, radius)
+}
+
+#[test]
+fn comb_moves_tips_along_the_stroke_and_keeps_segment_lengths() {
+    let mut groom = EditableGroom::new(spec(2_000), 1.0).unwrap();
+    let before = groom.guides().clone();
+    let center = root(&groom, 5);
+    let mut d = dab(center, 0.12);
+    d.direction = Vec3::new(0.03, 0.0, 0.02);
+    d.strength = 1.0;
+    groom
+        .brush(&Brush::Comb, &d)
+        .unwrap()
+        .expect("the dab touches guides");
+    let after = groom.guides();
+    let mut moved = 0;
+    for g in 0..after.len() {
+        let (a, b) = (before.guide(g), after.guide(g));
+        assert_eq!(a[0], b[0], "roots stay");
+        for (la, lb) in lengths(a).iter().zip(lengths(b)) {
+            assert!((la - lb).abs() <= 1e-4 * la, "segment {la} became {lb}");
+        }
+        if a != b {
+            moved += 1;
+            let tip = b[b.len() - 1] - a[a.len() - 1];
+            assert!(tip.dot(d.direction) > 0.0, "guide {g}'s tip moved {tip}");
+        }
+        for p in b {
+            assert!(height_above_skin(groom.mesh(), groom.bvh(), *p) > -1e-5);
+        }
+    }
+    assert!(moved > 0);
+}
+
+#[test]
+fn cut_leaves_no_point_past_the_cut_and_length_grows() {
+    let mut groom = EditableGroom::new(spec(1_000), 1.0).unwrap();
+    // A sphere through the guides' middles, beside guide 3's root.
+    let g3 = groom.guides().guide(3).to_vec();
+    let d = dab(g3[5], 0.03);
+    groom.brush(&Brush::Cut, &d).unwrap().expect("cuts guide 3");
+    for g in 0..groom.guides().len() {
+        let guide = groom.guides().guide(g);
+        if d.center.distance(guide[0]) >= d.radius {
+            for p in guide {
+                assert!(
+                    p.distance(d.center) >= d.radius * (1.0 - 1e-4),
+                    "guide {g} has a point inside the cut"
+                );
+            }
+        }
+    }
+    let cut_length: f32 = lengths(groom.guides().guide(3)).iter().sum();
+    assert!(cut_length < lengths(&g3).iter().sum::<f32>());
+    let mut grow = dab(g3[0], 0.05);
+    grow.strength = 0.5;
+    groom.brush(&Brush::Length, &grow).unwrap().unwrap();
+    let grown: f32 = lengths(groom.guides().guide(3)).iter().sum();
+    assert!(grown > cut_length * 1.2, "{grown} after {cut_length}");
+}
+
+#[test]
+fn puff_raises_guides_and_smooth_keeps_lengths() {
+    let mut groom = EditableGroom::new(spec(1_000), 1.0).unwrap();
+    let angle = |groom: &EditableGroom, g: usize| {
+        let guide = groom.guides().guide(g);
+        let normal = groom.guides().roots()[g].normal(groom.mesh());
+        (guide[guide.len() - 1] - guide[0]).normalize().dot(normal)
+    };
+    let before = angle(&groom, 7);
+    let mut d = dab(root(&groom, 7), 0.2);
+    d.strength = 0.8;
+    groom.brush(&Brush::Puff, &d).unwrap().unwrap();
+    // Closer to the normal by at least a third of the way left.
+    let after = angle(&groom, 7);
+    assert!(
+        after > before + 0.3 * (1.0 - before),
+        "{after} after {before}"
+    );
+    let l0 = lengths(groom.guides().guide(7));
+    d.falloff = Falloff::Constant;
+    groom.brush(&Brush::Smooth, &d).unwrap();
+    for (a, b) in l0.iter().zip(lengths(groom.guides().guide(7))) {
+        assert!((a - b).abs() <= 1e-4 * a);
+    }
+}
+
+#[test]
+fn added_guides_are_rooted_on_the_skin_with_their_neighbours_shape() {
+    let mut groom = EditableGroom::new(spec(1_000), 1.0).unwrap();
+    let before = groom.generator().guides().clone();
+    let count = before.len();
+    let d = dab(root(&groom, 11), 0.1);
+    groom.brush(&Brush::Add { count: 3 }, &d).unwrap().unwrap();
+    let after = groom.guides();
+    assert_eq!(after.len(), count + 3);
+    // What the old guides interpolate at each new root.
+    let interpolator = pelage::interp::Interpolator::new(
+        groom.mesh(),
+        before,
+        &pelage::interp::InterpolationMethod::by_name("shepard").unwrap(),
+    );
+    for g in count..count + 3 {
+        let r = after.roots()[g];
+        let guide = after.guide(g);
+        assert!(guide[0].distance(r.position(groom.mesh())) < 1e-6);
+        assert!(guide[0].distance(d.center) < d.radius);
+        let mut shape = vec![Vec3::ZERO; guide.len()];
+        interpolator.hair(groom.mesh(), r, &mut Default::default(), &mut shape);
+        for (a, b) in shape.iter().zip(guide) {
+            assert!(
+                a.distance(*b) < 1e-3,
+                "added guide {g} strays from its neighbours"
+            );
+        }
+    }
+}
+
+#[test]
+fn deleted_guides_weigh_on_no_hair() {
+    let mut groom = EditableGroom::new(spec(3_000), 1.0).unwrap();
+    let d = dab(root(&groom, 2), 0.15);
+    let inside = (0..groom.guides().len())
+        .filter(|&g| root(&groom, g).distance(d.center) < d.radius)
+        .count();
+    assert!(inside >= 1);
+    let count = groom.guides().len();
+    groom.brush(&Brush::Delete, &d).unwrap().unwrap();
+    assert_eq!(groom.guides().len(), count - inside);
+    for (_, _, weights) in groom.hair_weights() {
+        for w in weights {
+            let r = groom.guides().guide(w.guide as usize)[0];
+            assert!(
+                r.distance(d.center) >= d.radius,
+                "a hair still follows a deleted guide"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_painted_parting_is_never_crossed() {
+    let mut groom = EditableGroom::new(spec(4_000), 1.0).unwrap();
+    // Part the back of the cow along a long stroke.
+    let (lo, hi) = groom.mesh().bounds();
+    for i in 0..12 {
+        let t = i as f32 / 11.0;
+        let center = Vec3::new(lo.x + t * (hi.x - lo.x), hi.y, 0.0);
+        let Some(hit) = groom.bvh().closest(center) else {
+            continue;
+        };
+        let mut d = dab(hit.point, 0.35);
+        d.falloff = Falloff::Constant;
+        groom.brush(&Brush::Part { region: 1 }, &d).unwrap();
+    }
+    let generator = groom.generator();
+    let guide_regions: Vec<u32> = groom
+        .guides()
+        .roots()
+        .iter()
+        .map(|r| generator.region_of(*r))
+        .collect();
+    assert!(guide_regions.contains(&0) && guide_regions.contains(&1));
+    let mut hairs_in = [0usize; 2];
+    for (_, region, weights) in groom.hair_weights() {
+        hairs_in[region.min(1) as usize] += 1;
+        for w in weights {
+            assert_eq!(
+                guide_regions[w.guide as usize], region,
+                "a hair crosses the parting"
+            );
+        }
+    }
+    assert!(hairs_in[0] > 100 && hairs_in[1] > 100, "{hairs_in:?}");
+}
+
+#[test]
+fn undo_restores_bit_for_bit_and_redo_reapplies() {
+    let mut groom = EditableGroom::new(spec(3_000), 0.5).unwrap();
+    let start = bits(&groom.curves());
+    let start_guides = groom.guides().curves().points().to_vec();
+    let mut d = dab(root(&groom, 9), 0.2);
+    d.direction = Vec3::new(0.0, 0.05, 0.0);
+    groom.brush(&Brush::Comb, &d).unwrap().unwrap();
+    let combed = bits(&groom.curves());
+    assert_ne!(combed, start);
+    groom
+        .brush(
+            &Brush::Paint {
+                layer: "density".into(),
+                value: 0.0,
+            },
+            &d,
+        )
+        .unwrap()
+        .unwrap();
+    let painted = bits(&groom.curves());
+    assert_ne!(painted, combed);
+    groom.undo().unwrap().unwrap();
+    assert_eq!(bits(&groom.curves()), combed);
+    groom.undo().unwrap().unwrap();
+    assert_eq!(bits(&groom.curves()), start);
+    assert_eq!(groom.guides().curves().points(), &start_guides[..]);
+    assert!(groom.undo().unwrap().is_none());
+    groom.redo().unwrap().unwrap();
+    assert_eq!(bits(&groom.curves()), combed);
+    groom.redo().unwrap().unwrap();
+    assert_eq!(bits(&groom.curves()), painted);
+    // The history is bounded: a tiny budget keeps no step.
+    groom.set_history_budget(16);
+    assert_eq!(groom.history_len(), (0, 0));
+}
+
+/// A wavy sheet symmetric across X = 0 (vertex x values exact negatives).
+fn symmetric_sheet() -> Mesh {
+    let n = 16;
+    let mut positions = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let x = (i as f32 - (n / 2) as f32) / (n / 2) as f32;
+            let z = j as f32 / n as f32;
+            positions.push(Vec3::new(x, 0.1 * (x * x) + 0.05 * z, z));
+        }
+    }
+    let mut triangles = Vec::new();
+    let w = n as u32 + 1;
+    for j in 0..n as u32 {
+        for i in 0..n as u32 {
+            let a = j * w + i;
+            // Diagonals mirrored too: left half one way, right half the other.
+            if i < n as u32 / 2 {
+                triangles.push([a, a + w, a + 1]);
+                triangles.push([a + 1, a + w, a + w + 1]);
+            } else {
+                triangles.push([a, a + w, a + w + 1]);
+                triangles.push([a, a + w + 1, a + 1]);
+            }
+        }
+    }
+    Mesh::new("sheet", positions, triangles, None, None).unwrap()
+}
+
+#[test]
+fn x_mirror_on_a_symmetric_mesh_gives_mirrored_guides() {
+    let mesh = Arc::new(symmetric_sheet());
+    // Pairs of guides at ±x, straight up and leaning outward.
+    let mut points = Vec::new();
+    let mut widths = Vec::new();
+    let mut offsets = vec![0u32];
+    for k in 0..6 {
+        let (x, z) = (0.15 + 0.12 * k as f32, 0.2 + 0.1 * k as f32);
+        for side in [1.0f32, -1.0] {
+            let base = Vec3::new(side * x, 0.1 * x * x + 0.05 * z, z);
+            for s in 0..6 {
+                points.push(base + Vec3::new(side * 0.01 * s as f32, 0.02 * s as f32, 0.0));
+                widths.push(0.001);
+            }
+            offsets.push(points.len() as u32);
+        }
+    }
+    let curves = Curves::new(points, widths, offsets).unwrap();
+    let (guides, report) = Guides::bind(&mesh, &curves, 6, 1e-3);
+    assert_eq!(report.kept, 12);
+    let spec = GroomSpec::new(mesh, guides, RootsSpec::new(500));
+    let mut groom = EditableGroom::new(spec, 1.0).unwrap();
+    let mut d = dab(Vec3::new(0.5, 0.1 * 0.25, 0.5), 0.35);
+    d.direction = Vec3::new(0.04, 0.0, 0.03);
+    d.mirror_x = true;
+    groom.brush(&Brush::Comb, &d).unwrap().unwrap();
+    let guides = groom.guides();
+    let mut changed = 0;
+    for pair in 0..6 {
+        let (a, b) = (guides.guide(2 * pair), guides.guide(2 * pair + 1));
+        for (p, q) in a.iter().zip(b) {
+            let mirrored = Vec3::new(-q.x, q.y, q.z);
+            assert!(p.distance(mirrored) < 1e-5, "pair {pair}: {p} and {q}");
+        }
+        changed += usize::from(a[5].distance(curves.points()[12 * pair + 5]) > 1e-4);
+    }
+    assert!(changed > 0);
+}
+
+/// Random dabs of every brush, with undo and redo between, each followed
+/// by a check that the groom equals the same groom grown from nothing.
+#[test]
+fn incremental_regrowth_equals_a_full_regrow_after_random_edits() {
+    let mut groom = EditableGroom::new(spec(6_000), 0.6).unwrap();
+    let brushes = [
+        Brush::Comb,
+        Brush::Length,
+        Brush::Cut,
+        Brush::Smooth,
+        Brush::Puff,
+        Brush::Clump,
+        Brush::Spread,
+        Brush::Add { count: 2 },
+        Brush::Delete,
+        Brush::Paint {
+            layer: "len".into(),
+            value: 1.6,
+        },
+        Brush::Paint {
+            layer: "density".into(),
+            value: 0.2,
+        },
+        Brush::Part { region: 1 },
+    ];
+    let vertices = groom.mesh().positions().to_vec();
+    let mut kinds = std::collections::BTreeSet::new();
+    let mut regrown = 0usize;
+    for step in 0..100u64 {
+        let h = mix64(step + 17);
+        let r = |k: u64| ((mix64(h ^ k) >> 40) as f32) / (1u64 << 24) as f32;
+        let action = h % 16;
+        let result = if action == 14 {
+            groom.undo().map(|r| r.map(|r| r.regrown_roots))
+        } else if action == 15 {
+            groom.redo().map(|r| r.map(|r| r.regrown_roots))
+        } else {
+            let brush = &brushes[(action % brushes.len() as u64) as usize];
+            let at = vertices[(mix64(h ^ 99) % vertices.len() as u64) as usize];
+            let mut d = dab(at, 0.05 + 0.15 * r(1));
+            d.strength = if *brush == Brush::Length {
+                r(2) - 0.5
+            } else {
+                0.3 + 0.7 * r(2)
+            };
+            d.direction = Vec3::new(r(3) - 0.5, r(4) - 0.5, r(5) - 0.5) * 0.05;
+            d.mirror_x = r(6) < 0.3;
+            d.falloff = [Falloff::Smooth, Falloff::Linear, Falloff::Constant][(h % 3) as usize];
+            kinds.insert(brush.name());
+            match groom.brush(brush, &d) {
+                // Deleting the last guides is refused: fine.
+                Err(e) if e.to_string().contains("every guide") => Ok(None),
+                other => other.map(|r| r.map(|r| r.regrown_roots)),
+            }
+        };
+        regrown += result.unwrap().unwrap_or(0);
+        if step % 10 == 9 || step == 99 {
+            let full = groom.regrown_from_scratch().unwrap();
+            assert_eq!(
+                bits(&groom.curves()),
+                bits(&full.curves()),
+                "step {step}: incremental and full regrowth differ"
+            );
+        }
+    }
+    assert_eq!(kinds.len(), brushes.len() - 1, "{kinds:?}");
+    // Incremental: far fewer hairs regrown than 100 full regrows.
+    assert!(regrown < 100 * groom.root_count() / 3, "{regrown}");
+}
+
+#[test]
+fn hairs_far_from_a_comb_are_untouched_and_few_are_regrown() {
+    let mut groom = EditableGroom::new(spec(20_000), 1.0).unwrap();
+    let before = groom.curves();
+    let guides_before = groom.guides().clone();
+    let mut d = dab(root(&groom, 20), 0.08);
+    d.direction = Vec3::new(0.0, 0.0, 0.05);
+    let regrowth = groom.brush(&Brush::Comb, &d).unwrap().unwrap();
+    assert!(regrowth.regrown_roots > 0);
+    assert!(
+        regrowth.regrown_roots * 4 < regrowth.hairs,
+        "{} of {} regrown",
+        regrowth.regrown_roots,
+        regrowth.hairs
+    );
+    let after = groom.curves();
+    // Hairs rooted far from every moved guide's root are bit-identical.
+    let moved: Vec<Vec3> = (0..groom.guides().len())
+        .filter(|&g| groom.guides().guide(g) != guides_before.guide(g))
+        .map(|g| root(&groom, g))
+        .collect();
+    assert!(!moved.is_empty());
+    let mesh = groom.mesh();
+    assert_eq!(before.ids(), after.ids(), "same hairs");
+    let mut far = 0;
+    for i in 0..before.curve_count() {
+        let p = before.roots().unwrap()[i].position(mesh);
+        if moved.iter().all(|m| m.distance(p) > 0.8) {
+            far += 1;
+            let r = before.range(i);
+            assert_eq!(&before.points()[r.clone()], &after.points()[r]);
+        }
+    }
+    assert!(far > 1000, "{far}");
+}
+
+#[test]
+fn the_editable_groom_grows_what_the_generator_grows() {
+    let spec = spec(5_000);
+    let groom = EditableGroom::new(spec.clone(), 1.0).unwrap();
+    let generator = spec.generator().unwrap();
+    let mut by_id = std::collections::HashMap::new();
+    let session = groom.curves();
+    for i in 0..session.curve_count() {
+        by_id.insert(session.ids().unwrap()[i], i);
+    }
+    let mut total = 0;
+    for p in 0..generator.parts().len() {
+        let part = generator.part(p).unwrap();
+        for i in 0..part.curve_count() {
+            let j = by_id[&part.ids().unwrap()[i]];
+            assert_eq!(
+                &part.points()[part.range(i)],
+                &session.points()[session.range(j)]
+            );
+            assert_eq!(
+                &part.widths()[part.range(i)],
+                &session.widths()[session.range(j)]
+            );
+            total += 1;
+        }
+    }
+    assert_eq!(total, session.curve_count());
+    // A preview is a subset of the full groom, hair for hair.
+    let preview = EditableGroom::new(groom.spec().clone(), 0.2)
+        .unwrap()
+        .curves();
+    assert!(preview.curve_count() < total / 3);
+    for i in 0..preview.curve_count() {
+        let j = by_id[&preview.ids().unwrap()[i]];
+        assert_eq!(
+            &preview.points()[preview.range(i)],
+            &session.points()[session.range(j)]
+        );
+    }
+}
+
+#[test]
+fn bad_edits_are_refused_and_change_nothing() {
+    let mut groom = EditableGroom::new(spec(500), 1.0).unwrap();
+    let before = bits(&groom.curves());
+    let e = groom
+        .apply(Edit::MoveGuides {
+            guides: vec![999],
+            points: vec![Vec3::ZERO; 8],
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("guide 999 of 60"), "{e}");
+    let e = groom
+        .apply(Edit::Paint {
+            layer: "nope".into(),
+            vertices: vec![0],
+            values: vec![1.0],
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("no paint layer 'nope'"), "{e}");
+    let e = groom
+        .apply(Edit::Paint {
+            layer: "len".into(),
+            vertices: vec![0],
+            values: vec![f32::NAN],
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("finite"), "{e}");
+    let e = groom
+        .brush(
+            &Brush::Paint {
+                layer: "bad name".into(),
+                value: 1.0,
+            },
+            &dab(Vec3::ZERO, 1.0),
+        )
+        .unwrap_err();
+    assert!(e.to_string().contains("letters, digits"), "{e}");
+    assert_eq!(bits(&groom.curves()), before);
+    assert_eq!(groom.history_len(), (0, 0));
+    let sequential = {
+        let mut s = spec(100);
+        s.roots.ids = pelage::groom::HairIds::Sequential;
+        s
+    };
+    let e = EditableGroom::new(sequential, 1.0).unwrap_err();
+    assert!(e.to_string().contains("stable hair ids"), "{e}");
+    assert!(EditableGroom::new(spec(100), 0.0).is_err());
+}
