@@ -27,6 +27,12 @@ pub struct GroomBenchArgs {
     /// Python module (bpy, set up in a cached venv by tools/bpy-python).
     #[arg(long, value_enum)]
     pub peer: Option<Peer>,
+    /// Measure grooming by hand instead: one comb dab regrown
+    /// incrementally against a full regrow, at full and preview density
+    /// (with `--peer blender`: Blender re-evaluating Interpolate Curves
+    /// after a guide edit).
+    #[arg(long)]
+    pub edit: bool,
     /// Internal: stream this many hairs to USD and print the peak RSS.
     #[arg(long, hide = true)]
     pub rss_child: Option<u64>,
@@ -165,7 +171,7 @@ fn parted_masked_text(hairs: u64, dir: &std::path::Path) -> anyhow::Result<Strin
 
 /// Blender's case: distribution and interpolation only, 8 points, no
 /// operators, no normals.
-fn blender_case_text(hairs: u64) -> String {
+pub(super) fn blender_case_text(hairs: u64) -> String {
     format!(
         "{}\n[finish]\npoints = 8\nnormals = false\n",
         groom_head(hairs)
@@ -262,6 +268,9 @@ struct GroomFigures {
 pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
     if let Some(hairs) = args.rss_child {
         return rss_child(hairs);
+    }
+    if args.edit {
+        return super::groom_edit::run(args);
     }
     let figures = measure(args)?;
     if args.json {

@@ -12,6 +12,7 @@ pub mod animation;
 pub mod dynamics;
 pub mod format;
 pub mod groom;
+mod groom_edit;
 pub mod interp;
 pub mod io;
 pub mod python;

@@ -9,8 +9,8 @@ use super::error::{GroomError, GroomErrorKind};
 use super::grow::{Workspace, sorted_by_triangle, sorted_by_triangle_with_ids};
 use super::load::part_count;
 use super::ops::{
-    ClumpCentres, OpKey, Opacity, Operator, Preparation, Resampling, Width, color_maps_mut,
-    root_to_tip_maps_mut,
+    CentreGuides, ClumpCentres, OpKey, Opacity, Operator, Preparation, Resampling, Width,
+    color_maps_mut, root_to_tip_maps_mut,
 };
 use super::parts::{Part, PartLayout};
 use super::regions::RegionLookup;
@@ -90,6 +90,9 @@ pub(crate) struct Reuse<'a> {
     /// The guide weighting (same guide roots and regions, same method);
     /// only with `regions`.
     pub(crate) weights: bool,
+    /// With `weights`: the only guides whose shape changed (`None`: any
+    /// may have). Clump centres of other guides keep their shapes.
+    pub(crate) moved_guides: Option<&'a [u32]>,
 }
 
 /// A part's roots, ordered by triangle, and their hairs' ids.
@@ -130,6 +133,7 @@ impl Generator {
                 roots: true,
                 regions: true,
                 weights: true,
+                moved_guides: None,
             },
         )
     }
@@ -147,6 +151,15 @@ impl Generator {
         let shared_regions = from.filter(|_| reuse.regions);
         let shared_roots = from.filter(|_| reuse.roots);
         let shared_weights = from.filter(|_| reuse.weights && reuse.regions);
+        let moved: Option<Vec<bool>> = reuse.moved_guides.map(|list| {
+            let mut moved = vec![false; spec.guides.len()];
+            for &g in list {
+                if let Some(m) = moved.get_mut(g as usize) {
+                    *m = true;
+                }
+            }
+            moved
+        });
         let count = spec.roots.count;
         if count == 0 {
             return Err(spec.error(
@@ -305,6 +318,7 @@ impl Generator {
             let op = op.prepare(&Preparation {
                 generator: &generator,
                 key,
+                reshaping: shared_weights.map(|g| (g, moved.as_deref())),
             })?;
             generator.colors |= op.adds_colors();
             generator.opacities |= op.adds_opacities();
@@ -316,30 +330,121 @@ impl Generator {
 
     /// Grows the centre hairs of the clump operator at chain position `k`
     /// through the operators before it. Centre ids live apart from hair ids
-    /// (top bits set), so their random numbers are their own.
-    pub(super) fn clump_centres(&self, k: usize, roots: &[SurfacePoint]) -> ClumpCentres {
+    /// (top bits set), so their random numbers are their own. Reshaping a
+    /// generator whose centres recorded their guides, only the centres of
+    /// moved guides grow again; the others keep their shapes.
+    pub(super) fn clump_centres(
+        &self,
+        k: usize,
+        roots: &[SurfacePoint],
+        reshaping: Option<(&Generator, Option<&[bool]>)>,
+    ) -> ClumpCentres {
+        let grow_one = |i: usize, ws: &mut Workspace, out: &mut Vec<Vec3>| {
+            let id = (1u64 << 63) | ((k as u64) << 40) | i as u64;
+            self.grow(roots[i], id, &self.ops[..k], ws);
+            match ws.batch.hairs().first() {
+                Some(hair) => out.extend_from_slice(&hair.points),
+                // Cut away entirely: the centre is its interpolated shape.
+                None => self.resampled(&ws.shape, out),
+            }
+        };
         let mesh = &self.mesh;
-        let shapes: Vec<Vec<Vec3>> = roots
+        let positions: Vec<Vec3> = roots.iter().map(|r| r.position(mesh)).collect();
+        // The same centres as the generator reshaped (a painted density
+        // may have moved them).
+        let previous = reshaping.and_then(|(g, moved)| {
+            let centres = match g.ops.get(k)?.unmasked() {
+                Operator::Clump(c) => c.centres(),
+                _ => return None,
+            };
+            (centres.roots() == positions.as_slice()).then_some((centres, moved))
+        });
+        if let Some((old, Some(moved))) = previous
+            && let Some(guides) = old.guides()
+        {
+            let changed: Vec<usize> = (0..roots.len())
+                .filter(|&i| guides.of(i).iter().any(|&g| moved[g as usize]))
+                .collect();
+            let grown: Vec<(usize, Vec<Vec3>)> = changed
+                .par_iter()
+                .map_init(Workspace::default, |ws, &i| {
+                    let mut out = Vec::with_capacity(self.points);
+                    grow_one(i, ws, &mut out);
+                    (i, out)
+                })
+                .collect();
+            let mut shapes = old.shape_array().to_vec();
+            for (i, shape) in grown {
+                shapes[i * self.points..(i + 1) * self.points].copy_from_slice(&shape);
+            }
+            return old.with_shapes(shapes);
+        }
+        let shapes: Vec<Vec<Vec3>> = (0..roots.len())
+            .collect::<Vec<_>>()
             .par_chunks(256)
-            .enumerate()
-            .map_init(Workspace::default, |ws, (c, chunk)| {
+            .map_init(Workspace::default, |ws, chunk| {
                 let mut out = Vec::with_capacity(chunk.len() * self.points);
-                for (i, root) in chunk.iter().enumerate() {
-                    let id = (1u64 << 63) | ((k as u64) << 40) | (c * 256 + i) as u64;
-                    self.grow(*root, id, &self.ops[..k], ws);
-                    match ws.batch.hairs().first() {
-                        Some(hair) => out.extend_from_slice(&hair.points),
-                        // Cut away entirely: the centre is its interpolated shape.
-                        None => self.resampled(&ws.shape, &mut out),
-                    }
+                for &i in chunk {
+                    grow_one(i, ws, &mut out);
                 }
                 out
             })
             .collect();
-        let positions = roots.iter().map(|r| r.position(mesh)).collect();
         let normals = roots.iter().map(|r| r.normal(mesh)).collect();
         let regions: Vec<u32> = roots.iter().map(|r| self.region_of(*r)).collect();
-        ClumpCentres::on_surface(positions, normals, &regions, shapes.concat(), self.points)
+        let centres =
+            ClumpCentres::on_surface(positions, normals, &regions, shapes.concat(), self.points);
+        let centres = centres.with_surface_roots(roots.to_vec());
+        // Reshaped, the centres depend on the guides they did before.
+        match previous.and_then(|(old, _)| old.guides_shared()) {
+            Some(guides) => centres.with_shared_guides(guides),
+            None => centres.with_guides(self.centre_guides(k, roots)),
+        }
+    }
+
+    /// The guides each centre of the clump at chain position `k` depends
+    /// on: its own weights' guides and, through the clump levels before
+    /// it, those of the centres it follows.
+    fn centre_guides(&self, k: usize, roots: &[SurfacePoint]) -> CentreGuides {
+        let earlier: Vec<&ClumpCentres> = self.ops[..k]
+            .iter()
+            .filter_map(|op| match op.unmasked() {
+                Operator::Clump(c) => Some(c.centres()),
+                _ => None,
+            })
+            .collect();
+        let per_centre: Vec<Vec<u32>> = roots
+            .par_iter()
+            .map_init(
+                || (Vec::new(), crate::interp::NeighbourCache::default()),
+                |(weights, near), root| {
+                    let context = self.root_context(*root);
+                    let hair_root = crate::interp::HairRoot {
+                        position: context.position,
+                        triangle: Some(root.tri),
+                        region: context.region,
+                    };
+                    self.interpolator.weighting().weights(hair_root, weights);
+                    let mut guides: Vec<u32> = weights.iter().map(|w| w.guide).collect();
+                    for level in &earlier {
+                        let followed = level.nearest_near(
+                            context.position,
+                            Some(context.normal),
+                            context.region,
+                            near,
+                            context.skin_triangle,
+                        );
+                        if let (Some((c, _)), Some(g)) = (followed, level.guides()) {
+                            guides.extend_from_slice(g.of(c));
+                        }
+                    }
+                    guides.sort_unstable();
+                    guides.dedup();
+                    guides
+                },
+            )
+            .collect();
+        CentreGuides::new(per_centre)
     }
 
     /// An error about the setting `key`, at its line when the groom came

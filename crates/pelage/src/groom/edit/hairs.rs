@@ -459,7 +459,9 @@ impl GrownHairs {
                     return;
                 }
                 replaced.sort_unstable_by_key(|(k, _)| *k);
-                splice(cell, &replaced, grown, flags);
+                if !(complete && replace_in_place(cell, &replaced, grown, flags)) {
+                    splice(cell, &replaced, grown, flags);
+                }
             });
         Ok(())
     }
@@ -577,6 +579,64 @@ fn truncate_hairs(cell: &mut CellHairs, roots: usize, curves: usize) {
     cell.curve_roots.truncate(curves);
     cell.root_uvs
         .truncate(if cell.root_uvs.is_empty() { 0 } else { curves });
+}
+
+/// Overwrites the hairs of the roots `replaced` lists in place when each
+/// grew as many curves of as many points as before (the common case: no
+/// `cut` or `strands` changed a count); `false`, with nothing changed,
+/// otherwise.
+fn replace_in_place(
+    cell: &mut CellHairs,
+    replaced: &[(usize, std::ops::Range<usize>)],
+    grown: Option<&Curves>,
+    (normals, colors, opacities, root_uvs): (bool, bool, bool, bool),
+) -> bool {
+    let Some(g) = grown else {
+        return replaced.is_empty();
+    };
+    let same_layout = cell.normals.is_empty() != normals
+        && cell.colors.is_empty() != colors
+        && cell.opacities.is_empty() != opacities
+        && cell.root_uvs.is_empty() != root_uvs;
+    let fits = |(k, range): &(usize, std::ops::Range<usize>)| {
+        let old = cell.curve_starts[*k] as usize..cell.curve_starts[*k + 1] as usize;
+        old.len() == range.len()
+            && old.zip(range.clone()).all(|(o, i)| {
+                (cell.point_starts[o + 1] - cell.point_starts[o]) as usize == g.range(i).len()
+            })
+    };
+    if !(same_layout || cell.points.is_empty()) || !replaced.iter().all(fits) {
+        return false;
+    }
+    if cell.points.is_empty() {
+        return false;
+    }
+    for (k, range) in replaced {
+        let first = cell.curve_starts[*k] as usize;
+        for (o, i) in (first..).zip(range.clone()) {
+            let to = cell.point_starts[o] as usize..cell.point_starts[o + 1] as usize;
+            let from = g.range(i);
+            cell.points[to.clone()].copy_from_slice(&g.points()[from.clone()]);
+            cell.widths[to.clone()].copy_from_slice(&g.widths()[from.clone()]);
+            if normals {
+                cell.normals[to.clone()]
+                    .copy_from_slice(&g.normals().expect("normals")[from.clone()]);
+            }
+            if colors {
+                cell.colors[to.clone()]
+                    .copy_from_slice(&g.colors().expect("colours")[from.clone()]);
+            }
+            if opacities {
+                cell.opacities[to].copy_from_slice(&g.opacities().expect("opacities")[from]);
+            }
+            cell.ids[o] = g.ids().expect("ids")[i];
+            cell.curve_roots[o] = g.roots().expect("roots")[i];
+            if root_uvs {
+                cell.root_uvs[o] = g.root_uvs().expect("root UVs")[i];
+            }
+        }
+    }
+    true
 }
 
 /// Rebuilds a cell's hairs: root `k`'s from `grown` where `replaced` (by

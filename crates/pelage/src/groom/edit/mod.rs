@@ -107,6 +107,8 @@ pub struct EditableGroom {
     /// The share of the groom's hairs grown (the first arrivals of every
     /// root cell: a preview is a subset of the full groom).
     fraction: f64,
+    /// Each root cell's hairs at the fraction.
+    counts: Vec<u64>,
     hairs: GrownHairs,
     undo: Vec<Step>,
     redo: Vec<Step>,
@@ -160,6 +162,7 @@ impl EditableGroom {
             spec,
             generator,
             fraction,
+            counts: Vec::new(),
             hairs: GrownHairs::default(),
             undo: Vec::new(),
             redo: Vec::new(),
@@ -174,6 +177,7 @@ impl EditableGroom {
         groom
             .hairs
             .update(None, &groom.generator, &counts, &change)?;
+        groom.counts = counts;
         Ok(groom)
     }
 
@@ -253,13 +257,17 @@ impl EditableGroom {
     pub fn set_fraction(&mut self, fraction: f64) -> Result<Regrowth, GroomError> {
         check_fraction(&self.spec, fraction)?;
         self.fraction = fraction;
-        let counts = self.counts(&self.generator);
+        self.counts = self.counts(&self.generator);
         let change = Change {
             roots: true,
             ..Default::default()
         };
-        self.hairs
-            .update(Some(&self.generator), &self.generator, &counts, &change)
+        self.hairs.update(
+            Some(&self.generator),
+            &self.generator,
+            &self.counts,
+            &change,
+        )
     }
 
     /// Applies `edit`, regrowing what it changes, and puts it on the undo
@@ -416,6 +424,7 @@ impl EditableGroom {
                     roots: true,
                     regions: true,
                     weights: false,
+                    only_guides_moved: false,
                 };
                 let change = Change {
                     recipes: true,
@@ -490,6 +499,7 @@ impl EditableGroom {
             roots: true,
             regions: true,
             weights: true,
+            only_guides_moved: true,
         };
         let change = Change {
             moved_guides: moved,
@@ -577,6 +587,7 @@ impl EditableGroom {
             roots: !density,
             regions: !regions,
             weights: !regions,
+            only_guides_moved: false,
         };
         let change = Change {
             roots: density,
@@ -609,6 +620,7 @@ impl EditableGroom {
                 roots: k.roots,
                 regions: k.regions,
                 weights: k.weights,
+                moved_guides: k.only_guides_moved.then_some(&change.moved_guides[..]),
             },
             None => Reuse::default(),
         };
@@ -620,13 +632,18 @@ impl EditableGroom {
             ));
         }
         let previous_spec = std::mem::replace(&mut self.spec, spec);
-        let counts = self.counts(&generator);
+        // The counts change only with the roots' sampler.
+        let counts = match keep {
+            Some(k) if k.roots => std::mem::take(&mut self.counts),
+            _ => self.counts(&generator),
+        };
         match self
             .hairs
             .update(Some(&self.generator), &generator, &counts, &change)
         {
             Ok(regrowth) => {
                 self.generator = generator;
+                self.counts = counts;
                 Ok(regrowth)
             }
             Err(e) => {
@@ -634,6 +651,7 @@ impl EditableGroom {
                 // range): grow the old groom again, whole.
                 self.spec = previous_spec;
                 let counts = self.counts(&self.generator);
+                self.counts = counts.clone();
                 let everything = Change {
                     everything: true,
                     ..Default::default()
@@ -653,6 +671,8 @@ struct Keep {
     roots: bool,
     regions: bool,
     weights: bool,
+    /// Nothing changed but the shapes of `Change::moved_guides`.
+    only_guides_moved: bool,
 }
 
 /// Whether an operator's or the finish's map reads layer `name`.

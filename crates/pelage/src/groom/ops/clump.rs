@@ -16,10 +16,12 @@ use crate::groom::ramp::Ramp;
 use crate::interp::{NearestPoints, NeighbourCache, QueryRegion};
 use crate::limits::MAX_CLUMPS;
 use crate::map::Map;
+use crate::mesh::SurfacePoint;
 use crate::sample::{DensitySampler, DensitySamplerOptions, sample_range};
 use crate::settings::{Bound, Rule};
 use glam::Vec3;
 use serde::Deserialize;
+use std::sync::Arc;
 use toml::Spanned;
 
 /// `clump` as a groom file writes it.
@@ -90,16 +92,53 @@ impl ClumpParams {
 
 /// The centre hairs of one clump level: roots in a kd-tree a region,
 /// shapes with the hairs' point count, and each root's skin normal.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct ClumpCentres {
-    roots: Vec<Vec3>,
+    /// Shared with the centres of a reshaped groom (same roots).
+    roots: Arc<Vec<Vec3>>,
     /// Indexed by region: a kd-tree over the region's centres and their
     /// indices among all (`None`: no centre there).
-    by_region: Vec<Option<(NearestPoints, Vec<u32>)>>,
+    by_region: Arc<Vec<Option<RegionCentres>>>,
     /// Each centre's skin normal (empty: no side test).
-    normals: Vec<Vec3>,
+    normals: Arc<Vec<Vec3>>,
     shapes: Vec<Vec3>,
     points: usize,
+    /// The centres' roots on the skin, when grown by a groom.
+    surface_roots: Arc<Vec<SurfacePoint>>,
+    /// The guides each centre's shape depends on (its own weights' and
+    /// those of the centres it follows at earlier levels), when known:
+    /// a reshaped groom regrows only the centres of moved guides.
+    guides: Option<Arc<CentreGuides>>,
+}
+
+/// One region's centres: a kd-tree over their roots and their indices
+/// among all centres.
+type RegionCentres = (NearestPoints, Vec<u32>);
+
+/// The guides each centre depends on, in compressed rows.
+#[derive(Debug, Default)]
+pub struct CentreGuides {
+    starts: Vec<u32>,
+    guides: Vec<u32>,
+}
+
+impl CentreGuides {
+    /// From each centre's guides (sorted, distinct).
+    pub fn new(per_centre: Vec<Vec<u32>>) -> Self {
+        let mut starts = Vec::with_capacity(per_centre.len() + 1);
+        starts.push(0);
+        let mut guides = Vec::new();
+        for g in per_centre {
+            guides.extend(g);
+            starts.push(guides.len() as u32);
+        }
+        Self { starts, guides }
+    }
+
+    /// The guides centre `i` depends on.
+    pub fn of(&self, i: usize) -> &[u32] {
+        &self.guides[self.starts[i] as usize..self.starts[i + 1] as usize]
+    }
 }
 
 /// Centres looked at first past the nearest when it lies on the other
@@ -138,12 +177,56 @@ impl ClumpCentres {
             })
             .collect();
         Self {
-            roots,
-            by_region,
-            normals,
+            roots: Arc::new(roots),
+            by_region: Arc::new(by_region),
+            normals: Arc::new(normals),
             shapes,
             points,
+            surface_roots: Arc::default(),
+            guides: None,
         }
+    }
+
+    /// Records the centres' roots on the skin.
+    pub(crate) fn with_surface_roots(mut self, roots: Vec<SurfacePoint>) -> Self {
+        self.surface_roots = Arc::new(roots);
+        self
+    }
+
+    /// The centres' roots on the skin (empty unless a groom grew them).
+    pub(crate) fn surface_roots(&self) -> &[SurfacePoint] {
+        &self.surface_roots
+    }
+
+    /// These centres (roots, search trees) in other shapes.
+    pub(crate) fn with_shapes(&self, shapes: Vec<Vec3>) -> Self {
+        assert_eq!(shapes.len(), self.shapes.len());
+        Self {
+            shapes,
+            ..self.clone()
+        }
+    }
+
+    /// Records the guides each centre depends on.
+    pub(crate) fn with_guides(mut self, guides: CentreGuides) -> Self {
+        self.guides = Some(Arc::new(guides));
+        self
+    }
+
+    /// The guides each centre depends on, shared, when recorded.
+    pub(crate) fn guides_shared(&self) -> Option<Arc<CentreGuides>> {
+        self.guides.clone()
+    }
+
+    /// Records the guides each centre depends on, shared.
+    pub(crate) fn with_shared_guides(mut self, guides: Arc<CentreGuides>) -> Self {
+        self.guides = Some(guides);
+        self
+    }
+
+    /// The guides each centre depends on, when recorded.
+    pub(crate) fn guides(&self) -> Option<&CentreGuides> {
+        self.guides.as_deref()
     }
 
     /// Number of centres.
@@ -209,6 +292,11 @@ impl ClumpCentres {
     /// Centre `i`'s points.
     pub fn shape(&self, i: usize) -> &[Vec3] {
         &self.shapes[i * self.points..(i + 1) * self.points]
+    }
+
+    /// Every centre's points, centre after centre.
+    pub(crate) fn shape_array(&self) -> &[Vec3] {
+        &self.shapes
     }
 
     /// Every centre's root.
@@ -335,9 +423,16 @@ impl OperatorKind for Clump {
                 GroomErrorKind::Invalid("a clump operator needs at least 1 clump".into()),
             ));
         }
-        let sampler = DensitySampler::new(cx.mesh(), &p.density, DensitySamplerOptions::default())
-            .map_err(|e| cx.error("density", GroomErrorKind::Sample(e)))?;
-        let roots = sample_range(&sampler, cx.seed(p.seed), 0..p.count);
+        // Reshaping a groom whose guides alone moved: the same centres.
+        let roots = match cx.unchanged_centre_roots() {
+            Some(roots) => roots,
+            None => {
+                let sampler =
+                    DensitySampler::new(cx.mesh(), &p.density, DensitySamplerOptions::default())
+                        .map_err(|e| cx.error("density", GroomErrorKind::Sample(e)))?;
+                sample_range(&sampler, cx.seed(p.seed), 0..p.count)
+            }
+        };
         Ok(Clump::new(cx.centres(&roots), p.rate, p.ramp, p.size))
     }
 

@@ -229,6 +229,9 @@ pub(crate) fn default_map(value: f32) -> MapValue {
 pub(crate) struct Preparation<'a> {
     pub(crate) generator: &'a Generator,
     pub(crate) key: OpKey,
+    /// The generator this one reshapes (same roots, weights, operators;
+    /// other guide shapes), with the guides that moved (`None`: any).
+    pub(crate) reshaping: Option<(&'a Generator, Option<&'a [bool]>)>,
 }
 
 impl Preparation<'_> {
@@ -250,10 +253,26 @@ impl Preparation<'_> {
         self.generator.mesh()
     }
 
+    /// The centre roots of this clump operator in the generator being
+    /// reshaped, when nothing but guide shapes changed (the same density,
+    /// count and seed sample the same roots).
+    pub fn unchanged_centre_roots(&self) -> Option<Vec<SurfacePoint>> {
+        let (previous, Some(_)) = self.reshaping? else {
+            return None;
+        };
+        match previous.operators().get(self.key.index)?.unmasked() {
+            super::Operator::Clump(c) if !c.centres().surface_roots().is_empty() => {
+                Some(c.centres().surface_roots().to_vec())
+            }
+            _ => None,
+        }
+    }
+
     /// Hairs grown from `roots` through the operators before this one: the
     /// centre hairs of a clump level.
     pub fn centres(&self, roots: &[SurfacePoint]) -> super::ClumpCentres {
-        self.generator.clump_centres(self.key.index, roots)
+        self.generator
+            .clump_centres(self.key.index, roots, self.reshaping)
     }
 }
 

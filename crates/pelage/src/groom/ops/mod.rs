@@ -29,7 +29,7 @@ mod strands;
 mod twist;
 mod width;
 
-pub use clump::{Clump, ClumpCentres, ClumpParams};
+pub use clump::{CentreGuides, Clump, ClumpCentres, ClumpParams};
 pub use color::Color;
 pub use curl::{Curl, CurlParams};
 pub use cut::Cut;
