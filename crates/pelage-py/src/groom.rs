@@ -70,6 +70,11 @@ impl PyGroom {
         Ok(this)
     }
 
+    /// The groom (a session opens it for editing).
+    pub(crate) fn groom(&self) -> &Groom {
+        &self.groom
+    }
+
     fn error(&self, error: GroomError) -> PyErr {
         groom_error(error, self.from_values)
     }

@@ -25,6 +25,7 @@ mod curves;
 mod groom;
 mod mesh;
 mod sample;
+mod session;
 
 pyo3::create_exception!(
     _pelage,
@@ -67,6 +68,7 @@ fn _pelage(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mesh::PyMesh>()?;
     m.add_class::<curves::PyCurves>()?;
     m.add_class::<groom::PyGroom>()?;
+    m.add_class::<session::PyGroomSession>()?;
     m.add_class::<sample::PySamples>()?;
     m.add_function(wrap_pyfunction!(sample::sample, m)?)?;
     m.add_function(wrap_pyfunction!(curves::read_curves, m)?)?;

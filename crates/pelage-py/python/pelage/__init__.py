@@ -7,7 +7,8 @@
     groom.write("fur.usdc")          # streamed, atomic
 
 The classes wrap pelage's Rust values (docs/python.md): `Mesh`, `Curves`,
-`Groom`, and `sample()` for hair roots. `pelage.ops` builds the operator
+`Groom`, `GroomSession` (brushes, undo, incremental regrowth), and
+`sample()` for hair roots. `pelage.ops` builds the operator
 tables of a groom (`ops=[pelage.ops.clump(count=300)]`). Errors are
 `pelage.PelageError`, with the file, line and setting in the message.
 """
@@ -15,6 +16,7 @@ tables of a groom (`ops=[pelage.ops.clump(count=300)]`). Errors are
 from ._pelage import (
     Curves,
     Groom,
+    GroomSession,
     Mesh,
     PelageError,
     Samples,
@@ -29,6 +31,7 @@ from . import ops
 __all__ = [
     "Curves",
     "Groom",
+    "GroomSession",
     "Mesh",
     "PelageError",
     "Samples",

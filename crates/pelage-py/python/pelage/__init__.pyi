@@ -2,6 +2,7 @@ from . import ops as ops
 from ._pelage import (
     Curves as Curves,
     Groom as Groom,
+    GroomSession as GroomSession,
     Mesh as Mesh,
     PelageError as PelageError,
     Samples as Samples,
