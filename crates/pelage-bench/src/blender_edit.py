@@ -75,7 +75,8 @@ for run in range(case["runs"] + 1):
     depsgraph = bpy.context.evaluated_depsgraph_get()
     depsgraph.update()
     evaluated = skin.evaluated_get(depsgraph)
-    curves = evaluated.evaluated_geometry().curves
+    geometry = evaluated.evaluated_geometry()
+    curves = geometry.curves
     elapsed = time.perf_counter() - start
     hairs, points = len(curves.curves), len(curves.points)
     if run > 0:  # the first evaluation builds everything
