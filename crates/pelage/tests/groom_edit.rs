@@ -621,3 +621,22 @@ path = "fur.usdc"
     // rounding, not a visible change.
     assert!(worst < 1e-4, "hairs moved by {worst}");
 }
+
+#[test]
+fn a_stroke_joined_into_one_step_is_undone_at_once() {
+    let mut groom = EditableGroom::new(spec(1_000), 1.0).unwrap();
+    let start = bits(&groom.curves());
+    for k in 0..4 {
+        let mut d = dab(root(&groom, 3 + k), 0.15);
+        d.direction = Vec3::new(0.0, 0.02, 0.0);
+        groom.brush(&Brush::Comb, &d).unwrap();
+    }
+    let combed = bits(&groom.curves());
+    let (steps, _) = groom.history_len();
+    groom.join_last_steps(steps);
+    assert_eq!(groom.history_len(), (1, 0));
+    groom.undo().unwrap().unwrap();
+    assert_eq!(bits(&groom.curves()), start);
+    groom.redo().unwrap().unwrap();
+    assert_eq!(bits(&groom.curves()), combed);
+}

@@ -7,6 +7,7 @@
 //! egui, input) whose handlers share its state.
 
 use super::curves::{CurvesSession, CurvesSource};
+use super::grooming::{GroomingSession, PALETTE};
 use super::script::{Script, Step};
 use super::shells::{ShellSession, Tool};
 use anyhow::Context as _;
@@ -44,6 +45,8 @@ pub struct Timings {
     pub simulation_ms: Vec<f64>,
     /// Screenshots written.
     pub screenshots: Vec<PathBuf>,
+    /// Milliseconds each groom brush dab took (edit and regrowth).
+    pub dab_ms: Vec<f64>,
 }
 
 /// The control panel's width in logical pixels (egui adds its margins).
@@ -55,12 +58,16 @@ pub enum Content {
     Shells(Box<ShellScene>),
     /// A groom or curves file.
     Curves(CurvesSource),
+    /// A groom file, groomed by hand.
+    Groom(PathBuf),
 }
 
-/// A session in the window: shell fur, or a groom.
+/// A session in the window: shell fur, a groom to look at, or a groom to
+/// groom.
 enum Session {
     Shells(Box<ShellSession>),
     Curves(Box<CurvesSession>),
+    Groom(Box<GroomingSession>),
 }
 
 impl Session {
@@ -68,20 +75,28 @@ impl Session {
         match self {
             Session::Shells(s) => s.initial_orbit(aspect),
             Session::Curves(c) => c.initial_orbit(aspect),
+            Session::Groom(g) => g.initial_orbit(aspect),
         }
     }
 
     fn fps(&self) -> f32 {
         match self {
             Session::Shells(s) => s.scene().fps.max(1.0),
-            Session::Curves(_) => 24.0,
+            Session::Curves(_) | Session::Groom(_) => 24.0,
         }
     }
 
     fn shells(&mut self) -> Option<&mut ShellSession> {
         match self {
             Session::Shells(s) => Some(s),
-            Session::Curves(_) => None,
+            _ => None,
+        }
+    }
+
+    fn grooming(&mut self) -> Option<&mut GroomingSession> {
+        match self {
+            Session::Groom(g) => Some(g),
+            _ => None,
         }
     }
 
@@ -96,14 +111,18 @@ impl Session {
                 c.advance();
                 Ok(0.0)
             }
+            Session::Groom(_) => Ok(0.0),
         }
     }
 
-    fn panel(&mut self, ui: &mut egui::Ui) {
+    /// The panel; a groom's panel answers with the actions asked for.
+    fn panel(&mut self, ui: &mut egui::Ui) -> Option<super::grooming::PanelActions> {
         match self {
             Session::Shells(s) => s.panel(ui),
             Session::Curves(c) => c.panel(ui),
+            Session::Groom(g) => return Some(g.panel(ui)),
         }
+        None
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -119,6 +138,7 @@ impl Session {
         match self {
             Session::Shells(s) => Ok(s.encode(ctx, encoder, orbit, view, width, height)?),
             Session::Curves(c) => c.encode(ctx, encoder, orbit, view, width, height),
+            Session::Groom(g) => g.encode(ctx, encoder, orbit, view, width, height),
         }
     }
 }
@@ -169,6 +189,8 @@ struct WindowState {
     last_frame: Option<Instant>,
     screenshot_requests: Vec<PathBuf>,
     screenshots_taken: u32,
+    /// A scripted step that failed (a save that could not be written).
+    script_error: Option<anyhow::Error>,
 }
 
 #[derive(Debug, Default)]
@@ -178,6 +200,7 @@ struct Pointer {
     button: Option<MouseButton>,
     dragged: bool,
     shift: bool,
+    ctrl: bool,
 }
 
 struct ScriptRun {
@@ -225,9 +248,17 @@ impl ApplicationHandler for App {
                     event_loop.exit();
                 }
             },
-            WindowEvent::ModifiersChanged(m) => state.pointer.shift = m.state().shift_key(),
+            WindowEvent::ModifiersChanged(m) => {
+                state.pointer.shift = m.state().shift_key();
+                state.pointer.ctrl = m.state().control_key();
+            }
             _ if consumed => {}
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                if let Err(err) = state.groom_key(event.logical_key.as_ref()) {
+                    self.error = Some(err);
+                    event_loop.exit();
+                    return;
+                }
                 match event.logical_key.as_ref() {
                     Key::Named(NamedKey::Escape) | Key::Character("q") => event_loop.exit(),
                     Key::Named(NamedKey::F12) | Key::Character("p") => {
@@ -236,7 +267,7 @@ impl ApplicationHandler for App {
                             .screenshot_requests
                             .push(PathBuf::from(format!("pelage-view-{n:03}.png")));
                     }
-                    Key::Character("h") => state.show_ui = !state.show_ui,
+                    Key::Character("h") if !state.pointer.ctrl => state.show_ui = !state.show_ui,
                     Key::Character("r") => state.orbit = state.home,
                     Key::Character("s") => {
                         if let Some(s) = state.session.shells() {
@@ -319,6 +350,9 @@ impl WindowState {
             Content::Curves(source) => {
                 Session::Curves(Box::new(CurvesSession::new(&ctx, source, format)?))
             }
+            Content::Groom(path) => {
+                Session::Groom(Box::new(GroomingSession::new(&ctx, &path, format)?))
+            }
         };
         let show_ui = options.script.as_ref().is_none_or(|s| s.ui);
         // Framed in the part of the window the panel leaves free.
@@ -363,6 +397,7 @@ impl WindowState {
             last_frame: None,
             screenshot_requests: Vec::new(),
             screenshots_taken: 0,
+            script_error: None,
         })
     }
 
@@ -376,6 +411,99 @@ impl WindowState {
 
     fn aspect(&self) -> f32 {
         self.config.width as f32 / self.config.height.max(1) as f32
+    }
+
+    /// A key of the groom mode: brushes, radius, strength, mirror, undo,
+    /// redo, save. Other sessions ignore it.
+    fn groom_key(&mut self, key: Key<&str>) -> anyhow::Result<()> {
+        let ctrl = self.pointer.ctrl;
+        let shift = self.pointer.shift;
+        let Some(g) = self.session.grooming() else {
+            return Ok(());
+        };
+        let Key::Character(ch) = key else {
+            return Ok(());
+        };
+        let ch = ch.to_ascii_lowercase();
+        let c = &mut g.controls;
+        match ch.as_str() {
+            "z" if ctrl && shift => g.redo()?,
+            "z" if ctrl => g.undo()?,
+            "s" if ctrl => {
+                let path = g.default_save_path();
+                if let Err(e) = g.save(&path) {
+                    g.status = crate::one_line(&e);
+                }
+            }
+            _ if ctrl => {}
+            "[" => c.radius /= 1.25,
+            "]" => c.radius *= 1.25,
+            "," => c.strength = (c.strength - 0.1).max(-1.0),
+            "." => c.strength = (c.strength + 0.1).min(1.0),
+            "m" => c.mirror_x = !c.mirror_x,
+            "-" => c.brush = PALETTE.len() - 1,
+            "0" => c.brush = 9,
+            d if d.len() == 1 && ("1"..="9").contains(&d) => {
+                c.brush = d.parse::<usize>().expect("a digit") - 1;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// A scripted stroke: dabs along the pixels from `from` to `to`.
+    fn scripted_stroke(&mut self, step: &super::script::BrushStep) {
+        let pixels: Vec<Vec2> = {
+            let (from, to) = (
+                Vec2::from(step.from),
+                Vec2::from(step.to.unwrap_or(step.from)),
+            );
+            let dabs = step.dabs.max(1);
+            (0..=dabs)
+                .map(|k| from.lerp(to, k as f32 / dabs as f32))
+                .collect()
+        };
+        let rays: Vec<(Vec3, Vec3)> = pixels.iter().map(|p| self.ray(*p)).collect();
+        let Some(g) = self.session.grooming() else {
+            eprintln!("warning: `brush` is for `--groom`; ignored");
+            return;
+        };
+        let c = &mut g.controls;
+        c.brush = PALETTE
+            .iter()
+            .position(|n| *n == step.name)
+            .expect("checked when the script was read");
+        c.radius = step.radius.unwrap_or(c.radius);
+        c.strength = step.strength.unwrap_or(c.strength);
+        c.mirror_x = step.mirror.unwrap_or(c.mirror_x);
+        if let Some(layer) = &step.layer {
+            c.layer = layer.clone();
+        }
+        c.value = step.value.unwrap_or(c.value);
+        c.region = step.region.unwrap_or(c.region);
+        c.add_count = step.count.unwrap_or(c.add_count);
+        if let Some(f) = step
+            .falloff
+            .as_deref()
+            .and_then(pelage::groom::brush::Falloff::parse)
+        {
+            c.falloff = f;
+        }
+        g.begin_stroke();
+        let mut missed = true;
+        for (origin, direction) in rays {
+            match g.stroke_to(origin, direction) {
+                Ok(hit) => missed &= !hit,
+                Err(e) => g.status = crate::one_line(&e),
+            }
+        }
+        g.end_stroke();
+        if missed {
+            eprintln!(
+                "warning: the {} stroke at pixel {:?} missed the mesh",
+                step.name, step.from
+            );
+        }
     }
 
     /// The ray through a window pixel (x right, y down).
@@ -422,6 +550,20 @@ impl WindowState {
     }
 
     fn mouse_button(&mut self, button: MouseButton, pressed: bool) {
+        if button == MouseButton::Left && matches!(self.session, Session::Groom(_)) {
+            let position = self.pointer.position;
+            let (origin, direction) = self.ray(position);
+            if let Some(g) = self.session.grooming() {
+                if pressed {
+                    g.begin_stroke();
+                    if let Err(e) = g.stroke_to(origin, direction) {
+                        g.status = crate::one_line(&e);
+                    }
+                } else {
+                    g.end_stroke();
+                }
+            }
+        }
         let p = &mut self.pointer;
         if pressed {
             p.pressed_at = Some(p.position);
@@ -433,7 +575,7 @@ impl WindowState {
         let position = p.position;
         let tool = match &self.session {
             Session::Shells(s) => s.controls.tool,
-            Session::Curves(_) => return,
+            Session::Curves(_) | Session::Groom(_) => return,
         };
         p.button = None;
         p.pressed_at = None;
@@ -466,6 +608,14 @@ impl WindowState {
             Some(MouseButton::Left) if matches!(&self.session, Session::Shells(s) if s.controls.tool == Tool::Push) =>
             {
                 self.push_at(start, position);
+            }
+            Some(MouseButton::Left) if matches!(&self.session, Session::Groom(_)) => {
+                let (origin, direction) = self.ray(position);
+                if let Some(g) = self.session.grooming()
+                    && let Err(e) = g.stroke_to(origin, direction)
+                {
+                    g.status = crate::one_line(&e);
+                }
             }
             Some(MouseButton::Right) if !self.pointer.shift => {
                 self.orbit.orbit(-delta.x * 0.01, delta.y * 0.01);
@@ -541,12 +691,61 @@ impl WindowState {
                             t.hairs = show.hairs.unwrap_or(t.hairs);
                             t.guides = show.guides.unwrap_or(t.guides);
                             t.roots = show.roots.unwrap_or(t.roots);
+                            if show.layer.is_some() {
+                                eprintln!("warning: `show.layer` is for `--groom`; ignored");
+                            }
                             t.percent = show.percent.map_or(t.percent, |p| p.clamp(0.1, 100.0));
+                        }
+                        Session::Groom(g) => {
+                            let t = &mut g.controls;
+                            t.skin = show.skin.unwrap_or(t.skin);
+                            t.hairs = show.hairs.unwrap_or(t.hairs);
+                            t.guides = show.guides.unwrap_or(t.guides);
+                            t.show_layer = show.layer.unwrap_or(t.show_layer);
                         }
                         Session::Shells(_) => {
                             eprintln!("warning: `show` is for groom and curves views; ignored");
                         }
                     },
+                    Step::Brush(b) => self.scripted_stroke(&b),
+                    Step::Undo(n) | Step::Redo(n) => {
+                        let undo = matches!(step, Step::Undo(_));
+                        if let Some(g) = self.session.grooming() {
+                            for _ in 0..n {
+                                let done = if undo { g.undo() } else { g.redo() };
+                                if let Err(e) = done {
+                                    g.status = crate::one_line(&e);
+                                }
+                            }
+                        } else {
+                            eprintln!("warning: undo and redo are for `--groom`; ignored");
+                        }
+                    }
+                    Step::Save(ref path) | Step::Export(ref path) => {
+                        let save = matches!(step, Step::Save(_));
+                        match self.session.grooming() {
+                            Some(g) => {
+                                let done = if save { g.save(path) } else { g.export(path) };
+                                if let Err(e) = done {
+                                    self.script_error = Some(e);
+                                    open = false;
+                                    break;
+                                }
+                            }
+                            None => {
+                                eprintln!("warning: save and export are for `--groom`; ignored")
+                            }
+                        }
+                    }
+                    Step::Fraction(percent) => {
+                        if let Some(g) = self.session.grooming()
+                            && let Err(e) = g.set_percent(percent)
+                        {
+                            self.script_error = Some(e);
+                            open = false;
+                            break;
+                        }
+                    }
                     Step::Quit(true) => {
                         open = false;
                         break;
@@ -595,6 +794,7 @@ impl WindowState {
         let simulation_ms = timings.simulation_ms.last().copied().unwrap_or(0.0);
         let show_ui = self.show_ui;
         let session = &mut self.session;
+        let mut actions = None;
         let mut output = self.egui.egui_ctx().run_ui(input, |ui| {
             if !show_ui {
                 return;
@@ -609,7 +809,7 @@ impl WindowState {
                         ));
                         ui.small("left: tool · right drag: orbit · shift/middle: pan · wheel: zoom · P: screenshot · H: hide · R: reset · S: shake");
                         ui.separator();
-                        session.panel(ui);
+                        actions = session.panel(ui);
                     });
                 });
         });
@@ -632,6 +832,31 @@ impl WindowState {
         let freed: Vec<egui::TextureId> = textures.free.iter().copied().collect();
         textures.clear();
 
+        if let (Some(a), Some(g)) = (actions, self.session.grooming()) {
+            if a.undo {
+                g.undo()?;
+            }
+            if a.redo {
+                g.redo()?;
+            }
+            if a.save {
+                let path = g.default_save_path();
+                if let Err(e) = g.save(&path) {
+                    g.status = crate::one_line(&e);
+                }
+            }
+            if let Some(percent) = a.percent {
+                g.set_percent(percent)?;
+            }
+        }
+        if let Some(err) = self.script_error.take() {
+            return Err(err);
+        }
+        if let Some(g) = self.session.grooming()
+            && g.dab_ms.len() != timings.dab_ms.len()
+        {
+            timings.dab_ms = g.dab_ms.clone();
+        }
         let simulation = self.session.update(&self.ctx, dt)?;
         timings.simulation_ms.push(simulation);
 

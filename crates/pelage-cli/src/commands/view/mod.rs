@@ -12,6 +12,8 @@ mod app;
 #[cfg(feature = "viewer")]
 mod curves;
 #[cfg(feature = "viewer")]
+mod grooming;
+#[cfg(feature = "viewer")]
 pub mod script;
 #[cfg(feature = "viewer")]
 mod shells;
@@ -38,6 +40,10 @@ pub struct ViewArgs {
     /// script, or after a few frames without one.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+    /// Groom the groom file by hand: brushes on its guides and paint
+    /// layers, undo, redo, save (docs/grooming.md).
+    #[arg(long)]
+    pub groom: bool,
     /// Window size, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x800", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -64,6 +70,18 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         .as_deref()
         .map_or("embedded spot".into(), |p| p.display().to_string());
     let content = match &args.input {
+        Some(path) if args.groom => {
+            if !is_groom_file(path)? {
+                anyhow::bail!(
+                    "{}: `--groom` grooms a groom file (TOML with [roots], [guides], …; docs/groom-format.md)",
+                    path.display()
+                );
+            }
+            app::Content::Groom(path.clone())
+        }
+        None if args.groom => anyhow::bail!(
+            "`--groom` needs a groom file: `pelage view fur.toml --groom` (`pelage demo` writes one)"
+        ),
         None => app::Content::Shells(Box::new(ShellScene::spot())),
         Some(path) if is_groom_file(path)? => {
             app::Content::Curves(curves::CurvesSource::Groom(path.clone()))
@@ -134,6 +152,14 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     };
+    if !timings.dab_ms.is_empty() {
+        println!(
+            "{} brush dabs: median {:.1} ms (edit and regrowth), slowest {:.1} ms",
+            timings.dab_ms.len(),
+            median(&timings.dab_ms),
+            timings.dab_ms.iter().copied().fold(0.0, f64::max)
+        );
+    }
     println!(
         "{} frames on {}: frame time median {:.1} ms ({:.1} fps), simulation median {:.2} ms",
         timings.frame_ms.len() + 1,

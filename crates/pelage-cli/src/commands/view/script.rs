@@ -20,6 +20,18 @@
 //! show = { skin = false, guides = true, percent = 10 }       # groom views
 //! [[step]]
 //! time = 0.4                         # hold a skinned scene's clip at 0.4 s
+//!
+//! # `pelage view fur.toml --groom`:
+//! [[step]]
+//! brush = { name = "comb", from = [500, 300], to = [560, 330], radius = 0.1, strength = 0.8 }
+//! [[step]]
+//! undo = 1                           # and redo = 1
+//! [[step]]
+//! save = "fur_groomed.toml"          # groom file + guides + paint layers
+//! [[step]]
+//! export = "shown.usdc"              # the hairs the window shows
+//! [[step]]
+//! fraction = 10                      # percent of the hairs grown
 //! ```
 
 use pelage::groom::GroomError;
@@ -59,8 +71,58 @@ pub enum Step {
     Time(f32),
     /// What a groom view draws: the panel's toggles.
     Show(ShowStep),
+    /// A brush stroke in the groom mode (`--groom`), dabs along the
+    /// pixels from `from` to `to`.
+    Brush(BrushStep),
+    /// Undo this many edits (`--groom`).
+    Undo(u32),
+    /// Redo this many edits (`--groom`).
+    Redo(u32),
+    /// Save the groom file, its guides and paint layers (`--groom`).
+    Save(PathBuf),
+    /// Write the hairs the window shows to a curves file (`--groom`).
+    Export(PathBuf),
+    /// Grow this percentage of the groom's hairs (`--groom`).
+    Fraction(f32),
     /// Close the window.
     Quit(bool),
+}
+
+/// `brush = { name, from, to, dabs, radius, strength, … }`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BrushStep {
+    /// The brush (`comb`, `length`, `cut`, `smooth`, `puff`, `clump`,
+    /// `spread`, `add`, `delete`, `paint`, `part`).
+    pub name: String,
+    /// Where the stroke starts (window pixel).
+    pub from: [f32; 2],
+    /// Where it ends (default: where it starts).
+    pub to: Option<[f32; 2]>,
+    /// Dabs along it (default 8; dabs closer than a quarter of the radius
+    /// on the skin are skipped, as a person's are).
+    #[serde(default = "default_dabs")]
+    pub dabs: u32,
+    /// Radius in world units (default: the panel's).
+    pub radius: Option<f32>,
+    /// Strength (default: the panel's).
+    pub strength: Option<f32>,
+    /// `smooth`, `linear` or `constant`.
+    pub falloff: Option<String>,
+    /// X-mirror.
+    pub mirror: Option<bool>,
+    /// The paint brush's layer.
+    pub layer: Option<String>,
+    /// The paint brush's value.
+    pub value: Option<f32>,
+    /// The part brush's region.
+    pub region: Option<u32>,
+    /// Guides an `add` dab adds.
+    pub count: Option<u32>,
+}
+
+fn default_dabs() -> u32 {
+    8
 }
 
 /// `drop = { at, radius, wetness }`.
@@ -104,6 +166,8 @@ pub struct ShowStep {
     pub roots: Option<bool>,
     /// Percentage of hairs drawn.
     pub percent: Option<f32>,
+    /// Hairs coloured by the paint layer (`--groom`).
+    pub layer: Option<bool>,
 }
 
 fn default_push_frames() -> u32 {
@@ -147,9 +211,41 @@ impl Script {
             .into_iter()
             .map(|step| match step {
                 Step::Screenshot(p) if p.is_relative() => Step::Screenshot(folder.join(p)),
+                Step::Save(p) if p.is_relative() => Step::Save(folder.join(p)),
+                Step::Export(p) if p.is_relative() => Step::Export(folder.join(p)),
                 other => other,
             })
-            .collect();
+            .collect::<Vec<_>>();
+        for step in &steps {
+            if let Step::Brush(b) = step
+                && !super::grooming::PALETTE.contains(&b.name.as_str())
+            {
+                return Err(GroomError::new(
+                    source.path.clone(),
+                    None,
+                    Some("step.brush.name".into()),
+                    pelage::groom::GroomErrorKind::Invalid(format!(
+                        "no brush '{}': use one of {}",
+                        b.name,
+                        super::grooming::PALETTE.join(", ")
+                    )),
+                ));
+            }
+            if let Step::Brush(BrushStep {
+                falloff: Some(f), ..
+            }) = step
+                && pelage::groom::brush::Falloff::parse(f).is_none()
+            {
+                return Err(GroomError::new(
+                    source.path.clone(),
+                    None,
+                    Some("step.brush.falloff".into()),
+                    pelage::groom::GroomErrorKind::Invalid(format!(
+                        "falloff '{f}': use smooth, linear or constant"
+                    )),
+                ));
+            }
+        }
         Ok(Self { ui: file.ui, steps })
     }
 

@@ -334,6 +334,25 @@ impl EditableGroom {
         Ok(regrowth)
     }
 
+    /// Joins the last `n` undo steps into one, undone and redone together
+    /// (a stroke's dabs, as a groomer expects one Ctrl+Z to take back).
+    pub fn join_last_steps(&mut self, n: usize) {
+        let n = n.min(self.undo.len());
+        if n < 2 {
+            return;
+        }
+        let steps = self.undo.split_off(self.undo.len() - n);
+        let bytes = steps.iter().map(|s| s.bytes).sum();
+        let (forward, mut inverse): (Vec<Edit>, Vec<Edit>) =
+            steps.into_iter().map(|s| (s.forward, s.inverse)).unzip();
+        inverse.reverse();
+        self.undo.push(Step {
+            forward: Edit::Group(forward),
+            inverse: Edit::Group(inverse),
+            bytes,
+        });
+    }
+
     /// Undoes the last edit (`None`: nothing to undo).
     pub fn undo(&mut self) -> Result<Option<Regrowth>, GroomError> {
         let Some(step) = self.undo.pop() else {
