@@ -66,6 +66,8 @@ pub struct Generator {
     /// Whether a `clump` searches for centres: only then do roots carry
     /// the ball around their triangle.
     pub(super) clumps: bool,
+    /// Whether clump centres record the guides they depend on.
+    records_centre_guides: bool,
     pub(super) normals: bool,
     pub(super) seed: u64,
     /// Arrays of parts handed back by [`Self::recycle`], for the next parts.
@@ -93,6 +95,9 @@ pub(crate) struct Reuse<'a> {
     /// With `weights`: the only guides whose shape changed (`None`: any
     /// may have). Clump centres of other guides keep their shapes.
     pub(crate) moved_guides: Option<&'a [u32]>,
+    /// Record the guides each clump centre depends on (an editable groom
+    /// reads them; a groom grown once does not pay for them).
+    pub(crate) centre_guides: bool,
 }
 
 /// A part's roots, ordered by triangle, and their hairs' ids.
@@ -134,6 +139,7 @@ impl Generator {
                 regions: true,
                 weights: true,
                 moved_guides: None,
+                centre_guides: self.records_centre_guides,
             },
         )
     }
@@ -301,6 +307,7 @@ impl Generator {
             colors,
             opacities,
             clumps: false,
+            records_centre_guides: reuse.centre_guides,
             normals: finish.normals,
             // A frame's generator (`reshaped`) grows parts of the same
             // sizes: it reuses its parent's arrays.
@@ -398,7 +405,10 @@ impl Generator {
         // Reshaped, the centres depend on the guides they did before.
         match previous.and_then(|(old, _)| old.guides_shared()) {
             Some(guides) => centres.with_shared_guides(guides),
-            None => centres.with_guides(self.centre_guides(k, roots)),
+            None if self.records_centre_guides => {
+                centres.with_guides(self.centre_guides(k, roots))
+            }
+            None => centres,
         }
     }
 

@@ -962,7 +962,12 @@ impl WindowState {
         let view = texture.create_view(&Default::default());
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         self.draw(&mut encoder, &view, paint, screen)?;
-        let image = pelage_gpu::read_texture(&self.ctx, encoder, &texture)?;
+        let mut image = pelage_gpu::read_texture(&self.ctx, encoder, &texture)?;
+        // An opaque window shows the colours and ignores alpha (which the
+        // curve ribbons' blending leaves below 1): so does the screenshot.
+        if self.config.alpha_mode == wgpu::CompositeAlphaMode::Opaque {
+            image.pixels_mut().for_each(|p| p.0[3] = 255);
+        }
         if let Some(folder) = path.parent().filter(|f| !f.as_os_str().is_empty()) {
             std::fs::create_dir_all(folder)
                 .with_context(|| format!("cannot create {}", folder.display()))?;

@@ -155,7 +155,13 @@ impl EditableGroom {
             ));
         }
         check_fraction(&spec, fraction)?;
-        let generator = spec.clone().generator()?;
+        let generator = Generator::rebuilt(
+            spec.clone(),
+            Reuse {
+                centre_guides: true,
+                ..Reuse::default()
+            },
+        )?;
         let mesh = &spec.mesh;
         let bvh = Arc::new(TriangleBvh::new(mesh.positions(), mesh.triangles()));
         let mut groom = Self {
@@ -640,8 +646,12 @@ impl EditableGroom {
                 regions: k.regions,
                 weights: k.weights,
                 moved_guides: k.only_guides_moved.then_some(&change.moved_guides[..]),
+                centre_guides: true,
             },
-            None => Reuse::default(),
+            None => Reuse {
+                centre_guides: true,
+                ..Reuse::default()
+            },
         };
         let generator = Generator::rebuilt(spec.clone(), reuse)?;
         if generator.root_cells().is_none() {
