@@ -180,32 +180,49 @@ pub struct MeshSection {
 
 impl MeshSection {
     /// The mesh it names (`"spot"`: the embedded one, otherwise a file
-    /// relative to `folder`), subdivided as asked.
+    /// relative to `folder`), subdivided as asked, with its paint layers.
     pub fn load(&self, folder: &std::path::Path) -> Result<crate::Mesh, crate::mesh::MeshError> {
+        self.with_layers(self.load_mesh(folder)?, folder)
+    }
+
+    /// The mesh it names, subdivided, without `layers`.
+    pub fn load_mesh(
+        &self,
+        folder: &std::path::Path,
+    ) -> Result<crate::Mesh, crate::mesh::MeshError> {
         let mesh = match self.path.get_ref().as_str() {
             "spot" => crate::assets::spot(),
             path => crate::Mesh::load(folder.join(path))?,
         };
-        let mut mesh = match self.subdivide {
-            0 => mesh,
-            n => mesh.subdivided_within_limits(n)?,
+        match self.subdivide {
+            0 => Ok(mesh),
+            n => mesh.subdivided_within_limits(n),
+        }
+    }
+
+    /// `mesh` with the paint layers of `layers` (none: as it is).
+    pub fn with_layers(
+        &self,
+        mut mesh: crate::Mesh,
+        folder: &std::path::Path,
+    ) -> Result<crate::Mesh, crate::mesh::MeshError> {
+        let Some(layers) = &self.layers else {
+            return Ok(mesh);
         };
-        if let Some(layers) = &self.layers {
-            let path = folder.join(layers.get_ref());
-            let painted = crate::Mesh::load(&path)?;
-            if painted.vertex_count() != mesh.vertex_count() {
-                return Err(crate::mesh::MeshError::whole(
-                    path.display().to_string(),
-                    crate::mesh::MeshErrorKind::Inconsistent(format!(
-                        "the paint layers have {} vertices where the mesh has {}: they were painted on another mesh (or another subdivision)",
-                        painted.vertex_count(),
-                        mesh.vertex_count()
-                    )),
-                ));
-            }
-            for layer in painted.vertex_attributes() {
-                mesh = mesh.with_vertex_attribute(layer.name.clone(), layer.values.to_vec())?;
-            }
+        let path = folder.join(layers.get_ref());
+        let painted = crate::Mesh::load(&path)?;
+        if painted.vertex_count() != mesh.vertex_count() {
+            return Err(crate::mesh::MeshError::whole(
+                path.display().to_string(),
+                crate::mesh::MeshErrorKind::Inconsistent(format!(
+                    "the paint layers have {} vertices where the mesh has {}: they were painted on another mesh (or another subdivision)",
+                    painted.vertex_count(),
+                    mesh.vertex_count()
+                )),
+            ));
+        }
+        for layer in painted.vertex_attributes() {
+            mesh = mesh.with_vertex_attribute(layer.name.clone(), layer.values.to_vec())?;
         }
         Ok(mesh)
     }

@@ -405,9 +405,7 @@ impl Generator {
         // Reshaped, the centres depend on the guides they did before.
         match previous.and_then(|(old, _)| old.guides_shared()) {
             Some(guides) => centres.with_shared_guides(guides),
-            None if self.records_centre_guides => {
-                centres.with_guides(self.centre_guides(k, roots))
-            }
+            None if self.records_centre_guides => centres.with_guides(self.centre_guides(k, roots)),
             None => centres,
         }
     }

@@ -514,12 +514,20 @@ pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>, ids: HairI
     wanted.min(most).max(1)
 }
 
-/// The mesh a `[mesh]` section names, subdivided as asked; a mesh that
-/// cannot be loaded is reported at its line.
+/// The mesh a `[mesh]` section names, subdivided as asked, with its paint
+/// layers; a mesh that cannot be loaded is reported at its line, layers
+/// that cannot at theirs.
 fn load_mesh_section(source: &SettingsSource, section: &MeshSection) -> Result<Mesh, GroomError> {
+    let mesh = section
+        .load_mesh(source.folder())
+        .map_err(|e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e)))?;
+    let at = section
+        .layers
+        .as_ref()
+        .map_or(section.path.span(), |l| l.span());
     section
-        .load(source.folder())
-        .map_err(|e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e)))
+        .with_layers(mesh, source.folder())
+        .map_err(|e| source.error_at(at, GroomErrorKind::Mesh(e)))
 }
 
 /// Whether a path names a curves file that can hold time samples (USD,
