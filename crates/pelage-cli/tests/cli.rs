@@ -1276,3 +1276,58 @@ fn groom_reports_unused_guides_regions_and_part_counts() {
     let region_hairs: u64 = regions.iter().map(|r| r["hairs"].as_u64().unwrap()).sum();
     assert_eq!(region_hairs, 3000);
 }
+
+#[test]
+fn groom_fraction_writes_a_subset_of_the_full_groom_with_wider_hairs() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("fur.toml");
+    std::fs::write(&groom, SMALL_GROOM).unwrap();
+    let write = |name: &str, extra: &[&str]| {
+        let path = dir.path().join(name);
+        let mut args = vec![
+            "groom",
+            groom.to_str().unwrap(),
+            "-o",
+            path.to_str().unwrap(),
+            "-q",
+        ];
+        args.extend_from_slice(extra);
+        let out = pelage(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        pelage::io::read_curves(&path).unwrap()
+    };
+    let full = write("full.usdc", &[]);
+    let tenth = write("tenth.usdc", &["--fraction", "0.1"]);
+    let index: std::collections::HashMap<u64, usize> = full
+        .ids()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .map(|(i, id)| (*id, i))
+        .collect();
+    // strands = 2: two curves a root.
+    assert_eq!(tenth.curve_count(), 600);
+    let scale = (1.0 / 0.1f64.sqrt()) as f32;
+    for i in 0..tenth.curve_count() {
+        let j = index[&tenth.ids().unwrap()[i]];
+        assert_eq!(tenth.points()[tenth.range(i)], full.points()[full.range(j)]);
+        let widened: Vec<f32> = full.widths()[full.range(j)]
+            .iter()
+            .map(|w| w * scale)
+            .collect();
+        assert_eq!(tenth.widths()[tenth.range(i)], widened[..]);
+    }
+    // The groom file's own fraction, checked at its line.
+    std::fs::write(&groom, format!("{SMALL_GROOM}[output]\nfraction = 0\n")).unwrap();
+    let out = pelage(&["groom", groom.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("fur.toml:22:12: output.fraction"),
+        "{}",
+        stderr(&out)
+    );
+    std::fs::write(&groom, SMALL_GROOM).unwrap();
+    let out = pelage(&["groom", groom.to_str().unwrap(), "--fraction", "1.5"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--fraction"), "{}", stderr(&out));
+}

@@ -95,6 +95,58 @@ fn raising_the_count_keeps_every_hair_bit_for_bit_and_lowering_it_moves_none() {
 }
 
 #[test]
+fn a_fraction_is_a_subset_of_the_groom_with_wider_hairs_and_fractions_nest() {
+    let density = Map::parse("noise:frequency=3,offset=0.6,scale=0.4").unwrap();
+    let spec = |fraction: f64| {
+        let mut s = spot_spec(8_000, density.clone());
+        s.roots.fraction = fraction;
+        s
+    };
+    let grown = |f: f64| grow(&spec(f).generator().unwrap());
+    let (full, fifth, tenth) = (grown(1.0), grown(0.2), grown(0.1));
+    let (full_ids, fifth_ids, tenth_ids) = (by_id(&full), by_id(&fifth), by_id(&tenth));
+    assert_eq!(
+        (full_ids.len(), fifth_ids.len(), tenth_ids.len()),
+        (8_000, 1_600, 800)
+    );
+    for (small, large) in [(&tenth_ids, &fifth_ids), (&fifth_ids, &full_ids)] {
+        for (id, hair) in small {
+            assert_eq!(
+                large.get(id),
+                Some(hair),
+                "hair {id} is not kept bit for bit"
+            );
+        }
+    }
+    // Widths: the full groom's times 1/√F.
+    let widths = |parts: &[Curves]| -> HashMap<u64, Vec<f32>> {
+        parts
+            .iter()
+            .flat_map(|c| {
+                (0..c.curve_count())
+                    .map(move |i| (c.ids().unwrap()[i], c.widths()[c.range(i)].to_vec()))
+            })
+            .collect()
+    };
+    let (full_w, tenth_w) = (widths(&full), widths(&tenth));
+    let scale = (1.0 / 0.1f64.sqrt()) as f32;
+    for (id, w) in &tenth_w {
+        let expected: Vec<f32> = full_w[id].iter().map(|x| x * scale).collect();
+        assert_eq!(w, &expected, "hair {id}'s widths");
+    }
+    // A fraction of grooms that renumber or thin every root is refused.
+    let mut sequential = spec(0.5);
+    sequential.roots.ids = pelage::groom::HairIds::Sequential;
+    let err = sequential.generator().unwrap_err().to_string();
+    assert!(
+        err.contains("output.fraction") && err.contains("stable ids"),
+        "{err}"
+    );
+    assert!(spec(0.0).generator().is_err());
+    assert!(spec(1.5).generator().is_err());
+}
+
+#[test]
 fn a_local_density_edit_leaves_hairs_far_from_it_in_place() {
     // A 32×32 density, then the same with a bright block at UV (0.7–0.85, 0.2–0.35).
     let texels = |edited: bool| {

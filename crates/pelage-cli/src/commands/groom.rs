@@ -41,6 +41,12 @@ pub struct GroomArgs {
     /// Override the groom file's seed.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Write this share of the hairs (0 to 1; replaces `[output]
+    /// fraction`): the hairs a full groom would have, chosen by stable id,
+    /// so 0.1 is a subset of 0.2; widths times 1/√F so the fur covers the
+    /// skin as the whole groom does. For layout, crowds and viewports.
+    #[arg(long, value_name = "F")]
+    pub fraction: Option<f64>,
     /// Frames of an animated skin, e.g. 1-24 (replaces `[animation]
     /// frames`; makes the groom animated when the file has no
     /// `[animation]`). Output: one .usdc or .abc with time samples.
@@ -78,7 +84,10 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
             .context("cannot set up the worker threads")?;
     }
     let start = Instant::now();
-    let groom = Groom::load_with_frames(&args.file, args.frames.clone())?;
+    let mut groom = Groom::load_with_frames(&args.file, args.frames.clone())?;
+    if let Some(fraction) = args.fraction {
+        groom.set_fraction(fraction)?;
+    }
     let output = args.output.clone().unwrap_or_else(|| groom.output_path());
     if args.assemble {
         return assemble(&groom, &output);
@@ -107,7 +116,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         bail!("{}: {}", path.display(), CurvesFormat::UNKNOWN_FOR_WRITING);
     }
     pelage::io::check_output(&path)?;
-    let count = groom.hair_count();
+    let count = groom.grown_count();
     let share = count as u128 * range.len() as u128 / parts.max(1) as u128;
     // Positions alone (12 bytes a point) are a floor of any format's size.
     let points = groom.points_per_hair() as u64;

@@ -490,6 +490,9 @@ pub struct OutputSection {
     /// `catmull-rom` (default) or `linear`.
     #[serde(default)]
     pub basis: CurveBasis,
+    /// The share of the hairs written (a preview that stays true to the
+    /// groom): see [`crate::groom::RootsSpec::fraction`].
+    pub fraction: Option<Spanned<f64>>,
 }
 
 #[cfg(test)]

@@ -68,6 +68,9 @@ pub struct Generator {
     pub(super) clumps: bool,
     /// Whether clump centres record the guides they depend on.
     records_centre_guides: bool,
+    /// Every width's factor: `1/√fraction`, so a preview covers the skin
+    /// as the whole groom does.
+    pub(super) width_scale: f32,
     pub(super) normals: bool,
     pub(super) seed: u64,
     /// Arrays of parts handed back by [`Self::recycle`], for the next parts.
@@ -166,6 +169,26 @@ impl Generator {
             }
             moved
         });
+        let fraction = spec.roots.fraction;
+        if !(fraction > 0.0 && fraction <= 1.0) {
+            return Err(spec.error(
+                "output.fraction",
+                GroomErrorKind::Invalid(format!(
+                    "fraction = {fraction}: the share of the hairs grown is above 0 and at most 1"
+                )),
+            ));
+        }
+        if fraction < 1.0
+            && (spec.roots.ids != HairIds::Stable
+                || spec.roots.distribution != RootDistribution::Random)
+        {
+            return Err(spec.error(
+                "output.fraction",
+                GroomErrorKind::Invalid(
+                    "a fraction grows the first arrivals of the root cells, so that it is a subset of the groom: it needs stable ids and random roots (remove `ids = \"sequential\"` or `distribution = \"blue-noise\"`)".into(),
+                ),
+            ));
+        }
         let count = spec.roots.count;
         if count == 0 {
             return Err(spec.error(
@@ -218,11 +241,13 @@ impl Generator {
                 let mesh = &spec.mesh;
                 let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
                     .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
-                let parts = part_count(mesh, count, spec.roots.parts, spec.roots.ids);
+                // A fraction grows the first arrivals: a subset of the groom.
+                let grown = spec.roots.grown_count();
+                let parts = part_count(mesh, grown, spec.roots.parts, spec.roots.ids);
                 let (cells, layout) = match spec.roots.ids {
                     HairIds::Stable => {
                         let cells = RootCells::new(mesh, &sampler);
-                        let counts = cells.counts(spec.roots.seed, count);
+                        let counts = cells.counts(spec.roots.seed, grown);
                         let layout = PartLayout::from_cells(&cells, &counts, parts);
                         (Some(Arc::new(cells)), layout)
                     }
@@ -308,6 +333,11 @@ impl Generator {
             opacities,
             clumps: false,
             records_centre_guides: reuse.centre_guides,
+            width_scale: if roots.fraction < 1.0 {
+                (1.0 / roots.fraction.sqrt()) as f32
+            } else {
+                1.0
+            },
             normals: finish.normals,
             // A frame's generator (`reshaped`) grows parts of the same
             // sizes: it reuses its parent's arrays.

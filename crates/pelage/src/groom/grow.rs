@@ -257,6 +257,11 @@ impl Generator {
                                 let range = i * n..(i + 1) * n;
                                 p[range.clone()].copy_from_slice(&hair.points);
                                 w[range.clone()].copy_from_slice(&hair.widths);
+                                if self.width_scale != 1.0 {
+                                    w[range.clone()]
+                                        .iter_mut()
+                                        .for_each(|x| *x *= self.width_scale);
+                                }
                                 if self.colors {
                                     c[range.clone()].copy_from_slice(&hair.colors);
                                 }
@@ -330,7 +335,8 @@ impl Generator {
             for hair in ws.batch.hairs() {
                 let a = &mut out.arrays;
                 a.points.extend_from_slice(&hair.points);
-                a.widths.extend_from_slice(&hair.widths);
+                a.widths
+                    .extend(hair.widths.iter().map(|x| x * self.width_scale));
                 if self.colors {
                     a.colors.extend_from_slice(&hair.colors);
                 }

@@ -32,6 +32,8 @@ pub struct Groom {
     guides: Arc<Guides>,
     bind_report: Option<BindReport>,
     animation: Option<LoadedAnimation>,
+    /// `--fraction`, in place of `[output] fraction`.
+    fraction: Option<f64>,
 }
 
 /// What `[animation]` (or `--frames`) loaded.
@@ -197,6 +199,7 @@ impl Groom {
             guides: Arc::new(guides),
             bind_report,
             animation,
+            fraction: None,
         })
     }
 
@@ -251,6 +254,39 @@ impl Groom {
     /// multiplies them).
     pub fn hair_count(&self) -> u64 {
         *self.file.roots.count.get_ref()
+    }
+
+    /// The share of the hairs grown: `--fraction` ([`Self::set_fraction`]),
+    /// else `[output] fraction`, else 1.
+    pub fn fraction(&self) -> f64 {
+        self.fraction
+            .or_else(|| self.file.output.fraction.as_ref().map(|f| *f.get_ref()))
+            .unwrap_or(1.0)
+    }
+
+    /// Grows this share of the hairs (a preview) in place of `[output]
+    /// fraction`. Fails unless it is in (0, 1].
+    pub fn set_fraction(&mut self, fraction: f64) -> Result<(), GroomError> {
+        if !(fraction > 0.0 && fraction <= 1.0) {
+            return Err(GroomError::new(
+                self.source.path.clone(),
+                None,
+                Some("--fraction".into()),
+                GroomErrorKind::Invalid(format!(
+                    "{fraction}: give the share of the hairs to grow, above 0 and at most 1"
+                )),
+            ));
+        }
+        self.fraction = Some(fraction);
+        Ok(())
+    }
+
+    /// The hairs grown: [`Self::hair_count`] times [`Self::fraction`],
+    /// rounded, at least 1.
+    pub fn grown_count(&self) -> u64 {
+        let mut roots = crate::groom::RootsSpec::new(self.hair_count());
+        roots.fraction = self.fraction();
+        roots.grown_count()
     }
 
     /// Points per hair (`[finish] points`).
@@ -310,7 +346,7 @@ impl Groom {
     pub fn part_count(&self) -> usize {
         part_count(
             &self.mesh,
-            *self.file.roots.count.get_ref(),
+            self.grown_count(),
             self.file.roots.parts.as_ref().map(|p| *p.get_ref()),
             self.file.roots.ids,
         )
@@ -367,7 +403,11 @@ impl Groom {
             parts: file.roots.parts.as_ref().map(|p| *p.get_ref()),
             ids: file.roots.ids,
             distribution: file.roots.distribution,
+            fraction: self.fraction(),
         };
+        if let Some(f) = &file.output.fraction {
+            mark(&mut lines, "output.fraction", source.line_of(f.span()));
+        }
         let method = &file.interpolation;
         let interpolation = match method.method {
             InterpolationKind::Shepard => InterpolationMethod::Shepard {

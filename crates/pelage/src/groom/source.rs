@@ -25,6 +25,11 @@ const GROOM_RULES: &[Rule] = &[
     ),
     Rule::new("roots.parts", Bound::Within(1.0, MAX_PARTS as f64), ""),
     Rule::new(
+        "output.fraction",
+        Bound::Above(0.0, 1.0),
+        "a share of the hairs",
+    ),
+    Rule::new(
         "guides.points",
         Bound::Within(2.0, MAX_CURVE_POINTS as f64),
         "points per guide",

@@ -176,6 +176,12 @@ pub struct RootsSpec {
     pub ids: HairIds,
     /// Independent random roots, or roots spread apart (blue noise).
     pub distribution: RootDistribution,
+    /// The share of the hairs grown (0 to 1; 1: all): a preview that stays
+    /// true to the groom. The first arrivals of the root cells (stable
+    /// ids), so a fraction's hairs are hairs of every larger fraction, bit
+    /// for bit, with widths times `1/√fraction` so the fur covers the skin
+    /// as the whole groom does.
+    pub fraction: f64,
 }
 
 /// How hairs are numbered and placed as the count or density changes.
@@ -247,7 +253,7 @@ impl RootDistribution {
 
 impl RootsSpec {
     /// `count` hairs, uniform density, seed 1, the default parts, stable
-    /// ids, random roots.
+    /// ids, random roots, all of them grown.
     pub fn new(count: u64) -> Self {
         Self {
             count,
@@ -256,7 +262,22 @@ impl RootsSpec {
             parts: None,
             ids: HairIds::default(),
             distribution: RootDistribution::default(),
+            fraction: 1.0,
         }
+    }
+
+    /// Sets the share of the hairs grown (a preview).
+    pub fn with_fraction(mut self, fraction: f64) -> Self {
+        self.fraction = fraction;
+        self
+    }
+
+    /// The hairs grown: `count` times the fraction, rounded, at least 1.
+    pub fn grown_count(&self) -> u64 {
+        if self.fraction >= 1.0 {
+            return self.count;
+        }
+        ((self.count as f64 * self.fraction).round() as u64).max(1)
     }
 
     /// Sets how hairs are numbered.

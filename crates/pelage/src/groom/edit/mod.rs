@@ -410,7 +410,8 @@ impl EditableGroom {
 
     /// Each root cell's count at the groom's fraction.
     fn counts(&self, generator: &Generator) -> Vec<u64> {
-        let hairs = ((self.spec.roots.count as f64 * self.fraction).round() as u64).max(1);
+        let grown = self.spec.roots.grown_count();
+        let hairs = ((grown as f64 * self.fraction).round() as u64).max(1);
         generator
             .root_cells()
             .expect("stable ids (checked when opened)")
