@@ -238,13 +238,16 @@ impl PyGroom {
     /// `frames` ("1-24", "1-48x2") makes it animated, or replaces the
     /// frames of its `[animation]`. `mesh` replaces the file's `[mesh]`
     /// (a DCC's mesh under a groom written for the command line).
+    /// `fraction` (0 to 1) grows that share of the hairs, a subset of the
+    /// groom by id with wider hairs (`[output] fraction`).
     #[staticmethod]
-    #[pyo3(signature = (path, *, frames = None, mesh = None))]
+    #[pyo3(signature = (path, *, frames = None, mesh = None, fraction = None))]
     fn load(
         py: Python<'_>,
         path: PathBuf,
         frames: Option<&str>,
         mesh: Option<&PyMesh>,
+        fraction: Option<f64>,
     ) -> PyResult<Self> {
         let frames = frames
             .map(pelage::anim::FrameRange::parse)
@@ -257,7 +260,11 @@ impl PyGroom {
         let groom = py
             .detach(|| {
                 let source = SettingsSource::read_groom(&path)?;
-                Groom::from_source_with_inputs(source, frames, inputs)
+                let mut groom = Groom::from_source_with_inputs(source, frames, inputs)?;
+                if let Some(fraction) = fraction {
+                    groom.set_fraction(fraction)?;
+                }
+                Ok(groom)
             })
             .map_err(|e| groom_error(e, false))?;
         Self::wrap(py, groom, false)

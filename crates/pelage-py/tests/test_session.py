@@ -90,3 +90,21 @@ def test_bad_brushes_say_what_to_do(filed_groom):
     with pytest.raises(pelage.PelageError, match="share of the hairs"):
         pelage.GroomSession(filed_groom, fraction=0.0)
     assert s.history == (0, 0)
+
+
+def test_a_loaded_fraction_is_a_subset_with_wider_hairs(filed_groom, tmp_path):
+    path = tmp_path / "fur.toml"
+    full = pelage.Groom.load(path).grow()
+    tenth = pelage.Groom.load(path, fraction=0.1).grow()
+    assert tenth.curve_count == round(full.curve_count / 10)
+    index = by_id(full)
+    for k, i in enumerate(tenth.ids):
+        j = index[int(i)]
+        a = tenth.points[tenth.offsets[k] : tenth.offsets[k + 1]]
+        b = full.points[full.offsets[j] : full.offsets[j + 1]]
+        assert np.array_equal(a, b)
+        wa = tenth.widths[tenth.offsets[k] : tenth.offsets[k + 1]]
+        wb = full.widths[full.offsets[j] : full.offsets[j + 1]]
+        assert np.array_equal(wa, wb * np.float32(1 / np.sqrt(0.1)))
+    with pytest.raises(pelage.PelageError, match="--fraction"):
+        pelage.Groom.load(path, fraction=2.0)

@@ -145,7 +145,13 @@ class Groom:
         base_dir: Optional[_Path] = None,
     ) -> None: ...
     @staticmethod
-    def load(path: _Path, *, frames: Optional[str] = None, mesh: Optional[Mesh] = None) -> "Groom": ...
+    def load(
+        path: _Path,
+        *,
+        frames: Optional[str] = None,
+        mesh: Optional[Mesh] = None,
+        fraction: Optional[float] = None,
+    ) -> "Groom": ...
     @staticmethod
     def from_text(text: str, *, path: _Path = "<groom>", mesh: Optional[Mesh] = None) -> "Groom": ...
     @property
