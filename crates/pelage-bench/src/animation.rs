@@ -135,6 +135,10 @@ struct AnimationFigures {
     paper_scaled: f64,
     rss: u64,
     peer: Result<BlenderDeform, String>,
+    /// Part 0 written over every frame to usdc, with and without
+    /// velocities (medians, alternated runs).
+    write_with_velocities_s: f64,
+    write_without_velocities_s: f64,
 }
 
 /// Runs the benchmark and prints its table (or its JSON).
@@ -170,6 +174,7 @@ fn measure(args: &AnimationBenchArgs) -> anyhow::Result<AnimationFigures> {
         rest_frame: 1.0,
         mode,
         shutter: Vec::new(),
+        velocities: true,
     };
     // Guides that ride the twisting skin, as a simulation following it
     // would give them.
@@ -307,6 +312,36 @@ fn measure(args: &AnimationBenchArgs) -> anyhow::Result<AnimationFigures> {
         Ok(())
     });
     scratch?;
+    // Velocities' cost: part 0 written over every frame, with and
+    // without them, runs alternated so that drift falls on both.
+    let without = AnimatedGroom::new(
+        spec.clone(),
+        skin.clone(),
+        AnimationSpec {
+            velocities: false,
+            ..animation(AnimationMode::Deform)
+        },
+        None,
+    )?;
+    let folder = std::env::temp_dir().join(format!("pelage-bench-anim-{}", std::process::id()));
+    std::fs::create_dir_all(&folder)?;
+    let file = folder.join("part.usdc");
+    let options = pelage::io::UsdOptions::default();
+    let (mut with_times, mut without_times) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        for (groom, times) in [(&deform, &mut with_times), (&without, &mut without_times)] {
+            let start = Instant::now();
+            groom.write(&file, 0..1, &options, false, |_| {})?;
+            times.push(start.elapsed().as_secs_f64());
+        }
+    }
+    let _ = std::fs::remove_dir_all(&folder);
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let (write_with_velocities_s, write_without_velocities_s) =
+        (median(&mut with_times), median(&mut without_times));
     let rss = peak_rss_bytes().unwrap_or(0);
     let peer = match args.peer {
         Some(super::groom::Peer::Blender) => {
@@ -330,6 +365,8 @@ fn measure(args: &AnimationBenchArgs) -> anyhow::Result<AnimationFigures> {
         paper_scaled,
         rss,
         peer,
+        write_with_velocities_s,
+        write_without_velocities_s,
     })
 }
 
@@ -365,6 +402,9 @@ impl AnimationFigures {
             "peer_from_scratch_s_per_frame": scratch_s,
             "paper_s_per_frame": paper_scaled,
             "peak_rss_bytes": rss,
+            "write_part_with_velocities_s": self.write_with_velocities_s,
+            "write_part_without_velocities_s": self.write_without_velocities_s,
+            "velocities_cost": self.write_with_velocities_s / self.write_without_velocities_s,
             "blender": match &peer {
                 Ok(b) => serde_json::json!({
                     "version": b.version,
@@ -440,7 +480,23 @@ impl AnimationFigures {
             Err(why) => println!("{:<66} not measured: {why}", "peer: Blender"),
         }
         println!(
-            "\ntargets: deform ≤ 0.25× growing, regrow ≤ 1.2× growing. Peak RSS {:.0} MB.",
+            "{:<66} {:>12.3} {:>12}",
+            format!(
+                "part 0 written to usdc, {} frames, with velocities",
+                times.len()
+            ),
+            self.write_with_velocities_s,
+            format!(
+                "{:.2}× without",
+                self.write_with_velocities_s / self.write_without_velocities_s
+            )
+        );
+        println!(
+            "{:<66} {:>12.3}",
+            "  without velocities", self.write_without_velocities_s
+        );
+        println!(
+            "\ntargets: deform ≤ 0.25× growing, regrow ≤ 1.2× growing, velocities ≤ 1.1× a write without them (the write rows are seconds for all frames). Peak RSS {:.0} MB.",
             rss as f64 / 1e6
         );
     }

@@ -15,6 +15,8 @@ use pelage::io::UsdcWriter;
 use pelage::{Curves, Map, Mesh};
 use std::sync::Arc;
 
+mod support;
+
 fn spot() -> Arc<Mesh> {
     Arc::new(pelage::assets::spot())
 }
@@ -48,6 +50,7 @@ fn animation(frames: &str, mode: AnimationMode) -> AnimationSpec {
         rest_frame: 1.0,
         mode,
         shutter: Vec::new(),
+        velocities: true,
     }
 }
 
@@ -435,4 +438,125 @@ fn an_obj_sequence_whose_topology_changes_names_the_frame() {
     );
     let missing = skin.positions_at(7.0).unwrap_err().to_string();
     assert!(missing.contains("skin.0007.obj"), "{missing}");
+}
+
+/// A skin sliding along a straight line at a constant speed per frame.
+fn sliding(mesh: &Arc<Mesh>, per_frame: Vec3) -> AnimatedSkin {
+    let rest: Vec<Vec3> = mesh.positions().to_vec();
+    AnimatedSkin::from_fn(mesh, move |f| {
+        let shift = per_frame * (f - 1.0) as f32;
+        rest.iter().map(|&p| p + shift).collect()
+    })
+}
+
+#[test]
+fn deform_velocities_times_the_frame_time_are_the_next_frames_displacement() {
+    let mesh = spot();
+    let per_frame = Vec3::new(0.01, -0.02, 0.015);
+    let fps = 24.0;
+    let groom = AnimatedGroom::new(
+        groom(&mesh),
+        sliding(&mesh, per_frame),
+        animation("1-4", AnimationMode::Deform),
+        None,
+    )
+    .unwrap();
+    for frame in [1.0, 2.0, 4.0] {
+        let now = groom.part_with_velocities(0, frame, fps).unwrap();
+        let next = groom.part(0, frame + 1.0).unwrap();
+        let worst = now
+            .points()
+            .iter()
+            .zip(now.velocities().unwrap())
+            .zip(next.points())
+            .map(|((x, v), y)| (*x + *v / fps as f32 - *y).length())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-5, "frame {frame}: off by {worst}");
+    }
+    // The file: usd-core reads `velocities` at every frame, in units a
+    // second (timeCodesPerSecond 24).
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sliding.usdc");
+    groom
+        .write(&path, 0..1, &Default::default(), false, |_| {})
+        .unwrap();
+    let text_path = dir.path().join("sliding.usda");
+    let Some((ok, out)) = support::usdcheck(&[
+        "--convert".as_ref(),
+        path.as_os_str(),
+        text_path.as_os_str(),
+    ]) else {
+        return;
+    };
+    assert!(ok, "{out}");
+    let text = std::fs::read_to_string(&text_path).unwrap();
+    let at = text
+        .find("vector3f[] velocities.timeSamples")
+        .unwrap_or_else(|| {
+            panic!(
+                "no time-sampled velocities in:\n{}",
+                &text[..2000.min(text.len())]
+            )
+        });
+    let expected = per_frame * fps as f32;
+    let first = &text[at..];
+    let tuple = &first[first.find("[(").unwrap() + 2..];
+    let values: Vec<f32> = tuple[..tuple.find(')').unwrap()]
+        .split(',')
+        .map(|x| x.trim().parse().unwrap())
+        .collect();
+    assert!(
+        (Vec3::from_slice(&values) - expected).length() < 1e-4,
+        "{values:?}"
+    );
+    for frame in ["1:", "2:", "3:", "4:"] {
+        assert!(
+            first[..first.find('}').unwrap()].contains(frame),
+            "frame {frame}"
+        );
+    }
+}
+
+#[test]
+fn the_running_fox_velocities_match_its_motion_over_a_short_step() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/fox/Fox.gltf");
+    let skin = AnimatedSkin::load(
+        &path,
+        &SkinOptions {
+            fps: 24.0,
+            clip: Some("Run".into()),
+            subdivide: 0,
+        },
+    )
+    .unwrap();
+    let mesh = Arc::new(skin.mesh_at(1.0).unwrap());
+    let mut spec = groom(&mesh);
+    spec.roots = RootsSpec::new(1500);
+    let groom =
+        AnimatedGroom::new(spec, skin, animation("1-12", AnimationMode::Deform), None).unwrap();
+    let fps = 24.0;
+    let (t, dt) = (6.0, 0.1);
+    let now = groom.part_with_velocities(0, t, fps).unwrap();
+    let (before, after) = (
+        groom.part(0, t - dt).unwrap(),
+        groom.part(0, t + dt).unwrap(),
+    );
+    let (mut err, mut moved) = (0.0f64, 0.0f64);
+    for ((v, a), b) in now
+        .velocities()
+        .unwrap()
+        .iter()
+        .zip(before.points())
+        .zip(after.points())
+    {
+        let displacement = *b - *a;
+        err += f64::from((*v * (2.0 * dt as f32 / fps as f32) - displacement).length());
+        moved += f64::from(displacement.length());
+    }
+    assert!(moved > 0.0, "the fox runs");
+    assert!(
+        err < 0.02 * moved,
+        "velocities off by {:.3} of the motion",
+        err / moved
+    );
 }

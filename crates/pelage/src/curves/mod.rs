@@ -49,6 +49,8 @@ pub struct Curves {
     roots: Option<Vec<SurfacePoint>>,
     root_uvs: Option<Vec<Vec2>>,
     ids: Option<Vec<u64>>,
+    /// Per-point velocities (units a second) of an animated frame.
+    velocities: Option<Vec<Vec3>>,
 }
 
 /// What the skin binding moves (points, normals) beside what it reads
@@ -324,6 +326,7 @@ impl Curves {
         copy_opt(&mut self.roots, other.roots.as_ref());
         copy_opt(&mut self.root_uvs, other.root_uvs.as_ref());
         copy_opt(&mut self.ids, other.ids.as_ref());
+        self.velocities = None;
         sized(&mut self.points, other.points.len());
         match &other.normals {
             Some(n) => sized(self.normals.get_or_insert_with(Vec::new), n.len()),
@@ -464,6 +467,26 @@ impl Curves {
     /// Per-point normals, if any.
     pub fn normals(&self) -> Option<&[Vec3]> {
         self.normals.as_deref()
+    }
+
+    /// Per-point velocities in units a second (an animated frame's, for
+    /// motion blur: USD `velocities`, Alembic `.velocities`), if any.
+    pub fn velocities(&self) -> Option<&[Vec3]> {
+        self.velocities.as_deref()
+    }
+
+    /// Sets (or, with `None`, removes) the per-point velocities. Fails
+    /// unless there is one finite velocity a point.
+    pub fn set_velocities(&mut self, velocities: Option<Vec<Vec3>>) -> Result<(), CurvesError> {
+        if let Some(v) = &velocities {
+            self.check_per_point(
+                "velocities",
+                v.len(),
+                first_non_finite(v, |x| x.is_finite()),
+            )?;
+        }
+        self.velocities = velocities;
+        Ok(())
     }
 
     /// Per-point colours, if any.

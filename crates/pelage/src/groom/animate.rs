@@ -36,6 +36,7 @@
 //!     rest_frame: 1.0,
 //!     mode: AnimationMode::Deform,
 //!     shutter: vec![],
+//!     velocities: true,
 //! };
 //! let groom = AnimatedGroom::new(spec, skin, animation, None)?;
 //! let (first, third) = (groom.part(0, 1.0)?, groom.part(0, 3.0)?);
@@ -59,6 +60,13 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Half the time step, in frames, of deform grooms' velocities: the
+/// hairs are carried to the skin this long before and after each time
+/// code. Exact for a skin moving linearly between its samples (OBJ
+/// sequences, linear glTF keys) away from a sample; at a sample it is
+/// the mean of the two sides.
+const VELOCITY_STEP: f64 = 1.0 / 32.0;
 
 /// How an animated groom follows its skin.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -102,6 +110,9 @@ pub struct AnimationSpec {
     /// Shutter offsets in frames (e.g. `[-0.25, 0.25]`): each frame is
     /// also written at these sub-frame times, for motion blur.
     pub shutter: Vec<f64>,
+    /// Write per-point velocities (deform grooms) so renderers blur from
+    /// one sample.
+    pub velocities: bool,
 }
 
 impl AnimationSpec {
@@ -381,6 +392,21 @@ impl AnimatedGroom {
         Ok(())
     }
 
+    /// Per-point velocities (units a second) of a deform part grown at
+    /// rest, between the skin just before and just after the time; `None`
+    /// when one is not finite.
+    fn velocities(
+        &self,
+        (rest, frames): (&Curves, &RestFrames),
+        poses: (&SkinPose, &SkinPose),
+        per_second: f32,
+    ) -> Option<Vec<Vec3>> {
+        let mut out = Vec::new();
+        self.binding
+            .velocities(rest, frames, poses, per_second, &mut out)
+            .then_some(out)
+    }
+
     /// The skin in `pose`, with the rest mesh's UVs.
     pub fn posed_mesh(&self, pose: &SkinPose) -> Result<crate::Mesh, GroomError> {
         let rest = &self.spec.mesh;
@@ -420,6 +446,64 @@ impl AnimatedGroom {
             )
         })?;
         Ok(carried.points().to_vec())
+    }
+
+    /// Part `p` at time code `time` with its per-point velocities in
+    /// units a second at `fps` time codes a second (deform grooms; a
+    /// regrown groom's hairs have none yet).
+    pub fn part_with_velocities(
+        &self,
+        p: usize,
+        time: f64,
+        fps: f64,
+    ) -> Result<Curves, GroomError> {
+        if self.animation.mode != AnimationMode::Deform {
+            return Err(self.spec.error(
+                "animation.mode",
+                GroomErrorKind::Invalid(
+                    "velocities are written for deform grooms; regrown hairs have none yet".into(),
+                ),
+            ));
+        }
+        let pose = self.pose(time)?;
+        let mut rest = None;
+        let mut out = Curves::default();
+        self.part_at(p, time, &pose, &self.generator, &mut rest, &mut out)?;
+        let (minus, plus, per_second) = self.velocity_poses(time, &pose, fps);
+        let (curves, frames) = rest.as_ref().expect("deform grows at rest");
+        let velocities = self
+            .velocities((curves, frames), (&minus, &plus), per_second)
+            .ok_or_else(|| {
+                self.spec.error(
+                    "animation",
+                    GroomErrorKind::NotFinite(format!("part {p} near frame {time}")),
+                )
+            })?;
+        out.set_velocities(Some(velocities)).map_err(|e| {
+            self.spec
+                .error("animation", GroomErrorKind::NotFinite(e.to_string()))
+        })?;
+        Ok(out)
+    }
+
+    /// The skin just before and after `time` (or at it, on a side the skin
+    /// has no sample), and the factor from their carries' difference to
+    /// units a second.
+    fn velocity_poses(&self, time: f64, pose: &SkinPose, fps: f64) -> (SkinPose, SkinPose, f32) {
+        let (minus, plus) = (
+            self.pose(time - VELOCITY_STEP),
+            self.pose(time + VELOCITY_STEP),
+        );
+        let span = [minus.is_ok(), plus.is_ok()]
+            .iter()
+            .filter(|ok| **ok)
+            .count() as f64
+            * VELOCITY_STEP;
+        let minus = minus.unwrap_or_else(|_| pose.clone());
+        let plus = plus.unwrap_or_else(|_| pose.clone());
+        // Neither side: no motion to measure.
+        let per_second = if span > 0.0 { fps / span } else { 0.0 };
+        (minus, plus, per_second as f32)
     }
 
     /// Part `p` at time code `time`, alone (tests, previews).
@@ -589,6 +673,18 @@ impl AnimatedGroom {
             .zip(&poses)
             .map(|(&t, pose)| self.frame_generator(t, pose))
             .collect::<Result<Vec<_>, _>>()?;
+        // Deform: each time's skin a little before and after it, to carry
+        // the hairs there for their velocities.
+        // A skin with no sample past its first or last time (an OBJ
+        // sequence's first file) is differenced on one side.
+        let velocity_poses = match self.animation.mode {
+            AnimationMode::Deform if self.animation.velocities => times
+                .iter()
+                .zip(&poses)
+                .map(|(&t, pose)| self.velocity_poses(t, pose, options.time_codes_per_second))
+                .collect::<Vec<_>>(),
+            _ => Vec::new(),
+        };
         if with_skin {
             for (output, layer) in outputs.iter().zip(&mut layers) {
                 for &time in &output.times {
@@ -612,6 +708,26 @@ impl AnimatedGroom {
                     let k = index(time);
                     let generator = generators[k].as_ref().unwrap_or(&self.generator);
                     self.part_at(p, time, &poses[k], generator, &mut rest, &mut out)?;
+                    if let (Some((minus, plus, per_second)), Some((curves, frames))) =
+                        (velocity_poses.get(k), &rest)
+                    {
+                        let velocities =
+                            self.velocities((curves, frames), (minus, plus), *per_second);
+                        let velocities = velocities.ok_or_else(|| {
+                            GroomWriteError::Groom(self.spec.error(
+                                "animation",
+                                GroomErrorKind::NotFinite(format!(
+                                    "part {p} at frame {time}: the skin's pose near it moved a hair to a value that is not finite"
+                                )),
+                            ))
+                        })?;
+                        out.set_velocities(Some(velocities)).map_err(|e| {
+                            GroomWriteError::Groom(self.spec.error(
+                                "animation",
+                                GroomErrorKind::NotFinite(format!("part {p} at frame {time}: {e}")),
+                            ))
+                        })?;
+                    }
                     if !counted {
                         summary.hairs += out.curve_count() as u64;
                         summary.points += out.points().len() as u64;

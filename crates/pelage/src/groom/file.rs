@@ -145,6 +145,14 @@ pub struct AnimationSection {
     /// also written at these sub-frame times (motion blur).
     #[serde(default)]
     pub motion_blur: Vec<f64>,
+    /// Write per-point velocities (deform grooms), for motion blur from
+    /// one sample.
+    #[serde(default = "default_true")]
+    pub velocities: bool,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 fn default_fps() -> f64 {

@@ -634,6 +634,7 @@ fn animation_spec(
         rest_frame,
         mode,
         shutter: section.map(|s| s.motion_blur.clone()).unwrap_or_default(),
+        velocities: section.is_none_or(|s| s.velocities),
     };
     Ok(Some((spec, fps, section.and_then(|s| s.clip.clone()))))
 }

@@ -215,6 +215,11 @@ pub(crate) fn basis_curves_attributes<'a>(
         let values = UsdValues::Vec3s(Cow::Borrowed(normals));
         attributes.push(UsdAttribute::new("normals", "normal3f[]", values).interpolated("vertex"));
     }
+    if let Some(velocities) = curves.velocities() {
+        // UsdGeomPointBased's velocities: one a point, units a second.
+        let values = UsdValues::Vec3s(Cow::Borrowed(velocities));
+        attributes.push(UsdAttribute::new("velocities", "vector3f[]", values));
+    }
     if let Some(colors) = curves.colors() {
         let values = UsdValues::Vec3s(Cow::Borrowed(colors));
         attributes.push(

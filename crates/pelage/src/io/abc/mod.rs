@@ -206,6 +206,10 @@ impl<W: Write + Seek> AbcWriter<W> {
             let sample = self.array_sample(bytemuck::cast_slice(normals), normals.len())?;
             samples.push(("N", sample));
         }
+        if let Some(velocities) = curves.velocities() {
+            let sample = self.array_sample(bytemuck::cast_slice(velocities), velocities.len())?;
+            samples.push((".velocities", sample));
+        }
         Ok(samples)
     }
 
@@ -249,11 +253,18 @@ impl<W: Write + Seek> AbcWriter<W> {
             });
         }
         let frames = time.is_some() as u32;
-        let mut animated = self.animated_samples(curves)?.into_iter();
-        let mut next = || animated.next().map(|(_, s)| vec![s]).unwrap_or_default();
-        let bounds = next();
-        let points = next();
-        let normals = next();
+        let animated = self.animated_samples(curves)?;
+        let take = |name: &str| -> Vec<Sample> {
+            animated
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, s)| vec![*s])
+                .unwrap_or_default()
+        };
+        let bounds = take(".selfBnds");
+        let points = take("P");
+        let normals = take("N");
+        let velocities = take(".velocities");
         let mut properties = vec![
             property(
                 ".selfBnds",
@@ -274,6 +285,18 @@ impl<W: Write + Seek> AbcWriter<W> {
                 points,
             ),
         ];
+        if !velocities.is_empty() {
+            // ICurves' velocities: one a point, units a second.
+            properties.push(property(
+                ".velocities",
+                "geoScope=vtx;interpretation=vector",
+                Kind::Array,
+                Pod::Float32,
+                3,
+                frames,
+                velocities,
+            ));
+        }
         let counts: Vec<u8> = curves
             .offsets()
             .windows(2)

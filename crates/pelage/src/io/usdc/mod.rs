@@ -35,7 +35,7 @@ use std::collections::{BTreeMap, HashSet};
 use std::io::{Seek, SeekFrom, Write};
 
 /// The attributes of an animated part that get a sample per frame.
-const ANIMATED: [&str; 3] = ["points", "extent", "normals"];
+const ANIMATED: [&str; 4] = ["points", "extent", "normals", "velocities"];
 
 /// A part written frame by frame: what later frames must match, and the
 /// samples of its animated attributes.
@@ -124,7 +124,14 @@ impl<W: Write + Seek> UsdcWriter<W> {
         let part = &self.animated[name];
         PrimWriteError::check_frame(name, time, &part.offsets, curves)?;
         let (lo, hi) = curve_extent(curves);
-        self.add_samples(name, time, curves.points(), [lo, hi], curves.normals())
+        self.add_samples(
+            name,
+            time,
+            curves.points(),
+            [lo, hi],
+            curves.normals(),
+            curves.velocities(),
+        )
     }
 
     /// Writes one frame of an animated skin: the first call for `name`
@@ -159,7 +166,14 @@ impl<W: Write + Seek> UsdcWriter<W> {
             )));
         }
         let (lo, hi) = mesh.bounds();
-        self.add_samples(name, time, mesh.positions(), [lo, hi], Some(mesh.normals()))
+        self.add_samples(
+            name,
+            time,
+            mesh.positions(),
+            [lo, hi],
+            Some(mesh.normals()),
+            None,
+        )
     }
 
     /// Adds a frame's points, extent and normals to the animated prim
@@ -171,6 +185,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
         points: &[glam::Vec3],
         extent: [glam::Vec3; 2],
         normals: Option<&[glam::Vec3]>,
+        velocities: Option<&[glam::Vec3]>,
     ) -> Result<(), PrimWriteError> {
         let part = &self.animated[name];
         let seen = |(_, _, samples): &SampledAttribute| samples.iter().any(|&(t, _)| t == time);
@@ -186,6 +201,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
             ("points", Some(points)),
             ("extent", Some(&extent[..])),
             ("normals", normals),
+            ("velocities", velocities),
         ] {
             if let Some(values) = values {
                 reps.push((attribute, self.plain_array(ValueType::Vec3f, values)?));
