@@ -475,6 +475,12 @@ fn deform_velocities_times_the_frame_time_are_the_next_frames_displacement() {
     }
     // The file: usd-core reads `velocities` at every frame, in units a
     // second (timeCodesPerSecond 24).
+    written_velocities_are(&groom, per_frame * fps as f32);
+}
+
+/// Writes part 0 of `groom` (frames 1-4) to usdc and checks with usd-core
+/// that every frame has `velocities`, the first one `expected`.
+fn written_velocities_are(groom: &AnimatedGroom, expected: Vec3) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sliding.usdc");
     groom
@@ -498,7 +504,6 @@ fn deform_velocities_times_the_frame_time_are_the_next_frames_displacement() {
                 &text[..2000.min(text.len())]
             )
         });
-    let expected = per_frame * fps as f32;
     let first = &text[at..];
     let tuple = &first[first.find("[(").unwrap() + 2..];
     let values: Vec<f32> = tuple[..tuple.find(')').unwrap()]
@@ -515,6 +520,39 @@ fn deform_velocities_times_the_frame_time_are_the_next_frames_displacement() {
             "frame {frame}"
         );
     }
+}
+
+#[test]
+fn regrown_velocities_are_central_differences_of_the_frames() {
+    let mesh = spot();
+    let per_frame = Vec3::new(-0.02, 0.01, 0.005);
+    let spec = groom(&mesh);
+    let guides = spec.guides.clone();
+    // Guides that slide with the skin.
+    let moving = move |f: f64| -> Curves {
+        let shift = per_frame * (f - 1.0) as f32;
+        let points = guides
+            .curves()
+            .points()
+            .iter()
+            .map(|&p| p + shift)
+            .collect();
+        Curves::new(
+            points,
+            guides.curves().widths().to_vec(),
+            guides.curves().offsets().to_vec(),
+        )
+        .unwrap()
+    };
+    let groom = AnimatedGroom::new(
+        spec,
+        sliding(&mesh, per_frame),
+        animation("1-4", AnimationMode::Regrow),
+        Some(GuideMotion::Program(Arc::new(moving))),
+    )
+    .unwrap();
+    assert!(groom.part_with_velocities(0, 2.0, 24.0).is_err());
+    written_velocities_are(&groom, per_frame * 24.0);
 }
 
 #[test]

@@ -450,7 +450,7 @@ impl AnimatedGroom {
 
     /// Part `p` at time code `time` with its per-point velocities in
     /// units a second at `fps` time codes a second (deform grooms; a
-    /// regrown groom's hairs have none yet).
+    /// regrown groom's come from its neighbouring frames, when written).
     pub fn part_with_velocities(
         &self,
         p: usize,
@@ -461,7 +461,7 @@ impl AnimatedGroom {
             return Err(self.spec.error(
                 "animation.mode",
                 GroomErrorKind::Invalid(
-                    "velocities are written for deform grooms; regrown hairs have none yet".into(),
+                    "a regrown groom's velocities come from its neighbouring frames: write it (AnimatedGroom::write) to get them".into(),
                 ),
             ));
         }
@@ -700,14 +700,58 @@ impl AnimatedGroom {
         let total = parts.len() * outputs.iter().map(|o| o.times.len()).sum::<usize>();
         let mut done = 0;
         let mut out = Curves::default();
+        // Regrow: velocities by central differences over the neighbouring
+        // time codes, whose growths are kept (three at most) as the
+        // frames go by.
+        let regrow_velocities =
+            self.animation.mode == AnimationMode::Regrow && self.animation.velocities;
         for p in parts {
             let mut rest = None;
             let mut counted = false;
+            let mut grown: Vec<Option<Curves>> = vec![None; times.len()];
             for (output, layer) in outputs.iter().zip(&mut layers) {
                 for &time in &output.times {
                     let k = index(time);
                     let generator = generators[k].as_ref().unwrap_or(&self.generator);
-                    self.part_at(p, time, &poses[k], generator, &mut rest, &mut out)?;
+                    if regrow_velocities {
+                        let (a, b) = (k.saturating_sub(1), (k + 1).min(times.len() - 1));
+                        for j in [a, k, b] {
+                            if grown[j].is_none() {
+                                let g = generators[j].as_ref().unwrap_or(&self.generator);
+                                let mut c = Curves::default();
+                                self.part_at(p, times[j], &poses[j], g, &mut None, &mut c)?;
+                                grown[j] = Some(c);
+                            }
+                        }
+                        grown[..a].iter_mut().for_each(|g| *g = None);
+                        let span = (times[b] - times[a]) as f32;
+                        let per_second = if span > 0.0 {
+                            options.time_codes_per_second as f32 / span
+                        } else {
+                            0.0
+                        };
+                        let (before, after) = (
+                            grown[a].as_ref().expect("grown above"),
+                            grown[b].as_ref().expect("grown above"),
+                        );
+                        let velocities: Vec<Vec3> = before
+                            .points()
+                            .iter()
+                            .zip(after.points())
+                            .map(|(x, y)| (*y - *x) * per_second)
+                            .collect();
+                        out = grown[k].take().expect("grown above");
+                        out.set_velocities(Some(velocities)).map_err(|e| {
+                            GroomWriteError::Groom(self.spec.error(
+                                "animation",
+                                GroomErrorKind::Invalid(format!(
+                                    "part {p} at frame {time}: the regrown hairs differ between neighbouring frames ({e}); write velocities = false"
+                                )),
+                            ))
+                        })?;
+                    } else {
+                        self.part_at(p, time, &poses[k], generator, &mut rest, &mut out)?;
+                    }
                     if let (Some((minus, plus, per_second)), Some((curves, frames))) =
                         (velocity_poses.get(k), &rest)
                     {
@@ -738,6 +782,11 @@ impl AnimatedGroom {
                             .prims()
                             .write_part_at(&part_name(p), time, &out)
                             .map_err(|e| write_error(&output.path, &e))?;
+                    }
+                    if regrow_velocities {
+                        // Kept for the next time code's differences.
+                        let k = index(time);
+                        grown[k] = Some(std::mem::take(&mut out));
                     }
                     done += 1;
                     progress(AnimationProgress {
