@@ -598,3 +598,99 @@ fn the_running_fox_velocities_match_its_motion_over_a_short_step() {
         err / moved
     );
 }
+
+/// usd-core's text of `path`'s time-sampled velocities, frame by frame
+/// (`None` without usd-core).
+fn velocity_samples(path: &std::path::Path) -> Option<std::collections::BTreeMap<String, String>> {
+    let text_path = path.with_extension("usda");
+    let (ok, out) = support::usdcheck(&[
+        "--convert".as_ref(),
+        path.as_os_str(),
+        text_path.as_os_str(),
+    ])?;
+    assert!(ok, "{out}");
+    let text = std::fs::read_to_string(&text_path).unwrap();
+    let at = text
+        .find("vector3f[] velocities.timeSamples")
+        .expect("velocities");
+    let block = &text[at..];
+    let block = &block[block.find('{').unwrap() + 1..block.find('}').unwrap()];
+    Some(
+        block
+            .split("],")
+            .filter(|s| s.contains(':'))
+            .map(|s| {
+                let (frame, values) = s.split_once(':').unwrap();
+                (
+                    frame.trim().to_string(),
+                    values.trim().trim_end_matches(']').to_string(),
+                )
+            })
+            .collect(),
+    )
+}
+
+#[test]
+fn regrown_velocities_do_not_depend_on_how_the_frames_are_split() {
+    let mesh = spot();
+    // A bending skin: velocities that change from frame to frame.
+    let rest: Vec<Vec3> = mesh.positions().to_vec();
+    let skin = AnimatedSkin::from_fn(&mesh, move |f| rest.iter().map(|&p| bend(p, f)).collect());
+    let spec = groom(&mesh);
+    let guides = spec.guides.clone();
+    let moving = move |f: f64| -> Curves {
+        let points = guides
+            .curves()
+            .points()
+            .iter()
+            .map(|&p| bend(p, f))
+            .collect();
+        Curves::new(
+            points,
+            guides.curves().widths().to_vec(),
+            guides.curves().offsets().to_vec(),
+        )
+        .unwrap()
+    };
+    let groom = AnimatedGroom::new(
+        spec,
+        skin,
+        animation("1-4", AnimationMode::Regrow),
+        Some(GuideMotion::Program(Arc::new(moving))),
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole.usdc");
+    groom
+        .write(&whole, 0..1, &Default::default(), false, |_| {})
+        .unwrap();
+    let halves = [dir.path().join("a.usdc"), dir.path().join("b.usdc")];
+    let outputs = [
+        pelage::groom::FrameOutput {
+            path: halves[0].clone(),
+            times: vec![1.0, 2.0],
+        },
+        pelage::groom::FrameOutput {
+            path: halves[1].clone(),
+            times: vec![3.0, 4.0],
+        },
+    ];
+    groom
+        .write_files(&outputs, 0..1, &Default::default(), false, |_| {})
+        .unwrap();
+    let Some(one) = velocity_samples(&whole) else {
+        return;
+    };
+    let (a, b) = (
+        velocity_samples(&halves[0]).unwrap(),
+        velocity_samples(&halves[1]).unwrap(),
+    );
+    assert_eq!(one.len(), 4);
+    for frame in ["1", "2"] {
+        assert_eq!(a[frame], one[frame], "frame {frame}");
+    }
+    for frame in ["3", "4"] {
+        assert_eq!(b[frame], one[frame], "frame {frame}");
+    }
+    assert_ne!(one["2"], one["3"], "the bend speeds up");
+}

@@ -486,6 +486,32 @@ impl AnimatedGroom {
         Ok(out)
     }
 
+    /// Part `p` regrown at `time` and carried there: with the window's
+    /// pose and generator when `time` is one of `times`, else its own.
+    fn regrown_part(
+        &self,
+        p: usize,
+        time: f64,
+        times: &[f64],
+        poses: &[SkinPose],
+        generators: &[Option<Generator>],
+    ) -> Result<Curves, GroomError> {
+        let mut out = Curves::default();
+        match times.iter().position(|&t| t == time) {
+            Some(k) => {
+                let generator = generators[k].as_ref().unwrap_or(&self.generator);
+                self.part_at(p, time, &poses[k], generator, &mut None, &mut out)?;
+            }
+            None => {
+                let pose = self.pose(time)?;
+                let regrown = self.frame_generator(time, &pose)?;
+                let generator = regrown.as_ref().unwrap_or(&self.generator);
+                self.part_at(p, time, &pose, generator, &mut None, &mut out)?;
+            }
+        }
+        Ok(out)
+    }
+
     /// The skin just before and after `time` (or at it, on a side the skin
     /// has no sample), and the factor from their carries' difference to
     /// units a second.
@@ -705,42 +731,45 @@ impl AnimatedGroom {
         // frames go by.
         let regrow_velocities =
             self.animation.mode == AnimationMode::Regrow && self.animation.velocities;
+        let all_times = self.animation.sample_times();
         for p in parts {
             let mut rest = None;
             let mut counted = false;
-            let mut grown: Vec<Option<Curves>> = vec![None; times.len()];
+            let mut grown: Vec<(f64, Curves)> = Vec::new();
             for (output, layer) in outputs.iter().zip(&mut layers) {
                 for &time in &output.times {
                     let k = index(time);
                     let generator = generators[k].as_ref().unwrap_or(&self.generator);
                     if regrow_velocities {
-                        let (a, b) = (k.saturating_sub(1), (k + 1).min(times.len() - 1));
-                        for j in [a, k, b] {
-                            if grown[j].is_none() {
-                                let g = generators[j].as_ref().unwrap_or(&self.generator);
-                                let mut c = Curves::default();
-                                self.part_at(p, times[j], &poses[j], g, &mut None, &mut c)?;
-                                grown[j] = Some(c);
+                        // The neighbours among all the groom's time codes,
+                        // not this run's: a farm task's or a window's edge
+                        // grows its neighbour, so every split writes what
+                        // one run writes.
+                        let i = all_times.partition_point(|&x| x < time);
+                        let a = if i > 0 { all_times[i - 1] } else { time };
+                        let b = all_times.get(i + 1).copied().unwrap_or(time);
+                        for t in [a, time, b] {
+                            if !grown.iter().any(|(x, _)| *x == t) {
+                                let c = self.regrown_part(p, t, &times, &poses, &generators)?;
+                                grown.push((t, c));
                             }
                         }
-                        grown[..a].iter_mut().for_each(|g| *g = None);
-                        let span = (times[b] - times[a]) as f32;
+                        grown.retain(|(x, _)| *x >= a);
+                        let span = (b - a) as f32;
                         let per_second = if span > 0.0 {
                             options.time_codes_per_second as f32 / span
                         } else {
                             0.0
                         };
-                        let (before, after) = (
-                            grown[a].as_ref().expect("grown above"),
-                            grown[b].as_ref().expect("grown above"),
-                        );
-                        let velocities: Vec<Vec3> = before
+                        let at =
+                            |t: f64| &grown.iter().find(|(x, _)| *x == t).expect("grown above").1;
+                        let velocities: Vec<Vec3> = at(a)
                             .points()
                             .iter()
-                            .zip(after.points())
+                            .zip(at(b).points())
                             .map(|(x, y)| (*y - *x) * per_second)
                             .collect();
-                        out = grown[k].take().expect("grown above");
+                        out = at(time).clone();
                         out.set_velocities(Some(velocities)).map_err(|e| {
                             GroomWriteError::Groom(self.spec.error(
                                 "animation",
@@ -782,11 +811,6 @@ impl AnimatedGroom {
                             .prims()
                             .write_part_at(&part_name(p), time, &out)
                             .map_err(|e| write_error(&output.path, &e))?;
-                    }
-                    if regrow_velocities {
-                        // Kept for the next time code's differences.
-                        let k = index(time);
-                        grown[k] = Some(std::mem::take(&mut out));
                     }
                     done += 1;
                     progress(AnimationProgress {
