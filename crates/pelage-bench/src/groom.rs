@@ -63,11 +63,8 @@ struct BlenderRun {
 /// why it was not measured.
 fn measure_blender(groom: &Groom, hairs: u64, runs: usize) -> anyhow::Result<BlenderRun> {
     let report = super::run_bpy_case("blender_hair.py", include_str!("blender_hair.py"), |dir| {
-        let mesh = groom.mesh();
-        super::write_mesh_case(dir, mesh)?;
-        let guides = groom.guides();
-        let points = guides.curves().points().iter().flat_map(|p| p.to_array());
-        super::write_le(&dir.join("guides.f32"), points.map(f32::to_le_bytes))?;
+        write_groom_case(dir, groom)?;
+        let (mesh, guides) = (groom.mesh(), groom.guides());
         let case = serde_json::json!({
             "hairs": hairs,
             "area": mesh.surface_area(),
@@ -86,6 +83,19 @@ fn measure_blender(groom: &Groom, hairs: u64, runs: usize) -> anyhow::Result<Ble
         points: number("points")? as u64,
         version: report["blender"].as_str().unwrap_or("?").to_string(),
     })
+}
+
+/// A groom's mesh and guide points, as Blender's cases read them
+/// (`positions.f32`, `triangles.u32`, `guides.f32`).
+pub(super) fn write_groom_case(dir: &std::path::Path, groom: &Groom) -> std::io::Result<()> {
+    super::write_mesh_case(dir, groom.mesh())?;
+    let points = groom
+        .guides()
+        .curves()
+        .points()
+        .iter()
+        .flat_map(|p| p.to_array());
+    super::write_le(&dir.join("guides.f32"), points.map(f32::to_le_bytes))
 }
 
 /// What both benchmark grooms share: spot ×2, a noise density, 1,000

@@ -190,11 +190,8 @@ fn measure_blender(
     runs: usize,
 ) -> anyhow::Result<BlenderEdit> {
     let report = super::run_bpy_case("blender_edit.py", include_str!("blender_edit.py"), |dir| {
-        let mesh = groom.mesh();
-        super::write_mesh_case(dir, mesh)?;
-        let guides = groom.guides();
-        let points = guides.curves().points().iter().flat_map(|p| p.to_array());
-        super::write_le(&dir.join("guides.f32"), points.map(f32::to_le_bytes))?;
+        super::groom::write_groom_case(dir, groom)?;
+        let (mesh, guides) = (groom.mesh(), groom.guides());
         let case = serde_json::json!({
             "hairs": hairs,
             "area": mesh.surface_area(),

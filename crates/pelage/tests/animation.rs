@@ -440,6 +440,20 @@ fn an_obj_sequence_whose_topology_changes_names_the_frame() {
     assert!(missing.contains("skin.0007.obj"), "{missing}");
 }
 
+/// `guides` with every point moved by `motion(point, frame)`, as a
+/// regrown groom's guide motion.
+fn moved_guides(
+    guides: &Arc<Guides>,
+    motion: impl Fn(Vec3, f64) -> Vec3 + Send + Sync + 'static,
+) -> impl Fn(f64) -> Curves + Send + Sync + 'static {
+    let guides = guides.clone();
+    move |f| {
+        let curves = guides.curves();
+        let points = curves.points().iter().map(|&p| motion(p, f)).collect();
+        Curves::new(points, curves.widths().to_vec(), curves.offsets().to_vec()).unwrap()
+    }
+}
+
 /// A skin sliding along a straight line at a constant speed per frame.
 fn sliding(mesh: &Arc<Mesh>, per_frame: Vec3) -> AnimatedSkin {
     let rest: Vec<Vec3> = mesh.positions().to_vec();
@@ -529,21 +543,7 @@ fn regrown_velocities_are_central_differences_of_the_frames() {
     let spec = groom(&mesh);
     let guides = spec.guides.clone();
     // Guides that slide with the skin.
-    let moving = move |f: f64| -> Curves {
-        let shift = per_frame * (f - 1.0) as f32;
-        let points = guides
-            .curves()
-            .points()
-            .iter()
-            .map(|&p| p + shift)
-            .collect();
-        Curves::new(
-            points,
-            guides.curves().widths().to_vec(),
-            guides.curves().offsets().to_vec(),
-        )
-        .unwrap()
-    };
+    let moving = moved_guides(&guides, move |p, f| p + per_frame * (f - 1.0) as f32);
     let groom = AnimatedGroom::new(
         spec,
         sliding(&mesh, per_frame),
@@ -638,20 +638,7 @@ fn regrown_velocities_do_not_depend_on_how_the_frames_are_split() {
     let skin = AnimatedSkin::from_fn(&mesh, move |f| rest.iter().map(|&p| bend(p, f)).collect());
     let spec = groom(&mesh);
     let guides = spec.guides.clone();
-    let moving = move |f: f64| -> Curves {
-        let points = guides
-            .curves()
-            .points()
-            .iter()
-            .map(|&p| bend(p, f))
-            .collect();
-        Curves::new(
-            points,
-            guides.curves().widths().to_vec(),
-            guides.curves().offsets().to_vec(),
-        )
-        .unwrap()
-    };
+    let moving = moved_guides(&guides, bend);
     let groom = AnimatedGroom::new(
         spec,
         skin,

@@ -300,6 +300,38 @@ impl Curves {
         }
     }
 
+    /// Curves from arrays a grower filled and checked as it went (every
+    /// value finite): the per-point attributes asked for, ids and roots,
+    /// and root UVs when there are any. A failure here is a bug.
+    pub(crate) fn assembled(a: CurveArrays, normals: bool, colors: bool, opacities: bool) -> Self {
+        let checked = Values::Checked;
+        let mut curves =
+            Curves::build(a.points, a.widths, a.offsets, checked).expect("consistent arrays");
+        if normals {
+            curves = curves
+                .with_normals_as(a.normals, checked)
+                .expect("one normal a point");
+        }
+        if colors {
+            curves = curves
+                .with_colors_as(a.colors, checked)
+                .expect("one colour a point");
+        }
+        if opacities {
+            curves = curves
+                .with_opacities_as(a.opacities, checked)
+                .expect("one opacity a point");
+        }
+        let mut curves = curves
+            .with_ids(a.ids)
+            .and_then(|c| c.with_roots(a.roots))
+            .expect("one id and root a curve");
+        if !a.root_uvs.is_empty() {
+            curves = curves.with_root_uvs(a.root_uvs).expect("one UV a curve");
+        }
+        curves
+    }
+
     /// Makes these curves `other`'s in everything but the values of
     /// points and normals, which are sized to match but left to the caller
     /// to write (the skin binding's carry: copying them only to overwrite

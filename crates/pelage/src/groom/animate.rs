@@ -740,7 +740,7 @@ impl AnimatedGroom {
                 for &time in &output.times {
                     let k = index(time);
                     let generator = generators[k].as_ref().unwrap_or(&self.generator);
-                    if regrow_velocities {
+                    let velocities = if regrow_velocities {
                         // The neighbours among all the groom's time codes,
                         // not this run's: a farm task's or a window's edge
                         // grows its neighbour, so every split writes what
@@ -761,43 +761,47 @@ impl AnimatedGroom {
                         } else {
                             0.0
                         };
-                        let at =
-                            |t: f64| &grown.iter().find(|(x, _)| *x == t).expect("grown above").1;
-                        let velocities: Vec<Vec3> = at(a)
+                        let slot = |t: f64| {
+                            grown
+                                .iter()
+                                .position(|(x, _)| *x == t)
+                                .expect("grown above")
+                        };
+                        let velocities = grown[slot(a)]
+                            .1
                             .points()
                             .iter()
-                            .zip(at(b).points())
+                            .zip(grown[slot(b)].1.points())
                             .map(|(x, y)| (*y - *x) * per_second)
                             .collect();
-                        out = at(time).clone();
-                        out.set_velocities(Some(velocities)).map_err(|e| {
+                        // Lent to `out` for the write, given back after it.
+                        let now = slot(time);
+                        out = std::mem::take(&mut grown[now].1);
+                        Some(velocities)
+                    } else {
+                        self.part_at(p, time, &poses[k], generator, &mut rest, &mut out)?;
+                        match (velocity_poses.get(k), &rest) {
+                            (Some((minus, plus, per_second)), Some((curves, frames))) => Some(
+                                self.velocities((curves, frames), (minus, plus), *per_second)
+                                    .ok_or_else(|| {
+                                        GroomWriteError::Groom(self.spec.error(
+                                            "animation",
+                                            GroomErrorKind::NotFinite(format!(
+                                                "part {p} at frame {time}: the skin's pose near it moved a hair to a value that is not finite"
+                                            )),
+                                        ))
+                                    })?,
+                            ),
+                            _ => None,
+                        }
+                    };
+                    if velocities.is_some() {
+                        out.set_velocities(velocities).map_err(|e| {
                             GroomWriteError::Groom(self.spec.error(
                                 "animation",
                                 GroomErrorKind::Invalid(format!(
-                                    "part {p} at frame {time}: the regrown hairs differ between neighbouring frames ({e}); write velocities = false"
+                                    "part {p} at frame {time}: {e}; write velocities = false"
                                 )),
-                            ))
-                        })?;
-                    } else {
-                        self.part_at(p, time, &poses[k], generator, &mut rest, &mut out)?;
-                    }
-                    if let (Some((minus, plus, per_second)), Some((curves, frames))) =
-                        (velocity_poses.get(k), &rest)
-                    {
-                        let velocities =
-                            self.velocities((curves, frames), (minus, plus), *per_second);
-                        let velocities = velocities.ok_or_else(|| {
-                            GroomWriteError::Groom(self.spec.error(
-                                "animation",
-                                GroomErrorKind::NotFinite(format!(
-                                    "part {p} at frame {time}: the skin's pose near it moved a hair to a value that is not finite"
-                                )),
-                            ))
-                        })?;
-                        out.set_velocities(Some(velocities)).map_err(|e| {
-                            GroomWriteError::Groom(self.spec.error(
-                                "animation",
-                                GroomErrorKind::NotFinite(format!("part {p} at frame {time}: {e}")),
                             ))
                         })?;
                     }
@@ -811,6 +815,11 @@ impl AnimatedGroom {
                             .prims()
                             .write_part_at(&part_name(p), time, &out)
                             .map_err(|e| write_error(&output.path, &e))?;
+                    }
+                    if regrow_velocities
+                        && let Some(entry) = grown.iter_mut().find(|(x, _)| *x == time)
+                    {
+                        entry.1 = std::mem::take(&mut out);
                     }
                     done += 1;
                     progress(AnimationProgress {

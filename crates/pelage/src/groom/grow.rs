@@ -11,7 +11,7 @@ use super::ops::{Hair, HairBatch, Operator, RootContext, Scratch};
 use crate::curves::frames::{
     FrameScratch, catmull_rom_tangents, hair_normals, rotation_minimizing_normals,
 };
-use crate::curves::{Curves, Values, vectors_finite};
+use crate::curves::{CurveArrays, Curves, vectors_finite};
 use crate::interp::{HairRoot, HairScratch, QueryRegion};
 use crate::map::MapSite;
 use crate::mesh::SurfacePoint;
@@ -292,7 +292,7 @@ impl Generator {
         let mut ids = spare.ids;
         ids.clear();
         ids.extend_from_slice(&hair_ids);
-        Ok(self.assemble(PartArrays {
+        Ok(self.assemble(CurveArrays {
             points,
             widths,
             normals,
@@ -301,6 +301,7 @@ impl Generator {
             offsets,
             ids,
             roots,
+            root_uvs: Vec::new(),
         }))
     }
 
@@ -362,54 +363,21 @@ impl Generator {
     /// A part's curves from its arrays, with the attributes this groom
     /// has and each hair's root UV. Every hair was found finite as it grew,
     /// so `Curves` does not scan the values again.
-    fn assemble(&self, a: PartArrays) -> Curves {
-        // The generator builds consistent arrays: a failure here is a bug.
-        let checked = Values::Checked;
-        let mut curves =
-            Curves::build(a.points, a.widths, a.offsets, checked).expect("consistent part arrays");
-        if self.normals {
-            curves = curves
-                .with_normals_as(a.normals, checked)
-                .expect("one normal a point");
-        }
-        if self.colors {
-            curves = curves
-                .with_colors_as(a.colors, checked)
-                .expect("one colour a point");
-        }
-        if self.opacities {
-            curves = curves
-                .with_opacities_as(a.opacities, checked)
-                .expect("one opacity a point");
-        }
-        self.with_root_uvs(
-            curves
-                .with_ids(a.ids)
-                .and_then(|c| c.with_roots(a.roots))
-                .expect("one id and root a curve"),
-        )
+    fn assemble(&self, a: CurveArrays) -> Curves {
+        self.with_root_uvs(Curves::assembled(
+            a,
+            self.normals,
+            self.colors,
+            self.opacities,
+        ))
     }
-}
-
-/// A part's arrays before they become [`Curves`] (per-point arrays stay
-/// empty for attributes the groom does not have).
-#[derive(Default)]
-struct PartArrays {
-    points: Vec<Vec3>,
-    widths: Vec<f32>,
-    normals: Vec<Vec3>,
-    colors: Vec<Vec3>,
-    opacities: Vec<f32>,
-    offsets: Vec<u32>,
-    ids: Vec<u64>,
-    roots: Vec<SurfacePoint>,
 }
 
 /// Hairs grown by one worker, in order: their arrays with a count of
 /// points a hair (offsets come when the chunks are joined).
 #[derive(Default)]
 struct PartChunk {
-    arrays: PartArrays,
+    arrays: CurveArrays,
     counts: Vec<u32>,
     /// Hairs each root grew.
     per_root: Vec<u32>,
@@ -419,8 +387,8 @@ struct PartChunk {
 }
 
 /// The chunks of a part, in order, as one part's arrays.
-fn concat(chunks: Vec<PartChunk>) -> PartArrays {
-    let mut all = PartArrays {
+fn concat(chunks: Vec<PartChunk>) -> CurveArrays {
+    let mut all = CurveArrays {
         offsets: vec![0u32],
         ..Default::default()
     };

@@ -219,22 +219,16 @@ impl CurvesSession {
         if self.uploaded != Some(self.controls) {
             self.upload(ctx)?;
         }
-        let style = PreviewStyle {
-            background: super::super::FUR_BACKGROUND,
-            ..PreviewStyle::default()
-        };
         let scene = self.scene.as_ref().expect("uploaded above");
-        self.renderer.encode(
+        encode_preview(
+            &self.renderer,
             ctx,
             encoder,
             scene,
-            &style,
-            Some(orbit.camera()),
+            orbit,
             resolve,
-            width,
-            height,
-        )?;
-        Ok(())
+            (width, height),
+        )
     }
 
     /// The control panel.
@@ -258,6 +252,34 @@ impl CurvesSession {
         );
         ui.checkbox(&mut c.watch, "reload when the file changes");
     }
+}
+
+/// Records an uploaded preview scene over the viewer's background, seen
+/// by `orbit`, into `resolve` (groom and curves sessions alike).
+pub(super) fn encode_preview(
+    renderer: &Renderer,
+    ctx: &GpuContext,
+    encoder: &mut pelage_gpu::wgpu::CommandEncoder,
+    scene: &GpuScene,
+    orbit: &OrbitCamera,
+    resolve: &pelage_gpu::wgpu::TextureView,
+    (width, height): (u32, u32),
+) -> anyhow::Result<()> {
+    let style = PreviewStyle {
+        background: super::super::FUR_BACKGROUND,
+        ..PreviewStyle::default()
+    };
+    renderer.encode(
+        ctx,
+        encoder,
+        scene,
+        &style,
+        Some(orbit.camera()),
+        resolve,
+        width,
+        height,
+    )?;
+    Ok(())
 }
 
 /// `curves` all in one colour.

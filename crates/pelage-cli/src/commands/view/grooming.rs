@@ -56,8 +56,6 @@ pub struct GroomingControls {
     pub hairs: bool,
     /// Colour the hairs by the paint layer at their roots.
     pub show_layer: bool,
-    /// Share of the groom's hairs grown, in percent.
-    pub percent: f32,
 }
 
 /// A stroke in progress: where its last dab was.
@@ -85,8 +83,9 @@ pub struct GroomingSession {
     pub status: String,
     /// Milliseconds each dab took (edit + regrowth).
     pub dab_ms: Vec<f64>,
-    /// The fraction grown now (the slider applies when released).
-    grown_percent: f32,
+    /// The slider's share of the hairs, in percent: the groom grows it
+    /// when the slider is released.
+    percent_slider: f32,
 }
 
 const GUIDE_COLOR: Vec3 = Vec3::new(1.0, 0.3, 0.0);
@@ -145,11 +144,10 @@ impl GroomingSession {
                 guides: true,
                 hairs: true,
                 show_layer: false,
-                percent,
             },
             status,
             dab_ms: Vec::new(),
-            grown_percent: percent,
+            percent_slider: percent,
         })
     }
 
@@ -318,10 +316,9 @@ impl GroomingSession {
     /// Grows another share of the hairs.
     pub fn set_percent(&mut self, percent: f32) -> anyhow::Result<()> {
         let percent = percent.clamp(0.01, 100.0);
-        self.controls.percent = percent;
+        self.percent_slider = percent;
         let started = Instant::now();
         let r = self.groom.set_fraction(f64::from(percent) / 100.0)?;
-        self.grown_percent = percent;
         self.status = format!(
             "{} hairs ({percent:.1} %) in {:.2} s",
             r.hairs,
@@ -389,35 +386,19 @@ impl GroomingSession {
         width: u32,
         height: u32,
     ) -> anyhow::Result<()> {
-        let shown = {
-            let mut c = self.controls.clone();
-            // The slider moves freely; the groom follows on release.
-            c.percent = self.grown_percent;
-            c
-        };
-        let mut uploaded = self.uploaded.clone();
-        if let Some(u) = &mut uploaded {
-            u.percent = self.grown_percent;
-        }
-        if self.dirty || uploaded.as_ref() != Some(&shown) {
+        if self.dirty || self.uploaded.as_ref() != Some(&self.controls) {
             self.upload(ctx)?;
         }
-        let style = PreviewStyle {
-            background: super::super::FUR_BACKGROUND,
-            ..PreviewStyle::default()
-        };
         let scene = self.scene.as_ref().expect("uploaded above");
-        self.renderer.encode(
+        super::curves::encode_preview(
+            &self.renderer,
             ctx,
             encoder,
             scene,
-            &style,
-            Some(orbit.camera()),
+            orbit,
             resolve,
-            width,
-            height,
-        )?;
-        Ok(())
+            (width, height),
+        )
     }
 
     /// The control panel. Returns the actions asked for.
@@ -478,13 +459,13 @@ impl GroomingSession {
         ui.checkbox(&mut c.guides, "guides (orange)");
         ui.checkbox(&mut c.show_layer, "hairs coloured by the paint layer");
         let slider = ui.add(
-            egui::Slider::new(&mut c.percent, 0.1..=100.0)
+            egui::Slider::new(&mut self.percent_slider, 0.1..=100.0)
                 .logarithmic(true)
                 .suffix(" %")
                 .text("of the hairs grown"),
         );
         if slider.drag_stopped() || (slider.changed() && !slider.dragged()) {
-            actions.percent = Some(c.percent);
+            actions.percent = Some(self.percent_slider);
         }
         ui.separator();
         let (undo, redo) = self.groom.history_len();

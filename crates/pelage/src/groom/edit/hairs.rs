@@ -19,7 +19,7 @@
 //! that keeps the roots and weights regrows exactly the hairs in those
 //! lists for the moved guides and the centres whose shape changed.
 
-use crate::curves::{Curves, Values};
+use crate::curves::Curves;
 use crate::groom::error::GroomError;
 use crate::groom::generator::Generator;
 use crate::groom::grow::sorted_by_triangle_with_ids;
@@ -517,32 +517,7 @@ impl GrownHairs {
             a.roots.extend_from_slice(&cell.curve_roots);
             a.root_uvs.extend_from_slice(&cell.root_uvs);
         }
-        let checked = Values::Checked;
-        let mut curves = Curves::build(a.points, a.widths, a.offsets, checked)
-            .expect("grown hairs are consistent");
-        if self.normals {
-            curves = curves
-                .with_normals_as(a.normals, checked)
-                .expect("one normal a point");
-        }
-        if self.colors {
-            curves = curves
-                .with_colors_as(a.colors, checked)
-                .expect("one colour a point");
-        }
-        if self.opacities {
-            curves = curves
-                .with_opacities_as(a.opacities, checked)
-                .expect("one opacity a point");
-        }
-        let mut curves = curves
-            .with_ids(a.ids)
-            .and_then(|c| c.with_roots(a.roots))
-            .expect("one id and root a curve");
-        if self.root_uvs {
-            curves = curves.with_root_uvs(a.root_uvs).expect("one UV a curve");
-        }
-        curves
+        Curves::assembled(a, self.normals, self.colors, self.opacities)
     }
 
     /// Hairs in the groom.
@@ -605,10 +580,8 @@ fn replace_in_place(
                 (cell.point_starts[o + 1] - cell.point_starts[o]) as usize == g.range(i).len()
             })
     };
-    if !(same_layout || cell.points.is_empty()) || !replaced.iter().all(fits) {
-        return false;
-    }
-    if cell.points.is_empty() {
+    // An empty cell (new roots) is rebuilt by `splice`.
+    if cell.points.is_empty() || !same_layout || !replaced.iter().all(fits) {
         return false;
     }
     for (k, range) in replaced {

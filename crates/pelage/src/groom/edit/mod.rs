@@ -285,14 +285,7 @@ impl EditableGroom {
     /// or a groom the generator refuses; the groom is left as it was.
     pub fn apply(&mut self, edit: Edit) -> Result<Regrowth, GroomError> {
         let (inverse, regrowth) = self.perform(edit.clone())?;
-        let bytes = edit.bytes() + inverse.bytes();
-        self.undo.push(Step {
-            forward: edit,
-            inverse,
-            bytes,
-        });
-        self.redo.clear();
-        self.trim_history();
+        self.push_step(edit, inverse);
         Ok(regrowth)
     }
 
@@ -329,14 +322,7 @@ impl EditableGroom {
                 }
             },
         };
-        let bytes = forward.bytes() + inverse.bytes();
-        self.undo.push(Step {
-            forward,
-            inverse,
-            bytes,
-        });
-        self.redo.clear();
-        self.trim_history();
+        self.push_step(forward, inverse);
         Ok(regrowth)
     }
 
@@ -397,6 +383,19 @@ impl EditableGroom {
     /// must equal).
     pub fn regrown_from_scratch(&self) -> Result<Self, GroomError> {
         Self::new(self.spec.clone(), self.fraction)
+    }
+
+    /// A new step on the undo stack: the redo stack is dropped, and the
+    /// history trimmed to its budget.
+    fn push_step(&mut self, forward: Edit, inverse: Edit) {
+        let bytes = forward.bytes() + inverse.bytes();
+        self.undo.push(Step {
+            forward,
+            inverse,
+            bytes,
+        });
+        self.redo.clear();
+        self.trim_history();
     }
 
     fn trim_history(&mut self) {
