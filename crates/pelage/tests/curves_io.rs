@@ -937,3 +937,68 @@ fn root_uvs_and_ids_reach_the_usd_file() {
             .contains("int64[] primvars:hair_id = [1099511627776, 0, 1]")
     );
 }
+
+#[test]
+fn look_grooms_write_shading_primvars_and_a_materialx_hair_material() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = |material: bool| {
+        format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 300\nparts = 2\n\
+             [guides]\ngenerate = {{ count = 30, length = 0.05 }}\n[finish]\npoints = 4\n\
+             [look]\nmelanin = 0.3\nmelanin_redness = 0.6\njitter = 0.1\nmaterial = {material}\n"
+        )
+    };
+    let mut files = Vec::new();
+    for material in [true, false] {
+        let groom = pelage::groom::Groom::from_text("look.toml", &text(material)).unwrap();
+        let generator = groom.generator(None).unwrap();
+        let parts: Vec<Curves> = (0..2).map(|p| generator.part(p).unwrap()).collect();
+        for ext in ["usda", "usdc"] {
+            let path = dir.path().join(format!("material{}.{ext}", material as u8));
+            let named = parts
+                .iter()
+                .enumerate()
+                .map(|(i, c)| (format!("part_{i}"), c));
+            write_curves(&path, named, &groom.export()).unwrap();
+            // pelage reads its own primvars back, all parts joined.
+            let back = read_usd_curves(&path).unwrap();
+            let want = pelage::io::join(parts.iter()).unwrap();
+            assert_eq!(back.shading(), want.shading(), "{}", path.display());
+            files.push(path);
+        }
+    }
+    let Some((ok, out)) = usdcheck(&files) else {
+        return;
+    };
+    // usdcheck checks the network against MaterialX's own node library
+    // (ids, input and output types, connections) and that every primvar
+    // the material reads is on the curves it is bound to.
+    assert!(ok, "{out}");
+    for f in &files[..2] {
+        let line = format!("{}: ok:", f.display());
+        let line = out.lines().find(|l| l.starts_with(&line)).unwrap();
+        assert!(
+            line.ends_with("2 curves prims bound to a material"),
+            "{line}"
+        );
+    }
+    for f in &files[2..] {
+        let line = format!("{}: ok:", f.display());
+        let line = out.lines().find(|l| l.starts_with(&line)).unwrap();
+        assert!(
+            line.ends_with("0 warnings"),
+            "material = false binds nothing: {line}"
+        );
+    }
+    let (same, out) = usdcheck(&[Path::new("--same"), &files[0], &files[1]]).unwrap();
+    assert!(same, "the usda and usdc writers disagree:\n{out}");
+
+    // A test of the test: a material reading a primvar the curves lack.
+    let good = std::fs::read_to_string(&files[0]).unwrap();
+    let bad = good.replacen("\"hair_melanin_redness\"", "\"hair_redness\"", 1);
+    assert_ne!(good, bad);
+    let bad_path = dir.path().join("missing_primvar.usda");
+    std::fs::write(&bad_path, bad).unwrap();
+    let (ok, out) = usdcheck(&[&bad_path]).unwrap();
+    assert!(!ok && out.contains("reads primvar hair_redness"), "{out}");
+}

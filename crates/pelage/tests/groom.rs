@@ -562,3 +562,97 @@ fn twist_turns_hairs_about_their_chord_keeping_roots_and_tips() {
         }
     }
 }
+
+/// A groom with a `[look]` over `parts` parts.
+fn looked(parts: u32, look: &str) -> String {
+    format!(
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 3000\nseed = 5\nparts = {parts}\n\
+         [guides]\ngenerate = {{ count = 40, length = 0.05 }}\n[finish]\npoints = 4\n[look]\n{look}"
+    )
+}
+
+#[test]
+fn look_maps_are_read_at_each_root_and_jitter_stays_in_its_band() {
+    let melanin_map = "noise:frequency=3,seed=2,offset=0.5,scale=0.4";
+    let exact = grown(&looked(
+        2,
+        &format!("melanin = \"{melanin_map}\"\nroughness = 0.45\ntint = [1.0, 0.5, 0.25]\n"),
+    ));
+    let spot = pelage::assets::spot();
+    let map = Map::parse(melanin_map).unwrap();
+    let shading = exact.shading().expect("a [look] groom carries shading");
+    let roots = exact.roots().unwrap();
+    assert_eq!(shading.len(), exact.curve_count());
+    for (i, root) in roots.iter().enumerate() {
+        let want = map
+            .at(&pelage::map::MapSite::on(&spot, *root))
+            .clamp(0.0, 1.0);
+        assert_eq!(shading.melanin[i], want, "hair {i}");
+        assert_eq!(shading.roughness[i], 0.45);
+        assert_eq!(shading.melanin_redness[i], 1.0, "the Cycles default");
+        assert_eq!(shading.tint[i], Vec3::new(1.0, 0.5, 0.25));
+    }
+    let spread = shading
+        .melanin
+        .iter()
+        .fold((1.0f32, 0.0f32), |(lo, hi), &m| (lo.min(m), hi.max(m)));
+    assert!(
+        spread.1 - spread.0 > 0.2,
+        "the map varies over Spot: {spread:?}"
+    );
+
+    // Jitter moves each value within ±jitter of the map's, each hair its
+    // own draw; the random number is uniform on [0, 1).
+    let jittered = grown(&looked(2, "roughness = 0.5\njitter = 0.2\n"));
+    let s = jittered.shading().unwrap();
+    assert!(s.roughness.iter().all(|&r| (0.4..=0.6).contains(&r)));
+    let distinct: HashSet<u32> = s.roughness.iter().map(|r| r.to_bits()).collect();
+    assert!(
+        distinct.len() > s.len() * 9 / 10,
+        "{} distinct of {}",
+        distinct.len(),
+        s.len()
+    );
+    assert!(s.roughness.iter().any(|&r| r < 0.45) && s.roughness.iter().any(|&r| r > 0.55));
+    assert!(s.random.iter().all(|&r| (0.0..1.0).contains(&r)));
+    let mean = s.random.iter().sum::<f32>() / s.len() as f32;
+    assert!((mean - 0.5).abs() < 0.03, "mean of hair_random {mean}");
+
+    // A hair's values follow its id, not the part it was grown in.
+    let one_part = grown(&looked(1, "roughness = 0.5\njitter = 0.2\n"));
+    let by_id = |c: &Curves| -> std::collections::HashMap<u64, (u32, u32, u32)> {
+        let s = c.shading().unwrap();
+        let ids = c.ids().unwrap();
+        (0..c.curve_count())
+            .map(|i| {
+                (
+                    ids[i],
+                    (
+                        s.melanin[i].to_bits(),
+                        s.roughness[i].to_bits(),
+                        s.random[i].to_bits(),
+                    ),
+                )
+            })
+            .collect()
+    };
+    assert_eq!(by_id(&one_part), by_id(&jittered));
+
+    // Without [look], no values (and no material) are written.
+    let plain = grown(&looked(1, "").replace("[look]\n", ""));
+    assert!(plain.shading().is_none());
+}
+
+#[test]
+fn look_values_out_of_range_are_errors_at_their_line() {
+    let melanin = error(&looked(1, "melanin = 1.5\n"));
+    assert!(
+        melanin.starts_with("fur/test.toml:12:11: look.melanin:"),
+        "{melanin}"
+    );
+    let unknown = error(&looked(1, "colour = 0.5\n"));
+    assert!(
+        unknown.contains("look") && unknown.contains("colour"),
+        "{unknown}"
+    );
+}

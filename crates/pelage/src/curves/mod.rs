@@ -6,7 +6,8 @@
 //! Besides positions and widths, curves carry the optional attributes
 //! renderers read (docs/design.md, "Data model"): per point a normal (ribbon
 //! orientation), a colour and an opacity; per curve its root on the mesh
-//! ([`SurfacePoint`]), the root's UV, and a stable id.
+//! ([`SurfacePoint`]), the root's UV, a stable id, and what a hair shader
+//! reads ([`HairShading`]).
 //!
 //! [`frames`] holds Catmull-Rom tangents and rotation-minimizing frames
 //! (Wang et al. 2008) for the per-point normals.
@@ -15,6 +16,9 @@
 //! of its lines are tests).
 
 pub mod frames;
+mod shading;
+
+pub use shading::HairShading;
 
 use crate::SurfacePoint;
 use glam::{Vec2, Vec3};
@@ -51,6 +55,8 @@ pub struct Curves {
     ids: Option<Vec<u64>>,
     /// Per-point velocities (units a second) of an animated frame.
     velocities: Option<Vec<Vec3>>,
+    /// Per-curve values for a hair shader.
+    shading: Option<HairShading>,
 }
 
 /// What the skin binding moves (points, normals) beside what it reads
@@ -276,11 +282,12 @@ impl Curves {
         }
     }
 
-    /// Every `step`-th curve (0, step, 2·step, …) with its points, widths
-    /// and colours: a lighter set for previews.
+    /// Every `step`-th curve (0, step, 2·step, …) with its points, widths,
+    /// colours and shading values: a lighter set for previews.
     pub fn every_nth(&self, step: usize) -> Curves {
         let step = step.max(1);
         let (mut points, mut widths, mut colors) = (Vec::new(), Vec::new(), Vec::new());
+        let mut shading = HairShading::default();
         let mut offsets = vec![0u32];
         for i in (0..self.curve_count()).step_by(step) {
             let range = self.range(i);
@@ -289,6 +296,9 @@ impl Curves {
             if let Some(c) = &self.colors {
                 colors.extend_from_slice(&c[range]);
             }
+            if let Some(s) = &self.shading {
+                shading.push_from(s, i);
+            }
             offsets.push(points.len() as u32);
         }
         Curves {
@@ -296,6 +306,7 @@ impl Curves {
             widths,
             offsets,
             colors: self.colors.is_some().then_some(colors),
+            shading: self.shading.is_some().then_some(shading),
             ..Curves::default()
         }
     }
@@ -358,6 +369,7 @@ impl Curves {
         copy_opt(&mut self.roots, other.roots.as_ref());
         copy_opt(&mut self.root_uvs, other.root_uvs.as_ref());
         copy_opt(&mut self.ids, other.ids.as_ref());
+        self.shading.clone_from(&other.shading);
         self.velocities = None;
         sized(&mut self.points, other.points.len());
         match &other.normals {
@@ -464,6 +476,23 @@ impl Curves {
         Ok(self)
     }
 
+    /// Adds each curve's values for a hair shader. Fails unless every
+    /// array holds one finite value a curve.
+    pub fn with_shading(mut self, shading: HairShading) -> Result<Self, CurvesError> {
+        if let Some((what, got)) = shading.mismatch(self.curve_count()) {
+            return Err(CurvesError::CurveLength {
+                what,
+                got,
+                curves: self.curve_count(),
+            });
+        }
+        if let Some((what, index)) = shading.first_non_finite() {
+            return Err(CurvesError::NonFinite { what, index });
+        }
+        self.shading = Some(shading);
+        Ok(self)
+    }
+
     /// Checks a per-point attribute's length; `first_non_finite` is the
     /// index of its first NaN or infinite value, if any.
     fn check_per_point(
@@ -544,6 +573,11 @@ impl Curves {
     /// Per-curve ids, if any.
     pub fn ids(&self) -> Option<&[u64]> {
         self.ids.as_deref()
+    }
+
+    /// Per-curve values for a hair shader, if any.
+    pub fn shading(&self) -> Option<&HairShading> {
+        self.shading.as_ref()
     }
 
     /// The number of points of the shortest and the longest curve

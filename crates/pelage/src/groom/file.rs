@@ -101,6 +101,49 @@ pub struct GroomFile {
     /// Regions of the skin that do not share guides or clumps (absent:
     /// one region).
     pub regions: Option<RegionsSection>,
+    /// Each hair's values for a hair shader (absent: none written).
+    pub look: Option<LookSection>,
+}
+
+/// `[look]`: see [`crate::groom::HairLook`]; the defaults are Cycles'
+/// Principled Hair defaults.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LookSection {
+    /// Melanin, 0 (white) to 1 (black).
+    #[serde(default = "look_melanin")]
+    pub melanin: MapValue,
+    /// The share of red pheomelanin, 0 to 1.
+    #[serde(default = "one")]
+    pub melanin_redness: MapValue,
+    /// Dye colour, linear RGB, each channel a map.
+    #[serde(default = "white")]
+    pub tint: [MapValue; 3],
+    /// Longitudinal roughness, 0 to 1.
+    #[serde(default = "look_roughness")]
+    pub roughness: MapValue,
+    /// Azimuthal roughness, 0 to 1.
+    #[serde(default = "look_roughness")]
+    pub radial_roughness: MapValue,
+    /// Per-hair variation of melanin, redness and roughnesses, a fraction.
+    #[serde(default = "zero")]
+    pub jitter: MapValue,
+    /// Seed of the variation and of `hair_random`.
+    #[serde(default)]
+    pub seed: u64,
+    /// Write a material reading the values (false: bind your own).
+    #[serde(default = "yes")]
+    pub material: bool,
+}
+
+fn look_melanin() -> MapValue {
+    Spanned::new(0..0, MapText::Number(0.8))
+}
+fn look_roughness() -> MapValue {
+    Spanned::new(0..0, MapText::Number(0.3))
+}
+fn white() -> [MapValue; 3] {
+    [one(), one(), one()]
 }
 
 /// `[regions]`: the skin split into regions. Hairs take their shape only

@@ -8,6 +8,7 @@
 use super::error::{GroomError, GroomErrorKind};
 use super::grow::{Workspace, sorted_by_triangle, sorted_by_triangle_with_ids};
 use super::load::part_count;
+use super::look::HairLook;
 use super::ops::{
     CentreGuides, ClumpCentres, OpKey, Opacity, Operator, Preparation, Resampling, Width,
     color_maps_mut, root_to_tip_maps_mut,
@@ -72,6 +73,8 @@ pub struct Generator {
     /// as the whole groom does.
     pub(super) width_scale: f32,
     pub(super) normals: bool,
+    /// Each hair's values for a hair shader.
+    pub(super) look: Option<HairLook>,
     pub(super) seed: u64,
     /// Arrays of parts handed back by [`Self::recycle`], for the next parts.
     pub(super) spare: Arc<Mutex<Vec<CurveArrays>>>,
@@ -307,6 +310,7 @@ impl Generator {
             ops,
             finish,
             origin,
+            look,
             ..
         } = spec;
         let (colors, opacities) = (finish.color.is_some(), finish.opacity.is_some());
@@ -339,6 +343,7 @@ impl Generator {
                 1.0
             },
             normals: finish.normals,
+            look,
             // A frame's generator (`reshaped`) grows parts of the same
             // sizes: it reuses its parent's arrays.
             spare: shared_roots.map_or_else(Default::default, |g| g.spare.clone()),
@@ -695,6 +700,11 @@ fn bind_maps(spec: &mut GroomSpec) -> Result<(), GroomError> {
         if let Some(regions) = &mut spec.regions {
             for map in regions.maps_mut() {
                 bind("regions.map".into(), map);
+            }
+        }
+        if let Some(look) = &mut spec.look {
+            for (key, map) in look.maps_mut() {
+                bind(format!("look.{key}"), map);
             }
         }
     }

@@ -364,12 +364,26 @@ impl Generator {
     /// has and each hair's root UV. Every hair was found finite as it grew,
     /// so `Curves` does not scan the values again.
     fn assemble(&self, a: CurveArrays) -> Curves {
-        self.with_root_uvs(Curves::assembled(
+        self.with_look(self.with_root_uvs(Curves::assembled(
             a,
             self.normals,
             self.colors,
             self.opacities,
-        ))
+        )))
+    }
+
+    /// Adds each hair's values for a hair shader (`[look]`), found from
+    /// its root and id, when the groom has a look.
+    pub(crate) fn with_look(&self, curves: Curves) -> Curves {
+        let Some(look) = &self.look else {
+            return curves;
+        };
+        let roots = curves.roots().expect("grown curves carry their roots");
+        let ids = curves.ids().expect("grown curves carry their ids");
+        let shading = look.shade(&self.mesh, roots, ids);
+        curves
+            .with_shading(shading)
+            .expect("one value a hair, each within 0 to 1 or a finite tint")
     }
 }
 

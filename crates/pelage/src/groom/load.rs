@@ -7,6 +7,7 @@ use super::animate::{AnimatedGroom, AnimationMode, AnimationSpec, GuideMotion};
 use super::error::{GroomError, GroomErrorKind};
 use super::file::{AnimationModeName, GroomFile, InterpolationKind, MapValue, MeshSection};
 use super::generator::Generator;
+use super::look::HairLook;
 use super::ops::{OpKey, SpecReader, map_on_mesh};
 use super::spec::{FinishSpec, GroomSpec, HairIds, RegionsSpec, RootsSpec, SpecOrigin};
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
@@ -299,6 +300,12 @@ impl Groom {
         self.file.output.basis
     }
 
+    /// Whether curves with hair-shading values get a material that reads
+    /// them (`[look] material`).
+    pub fn writes_hair_material(&self) -> bool {
+        self.file.look.as_ref().is_none_or(|l| l.material)
+    }
+
     /// Whether the skin is written beside the curves (`[output]
     /// with_mesh`).
     pub fn writes_skin(&self) -> bool {
@@ -515,6 +522,23 @@ impl Groom {
                 ));
             }
         }
+        let look = match &file.look {
+            None => None,
+            Some(l) => {
+                mark(&mut lines, "look", source.line_of(l.melanin.span()));
+                let mut r = SpecReader::new(source, &self.mesh, &mut lines, "look".into());
+                Some(HairLook {
+                    melanin: r.map("melanin", &l.melanin)?,
+                    melanin_redness: r.map("melanin_redness", &l.melanin_redness)?,
+                    tint: r.rgb("tint", &l.tint)?,
+                    roughness: r.map("roughness", &l.roughness)?,
+                    radial_roughness: r.map("radial_roughness", &l.radial_roughness)?,
+                    jitter: r.map("jitter", &l.jitter)?,
+                    seed: l.seed,
+                    material: l.material,
+                })
+            }
+        };
         Ok(GroomSpec {
             name: source.path.clone(),
             mesh: self.mesh.clone(),
@@ -524,6 +548,7 @@ impl Groom {
             ops,
             finish,
             regions,
+            look,
             origin: Some(Arc::new(SpecOrigin { lines })),
         })
     }

@@ -17,6 +17,8 @@
 //!   file; [`FarmRun`] (`K/N`) is one run of a farm and
 //!   [`find_part_files`] finds the runs' files, which [`write_assembly`]
 //!   ties together in USD ([`Groom::assemble`] does both).
+//! - [`HairLook`] (`look.rs`): `[look]`, each hair's values for a
+//!   physically based hair shader.
 //! - [`GroomReport`] (`report.rs`): what a groom grew and left out, for
 //!   every front end.
 //!
@@ -39,6 +41,7 @@ pub(crate) mod file;
 mod generator;
 mod grow;
 mod load;
+mod look;
 pub mod ops;
 mod output;
 pub mod parts;
@@ -57,6 +60,7 @@ pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
 pub use farm::{FarmError, FarmRun, find_part_files};
 pub use generator::{Generator, GroomSummary, HAIRS_PER_PART};
 pub use load::{Groom, GroomInputs};
+pub use look::HairLook;
 pub use output::{GroomWriteError, StreamError, part_file, part_name, part_slice, write_assembly};
 pub use parts::{Part, PartLayout};
 pub use ramp::Ramp;

@@ -64,6 +64,20 @@ const GROOM_RULES: &[Rule] = &[
     Rule::new("finish.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
     Rule::new("finish.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
     Rule::new("animation.fps", Bound::more_than(0.0), "frames per second"),
+    Rule::new(
+        "look.melanin",
+        Bound::Within(0.0, 1.0),
+        "Cycles' melanin scale",
+    ),
+    Rule::new("look.melanin_redness", Bound::Within(0.0, 1.0), "a share"),
+    Rule::new("look.tint", Bound::at_least(0.0), "a linear colour"),
+    Rule::new("look.roughness", Bound::Within(0.0, 1.0), "a roughness"),
+    Rule::new(
+        "look.radial_roughness",
+        Bound::Within(0.0, 1.0),
+        "a roughness",
+    ),
+    Rule::new("look.jitter", Bound::Within(0.0, 1.0), "a fraction"),
 ];
 
 impl SettingsSource {

@@ -26,6 +26,7 @@
 
 use super::error::{GroomError, GroomErrorKind};
 use super::generator::Generator;
+use super::look::HairLook;
 pub use super::ops::GroomOp;
 use super::ops::{Color, RootToTip};
 use crate::guides::Guides;
@@ -60,6 +61,8 @@ pub struct GroomSpec {
     pub finish: FinishSpec,
     /// Regions that share no guides and no clumps (`None`: one region).
     pub regions: Option<RegionsSpec>,
+    /// Each hair's values for a hair shader (`None`: none written).
+    pub look: Option<HairLook>,
     /// Where the settings were written, for a groom read from a file.
     pub(crate) origin: Option<Arc<SpecOrigin>>,
 }
@@ -87,8 +90,15 @@ impl GroomSpec {
             ops: Vec::new(),
             finish: FinishSpec::default(),
             regions: None,
+            look: None,
             origin: None,
         }
+    }
+
+    /// Gives every hair values for a hair shader.
+    pub fn with_look(mut self, look: HairLook) -> Self {
+        self.look = Some(look);
+        self
     }
 
     /// Splits the skin into regions.

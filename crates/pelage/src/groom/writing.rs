@@ -23,6 +23,7 @@ impl Groom {
         UsdOptions {
             basis: self.curve_basis(),
             time_codes_per_second: self.fps().unwrap_or(DEFAULT_FPS),
+            hair_material: self.writes_hair_material(),
             ..UsdOptions::default()
         }
     }

@@ -231,6 +231,14 @@ pub fn join<'c>(
     if let Some(roots) = concat_all(&parts, Curves::roots) {
         joined = joined.with_roots(roots)?;
     }
+    let shading: Option<Vec<_>> = parts.iter().map(|c| c.shading()).collect();
+    if let Some(shading) = shading.filter(|s| !s.is_empty()) {
+        let mut all = crate::curves::HairShading::with_capacity(joined.curve_count());
+        for part in shading {
+            all.extend_from(part);
+        }
+        joined = joined.with_shading(all)?;
+    }
     Ok(joined)
 }
 

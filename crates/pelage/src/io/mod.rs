@@ -22,6 +22,7 @@ pub(crate) use atomic::folder_of;
 mod curves_file;
 mod curves_ply;
 mod hair;
+mod hair_material;
 mod points_ply;
 mod read_error;
 mod render_text;

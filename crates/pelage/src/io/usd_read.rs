@@ -221,6 +221,38 @@ fn with_primvars(
     if let Some(ids) = ids {
         curves = curves.with_ids(ids)?;
     }
+    // Hair-shading values only where all of them are there, as pelage
+    // writes them.
+    let float = |name: &str| match per(&format!("primvars:{name}"), "uniform") {
+        Some(Value::FloatVec(v)) => Some(v),
+        _ => None,
+    };
+    let tint = match per("primvars:hair_tint", "uniform") {
+        Some(Value::Vec3fVec(v)) => {
+            Some(v.iter().map(|c| glam::Vec3::new(c.x, c.y, c.z)).collect())
+        }
+        _ => None,
+    };
+    let names: [&str; 5] = std::array::from_fn(|i| crate::curves::HairShading::NAMES[i]);
+    let [melanin, redness, roughness, radial, random] = names.map(float);
+    if let (
+        Some(melanin),
+        Some(melanin_redness),
+        Some(tint),
+        Some(roughness),
+        Some(radial_roughness),
+        Some(random),
+    ) = (melanin, redness, tint, roughness, radial, random)
+    {
+        curves = curves.with_shading(crate::curves::HairShading {
+            melanin,
+            melanin_redness,
+            tint,
+            roughness,
+            radial_roughness,
+            random,
+        })?;
+    }
     Ok(curves)
 }
 

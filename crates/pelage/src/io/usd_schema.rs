@@ -6,8 +6,9 @@
 //!
 //! What each attribute means and how many values it needs follows the
 //! `UsdGeomBasisCurves` schema: `widths`, `normals`, `displayColor` and
-//! `displayOpacity` are per point (`vertex`), the root UV (`st`) and the
-//! hair id are per curve (`uniform`), and every prim has an `extent`
+//! `displayOpacity` are per point (`vertex`), the root UV (`st`), the
+//! hair id and the hair-shading values (`hair_melanin`, …) are per curve
+//! (`uniform`), and every prim has an `extent`
 //! padded by half the widest hair, as `UsdGeomCurves::ComputeExtent` does.
 
 use super::usda::{CurveBasis, PrimWriteError, UsdOptions, UsdWrap};
@@ -232,6 +233,18 @@ pub(crate) fn basis_curves_attributes<'a>(
             UsdAttribute::new("primvars:displayOpacity", "float[]", values).interpolated("vertex"),
         );
     }
+    if let Some(shading) = curves.shading() {
+        for ((_, values), name) in shading.floats().into_iter().zip(SHADING_PRIMVARS) {
+            attributes.push(
+                UsdAttribute::new(name, "float[]", UsdValues::Floats(values))
+                    .interpolated("uniform"),
+            );
+        }
+        let tint = UsdValues::Vec3s(Cow::Borrowed(&shading.tint));
+        attributes.push(
+            UsdAttribute::new("primvars:hair_tint", "color3f[]", tint).interpolated("uniform"),
+        );
+    }
     if let Some(uvs) = curves.root_uvs() {
         let values = UsdValues::Vec2s(uvs);
         attributes
@@ -252,6 +265,22 @@ pub(crate) fn basis_curves_attributes<'a>(
         attributes.push(attribute.interpolated("uniform"));
     }
     Ok(attributes)
+}
+
+/// The primvars of [`crate::curves::HairShading::floats`], in its order:
+/// `primvars:` and the attribute's name.
+const SHADING_PRIMVARS: [&str; 5] = [
+    "primvars:hair_melanin",
+    "primvars:hair_melanin_redness",
+    "primvars:hair_roughness",
+    "primvars:hair_radial_roughness",
+    "primvars:hair_random",
+];
+
+/// Whether a part's prim is bound to the hair material: its curves carry
+/// hair-shading values and the options ask for the material.
+pub(crate) fn binds_hair_material(curves: &Curves, options: &UsdOptions) -> bool {
+    options.hair_material && curves.shading().is_some()
 }
 
 /// The attributes of the skin's `Mesh` prim: triangles, vertex normals,
@@ -353,4 +382,18 @@ pub(crate) fn curve_extent(curves: &Curves) -> (Vec3, Vec3) {
     };
     let pad = curves.widths().iter().fold(0.0f32, |m, &w| m.max(w.abs())) * 0.5;
     (lo - Vec3::splat(pad), hi + Vec3::splat(pad))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::curves::HairShading;
+
+    #[test]
+    fn shading_primvars_are_the_attribute_names() {
+        let floats = HairShading::default();
+        for ((name, _), primvar) in floats.floats().into_iter().zip(SHADING_PRIMVARS) {
+            assert_eq!(primvar, format!("primvars:{name}"));
+        }
+    }
 }

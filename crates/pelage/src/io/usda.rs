@@ -9,10 +9,11 @@
 //! The attributes themselves come from `usd_schema`, shared with the usdc
 //! writer.
 
+use super::hair_material::{MATERIAL_NAME, NetworkPrim, NetworkValue, hair_material};
 use super::text::{put_f32, put_tuple2, put_tuple3, put_u64};
 use super::usd_schema::{
-    PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes, check_name,
-    mesh_attributes, points_attributes,
+    PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes,
+    binds_hair_material, check_name, mesh_attributes, points_attributes,
 };
 use crate::Curves;
 use crate::mesh::Mesh;
@@ -101,6 +102,9 @@ pub struct UsdOptions {
     pub root: String,
     /// `timeCodesPerSecond` (and `framesPerSecond`) of an animated stage.
     pub time_codes_per_second: f64,
+    /// Bind curves that carry hair-shading values to a MaterialX hair
+    /// material written beside them (`hair_material`).
+    pub hair_material: bool,
 }
 
 impl Default for UsdOptions {
@@ -112,6 +116,7 @@ impl Default for UsdOptions {
             meters_per_unit: 1.0,
             root: "groom".into(),
             time_codes_per_second: 24.0,
+            hair_material: true,
         }
     }
 }
@@ -266,6 +271,9 @@ pub struct UsdaWriter<W: Write> {
     out: W,
     options: UsdOptions,
     names: HashSet<String>,
+    /// Whether the hair material is written (before the first part bound
+    /// to it).
+    material_written: bool,
 }
 
 impl<W: Write> UsdaWriter<W> {
@@ -288,6 +296,7 @@ impl<W: Write> UsdaWriter<W> {
             out,
             options: options.clone(),
             names: HashSet::new(),
+            material_written: false,
         })
     }
 
@@ -302,7 +311,14 @@ impl<W: Write> UsdaWriter<W> {
     /// Writes one part as a `BasisCurves` prim named `name`.
     pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         let attributes = basis_curves_attributes(name, curves, &self.options)?;
-        self.write_prim("BasisCurves", name, &attributes)
+        let bound = binds_hair_material(curves, &self.options);
+        if bound && !self.material_written {
+            self.claim(MATERIAL_NAME)?;
+            let path = format!("/{}/{MATERIAL_NAME}", self.options.root);
+            write_network(&mut self.out, &hair_material(), 1, &path)?;
+            self.material_written = true;
+        }
+        self.write_prim_bound("BasisCurves", name, &attributes, bound)
     }
 
     /// Writes sampled surface points as a `Points` prim named `name`.
@@ -327,11 +343,36 @@ impl<W: Write> UsdaWriter<W> {
         name: &str,
         attributes: &[UsdAttribute],
     ) -> Result<(), PrimWriteError> {
+        self.write_prim_bound(type_name, name, attributes, false)
+    }
+
+    /// [`Self::write_prim`], `bound` to the hair material or not.
+    fn write_prim_bound(
+        &mut self,
+        type_name: &str,
+        name: &str,
+        attributes: &[UsdAttribute],
+        bound: bool,
+    ) -> Result<(), PrimWriteError> {
         self.claim(name)?;
         let out = &mut self.out;
-        writeln!(out, "    def {type_name} \"{name}\"\n    {{")?;
+        if bound {
+            writeln!(
+                out,
+                "    def {type_name} \"{name}\" (\n        prepend apiSchemas = [\"MaterialBindingAPI\"]\n    )\n    {{"
+            )?;
+        } else {
+            writeln!(out, "    def {type_name} \"{name}\"\n    {{")?;
+        }
         for attribute in attributes {
             write_attribute(out, attribute)?;
+        }
+        if bound {
+            let root = &self.options.root;
+            writeln!(
+                out,
+                "        rel material:binding = </{root}/{MATERIAL_NAME}>"
+            )?;
         }
         writeln!(out, "    }}")?;
         Ok(())
@@ -414,6 +455,50 @@ fn write_attribute(out: &mut impl Write, attribute: &UsdAttribute) -> std::io::R
         UsdValues::Vec2s(values) => write_array(out, &decl, values, interpolation, put_tuple2),
         UsdValues::Vec3s(values) => write_array(out, &decl, values, interpolation, put_tuple3),
     }
+}
+
+/// Writes a network prim and its children at `depth` levels of indent;
+/// connections name shaders under `material` (the material's path).
+fn write_network(
+    out: &mut impl Write,
+    prim: &NetworkPrim,
+    depth: usize,
+    material: &str,
+) -> std::io::Result<()> {
+    let indent = "    ".repeat(depth);
+    writeln!(
+        out,
+        "{indent}def {} \"{}\"\n{indent}{{",
+        prim.type_name, prim.name
+    )?;
+    for a in &prim.attributes {
+        let variability = if a.uniform { "uniform " } else { "" };
+        let decl = format!("{indent}    {variability}{} {}", a.type_name, a.name);
+        let mut text = Vec::new();
+        match a.value {
+            NetworkValue::Declared => {}
+            NetworkValue::Token(t) | NetworkValue::Text(t) => {
+                text.extend_from_slice(format!(" = \"{t}\"").as_bytes())
+            }
+            NetworkValue::Float(v) => {
+                text.extend_from_slice(b" = ");
+                put_f32(v, &mut text);
+            }
+            NetworkValue::Color(c) => {
+                text.extend_from_slice(b" = ");
+                put_tuple3(&c, &mut text);
+            }
+            NetworkValue::Connect(shader, output) => text
+                .extend_from_slice(format!(".connect = <{material}/{shader}.{output}>").as_bytes()),
+        }
+        out.write_all(decl.as_bytes())?;
+        out.write_all(&text)?;
+        writeln!(out)?;
+    }
+    for child in &prim.children {
+        write_network(out, child, depth + 1, material)?;
+    }
+    writeln!(out, "{indent}}}")
 }
 
 /// `path` as a USD asset path in text USD: `@path@`, or where the path

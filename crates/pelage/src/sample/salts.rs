@@ -19,13 +19,29 @@ pub const CELL_ROOTS: u64 = 0xCE11_2007;
 /// Blue-noise roots: the candidates a part's roots are chosen from.
 pub const BLUE_NOISE: u64 = 0xB10E_2015;
 
+/// `[look]`: a hair's melanin jitter.
+pub const LOOK_MELANIN: u64 = 0x100C_3E1A;
+/// `[look]`: a hair's melanin redness jitter.
+pub const LOOK_REDNESS: u64 = 0x100C_4ED0;
+/// `[look]`: a hair's roughness jitter.
+pub const LOOK_ROUGHNESS: u64 = 0x100C_2006;
+/// `[look]`: a hair's radial roughness jitter.
+pub const LOOK_RADIAL_ROUGHNESS: u64 = 0x100C_2AD1;
+/// `[look]`: a hair's `hair_random`.
+pub const LOOK_RANDOM: u64 = 0x100C_0AA0;
+
 /// Every salt above, with its name.
-pub const ALL: [(&str, u64); 5] = [
+pub const ALL: [(&str, u64); 10] = [
     ("PART_ROOTS", PART_ROOTS),
     ("DROPLETS", DROPLETS),
     ("CELL_ARRIVALS", CELL_ARRIVALS),
     ("CELL_ROOTS", CELL_ROOTS),
     ("BLUE_NOISE", BLUE_NOISE),
+    ("LOOK_MELANIN", LOOK_MELANIN),
+    ("LOOK_REDNESS", LOOK_REDNESS),
+    ("LOOK_ROUGHNESS", LOOK_ROUGHNESS),
+    ("LOOK_RADIAL_ROUGHNESS", LOOK_RADIAL_ROUGHNESS),
+    ("LOOK_RANDOM", LOOK_RANDOM),
 ];
 
 #[cfg(test)]

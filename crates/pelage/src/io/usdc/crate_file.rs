@@ -41,6 +41,8 @@ pub(super) enum ValueType {
     Token = 11,
     Vec2f = 20,
     Vec3f = 24,
+    TokenListOp = 32,
+    PathListOp = 34,
     TokenVector = 41,
     Specifier = 42,
     Variability = 44,
@@ -88,6 +90,17 @@ pub(super) enum SpecType {
     Attribute = 1,
     Prim = 6,
     PseudoRoot = 7,
+    Relationship = 8,
+}
+
+/// The header byte of a list op (`_ListOpHeader`): which of its lists
+/// follow, each as a count and the items, in the order explicit, added,
+/// prepended, appended, deleted, ordered.
+pub(super) mod list_op {
+    /// The list replaces what weaker layers say (`rel x = </a>`).
+    pub const EXPLICIT: u8 = 1 << 0;
+    pub const HAS_EXPLICIT_ITEMS: u8 = 1 << 1;
+    pub const HAS_PREPENDED_ITEMS: u8 = 1 << 5;
 }
 
 /// `Usd_IntegerCompression`'s coding of a run of integers before LZ4: a

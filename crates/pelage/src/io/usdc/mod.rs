@@ -20,18 +20,19 @@ mod read;
 
 pub(crate) use read::{read_usdc, read_usdc_bytes};
 
+use super::hair_material::{MATERIAL_NAME, NetworkPrim, NetworkValue, hair_material};
 use super::usd_schema::{
-    PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes, check_name,
-    curve_extent, mesh_attributes, points_attributes,
+    PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes,
+    binds_hair_material, check_name, curve_extent, mesh_attributes, points_attributes,
 };
 use super::{PrimWriteError, UpAxis, UsdOptions};
 use crate::Curves;
 use crate::mesh::Mesh;
 use crate_file::{
     BOOTSTRAP_SIZE, Counted, MIN_COMPRESSED_ARRAY_SIZE, ROOT_PATH, Spec, SpecType, Structure,
-    VERSION, ValueRep, ValueType, compressed_integers, float_lookup_table,
+    VERSION, ValueRep, ValueType, compressed_integers, float_lookup_table, list_op,
 };
-use std::collections::{BTreeMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::io::{Seek, SeekFrom, Write};
 
 /// The attributes of an animated part that get a sample per frame.
@@ -64,6 +65,9 @@ pub struct UsdcWriter<W: Write + Seek> {
     /// By name, so that the time samples are written in the same order
     /// on every run (the file is byte-reproducible).
     animated: BTreeMap<String, AnimatedPart>,
+    /// The hair material's path, once written (before the first part
+    /// bound to it).
+    material: Option<u32>,
 }
 
 impl<W: Write + Seek> UsdcWriter<W> {
@@ -86,13 +90,15 @@ impl<W: Write + Seek> UsdcWriter<W> {
             children: Vec::new(),
             names: HashSet::new(),
             animated: BTreeMap::new(),
+            material: None,
         })
     }
 
     /// Writes one part as a `BasisCurves` prim named `name`.
     pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         let attributes = basis_curves_attributes(name, curves, &self.options)?;
-        self.write_prim("BasisCurves", name, &attributes, false)?;
+        let material = self.material_for(curves)?;
+        self.write_prim_bound("BasisCurves", name, &attributes, false, material)?;
         Ok(())
     }
 
@@ -110,7 +116,8 @@ impl<W: Write + Seek> UsdcWriter<W> {
         PrimWriteError::check_time(name, time)?;
         if !self.animated.contains_key(name) {
             let attributes = basis_curves_attributes(name, curves, &self.options)?;
-            let specs = self.write_prim("BasisCurves", name, &attributes, true)?;
+            let material = self.material_for(curves)?;
+            let specs = self.write_prim_bound("BasisCurves", name, &attributes, true, material)?;
             let samples = specs
                 .into_iter()
                 .map(|(spec, attribute)| (spec, attribute, Vec::new()))
@@ -233,6 +240,153 @@ impl<W: Write + Seek> UsdcWriter<W> {
         Ok(())
     }
 
+    /// Takes `name` for a prim under the default prim.
+    fn claim(&mut self, name: &str) -> Result<(), PrimWriteError> {
+        check_name(name)?;
+        if !self.names.insert(name.to_string()) {
+            return Err(PrimWriteError::DuplicateName(name.to_string()));
+        }
+        Ok(())
+    }
+
+    /// The hair material's path where `curves` are bound to it, the
+    /// material written first if it is not yet.
+    fn material_for(&mut self, curves: &Curves) -> Result<Option<u32>, PrimWriteError> {
+        if !binds_hair_material(curves, &self.options) {
+            return Ok(None);
+        }
+        if self.material.is_none() {
+            self.claim(MATERIAL_NAME)?;
+            let path = self.write_network(self.root, &hair_material())?;
+            self.children.push(self.structure.token(MATERIAL_NAME));
+            self.material = Some(path);
+        }
+        Ok(self.material)
+    }
+
+    /// Writes a network prim and its children under `parent`; returns its
+    /// path. Every path is made before any spec, since a connection may
+    /// name a shader written after it.
+    fn write_network(&mut self, parent: u32, network: &NetworkPrim) -> Result<u32, PrimWriteError> {
+        struct Made<'a> {
+            prim: &'a NetworkPrim,
+            path: u32,
+            attributes: Vec<u32>,
+        }
+        fn make<'a>(
+            s: &mut Structure,
+            parent: u32,
+            prim: &'a NetworkPrim,
+            made: &mut Vec<Made<'a>>,
+        ) {
+            let path = s.child_path(parent, prim.name, false);
+            let attributes = prim
+                .attributes
+                .iter()
+                .map(|a| s.child_path(path, a.name, true))
+                .collect();
+            made.push(Made {
+                prim,
+                path,
+                attributes,
+            });
+            for child in &prim.children {
+                make(s, path, child, made);
+            }
+        }
+        let mut made = Vec::new();
+        make(&mut self.structure, parent, network, &mut made);
+        let by_name: HashMap<(&str, &str), u32> = made
+            .iter()
+            .flat_map(|m| {
+                m.prim
+                    .attributes
+                    .iter()
+                    .zip(&m.attributes)
+                    .map(|(a, &p)| ((m.prim.name, a.name), p))
+            })
+            .collect();
+        for m in &made {
+            for (attribute, &path) in m.prim.attributes.iter().zip(&m.attributes) {
+                let mut fields =
+                    attribute_fields(&mut self.structure, attribute.type_name, attribute.uniform);
+                let s = &mut self.structure;
+                let (field, value) = match attribute.value {
+                    NetworkValue::Declared => (None, None),
+                    NetworkValue::Token(t) => (
+                        Some("default"),
+                        Some(ValueRep::inlined(ValueType::Token, s.token(t))),
+                    ),
+                    NetworkValue::Text(t) => (
+                        Some("default"),
+                        Some(ValueRep::inlined(ValueType::String, s.string(t))),
+                    ),
+                    NetworkValue::Float(v) => (
+                        Some("default"),
+                        Some(ValueRep::inlined(ValueType::Float, v.to_bits())),
+                    ),
+                    NetworkValue::Color(c) => {
+                        let at = self.out.position;
+                        write_le_words(&mut self.out, bytemuck::cast_slice(&c.to_array()))?;
+                        (Some("default"), Some(ValueRep::at(ValueType::Vec3f, at)))
+                    }
+                    NetworkValue::Connect(shader, output) => {
+                        let target = by_name[&(shader, output)];
+                        (Some("connectionPaths"), Some(self.explicit_paths(target)?))
+                    }
+                };
+                if let (Some(field), Some(value)) = (field, value) {
+                    fields.push((self.structure.token(field), value));
+                }
+                self.structure.specs.push(Spec {
+                    path,
+                    kind: SpecType::Attribute,
+                    fields,
+                });
+            }
+            let names: Vec<u32> = m
+                .prim
+                .attributes
+                .iter()
+                .map(|a| self.structure.token(a.name))
+                .collect();
+            let properties = self.token_vector(&names)?;
+            let mut fields = prim_fields(
+                &mut self.structure,
+                m.prim.type_name,
+                "properties",
+                properties,
+            );
+            if !m.prim.children.is_empty() {
+                let names: Vec<u32> = m
+                    .prim
+                    .children
+                    .iter()
+                    .map(|c| self.structure.token(c.name))
+                    .collect();
+                let children = self.token_vector(&names)?;
+                fields.push((self.structure.token("primChildren"), children));
+            }
+            self.structure.specs.push(Spec {
+                path: m.path,
+                kind: SpecType::Prim,
+                fields,
+            });
+        }
+        Ok(made[0].path)
+    }
+
+    /// A path list op holding `target` alone, explicit (what text USD's
+    /// `x.connect = <…>` and `rel x = <…>` mean).
+    fn explicit_paths(&mut self, target: u32) -> std::io::Result<ValueRep> {
+        let at = self.out.position;
+        self.out
+            .write_all(&[list_op::EXPLICIT | list_op::HAS_EXPLICIT_ITEMS])?;
+        self.out.write_all(&1u64.to_le_bytes())?;
+        self.out.write_all(&target.to_le_bytes())?;
+        Ok(ValueRep::at(ValueType::PathListOp, at))
+    }
+
     /// Writes a prim's attribute values and records its specs. With
     /// `animated`, the attributes named in [`ANIMATED`] get no default
     /// value; their spec indices are returned for the time samples.
@@ -243,28 +397,30 @@ impl<W: Write + Seek> UsdcWriter<W> {
         attributes: &[UsdAttribute],
         animated: bool,
     ) -> Result<Vec<(usize, &'static str)>, PrimWriteError> {
-        check_name(name)?;
-        if !self.names.insert(name.to_string()) {
-            return Err(PrimWriteError::DuplicateName(name.to_string()));
-        }
+        self.write_prim_bound(type_name, name, attributes, animated, None)
+    }
+
+    /// [`Self::write_prim`], bound to the `material` at that path or not:
+    /// `MaterialBindingAPI` prepended to its API schemas and a
+    /// `material:binding` relationship.
+    fn write_prim_bound(
+        &mut self,
+        type_name: &str,
+        name: &str,
+        attributes: &[UsdAttribute],
+        animated: bool,
+        material: Option<u32>,
+    ) -> Result<Vec<(usize, &'static str)>, PrimWriteError> {
+        self.claim(name)?;
         let prim = self.structure.child_path(self.root, name, false);
         let mut sampled = Vec::new();
         let mut properties = Vec::with_capacity(attributes.len());
         for attribute in attributes {
             let path = self.structure.child_path(prim, attribute.name, true);
             properties.push(self.structure.token(attribute.name));
+            let mut fields =
+                attribute_fields(&mut self.structure, attribute.type_name, attribute.uniform);
             let s = &mut self.structure;
-            let mut fields = vec![
-                (
-                    s.token("typeName"),
-                    ValueRep::inlined(ValueType::Token, s.token(attribute.type_name)),
-                ),
-                (s.token("custom"), ValueRep::inlined(ValueType::Bool, 0)),
-                (
-                    s.token("variability"),
-                    ValueRep::inlined(ValueType::Variability, attribute.uniform as u32),
-                ),
-            ];
             if let Some(interpolation) = attribute.interpolation {
                 let value = ValueRep::inlined(ValueType::Token, s.token(interpolation));
                 fields.push((s.token("interpolation"), value));
@@ -281,19 +437,38 @@ impl<W: Write + Seek> UsdcWriter<W> {
                 fields,
             });
         }
+        let mut api_schemas = None;
+        if let Some(material) = material {
+            const BINDING: &str = "material:binding";
+            let path = self.structure.child_path(prim, BINDING, true);
+            properties.push(self.structure.token(BINDING));
+            let targets = self.explicit_paths(material)?;
+            let s = &mut self.structure;
+            let fields = vec![
+                (s.token("targetPaths"), targets),
+                (s.token("custom"), ValueRep::inlined(ValueType::Bool, 0)),
+                (
+                    s.token("variability"),
+                    ValueRep::inlined(ValueType::Variability, 1),
+                ),
+            ];
+            self.structure.specs.push(Spec {
+                path,
+                kind: SpecType::Relationship,
+                fields,
+            });
+            let schema = self.structure.token("MaterialBindingAPI");
+            let at = self.out.position;
+            self.out.write_all(&[list_op::HAS_PREPENDED_ITEMS])?;
+            self.out.write_all(&1u64.to_le_bytes())?;
+            self.out.write_all(&schema.to_le_bytes())?;
+            api_schemas = Some(ValueRep::at(ValueType::TokenListOp, at));
+        }
         let properties = self.token_vector(&properties)?;
-        let s = &mut self.structure;
-        let fields = vec![
-            (
-                s.token("specifier"),
-                ValueRep::inlined(ValueType::Specifier, 0),
-            ),
-            (
-                s.token("typeName"),
-                ValueRep::inlined(ValueType::Token, s.token(type_name)),
-            ),
-            (s.token("properties"), properties),
-        ];
+        let mut fields = prim_fields(&mut self.structure, type_name, "properties", properties);
+        if let Some(schemas) = api_schemas {
+            fields.push((self.structure.token("apiSchemas"), schemas));
+        }
         self.structure.specs.push(Spec {
             path: prim,
             kind: SpecType::Prim,
@@ -455,18 +630,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
         }
         let children = self.children.clone();
         let prim_children = self.token_vector(&children)?;
-        let s = &mut self.structure;
-        let root_fields = vec![
-            (
-                s.token("specifier"),
-                ValueRep::inlined(ValueType::Specifier, 0),
-            ),
-            (
-                s.token("typeName"),
-                ValueRep::inlined(ValueType::Token, s.token("Xform")),
-            ),
-            (s.token("primChildren"), prim_children),
-        ];
+        let root_fields = prim_fields(&mut self.structure, "Xform", "primChildren", prim_children);
         self.structure.specs.push(Spec {
             path: self.root,
             kind: SpecType::Prim,
@@ -552,6 +716,43 @@ impl<W: Write + Seek> PrimWriter for UsdcWriter<W> {
     fn write_mesh_at(&mut self, name: &str, time: f64, mesh: &Mesh) -> Result<(), PrimWriteError> {
         UsdcWriter::write_mesh_at(self, name, time, mesh)
     }
+}
+
+/// The fields every attribute spec starts with: its type, not custom,
+/// its variability.
+fn attribute_fields(s: &mut Structure, type_name: &str, uniform: bool) -> Vec<(u32, ValueRep)> {
+    vec![
+        (
+            s.token("typeName"),
+            ValueRep::inlined(ValueType::Token, s.token(type_name)),
+        ),
+        (s.token("custom"), ValueRep::inlined(ValueType::Bool, 0)),
+        (
+            s.token("variability"),
+            ValueRep::inlined(ValueType::Variability, uniform as u32),
+        ),
+    ]
+}
+
+/// The fields of a prim spec: `def`, its type, and the token list
+/// `names` of its `properties` or `primChildren` (`listing`).
+fn prim_fields(
+    s: &mut Structure,
+    type_name: &str,
+    listing: &str,
+    names: ValueRep,
+) -> Vec<(u32, ValueRep)> {
+    vec![
+        (
+            s.token("specifier"),
+            ValueRep::inlined(ValueType::Specifier, 0),
+        ),
+        (
+            s.token("typeName"),
+            ValueRep::inlined(ValueType::Token, s.token(type_name)),
+        ),
+        (s.token(listing), names),
+    ]
 }
 
 /// Writes 4-byte words little-endian: as they are in memory on
