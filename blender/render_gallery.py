@@ -1,11 +1,15 @@
 """Render fur grown by the add-on with Cycles, for the gallery:
 
-    tools/bpy-python blender/render_gallery.py EXTENSION.zip OUT.png
+    tools/bpy-python blender/render_gallery.py EXTENSION.zip OUT.png [--patches]
 
 Installs the extension into a fresh user folder, grows fur on Suzanne with
-"Grow pelage fur" (the panel's settings below), gives it Cycles'
-Principled Hair BSDF and renders 800×600 on the CPU (a few minutes on two
-cores). docs/gallery/blender-addon-suzanne.png is made this way.
+"Grow pelage fur" (the panel's settings below) and renders 800×600 on the
+CPU with Cycles (a few minutes on two cores). The fur is shaded by the
+material the add-on makes, a Principled Hair BSDF reading each hair's
+melanin, redness and roughness from the look (no material is set up
+here). docs/gallery/blender-addon-suzanne.png is made this way; with
+``--patches`` the settings come from a groom file whose ``[look]`` melanin
+is a noise map (docs/gallery/blender-look-patches.png).
 """
 
 import math
@@ -18,7 +22,9 @@ os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="pelage-blender-"
 import bpy  # noqa: E402
 import mathutils  # noqa: E402
 
-zip_path, out = os.path.abspath(sys.argv[-2]), os.path.abspath(sys.argv[-1])
+patches = sys.argv[-1] == "--patches"
+args = sys.argv[:-1] if patches else sys.argv
+zip_path, out = os.path.abspath(args[-2]), os.path.abspath(args[-1])
 assert bpy.ops.extensions.package_install_files(
     filepath=zip_path, repo="user_default", enable_on_install=True
 ) == {"FINISHED"}
@@ -49,19 +55,27 @@ settings.clump = 0.35
 settings.curl = 0.0
 settings.noise = 0.15
 settings.seed = 3
+settings.melanin = 0.55
+settings.melanin_redness = 0.8
+settings.roughness = 0.35
+settings.look_jitter = 0.2
+if patches:
+    # The same fur from a groom file, its melanin a noise map clamped to
+    # 0 and 1 in places: a patched coat, each hair its own shade.
+    groom = os.path.join(tempfile.mkdtemp(), "patches.toml")
+    with open(groom, "w") as f:
+        f.write(
+            '[mesh]\npath = "spot"\n[roots]\ncount = 200000\nseed = 3\n'
+            "[guides]\npoints = 10\ngenerate = { count = 800, length = 0.08, gravity = 0.3, comb = [0, 0, 1] }\n"
+            "[finish]\npoints = 10\nwidth = { root = 0.0025, tip = 0.00025 }\n"
+            '[[ops]]\nclump = { count = 2000, rate = 0.35 }\n[[ops]]\nnoise = { amplitude = 0.012, frequency = 80 }\n'
+            '[look]\nmelanin = "noise:frequency=4,seed=4,offset=0.45,scale=3"\n'
+            "melanin_redness = 0.9\nroughness = 0.3\njitter = 0.15\n"
+        )
+    settings.groom_file = groom
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
 fur = [o for o in bpy.data.objects if o.type == "CURVES"][0]
-hair = bpy.data.materials.new("hair")
-hair.use_nodes = True
-nodes = hair.node_tree.nodes
-nodes.remove(nodes["Principled BSDF"])
-bsdf = nodes.new("ShaderNodeBsdfHairPrincipled")
-bsdf.parametrization = "MELANIN"
-bsdf.inputs["Melanin"].default_value = 0.55
-bsdf.inputs["Melanin Redness"].default_value = 0.8
-bsdf.inputs["Roughness"].default_value = 0.35
-hair.node_tree.links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
-fur.data.materials.append(hair)
+assert fur.data.materials[0].name == "pelage hair"
 
 camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
 scene.collection.objects.link(camera)

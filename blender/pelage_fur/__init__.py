@@ -73,6 +73,12 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     curl: FloatProperty(name="Curl", description="Curl radius, relative to the length (0: off)", default=0.0, min=0.0, max=2.0)
     noise: FloatProperty(name="Noise", description="Noise amplitude, relative to the length (0: off)", default=0.1, min=0.0, max=2.0)
     seed: IntProperty(name="Seed", default=1, min=0)
+    # The look: Principled Hair BSDF (Chiang) values, Cycles' defaults.
+    melanin: FloatProperty(name="Melanin", description="Hair pigment, 0 white to 1 black", default=0.8, min=0.0, max=1.0)
+    melanin_redness: FloatProperty(name="Redness", description="Share of red pheomelanin in the pigment", default=1.0, min=0.0, max=1.0)
+    roughness: FloatProperty(name="Roughness", description="Longitudinal roughness: how far highlights spread along hairs", default=0.3, min=0.0, max=1.0)
+    radial_roughness: FloatProperty(name="Radial Roughness", description="Azimuthal roughness: how far light spreads around hairs", default=0.3, min=0.0, max=1.0)
+    look_jitter: FloatProperty(name="Variation", description="Per-hair variation of pigment and roughness, a fraction", default=0.1, min=0.0, max=1.0)
 
 
 def surface_of(context):
@@ -108,6 +114,34 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
         for warning in warnings:
             self.report({"WARNING"}, f"pelage: {warning}")
         self.report({"INFO"}, f"pelage: {grown.curve_count:,} hairs, {grown.point_count:,} points on {surface.name}")
+        return {"FINISHED"}
+
+
+class PELAGE_OT_shade_hair(bpy.types.Operator):
+    """Give the selected hair curves that carry pelage's per-hair look (a
+    pelage USD file imported by Blender's USD importer) the pelage hair
+    material, which reads it"""
+
+    bl_idname = "pelage.shade_hair"
+    bl_label = "Shade with pelage hair"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @staticmethod
+    def shadeable(context):
+        return [o for o in context.selected_objects
+                if o.type == "CURVES" and fur.SHADING_FLOATS[0] in o.data.attributes]
+
+    @classmethod
+    def poll(cls, context):
+        return bool(cls.shadeable(context))
+
+    def execute(self, context):
+        material = fur.hair_material()
+        objects = self.shadeable(context)
+        for obj in objects:
+            obj.data.materials.clear()
+            obj.data.materials.append(material)
+        self.report({"INFO"}, f"pelage: {len(objects)} curves objects shaded with {material.name!r}")
         return {"FINISHED"}
 
 
@@ -174,6 +208,11 @@ class PELAGE_PT_fur(bpy.types.Panel):
         column.prop(settings, "preset")
         for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed"):
             column.prop(settings, name)
+        look = layout.column(align=True)
+        look.enabled = not settings.groom_file
+        look.label(text="Look (Principled Hair BSDF)")
+        for name in ("melanin", "melanin_redness", "roughness", "radial_roughness", "look_jitter"):
+            look.prop(settings, name)
         layout.operator(PELAGE_OT_grow_fur.bl_idname, icon="CURVES")
         row = layout.row(align=True)
         row.operator(PELAGE_OT_export_usd.bl_idname)
@@ -183,6 +222,7 @@ class PELAGE_PT_fur(bpy.types.Panel):
 CLASSES = (
     PelageFurSettings,
     PELAGE_OT_grow_fur,
+    PELAGE_OT_shade_hair,
     PELAGE_OT_export_usd,
     PELAGE_OT_export_alembic,
     PELAGE_PT_fur,
@@ -191,6 +231,7 @@ CLASSES = (
 
 def menu_entry(self, context):
     self.layout.operator(PELAGE_OT_grow_fur.bl_idname, icon="CURVES")
+    self.layout.operator(PELAGE_OT_shade_hair.bl_idname, icon="MATERIAL")
 
 
 def register():

@@ -18,6 +18,14 @@ import numpy as np
 #: Attribute names on the created curves.
 HAIR_ID = "hair_id"
 COLOR = "color"
+#: pelage's per-hair shader values (``Curves.shading``), per curve; the
+#: USD writer's primvars have the same names, so Blender's USD importer
+#: brings a pelage file's values in as these attributes too.
+SHADING_FLOATS = ("hair_melanin", "hair_melanin_redness", "hair_roughness",
+                  "hair_radial_roughness", "hair_random")
+TINT = "hair_tint"
+#: The material that reads them.
+HAIR_MATERIAL = "pelage hair"
 
 
 #: Blender's world is Z-up, pelage's (its gravity, its combs) Y-up, as USD's
@@ -107,6 +115,9 @@ def groom_from_settings(mesh, settings):
         ops=ops,
         finish={"points": settings.points,
                 "width": {"root": settings.width, "tip": settings.width * 0.1}},
+        look={"melanin": settings.melanin, "melanin_redness": settings.melanin_redness,
+              "roughness": settings.roughness, "radial_roughness": settings.radial_roughness,
+              "jitter": settings.look_jitter, "seed": settings.seed},
     )
 
 
@@ -114,8 +125,9 @@ def curves_to_blender(name, curves, surface=None, uv_map=None, matrix=None):
     """A new hair Curves datablock holding ``curves`` (a ``pelage.Curves``):
     positions (through the 4×4 ``matrix`` when given), ``radius`` (half
     pelage's widths), ``color`` when the groom has colours, ``hair_id`` per
-    curve (pelage's stable id, low 31 bits) and ``surface_uv_coordinate``
-    bound to ``surface``'s ``uv_map``."""
+    curve (pelage's stable id, low 31 bits), ``surface_uv_coordinate``
+    bound to ``surface``'s ``uv_map``, and with a look the per-hair shader
+    values with the material that reads them (``hair_material``)."""
     import bpy
 
     data = bpy.data.hair_curves.new(name)
@@ -136,11 +148,55 @@ def curves_to_blender(name, curves, surface=None, uv_map=None, matrix=None):
     if curves.root_uvs is not None:
         uv = data.attributes.new("surface_uv_coordinate", "FLOAT2", "CURVE")
         uv.data.foreach_set("vector", curves.root_uvs.ravel())
+    shading = getattr(curves, "shading", None)
+    if shading is not None:
+        for name in SHADING_FLOATS:
+            data.attributes.new(name, "FLOAT", "CURVE").data.foreach_set("value", shading[name])
+        rgba = np.ones((curves.curve_count, 4), dtype=np.float32)
+        rgba[:, :3] = shading[TINT]
+        data.attributes.new(TINT, "FLOAT_COLOR", "CURVE").data.foreach_set("color", rgba.ravel())
+        data.materials.append(hair_material())
     if surface is not None:
         data.surface = surface
         if uv_map:
             data.surface_uv_map = uv_map
     return data
+
+
+def hair_material():
+    """The material ``pelage hair`` (made once a file): Blender's Principled
+    Hair BSDF, Chiang model with the melanin parametrization, its melanin,
+    redness, tint, roughnesses and random number read per hair from
+    pelage's attributes. It is the MaterialX network pelage writes to USD,
+    in Cycles' own node, so a groom looks alike in both; it also shades
+    curves imported from a pelage USD file, whose primvars arrive as these
+    attributes."""
+    import bpy
+
+    material = bpy.data.materials.get(HAIR_MATERIAL)
+    if material is not None:
+        return material
+    material = bpy.data.materials.new(HAIR_MATERIAL)
+    material.use_nodes = True
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    nodes.clear()
+    output = nodes.new("ShaderNodeOutputMaterial")
+    hair = nodes.new("ShaderNodeBsdfHairPrincipled")
+    hair.model = "CHIANG"
+    hair.parametrization = "MELANIN"
+    hair.location = (-300, 0)
+    links.new(hair.outputs["BSDF"], output.inputs["Surface"])
+    inputs = [("Melanin", "hair_melanin"), ("Melanin Redness", "hair_melanin_redness"),
+              ("Tint", TINT), ("Roughness", "hair_roughness"),
+              ("Radial Roughness", "hair_radial_roughness"), ("Random", "hair_random")]
+    for k, (socket, name) in enumerate(inputs):
+        attribute = nodes.new("ShaderNodeAttribute")
+        attribute.attribute_type = "GEOMETRY"
+        attribute.attribute_name = name
+        attribute.location = (-600, 200 - 120 * k)
+        value = attribute.outputs["Color" if name == TINT else "Fac"]
+        links.new(value, hair.inputs[socket])
+    return material
 
 
 def deform_on_surface_modifier(obj):

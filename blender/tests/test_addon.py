@@ -98,6 +98,26 @@ uvs = uvs.reshape(-1, 2)
 assert np.allclose(uvs, (roots[:, :2] + 1) / 2, atol=1e-4), "surface UVs match the roots"
 print("grid: 3,000 curves × 10 points; radius, hair_id, surface_uv_coordinate; roots on the surface")
 
+# The look: per-hair shader values as curve attributes, read by a
+# Principled Hair BSDF (Chiang, melanin) through Attribute nodes.
+melanin = np.empty(len(curves.curves), np.float32)
+curves.attributes["hair_melanin"].data.foreach_get("value", melanin)
+want = settings.melanin
+spread = settings.look_jitter * want
+assert np.all(np.abs(melanin - want) <= spread + 1e-6), (melanin.min(), melanin.max())
+assert len(np.unique(melanin)) > len(melanin) // 2, "each hair its own variation"
+for name in ("hair_melanin_redness", "hair_roughness", "hair_radial_roughness", "hair_random", "hair_tint"):
+    assert curves.attributes[name].domain == "CURVE", name
+material = curves.materials[0]
+hair = next(n for n in material.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfHairPrincipled")
+assert hair.model == "CHIANG" and hair.parametrization == "MELANIN"
+fed = {link.to_socket.name: link.from_node.attribute_name
+       for link in material.node_tree.links if link.to_node == hair}
+assert fed == {"Melanin": "hair_melanin", "Melanin Redness": "hair_melanin_redness", "Tint": "hair_tint",
+               "Roughness": "hair_roughness", "Radial Roughness": "hair_radial_roughness",
+               "Random": "hair_random"}, fed
+print(f"look: hair_melanin {melanin.min():.3f}-{melanin.max():.3f} per curve, read by {material.name!r}")
+
 # The same seed grows the same fur (the operator is deterministic).
 bpy.ops.pelage.grow_fur()
 second = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
@@ -150,7 +170,8 @@ with tempfile.TemporaryDirectory() as folder:
     good = os.path.join(folder, "fur.toml")
     with open(good, "w") as f:
         f.write('[mesh]\npath = "spot"\n[roots]\ncount = 700\n'
-                '[guides]\ngenerate = { count = 20, length = 0.05 }\n[finish]\npoints = 5\n')
+                '[guides]\ngenerate = { count = 20, length = 0.05 }\n[finish]\npoints = 5\n'
+                '[look]\nmelanin = 0.4\n')
     clear_scene()
     bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=3)
     ico = bpy.context.active_object
@@ -178,6 +199,18 @@ with tempfile.TemporaryDirectory() as folder:
         assert op(filepath=out) == {"FINISHED"}
         assert pelage.read_curves(out).curve_count == 700
     print("export: USD and Alembic written, 700 curves each")
+
+    # Blender's USD importer brings the look in as the attributes the
+    # add-on's material reads.
+    bpy.ops.wm.usd_import(filepath=os.path.join(folder, "fur.usdc"))
+    imported = [o for o in bpy.context.selected_objects if o.type == "CURVES"]
+    assert imported, "the USD import made curves"
+    melanin = np.empty(len(imported[0].data.curves), np.float32)
+    imported[0].data.attributes["hair_melanin"].data.foreach_get("value", melanin)
+    assert np.allclose(melanin, 0.4), melanin[:4]
+    assert bpy.ops.pelage.shade_hair() == {"FINISHED"}
+    assert all(o.data.materials[0].name == "pelage hair" for o in imported)
+    print("USD import: hair_melanin arrives as a curve attribute; Shade with pelage hair binds the material")
 
     # 5. The guides a groom leaves out reach the user, from the library's report.
     # The add-on's module, wherever Blender installed the extension.

@@ -178,6 +178,26 @@ impl PyCurves {
             .transpose()
     }
 
+    /// Hair-shader values of a groom with a `[look]`, or `None`: a dict
+    /// from the attribute names (`hair_melanin`, `hair_melanin_redness`,
+    /// `hair_roughness`, `hair_radial_roughness`, `hair_random`: (curves,)
+    /// float32; `hair_tint`: (curves, 3) float32 linear RGB).
+    #[getter]
+    fn shading<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, pyo3::types::PyDict>>> {
+        let Some(shading) = slf.get().inner.shading() else {
+            return Ok(None);
+        };
+        let py = slf.py();
+        let dict = pyo3::types::PyDict::new(py);
+        let owner = slf.clone().into_any();
+        for (name, values) in shading.floats() {
+            dict.set_item(name, view1(owner.clone(), values)?)?;
+        }
+        let tint = view2(owner, floats(&shading.tint), 3)?;
+        dict.set_item(pelage::curves::HairShading::TINT, tint)?;
+        Ok(Some(dict))
+    }
+
     /// The mesh triangle under each root, (curves,) uint32, or `None`
     /// when the curves carry no roots (read from a file).
     #[getter]

@@ -133,7 +133,7 @@ impl PyGroom {
 #[pymethods]
 impl PyGroom {
     #[new]
-    #[pyo3(signature = (*, mesh, guides, roots, ops = None, interpolation = None, finish = None, output = None, animation = None, regions = None, base_dir = None))]
+    #[pyo3(signature = (*, mesh, guides, roots, ops = None, interpolation = None, finish = None, output = None, animation = None, regions = None, look = None, base_dir = None))]
     #[allow(
         clippy::too_many_arguments,
         reason = "one keyword argument a groom-file table"
@@ -149,6 +149,7 @@ impl PyGroom {
         output: Option<&Bound<'_, PyAny>>,
         animation: Option<&Bound<'_, PyAny>>,
         regions: Option<&Bound<'_, PyAny>>,
+        look: Option<&Bound<'_, PyAny>>,
         base_dir: Option<PathBuf>,
     ) -> PyResult<Self> {
         let mut table = toml::Table::new();
@@ -216,6 +217,7 @@ impl PyGroom {
             ("output", output),
             ("animation", animation),
             ("regions", regions),
+            ("look", look),
         ] {
             if let Some(value) = value.filter(|v| !v.is_none()) {
                 table.insert(key.into(), to_toml(value, key)?);

@@ -241,6 +241,29 @@ def test_regions_masks_and_stable_ids_from_python(spot):
         small_groom(spot, regions={"faces": "groups"}).grow()
 
 
+def test_look_gives_each_hair_shader_values_written_as_usd_primvars(spot, tmp_path):
+    groom = small_groom(spot, look={"melanin": 0.25, "roughness": 0.4, "jitter": 0.1,
+                                    "tint": [1.0, 0.8, 0.6]})
+    curves = groom.grow()
+    shading = curves.shading
+    n = curves.curve_count
+    assert set(shading) == {"hair_melanin", "hair_melanin_redness", "hair_tint",
+                            "hair_roughness", "hair_radial_roughness", "hair_random"}
+    assert shading["hair_tint"].shape == (n, 3)
+    assert np.allclose(shading["hair_tint"], [1.0, 0.8, 0.6])
+    melanin = shading["hair_melanin"]
+    assert melanin.shape == (n,) and melanin.min() >= 0.225 and melanin.max() <= 0.275
+    assert len(np.unique(melanin)) > n // 2, "jitter gives each hair its own value"
+    path = tmp_path / "fur.usda"
+    groom.write(path)
+    back = pelage.read_curves(path)
+    assert np.array_equal(back.shading["hair_melanin"], melanin)
+    assert 'rel material:binding = </groom/hair_material>' in path.read_text()
+    assert small_groom(spot).grow().shading is None
+    with pytest.raises(pelage.PelageError, match="look.roughness"):
+        small_groom(spot, look={"roughness": 2.0}).grow()
+
+
 def test_the_ops_builders_match_the_librarys_operator_schema():
     """`pelage.ops` is written by hand; this holds it to the operators the
     library defines (their serde definitions), so a new operator or key

@@ -966,6 +966,15 @@ fn look_grooms_write_shading_primvars_and_a_materialx_hair_material() {
             assert_eq!(back.shading(), want.shading(), "{}", path.display());
             files.push(path);
         }
+        // Alembic carries them as per-curve arbitrary parameters.
+        let path = dir.path().join(format!("material{}.abc", material as u8));
+        let named = parts
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (format!("part_{i}"), c));
+        write_curves(&path, named, &groom.export()).unwrap();
+        let want = pelage::io::join(parts.iter()).unwrap();
+        assert_eq!(read_curves(&path).unwrap().shading(), want.shading());
     }
     let Some((ok, out)) = usdcheck(&files) else {
         return;

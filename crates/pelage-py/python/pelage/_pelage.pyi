@@ -99,6 +99,8 @@ class Curves:
     @property
     def ids(self) -> Optional[npt.NDArray[np.uint64]]: ...
     @property
+    def shading(self) -> Optional[dict[str, npt.NDArray[np.float32]]]: ...
+    @property
     def root_triangles(self) -> Optional[npt.NDArray[np.uint32]]: ...
     @property
     def root_barycentrics(self) -> Optional[npt.NDArray[np.float32]]: ...
@@ -142,6 +144,7 @@ class Groom:
         output: Optional[Dict[str, Any]] = None,
         animation: Optional[Dict[str, Any]] = None,
         regions: Optional[Dict[str, Any]] = None,
+        look: Optional[Dict[str, Any]] = None,
         base_dir: Optional[_Path] = None,
     ) -> None: ...
     @staticmethod

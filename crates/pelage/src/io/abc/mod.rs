@@ -3,7 +3,9 @@
 //! schema names them, and colour, hair id and root UV as arbitrary geometry
 //! parameters under the names Unreal's groom importer reads (`groom_color`,
 //! `groom_id`, `groom_root_uv`), so the file goes straight into a game
-//! engine as well as into Blender, Houdini or Maya.
+//! engine as well as into Blender, Houdini or Maya; hair-shading values
+//! (`hair_melanin`, …) are arbitrary parameters per curve under the USD
+//! primvars' names.
 //!
 //! Arrays are written to the file as each part arrives; the groups that
 //! list them (a few hundred bytes a part) are written at
@@ -398,6 +400,33 @@ impl<W: Write + Seek> AbcWriter<W> {
                 "vector",
                 Pod::Float32,
                 2,
+                0,
+                vec![sample],
+            ));
+        }
+        if let Some(shading) = curves.shading() {
+            // Under the USD primvars' names: Blender's importer makes them
+            // the same curve attributes its USD importer does.
+            for (name, values) in shading.floats() {
+                let sample = self.array_sample(bytemuck::cast_slice(values), values.len())?;
+                arbitrary.push(geom_param(
+                    name,
+                    Scope::Uniform,
+                    "",
+                    Pod::Float32,
+                    1,
+                    0,
+                    vec![sample],
+                ));
+            }
+            let tint = &shading.tint;
+            let sample = self.array_sample(bytemuck::cast_slice(tint), tint.len())?;
+            arbitrary.push(geom_param(
+                crate::curves::HairShading::TINT,
+                Scope::Uniform,
+                "rgb",
+                Pod::Float32,
+                3,
                 0,
                 vec![sample],
             ));

@@ -1,8 +1,9 @@
 //! Curves from Alembic (Ogawa): every `ICurves` object of the archive, in
 //! file order, joined — what pelage's writer, Blender and Houdini write.
 //! Positions, vertex counts and widths come from the curves schema;
-//! normals (`N`), and the arbitrary parameters `groom_color`, `groom_id`
-//! and `groom_root_uv`, where present with pelage's layout. Each
+//! normals (`N`), and the arbitrary parameters `groom_color`, `groom_id`,
+//! `groom_root_uv` and the hair-shading values, where present with
+//! pelage's layout. Each
 //! property's first sample is read (the first frame of an animation).
 //! Transforms of parent `Xform` objects are not applied: pelage reads
 //! curves in the space they were written in.
@@ -911,6 +912,41 @@ fn read_curves_object(
                 .collect();
             curves = curves
                 .with_root_uvs(uvs)
+                .map_err(|e| fail(format!("{path}: {e}")))?;
+        }
+        // Hair-shading values where all six are there, as pelage writes
+        // them.
+        let per_curve = |name: &str, extent: u8| -> Result<Option<Vec<f32>>, CurvesReadError> {
+            Ok(sample(name, &[10], extent)?
+                .filter(|(_, b)| b.len() == curve_count * 4 * extent as usize)
+                .map(|(_, b)| floats(b).collect()))
+        };
+        let names = crate::curves::HairShading::NAMES;
+        let floats_of: Vec<Option<Vec<f32>>> = names[..5]
+            .iter()
+            .map(|name| per_curve(name, 1))
+            .collect::<Result<_, _>>()?;
+        let tint = per_curve(crate::curves::HairShading::TINT, 3)?;
+        if let (Some(tint), true) = (tint, floats_of.iter().all(Option::is_some)) {
+            let [
+                melanin,
+                melanin_redness,
+                roughness,
+                radial_roughness,
+                random,
+            ] = <[Option<Vec<f32>>; 5]>::try_from(floats_of)
+                .expect("five names")
+                .map(|v| v.expect("checked"));
+            let shading = crate::curves::HairShading {
+                melanin,
+                melanin_redness,
+                tint: tint.chunks_exact(3).map(Vec3::from_slice).collect(),
+                roughness,
+                radial_roughness,
+                random,
+            };
+            curves = curves
+                .with_shading(shading)
                 .map_err(|e| fail(format!("{path}: {e}")))?;
         }
     }
