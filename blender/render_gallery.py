@@ -1,6 +1,6 @@
 """Render fur grown by the add-on with Cycles, for the gallery:
 
-    tools/bpy-python blender/render_gallery.py EXTENSION.zip OUT.png [--patches]
+    tools/bpy-python blender/render_gallery.py EXTENSION.zip OUT.png [--patches | --no-material]
 
 Installs the extension into a fresh user folder, grows fur on Suzanne with
 "Grow pelage fur" (the panel's settings below) and renders 800×600 on the
@@ -9,7 +9,9 @@ material the add-on makes, a Principled Hair BSDF reading each hair's
 melanin, redness and roughness from the look (no material is set up
 here). docs/gallery/blender-addon-suzanne.png is made this way; with
 ``--patches`` the settings come from a groom file whose ``[look]`` melanin
-is a noise map (docs/gallery/blender-look-patches.png).
+is a noise map (docs/gallery/blender-look-patches.png); with
+``--no-material`` the add-on's material is taken off, for the picture
+beside it (docs/gallery/blender-addon-suzanne-no-material.png).
 """
 
 import math
@@ -23,7 +25,8 @@ import bpy  # noqa: E402
 import mathutils  # noqa: E402
 
 patches = sys.argv[-1] == "--patches"
-args = sys.argv[:-1] if patches else sys.argv
+bare = sys.argv[-1] == "--no-material"
+args = sys.argv[:-1] if patches or bare else sys.argv
 zip_path, out = os.path.abspath(args[-2]), os.path.abspath(args[-1])
 assert bpy.ops.extensions.package_install_files(
     filepath=zip_path, repo="user_default", enable_on_install=True
@@ -76,6 +79,10 @@ if patches:
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
 fur = [o for o in bpy.data.objects if o.type == "CURVES"][0]
 assert fur.data.materials[0].name == "pelage hair"
+if bare:
+    # The same fur as Cycles draws curves with no material: the other
+    # half of the gallery pair.
+    fur.data.materials.clear()
 
 camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
 scene.collection.objects.link(camera)

@@ -7,7 +7,9 @@ Lines (for tests to read):
     object NAME: radius[0] = R
     object NAME: color[0] = R G B          (the first colour attribute, if any)
     mesh NAME: V vertices, F faces
+    mesh NAME: volume X                    (signed, world space: > 0 when faces wind outward)
     frame F: NAME point[I] = X Y Z         (evaluated, with --frames and --point)
+    frame F: mesh NAME vertex[I] = X Y Z   (evaluated, world space, likewise)
 """
 import argparse
 import sys
@@ -46,8 +48,22 @@ times = sorted(import_once() for _ in range(max(1, args.repeat)))
 print(f"import {times[len(times) // 2]:.4f} seconds")
 print(f"blender {bpy.app.version_string}")
 
-for ob in sorted((o for o in bpy.data.objects if o.type == "MESH"), key=lambda o: o.name):
+def signed_volume(ob):
+    """The divergence theorem's volume of the faces' fans, world space."""
+    m = ob.matrix_world
+    co = [m @ v.co for v in ob.data.vertices]
+    total = 0.0
+    for poly in ob.data.polygons:
+        vs = [co[i] for i in poly.vertices]
+        for k in range(1, len(vs) - 1):
+            total += vs[0].dot(vs[k].cross(vs[k + 1])) / 6.0
+    return total
+
+
+meshes = sorted((o for o in bpy.data.objects if o.type == "MESH"), key=lambda o: o.name)
+for ob in meshes:
     print(f"mesh {ob.name}: {len(ob.data.vertices)} vertices, {len(ob.data.polygons)} faces")
+    print(f"mesh {ob.name}: volume {signed_volume(ob)!r}")
 curves = sorted((o for o in bpy.data.objects if o.type == "CURVES"), key=lambda o: o.name)
 if not curves:
     print(f"{args.file}: Blender made no curves object")
@@ -72,3 +88,8 @@ for frame in [f for f in args.frames.split(",") if f]:
         if args.point < len(data.points):
             p = data.points[args.point].position
             print(f"frame {frame}: {ob.name} point[{args.point}] = {p[0]!r} {p[1]!r} {p[2]!r}")
+    for ob in meshes:
+        evaluated = ob.evaluated_get(depsgraph)
+        if args.point < len(evaluated.data.vertices):
+            p = evaluated.matrix_world @ evaluated.data.vertices[args.point].co
+            print(f"frame {frame}: mesh {ob.name} vertex[{args.point}] = {p[0]!r} {p[1]!r} {p[2]!r}")

@@ -963,6 +963,72 @@ clip = "Walk"
 }
 
 #[test]
+fn an_animated_alembic_groom_holds_its_skin_which_blender_imports_as_from_usd() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = fox_groom(dir.path(), "");
+    let (abc, usdc) = (dir.path().join("fox.abc"), dir.path().join("fox.usdc"));
+    for out_path in [&abc, &usdc] {
+        let out = pelage(&[
+            "groom",
+            groom.to_str().unwrap(),
+            "-o",
+            out_path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    // The curves are the same in both files (the skin object is skipped).
+    let (from_abc, from_usd) = (
+        pelage::io::read_curves(&abc).unwrap(),
+        pelage::io::read_curves(&usdc).unwrap(),
+    );
+    assert_eq!(from_abc.points(), from_usd.points());
+    // Blender's Alembic importer makes the same skin, frame by frame, as
+    // its USD importer: positions, and faces that wind outward (Alembic's
+    // clockwise faces turned back).
+    let args = |f: &Path| {
+        [
+            f.to_str().unwrap().to_string(),
+            "--frames".into(),
+            "1,5".into(),
+        ]
+    };
+    let Some((ok, from_abc)) = blendercheck(&args(&abc)) else {
+        return;
+    };
+    assert!(ok, "{from_abc}");
+    let (ok, from_usd) = blendercheck(&args(&usdc)).unwrap();
+    assert!(ok, "{from_usd}");
+    for prefix in [
+        "mesh skin: volume ",
+        "frame 1: mesh skin vertex[0] = ",
+        "frame 5: mesh skin vertex[0] = ",
+    ] {
+        let (a, u) = (
+            support::numbers_after(&from_abc, prefix),
+            support::numbers_after(&from_usd, prefix),
+        );
+        for (x, y) in a.iter().zip(&u) {
+            assert!(
+                (x - y).abs() <= 1e-4 * y.abs().max(1.0),
+                "{prefix}{a:?} vs {u:?}"
+            );
+        }
+    }
+    assert!(support::numbers_after(&from_abc, "mesh skin: volume ")[0] > 0.0);
+    let moved = |text: &str| {
+        let (a, b) = (
+            support::numbers_after(text, "frame 1: mesh skin vertex[0] = "),
+            support::numbers_after(text, "frame 5: mesh skin vertex[0] = "),
+        );
+        a.iter()
+            .zip(&b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(moved(&from_abc) > 0.1, "the skin walks in Alembic too");
+}
+
+#[test]
 fn an_animated_groom_is_one_time_sampled_file_that_usd_and_blender_read_frame_by_frame() {
     let dir = tempfile::tempdir().unwrap();
     let groom = fox_groom(dir.path(), "");

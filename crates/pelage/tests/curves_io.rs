@@ -332,7 +332,7 @@ fn alembic_round_trips_what_it_holds_and_blender_imports_it() {
     );
     assert!(std::fs::read(&abc).unwrap().starts_with(b"Ogawa\xff\0\x01"));
 
-    // Everything but opacity (Alembic grooms have none) comes back exactly.
+    // Every attribute comes back exactly.
     let back = read_curves(&abc).unwrap();
     let joined = pelage::io::join([&groom, &second]).unwrap();
     assert_eq!(back.offsets(), joined.offsets());
@@ -342,7 +342,7 @@ fn alembic_round_trips_what_it_holds_and_blender_imports_it() {
     assert_eq!(back.colors(), joined.colors());
     assert_eq!(back.root_uvs(), joined.root_uvs());
     assert_eq!(back.ids(), joined.ids());
-    assert_eq!(back.opacities(), None);
+    assert_eq!(back.opacities(), joined.opacities());
 
     // abc → usdc → abc: the same values, the same bytes.
     let one = |c: &Curves| [("p".to_string(), c.clone())];
@@ -366,21 +366,22 @@ fn alembic_round_trips_what_it_holds_and_blender_imports_it() {
     write(&a2, &through_usd);
     assert!(std::fs::read(&a1).unwrap() == std::fs::read(&a2).unwrap());
 
-    // The skin is refused rather than silently left out.
+    // The skin goes in as a polygon mesh beside the curves; pelage's
+    // reader takes the curves and passes over it.
     let spot = pelage::assets::spot();
     let export = CurvesExport {
         mesh: Some(&spot),
         ..Default::default()
     };
     let parts = one(&groom);
-    let err = write_curves(
-        &dir.path().join("x.abc"),
+    let with_skin = dir.path().join("x.abc");
+    write_curves(
+        &with_skin,
         parts.iter().map(|(n, c)| (n.clone(), c)),
         &export,
     )
-    .unwrap_err()
-    .to_string();
-    assert!(err.contains("Alembic files hold curves only"), "{err}");
+    .unwrap();
+    assert_eq!(read_curves(&with_skin).unwrap().points(), groom.points());
 
     // Blender's own importer makes the same curves, widths as radii.
     let Some((ok, report)) = blendercheck(&[&abc]) else {

@@ -665,15 +665,6 @@ impl AnimatedGroom {
                     )));
                 }
             };
-            if with_skin && format == CurvesFormat::Abc {
-                return Err(GroomWriteError::Groom(self.spec.error(
-                    "output.with_mesh",
-                    GroomErrorKind::Invalid(format!(
-                        "{}: Alembic output holds the curves only; write the skin to .usdc, or set with_mesh = false",
-                        output.path.display()
-                    )),
-                )));
-            }
             let file = AtomicFile::create(&output.path)?;
             let layer = match format {
                 CurvesFormat::Usdc => UsdcWriter::new(file, options).map(TimeSampledLayer::Usdc),

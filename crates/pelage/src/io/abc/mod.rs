@@ -26,7 +26,7 @@ pub use read::{abc_curves_from_bytes, read_abc_curves, read_abc_curves_at};
 
 use super::usd_schema::{check_name, curve_extent};
 use super::{CurveBasis, PrimWriteError, UsdOptions};
-use crate::Curves;
+use crate::{Curves, Mesh};
 use ogawa::{Child, EMPTY_DATA, EMPTY_GROUP, OgawaWriter, murmur3_128};
 use std::collections::HashSet;
 use std::io::{Seek, Write};
@@ -54,11 +54,13 @@ impl Pod {
     }
 }
 
-/// Per-point (`vtx`) or per-curve (`uni`) geometry parameters.
+/// Per-point (`vtx`), per-curve (`uni`) or per-corner (`fvr`) geometry
+/// parameters.
 #[derive(Debug, Clone, Copy)]
 enum Scope {
     Vertex,
     Uniform,
+    FaceVarying,
 }
 
 #[derive(Debug)]
@@ -107,10 +109,12 @@ impl Property {
     }
 }
 
-/// One part's object: its `.geom` compound, and what later frames must
-/// match.
+/// One object (a part's curves, or the skin): its `.geom` compound, its
+/// schema's object metadata, and what later frames must match (curve
+/// offsets; a mesh's vertex and triangle counts).
 struct Part {
     name: String,
+    object: &'static str,
     geom: Property,
     offsets: Vec<u32>,
     times: Vec<f64>,
@@ -129,6 +133,9 @@ pub struct AbcWriter<W: Write + Seek> {
 /// The curves schema's object and compound metadata.
 const CURVES_OBJECT: &str = "schema=AbcGeom_Curve_v2;schemaBaseType=AbcGeom_GeomBase_v1;schemaObjTitle=AbcGeom_Curve_v2:.geom";
 const CURVES_GEOM: &str = "schema=AbcGeom_Curve_v2;schemaBaseType=AbcGeom_GeomBase_v1";
+/// The polygon mesh schema's (the skin).
+const MESH_OBJECT: &str = "schema=AbcGeom_PolyMesh_v1;schemaBaseType=AbcGeom_GeomBase_v1;schemaObjTitle=AbcGeom_PolyMesh_v1:.geom";
+const MESH_GEOM: &str = "schema=AbcGeom_PolyMesh_v1;schemaBaseType=AbcGeom_GeomBase_v1";
 /// What Alembic's `ALEMBIC_OGAWA_FILE_VERSION` and library version say.
 const OGAWA_FILE_VERSION: i32 = 0;
 const LIBRARY_VERSION: i32 = 10_800;
@@ -365,6 +372,18 @@ impl<W: Write + Seek> AbcWriter<W> {
                 vec![sample],
             ));
         }
+        if let Some(opacities) = curves.opacities() {
+            let sample = self.array_sample(bytemuck::cast_slice(opacities), opacities.len())?;
+            arbitrary.push(geom_param(
+                "groom_opacity",
+                Scope::Vertex,
+                "",
+                Pod::Float32,
+                1,
+                0,
+                vec![sample],
+            ));
+        }
         if let Some(ids) = curves.ids() {
             let (bytes, pod): (Vec<u8>, Pod) = if ids.iter().all(|&id| id <= i32::MAX as u64) {
                 (
@@ -436,8 +455,173 @@ impl<W: Write + Seek> AbcWriter<W> {
         }
         self.parts.push(Part {
             name: name.to_string(),
+            object: CURVES_OBJECT,
             geom: Property::compound(".geom", CURVES_GEOM, properties),
             offsets: curves.offsets().to_vec(),
+            times: time.into_iter().collect(),
+        });
+        Ok(())
+    }
+
+    /// Writes the skin as an `IPolyMesh` object named `name`: positions,
+    /// triangles and UVs (`uv`, per vertex or per corner as the mesh has
+    /// them).
+    pub fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), PrimWriteError> {
+        self.start_mesh(name, mesh, None)
+    }
+
+    /// Writes one frame of an animated skin: the first call for `name`
+    /// writes the object (triangles and UVs from this frame); every call
+    /// adds a sample of `P` and the bounds at `time`. Later frames have as
+    /// many vertices and triangles, on the frames the parts have.
+    pub fn write_mesh_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        mesh: &Mesh,
+    ) -> Result<(), PrimWriteError> {
+        PrimWriteError::check_time(name, time)?;
+        let Some(index) = self.parts.iter().position(|p| p.name == name) else {
+            return self.start_mesh(name, mesh, Some(time));
+        };
+        let part = &self.parts[index];
+        let shape = [mesh.vertex_count() as u32, mesh.triangle_count() as u32];
+        if part.times.is_empty() || part.object != MESH_OBJECT {
+            return Err(PrimWriteError::DuplicateName(name.to_string()));
+        }
+        if part.offsets != shape {
+            return Err(PrimWriteError::BadSetting(format!(
+                "mesh {name:?} at time {time}: {} vertices and {} triangles where the first frame had {} and {}",
+                shape[0], shape[1], part.offsets[0], part.offsets[1]
+            )));
+        }
+        let last = *part.times.last().expect("an animated mesh has a frame");
+        if time <= last {
+            return Err(PrimWriteError::BadSetting(format!(
+                "mesh {name:?}: frame at {time} after the frame at {last}; write frames in increasing time"
+            )));
+        }
+        let (bounds, points) = self.mesh_samples(mesh)?;
+        let part = &mut self.parts[index];
+        for (child, sample) in [(".selfBnds", bounds), ("P", points)] {
+            part.geom
+                .child(child)
+                .expect("written with the mesh")
+                .samples
+                .push(sample);
+        }
+        part.times.push(time);
+        Ok(())
+    }
+
+    /// A mesh's bounds and positions samples.
+    fn mesh_samples(&mut self, mesh: &Mesh) -> std::io::Result<(Sample, Sample)> {
+        let (lo, hi) = mesh.bounds();
+        let bounds: Vec<u8> = [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
+            .iter()
+            .flat_map(|&v| f64::from(v).to_le_bytes())
+            .collect();
+        let bounds = self.array_sample(&bounds, 1)?;
+        let positions = mesh.positions();
+        let points = self.array_sample(bytemuck::cast_slice(positions), positions.len())?;
+        Ok((bounds, points))
+    }
+
+    fn start_mesh(
+        &mut self,
+        name: &str,
+        mesh: &Mesh,
+        time: Option<f64>,
+    ) -> Result<(), PrimWriteError> {
+        check_name(name)?;
+        if !self.names.insert(name.to_string()) {
+            return Err(PrimWriteError::DuplicateName(name.to_string()));
+        }
+        let frames = time.is_some() as u32;
+        let (bounds, points) = self.mesh_samples(mesh)?;
+        // Alembic's faces wind clockwise (as Maya's); pelage's wind
+        // counter-clockwise: each triangle is written as (a, c, b), and
+        // per-corner values in the same order. Readers (Blender's among
+        // them) turn them back.
+        let corners = |t: &[u32; 3]| [t[0], t[2], t[1]];
+        let indices: Vec<u8> = mesh
+            .triangles()
+            .iter()
+            .flat_map(corners)
+            .flat_map(|i| (i as i32).to_le_bytes())
+            .collect();
+        let counts: Vec<u8> = std::iter::repeat_n(3i32.to_le_bytes(), mesh.triangle_count())
+            .flatten()
+            .collect();
+        let indices = self.array_sample(&indices, mesh.triangle_count() * 3)?;
+        let counts = self.array_sample(&counts, mesh.triangle_count())?;
+        let mut properties = vec![
+            property(
+                ".selfBnds",
+                "interpretation=box",
+                Kind::Scalar,
+                Pod::Float64,
+                6,
+                frames,
+                vec![bounds],
+            ),
+            property(
+                "P",
+                "geoScope=vtx;interpretation=point",
+                Kind::Array,
+                Pod::Float32,
+                3,
+                frames,
+                vec![points],
+            ),
+            property(
+                ".faceIndices",
+                "",
+                Kind::Array,
+                Pod::Int32,
+                1,
+                0,
+                vec![indices],
+            ),
+            property(
+                ".faceCounts",
+                "",
+                Kind::Array,
+                Pod::Int32,
+                1,
+                0,
+                vec![counts],
+            ),
+        ];
+        let uvs = match mesh.uvs() {
+            None => None,
+            Some(crate::mesh::Uvs::PerVertex(uvs)) => Some((Scope::Vertex, uvs.clone())),
+            Some(crate::mesh::Uvs::PerCorner { values, indices }) => Some((
+                Scope::FaceVarying,
+                indices
+                    .iter()
+                    .flat_map(corners)
+                    .map(|i| values[i as usize])
+                    .collect(),
+            )),
+        };
+        if let Some((scope, uvs)) = uvs {
+            let sample = self.array_sample(bytemuck::cast_slice(&uvs), uvs.len())?;
+            properties.push(geom_param(
+                "uv",
+                scope,
+                "vector",
+                Pod::Float32,
+                2,
+                0,
+                vec![sample],
+            ));
+        }
+        self.parts.push(Part {
+            name: name.to_string(),
+            object: MESH_OBJECT,
+            geom: Property::compound(".geom", MESH_GEOM, properties),
+            offsets: vec![mesh.vertex_count() as u32, mesh.triangle_count() as u32],
             times: time.into_iter().collect(),
         });
         Ok(())
@@ -461,8 +645,8 @@ impl<W: Write + Seek> AbcWriter<W> {
             headers.extend_from_slice(&(part.name.len() as u32).to_le_bytes());
             headers.extend_from_slice(part.name.as_bytes());
             headers.push(0xff);
-            headers.extend_from_slice(&(CURVES_OBJECT.len() as u32).to_le_bytes());
-            headers.extend_from_slice(CURVES_OBJECT.as_bytes());
+            headers.extend_from_slice(&(part.object.len() as u32).to_le_bytes());
+            headers.extend_from_slice(part.object.as_bytes());
         }
         headers.extend_from_slice(&murmur3_128(&headers));
         headers.extend_from_slice(&[0u8; 16]);
@@ -599,6 +783,7 @@ fn geom_param(
     let scope = match scope {
         Scope::Vertex => "vtx",
         Scope::Uniform => "uni",
+        Scope::FaceVarying => "fvr",
     };
     let interpretation = if interpretation.is_empty() {
         String::new()
@@ -712,21 +897,23 @@ impl<W: Write + Seek> super::PrimWriter for AbcWriter<W> {
         AbcWriter::write_part(self, name, curves)
     }
 
-    /// Alembic files from pelage hold curves only.
-    fn write_mesh(&mut self, _name: &str, _mesh: &crate::Mesh) -> Result<(), PrimWriteError> {
-        Err(PrimWriteError::BadSetting(
-            "pelage's Alembic files hold curves only: leave the skin out ([output] with_mesh = false, no --with-mesh) or write USD".into(),
-        ))
+    fn write_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<(), PrimWriteError> {
+        AbcWriter::write_mesh(self, name, mesh)
     }
 
-    /// Alembic files from pelage hold curves only.
+    fn write_mesh_at(&mut self, name: &str, time: f64, mesh: &Mesh) -> Result<(), PrimWriteError> {
+        AbcWriter::write_mesh_at(self, name, time, mesh)
+    }
+
+    /// Alembic files from pelage hold curves and the skin.
     fn write_points(
         &mut self,
         _name: &str,
         _points: &super::SurfacePoints,
     ) -> Result<(), PrimWriteError> {
         Err(PrimWriteError::BadSetting(
-            "pelage's Alembic files hold curves only: write sampled points as .ply or USD".into(),
+            "pelage's Alembic files hold curves and the skin: write sampled points as .ply or USD"
+                .into(),
         ))
     }
 

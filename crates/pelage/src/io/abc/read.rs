@@ -1,8 +1,8 @@
 //! Curves from Alembic (Ogawa): every `ICurves` object of the archive, in
 //! file order, joined — what pelage's writer, Blender and Houdini write.
 //! Positions, vertex counts and widths come from the curves schema;
-//! normals (`N`), and the arbitrary parameters `groom_color`, `groom_id`,
-//! `groom_root_uv` and the hair-shading values, where present with
+//! normals (`N`), and the arbitrary parameters `groom_color`,
+//! `groom_opacity`, `groom_id`, `groom_root_uv` and the hair-shading values, where present with
 //! pelage's layout. Each
 //! property's first sample is read (the first frame of an animation).
 //! Transforms of parent `Xform` objects are not applied: pelage reads
@@ -883,6 +883,11 @@ fn read_curves_object(
                 .collect();
             curves = curves
                 .with_colors(colors)
+                .map_err(|e| fail(format!("{path}: {e}")))?;
+        }
+        if let Some((_, b)) = sample("groom_opacity", &[10], 1)?.filter(|(_, b)| b.len() == n * 4) {
+            curves = curves
+                .with_opacities(floats(b).collect())
                 .map_err(|e| fail(format!("{path}: {e}")))?;
         }
         let curve_count = curves.curve_count();
