@@ -435,9 +435,13 @@ fn assemble(groom: &Groom, output: &Path) -> anyhow::Result<()> {
             files,
             extent: (lo, hi),
         } => println!(
-            "{} → {} part files referenced, extent ({:.4}, {:.4}, {:.4}) to ({:.4}, {:.4}, {:.4})",
+            "{} → {} part files {}, extent ({:.4}, {:.4}, {:.4}) to ({:.4}, {:.4}, {:.4})",
             output.display(),
             files.len(),
+            match pelage::io::CurvesFormat::from_path(output) {
+                Some(pelage::io::CurvesFormat::Abc) => "joined",
+                _ => "referenced",
+            },
             lo.x,
             lo.y,
             lo.z,

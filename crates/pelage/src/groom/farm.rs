@@ -114,10 +114,10 @@ pub enum FarmError {
         /// The other.
         b: usize,
     },
-    /// Part files that are Alembic: only USD parts are assembled (a USD
-    /// layer references them; Alembic has no references).
+    /// Alembic part files assembled into a USD layer: they are joined
+    /// into one Alembic file instead (Alembic has no references).
     #[error(
-        "{path}: Alembic part files cannot be assembled (pelage assembles USD parts, referenced from one layer); write the parts as .usdc (`-o NAME.usdc --part K/N`), or use them one by one"
+        "{path}: Alembic part files are joined into one Alembic file: assemble with `-o NAME.abc` (a USD layer references USD parts only)"
     )]
     AlembicParts {
         /// One of the Alembic part files.
@@ -135,7 +135,8 @@ pub enum FarmError {
 
 /// The part files of one farm run of `output` (`NAME.part-K-of-N.EXT`
 /// beside it, every `K` of one `N`), in run order. A run's file may be
-/// text or binary USD whatever the output's extension.
+/// text or binary USD whatever the output's extension; an Alembic output's
+/// are Alembic.
 ///
 /// # Errors
 /// No part file, files of two farms of different sizes, a run's file
@@ -175,6 +176,8 @@ pub fn find_part_files(output: &Path) -> Result<Vec<PathBuf>, FarmError> {
             _ => runs = Some(n),
         }
     }
+    let alembic_output =
+        crate::io::CurvesFormat::from_path(output) == Some(crate::io::CurvesFormat::Abc);
     let n = runs.ok_or_else(|| FarmError::NoParts {
         stem: stem.clone(),
         folder: folder.clone(),
@@ -182,14 +185,21 @@ pub fn find_part_files(output: &Path) -> Result<Vec<PathBuf>, FarmError> {
     (1..=n)
         .map(|k| {
             let named = part_file(output, k, n);
-            let found = ["usda", "usdc", "usd"]
+            let extensions: &[&str] = if alembic_output {
+                &["abc"]
+            } else {
+                &["usda", "usdc", "usd"]
+            };
+            let found = extensions
                 .iter()
                 .map(|ext| named.with_extension(ext))
                 .find(|f| f.exists());
             let alembic = named.with_extension("abc");
             match found {
                 Some(f) => Ok(f),
-                None if alembic.exists() => Err(FarmError::AlembicParts { path: alembic }),
+                None if !alembic_output && alembic.exists() => {
+                    Err(FarmError::AlembicParts { path: alembic })
+                }
                 None => Err(FarmError::Missing {
                     path: named,
                     run: FarmRun { k, n },

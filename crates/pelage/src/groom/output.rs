@@ -1,15 +1,17 @@
 //! Writing a groom: parts stream to the writer as they are grown (docs/design.md,
 //! "Streaming"), and a farm's per-part files are tied together by a small
-//! root USD layer ([`write_assembly`]).
+//! root USD layer ([`write_assembly`]) or, Alembic having no references,
+//! joined into one archive ([`write_alembic_assembly`]).
 
 use super::error::GroomError;
 use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
-    CurvesExport, CurvesFormat, PrimWriteError, PrimWriter, UpAxis, UsdOptions, UsdaWriter,
-    WriteError, read_usd_extent, write_atomically, write_atomically_with, write_curves,
-    write_streamed,
+    AbcWriter, CurvesExport, CurvesFormat, PrimWriteError, PrimWriter, UpAxis, UsdOptions,
+    UsdaWriter, WriteError, read_abc_parts, read_usd_extent, write_atomically,
+    write_atomically_with, write_curves, write_streamed,
 };
+use crate::mesh::Mesh;
 use glam::Vec3;
 use std::io::{BufRead, Write};
 use std::ops::Range;
@@ -384,6 +386,47 @@ pub fn write_assembly(
         writeln!(out, "}}")
     })?;
     Ok(whole)
+}
+
+/// Joins a farm's Alembic part files into one archive at `path`: the skin
+/// first when given, then every run's part objects in run order, read
+/// back and written again — the archive one run writes, byte for byte.
+/// One part file is in memory at a time. Returns the groom's extent.
+pub fn write_alembic_assembly(
+    path: &Path,
+    part_files: &[PathBuf],
+    options: &UsdOptions,
+    skin: Option<&Mesh>,
+) -> Result<(Vec3, Vec3), WriteError> {
+    let fail = |message: String| WriteError {
+        path: path.to_path_buf(),
+        error: std::io::Error::other(message),
+    };
+    if CurvesFormat::from_path(path) != Some(CurvesFormat::Abc) {
+        return Err(fail(
+            "Alembic part files are joined into an Alembic file: name it .abc".into(),
+        ));
+    }
+    let mut whole: Option<(Vec3, Vec3)> = None;
+    write_atomically(path, |out| {
+        let other = |e: PrimWriteError| std::io::Error::other(e);
+        let mut abc = AbcWriter::new(out, options).map_err(other)?;
+        if let Some(mesh) = skin {
+            abc.write_mesh("skin", mesh).map_err(other)?;
+        }
+        for file in part_files {
+            for (name, curves) in
+                read_abc_parts(file).map_err(|e| std::io::Error::other(e.to_string()))?
+            {
+                let (lo, hi) = crate::io::curve_extent(&curves);
+                whole = Some(whole.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
+                abc.write_part(&name, &curves).map_err(other)?;
+            }
+        }
+        abc.finish().map_err(other)?;
+        Ok(())
+    })?;
+    Ok(whole.unwrap_or((Vec3::ZERO, Vec3::ZERO)))
 }
 
 #[cfg(test)]

@@ -8,8 +8,8 @@
 use super::clips::{ClipAssembly, find_frame_files, write_clip_assembly};
 use super::farm::{FarmError, FarmRun, find_part_files};
 use super::load::Groom;
-use super::output::write_assembly;
-use crate::io::{CurvesExport, UsdOptions, WriteError};
+use super::output::{write_alembic_assembly, write_assembly};
+use crate::io::{CurvesExport, CurvesFormat, UsdOptions, WriteError};
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
@@ -59,10 +59,14 @@ impl Groom {
     }
 
     /// Ties a farm's files beside `output` together: for a still groom a
-    /// USD layer referencing every run's part file with its extent, for an
-    /// animated one a layer stitching the frame files with value clips.
+    /// USD layer referencing every run's part file with its extent (or,
+    /// for an `.abc` output, the runs' Alembic parts joined into one
+    /// archive), for an animated one a layer stitching the frame files
+    /// with value clips.
     pub fn assemble(&self, output: &Path) -> Result<Assembly, AssembleError> {
+        let alembic = CurvesFormat::from_path(output) == Some(CurvesFormat::Abc);
         match self.animation() {
+            Some(_) if alembic => Err(AssembleError::AlembicFrames(output.to_path_buf())),
             Some(animation) => {
                 let found = find_frame_files(output).map_err(|error| {
                     AssembleError::Farm(FarmError::List {
@@ -81,7 +85,12 @@ impl Groom {
             }
             None => {
                 let files = find_part_files(output)?;
-                let extent = write_assembly(output, &files, &self.usd_options())?;
+                let extent = if alembic {
+                    let skin = self.writes_skin().then(|| self.mesh());
+                    write_alembic_assembly(output, &files, &self.usd_options(), skin)?
+                } else {
+                    write_assembly(output, &files, &self.usd_options())?
+                };
                 Ok(Assembly::Parts { files, extent })
             }
         }
@@ -115,6 +124,13 @@ pub enum AssembleError {
         .0.display()
     )]
     NoFrames(PathBuf),
+    /// An animated farm assembled into Alembic, which has no value clips
+    /// to stitch frame files with.
+    #[error(
+        "{}: an animated farm's frame files are stitched with USD value clips, which Alembic lacks; assemble into a .usda (`--assemble -o NAME.usda`) and write the runs as .usdc",
+        .0.display()
+    )]
+    AlembicFrames(PathBuf),
     /// The assembly layer could not be written (or a file read).
     #[error(transparent)]
     Write(#[from] WriteError),

@@ -32,7 +32,9 @@ mod usd_schema;
 mod usda;
 mod usdc;
 
-pub use abc::{AbcWriter, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at};
+pub use abc::{
+    AbcWriter, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at, read_abc_parts,
+};
 pub use atomic::{
     AtomicFile, check_free_space, check_input, check_output, note_input, protect_inputs,
     remove_temporary_files, write_atomically, write_atomically_with,
@@ -52,6 +54,7 @@ pub use usd_read::{
     read_usd_extent, read_usd_layer_info, usd_curves_from_bytes,
 };
 pub(crate) use usd_read::{UsdSkin, read_usd_skin, usd_skin_from_bytes};
+pub(crate) use usd_schema::curve_extent;
 pub use usd_schema::{PrimWriter, SurfacePoints};
 pub(crate) use usda::asset_path;
 pub use usda::{CurveBasis, PrimWriteError, UpAxis, UsdOptions, UsdWrap, UsdaWriter};

@@ -22,7 +22,7 @@
 mod ogawa;
 mod read;
 
-pub use read::{abc_curves_from_bytes, read_abc_curves, read_abc_curves_at};
+pub use read::{abc_curves_from_bytes, read_abc_curves, read_abc_curves_at, read_abc_parts};
 
 use super::usd_schema::{check_name, curve_extent};
 use super::{CurveBasis, PrimWriteError, UsdOptions};

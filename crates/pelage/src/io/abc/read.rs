@@ -448,6 +448,24 @@ pub fn abc_curves_from_bytes(
     path: &Path,
     seconds: Option<f64>,
 ) -> Result<Curves, CurvesReadError> {
+    let parts = abc_parts_from_bytes(bytes, path, seconds)?;
+    super::super::join(parts.iter().map(|(_, c)| c))
+        .map_err(|e| CurvesReadError::whole(path, e.into()))
+}
+
+/// Every curves object of an Alembic file apart, in file order, each with
+/// its name (the last element of its path): what pelage wrote as parts.
+/// Its first sample, as [`read_abc_curves`].
+pub fn read_abc_parts(path: &Path) -> Result<Vec<(String, Curves)>, CurvesReadError> {
+    let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
+    abc_parts_from_bytes(&bytes, path, None)
+}
+
+fn abc_parts_from_bytes(
+    bytes: &[u8],
+    path: &Path,
+    seconds: Option<f64>,
+) -> Result<Vec<(String, Curves)>, CurvesReadError> {
     let (file, root) = Ogawa::open(bytes, path)?;
     let top = file.group(root, "the archive")?;
     if top.len() < 6 {
@@ -491,9 +509,11 @@ pub fn abc_curves_from_bytes(
     let at = seconds.map(|s| (s, &samplings[..]));
     let mut parts = Vec::with_capacity(found.len());
     for (name, geom, world) in found {
-        parts.push(read_curves_object(&file, &name, geom, &indexed, world, at)?);
+        let curves = read_curves_object(&file, &name, geom, &indexed, world, at)?;
+        let last = name.rsplit('/').next().unwrap_or(&name).to_string();
+        parts.push((last, curves));
     }
-    super::super::join(&parts).map_err(|e| CurvesReadError::whole(path, e.into()))
+    Ok(parts)
 }
 
 /// A curves object: its path, its `.geom` compound, and the transform of
