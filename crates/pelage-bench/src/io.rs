@@ -199,6 +199,7 @@ fn blender_imports() -> anyhow::Result<BlenderImports> {
         let export = CurvesExport {
             usd: UsdOptions::default(),
             mesh: Some(groom.mesh()),
+            guides: None,
         };
         let parts = 0..generator.parts().len();
         let (ours, text, theirs) = (

@@ -459,10 +459,12 @@ fn usd_body(path: &Path) -> String {
 fn an_alembic_farm_joins_into_the_file_one_run_writes_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     let groom = dir.path().join("fur.toml");
-    // With the skin (run 1 writes it), opacity and a look: every kind of
-    // object and attribute the Alembic writer knows.
+    // With the skin and the guides (run 1 writes them), regions, opacity
+    // and a look: every kind of object and attribute the Alembic writer
+    // knows.
     let text = format!(
-        "{SMALL_GROOM}opacity = {{ root = 1.0, tip = 0.4 }}\n[output]\nwith_mesh = true\n[look]\nmelanin = 0.3\njitter = 0.2\n"
+        "{SMALL_GROOM}opacity = {{ root = 1.0, tip = 0.4 }}\n[output]\nwith_mesh = true\nguides = true\n\
+         [look]\nmelanin = 0.3\njitter = 0.2\n[regions]\nmap = \"noise:frequency=1,offset=0.5,scale=1\"\n"
     );
     std::fs::write(&groom, text).unwrap();
     let g = groom.to_str().unwrap();
@@ -491,6 +493,31 @@ fn an_alembic_farm_joins_into_the_file_one_run_writes_byte_for_byte() {
         std::fs::read(&one).unwrap() == std::fs::read(&farm).unwrap(),
         "the joined parts differ from the single run's file"
     );
+    // The guides are one object flagged groom_guide, the hairs the parts,
+    // each curve with its region as groom_group_id; a reader of the hairs
+    // passes over the guides.
+    let objects = pelage::io::read_abc_objects(&one).unwrap();
+    let guides: Vec<_> = objects.iter().filter(|o| o.2).collect();
+    assert_eq!(guides.len(), 1);
+    assert_eq!(
+        (guides[0].0.as_str(), guides[0].1.curve_count()),
+        ("guides", 60)
+    );
+    let regions: std::collections::HashSet<u32> = objects
+        .iter()
+        .flat_map(|o| {
+            o.1.regions()
+                .expect("every object has its regions")
+                .to_vec()
+        })
+        .collect();
+    assert_eq!(regions.len(), 2, "{regions:?}");
+    let hairs: usize = objects
+        .iter()
+        .filter(|o| !o.2)
+        .map(|o| o.1.curve_count())
+        .sum();
+    assert_eq!(pelage::io::read_curves(&one).unwrap().curve_count(), hairs);
     // A USD layer cannot reference Alembic parts, and says what to do.
     let out = pelage(&[
         "groom",

@@ -178,6 +178,17 @@ impl PyCurves {
             .transpose()
     }
 
+    /// The skin region each curve grew in (a groom with `[regions]`),
+    /// (curves,) uint32, or `None`.
+    #[getter]
+    fn regions<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray1<u32>>>> {
+        slf.get()
+            .inner
+            .regions()
+            .map(|r| view1(slf.clone().into_any(), r))
+            .transpose()
+    }
+
     /// Hair-shader values of a groom with a `[look]`, or `None`: a dict
     /// from the attribute names (`hair_melanin`, `hair_melanin_redness`,
     /// `hair_roughness`, `hair_radial_roughness`, `hair_random`: (curves,)
@@ -348,6 +359,7 @@ fn write_one(
             ..UsdOptions::default()
         },
         mesh: mesh.map(|m| m.inner.as_ref()),
+        guides: None,
     };
     py.detach(|| pelage::io::write_curves(&path, [("curves".to_string(), curves)], &export))
         .map_err(to_py_err)

@@ -509,7 +509,7 @@ impl PyGroom {
             let generator = self.generator(py, seed)?;
             let (range, path) = farm()?;
             create_folder(&path)?;
-            let export = self.groom.export();
+            let export = self.groom.export_for(&generator, run);
             let total = range.len();
             let mut done = 0;
             let mut gathered = ReportBuilder::new(&generator);

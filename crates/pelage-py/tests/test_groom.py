@@ -237,6 +237,7 @@ def test_regions_masks_and_stable_ids_from_python(spot):
         a = small.points[small.offsets[k]:small.offsets[k + 1]]
         b = large.points[offsets[j]:offsets[j + 1]]
         assert np.array_equal(a, b), f"hair {i} changed"
+    assert set(np.unique(large.regions)) == {0, 1}, "each hair's side of the parting"
     with pytest.raises(pelage.PelageError, match="regions: the mesh has no face sets"):
         small_groom(spot, regions={"faces": "groups"}).grow()
 

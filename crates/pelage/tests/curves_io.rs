@@ -60,6 +60,7 @@ fn write_usd(path: &Path, parts: &[(&str, &Curves)], options: &UsdOptions, mesh:
     let export = CurvesExport {
         usd: options.clone(),
         mesh: mesh.then_some(&spot),
+        guides: None,
     };
     write_curves(
         path,
@@ -713,6 +714,7 @@ fn usd_writer_refuses_what_usd_cannot_hold() {
         let export = CurvesExport {
             usd: bad,
             mesh: None,
+            guides: None,
         };
         for ext in ["usda", "usdc", "abc"] {
             let dir = tempfile::tempdir().unwrap();
@@ -946,7 +948,8 @@ fn look_grooms_write_shading_primvars_and_a_materialx_hair_material() {
         format!(
             "[mesh]\npath = \"spot\"\n[roots]\ncount = 300\nparts = 2\n\
              [guides]\ngenerate = {{ count = 30, length = 0.05 }}\n[finish]\npoints = 4\n\
-             [look]\nmelanin = 0.3\nmelanin_redness = 0.6\njitter = 0.1\nmaterial = {material}\n"
+             [look]\nmelanin = 0.3\nmelanin_redness = 0.6\njitter = 0.1\nmaterial = {material}\n\
+             [regions]\nmap = \"noise:frequency=1,offset=0.5,scale=1\"\n[output]\nguides = true\n"
         )
     };
     let mut files = Vec::new();
@@ -960,11 +963,15 @@ fn look_grooms_write_shading_primvars_and_a_materialx_hair_material() {
                 .iter()
                 .enumerate()
                 .map(|(i, c)| (format!("part_{i}"), c));
-            write_curves(&path, named, &groom.export()).unwrap();
-            // pelage reads its own primvars back, all parts joined.
+            write_curves(&path, named, &groom.export_for(&generator, None)).unwrap();
+            // pelage reads its own primvars back, all parts joined (the
+            // guides, `purpose = "guide"`, are not hairs).
             let back = read_usd_curves(&path).unwrap();
             let want = pelage::io::join(parts.iter()).unwrap();
             assert_eq!(back.shading(), want.shading(), "{}", path.display());
+            assert_eq!(back.regions(), want.regions());
+            let regions = want.regions().unwrap();
+            assert!(regions.contains(&0) && regions.contains(&1));
             files.push(path);
         }
         // Alembic carries them as per-curve arbitrary parameters.
@@ -973,9 +980,11 @@ fn look_grooms_write_shading_primvars_and_a_materialx_hair_material() {
             .iter()
             .enumerate()
             .map(|(i, c)| (format!("part_{i}"), c));
-        write_curves(&path, named, &groom.export()).unwrap();
+        write_curves(&path, named, &groom.export_for(&generator, None)).unwrap();
         let want = pelage::io::join(parts.iter()).unwrap();
-        assert_eq!(read_curves(&path).unwrap().shading(), want.shading());
+        let back = read_curves(&path).unwrap();
+        assert_eq!(back.shading(), want.shading());
+        assert_eq!(back.regions(), want.regions());
     }
     let Some((ok, out)) = usdcheck(&files) else {
         return;

@@ -90,6 +90,7 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
     let export = CurvesExport {
         usd: args.usd_options(),
         mesh: mesh.as_ref(),
+        guides: None,
     };
     write_curves(&args.output, [("curves".to_string(), &curves)], &export)?;
     let (lo, hi) = curves.point_count_range();

@@ -135,7 +135,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         parts,
         "the file and the generator agree on parts"
     );
-    let export = groom.export();
+    let export = groom.export_for(&generator, args.part);
     let planned: u64 = generator.parts()[range.clone()]
         .iter()
         .map(|p| p.hair_count)

@@ -57,6 +57,8 @@ pub struct Curves {
     velocities: Option<Vec<Vec3>>,
     /// Per-curve values for a hair shader.
     shading: Option<HairShading>,
+    /// The skin region each curve grew in (a groom with `[regions]`).
+    regions: Option<Vec<u32>>,
 }
 
 /// What the skin binding moves (points, normals) beside what it reads
@@ -283,11 +285,12 @@ impl Curves {
     }
 
     /// Every `step`-th curve (0, step, 2·step, …) with its points, widths,
-    /// colours and shading values: a lighter set for previews.
+    /// colours, shading values and regions: a lighter set for previews.
     pub fn every_nth(&self, step: usize) -> Curves {
         let step = step.max(1);
         let (mut points, mut widths, mut colors) = (Vec::new(), Vec::new(), Vec::new());
         let mut shading = HairShading::default();
+        let mut regions = Vec::new();
         let mut offsets = vec![0u32];
         for i in (0..self.curve_count()).step_by(step) {
             let range = self.range(i);
@@ -299,6 +302,9 @@ impl Curves {
             if let Some(s) = &self.shading {
                 shading.push_from(s, i);
             }
+            if let Some(r) = &self.regions {
+                regions.push(r[i]);
+            }
             offsets.push(points.len() as u32);
         }
         Curves {
@@ -307,6 +313,7 @@ impl Curves {
             offsets,
             colors: self.colors.is_some().then_some(colors),
             shading: self.shading.is_some().then_some(shading),
+            regions: self.regions.is_some().then_some(regions),
             ..Curves::default()
         }
     }
@@ -370,6 +377,7 @@ impl Curves {
         copy_opt(&mut self.root_uvs, other.root_uvs.as_ref());
         copy_opt(&mut self.ids, other.ids.as_ref());
         self.shading.clone_from(&other.shading);
+        copy_opt(&mut self.regions, other.regions.as_ref());
         self.velocities = None;
         sized(&mut self.points, other.points.len());
         match &other.normals {
@@ -493,6 +501,14 @@ impl Curves {
         Ok(self)
     }
 
+    /// Adds the skin region each curve grew in (written as USD's
+    /// `hair_region` and Alembic's `groom_group_id`).
+    pub fn with_regions(mut self, regions: Vec<u32>) -> Result<Self, CurvesError> {
+        self.check_per_curve("regions", regions.len())?;
+        self.regions = Some(regions);
+        Ok(self)
+    }
+
     /// Checks a per-point attribute's length; `first_non_finite` is the
     /// index of its first NaN or infinite value, if any.
     fn check_per_point(
@@ -578,6 +594,11 @@ impl Curves {
     /// Per-curve values for a hair shader, if any.
     pub fn shading(&self) -> Option<&HairShading> {
         self.shading.as_ref()
+    }
+
+    /// The skin region each curve grew in, if known.
+    pub fn regions(&self) -> Option<&[u32]> {
+        self.regions.as_deref()
     }
 
     /// The number of points of the shortest and the longest curve

@@ -535,9 +535,13 @@ pub struct OutputSection {
     /// Output file relative to the groom file (default: the groom file's
     /// name with `.usdc`: binary USD).
     pub path: Option<String>,
-    /// Also write the skin mesh (USD only).
+    /// Also write the skin mesh (USD, Alembic).
     #[serde(default)]
     pub with_mesh: bool,
+    /// Also write the guide curves (USD `purpose = "guide"`, Alembic
+    /// `groom_guide`); still grooms only.
+    #[serde(default)]
+    pub guides: Option<Spanned<bool>>,
     /// `catmull-rom` (default) or `linear`.
     #[serde(default)]
     pub basis: CurveBasis,

@@ -7,8 +7,8 @@
 
 use super::error::{GroomError, GroomErrorKind};
 use super::grow::{Workspace, sorted_by_triangle, sorted_by_triangle_with_ids};
+use super::hair_look::HairLook;
 use super::load::part_count;
-use super::look::HairLook;
 use super::ops::{
     CentreGuides, ClumpCentres, OpKey, Opacity, Operator, Preparation, Resampling, Width,
     color_maps_mut, root_to_tip_maps_mut,
@@ -499,6 +499,24 @@ impl Generator {
     /// The region of a point of the skin (0 when it is not split).
     pub fn region_of(&self, point: SurfacePoint) -> u32 {
         self.regions.as_ref().map_or(0, |r| r.of(&self.mesh, point))
+    }
+
+    /// The guides' curves as written beside the hairs, with the region
+    /// of each guide's root when the skin is split.
+    pub fn guide_curves(&self) -> Curves {
+        let curves = self.guides.curves().clone();
+        match self.regions {
+            Some(_) => {
+                let regions = self
+                    .guides
+                    .roots()
+                    .iter()
+                    .map(|&r| self.region_of(r))
+                    .collect();
+                curves.with_regions(regions).expect("one region a guide")
+            }
+            None => curves,
+        }
     }
 
     /// The skin's regions, when it is split.

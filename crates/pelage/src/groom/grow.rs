@@ -364,7 +364,7 @@ impl Generator {
     /// has and each hair's root UV. Every hair was found finite as it grew,
     /// so `Curves` does not scan the values again.
     fn assemble(&self, a: CurveArrays) -> Curves {
-        self.with_look(self.with_root_uvs(Curves::assembled(
+        self.with_root_values(self.with_root_uvs(Curves::assembled(
             a,
             self.normals,
             self.colors,
@@ -372,18 +372,25 @@ impl Generator {
         )))
     }
 
-    /// Adds each hair's values for a hair shader (`[look]`), found from
-    /// its root and id, when the groom has a look.
-    pub(crate) fn with_look(&self, curves: Curves) -> Curves {
-        let Some(look) = &self.look else {
-            return curves;
-        };
+    /// Adds what each hair's root and id alone decide: its values for a
+    /// hair shader when the groom has a `[look]`, its region when it has
+    /// `[regions]`.
+    pub(crate) fn with_root_values(&self, mut curves: Curves) -> Curves {
         let roots = curves.roots().expect("grown curves carry their roots");
-        let ids = curves.ids().expect("grown curves carry their ids");
-        let shading = look.shade(&self.mesh, roots, ids);
+        let regions = self
+            .regions()
+            .map(|_| roots.iter().map(|&r| self.region_of(r)).collect());
+        if let Some(look) = &self.look {
+            let ids = curves.ids().expect("grown curves carry their ids");
+            let shading = look.shade(&self.mesh, roots, ids);
+            curves = curves
+                .with_shading(shading)
+                .expect("one value a hair, each within 0 to 1 or a finite tint");
+        }
+        if let Some(regions) = regions {
+            curves = curves.with_regions(regions).expect("one region a hair");
+        }
         curves
-            .with_shading(shading)
-            .expect("one value a hair, each within 0 to 1 or a finite tint")
     }
 }
 

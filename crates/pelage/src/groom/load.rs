@@ -7,7 +7,7 @@ use super::animate::{AnimatedGroom, AnimationMode, AnimationSpec, GuideMotion};
 use super::error::{GroomError, GroomErrorKind};
 use super::file::{AnimationModeName, GroomFile, InterpolationKind, MapValue, MeshSection};
 use super::generator::Generator;
-use super::look::HairLook;
+use super::hair_look::HairLook;
 use super::ops::{OpKey, SpecReader, map_on_mesh};
 use super::spec::{FinishSpec, GroomSpec, HairIds, RegionsSpec, RootsSpec, SpecOrigin};
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
@@ -225,6 +225,14 @@ impl Groom {
         let Some(animation) = &self.animation else {
             return Ok(None);
         };
+        if let Some(guides) = self.file.output.guides.as_ref().filter(|g| *g.get_ref()) {
+            return Err(self.source.error_at(
+                guides.span(),
+                GroomErrorKind::Invalid(
+                    "guides are written with still grooms; an animated groom's are not (set guides = false)".into(),
+                ),
+            ));
+        }
         let mut spec = self.spec()?;
         if let Some(seed) = seed {
             spec.roots.seed = seed;
@@ -304,6 +312,16 @@ impl Groom {
     /// them (`[look] material`).
     pub fn writes_hair_material(&self) -> bool {
         self.file.look.as_ref().is_none_or(|l| l.material)
+    }
+
+    /// Whether the guide curves are written beside the hairs (`[output]
+    /// guides`).
+    pub fn writes_guides(&self) -> bool {
+        self.file
+            .output
+            .guides
+            .as_ref()
+            .is_some_and(|g| *g.get_ref())
     }
 
     /// Whether the skin is written beside the curves (`[output]

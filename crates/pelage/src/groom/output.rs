@@ -8,7 +8,7 @@ use super::generator::{Generator, GroomSummary};
 use crate::curves::Curves;
 use crate::io::{
     AbcWriter, CurvesExport, CurvesFormat, PrimWriteError, PrimWriter, UpAxis, UsdOptions,
-    UsdaWriter, WriteError, read_abc_parts, read_usd_extent, write_atomically,
+    UsdaWriter, WriteError, read_abc_objects, read_usd_extent, write_atomically,
     write_atomically_with, write_curves, write_streamed,
 };
 use crate::mesh::Mesh;
@@ -164,6 +164,9 @@ impl Generator {
     ) -> Result<(), StreamError> {
         if let Some(mesh) = export.mesh {
             usd.write_mesh("skin", mesh)?;
+        }
+        if let Some(guides) = &export.guides {
+            usd.write_guides("guides", guides)?;
         }
         std::thread::scope(|scope| {
             type Grown = (usize, Result<Curves, GroomError>);
@@ -389,8 +392,9 @@ pub fn write_assembly(
 }
 
 /// Joins a farm's Alembic part files into one archive at `path`: the skin
-/// first when given, then every run's part objects in run order, read
-/// back and written again — the archive one run writes, byte for byte.
+/// first when given, then every run's guides (run 1 writes them) and part
+/// objects in run order, read back and written again — the archive one
+/// run writes, byte for byte.
 /// One part file is in memory at a time. Returns the groom's extent.
 pub fn write_alembic_assembly(
     path: &Path,
@@ -415,12 +419,17 @@ pub fn write_alembic_assembly(
             abc.write_mesh("skin", mesh).map_err(other)?;
         }
         for file in part_files {
-            for (name, curves) in
-                read_abc_parts(file).map_err(|e| std::io::Error::other(e.to_string()))?
-            {
-                let (lo, hi) = crate::io::curve_extent(&curves);
+            let objects =
+                read_abc_objects(file).map_err(|e| std::io::Error::other(e.to_string()))?;
+            // Guides (run 1's) first, as one run writes them before its parts.
+            let (guides, hairs): (Vec<_>, Vec<_>) = objects.into_iter().partition(|o| o.2);
+            for (name, curves, _) in &guides {
+                abc.write_guides(name, curves).map_err(other)?;
+            }
+            for (name, curves, _) in &hairs {
+                let (lo, hi) = crate::io::curve_extent(curves);
                 whole = Some(whole.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
-                abc.write_part(&name, &curves).map_err(other)?;
+                abc.write_part(name, curves).map_err(other)?;
             }
         }
         abc.finish().map_err(other)?;

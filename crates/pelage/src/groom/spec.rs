@@ -26,7 +26,7 @@
 
 use super::error::{GroomError, GroomErrorKind};
 use super::generator::Generator;
-use super::look::HairLook;
+use super::hair_look::HairLook;
 pub use super::ops::GroomOp;
 use super::ops::{Color, RootToTip};
 use crate::guides::Guides;

@@ -7,6 +7,7 @@
 
 use super::clips::{ClipAssembly, find_frame_files, write_clip_assembly};
 use super::farm::{FarmError, FarmRun, find_part_files};
+use super::generator::Generator;
 use super::load::Groom;
 use super::output::{write_alembic_assembly, write_assembly};
 use crate::io::{CurvesExport, CurvesFormat, UsdOptions, WriteError};
@@ -34,6 +35,23 @@ impl Groom {
         CurvesExport {
             usd: self.usd_options(),
             mesh: self.writes_skin().then(|| self.mesh()),
+            guides: None,
+        }
+    }
+
+    /// Whether run `run` writes the guides: with `[output] guides`, the
+    /// first run only (as the skin).
+    pub fn writes_guides_in(&self, run: Option<FarmRun>) -> bool {
+        self.writes_guides() && run.is_none_or(|r| r.k == 1)
+    }
+
+    /// What a still groom (or run `run` of its farm) writes with
+    /// `generator`: [`Self::export`], and with `[output] guides` in the
+    /// first run the guide curves with their regions.
+    pub fn export_for(&self, generator: &Generator, run: Option<FarmRun>) -> CurvesExport<'_> {
+        CurvesExport {
+            guides: self.writes_guides_in(run).then(|| generator.guide_curves()),
+            ..self.export()
         }
     }
 

@@ -95,8 +95,12 @@ pub fn read_curves(path: &Path) -> Result<Curves, CurvesReadError> {
 pub struct CurvesExport<'a> {
     /// USD stage options; their basis also applies to RIB and pbrt.
     pub usd: UsdOptions,
-    /// The skin, written beside the curves in USD (`--with-mesh`).
+    /// The skin, written beside the curves in USD and Alembic
+    /// (`--with-mesh`).
     pub mesh: Option<&'a Mesh>,
+    /// The guide curves, written beside the hairs in USD and Alembic
+    /// (`[output] guides`) as `guides`.
+    pub guides: Option<Curves>,
 }
 
 /// Writes `parts` (name, curves) to `path` in the format its extension
@@ -192,6 +196,9 @@ fn write_usd_prims<'c>(
     if let Some(mesh) = export.mesh {
         usd.write_mesh("skin", mesh).map_err(other)?;
     }
+    if let Some(guides) = &export.guides {
+        usd.write_guides("guides", guides).map_err(other)?;
+    }
     for (name, curves) in parts {
         usd.write_part(&name, curves).map_err(other)?;
     }
@@ -230,6 +237,9 @@ pub fn join<'c>(
     }
     if let Some(roots) = concat_all(&parts, Curves::roots) {
         joined = joined.with_roots(roots)?;
+    }
+    if let Some(regions) = concat_all(&parts, Curves::regions) {
+        joined = joined.with_regions(regions)?;
     }
     let shading: Option<Vec<_>> = parts.iter().map(|c| c.shading()).collect();
     if let Some(shading) = shading.filter(|s| !s.is_empty()) {

@@ -33,7 +33,8 @@ mod usda;
 mod usdc;
 
 pub use abc::{
-    AbcWriter, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at, read_abc_parts,
+    AbcCurvesObject, AbcWriter, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at,
+    read_abc_objects,
 };
 pub use atomic::{
     AtomicFile, check_free_space, check_input, check_output, note_input, protect_inputs,

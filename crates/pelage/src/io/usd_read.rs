@@ -102,6 +102,7 @@ fn curves_from_layer(
         ));
     }
     let mut parts = Vec::with_capacity(prims.len());
+    let mut guides = Vec::new();
     for prim in &prims {
         let fail = |kind| CurvesReadError::whole(path, kind);
         let at = |what: &str| format!("{}: {what}", prim.as_str());
@@ -164,9 +165,17 @@ fn curves_from_layer(
             .map_err(|e| CurvesReadError::whole(path, e.into()))?;
         let curves = with_primvars(curves, data, prim, transform)
             .map_err(|e| fail(Kind::Inconsistent(at(&e.to_string()))))?;
-        parts.push(curves);
+        let guide =
+            matches!(attribute(data, prim, "purpose"), Some(Value::Token(t)) if t == "guide");
+        match guide {
+            true => guides.push(curves),
+            false => parts.push(curves),
+        }
     }
-    super::join(&parts).map_err(|e| CurvesReadError::whole(path, e.into()))
+    // Guides (`purpose = "guide"`) are not hairs: read them only from a
+    // file that holds nothing else (a guides file).
+    let read = if parts.is_empty() { &guides } else { &parts };
+    super::join(read).map_err(|e| CurvesReadError::whole(path, e.into()))
 }
 
 /// Adds the attributes pelage writes, where the prim has them with the
@@ -220,6 +229,12 @@ fn with_primvars(
     };
     if let Some(ids) = ids {
         curves = curves.with_ids(ids)?;
+    }
+    if let Some(Value::IntVec(v)) = per("primvars:hair_region", "uniform") {
+        let regions: Option<Vec<u32>> = v.iter().map(|&r| u32::try_from(r).ok()).collect();
+        if let Some(regions) = regions {
+            curves = curves.with_regions(regions)?;
+        }
     }
     // Hair-shading values only where all of them are there, as pelage
     // writes them.

@@ -45,6 +45,11 @@ pub trait PrimWriter {
             "this format has no time samples; write animated grooms to .usdc or .abc".into(),
         ))
     }
+    /// Writes the groom's guide curves as `name`: in USD a `BasisCurves`
+    /// prim with `purpose = "guide"` (drawn by DCCs, skipped by
+    /// renderers), in Alembic an `ICurves` object flagged
+    /// `groom_guide = 1` (Unreal's groom importer).
+    fn write_guides(&mut self, name: &str, guides: &Curves) -> Result<(), PrimWriteError>;
     /// Writes one frame of an animated skin (time code `time`), as
     /// [`Self::write_part_at`] does for curves. Writers without animated
     /// meshes refuse.
@@ -264,6 +269,25 @@ pub(crate) fn basis_curves_attributes<'a>(
         };
         attributes.push(attribute.interpolated("uniform"));
     }
+    if let Some(regions) = curves.regions() {
+        // Regions are few (a parting's sides, face sets): always int.
+        let values = UsdValues::Ints(Cow::Borrowed(regions));
+        attributes.push(
+            UsdAttribute::new("primvars:hair_region", "int[]", values).interpolated("uniform"),
+        );
+    }
+    Ok(attributes)
+}
+
+/// The attributes of the guides' `BasisCurves` prim: a part's, with
+/// `purpose = "guide"` (DCCs draw them, renderers skip them).
+pub(crate) fn guide_curves_attributes<'a>(
+    name: &str,
+    guides: &'a Curves,
+    options: &UsdOptions,
+) -> Result<Vec<UsdAttribute<'a>>, PrimWriteError> {
+    let mut attributes = basis_curves_attributes(name, guides, options)?;
+    attributes.push(UsdAttribute::uniform_token("purpose", "guide"));
     Ok(attributes)
 }
 

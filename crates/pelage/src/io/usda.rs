@@ -13,7 +13,7 @@ use super::hair_material::{MATERIAL_NAME, NetworkPrim, NetworkValue, hair_materi
 use super::text::{put_f32, put_tuple2, put_tuple3, put_u64};
 use super::usd_schema::{
     PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes,
-    binds_hair_material, check_name, mesh_attributes, points_attributes,
+    binds_hair_material, check_name, guide_curves_attributes, mesh_attributes, points_attributes,
 };
 use crate::Curves;
 use crate::mesh::Mesh;
@@ -321,6 +321,13 @@ impl<W: Write> UsdaWriter<W> {
         self.write_prim_bound("BasisCurves", name, &attributes, bound)
     }
 
+    /// Writes the groom's guides as a `BasisCurves` prim named `name` with
+    /// `purpose = "guide"`.
+    pub fn write_guides(&mut self, name: &str, guides: &Curves) -> Result<(), PrimWriteError> {
+        let attributes = guide_curves_attributes(name, guides, &self.options)?;
+        self.write_prim("BasisCurves", name, &attributes)
+    }
+
     /// Writes sampled surface points as a `Points` prim named `name`.
     pub fn write_points(
         &mut self,
@@ -422,6 +429,10 @@ fn write_array<T: Sync>(
 }
 
 impl<W: Write> PrimWriter for UsdaWriter<W> {
+    fn write_guides(&mut self, name: &str, guides: &Curves) -> Result<(), PrimWriteError> {
+        UsdaWriter::write_guides(self, name, guides)
+    }
+
     fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         UsdaWriter::write_part(self, name, curves)
     }

@@ -235,7 +235,7 @@ impl EditableGroom {
     /// The grown hairs, root cell after root cell, with their ids and
     /// roots (the order differs from a written groom's parts; ids match).
     pub fn curves(&self) -> Curves {
-        self.generator.with_look(self.hairs.curves())
+        self.generator.with_root_values(self.hairs.curves())
     }
 
     /// Every root with its region and its guide weights.

@@ -22,7 +22,9 @@
 mod ogawa;
 mod read;
 
-pub use read::{abc_curves_from_bytes, read_abc_curves, read_abc_curves_at, read_abc_parts};
+pub use read::{
+    AbcCurvesObject, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at, read_abc_objects,
+};
 
 use super::usd_schema::{check_name, curve_extent};
 use super::{CurveBasis, PrimWriteError, UsdOptions};
@@ -241,11 +243,29 @@ impl<W: Write + Seek> AbcWriter<W> {
         Ok((self.ogawa.data(&[&key, bytes])?, points))
     }
 
+    /// Writes the groom's guide curves as an `ICurves` object named
+    /// `name`, flagged `groom_guide = 1` (with their regions as
+    /// `groom_group_id`): what Unreal's groom importer simulates and
+    /// interpolates from.
+    pub fn write_guides(&mut self, name: &str, guides: &Curves) -> Result<(), PrimWriteError> {
+        self.start_part_as(name, guides, None, true)
+    }
+
     fn start_part(
         &mut self,
         name: &str,
         curves: &Curves,
         time: Option<f64>,
+    ) -> Result<(), PrimWriteError> {
+        self.start_part_as(name, curves, time, false)
+    }
+
+    fn start_part_as(
+        &mut self,
+        name: &str,
+        curves: &Curves,
+        time: Option<f64>,
+        guide: bool,
     ) -> Result<(), PrimWriteError> {
         check_name(name)?;
         if !self.names.insert(name.to_string()) {
@@ -406,6 +426,35 @@ impl<W: Write + Seek> AbcWriter<W> {
                 Scope::Uniform,
                 "",
                 pod,
+                1,
+                0,
+                vec![sample],
+            ));
+        }
+        if let Some(regions) = curves.regions() {
+            // Unreal's groom groups: one a region, guides matched to hairs
+            // by it.
+            let sample = self.array_sample(bytemuck::cast_slice(regions), regions.len())?;
+            arbitrary.push(geom_param(
+                "groom_group_id",
+                Scope::Uniform,
+                "",
+                Pod::Int32,
+                1,
+                0,
+                vec![sample],
+            ));
+        }
+        if guide {
+            let ones: Vec<u8> = std::iter::repeat_n(1i32.to_le_bytes(), curves.curve_count())
+                .flatten()
+                .collect();
+            let sample = self.array_sample(&ones, curves.curve_count())?;
+            arbitrary.push(geom_param(
+                "groom_guide",
+                Scope::Uniform,
+                "",
+                Pod::Int32,
                 1,
                 0,
                 vec![sample],
@@ -924,5 +973,9 @@ impl<W: Write + Seek> super::PrimWriter for AbcWriter<W> {
         curves: &Curves,
     ) -> Result<(), PrimWriteError> {
         AbcWriter::write_part_at(self, name, time, curves)
+    }
+
+    fn write_guides(&mut self, name: &str, guides: &Curves) -> Result<(), PrimWriteError> {
+        AbcWriter::write_guides(self, name, guides)
     }
 }

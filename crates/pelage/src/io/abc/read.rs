@@ -453,19 +453,41 @@ pub fn abc_curves_from_bytes(
         .map_err(|e| CurvesReadError::whole(path, e.into()))
 }
 
-/// Every curves object of an Alembic file apart, in file order, each with
-/// its name (the last element of its path): what pelage wrote as parts.
-/// Its first sample, as [`read_abc_curves`].
-pub fn read_abc_parts(path: &Path) -> Result<Vec<(String, Curves)>, CurvesReadError> {
+/// A curves object of an Alembic file: its name (the last element of its
+/// path), its curves, and whether it is flagged `groom_guide`.
+pub type AbcCurvesObject = (String, Curves, bool);
+
+/// Every curves object of an Alembic file apart, in file order, guides
+/// (`groom_guide`) flagged: what pelage wrote as parts and guides. Their
+/// first sample, as [`read_abc_curves`].
+pub fn read_abc_objects(path: &Path) -> Result<Vec<AbcCurvesObject>, CurvesReadError> {
     let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
-    abc_parts_from_bytes(&bytes, path, None)
+    abc_objects_from_bytes(&bytes, path, None)
 }
 
+/// The hairs of an Alembic file, object by object (the guides where it
+/// holds nothing else), as [`read_abc_curves`] joins them.
 fn abc_parts_from_bytes(
     bytes: &[u8],
     path: &Path,
     seconds: Option<f64>,
 ) -> Result<Vec<(String, Curves)>, CurvesReadError> {
+    let objects = abc_objects_from_bytes(bytes, path, seconds)?;
+    // Guide objects are not hairs: read them only from a file that holds
+    // nothing else (a guides file).
+    let only_guides = objects.iter().all(|(_, _, guide)| *guide);
+    Ok(objects
+        .into_iter()
+        .filter(|(_, _, guide)| *guide == only_guides)
+        .map(|(name, curves, _)| (name, curves))
+        .collect())
+}
+
+fn abc_objects_from_bytes(
+    bytes: &[u8],
+    path: &Path,
+    seconds: Option<f64>,
+) -> Result<Vec<AbcCurvesObject>, CurvesReadError> {
     let (file, root) = Ogawa::open(bytes, path)?;
     let top = file.group(root, "the archive")?;
     if top.len() < 6 {
@@ -507,13 +529,13 @@ fn abc_parts_from_bytes(
         None => Vec::new(),
     };
     let at = seconds.map(|s| (s, &samplings[..]));
-    let mut parts = Vec::with_capacity(found.len());
+    let mut objects = Vec::with_capacity(found.len());
     for (name, geom, world) in found {
-        let curves = read_curves_object(&file, &name, geom, &indexed, world, at)?;
+        let (curves, guide) = read_curves_object(&file, &name, geom, &indexed, world, at)?;
         let last = name.rsplit('/').next().unwrap_or(&name).to_string();
-        parts.push((last, curves));
+        objects.push((last, curves, guide));
     }
-    Ok(parts)
+    Ok(objects)
 }
 
 /// A curves object: its path, its `.geom` compound, and the transform of
@@ -753,8 +775,9 @@ fn read_curves_object(
     indexed: &[String],
     world: DMat4,
     at: Option<(f64, &[TimeSampling])>,
-) -> Result<Curves, CurvesReadError> {
+) -> Result<(Curves, bool), CurvesReadError> {
     let what = |p: &str| format!("{path}/.geom/{p}");
+    let mut guide = false;
     let fail = |message: String| file.fail(geom, message);
     let geom = Compound::read(file, geom, indexed, &what(""))?;
     let property = |name: &str, pod: &[u8], extent: u8| -> Result<Option<&[u8]>, CurvesReadError> {
@@ -910,7 +933,21 @@ fn read_curves_object(
                 .with_opacities(floats(b).collect())
                 .map_err(|e| fail(format!("{path}: {e}")))?;
         }
+        guide = arb.get("groom_guide").is_some();
         let curve_count = curves.curve_count();
+        if let Some((_, b)) =
+            sample("groom_group_id", &[6], 1)?.filter(|(_, b)| b.len() == curve_count * 4)
+        {
+            let regions: Option<Vec<u32>> = b
+                .chunks_exact(4)
+                .map(|c| u32::try_from(i32::from_le_bytes(c.try_into().expect("4"))).ok())
+                .collect();
+            if let Some(regions) = regions {
+                curves = curves
+                    .with_regions(regions)
+                    .map_err(|e| fail(format!("{path}: {e}")))?;
+            }
+        }
         if let Some((pod, b)) = sample("groom_id", &[6, 8], 1)? {
             let ids: Option<Vec<u64>> = if pod == 6 {
                 b.chunks_exact(4)
@@ -975,5 +1012,5 @@ fn read_curves_object(
                 .map_err(|e| fail(format!("{path}: {e}")))?;
         }
     }
-    Ok(curves)
+    Ok((curves, guide))
 }

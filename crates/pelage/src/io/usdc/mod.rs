@@ -23,7 +23,8 @@ pub(crate) use read::{read_usdc, read_usdc_bytes};
 use super::hair_material::{MATERIAL_NAME, NetworkPrim, NetworkValue, hair_material};
 use super::usd_schema::{
     PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes,
-    binds_hair_material, check_name, curve_extent, mesh_attributes, points_attributes,
+    binds_hair_material, check_name, curve_extent, guide_curves_attributes, mesh_attributes,
+    points_attributes,
 };
 use super::{PrimWriteError, UpAxis, UsdOptions};
 use crate::Curves;
@@ -99,6 +100,14 @@ impl<W: Write + Seek> UsdcWriter<W> {
         let attributes = basis_curves_attributes(name, curves, &self.options)?;
         let material = self.material_for(curves)?;
         self.write_prim_bound("BasisCurves", name, &attributes, false, material)?;
+        Ok(())
+    }
+
+    /// Writes the groom's guides as a `BasisCurves` prim named `name` with
+    /// `purpose = "guide"`.
+    pub fn write_guides(&mut self, name: &str, guides: &Curves) -> Result<(), PrimWriteError> {
+        let attributes = guide_curves_attributes(name, guides, &self.options)?;
+        self.write_prim("BasisCurves", name, &attributes, false)?;
         Ok(())
     }
 
@@ -692,6 +701,10 @@ impl<W: Write + Seek> UsdcWriter<W> {
 }
 
 impl<W: Write + Seek> PrimWriter for UsdcWriter<W> {
+    fn write_guides(&mut self, name: &str, guides: &Curves) -> Result<(), PrimWriteError> {
+        UsdcWriter::write_guides(self, name, guides)
+    }
+
     fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         UsdcWriter::write_part(self, name, curves)
     }
