@@ -119,6 +119,10 @@ generate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }
 
 /// The Stubble figure: `method` interpolation, clump + noise, 16 points,
 /// normals and widths.
+/// A `[look]` for the bench's groom: melanin from a noise map, the rest
+/// constants, every value jittered.
+const LOOK: &str = "\n[look]\nmelanin = \"noise:frequency=3,seed=2,offset=0.5,scale=0.4\"\nroughness = 0.3\njitter = 0.1\n";
+
 pub(super) fn groom_text(hairs: u64, method: &str) -> String {
     format!(
         r#"{head}
@@ -265,6 +269,8 @@ struct GroomFigures {
     parted_s: f64,
     /// `--fraction 0.1`: the first tenth of the arrivals, wider.
     fraction_s: f64,
+    /// With a `[look]`: hair-shader values from a noise map, jittered.
+    look_s: f64,
     stable_ratio: f64,
     parted_ratio: f64,
     style_prep_s: f64,
@@ -337,6 +343,9 @@ fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
     tenth.set_fraction(0.1)?;
     let (fraction_s, fraction_counted) = median_seconds(runs, false, || grow_all(&tenth));
     fraction_counted?;
+    let looked = Groom::from_text("<bench>", groom_text(hairs, "shepard") + LOOK)?;
+    let (look_s, look_counted) = median_seconds(runs, false, || grow_all(&looked));
+    look_counted?;
     let stable_ratio = shepard_s / sequential_s;
     let parted_ratio = parted_s / sequential_s;
     let (style_prep_s, _) = median_seconds(1, false, || style.generator(None).map(|_| ()));
@@ -384,6 +393,7 @@ fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
         sequential_s,
         parted_s,
         fraction_s,
+        look_s,
         stable_ratio,
         parted_ratio,
         style_prep_s,
@@ -416,6 +426,7 @@ impl GroomFigures {
             sequential_s,
             parted_s,
             fraction_s,
+            look_s,
             stable_ratio,
             parted_ratio,
             style_prep_s,
@@ -458,6 +469,8 @@ impl GroomFigures {
             "parting_two_masks_ratio": parted_ratio,
             "fraction_0_1_seconds": fraction_s,
             "fraction_0_1_ratio": fraction_s / shepard_s,
+            "look_seconds": look_s,
+            "look_ratio": look_s / shepard_s,
             "rss_hairs": rss_hairs,
             "peak_rss_bytes": rss,
             "rss_usd_bytes": usd_bytes,
@@ -484,6 +497,7 @@ impl GroomFigures {
             sequential_s,
             parted_s,
             fraction_s,
+            look_s,
             stable_ratio,
             parted_ratio,
             style_s,
@@ -542,6 +556,13 @@ impl GroomFigures {
             fraction_s,
             hair_count as f64 / 10.0 / fraction_s / 1e6,
             format!("{:.3}× all", fraction_s / shepard_s)
+        );
+        println!(
+            "{:<40} {:>10.3} {:>12.2} {:>14}",
+            "  with a [look] (melanin map, jitter)",
+            look_s,
+            hair_count as f64 / look_s / 1e6,
+            format!("{:.3}× all", look_s / shepard_s)
         );
         println!(
             "{:<40} {:>10.3} {:>12.2} {:>14}",
