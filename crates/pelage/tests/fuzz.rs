@@ -506,6 +506,11 @@ fn fuzz_groom_toml() {
         "]",
         "\u{feff}",
         "frames = \"1-100000000\"\n",
+        "[look]\n",
+        "melanin = ",
+        "tint = [1, 2]\n",
+        "jitter = 2\n",
+        "[output]\nguides = true\n",
     ];
     fuzz("groom", &tokens, true, |data| {
         if let Ok(text) = std::str::from_utf8(data) {
