@@ -63,6 +63,13 @@ class PelageFurSettings(bpy.types.PropertyGroup):
         description="A pelage groom file (.toml); its [mesh] is replaced by this object. Empty: use the settings below",
         subtype="FILE_PATH",
     )
+    guides_object: PointerProperty(
+        type=bpy.types.Object,
+        name="Guides",
+        description="A hair Curves object on this surface whose curves shape the fur "
+                    "(Add › Curves › Empty Hair, sculpted with Blender's brushes); empty: guides grown here",
+        poll=lambda _settings, obj: obj.type == "CURVES",
+    )
     count: IntProperty(name="Count", description="Hairs", default=20_000, min=1, soft_max=2_000_000)
     guides: IntProperty(name="Guides", description="Guide curves grown on the surface", default=200, min=1, soft_max=5_000)
     length: FloatProperty(name="Length", description="Guide length", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
@@ -159,7 +166,7 @@ class _PelageExport(ExportHelper):
         depsgraph = context.evaluated_depsgraph_get()
         try:
             mesh, _ = fur.mesh_to_pelage(surface, depsgraph)
-            groom = fur.groom_from_settings(mesh, surface.pelage_fur)
+            groom = fur.groom_for(surface, surface.pelage_fur, mesh, depsgraph)
             summary = groom.write(self.filepath)
         except PelageError as error:
             self.report({"ERROR"}, str(error))
@@ -206,8 +213,13 @@ class PELAGE_PT_fur(bpy.types.Panel):
         column = layout.column(align=True)
         column.enabled = not settings.groom_file
         column.prop(settings, "preset")
+        column.prop(settings, "guides_object")
+        grown_guides = settings.guides_object is None
         for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed"):
-            column.prop(settings, name)
+            row = column.row()
+            # Length, gravity and the guide count shape grown guides only.
+            row.enabled = grown_guides or name not in ("guides", "length", "gravity")
+            row.prop(settings, name)
         look = layout.column(align=True)
         look.enabled = not settings.groom_file
         look.label(text="Look (Principled Hair BSDF)")

@@ -88,10 +88,31 @@ def mesh_to_pelage(obj, depsgraph):
         evaluated.to_mesh_clear()
 
 
-def groom_from_settings(mesh, settings):
+def guides_from_curves_object(obj, depsgraph):
+    """The curves of the hair Curves object ``obj`` (evaluated: Blender's
+    sculpt brushes and modifiers applied) as a ``pelage.Curves`` in
+    pelage's Y-up world (``to_pelage_space``), to be bound to the surface
+    as guides. Any point count: pelage resamples them."""
+    import pelage
+
+    data = obj.evaluated_get(depsgraph).data
+    if len(data.curves) == 0:
+        raise pelage.PelageError(f"{obj.name}: the guides object has no curves; add some with Blender's hair brushes")
+    points = np.empty(len(data.points) * 3, dtype=np.float32)
+    data.position_data.foreach_get("vector", points)
+    offsets = np.empty(len(data.curves) + 1, dtype=np.int32)
+    data.curve_offset_data.foreach_get("value", offsets)
+    world = transform_points(to_pelage_space(obj), points.reshape(-1, 3))
+    return pelage.Curves.from_arrays(world, offsets.astype(np.uint32))
+
+
+def groom_from_settings(mesh, settings, guides=None, size=1.0):
     """A ``pelage.Groom`` on ``mesh`` from the panel's settings: the groom
     file when one is set (its ``[mesh]`` replaced by ``mesh``), else
-    grown guides, roots and the clump, curl and noise operators."""
+    roots, the clump, curl and noise operators and the look, shaped by
+    ``guides`` (a ``pelage.Curves`` from ``guides_from_curves_object``,
+    bound within a 200th of ``size``, the surface's largest dimension)
+    or by guides grown on the surface."""
     import pelage
 
     if settings.groom_file:
@@ -107,10 +128,14 @@ def groom_from_settings(mesh, settings):
     if settings.noise > 0:
         ops.append(pelage.ops.noise(amplitude=settings.noise * settings.length * 0.2,
                                     frequency=4.0 / max(settings.length, 1e-6)))
+    if guides is not None:
+        guides = {"curves": guides, "points": max(settings.points, 4), "tolerance": size * 0.005}
+    else:
+        guides = {"generate": {"count": settings.guides, "length": settings.length,
+                               "gravity": settings.gravity, "seed": settings.seed}}
     return pelage.Groom(
         mesh=mesh,
-        guides={"generate": {"count": settings.guides, "length": settings.length,
-                             "gravity": settings.gravity, "seed": settings.seed}},
+        guides=guides,
         roots={"count": settings.count, "seed": settings.seed},
         ops=ops,
         finish={"points": settings.points,
@@ -229,6 +254,15 @@ def guide_warnings(report):
     return notes
 
 
+def groom_for(surface, settings, mesh, depsgraph):
+    """The groom the panel of ``surface`` describes on its pelage ``mesh``,
+    with the guides object's curves as guides when one is set."""
+    guides = None
+    if settings.guides_object is not None and not settings.groom_file:
+        guides = guides_from_curves_object(settings.guides_object, depsgraph)
+    return groom_from_settings(mesh, settings, guides, max(surface.dimensions) or 1.0)
+
+
 def grow_on_object(context, surface, settings, progress=None):
     """Grows fur on the mesh object ``surface`` and links a Curves object
     parented to it. Returns ``(curves_object, pelage_curves, warnings)``:
@@ -237,7 +271,7 @@ def grow_on_object(context, surface, settings, progress=None):
 
     depsgraph = context.evaluated_depsgraph_get()
     mesh, uv_map = mesh_to_pelage(surface, depsgraph)
-    groom = groom_from_settings(mesh, settings)
+    groom = groom_for(surface, settings, mesh, depsgraph)
     grown = groom.grow(progress=progress)
     # Back from pelage's Y-up world into the surface's local space, where
     # Blender keeps the points of curves parented to it.

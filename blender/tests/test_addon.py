@@ -118,6 +118,40 @@ assert fed == {"Melanin": "hair_melanin", "Melanin Redness": "hair_melanin_redne
                "Random": "hair_random"}, fed
 print(f"look: hair_melanin {melanin.min():.3f}-{melanin.max():.3f} per curve, read by {material.name!r}")
 
+# Guides from Blender: a hair Curves object (as Add › Curves › Empty Hair
+# and Blender's brushes make) whose four curves lean four ways shapes the
+# fur; hairs rooted by a guide lean its way.
+leans = np.array([[1, 0, 1], [-1, 0, 1], [0, 1, 1], [0, -1, 1]], np.float64)
+leans /= np.linalg.norm(leans, axis=1)[:, None]
+guide_roots = np.array([[0.5, 0.5, 0], [-0.5, 0.5, 0], [0.5, -0.5, 0], [-0.5, -0.5, 0]], np.float64)
+sculpted = bpy.data.hair_curves.new("sculpted")
+sculpted.add_curves([7] * 4)  # any point count: pelage resamples
+steps = np.linspace(0, 0.2, 7)
+guide_points = (guide_roots[:, None, :] + steps[None, :, None] * leans[:, None, :]).reshape(-1, 3)
+sculpted.position_data.foreach_set("vector", guide_points.astype(np.float32).ravel())
+guides_object = bpy.data.objects.new("sculpted", sculpted)
+bpy.context.collection.objects.link(guides_object)
+settings.guides_object = guides_object
+shaping = settings.clump, settings.noise
+settings.clump, settings.noise = 0.0, 0.0  # the guides' shape alone
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+guided = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+guided_points, guided_offsets = arrays(guided.data)
+guided_roots = guided_points[guided_offsets[:-1]]
+guided_tips = guided_points[guided_offsets[1:] - 1]
+for root, lean in zip(guide_roots, leans):
+    near = np.linalg.norm(guided_roots - root, axis=1) < 0.08
+    assert near.sum() >= 5, near.sum()
+    ways = guided_tips[near] - guided_roots[near]
+    length = np.linalg.norm(ways, axis=1)
+    ways /= length[:, None]
+    assert np.all(ways @ lean > 0.97), (root, (ways @ lean).min())
+    assert np.allclose(length, 0.2, rtol=0.05), length
+bpy.data.objects.remove(guided)
+settings.guides_object = None
+settings.clump, settings.noise = shaping
+print("guides from Blender: hairs by each sculpted guide lean its way, at its length")
+
 # The same seed grows the same fur (the operator is deterministic).
 bpy.ops.pelage.grow_fur()
 second = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
