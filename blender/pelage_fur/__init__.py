@@ -70,6 +70,10 @@ class PelageFurSettings(bpy.types.PropertyGroup):
                     "(Add › Curves › Empty Hair, sculpted with Blender's brushes); empty: guides grown here",
         poll=lambda _settings, obj: obj.type == "CURVES",
     )
+    density_group: StringProperty(
+        name="Density",
+        description="A vertex group (or float attribute) whose weights scale where hairs grow; empty: evenly",
+    )
     count: IntProperty(name="Count", description="Hairs", default=20_000, min=1, soft_max=2_000_000)
     guides: IntProperty(name="Guides", description="Guide curves grown on the surface", default=200, min=1, soft_max=5_000)
     length: FloatProperty(name="Length", description="Guide length", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
@@ -214,6 +218,7 @@ class PELAGE_PT_fur(bpy.types.Panel):
         column.enabled = not settings.groom_file
         column.prop(settings, "preset")
         column.prop(settings, "guides_object")
+        column.prop_search(settings, "density_group", surface_of(context), "vertex_groups")
         grown_guides = settings.guides_object is None
         for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed"):
             row = column.row()

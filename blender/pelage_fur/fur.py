@@ -4,8 +4,10 @@ pelage is imported where it is used, so that ``curves_to_blender`` also
 serves scripts (and pelage's benchmark) that only have arrays.
 
 Everything here moves data in bulk (``foreach_get`` / ``foreach_set`` with
-numpy arrays): no Python loop runs per vertex, point or curve, so a
-million hairs become a Curves object in about a second.
+numpy arrays): no Python loop runs per point or curve, so a million
+hairs become a Curves object in about a second. Vertex-group weights are
+the one exception (Blender has no bulk accessor for them): one pass over
+the mesh's vertices, only when the object has vertex groups.
 
 The Curves object is what Blender's own hair tools make: points in the
 surface object's space, ``radius`` per point, ``surface_uv_coordinate`` per
@@ -82,10 +84,36 @@ def mesh_to_pelage(obj, depsgraph):
             triangles.reshape(-1, 3),
             uvs=corner_uvs,
             name=obj.name,
+            vertex_maps=vertex_maps_of(obj, mesh),
         )
         return result, (uv_layer.name if uv_layer is not None else None)
     finally:
         evaluated.to_mesh_clear()
+
+
+def vertex_maps_of(obj, mesh):
+    """The object's vertex groups and the mesh's float point attributes,
+    by name, one float32 a vertex: what a groom reads as ``"vertex:NAME"``
+    maps (density, lengths, masks). Vertex groups have no bulk accessor
+    in Blender's Python API, so their weights take one Python pass over
+    the vertices (only when the object has vertex groups)."""
+    count = len(mesh.vertices)
+    maps = {}
+    if obj.vertex_groups:
+        weights = np.zeros((len(obj.vertex_groups), count), dtype=np.float32)
+        for vertex in mesh.vertices:
+            for element in vertex.groups:
+                if element.group < len(weights):
+                    weights[element.group, vertex.index] = element.weight
+        for group in obj.vertex_groups:
+            maps[group.name] = weights[group.index]
+    for attribute in mesh.attributes:
+        if (attribute.domain == "POINT" and attribute.data_type == "FLOAT"
+                and not attribute.name.startswith(".") and attribute.name not in maps):
+            values = np.empty(count, dtype=np.float32)
+            attribute.data.foreach_get("value", values)
+            maps[attribute.name] = values
+    return maps
 
 
 def guides_from_curves_object(obj, depsgraph):
@@ -136,7 +164,8 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0):
     return pelage.Groom(
         mesh=mesh,
         guides=guides,
-        roots={"count": settings.count, "seed": settings.seed},
+        roots=dict({"count": settings.count, "seed": settings.seed},
+                   **({"density": f"vertex:{settings.density_group}"} if settings.density_group else {})),
         ops=ops,
         finish={"points": settings.points,
                 "width": {"root": settings.width, "tip": settings.width * 0.1}},

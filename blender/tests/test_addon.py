@@ -152,6 +152,20 @@ settings.guides_object = None
 settings.clump, settings.noise = shaping
 print("guides from Blender: hairs by each sculpted guide lean its way, at its length")
 
+# A vertex group painted on half the grid (weight 1 for x > 0, none
+# elsewhere) as the density puts the roots on that half.
+half = grid.vertex_groups.new(name="half")
+half.add([v.index for v in grid.data.vertices if v.co.x > 1e-6], 1.0, "REPLACE")
+settings.density_group = "half"
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+painted = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+painted_points, painted_offsets = arrays(painted.data)
+share = (painted_points[painted_offsets[:-1], 0] > 0).mean()
+assert share >= 0.95, share
+bpy.data.objects.remove(painted)
+settings.density_group = ""
+print(f"density from a vertex group: {share:.1%} of the roots on the painted half")
+
 # The same seed grows the same fur (the operator is deterministic).
 bpy.ops.pelage.grow_fur()
 second = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]

@@ -52,16 +52,19 @@ impl PyMesh {
     /// (m, 3) vertex indices, and optionally `uvs`: (n, 2) per vertex, or
     /// (3m, 2) per corner (three a triangle, in the triangles' order, as
     /// Blender's UV layers are). `normals` (n, 3) when you have them
-    /// (computed otherwise). Everything is checked: finite values, indices
-    /// in range, matching sizes.
+    /// (computed otherwise). `vertex_maps`: named per-vertex scalars, each
+    /// (n,) floats, read by a groom's maps as `"vertex:NAME"` (a DCC's
+    /// painted weights). Everything is checked: finite values, indices in
+    /// range, matching sizes.
     #[staticmethod]
-    #[pyo3(signature = (positions, triangles, uvs = None, normals = None, name = "<python mesh>".to_string()))]
+    #[pyo3(signature = (positions, triangles, uvs = None, normals = None, name = "<python mesh>".to_string(), vertex_maps = None))]
     fn from_arrays(
         positions: &Bound<'_, PyAny>,
         triangles: &Bound<'_, PyAny>,
         uvs: Option<&Bound<'_, PyAny>>,
         normals: Option<&Bound<'_, PyAny>>,
         name: String,
+        vertex_maps: Option<&Bound<'_, pyo3::types::PyDict>>,
     ) -> PyResult<Self> {
         let positions = vec3s(rows::<f32, 3>(positions, "positions")?);
         let triangles = triangle_rows(triangles)?;
@@ -92,7 +95,12 @@ impl PyMesh {
                 }
             }
         };
-        let mesh = Mesh::new(name, positions, triangles, normals, uvs).map_err(to_py_err)?;
+        let mut mesh = Mesh::new(name, positions, triangles, normals, uvs).map_err(to_py_err)?;
+        for (key, values) in vertex_maps.into_iter().flat_map(|d| d.iter()) {
+            let key: String = key.extract()?;
+            let values = crate::convert::column::<f32>(&values, &format!("vertex_maps[{key:?}]"))?;
+            mesh = mesh.with_vertex_attribute(key, values).map_err(to_py_err)?;
+        }
         Ok(Self {
             inner: Arc::new(mesh),
         })

@@ -265,6 +265,24 @@ def test_look_gives_each_hair_shader_values_written_as_usd_primvars(spot, tmp_pa
         small_groom(spot, look={"roughness": 2.0}).grow()
 
 
+def test_a_vertex_map_given_with_the_mesh_drives_the_density():
+    # A grid of 21 × 21 vertices in the XZ plane; the map is 1 on x > 0.
+    xs = np.linspace(-1, 1, 21, dtype=np.float32)
+    x, z = np.meshgrid(xs, xs)
+    positions = np.stack([x.ravel(), np.zeros(x.size, np.float32), z.ravel()], axis=1)
+    quads = [(i * 21 + j, (i + 1) * 21 + j, (i + 1) * 21 + j + 1, i * 21 + j + 1)
+             for i in range(20) for j in range(20)]
+    triangles = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))], np.uint32)
+    half = (positions[:, 0] > 0).astype(np.float32)
+    mesh = pelage.Mesh.from_arrays(positions, triangles, vertex_maps={"half": half})
+    curves = pelage.Groom(mesh=mesh, guides={"generate": {"count": 20, "length": 0.1}},
+                          roots={"count": 4000, "density": "vertex:half"}).grow()
+    roots = curves.points[curves.offsets[:-1]]
+    assert (roots[:, 0] > 0).mean() >= 0.95
+    with pytest.raises(pelage.PelageError, match="3 values for 441 vertices"):
+        pelage.Mesh.from_arrays(positions, triangles, vertex_maps={"half": half[:3]})
+
+
 def test_the_ops_builders_match_the_librarys_operator_schema():
     """`pelage.ops` is written by hand; this holds it to the operators the
     library defines (their serde definitions), so a new operator or key

@@ -30,6 +30,7 @@ class Mesh:
         uvs: Optional[npt.ArrayLike] = None,
         normals: Optional[npt.ArrayLike] = None,
         name: str = "<python mesh>",
+        vertex_maps: Optional[Dict[str, npt.ArrayLike]] = None,
     ) -> "Mesh": ...
     def subdivided(self, levels: int) -> "Mesh": ...
     @property
