@@ -74,6 +74,16 @@ class PelageFurSettings(bpy.types.PropertyGroup):
         name="Density",
         description="A vertex group (or float attribute) whose weights scale where hairs grow; empty: evenly",
     )
+    parting: EnumProperty(
+        name="Parting",
+        description="Regions whose hairs take no shape or clumps from one another's guides",
+        items=[
+            ("NONE", "None", "One region: every guide shapes every hair near it"),
+            ("FACE_SETS", "Face sets", "Each sculpt face set a region"),
+            ("MATERIALS", "Material slots", "Each material slot a region"),
+        ],
+        default="NONE",
+    )
     count: IntProperty(name="Count", description="Hairs", default=20_000, min=1, soft_max=2_000_000)
     guides: IntProperty(name="Guides", description="Guide curves grown on the surface", default=200, min=1, soft_max=5_000)
     length: FloatProperty(name="Length", description="Guide length", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
@@ -219,6 +229,7 @@ class PELAGE_PT_fur(bpy.types.Panel):
         column.prop(settings, "preset")
         column.prop(settings, "guides_object")
         column.prop_search(settings, "density_group", surface_of(context), "vertex_groups")
+        column.prop(settings, "parting")
         grown_guides = settings.guides_object is None
         for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed"):
             row = column.row()

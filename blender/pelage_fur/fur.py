@@ -85,6 +85,7 @@ def mesh_to_pelage(obj, depsgraph):
             uvs=corner_uvs,
             name=obj.name,
             vertex_maps=vertex_maps_of(obj, mesh),
+            **face_sets_of(mesh),
         )
         return result, (uv_layer.name if uv_layer is not None else None)
     finally:
@@ -114,6 +115,29 @@ def vertex_maps_of(obj, mesh):
             attribute.data.foreach_get("value", values)
             maps[attribute.name] = values
     return maps
+
+
+#: Blender's face sets: an integer attribute on faces.
+FACE_SETS = ".sculpt_face_set"
+
+
+def face_sets_of(mesh):
+    """The mesh's face sets and material slots, one id a loop triangle, as
+    ``Mesh.from_arrays`` takes them (``face_sets``, ``materials``): the
+    regions of a parting (``regions={"faces": "groups" | "materials"}``).
+    A mesh without face sets has none; every mesh has material slots."""
+    polygon = np.empty(len(mesh.loop_triangles), dtype=np.int32)
+    mesh.loop_triangles.foreach_get("polygon_index", polygon)
+    sets = {}
+    materials = np.empty(len(mesh.polygons), dtype=np.int32)
+    mesh.polygons.foreach_get("material_index", materials)
+    sets["materials"] = materials[polygon]
+    attribute = mesh.attributes.get(FACE_SETS)
+    if attribute is not None and attribute.domain == "FACE" and attribute.data_type == "INT":
+        values = np.empty(len(mesh.polygons), dtype=np.int32)
+        attribute.data.foreach_get("value", values)
+        sets["face_sets"] = values[polygon]
+    return sets
 
 
 def guides_from_curves_object(obj, depsgraph):
@@ -161,9 +185,11 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0):
     else:
         guides = {"generate": {"count": settings.guides, "length": settings.length,
                                "gravity": settings.gravity, "seed": settings.seed}}
+    parting = {"FACE_SETS": {"faces": "groups"}, "MATERIALS": {"faces": "materials"}}
     return pelage.Groom(
         mesh=mesh,
         guides=guides,
+        regions=parting.get(settings.parting),
         roots=dict({"count": settings.count, "seed": settings.seed},
                    **({"density": f"vertex:{settings.density_group}"} if settings.density_group else {})),
         ops=ops,

@@ -148,9 +148,35 @@ for root, lean in zip(guide_roots, leans):
     assert np.all(ways @ lean > 0.97), (root, (ways @ lean).min())
     assert np.allclose(length, 0.2, rtol=0.05), length
 bpy.data.objects.remove(guided)
+print("guides from Blender: hairs by each sculpted guide lean its way, at its length")
+
+# A face-set parting: the sculpted guides lean away from x = 0 on each
+# side; with the face sets as regions, hairs by the line lean fully their
+# side's way, never blended across it.
+x_guides = np.array([[-0.6, 0.3, 0], [-0.2, -0.3, 0], [0.2, 0.3, 0], [0.6, -0.3, 0]])
+sideways = np.where(x_guides[:, :1] > 0, 1.0, -1.0) * np.array([[1, 0, 0]]) + np.array([[0, 0, 1]])
+sideways /= np.linalg.norm(sideways, axis=1)[:, None]
+parting_guides = (x_guides[:, None, :] + steps[None, :, None] * sideways[:, None, :]).reshape(-1, 3)
+sculpted.position_data.foreach_set("vector", parting_guides.astype(np.float32).ravel())
+sets = grid.data.attributes.new(".sculpt_face_set", "INT", "FACE")
+centres = np.empty(len(grid.data.polygons) * 3, np.float32)
+grid.data.polygons.foreach_get("center", centres)
+sets.data.foreach_set("value", np.where(centres.reshape(-1, 3)[:, 0] > 0, 2, 1).astype(np.int32))
+settings.parting = "FACE_SETS"
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+parted = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+parted_points, parted_offsets = arrays(parted.data)
+starts, ends = parted_points[parted_offsets[:-1]], parted_points[parted_offsets[1:] - 1]
+lean_x = (ends[:, 0] - starts[:, 0]) / np.linalg.norm(ends - starts, axis=1)
+by_the_line = np.abs(starts[:, 0]) < 0.2
+assert by_the_line.sum() > 50, by_the_line.sum()
+assert np.all(lean_x[by_the_line] * np.sign(starts[by_the_line, 0]) > 0.65), lean_x[by_the_line].min()
+bpy.data.objects.remove(parted)
+grid.data.attributes.remove(grid.data.attributes[".sculpt_face_set"])
+settings.parting = "NONE"
+print("parting: face sets keep each side's hairs leaning its own way by the line")
 settings.guides_object = None
 settings.clump, settings.noise = shaping
-print("guides from Blender: hairs by each sculpted guide lean its way, at its length")
 
 # A vertex group painted on half the grid (weight 1 for x > 0, none
 # elsewhere) as the density puts the roots on that half.

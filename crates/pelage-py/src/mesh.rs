@@ -54,10 +54,13 @@ impl PyMesh {
     /// Blender's UV layers are). `normals` (n, 3) when you have them
     /// (computed otherwise). `vertex_maps`: named per-vertex scalars, each
     /// (n,) floats, read by a groom's maps as `"vertex:NAME"` (a DCC's
-    /// painted weights). Everything is checked: finite values, indices in
-    /// range, matching sizes.
+    /// painted weights). `face_sets` and `materials`: (m,) integers, a set
+    /// a triangle (a DCC's face sets, material slots), the regions of
+    /// `regions={"faces": "groups"}` and `{"faces": "materials"}`.
+    /// Everything is checked: finite values, indices in range, matching
+    /// sizes.
     #[staticmethod]
-    #[pyo3(signature = (positions, triangles, uvs = None, normals = None, name = "<python mesh>".to_string(), vertex_maps = None))]
+    #[pyo3(signature = (positions, triangles, uvs = None, normals = None, name = "<python mesh>".to_string(), vertex_maps = None, face_sets = None, materials = None))]
     fn from_arrays(
         positions: &Bound<'_, PyAny>,
         triangles: &Bound<'_, PyAny>,
@@ -65,6 +68,8 @@ impl PyMesh {
         normals: Option<&Bound<'_, PyAny>>,
         name: String,
         vertex_maps: Option<&Bound<'_, pyo3::types::PyDict>>,
+        face_sets: Option<&Bound<'_, PyAny>>,
+        materials: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let positions = vec3s(rows::<f32, 3>(positions, "positions")?);
         let triangles = triangle_rows(triangles)?;
@@ -100,6 +105,13 @@ impl PyMesh {
             let key: String = key.extract()?;
             let values = crate::convert::column::<f32>(&values, &format!("vertex_maps[{key:?}]"))?;
             mesh = mesh.with_vertex_attribute(key, values).map_err(to_py_err)?;
+        }
+        for (kind, sets) in [("groups", face_sets), ("materials", materials)] {
+            let Some(sets) = sets else { continue };
+            let what = if kind == "groups" { "face_sets" } else { "materials" };
+            crate::convert::require_integers(sets, what)?;
+            let ids = crate::convert::column::<i64>(sets, what)?;
+            mesh = mesh.with_face_groups(face_groups(kind, &ids)).map_err(to_py_err)?;
         }
         Ok(Self {
             inner: Arc::new(mesh),
@@ -238,4 +250,25 @@ fn subdivide_checked(py: Python<'_>, mesh: Mesh, levels: u32) -> PyResult<Mesh> 
     }
     py.detach(|| mesh.subdivided_within_limits(levels))
         .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// Integer set ids, one a triangle, as named face sets of `kind`: each
+/// distinct id a set named after it, in order of first appearance.
+fn face_groups(kind: &str, ids: &[i64]) -> pelage::mesh::FaceGroups {
+    let mut names = Vec::new();
+    let mut index = std::collections::HashMap::new();
+    let of_triangle = ids
+        .iter()
+        .map(|id| {
+            *index.entry(*id).or_insert_with(|| {
+                names.push(id.to_string());
+                names.len() as u32 - 1
+            })
+        })
+        .collect();
+    pelage::mesh::FaceGroups {
+        kind: kind.to_string(),
+        names,
+        of_triangle,
+    }
 }

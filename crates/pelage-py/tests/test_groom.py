@@ -265,7 +265,7 @@ def test_look_gives_each_hair_shader_values_written_as_usd_primvars(spot, tmp_pa
         small_groom(spot, look={"roughness": 2.0}).grow()
 
 
-def test_a_vertex_map_given_with_the_mesh_drives_the_density():
+def test_vertex_maps_and_face_sets_given_with_the_mesh_drive_density_and_regions():
     # A grid of 21 × 21 vertices in the XZ plane; the map is 1 on x > 0.
     xs = np.linspace(-1, 1, 21, dtype=np.float32)
     x, z = np.meshgrid(xs, xs)
@@ -281,6 +281,29 @@ def test_a_vertex_map_given_with_the_mesh_drives_the_density():
     assert (roots[:, 0] > 0).mean() >= 0.95
     with pytest.raises(pelage.PelageError, match="3 values for 441 vertices"):
         pelage.Mesh.from_arrays(positions, triangles, vertex_maps={"half": half[:3]})
+
+    # Face sets as regions: guides on each side lean away from the line
+    # between the sets; with the parting every hair leans its side's way.
+    centres = positions[triangles].mean(axis=1)
+    sides = np.where(centres[:, 0] > 0, 7, 3)
+    parted = pelage.Mesh.from_arrays(positions, triangles, face_sets=sides)
+    roots = np.array([[x, 0, z] for x in (-0.6, -0.2, 0.2, 0.6) for z in (-0.5, 0.5)], np.float32)
+    lean = np.where(roots[:, :1] > 0, 1.0, -1.0) * np.array([[0.1, 0, 0]], np.float32)
+    up = np.array([[0, 0.1, 0]], np.float32)
+    guide_points = np.stack([roots, roots + up * 0.5 + lean * 0.5, roots + up + lean], axis=1)
+    guides = pelage.Curves.from_arrays(guide_points.reshape(-1, 3), np.arange(0, 25, 3, dtype=np.uint32))
+    hairs = pelage.Groom(mesh=parted, guides={"curves": guides, "points": 4},
+                         roots=2000, regions={"faces": "groups"}).grow()
+    starts, ends = hairs.points[hairs.offsets[:-1]], hairs.points[hairs.offsets[1:] - 1]
+    lean_x = ends[:, 0] - starts[:, 0]
+    assert np.all(np.sign(lean_x) == np.sign(starts[:, 0])), "a hair leans across the parting"
+    # By the line, where guides of both sides are near, each hair still
+    # leans fully its side's way (without the parting they blend to
+    # nearly straight up).
+    by_the_line = np.abs(starts[:, 0]) < 0.1
+    assert by_the_line.sum() > 50 and np.all(np.abs(lean_x[by_the_line]) > 0.099)
+    with pytest.raises(TypeError, match="face_sets: expected integer"):
+        pelage.Mesh.from_arrays(positions, triangles, face_sets=sides.astype(np.float32))
 
 
 def test_the_ops_builders_match_the_librarys_operator_schema():

@@ -31,6 +31,8 @@ class Mesh:
         normals: Optional[npt.ArrayLike] = None,
         name: str = "<python mesh>",
         vertex_maps: Optional[Dict[str, npt.ArrayLike]] = None,
+        face_sets: Optional[npt.ArrayLike] = None,
+        materials: Optional[npt.ArrayLike] = None,
     ) -> "Mesh": ...
     def subdivided(self, levels: int) -> "Mesh": ...
     @property
