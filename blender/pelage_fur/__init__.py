@@ -84,6 +84,11 @@ class PelageFurSettings(bpy.types.PropertyGroup):
         ],
         default="NONE",
     )
+    last_grow: StringProperty(
+        name="Last grow",
+        description="What the last grow made (filled by Grow pelage fur)",
+        options={"SKIP_SAVE"},
+    )
     count: IntProperty(name="Count", description="Hairs", default=20_000, min=1, soft_max=2_000_000)
     guides: IntProperty(name="Guides", description="Guide curves grown on the surface", default=200, min=1, soft_max=5_000)
     length: FloatProperty(name="Length", description="Guide length", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
@@ -242,6 +247,10 @@ class PELAGE_PT_fur(bpy.types.Panel):
         for name in ("melanin", "melanin_redness", "roughness", "radial_roughness", "look_jitter"):
             look.prop(settings, name)
         layout.operator(PELAGE_OT_grow_fur.bl_idname, icon="CURVES")
+        if settings.last_grow:
+            report = layout.box().column(align=True)
+            for line in settings.last_grow.split("\n"):
+                report.label(text=line)
         row = layout.row(align=True)
         row.operator(PELAGE_OT_export_usd.bl_idname)
         row.operator(PELAGE_OT_export_alembic.bl_idname)

@@ -324,6 +324,9 @@ def grow_on_object(context, surface, settings, progress=None):
     the guides the groom left out, with why."""
     import bpy
 
+    import time
+
+    start = time.perf_counter()
     depsgraph = context.evaluated_depsgraph_get()
     mesh, uv_map = mesh_to_pelage(surface, depsgraph)
     groom = groom_for(surface, settings, mesh, depsgraph)
@@ -343,4 +346,24 @@ def grow_on_object(context, surface, settings, progress=None):
         surface.add_rest_position_attribute = True
         deform_on_surface_modifier(obj)
     obj["pelage_settings"] = groom.settings
-    return obj, grown, guide_warnings(groom.report())
+    report = groom.report()
+    settings.last_grow = "\n".join(grow_summary(report, grown, time.perf_counter() - start))
+    return obj, grown, guide_warnings(report)
+
+
+def grow_summary(report, grown, seconds):
+    """The panel's lines about a grow: hairs, points and time; with
+    regions, each one's hairs and guides (a region without guides borrows
+    every guide); the guides left out."""
+    lines = [f"{grown.curve_count:,} hairs, {grown.point_count:,} points in {seconds:.2f} s"]
+    regions = report.get("regions") or []
+    if regions and grown.regions is not None:
+        ids, counts = np.unique(grown.regions, return_counts=True)
+        hairs = dict(zip(ids.tolist(), counts.tolist()))
+        for region in regions:
+            guides = region["guides"] or "no guides: borrows all"
+            lines.append(f"region {region['name']}: {hairs.get(region['region'], 0):,} hairs, guides {guides}")
+    dropped = len(report["guides"]["dropped"]) + len(report["guides"]["unused_by_style_mesh"])
+    if dropped:
+        lines.append(f"{dropped} guides left out (see the warnings)")
+    return lines

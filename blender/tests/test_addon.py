@@ -171,6 +171,11 @@ lean_x = (ends[:, 0] - starts[:, 0]) / np.linalg.norm(ends - starts, axis=1)
 by_the_line = np.abs(starts[:, 0]) < 0.2
 assert by_the_line.sum() > 50, by_the_line.sum()
 assert np.all(lean_x[by_the_line] * np.sign(starts[by_the_line, 0]) > 0.65), lean_x[by_the_line].min()
+# The panel says what grew, region by region.
+lines = settings.last_grow.split("\n")
+assert lines[0].startswith(f"{len(parted.data.curves):,} hairs"), lines
+per_region = [int(line.split(": ")[1].split(" hairs")[0].replace(",", "")) for line in lines[1:]]
+assert len(per_region) == 2 and sum(per_region) == len(parted.data.curves), lines
 bpy.data.objects.remove(parted)
 grid.data.attributes.remove(grid.data.attributes[".sculpt_face_set"])
 settings.parting = "NONE"
