@@ -108,10 +108,16 @@ impl PyMesh {
         }
         for (kind, sets) in [("groups", face_sets), ("materials", materials)] {
             let Some(sets) = sets else { continue };
-            let what = if kind == "groups" { "face_sets" } else { "materials" };
+            let what = if kind == "groups" {
+                "face_sets"
+            } else {
+                "materials"
+            };
             crate::convert::require_integers(sets, what)?;
             let ids = crate::convert::column::<i64>(sets, what)?;
-            mesh = mesh.with_face_groups(face_groups(kind, &ids)).map_err(to_py_err)?;
+            mesh = mesh
+                .with_face_groups(face_groups(kind, &ids))
+                .map_err(to_py_err)?;
         }
         Ok(Self {
             inner: Arc::new(mesh),

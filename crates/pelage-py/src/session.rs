@@ -141,6 +141,26 @@ impl PyGroomSession {
         done.map(|r| regrowth_dict(py, r)).transpose()
     }
 
+    /// Takes `curves` (a DCC's guide curves, any point count, in the
+    /// mesh's space) as the guides: only the guides whose points moved
+    /// regrow their hairs; added, deleted or slid guides replace them all.
+    /// Roots farther than `tolerance` from the surface are left out.
+    /// Returns `{"regrown": roots regrown, "hairs": hairs now}`, or None
+    /// when nothing changed. One undo step.
+    #[pyo3(signature = (curves, *, tolerance = 1e-3))]
+    fn set_guides<'py>(
+        &self,
+        py: Python<'py>,
+        curves: &crate::curves::PyCurves,
+        tolerance: f32,
+    ) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let curves = &curves.inner;
+        let done = py
+            .detach(|| self.with(|g| g.set_guide_curves(curves, tolerance)))
+            .map_err(to_py_err)?;
+        done.map(|r| regrowth_dict(py, r)).transpose()
+    }
+
     /// Undoes the last edit; False when there is none.
     fn undo(&self, py: Python<'_>) -> PyResult<bool> {
         let done = py.detach(|| self.with(|g| g.undo())).map_err(to_py_err)?;

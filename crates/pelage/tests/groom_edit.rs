@@ -640,3 +640,72 @@ fn a_stroke_joined_into_one_step_is_undone_at_once() {
     groom.redo().unwrap().unwrap();
     assert_eq!(bits(&groom.curves()), combed);
 }
+
+#[test]
+fn guide_curves_from_a_dcc_move_only_the_guides_whose_points_moved() {
+    // A DCC's guide curves, with more points than pelage keeps (any count
+    // is resampled), bound as the groom's guides.
+    let dense = |g: &Guides, tip: Option<(usize, Vec3)>| {
+        let mut points = Vec::new();
+        for i in 0..g.len() {
+            let guide = g.guide(i);
+            for k in 0..=28 {
+                let t = k as f32 / 28.0 * (guide.len() - 1) as f32;
+                let (j, f) = (t.floor() as usize, t.fract());
+                let mut p = guide[j].lerp(guide[(j + 1).min(guide.len() - 1)], f);
+                if let Some((moved, by)) = tip
+                    && moved == i
+                {
+                    p += by * (k as f32 / 28.0);
+                }
+                points.push(p);
+            }
+        }
+        let offsets = (0..=g.len() as u32).map(|i| i * 29).collect();
+        Curves::new(points, vec![0.001; g.len() * 29], offsets).unwrap()
+    };
+    let mut spec = spec(10_000);
+    let grown = spec.guides.clone();
+    let (bound, report) = Guides::bind(&spec.mesh, &dense(&grown, None), 8, 1e-4);
+    assert_eq!(report.kept, grown.len());
+    spec.guides = Arc::new(bound);
+    let mut groom = EditableGroom::new(spec, 1.0).unwrap();
+    let before = groom.curves();
+    // Handed back unchanged, nothing regrows.
+    assert!(
+        groom
+            .set_guide_curves(&dense(&grown, None), 1e-4)
+            .unwrap()
+            .is_none()
+    );
+    // Guide 20's tip pulled sideways: its neighbours' hairs regrow, far
+    // hairs keep every bit.
+    let pulled = dense(&grown, Some((20, Vec3::new(0.0, 0.0, 0.04))));
+    let regrowth = groom
+        .set_guide_curves(&pulled, 1e-4)
+        .unwrap()
+        .expect("a guide moved");
+    assert!(regrowth.regrown_roots > 0 && regrowth.regrown_roots * 4 < regrowth.hairs);
+    let after = groom.curves();
+    let moved = root(&groom, 20);
+    let mesh = groom.mesh();
+    let mut far = 0;
+    for i in 0..before.curve_count() {
+        if before.roots().unwrap()[i].position(mesh).distance(moved) > 0.8 {
+            far += 1;
+            let r = before.range(i);
+            assert_eq!(&before.points()[r.clone()], &after.points()[r]);
+        }
+    }
+    assert!(far > 500, "{far}");
+    // A guide left out: the guides are replaced (one fewer).
+    let all = dense(&grown, None);
+    let points = all.points()[29..].to_vec();
+    let offsets = (0..grown.len() as u32).map(|i| i * 29).collect();
+    let fewer = Curves::new(points, vec![0.001; (grown.len() - 1) * 29], offsets).unwrap();
+    groom
+        .set_guide_curves(&fewer, 1e-4)
+        .unwrap()
+        .expect("guides replaced");
+    assert_eq!(groom.guides().len(), grown.len() - 1);
+}

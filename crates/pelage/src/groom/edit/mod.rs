@@ -289,6 +289,39 @@ impl EditableGroom {
         Ok(regrowth)
     }
 
+    /// Takes a DCC's guide curves (any point count) as the guides, bound to
+    /// the mesh as [`Guides::bind`] binds them. Where they keep the guides'
+    /// count and roots (the artist moved points, as most sculpt brushes
+    /// do), only the guides whose points changed are moved
+    /// ([`Edit::MoveGuides`]): hairs out of their reach are not regrown.
+    /// Otherwise (guides added, deleted or slid) the guides are replaced
+    /// ([`Edit::ReplaceGuides`]). `None` when nothing changed.
+    ///
+    /// # Errors
+    /// As [`Self::apply`].
+    pub fn set_guide_curves(
+        &mut self,
+        curves: &Curves,
+        tolerance: f32,
+    ) -> Result<Option<Regrowth>, GroomError> {
+        let old = self.guides();
+        let (bound, _) = Guides::bind(self.mesh(), curves, old.points_per_guide(), tolerance);
+        if bound.len() != old.len() || bound.roots() != old.roots() {
+            return self.apply(Edit::ReplaceGuides(Arc::new(bound))).map(Some);
+        }
+        let (mut guides, mut points) = (Vec::new(), Vec::new());
+        for i in 0..bound.len() {
+            if bound.guide(i) != old.guide(i) {
+                guides.push(i as u32);
+                points.extend_from_slice(bound.guide(i));
+            }
+        }
+        if guides.is_empty() {
+            return Ok(None);
+        }
+        self.apply(Edit::MoveGuides { guides, points }).map(Some)
+    }
+
     /// Applies `first`, then the edit `then` makes on the groom it left
     /// (`None`: nothing more), as one undo step; on an error nothing
     /// changed.
