@@ -9,7 +9,7 @@ Alembic" write the same groom with pelage's own writers.
 """
 
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper
 
 from pelage import PelageError
@@ -83,6 +83,17 @@ class PelageFurSettings(bpy.types.PropertyGroup):
             ("MATERIALS", "Material slots", "Each material slot a region"),
         ],
         default="NONE",
+    )
+    live: BoolProperty(
+        name="Live",
+        description="Regrow the fur as the guides object is sculpted: the hairs near the stroke only",
+        default=False,
+    )
+    display_fraction: FloatProperty(
+        name="Display Fraction",
+        description="Share of the hairs a live groom shows (the same hairs as the whole groom); "
+                    "exports write them all",
+        default=1.0, min=0.01, max=1.0,
     )
     last_grow: StringProperty(
         name="Last grow",
@@ -233,6 +244,10 @@ class PELAGE_PT_fur(bpy.types.Panel):
         column.enabled = not settings.groom_file
         column.prop(settings, "preset")
         column.prop(settings, "guides_object")
+        live = column.row(align=True)
+        live.enabled = settings.guides_object is not None
+        live.prop(settings, "live")
+        live.prop(settings, "display_fraction", text="Display")
         column.prop_search(settings, "density_group", surface_of(context), "vertex_groups")
         column.prop(settings, "parting")
         grown_guides = settings.guides_object is None
@@ -276,9 +291,13 @@ def register():
         bpy.utils.register_class(cls)
     bpy.types.Object.pelage_fur = PointerProperty(type=PelageFurSettings)
     bpy.types.VIEW3D_MT_object.append(menu_entry)
+    bpy.app.handlers.depsgraph_update_post.append(fur.on_depsgraph_update)
 
 
 def unregister():
+    if fur.on_depsgraph_update in bpy.app.handlers.depsgraph_update_post:
+        bpy.app.handlers.depsgraph_update_post.remove(fur.on_depsgraph_update)
+    fur.LIVE.clear()
     bpy.types.VIEW3D_MT_object.remove(menu_entry)
     del bpy.types.Object.pelage_fur
     for cls in reversed(CLASSES):

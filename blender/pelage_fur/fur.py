@@ -47,9 +47,11 @@ def to_pelage_space(obj):
 
 
 def transform_points(matrix, points):
-    """``points`` (n, 3) through the affine 4×4 ``matrix``, as float32."""
-    p = np.asarray(points, dtype=np.float64)
-    return (p @ matrix[:3, :3].T + matrix[:3, 3]).astype(np.float32)
+    """``points`` (n, 3) through the affine 4×4 ``matrix``, as float32
+    (computed in float32: a live groom moves a million points a stroke)."""
+    m = np.asarray(matrix, dtype=np.float32)
+    p = np.asarray(points, dtype=np.float32)
+    return p @ m[:3, :3].T + m[:3, 3]
 
 
 def mesh_to_pelage(obj, depsgraph):
@@ -140,14 +142,16 @@ def face_sets_of(mesh):
     return sets
 
 
-def guides_from_curves_object(obj, depsgraph):
-    """The curves of the hair Curves object ``obj`` (evaluated: Blender's
-    sculpt brushes and modifiers applied) as a ``pelage.Curves`` in
-    pelage's Y-up world (``to_pelage_space``), to be bound to the surface
-    as guides. Any point count: pelage resamples them."""
+def guides_from_curves_object(obj, depsgraph=None):
+    """The curves of the hair Curves object ``obj`` as a ``pelage.Curves``
+    in pelage's Y-up world (``to_pelage_space``), to be bound to the
+    surface as guides; any point count (pelage resamples them). Evaluated
+    (its modifiers applied) with a ``depsgraph``; without, the curves as
+    Blender's sculpt brushes leave them, read with no scene evaluation (a
+    live update's)."""
     import pelage
 
-    data = obj.evaluated_get(depsgraph).data
+    data = obj.evaluated_get(depsgraph).data if depsgraph is not None else obj.data
     if len(data.curves) == 0:
         raise pelage.PelageError(f"{obj.name}: the guides object has no curves; add some with Blender's hair brushes")
     points = np.empty(len(data.points) * 3, dtype=np.float32)
@@ -330,7 +334,17 @@ def grow_on_object(context, surface, settings, progress=None):
     depsgraph = context.evaluated_depsgraph_get()
     mesh, uv_map = mesh_to_pelage(surface, depsgraph)
     groom = groom_for(surface, settings, mesh, depsgraph)
-    grown = groom.grow(progress=progress)
+    LIVE.pop(surface.name, None)
+    live = settings.live and settings.guides_object is not None and not settings.groom_file
+    if live:
+        # The live groom: sculpting the guides regrows the hairs near the
+        # stroke (live_update), at the display fraction.
+        import pelage
+
+        session = pelage.GroomSession(groom, fraction=settings.display_fraction)
+        grown = session.curves()
+    else:
+        grown = groom.grow(progress=progress)
     # Back from pelage's Y-up world into the surface's local space, where
     # Blender keeps the points of curves parented to it.
     back = np.linalg.inv(to_pelage_space(surface))
@@ -346,6 +360,8 @@ def grow_on_object(context, surface, settings, progress=None):
         surface.add_rest_position_attribute = True
         deform_on_surface_modifier(obj)
     obj["pelage_settings"] = groom.settings
+    if live:
+        LIVE[surface.name] = LiveGroom(session, obj.name, max(surface.dimensions) * 0.005 or 1e-3)
     report = groom.report()
     settings.last_grow = "\n".join(grow_summary(report, grown, time.perf_counter() - start))
     return obj, grown, guide_warnings(report)
@@ -367,3 +383,90 @@ def grow_summary(report, grown, seconds):
     if dropped:
         lines.append(f"{dropped} guides left out (see the warnings)")
     return lines
+
+
+class LiveGroom:
+    """A surface's live groom: its pelage session, the fur object it
+    fills, and the tolerance its guides are bound with."""
+
+    def __init__(self, session, fur_name, tolerance):
+        self.session = session
+        self.fur_name = fur_name
+        self.tolerance = tolerance
+
+
+#: Live grooms by surface object name.
+LIVE = {}
+#: Surfaces whose live update is scheduled (a stroke's many depsgraph
+#: updates make one regrow).
+PENDING = set()
+
+
+def live_update(surface):
+    """Regrows the live fur of ``surface`` after its guides object changed:
+    the guides whose points moved regrow their hairs only (pelage's
+    incremental regrowth); the fur object's points are replaced in place
+    (a new datablock when the hair count changed). Returns pelage's
+    ``{"regrown", "hairs"}``, or None when nothing changed or the surface
+    has no live groom."""
+    import bpy
+
+    live = LIVE.get(surface.name)
+    obj = bpy.data.objects.get(live.fur_name) if live else None
+    guides_object = surface.pelage_fur.guides_object
+    if obj is None or guides_object is None:
+        return None
+    guides = guides_from_curves_object(guides_object)
+    done = live.session.set_guides(guides, tolerance=live.tolerance)
+    if done is None:
+        return None
+    back = np.linalg.inv(to_pelage_space(surface))
+    data = obj.data
+    if done["hairs"] == len(data.curves):
+        # The same hairs: their points alone, moved in place.
+        points = live.session.points()
+        if len(points) == len(data.points):
+            data.position_data.foreach_set("vector", transform_points(back, points).ravel())
+            data.update_tag()
+            return done
+    # Hairs added or removed: a new datablock.
+    old = obj.data
+    obj.data = curves_to_blender(old.name, live.session.curves(), surface, old.surface_uv_map or None, back)
+    bpy.data.hair_curves.remove(old)
+    return done
+
+
+def schedule_live_update(name):
+    """Runs ``live_update`` on the surface ``name`` once, shortly: the
+    depsgraph reports a sculpt stroke many times."""
+    import bpy
+
+    if name in PENDING:
+        return
+    PENDING.add(name)
+
+    def run():
+        PENDING.discard(name)
+        surface = bpy.data.objects.get(name)
+        if surface is not None:
+            live_update(surface)
+        return None
+
+    bpy.app.timers.register(run, first_interval=0.05)
+
+
+def on_depsgraph_update(scene, depsgraph):
+    """Schedules the live update of every live surface whose guides object
+    (or its curves) the update touched."""
+    import bpy
+
+    touched = {update.id.original for update in depsgraph.updates}
+    for name in list(LIVE):
+        surface = bpy.data.objects.get(name)
+        if surface is None:
+            LIVE.pop(name, None)
+            continue
+        settings = surface.pelage_fur
+        guides = settings.guides_object
+        if settings.live and guides is not None and (guides in touched or guides.data in touched):
+            schedule_live_update(name)

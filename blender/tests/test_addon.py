@@ -183,6 +183,40 @@ print("parting: face sets keep each side's hairs leaning its own way by the line
 settings.guides_object = None
 settings.clump, settings.noise = shaping
 
+# Live: with Live on, sculpting the guides object regrows only the hairs
+# near the stroke; the rest keep every bit.
+addon_fur = next(m for name, m in sys.modules.items() if name.endswith("pelage_fur.fur"))
+grid5 = np.linspace(-0.8, 0.8, 5)
+live_roots = np.array([[x, y, 0.0] for x in grid5 for y in grid5])
+live_curves = bpy.data.hair_curves.new("live guides")
+live_curves.add_curves([7] * 25)
+live_points = (live_roots[:, None, :] + steps[None, :, None] * np.array([0, 0, 1.0])).reshape(-1, 3)
+live_curves.position_data.foreach_set("vector", live_points.astype(np.float32).ravel())
+live_object = bpy.data.objects.new("live guides", live_curves)
+bpy.context.collection.objects.link(live_object)
+settings.guides_object, settings.live = live_object, True
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+live_fur = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+before, live_offsets = arrays(live_fur.data)
+# Guide 0 (at (-0.8, -0.8)) combed sideways.
+combed = live_points.copy()
+combed[0:7] += steps[:, None] * np.array([1.0, 0.0, 0.0])
+live_curves.position_data.foreach_set("vector", combed.astype(np.float32).ravel())
+bpy.context.view_layer.update()
+assert grid.name in addon_fur.PENDING, "the depsgraph handler scheduled the regrow"
+done = addon_fur.live_update(grid)
+assert done is not None and 0 < done["regrown"] < done["hairs"] // 4, done
+after, _ = arrays(live_fur.data)
+live_starts = before[live_offsets[:-1]]
+far = np.linalg.norm(live_starts[:, :2] - [-0.8, -0.8], axis=1) > 0.9
+moved_by = np.array([np.abs(after[a:b] - before[a:b]).max() for a, b in zip(live_offsets[:-1], live_offsets[1:])])
+assert far.sum() > 1000 and np.all(moved_by[far] == 0), "hairs far from the stroke keep every bit"
+assert moved_by[~far].max() > 0.05, "hairs by the combed guide follow it"
+assert addon_fur.live_update(grid) is None, "nothing changed since"
+bpy.data.objects.remove(live_fur)
+settings.guides_object, settings.live = None, False
+print(f"live: a combed guide regrew {done['regrown']:,} of {done['hairs']:,} hairs; far ones kept every bit")
+
 # A vertex group painted on half the grid (weight 1 for x > 0, none
 # elsewhere) as the density puts the roots on that half.
 half = grid.vertex_groups.new(name="half")

@@ -7,7 +7,7 @@ use crate::curves::PyCurves;
 use crate::groom::PyGroom;
 use crate::to_py_err;
 use glam::Vec3;
-use numpy::PyArray1;
+use numpy::{PyArray1, PyArrayMethods};
 use pelage::groom::brush::{Brush, Dab, Falloff};
 use pelage::groom::edit::{EditableGroom, Regrowth};
 use pyo3::exceptions::PyValueError;
@@ -176,6 +176,17 @@ impl PyGroomSession {
     /// The groom's hairs now (with ids and roots), as `Curves`.
     fn curves(&self, py: Python<'_>) -> PyCurves {
         PyCurves::new(py.detach(|| self.with(|g| g.curves())))
+    }
+
+    /// The hairs' points alone, (n, 3) float32, in the order of
+    /// `curves()`: what a viewport refreshes after an edit that keeps the
+    /// hair count, without assembling every attribute.
+    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f32>> {
+        let points = py.detach(|| self.with(|g| g.points()));
+        let flat: Vec<f32> = bytemuck::cast_slice(&points).to_vec();
+        numpy::PyArray1::from_vec(py, flat)
+            .reshape([points.len(), 3])
+            .expect("three floats a point")
     }
 
     /// The guides now, as `Curves` (with their roots).

@@ -492,6 +492,16 @@ impl GrownHairs {
     }
 
     /// Every hair, cell after cell (each cell's roots in order).
+    /// Every hair's points, in the order of [`Self::curves`], alone.
+    pub(crate) fn points(&self) -> Vec<Vec3> {
+        let count = self.cells.iter().map(|c| c.points.len()).sum();
+        let mut points = Vec::with_capacity(count);
+        for cell in &self.cells {
+            points.extend_from_slice(&cell.points);
+        }
+        points
+    }
+
     pub(crate) fn curves(&self) -> Curves {
         let hairs: usize = self.cells.iter().map(CellHairs::hair_count).sum();
         let points: usize = self.cells.iter().map(|c| c.points.len()).sum();

@@ -238,6 +238,13 @@ impl EditableGroom {
         self.generator.with_root_values(self.hairs.curves())
     }
 
+    /// The hairs' points alone, in the order of [`Self::curves`]: what a
+    /// viewport refreshes after an edit that keeps the hair count.
+    pub fn points(&self) -> Vec<Vec3> {
+        self.hairs.points()
+    }
+
+
     /// Every root with its region and its guide weights.
     pub fn hair_weights(&self) -> impl Iterator<Item = (SurfacePoint, u32, &[GuideWeight])> {
         self.hairs.recipes()
