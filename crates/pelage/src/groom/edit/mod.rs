@@ -244,7 +244,6 @@ impl EditableGroom {
         self.hairs.points()
     }
 
-
     /// Every root with its region and its guide weights.
     pub fn hair_weights(&self) -> impl Iterator<Item = (SurfacePoint, u32, &[GuideWeight])> {
         self.hairs.recipes()
