@@ -46,12 +46,14 @@ impl Groom {
     }
 
     /// What a still groom (or run `run` of its farm) writes with
-    /// `generator`: [`Self::export`], and with `[output] guides` in the
-    /// first run the guide curves with their regions.
+    /// `generator`: [`Self::export`], with the skin and (`[output]
+    /// guides`) the guide curves with their regions in the first run only,
+    /// so an assembly holds one of each.
     pub fn export_for(&self, generator: &Generator, run: Option<FarmRun>) -> CurvesExport<'_> {
         CurvesExport {
+            usd: self.usd_options(),
+            mesh: self.writes_skin_in(run).then(|| self.mesh()),
             guides: self.writes_guides_in(run).then(|| generator.guide_curves()),
-            ..self.export()
         }
     }
 
