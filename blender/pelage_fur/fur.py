@@ -446,10 +446,20 @@ def schedule_live_update(name):
     PENDING.add(name)
 
     def run():
+        import pelage
+
         PENDING.discard(name)
         surface = bpy.data.objects.get(name)
-        if surface is not None:
-            live_update(surface)
+        if surface is None:
+            return None
+        try:
+            done = live_update(surface)
+        except pelage.PelageError as error:
+            # A timer has no operator to report through: the panel says it.
+            surface.pelage_fur.last_grow = f"live: {error}"
+            return None
+        if done is not None:
+            surface.pelage_fur.last_grow = f"live: {done['regrown']:,} of {done['hairs']:,} hairs regrown"
         return None
 
     bpy.app.timers.register(run, first_interval=0.05)
