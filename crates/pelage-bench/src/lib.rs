@@ -9,6 +9,7 @@
 //! runs, and comparisons are ratios taken within one run.
 
 pub mod animation;
+pub mod blender;
 pub mod dynamics;
 pub mod format;
 pub mod groom;
@@ -54,6 +55,9 @@ pub enum BenchWhat {
     /// The Python package against the library, and the Blender add-on
     /// making hair Curves (`--blender`).
     Python(python::PythonBenchArgs),
+    /// Grooming in Blender: a guide edit with the add-on's Live mode
+    /// against Blender's Interpolate Curves.
+    Blender(blender::BlenderBenchArgs),
 }
 
 /// The demo groom file (`pelage demo`), which the I/O benchmark grows.
@@ -84,6 +88,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Dynamics(a) => dynamics::run(a),
         BenchWhat::Animation(a) => animation::run(a),
         BenchWhat::Python(a) => python::run(a),
+        BenchWhat::Blender(a) => blender::run(a),
     }
 }
 

@@ -1,0 +1,109 @@
+//! `pelage bench blender`: grooming in Blender with the add-on's Live mode
+//! against Blender's own hair nodes, both timed in one bpy process
+//! (`blender_live.py`).
+//!
+//! A guide edit in a hair Curves object → the fur updated: pelage's
+//! incremental regrowth and the transfer of the points into the fur's
+//! Curves object (the add-on's `live_update`), median of the edits;
+//! beside it the peer, Blender 5's Distribute Points on Faces +
+//! Interpolate Curves re-evaluated after the same edits on the same
+//! surface, guides and hair count. Targets: ≤ 100 ms an edit at 100,000
+//! hairs, ≥ 5× faster than the peer.
+//!
+//! Needs pelage in bpy's venv: `tools/python-wheel --release --into
+//! ~/.cache/pelage/bpy-venv/bin/python`.
+
+use crate::format::thousands;
+use anyhow::Context;
+use clap::Args;
+
+/// Arguments of `pelage bench blender`.
+#[derive(Debug, Args)]
+pub struct BlenderBenchArgs {
+    /// A reduced run (20,000 hairs, 10 edits).
+    #[arg(long)]
+    pub quick: bool,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs the benchmark and prints its table (or its JSON).
+pub fn run(args: &BlenderBenchArgs) -> anyhow::Result<()> {
+    let (hairs, edits) = if args.quick {
+        (20_000, 10)
+    } else {
+        (100_000, 20)
+    };
+    let report = super::run_bpy_case("blender_live.py", include_str!("blender_live.py"), |dir| {
+        let case = serde_json::json!({
+            "addon_dir": super::addon_dir()?,
+            "hairs": hairs,
+            "guides_a_side": 20,
+            "edits": edits,
+        });
+        std::fs::write(dir.join("case.json"), case.to_string())?;
+        Ok(())
+    })
+    .context(
+        "the Blender case did not run (it needs pelage in bpy's venv: tools/python-wheel --release --into ~/.cache/pelage/bpy-venv/bin/python)",
+    )?;
+    let number = |key: &str| {
+        report[key]
+            .as_f64()
+            .with_context(|| format!("{key}: a number in Blender's report"))
+    };
+    let (edit, full, peer) = (
+        number("edit_update_s")?,
+        number("full_update_s")?,
+        number("blender_interpolate_s")?,
+    );
+    let hairs_made = number("hairs")? as u64;
+    if args.json {
+        let mut json = report.clone();
+        json["speedup_over_blender"] = serde_json::json!(peer / edit);
+        println!("{json}");
+        return Ok(());
+    }
+    println!(
+        "pelage bench blender — {} hairs × 12 points on a 40 × 40 grid, 400 guides in a hair Curves object; Blender {}; median of {} guide edits",
+        thousands(hairs_made),
+        report["blender"].as_str().unwrap_or("?"),
+        report["edits"]
+    );
+    println!();
+    println!("{:<52} {:>10}", "", "ms");
+    println!(
+        "{:<52} {:>10.1}",
+        "pelage Live: an edit → the fur updated",
+        edit * 1e3
+    );
+    println!(
+        "{:<52} {:>10}",
+        "  fastest – slowest",
+        format!(
+            "{:.0}–{:.0}",
+            number("edit_update_min_s")? * 1e3,
+            number("edit_update_max_s")? * 1e3
+        )
+    );
+    println!(
+        "{:<52} {:>10.1}",
+        "pelage: Grow with Live on (the start)",
+        full * 1e3
+    );
+    println!(
+        "{:<52} {:>10.1}",
+        format!(
+            "peer: Blender's Interpolate Curves ({} hairs)",
+            thousands(number("blender_hairs")? as u64)
+        ),
+        peer * 1e3
+    );
+    println!();
+    println!(
+        "pelage {:.1}× faster than Blender an edit; targets: ≤ 100 ms an edit at 100,000 hairs, ≥ 5× the peer",
+        peer / edit
+    );
+    Ok(())
+}
