@@ -424,9 +424,9 @@ def live_update(surface):
     data = obj.data
     if done["hairs"] == len(data.curves):
         # The same hairs: their points alone, moved in place.
-        points = live.session.points()
+        points = live.session.points(back)
         if len(points) == len(data.points):
-            data.position_data.foreach_set("vector", transform_points(back, points).ravel())
+            data.position_data.foreach_set("vector", points.ravel())
             data.update_tag()
             return done
     # Hairs added or removed: a new datablock.

@@ -180,13 +180,50 @@ impl PyGroomSession {
 
     /// The hairs' points alone, (n, 3) float32, in the order of
     /// `curves()`: what a viewport refreshes after an edit that keeps the
-    /// hair count, without assembling every attribute.
-    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f32>> {
-        let points = py.detach(|| self.with(|g| g.points()));
-        let flat: Vec<f32> = bytemuck::cast_slice(&points).to_vec();
-        numpy::PyArray1::from_vec(py, flat)
-            .reshape([points.len(), 3])
-            .expect("three floats a point")
+    /// hair count, without assembling every attribute. With `matrix` (a
+    /// 4×4 affine transform, row-major, as numpy and Blender write it)
+    /// the points are turned by it first, on every thread: a DCC's object
+    /// space without a pass of numpy over a million points.
+    #[pyo3(signature = (matrix = None))]
+    fn points<'py>(
+        &self,
+        py: Python<'py>,
+        matrix: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, numpy::PyArray2<f32>>> {
+        let matrix = match matrix {
+            None => None,
+            Some(m) => {
+                let rows = crate::convert::rows::<f64, 4>(m, "matrix")?;
+                if rows.len() != 4 {
+                    return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                        "matrix: {} rows; expected a 4×4 transform",
+                        rows.len()
+                    )));
+                }
+                let c = |j: usize| glam::DVec3::new(rows[0][j], rows[1][j], rows[2][j]).as_vec3();
+                Some(glam::Affine3A::from_cols(
+                    c(0).into(),
+                    c(1).into(),
+                    c(2).into(),
+                    c(3).into(),
+                ))
+            }
+        };
+        let points = py.detach(|| {
+            let mut points = self.with(|g| g.points());
+            if let Some(m) = matrix {
+                use rayon::prelude::*;
+                points
+                    .par_iter_mut()
+                    .for_each(|p| *p = m.transform_point3(*p));
+            }
+            points
+        });
+        let n = points.len();
+        let flat: Vec<f32> = bytemuck::cast_vec(points);
+        Ok(numpy::PyArray1::from_vec(py, flat)
+            .reshape([n, 3])
+            .expect("three floats a point"))
     }
 
     /// The guides now, as `Curves` (with their roots).

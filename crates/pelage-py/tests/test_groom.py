@@ -238,6 +238,13 @@ def test_regions_masks_and_stable_ids_from_python(spot):
         b = large.points[offsets[j]:offsets[j + 1]]
         assert np.array_equal(a, b), f"hair {i} changed"
     assert set(np.unique(large.regions)) == {0, 1}, "each hair's side of the parting"
+    # A session's points alone, as curves() orders them, turned if asked.
+    session = pelage.GroomSession(small_groom(spot, count=2_000))
+    points = session.points()
+    assert np.array_equal(points, session.curves().points)
+    shift = np.eye(4)
+    shift[:3, 3] = (1.0, 2.0, 3.0)
+    assert np.allclose(session.points(shift), points + [1.0, 2.0, 3.0])
     with pytest.raises(pelage.PelageError, match="regions: the mesh has no face sets"):
         small_groom(spot, regions={"faces": "groups"}).grow()
 
