@@ -261,6 +261,10 @@ class PELAGE_PT_fur(bpy.types.Panel):
         look.label(text="Look (Principled Hair BSDF)")
         for name in ("melanin", "melanin_redness", "roughness", "radial_roughness", "look_jitter"):
             look.prop(settings, name)
+        if not surface_of(context).data.uv_layers:
+            # Pelage grows without UVs (object-space noise, vertex maps);
+            # Blender's deformer is what needs them.
+            layout.label(text="No UV map: the fur will not follow deformation", icon="INFO")
         layout.operator(PELAGE_OT_grow_fur.bl_idname, icon="CURVES")
         if settings.last_grow:
             report = layout.box().column(align=True)

@@ -231,6 +231,38 @@ bpy.data.objects.remove(painted)
 settings.density_group = ""
 print(f"density from a vertex group: {share:.1%} of the roots on the painted half")
 
+# The panel draws: every setting it shows exists, every button is an
+# operator (a layout that checks what it is asked to draw).
+class CheckedLayout:
+    enabled = True
+
+    def column(self, **_):
+        return CheckedLayout()
+
+    row = box = column
+
+    def prop(self, data, name, **_):
+        assert hasattr(data, name), name
+
+    def prop_search(self, data, name, search_data, search_name, **_):
+        assert hasattr(data, name) and hasattr(search_data, search_name), (name, search_name)
+
+    def label(self, text="", **_):
+        assert isinstance(text, str)
+
+    def operator(self, idname, **_):
+        category, name = idname.split(".")
+        assert hasattr(getattr(bpy.ops, category), name), idname
+
+
+addon = next(m for name, m in sys.modules.items() if name.endswith("pelage_fur") and hasattr(m, "PELAGE_PT_fur"))
+bpy.context.view_layer.objects.active = grid
+for guides_set in (None, bpy.data.objects["sculpted"]):
+    settings.guides_object = guides_set
+    addon.PELAGE_PT_fur.draw(type("Panel", (), {"layout": CheckedLayout()})(), bpy.context)
+settings.guides_object = None
+print("panel: every drawn setting and button exists")
+
 # The same seed grows the same fur (the operator is deterministic).
 bpy.ops.pelage.grow_fur()
 second = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
