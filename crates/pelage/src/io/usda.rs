@@ -238,6 +238,24 @@ impl PrimWriteError {
         )))
     }
 
+    /// Refuses a frame of an animated mesh whose vertex or triangle count
+    /// differs from its first frame's (`first`: those two counts).
+    pub(crate) fn check_mesh_frame(
+        name: &str,
+        time: f64,
+        first: &[u32],
+        mesh: &Mesh,
+    ) -> Result<(), Self> {
+        let shape = [mesh.vertex_count() as u32, mesh.triangle_count() as u32];
+        if first == shape {
+            return Ok(());
+        }
+        Err(Self::BadSetting(format!(
+            "mesh {name:?} at time {time}: {} vertices and {} triangles where the first frame had {} and {}",
+            shape[0], shape[1], first[0], first[1]
+        )))
+    }
+
     /// Refuses a frame of an animated part whose curves differ from its
     /// first frame's (`first`: that frame's offsets).
     pub(crate) fn check_frame(

@@ -175,21 +175,42 @@ impl<W: Write + Seek> AbcWriter<W> {
         curves: &Curves,
     ) -> Result<(), PrimWriteError> {
         PrimWriteError::check_time(name, time)?;
-        let Some(index) = self.parts.iter().position(|p| p.name == name) else {
+        let Some(index) = self.next_frame("part", name, time)? else {
             return self.start_part(name, curves, Some(time));
         };
-        let part = &self.parts[index];
-        if part.times.is_empty() {
+        PrimWriteError::check_frame(name, time, &self.parts[index].offsets, curves)?;
+        let samples = self.animated_samples(curves)?;
+        self.push_frame(index, time, samples);
+        Ok(())
+    }
+
+    /// The index of the animated object `name` a frame at `time` goes to
+    /// (`None`: not written yet). Refuses an object written still, and a
+    /// frame not after its last one (`what`, "part" or "mesh", says which
+    /// in the message).
+    fn next_frame(
+        &self,
+        what: &str,
+        name: &str,
+        time: f64,
+    ) -> Result<Option<usize>, PrimWriteError> {
+        let Some(index) = self.parts.iter().position(|p| p.name == name) else {
+            return Ok(None);
+        };
+        let Some(&last) = self.parts[index].times.last() else {
             return Err(PrimWriteError::DuplicateName(name.to_string()));
-        }
-        PrimWriteError::check_frame(name, time, &part.offsets, curves)?;
-        let last = *part.times.last().expect("an animated part has a frame");
+        };
         if time <= last {
             return Err(PrimWriteError::BadSetting(format!(
-                "part {name:?}: frame at {time} after the frame at {last}; write frames in increasing time"
+                "{what} {name:?}: frame at {time} after the frame at {last}; write frames in increasing time"
             )));
         }
-        let samples = self.animated_samples(curves)?;
+        Ok(Some(index))
+    }
+
+    /// Adds one frame's samples (by property name under `.geom`) to the
+    /// object at `index`.
+    fn push_frame(&mut self, index: usize, time: f64, samples: Vec<(&str, Sample)>) {
         let part = &mut self.parts[index];
         for (name, sample) in samples {
             if let Some(property) = part.geom.child(name) {
@@ -197,7 +218,6 @@ impl<W: Write + Seek> AbcWriter<W> {
             }
         }
         part.times.push(time);
-        Ok(())
     }
 
     /// The samples of the animated properties for one frame, by path
@@ -207,7 +227,7 @@ impl<W: Write + Seek> AbcWriter<W> {
         curves: &Curves,
     ) -> std::io::Result<Vec<(&'static str, Sample)>> {
         let mut samples = vec![
-            (".selfBnds", self.bounds_sample(curves)?),
+            (".selfBnds", self.bounds_sample(curve_extent(curves))?),
             (
                 "P",
                 self.array_sample(bytemuck::cast_slice(curves.points()), curves.points().len())?,
@@ -224,13 +244,22 @@ impl<W: Write + Seek> AbcWriter<W> {
         Ok(samples)
     }
 
-    fn bounds_sample(&mut self, curves: &Curves) -> std::io::Result<Sample> {
-        let (lo, hi) = curve_extent(curves);
+    /// A box's sample (`.selfBnds`): its corners as six doubles.
+    fn bounds_sample(&mut self, (lo, hi): (glam::Vec3, glam::Vec3)) -> std::io::Result<Sample> {
         let bounds: Vec<u8> = [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
             .iter()
             .flat_map(|&v| f64::from(v).to_le_bytes())
             .collect();
         self.array_sample(&bounds, 1)
+    }
+
+    /// Takes `name` for an object of the archive.
+    fn claim(&mut self, name: &str) -> Result<(), PrimWriteError> {
+        check_name(name)?;
+        if !self.names.insert(name.to_string()) {
+            return Err(PrimWriteError::DuplicateName(name.to_string()));
+        }
+        Ok(())
     }
 
     /// A sample's data block: its key (MurmurHash3 of the bytes), then the
@@ -267,10 +296,7 @@ impl<W: Write + Seek> AbcWriter<W> {
         time: Option<f64>,
         guide: bool,
     ) -> Result<(), PrimWriteError> {
-        check_name(name)?;
-        if !self.names.insert(name.to_string()) {
-            return Err(PrimWriteError::DuplicateName(name.to_string()));
-        }
+        self.claim(name)?;
         let min = self.options.min_points_per_curve();
         if let Some(curve) = (0..curves.curve_count()).find(|&i| curves.range(i).len() < min) {
             return Err(PrimWriteError::ShortCurve {
@@ -530,47 +556,21 @@ impl<W: Write + Seek> AbcWriter<W> {
         mesh: &Mesh,
     ) -> Result<(), PrimWriteError> {
         PrimWriteError::check_time(name, time)?;
-        let Some(index) = self.parts.iter().position(|p| p.name == name) else {
+        let Some(index) = self.next_frame("mesh", name, time)? else {
             return self.start_mesh(name, mesh, Some(time));
         };
-        let part = &self.parts[index];
-        let shape = [mesh.vertex_count() as u32, mesh.triangle_count() as u32];
-        if part.times.is_empty() || part.object != MESH_OBJECT {
+        if self.parts[index].object != MESH_OBJECT {
             return Err(PrimWriteError::DuplicateName(name.to_string()));
         }
-        if part.offsets != shape {
-            return Err(PrimWriteError::BadSetting(format!(
-                "mesh {name:?} at time {time}: {} vertices and {} triangles where the first frame had {} and {}",
-                shape[0], shape[1], part.offsets[0], part.offsets[1]
-            )));
-        }
-        let last = *part.times.last().expect("an animated mesh has a frame");
-        if time <= last {
-            return Err(PrimWriteError::BadSetting(format!(
-                "mesh {name:?}: frame at {time} after the frame at {last}; write frames in increasing time"
-            )));
-        }
+        PrimWriteError::check_mesh_frame(name, time, &self.parts[index].offsets, mesh)?;
         let (bounds, points) = self.mesh_samples(mesh)?;
-        let part = &mut self.parts[index];
-        for (child, sample) in [(".selfBnds", bounds), ("P", points)] {
-            part.geom
-                .child(child)
-                .expect("written with the mesh")
-                .samples
-                .push(sample);
-        }
-        part.times.push(time);
+        self.push_frame(index, time, vec![(".selfBnds", bounds), ("P", points)]);
         Ok(())
     }
 
     /// A mesh's bounds and positions samples.
     fn mesh_samples(&mut self, mesh: &Mesh) -> std::io::Result<(Sample, Sample)> {
-        let (lo, hi) = mesh.bounds();
-        let bounds: Vec<u8> = [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]
-            .iter()
-            .flat_map(|&v| f64::from(v).to_le_bytes())
-            .collect();
-        let bounds = self.array_sample(&bounds, 1)?;
+        let bounds = self.bounds_sample(mesh.bounds())?;
         let positions = mesh.positions();
         let points = self.array_sample(bytemuck::cast_slice(positions), positions.len())?;
         Ok((bounds, points))
@@ -582,10 +582,7 @@ impl<W: Write + Seek> AbcWriter<W> {
         mesh: &Mesh,
         time: Option<f64>,
     ) -> Result<(), PrimWriteError> {
-        check_name(name)?;
-        if !self.names.insert(name.to_string()) {
-            return Err(PrimWriteError::DuplicateName(name.to_string()));
-        }
+        self.claim(name)?;
         let frames = time.is_some() as u32;
         let (bounds, points) = self.mesh_samples(mesh)?;
         // Alembic's faces wind clockwise (as Maya's); pelage's wind

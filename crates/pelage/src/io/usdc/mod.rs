@@ -174,13 +174,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
             };
             self.animated.insert(name.to_string(), part);
         }
-        let first = &self.animated[name].offsets;
-        if *first != shape {
-            return Err(PrimWriteError::BadSetting(format!(
-                "mesh {name:?} at time {time}: {} vertices and {} triangles where the first frame had {} and {}",
-                shape[0], shape[1], first[0], first[1]
-            )));
-        }
+        PrimWriteError::check_mesh_frame(name, time, &self.animated[name].offsets, mesh)?;
         let (lo, hi) = mesh.bounds();
         self.add_samples(
             name,
