@@ -45,8 +45,38 @@ impl HairShading {
         "hair_tint",
     ];
 
+    /// The scalar attributes' names, in the order of [`Self::floats`].
+    pub const FLOAT_NAMES: [&'static str; 5] = [
+        Self::NAMES[0],
+        Self::NAMES[1],
+        Self::NAMES[2],
+        Self::NAMES[3],
+        Self::NAMES[4],
+    ];
+
     /// The tint's attribute name.
-    pub const TINT: &'static str = "hair_tint";
+    pub const TINT: &'static str = Self::NAMES[5];
+
+    /// The values a reader found under [`Self::FLOAT_NAMES`] (in that
+    /// order) and [`Self::TINT`]: `None` unless all six are there, as
+    /// pelage writes them. The inverse of [`Self::floats`].
+    pub fn from_found(floats: [Option<Vec<f32>>; 5], tint: Option<Vec<Vec3>>) -> Option<Self> {
+        let [
+            melanin,
+            melanin_redness,
+            roughness,
+            radial_roughness,
+            random,
+        ] = floats;
+        Some(Self {
+            melanin: melanin?,
+            melanin_redness: melanin_redness?,
+            tint: tint?,
+            roughness: roughness?,
+            radial_roughness: radial_roughness?,
+            random: random?,
+        })
+    }
 
     /// Room for `curves` hairs.
     pub fn with_capacity(curves: usize) -> Self {
@@ -74,12 +104,13 @@ impl HairShading {
     /// The scalar attributes with their names ([`Self::NAMES`] but the
     /// tint).
     pub fn floats(&self) -> [(&'static str, &[f32]); 5] {
+        let [a, b, c, d, e] = Self::FLOAT_NAMES;
         [
-            (Self::NAMES[0], &self.melanin),
-            (Self::NAMES[1], &self.melanin_redness),
-            (Self::NAMES[2], &self.roughness),
-            (Self::NAMES[3], &self.radial_roughness),
-            (Self::NAMES[4], &self.random),
+            (a, &self.melanin),
+            (b, &self.melanin_redness),
+            (c, &self.roughness),
+            (d, &self.radial_roughness),
+            (e, &self.random),
         ]
     }
 

@@ -242,31 +242,16 @@ fn with_primvars(
         Some(Value::FloatVec(v)) => Some(v),
         _ => None,
     };
-    let tint = match per("primvars:hair_tint", "uniform") {
+    let tint_name = format!("primvars:{}", crate::curves::HairShading::TINT);
+    let tint = match per(&tint_name, "uniform") {
         Some(Value::Vec3fVec(v)) => {
             Some(v.iter().map(|c| glam::Vec3::new(c.x, c.y, c.z)).collect())
         }
         _ => None,
     };
-    let names: [&str; 5] = std::array::from_fn(|i| crate::curves::HairShading::NAMES[i]);
-    let [melanin, redness, roughness, radial, random] = names.map(float);
-    if let (
-        Some(melanin),
-        Some(melanin_redness),
-        Some(tint),
-        Some(roughness),
-        Some(radial_roughness),
-        Some(random),
-    ) = (melanin, redness, tint, roughness, radial, random)
-    {
-        curves = curves.with_shading(crate::curves::HairShading {
-            melanin,
-            melanin_redness,
-            tint,
-            roughness,
-            radial_roughness,
-            random,
-        })?;
+    let found = crate::curves::HairShading::FLOAT_NAMES.map(float);
+    if let Some(shading) = crate::curves::HairShading::from_found(found, tint) {
+        curves = curves.with_shading(shading)?;
     }
     Ok(curves)
 }

@@ -22,6 +22,7 @@ use super::super::read_error::{
 use super::super::usd_read::DEFAULT_WIDTH;
 use super::ogawa::{Child, EMPTY_DATA};
 use crate::Curves;
+use crate::curves::HairShading;
 use crate::limits::{MAX_NAME_BYTES, MAX_PATH_BYTES};
 use crate::mesh::Location;
 use glam::{DMat4, DVec3, Vec2, Vec3};
@@ -983,30 +984,13 @@ fn read_curves_object(
                 .filter(|(_, b)| b.len() == curve_count * 4 * extent as usize)
                 .map(|(_, b)| floats(b).collect()))
         };
-        let names = crate::curves::HairShading::NAMES;
-        let floats_of: Vec<Option<Vec<f32>>> = names[..5]
-            .iter()
-            .map(|name| per_curve(name, 1))
-            .collect::<Result<_, _>>()?;
-        let tint = per_curve(crate::curves::HairShading::TINT, 3)?;
-        if let (Some(tint), true) = (tint, floats_of.iter().all(Option::is_some)) {
-            let [
-                melanin,
-                melanin_redness,
-                roughness,
-                radial_roughness,
-                random,
-            ] = <[Option<Vec<f32>>; 5]>::try_from(floats_of)
-                .expect("five names")
-                .map(|v| v.expect("checked"));
-            let shading = crate::curves::HairShading {
-                melanin,
-                melanin_redness,
-                tint: tint.chunks_exact(3).map(Vec3::from_slice).collect(),
-                roughness,
-                radial_roughness,
-                random,
-            };
+        let mut found: [Option<Vec<f32>>; 5] = Default::default();
+        for (slot, name) in found.iter_mut().zip(HairShading::FLOAT_NAMES) {
+            *slot = per_curve(name, 1)?;
+        }
+        let tint = per_curve(HairShading::TINT, 3)?
+            .map(|t| t.chunks_exact(3).map(Vec3::from_slice).collect());
+        if let Some(shading) = HairShading::from_found(found, tint) {
             curves = curves
                 .with_shading(shading)
                 .map_err(|e| fail(format!("{path}: {e}")))?;

@@ -347,13 +347,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
                     fields,
                 });
             }
-            let names: Vec<u32> = m
-                .prim
-                .attributes
-                .iter()
-                .map(|a| self.structure.token(a.name))
-                .collect();
-            let properties = self.token_vector(&names)?;
+            let properties = self.name_list(m.prim.attributes.iter().map(|a| a.name))?;
             let mut fields = prim_fields(
                 &mut self.structure,
                 m.prim.type_name,
@@ -361,13 +355,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
                 properties,
             );
             if !m.prim.children.is_empty() {
-                let names: Vec<u32> = m
-                    .prim
-                    .children
-                    .iter()
-                    .map(|c| self.structure.token(c.name))
-                    .collect();
-                let children = self.token_vector(&names)?;
+                let children = self.name_list(m.prim.children.iter().map(|c| c.name))?;
                 fields.push((self.structure.token("primChildren"), children));
             }
             self.structure.specs.push(Spec {
@@ -377,6 +365,12 @@ impl<W: Write + Seek> UsdcWriter<W> {
             });
         }
         Ok(made[0].path)
+    }
+
+    /// A list of names as tokens (`properties`, `primChildren`).
+    fn name_list<'n>(&mut self, names: impl Iterator<Item = &'n str>) -> std::io::Result<ValueRep> {
+        let tokens: Vec<u32> = names.map(|n| self.structure.token(n)).collect();
+        self.token_vector(&tokens)
     }
 
     /// A path list op holding `target` alone, explicit (what text USD's
