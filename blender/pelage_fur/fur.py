@@ -189,13 +189,15 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0):
     else:
         guides = {"generate": {"count": settings.guides, "length": settings.length,
                                "gravity": settings.gravity, "seed": settings.seed}}
+    roots = {"count": settings.count, "seed": settings.seed}
+    if settings.density_group:
+        roots["density"] = f"vertex:{settings.density_group}"
     parting = {"FACE_SETS": {"faces": "groups"}, "MATERIALS": {"faces": "materials"}}
     return pelage.Groom(
         mesh=mesh,
         guides=guides,
         regions=parting.get(settings.parting),
-        roots=dict({"count": settings.count, "seed": settings.seed},
-                   **({"density": f"vertex:{settings.density_group}"} if settings.density_group else {})),
+        roots=roots,
         ops=ops,
         finish={"points": settings.points,
                 "width": {"root": settings.width, "tip": settings.width * 0.1}},
@@ -232,6 +234,7 @@ def curves_to_blender(name, curves, surface=None, uv_map=None, matrix=None):
     if curves.root_uvs is not None:
         uv = data.attributes.new("surface_uv_coordinate", "FLOAT2", "CURVE")
         uv.data.foreach_set("vector", curves.root_uvs.ravel())
+    # Plain arrays (the benchmark's stand-in for Curves) carry no look.
     shading = getattr(curves, "shading", None)
     if shading is not None:
         for name in SHADING_FLOATS:

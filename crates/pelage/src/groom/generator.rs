@@ -505,18 +505,16 @@ impl Generator {
     /// of each guide's root when the skin is split.
     pub fn guide_curves(&self) -> Curves {
         let curves = self.guides.curves().clone();
-        match self.regions {
-            Some(_) => {
-                let regions = self
-                    .guides
-                    .roots()
-                    .iter()
-                    .map(|&r| self.region_of(r))
-                    .collect();
-                curves.with_regions(regions).expect("one region a guide")
-            }
+        match self.regions_at(self.guides.roots()) {
+            Some(regions) => curves.with_regions(regions).expect("one region a guide"),
             None => curves,
         }
+    }
+
+    /// The region of each of `roots` when the skin is split.
+    pub(super) fn regions_at(&self, roots: &[SurfacePoint]) -> Option<Vec<u32>> {
+        let lookup = self.regions.as_ref()?;
+        Some(roots.iter().map(|&r| lookup.of(&self.mesh, r)).collect())
     }
 
     /// The skin's regions, when it is split.

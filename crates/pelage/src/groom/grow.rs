@@ -377,9 +377,7 @@ impl Generator {
     /// `[regions]`.
     pub(crate) fn with_root_values(&self, mut curves: Curves) -> Curves {
         let roots = curves.roots().expect("grown curves carry their roots");
-        let regions = self
-            .regions()
-            .map(|_| roots.iter().map(|&r| self.region_of(r)).collect());
+        let regions = self.regions_at(roots);
         if let Some(look) = &self.look {
             let ids = curves.ids().expect("grown curves carry their ids");
             let shading = look.shade(&self.mesh, roots, ids);
