@@ -61,6 +61,8 @@ impl PyMesh {
     /// sizes.
     #[staticmethod]
     #[pyo3(signature = (positions, triangles, uvs = None, normals = None, name = "<python mesh>".to_string(), vertex_maps = None, face_sets = None, materials = None))]
+    // Python callers pass these by keyword; a struct would only move the list.
+    #[allow(clippy::too_many_arguments)]
     fn from_arrays(
         positions: &Bound<'_, PyAny>,
         triangles: &Bound<'_, PyAny>,

@@ -954,7 +954,7 @@ fn look_grooms_write_shading_primvars_and_a_materialx_hair_material() {
     };
     let mut files = Vec::new();
     for material in [true, false] {
-        let groom = pelage::groom::Groom::from_text("look.toml", &text(material)).unwrap();
+        let groom = pelage::groom::Groom::from_text("look.toml", text(material)).unwrap();
         let generator = groom.generator(None).unwrap();
         let parts: Vec<Curves> = (0..2).map(|p| generator.part(p).unwrap()).collect();
         for ext in ["usda", "usdc"] {
