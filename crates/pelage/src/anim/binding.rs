@@ -43,6 +43,11 @@ impl SkinPose {
         &self.positions
     }
 
+    /// The area-weighted vertex normals.
+    pub fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
+
     /// The point `root` of this pose and its surface frame, as a matrix
     /// whose columns are tangent, bitangent and normal.
     pub fn frame_at(&self, triangles: &[[u32; 3]], root: SurfacePoint) -> (Vec3, Mat3) {

@@ -11,17 +11,19 @@
 //! - [`strands`]: guide strands simulated on their own (Dynamic
 //!   Follow-The-Leader with bending, follow and friction), and
 //!   [`skin_sdf`], the posed skin as a signed-distance grid they collide
-//!   with.
+//!   with; [`guide_sim`]: a groom's guides simulated on an animated skin.
 //!
 //! The shell renderer reads [`MassSpringSystem::corner_tip_offsets`]: how
 //! far each skin corner's strand tip has moved from rest.
 
+pub mod guide_sim;
 pub mod skin_sdf;
 pub mod solver;
 pub mod strands;
 pub mod system;
 
-pub use solver::{Brush, DynamicsParams, Solver, Wind, WindNow};
+pub use guide_sim::GuideSimulation;
 pub use skin_sdf::SkinSdf;
+pub use solver::{Brush, DynamicsParams, Solver, Wind, WindNow};
 pub use strands::{MAX_STRAND_POINTS, RootFrame, StrandError, StrandParams, Strands};
 pub use system::{MassSpringSystem, Topology};

@@ -27,6 +27,10 @@ use crate::mesh::closest_on_triangle;
 use glam::Vec3;
 use rayon::prelude::*;
 
+/// Within this many cells of the skin (by the interpolated distance), a
+/// query measures the exact distance to the nearby triangles.
+const EXACT_WITHIN: f32 = 2.0;
+
 /// The signed distance to a posed skin on a uniform grid of nodes.
 #[derive(Debug, Clone)]
 pub struct SkinSdf {
@@ -35,6 +39,11 @@ pub struct SkinSdf {
     dims: [usize; 3],
     /// Signed distance at each node, x fastest.
     distances: Vec<f32>,
+    /// The triangle closest to each node (`u32::MAX` outside the band).
+    nearest: Vec<u32>,
+    /// The posed skin, for exact distances near it.
+    corners: Vec<[Vec3; 3]>,
+    corner_normals: Vec<[Vec3; 3]>,
     /// What a node outside the band holds.
     far: f32,
 }
@@ -85,13 +94,16 @@ impl SkinSdf {
             }
         }
         let mut distances = vec![far; nx * ny * nz];
+        let mut nearest = vec![u32::MAX; nx * ny * nz];
         distances
             .par_chunks_mut(nx * ny)
+            .zip(nearest.par_chunks_mut(nx * ny))
             .zip(by_slab.par_iter())
             .enumerate()
-            .for_each(|(z, (slab, tris))| {
-                // Unsigned distance and the nearest triangle's normal side.
-                let mut best = vec![(f32::INFINITY, 0.0f32); nx * ny];
+            .for_each(|(z, ((slab, slab_nearest), tris))| {
+                // Unsigned distance, the nearest triangle's normal side,
+                // the triangle.
+                let mut best = vec![(f32::INFINITY, 0.0f32, u32::MAX); nx * ny];
                 let pz = origin.z + z as f32 * cell;
                 for &ti in tris {
                     let t = triangles[ti as usize];
@@ -102,42 +114,67 @@ impl SkinSdf {
                     let (y0, _) = node_range(lo.y, 1, ny);
                     let (_, y1) = node_range(hi.y, 1, ny);
                     let face = (c[1] - c[0]).cross(c[2] - c[0]).normalize_or_zero();
+                    let centre = (c[0] + c[1] + c[2]) / 3.0;
+                    let radius = c.iter().map(|&v| (v - centre).length()).fold(0.0, f32::max);
                     for y in y0..=y1 {
                         let py = origin.y + y as f32 * cell;
                         for x in x0..=x1 {
                             let p = Vec3::new(origin.x + x as f32 * cell, py, pz);
-                            // Nodes beyond the band from the plane cannot
-                            // be within it of the triangle.
-                            if (p - c[0]).dot(face).abs() > far {
+                            // The distance to the plane and to the
+                            // bounding sphere are both at most the
+                            // distance to the triangle: nodes beyond the
+                            // band by either, or already nearer another
+                            // triangle, need no closest point.
+                            let slot = &mut best[y * nx + x];
+                            let plane = (p - c[0]).dot(face).abs();
+                            let sphere = (p - centre).length() - radius;
+                            let bound = plane.max(sphere);
+                            if bound > far || bound >= slot.0 {
                                 continue;
                             }
                             let (q, w) = closest_on_triangle(p, c);
                             let d = (p - q).length();
-                            let slot = &mut best[y * nx + x];
                             if d < slot.0 {
                                 let n = w[0] * normals[t[0] as usize]
                                     + w[1] * normals[t[1] as usize]
                                     + w[2] * normals[t[2] as usize];
                                 let n = if n.length_squared() > 1e-12 { n } else { face };
                                 let side = (p - q).dot(n);
-                                *slot = (d, if side < 0.0 { -1.0 } else { 1.0 });
+                                *slot = (d, if side < 0.0 { -1.0 } else { 1.0 }, ti);
                             }
                         }
                     }
                 }
-                for (out, &(d, sign)) in slab.iter_mut().zip(&best) {
+                for ((out, out_nearest), &(d, sign, ti)) in
+                    slab.iter_mut().zip(slab_nearest.iter_mut()).zip(&best)
+                {
                     if d < far {
                         *out = sign * d;
+                        *out_nearest = ti;
                     }
                 }
             });
+        let corners = triangles.iter().map(|&t| corners_of(t)).collect();
+        let corner_normals = triangles
+            .iter()
+            .map(|t| t.map(|i| normals[i as usize]))
+            .collect();
         Self {
             origin,
             cell,
             dims,
             distances,
+            nearest,
+            corners,
+            corner_normals,
             far,
         }
+    }
+
+    /// The triangle closest to each node (`u32::MAX` for nodes outside
+    /// the band), x fastest.
+    pub fn nearest_triangles(&self) -> &[u32] {
+        &self.nearest
     }
 
     /// The grid's first node, node spacing and node counts (x, y, z).
@@ -190,8 +227,64 @@ impl SkinSdf {
         let dx1 = (c101 - c001) + f.y * ((c111 - c011) - (c101 - c001));
         let dy0 = x10 - x00;
         let dy1 = x11 - x01;
+        if d < EXACT_WITHIN * self.cell {
+            // Near the skin: the exact distance to the nearest of the
+            // corners' closest triangles. Interpolation alone cannot see
+            // a part thinner than two cells (a leg, an ear): the nodes on
+            // both sides of it are outside, and so would be every point
+            // between them.
+            let node = |x: usize, y: usize, z: usize| (z * ny + y) * nx + x;
+            let ids = [
+                node(ix, iy, iz),
+                node(ix + 1, iy, iz),
+                node(ix, iy + 1, iz),
+                node(ix + 1, iy + 1, iz),
+                node(ix, iy, iz + 1),
+                node(ix + 1, iy, iz + 1),
+                node(ix, iy + 1, iz + 1),
+                node(ix + 1, iy + 1, iz + 1),
+            ]
+            .map(|i| self.nearest[i]);
+            if let Some(exact) = self.exact(p, &ids) {
+                return exact;
+            }
+        }
         let grad = Vec3::new(dx0 + f.z * (dx1 - dx0), dy0 + f.z * (dy1 - dy0), y1 - y0);
         (d, grad.normalize_or_zero())
+    }
+
+    /// The signed distance to the closest of `triangles` (each tried
+    /// once) and the direction out; `None` when none is in the band.
+    fn exact(&self, p: Vec3, triangles: &[u32; 8]) -> Option<(f32, Vec3)> {
+        let mut best: Option<(f32, Vec3, usize, [f32; 3])> = None;
+        for (k, &t) in triangles.iter().enumerate() {
+            if t == u32::MAX || triangles[..k].contains(&t) {
+                continue;
+            }
+            let (q, w) = closest_on_triangle(p, self.corners[t as usize]);
+            let d2 = (p - q).length_squared();
+            if best.is_none_or(|b| d2 < b.0) {
+                best = Some((d2, q, t as usize, w));
+            }
+        }
+        let (d2, q, t, w) = best?;
+        let [n0, n1, n2] = self.corner_normals[t];
+        let c = self.corners[t];
+        let n = (w[0] * n0 + w[1] * n1 + w[2] * n2)
+            .try_normalize()
+            .or_else(|| (c[1] - c[0]).cross(c[2] - c[0]).try_normalize())
+            .unwrap_or(Vec3::Y);
+        let away = p - q;
+        let sign = if away.dot(n) < 0.0 { -1.0 } else { 1.0 };
+        let d = d2.sqrt();
+        // The line to the closest point is the way out; on the surface
+        // itself, the normal.
+        let out = if d > 1e-6 * self.cell {
+            sign * away / d
+        } else {
+            n
+        };
+        Some((sign * d, out))
     }
 }
 

@@ -46,6 +46,9 @@ use super::solver::{Wind, WindNow};
 use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
+/// Times a point is pushed out of the skin and put back at its length.
+const COLLISION_PASSES: usize = 3;
+
 /// The most points a simulated strand has (per-strand scratch lives on
 /// the stack, and a guide needs far fewer).
 pub const MAX_STRAND_POINTS: usize = 64;
@@ -165,7 +168,11 @@ impl Strands {
             let to_local = root.frame.transpose();
             for (i, &p) in strand.iter().enumerate() {
                 rest_local.push(to_local * (p - root.position));
-                lengths.push(if i == 0 { 0.0 } else { (p - strand[i - 1]).length() });
+                lengths.push(if i == 0 {
+                    0.0
+                } else {
+                    (p - strand[i - 1]).length()
+                });
             }
         }
         Ok(Self {
@@ -239,17 +246,22 @@ impl Strands {
 
     /// Advances `dt` seconds, ending at time `time` (for the wind), in
     /// `params.substeps` substeps while the roots move linearly from
-    /// where they were to `roots`, colliding with `skin` (the posed skin
-    /// at the end of the step) when given.
+    /// where they were to `roots`, colliding with the skin: `skin[s]` is
+    /// the skin at the end of substep `s` (one grid for all substeps: a
+    /// skin standing still); empty for no collisions.
     pub fn step(
         &mut self,
         params: &StrandParams,
         dt: f32,
         time: f32,
         roots: &[RootFrame],
-        skin: Option<&SkinSdf>,
+        skin: &[SkinSdf],
     ) {
         assert_eq!(roots.len(), self.len(), "one root a strand");
+        assert!(
+            skin.len() <= 1 || skin.len() == params.substeps.max(1) as usize,
+            "one skin grid, or one a substep"
+        );
         let substeps = params.substeps.max(1);
         let iterations = params.iterations.max(1);
         let h = dt / substeps as f32;
@@ -292,7 +304,8 @@ impl Strands {
                 for (s, wind) in wind_at.iter().enumerate() {
                     let a = (s + 1) as f32 / substeps as f32;
                     let root = lerp_root(from, to, a);
-                    substep(x, v, local, lengths, &root, &consts, wind.as_ref(), skin);
+                    let grid = skin.get(s).or(skin.first());
+                    substep(x, v, local, lengths, &root, &consts, wind.as_ref(), grid);
                 }
             });
         self.roots = roots.to_vec();
@@ -339,7 +352,9 @@ fn lerp_root(from: &RootFrame, to: &RootFrame, a: f32) -> RootFrame {
         .lerp(to.frame.z_axis, a)
         .try_normalize()
         .unwrap_or(to.frame.z_axis);
-    let t = (t - n * n.dot(t)).try_normalize().unwrap_or(to.frame.x_axis);
+    let t = (t - n * n.dot(t))
+        .try_normalize()
+        .unwrap_or(to.frame.x_axis);
     RootFrame {
         position,
         frame: Mat3::from_cols(t, n.cross(t), n),
@@ -410,12 +425,23 @@ fn substep(
         for i in 1..n {
             let before = p[i];
             let mut q = p[i - 1] + lengths[i] * (p[i] - p[i - 1]).normalize_or(frame.z_axis);
-            if let Some(sdf) = skin {
-                let (d, out) = sdf.sample(q);
-                if d < k.thickness && out != Vec3::ZERO {
-                    q += (k.thickness - d) * out;
-                    q = p[i - 1] + lengths[i] * (q - p[i - 1]).normalize_or(out);
+            if let Some(skin) = skin {
+                // Out of the skin and back to the rest length, a few times:
+                // the length pass can turn a point back in where the skin
+                // is curved; the last move is out, so the skin wins over
+                // a sliver of stretch.
+                for _ in 0..COLLISION_PASSES {
+                    let (d, out) = skin.sample(q);
+                    if d >= k.thickness || out == Vec3::ZERO {
+                        break;
+                    }
+                    let pushed = q + (k.thickness - d) * out;
                     touched[i] = out;
+                    q = p[i - 1] + lengths[i] * (pushed - p[i - 1]).normalize_or(out);
+                    let (d, _) = skin.sample(q);
+                    if d < k.thickness {
+                        q = pushed;
+                    }
                 }
             }
             p[i] = q;
@@ -477,7 +503,7 @@ mod tests {
         let mut crossings = Vec::new();
         let mut last = strand.positions()[1].x;
         for step in 1..=6000 {
-            strand.step(&params, dt, step as f32 * dt, &[upright()], None);
+            strand.step(&params, dt, step as f32 * dt, &[upright()], &[]);
             let x = strand.positions()[1].x;
             if last > 0.0 && x <= 0.0 {
                 // Interpolated time of the downward crossing.
@@ -512,7 +538,7 @@ mod tests {
                 position: Vec3::new((3.0 * t).sin(), 0.0, (3.0 * t).cos()) * 0.3,
                 frame: Mat3::IDENTITY,
             };
-            strand.step(&params, 1.0 / 240.0, t, &[root], None);
+            strand.step(&params, 1.0 / 240.0, t, &[root], &[]);
         }
         let p = strand.positions();
         for i in 1..16 {
@@ -536,7 +562,7 @@ mod tests {
         };
         let mut free = straight(12, 0.3, dir);
         for step in 1..=480 {
-            free.step(&params, 1.0 / 120.0, step as f32 / 120.0, &[upright()], None);
+            free.step(&params, 1.0 / 120.0, step as f32 / 120.0, &[upright()], &[]);
         }
         let p = free.positions();
         for i in 1..12 {
@@ -547,7 +573,7 @@ mod tests {
         let mut kept = straight(12, 0.3, dir);
         let groomed = kept.positions().to_vec();
         for step in 1..=480 {
-            kept.step(&params, 1.0 / 120.0, step as f32 / 120.0, &[upright()], None);
+            kept.step(&params, 1.0 / 120.0, step as f32 / 120.0, &[upright()], &[]);
         }
         for (a, b) in kept.positions().iter().zip(&groomed) {
             assert!((*a - *b).length() < 1e-5, "{a} vs groomed {b}");
@@ -568,7 +594,7 @@ mod tests {
         let g = params.gravity;
         let mut energy = strand.energy(g);
         for step in 1..=400 {
-            strand.step(&params, 1.0 / 60.0, step as f32 / 60.0, &[upright()], None);
+            strand.step(&params, 1.0 / 60.0, step as f32 / 60.0, &[upright()], &[]);
             let now = strand.energy(g);
             assert!(now <= energy + 1e-9, "step {step}: {energy} → {now}");
             energy = now;

@@ -1,0 +1,197 @@
+//! Guides simulated on an animated skin: [`Strands`] whose roots are the
+//! guides' roots on the posed skin (the surface frames of
+//! [`SkinPose::frame_at`], as deform carries hair), colliding with the
+//! skin's [`SkinSdf`], built at every substep from the skin's vertices
+//! interpolated linearly between frames: a running leg moves farther in
+//! a frame than it is thick, and must push the fur on its way rather than
+//! jump over it.
+
+use super::skin_sdf::SkinSdf;
+use super::strands::{RootFrame, StrandError, StrandParams, Strands};
+use crate::Curves;
+use crate::anim::SkinPose;
+use crate::guides::Guides;
+use crate::mesh::SurfacePoint;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// Nodes along the skin's longest side of its collision grid: the grid
+/// only has to find the triangles near a point (distances there are
+/// exact), and it is rebuilt every substep.
+const GRID_NODES_ALONG: f32 = 64.0;
+
+/// A groom's guides moving with an animated skin.
+#[derive(Debug, Clone)]
+pub struct GuideSimulation {
+    triangles: Vec<[u32; 3]>,
+    roots: Vec<SurfacePoint>,
+    widths: Vec<f32>,
+    strands: Strands,
+    params: StrandParams,
+    collide: bool,
+    /// Node spacing of the collision grid, and the depth it must cover
+    /// besides the skin's own motion in a substep.
+    cell: f32,
+    depth: f32,
+    /// The skin's vertices at the end of the last step.
+    last_positions: Vec<Vec3>,
+}
+
+impl GuideSimulation {
+    /// The guides at rest on `rest` (the pose they were bound on), to be
+    /// moved with `params`, colliding with the skin when `collide`.
+    pub fn new(
+        guides: &Guides,
+        triangles: &[[u32; 3]],
+        rest: &SkinPose,
+        params: StrandParams,
+        collide: bool,
+    ) -> Result<Self, StrandError> {
+        let roots: Vec<RootFrame> = guides
+            .roots()
+            .par_iter()
+            .map(|&r| root_frame(rest, triangles, r))
+            .collect();
+        let strands = Strands::new(guides.curves().points(), guides.points_per_guide(), &roots)?;
+        let (lo, hi) = bounds(rest.positions());
+        let longest = (hi - lo).max_element().max(f32::MIN_POSITIVE);
+        let segment = strands
+            .rest_lengths()
+            .iter()
+            .copied()
+            .fold(0.0f32, f32::max);
+        let cell = longest / GRID_NODES_ALONG;
+        let depth = segment + params.thickness.max(0.0) + cell;
+        Ok(Self {
+            triangles: triangles.to_vec(),
+            roots: guides.roots().to_vec(),
+            widths: guides.curves().widths().to_vec(),
+            strands,
+            params,
+            collide,
+            cell,
+            depth,
+            last_positions: rest.positions().to_vec(),
+        })
+    }
+
+    /// The strands as simulated so far.
+    pub fn strands(&self) -> &Strands {
+        &self.strands
+    }
+
+    /// The settings.
+    pub fn params(&self) -> &StrandParams {
+        &self.params
+    }
+
+    /// The guides' root frames on `pose`.
+    pub fn root_frames(&self, pose: &SkinPose) -> Vec<RootFrame> {
+        self.roots
+            .par_iter()
+            .map(|&r| root_frame(pose, &self.triangles, r))
+            .collect()
+    }
+
+    /// The collision grid of `pose`.
+    pub fn skin_sdf(&self, pose: &SkinPose) -> SkinSdf {
+        SkinSdf::new(
+            pose.positions(),
+            pose.normals(),
+            &self.triangles,
+            self.cell,
+            self.depth,
+        )
+    }
+
+    /// Puts the guides in their groomed shape on `pose`, at rest (the
+    /// start of a simulation).
+    pub fn reset(&mut self, pose: &SkinPose) {
+        let roots = self.root_frames(pose);
+        self.strands.reset(&roots);
+        self.last_positions = pose.positions().to_vec();
+    }
+
+    /// The skin's grid at the end of every substep of a step to `pose`:
+    /// the vertices interpolated from where they were, the band deepened
+    /// by how far they move in a substep.
+    pub fn substep_grids(&self, pose: &SkinPose) -> Vec<SkinSdf> {
+        if !self.collide {
+            return Vec::new();
+        }
+        let substeps = self.params.substeps.max(1);
+        let to = pose.positions();
+        let from = if self.last_positions.len() == to.len() {
+            &self.last_positions[..]
+        } else {
+            to
+        };
+        let moved = from
+            .iter()
+            .zip(to)
+            .map(|(a, b)| (*a - *b).length())
+            .fold(0.0f32, f32::max);
+        let depth = self.depth + moved / substeps as f32;
+        (1..=substeps)
+            .map(|s| {
+                let a = s as f32 / substeps as f32;
+                if a >= 1.0 {
+                    return SkinSdf::new(to, pose.normals(), &self.triangles, self.cell, depth);
+                }
+                let positions: Vec<Vec3> =
+                    from.iter().zip(to).map(|(p, q)| p.lerp(*q, a)).collect();
+                let normals = crate::mesh::area_weighted_normals(&positions, &self.triangles);
+                SkinSdf::new(&positions, &normals, &self.triangles, self.cell, depth)
+            })
+            .collect()
+    }
+
+    /// Advances `dt` seconds to time `time`, when the skin is at `pose`.
+    pub fn advance(&mut self, pose: &SkinPose, dt: f32, time: f32) {
+        let roots = self.root_frames(pose);
+        let grids = self.substep_grids(pose);
+        self.advance_with(pose, &roots, &grids, dt, time);
+    }
+
+    /// [`advance`](Self::advance) with the roots and the skin's grids
+    /// already made (for a caller that times them or makes them
+    /// elsewhere).
+    pub fn advance_with(
+        &mut self,
+        pose: &SkinPose,
+        roots: &[RootFrame],
+        grids: &[SkinSdf],
+        dt: f32,
+        time: f32,
+    ) {
+        self.strands.step(&self.params, dt, time, roots, grids);
+        self.last_positions.clear();
+        self.last_positions.extend_from_slice(pose.positions());
+    }
+
+    /// The guides as they are now: one curve each, with the guides'
+    /// widths and roots.
+    pub fn curves(&self) -> Curves {
+        let n = self.strands.points_per_strand();
+        let offsets = (0..=self.roots.len()).map(|i| (i * n) as u32).collect();
+        Curves::new(
+            self.strands.positions().to_vec(),
+            self.widths.clone(),
+            offsets,
+        )
+        .and_then(|c| c.with_roots(self.roots.clone()))
+        .expect("the guides' own layout")
+    }
+}
+
+fn root_frame(pose: &SkinPose, triangles: &[[u32; 3]], root: SurfacePoint) -> RootFrame {
+    let (position, frame) = pose.frame_at(triangles, root);
+    RootFrame { position, frame }
+}
+
+fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
+    points.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    )
+}
