@@ -37,6 +37,10 @@ pub struct DynamicsBenchArgs {
     /// Leave out the GPU column.
     #[arg(long)]
     pub no_gpu: bool,
+    /// Guide strands on the running Fox instead (Dynamic
+    /// Follow-The-Leader with body collisions): frames per second.
+    #[arg(long)]
+    pub strands: bool,
 }
 
 struct Row {
@@ -95,6 +99,9 @@ const SOLVERS: [Solver; 2] = [
 
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
+    if args.strands {
+        return super::strands::run(args);
+    }
     let gpu = if args.no_gpu {
         None
     } else {

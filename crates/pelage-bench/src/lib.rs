@@ -21,6 +21,7 @@ pub mod render;
 pub mod sampler;
 pub mod shells;
 mod shells_game;
+mod strands;
 
 use clap::{Args, Subcommand};
 use std::time::Instant;

@@ -276,6 +276,7 @@ mod tests {
     use crate::dynamics::StepUniform;
     use crate::renderer::FrameUniforms;
     use crate::shells::ShellUniforms;
+    use crate::strands::{GridHeader, StrandStepUniform};
 
     /// The size and `(member, offset)` list of the struct `name` in `wgsl`,
     /// as naga lays it out.
@@ -316,6 +317,15 @@ mod tests {
         check("shells.wgsl", "Shell", shell, ShellUniforms::FIELDS);
         let step = std::mem::size_of::<StepUniform>();
         check("dynamics.wgsl", "Step", step, StepUniform::FIELDS);
+        let strand = std::mem::size_of::<StrandStepUniform>();
+        check(
+            "strands.wgsl",
+            "StrandStep",
+            strand,
+            StrandStepUniform::FIELDS,
+        );
+        let grid = std::mem::size_of::<GridHeader>();
+        check("strands.wgsl", "Grid", grid, GridHeader::FIELDS);
     }
 
     /// A vertex input: name, location and type (`f32x3`).

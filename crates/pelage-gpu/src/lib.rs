@@ -19,6 +19,7 @@ mod motion;
 mod readback;
 mod renderer;
 mod shells;
+mod strands;
 
 pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
@@ -31,6 +32,7 @@ pub use shells::{
     FinParams, ShellFeatures, ShellLevel, ShellLod, ShellModel, ShellParams, ShellRenderer,
     ShellScenePlayer, ShellTarget, ShellTargetFormats, ShellUpload, ShellView, vertex_tangents,
 };
+pub use strands::{GpuStrands, MAX_GPU_STRAND_POINTS};
 /// wgpu itself, so callers (a window, the viewer) build surfaces with the same version.
 pub use wgpu;
 
@@ -113,7 +115,21 @@ pub const SHADERS: &[(&str, &str)] = &[
     // Shell fur has its own uniform block.
     ("shells.wgsl", include_str!("shaders/shells.wgsl")),
     // The explicit mass-spring substep (compute).
-    ("dynamics.wgsl", include_str!("shaders/dynamics.wgsl")),
+    (
+        "dynamics.wgsl",
+        concat!(
+            include_str!("shaders/dynamics.wgsl"),
+            include_str!("shaders/noise.wgsl")
+        ),
+    ),
+    // Guide strands' substeps (compute).
+    (
+        "strands.wgsl",
+        concat!(
+            include_str!("shaders/strands.wgsl"),
+            include_str!("shaders/noise.wgsl")
+        ),
+    ),
     // Linear-blend skinning of shell models (compute).
     ("skin.wgsl", include_str!("shaders/skin.wgsl")),
 ];

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 /// Nodes along the skin's longest side of its collision grid: the grid
 /// only has to find the triangles near a point (distances there are
 /// exact), and it is rebuilt every substep.
-const GRID_NODES_ALONG: f32 = 64.0;
+const GRID_NODES_ALONG: f32 = 48.0;
 
 /// A groom's guides moving with an animated skin.
 #[derive(Debug, Clone)]
@@ -29,10 +29,11 @@ pub struct GuideSimulation {
     strands: Strands,
     params: StrandParams,
     collide: bool,
-    /// Node spacing of the collision grid, and the depth it must cover
-    /// besides the skin's own motion in a substep.
+    /// Node spacing of the collision grid.
     cell: f32,
-    depth: f32,
+    /// The longest segment: how far a point can go into the skin in one
+    /// length pass.
+    segment: f32,
     /// The skin's vertices at the end of the last step.
     last_positions: Vec<Vec3>,
 }
@@ -61,7 +62,6 @@ impl GuideSimulation {
             .copied()
             .fold(0.0f32, f32::max);
         let cell = longest / GRID_NODES_ALONG;
-        let depth = segment + params.thickness.max(0.0) + cell;
         Ok(Self {
             triangles: triangles.to_vec(),
             roots: guides.roots().to_vec(),
@@ -70,7 +70,7 @@ impl GuideSimulation {
             params,
             collide,
             cell,
-            depth,
+            segment,
             last_positions: rest.positions().to_vec(),
         })
     }
@@ -100,8 +100,16 @@ impl GuideSimulation {
             pose.normals(),
             &self.triangles,
             self.cell,
-            self.depth,
+            self.depth(0.0),
         )
+    }
+
+    /// How deep a grid's exact band must reach: a point goes into the skin
+    /// by at most a segment (its own move) or by the skin's move in a
+    /// substep over it, plus the thickness it is kept at, plus a cell of
+    /// interpolation.
+    fn depth(&self, skin_move: f32) -> f32 {
+        self.segment.max(skin_move) + self.params.thickness.max(0.0) + self.cell
     }
 
     /// Puts the guides in their groomed shape on `pose`, at rest (the
@@ -131,7 +139,7 @@ impl GuideSimulation {
             .zip(to)
             .map(|(a, b)| (*a - *b).length())
             .fold(0.0f32, f32::max);
-        let depth = self.depth + moved / substeps as f32;
+        let depth = self.depth(moved / substeps as f32);
         (1..=substeps)
             .map(|s| {
                 let a = s as f32 / substeps as f32;
@@ -165,6 +173,14 @@ impl GuideSimulation {
         time: f32,
     ) {
         self.strands.step(&self.params, dt, time, roots, grids);
+        self.last_positions.clear();
+        self.last_positions.extend_from_slice(pose.positions());
+    }
+
+    /// Records that the skin is now at `pose` without stepping (for a
+    /// caller that stepped the strands elsewhere, on a GPU): the next
+    /// step's grids start from it.
+    pub fn note_pose(&mut self, pose: &SkinPose) {
         self.last_positions.clear();
         self.last_positions.extend_from_slice(pose.positions());
     }

@@ -171,6 +171,12 @@ impl SkinSdf {
         }
     }
 
+    /// The posed skin's triangles, as corner positions, and their
+    /// corners' vertex normals (for a GPU port).
+    pub fn triangles(&self) -> (&[[Vec3; 3]], &[[Vec3; 3]]) {
+        (&self.corners, &self.corner_normals)
+    }
+
     /// The triangle closest to each node (`u32::MAX` for nodes outside
     /// the band), x fastest.
     pub fn nearest_triangles(&self) -> &[u32] {

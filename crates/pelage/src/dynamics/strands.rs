@@ -49,6 +49,17 @@ use rayon::prelude::*;
 /// Times a point is pushed out of the skin and put back at its length.
 const COLLISION_PASSES: usize = 3;
 
+/// A point put back at its length may sink this far into its thickness
+/// (as a fraction of it) before the push wins over the length. Below one:
+/// a point resting on the skin sits at one thickness, and rounding must
+/// not decide between its length and its push.
+const KEEP_LENGTH_WITHIN: f32 = 0.9;
+
+/// A point this close to the skin, in thicknesses, rubs on it (friction).
+/// A little more than one: a point pushed out rests at exactly one
+/// thickness, and rounding must not decide whether it rubs.
+const CONTACT: f32 = 1.05;
+
 /// The most points a simulated strand has (per-strand scratch lives on
 /// the stack, and a guide needs far fewer).
 pub const MAX_STRAND_POINTS: usize = 64;
@@ -263,28 +274,8 @@ impl Strands {
             "one skin grid, or one a substep"
         );
         let substeps = params.substeps.max(1);
-        let iterations = params.iterations.max(1);
-        let h = dt / substeps as f32;
-        let per_iteration = |k: f32| {
-            let k = k.clamp(0.0, 1.0);
-            if k >= 1.0 {
-                1.0
-            } else {
-                1.0 - (1.0 - k).powf(h * 60.0 / iterations as f32)
-            }
-        };
-        let consts = SubstepConstants {
-            h,
-            decay: (-params.damping.max(0.0) * h).exp(),
-            gravity_h: params.gravity * h,
-            drag: (params.drag.max(0.0) * h).min(1.0),
-            follow: per_iteration(params.follow),
-            bend: per_iteration(params.bend),
-            ftl: params.ftl_damping.clamp(0.0, 1.0),
-            thickness: params.thickness,
-            friction: params.friction.clamp(0.0, 1.0),
-            iterations,
-        };
+        let consts = params.substep_constants(dt);
+        let h = consts.h;
         let n = self.points_per_strand;
         let starts = &self.roots;
         let wind_at: Vec<Option<WindNow>> = (0..substeps)
@@ -325,17 +316,59 @@ impl Strands {
     }
 }
 
-struct SubstepConstants {
-    h: f32,
-    decay: f32,
-    gravity_h: Vec3,
-    drag: f32,
-    follow: f32,
-    bend: f32,
-    ftl: f32,
-    thickness: f32,
-    friction: f32,
-    iterations: u32,
+/// What a substep of a step of `dt` computes with, derived once from
+/// [`StrandParams`] (and handed as is to a GPU port).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SubstepConstants {
+    /// The substep's length.
+    pub h: f32,
+    /// `e^(−damping·h)`.
+    pub decay: f32,
+    /// Gravity × `h`.
+    pub gravity_h: Vec3,
+    /// `min(1, drag·h)`.
+    pub drag: f32,
+    /// The follow and bend fractions an iteration.
+    pub follow: f32,
+    /// See `follow`.
+    pub bend: f32,
+    /// DFTL's `s`.
+    pub ftl: f32,
+    /// Collision thickness.
+    pub thickness: f32,
+    /// Friction, 0 to 1.
+    pub friction: f32,
+    /// Iterations a substep (at least 1).
+    pub iterations: u32,
+}
+
+impl StrandParams {
+    /// The constants of a substep of a step of `dt` seconds.
+    pub fn substep_constants(&self, dt: f32) -> SubstepConstants {
+        let substeps = self.substeps.max(1);
+        let iterations = self.iterations.max(1);
+        let h = dt / substeps as f32;
+        let per_iteration = |k: f32| {
+            let k = k.clamp(0.0, 1.0);
+            if k >= 1.0 {
+                1.0
+            } else {
+                1.0 - (1.0 - k).powf(h * 60.0 / iterations as f32)
+            }
+        };
+        SubstepConstants {
+            h,
+            decay: (-self.damping.max(0.0) * h).exp(),
+            gravity_h: self.gravity * h,
+            drag: (self.drag.max(0.0) * h).min(1.0),
+            follow: per_iteration(self.follow),
+            bend: per_iteration(self.bend),
+            ftl: self.ftl_damping.clamp(0.0, 1.0),
+            thickness: self.thickness,
+            friction: self.friction.clamp(0.0, 1.0),
+            iterations,
+        }
+    }
 }
 
 /// The root a fraction `a` of the way from `from` to `to`: positions and
@@ -432,14 +465,19 @@ fn substep(
                 // a sliver of stretch.
                 for _ in 0..COLLISION_PASSES {
                     let (d, out) = skin.sample(q);
-                    if d >= k.thickness || out == Vec3::ZERO {
+                    if out == Vec3::ZERO {
+                        break;
+                    }
+                    if d < k.thickness * CONTACT {
+                        touched[i] = out;
+                    }
+                    if d >= k.thickness {
                         break;
                     }
                     let pushed = q + (k.thickness - d) * out;
-                    touched[i] = out;
                     q = p[i - 1] + lengths[i] * (pushed - p[i - 1]).normalize_or(out);
                     let (d, _) = skin.sample(q);
-                    if d < k.thickness {
+                    if d < k.thickness * KEEP_LENGTH_WITHIN {
                         q = pushed;
                     }
                 }

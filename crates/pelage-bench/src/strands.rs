@@ -1,0 +1,312 @@
+//! `pelage bench dynamics --strands`: guides simulated on the running
+//! Khronos Fox (Dynamic Follow-The-Leader with bending, follow and body
+//! collisions; `pelage::dynamics::GuideSimulation`), frames per second on
+//! the CPU (all threads) and on the GPU adapter present
+//! (`pelage_gpu::GpuStrands`; lavapipe without a GPU), 4 substeps a
+//! frame. Targets (2 cores): ≥ 24 simulated frames a second at 10,000
+//! guides × 16 points (2,000 in `--quick`).
+//!
+//! Beside them, the choice of collision structure measured in the same
+//! run: the skin's distance grid (built once a substep, read per point)
+//! against closest-point queries over a triangle BVH (built once a
+//! substep, queried per point), on the same points.
+
+use crate::format::thousands;
+use glam::Vec3;
+use pelage::anim::{AnimatedSkin, SkinOptions, SkinPose};
+use pelage::dynamics::{GuideSimulation, StrandParams};
+use pelage::guides::{GuideGrowth, Guides};
+use pelage::map::Map;
+use pelage::mesh::TriangleBvh;
+use std::time::Instant;
+
+/// What one run measured.
+struct Figures {
+    guides: usize,
+    points_per_guide: usize,
+    substeps: u32,
+    frames: usize,
+    /// Median seconds a frame: all of it, and its parts.
+    frame_s: f64,
+    roots_s: f64,
+    grids_s: f64,
+    step_s: f64,
+    /// The collision structures on the same points.
+    grid_build_s: f64,
+    grid_query_ns: f64,
+    bvh_build_s: f64,
+    bvh_query_ns: f64,
+    gpu: Option<GpuFigures>,
+}
+
+struct GpuFigures {
+    adapter: String,
+    software: bool,
+    frame_s: f64,
+    /// Largest distance between a CPU and a GPU point after the frames,
+    /// as a fraction of the Fox's size.
+    max_difference: f32,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The Fox running, its skin posed for `frames` frames, and `count`
+/// guides of `points` points grown on its first frame.
+pub(crate) struct FoxRun {
+    pub triangles: Vec<[u32; 3]>,
+    pub poses: Vec<SkinPose>,
+    pub guides: Guides,
+    pub size: f32,
+}
+
+pub(crate) fn fox_run(count: usize, points: usize, frames: usize) -> anyhow::Result<FoxRun> {
+    let dir = std::env::temp_dir().join(format!("pelage-bench-strands-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let path = dir.join("Fox.gltf");
+    std::fs::write(&path, pelage::assets::FOX_GLTF)?;
+    let options = SkinOptions {
+        clip: Some("Run".into()),
+        ..Default::default()
+    };
+    let skin = AnimatedSkin::load(&path, &options);
+    let _ = std::fs::remove_dir_all(&dir);
+    let skin = skin?;
+    let rest = skin.mesh_at(1.0)?;
+    let (lo, hi) = rest.bounds();
+    let size = (hi - lo).max_element();
+    let guides = Guides::grow(
+        &rest,
+        &GuideGrowth {
+            count,
+            length: Map::Constant(0.06 * size),
+            points,
+            width: 0.002 * size,
+            ..Default::default()
+        },
+    )?;
+    let triangles = rest.triangles().to_vec();
+    let poses = (1..=frames)
+        .map(|f| Ok(SkinPose::new(skin.positions_at(f as f64)?, &triangles)))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok(FoxRun {
+        triangles,
+        poses,
+        guides,
+        size,
+    })
+}
+
+/// The settings the benchmark (and the GPU test) simulate with: long fur
+/// on a Fox about 1.4 m long in its own units.
+pub(crate) fn fox_params(size: f32) -> StrandParams {
+    StrandParams {
+        substeps: 4,
+        gravity: Vec3::new(0.0, -9.81 * size / 1.4, 0.0),
+        thickness: 0.004 * size,
+        bend: 0.3,
+        follow: 0.05,
+        ..Default::default()
+    }
+}
+
+fn measure(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<Figures> {
+    let (count, frames) = if args.quick {
+        (2_000, 24)
+    } else {
+        (10_000, 48)
+    };
+    let points = 16;
+    let run = fox_run(count, points, frames + 1)?;
+    let params = fox_params(run.size);
+    let substeps = params.substeps;
+    let mut sim = GuideSimulation::new(
+        &run.guides,
+        &run.triangles,
+        &run.poses[0],
+        params.clone(),
+        true,
+    )?;
+    let dt = 1.0 / 24.0;
+    let (mut frame_t, mut roots_t, mut grids_t, mut step_t) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (f, pose) in run.poses.iter().enumerate().skip(1) {
+        let start = Instant::now();
+        let roots = sim.root_frames(pose);
+        let t_roots = start.elapsed().as_secs_f64();
+        let grids = sim.substep_grids(pose);
+        let t_grids = start.elapsed().as_secs_f64();
+        sim.advance_with(pose, &roots, &grids, dt, f as f32 * dt);
+        let t_all = start.elapsed().as_secs_f64();
+        frame_t.push(t_all);
+        roots_t.push(t_roots);
+        grids_t.push(t_grids - t_roots);
+        step_t.push(t_all - t_grids);
+    }
+    // The two collision structures on the last frame's points.
+    let last = run.poses.last().expect("frames");
+    let queries: Vec<Vec3> = sim.strands().positions().to_vec();
+    let (grid_build_s, grid) = crate::median_seconds(5, true, || sim.skin_sdf(last));
+    let (grid_all, _) = crate::median_seconds(5, true, || {
+        queries.iter().map(|&p| grid.sample(p).0).sum::<f32>()
+    });
+    let (bvh_build_s, bvh) = crate::median_seconds(5, true, || {
+        TriangleBvh::new(last.positions(), &run.triangles)
+    });
+    let (bvh_all, _) = crate::median_seconds(3, false, || {
+        queries
+            .iter()
+            .map(|&p| bvh.closest(p).map_or(0.0, |c| c.distance_squared))
+            .sum::<f32>()
+    });
+    let per_query = |s: f64| s * 1e9 / queries.len() as f64;
+    let gpu = if args.no_gpu {
+        None
+    } else {
+        match gpu_figures(&run, &params, &sim) {
+            Ok(g) => Some(g),
+            Err(e) => {
+                eprintln!("no GPU column: {e:#}");
+                None
+            }
+        }
+    };
+    Ok(Figures {
+        guides: run.guides.len(),
+        points_per_guide: points,
+        substeps,
+        frames,
+        frame_s: median(frame_t),
+        roots_s: median(roots_t),
+        grids_s: median(grids_t),
+        step_s: median(step_t),
+        grid_build_s,
+        grid_query_ns: per_query(grid_all),
+        bvh_build_s,
+        bvh_query_ns: per_query(bvh_all),
+        gpu,
+    })
+}
+
+/// The same frames on the GPU: the strands' step as a compute shader,
+/// the skin's grids and roots made on the CPU and uploaded each frame.
+fn gpu_figures(
+    run: &FoxRun,
+    params: &StrandParams,
+    cpu: &GuideSimulation,
+) -> anyhow::Result<GpuFigures> {
+    let ctx = pelage_gpu::GpuContext::headless()?;
+    let mut sim = GuideSimulation::new(
+        &run.guides,
+        &run.triangles,
+        &run.poses[0],
+        params.clone(),
+        true,
+    )?;
+    let mut gpu = pelage_gpu::GpuStrands::new(&ctx, sim.strands())?;
+    let dt = 1.0 / 24.0;
+    let mut times = Vec::new();
+    for (f, pose) in run.poses.iter().enumerate().skip(1) {
+        let start = Instant::now();
+        let roots = sim.root_frames(pose);
+        let grids = sim.substep_grids(pose);
+        gpu.step(&ctx, params, dt, f as f32 * dt, &roots, &grids)?;
+        gpu.wait(&ctx)?;
+        times.push(start.elapsed().as_secs_f64());
+        sim.note_pose(pose);
+    }
+    let points = gpu.read_positions(&ctx)?;
+    let max_difference = points
+        .iter()
+        .zip(cpu.strands().positions())
+        .map(|(a, b)| (*a - *b).length() / run.size)
+        .fold(0.0f32, f32::max);
+    Ok(GpuFigures {
+        adapter: ctx.adapter_name(),
+        software: ctx.is_software(),
+        frame_s: median(times),
+        max_difference,
+    })
+}
+
+/// Runs the benchmark and prints its table (or its JSON).
+pub fn run(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<()> {
+    let f = measure(args)?;
+    let fps = 1.0 / f.frame_s;
+    let gpu_fps = f.gpu.as_ref().map(|g| 1.0 / g.frame_s);
+    if args.json {
+        let report = serde_json::json!({
+            "guides": f.guides,
+            "points_per_guide": f.points_per_guide,
+            "substeps": f.substeps,
+            "frames": f.frames,
+            "threads": rayon::current_num_threads(),
+            "cpu_frames_per_s": fps,
+            "cpu_frame_s": f.frame_s,
+            "cpu_roots_s": f.roots_s,
+            "cpu_grids_s": f.grids_s,
+            "cpu_step_s": f.step_s,
+            "grid_build_s": f.grid_build_s,
+            "grid_query_ns": f.grid_query_ns,
+            "bvh_build_s": f.bvh_build_s,
+            "bvh_query_ns": f.bvh_query_ns,
+            "gpu_frames_per_s": gpu_fps,
+            "gpu_adapter": f.gpu.as_ref().map(|g| g.adapter.clone()),
+            "gpu_software": f.gpu.as_ref().map(|g| g.software),
+            "gpu_max_difference": f.gpu.as_ref().map(|g| g.max_difference),
+        });
+        println!("{report}");
+        return Ok(());
+    }
+    println!(
+        "pelage bench dynamics --strands — the running Fox, {} guides × {} points, {} substeps a frame, body collisions; median of {} frames, {} threads",
+        thousands(f.guides as u64),
+        f.points_per_guide,
+        f.substeps,
+        f.frames,
+        rayon::current_num_threads()
+    );
+    println!();
+    println!(
+        "{:>10}  {:>12}  {:>14}  {:>10}  {:>10}  {:>10}",
+        "", "frames/s", "frame", "roots", "grids", "strands"
+    );
+    println!(
+        "{:>10}  {:>12.1}  {:>11.2} ms  {:>7.2} ms  {:>7.2} ms  {:>7.2} ms   target ≥ 24 frames/s",
+        "CPU",
+        fps,
+        f.frame_s * 1e3,
+        f.roots_s * 1e3,
+        f.grids_s * 1e3,
+        f.step_s * 1e3
+    );
+    match &f.gpu {
+        Some(g) => println!(
+            "{:>10}  {:>12.1}  {:>11.2} ms  (on {}{}; CPU and GPU points within {:.2e} of the Fox's size after {} frames)",
+            "GPU",
+            1.0 / g.frame_s,
+            g.frame_s * 1e3,
+            g.adapter,
+            if g.software { ", software" } else { "" },
+            g.max_difference,
+            f.frames
+        ),
+        None => println!("{:>10}  {:>12}", "GPU", "—"),
+    }
+    println!();
+    println!("collision structure, on the last frame's points (the grid is what the solver uses):");
+    println!(
+        "  distance grid: built in {:.2} ms, {:.0} ns a query",
+        f.grid_build_s * 1e3,
+        f.grid_query_ns
+    );
+    println!(
+        "  triangle BVH:  built in {:.2} ms, {:.0} ns a query ({:.1}× the grid's query)",
+        f.bvh_build_s * 1e3,
+        f.bvh_query_ns,
+        f.bvh_query_ns / f.grid_query_ns
+    );
+    Ok(())
+}
