@@ -41,6 +41,12 @@ pub struct DynamicsBenchArgs {
     /// Follow-The-Leader with body collisions): frames per second.
     #[arg(long)]
     pub strands: bool,
+    /// With `--strands`: guides (default 10,000; 2,000 with `--quick`).
+    #[arg(long, requires = "strands")]
+    pub guides: Option<usize>,
+    /// With `--strands`: points a guide (default 16).
+    #[arg(long, requires = "strands", default_value_t = 16)]
+    pub points: usize,
 }
 
 struct Row {

@@ -119,6 +119,10 @@ generate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }
 
 /// The Stubble figure: `method` interpolation, clump + noise, 16 points,
 /// normals and widths.
+/// Hairs kept out of the skin, for the bench's groom: appended to its
+/// last section, `[finish]`.
+const OUTSIDE_SKIN: &str = "outside_skin = true\n";
+
 /// A `[look]` for the bench's groom: melanin from a noise map, the rest
 /// constants, every value jittered.
 const LOOK: &str = "\n[look]\nmelanin = \"noise:frequency=3,seed=2,offset=0.5,scale=0.4\"\nroughness = 0.3\njitter = 0.1\n";
@@ -271,6 +275,8 @@ struct GroomFigures {
     fraction_s: f64,
     /// With a `[look]`: hair-shader values from a noise map, jittered.
     look_s: f64,
+    /// With `[finish] outside_skin`: points pushed out of the skin.
+    outside_s: f64,
     stable_ratio: f64,
     parted_ratio: f64,
     style_prep_s: f64,
@@ -346,6 +352,9 @@ fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
     let looked = Groom::from_text("<bench>", groom_text(hairs, "shepard") + LOOK)?;
     let (look_s, look_counted) = median_seconds(runs, false, || grow_all(&looked));
     look_counted?;
+    let outside = Groom::from_text("<bench>", groom_text(hairs, "shepard") + OUTSIDE_SKIN)?;
+    let (outside_s, outside_counted) = median_seconds(runs, false, || grow_all(&outside));
+    outside_counted?;
     let stable_ratio = shepard_s / sequential_s;
     let parted_ratio = parted_s / sequential_s;
     let (style_prep_s, _) = median_seconds(1, false, || style.generator(None).map(|_| ()));
@@ -394,6 +403,7 @@ fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
         parted_s,
         fraction_s,
         look_s,
+        outside_s,
         stable_ratio,
         parted_ratio,
         style_prep_s,
@@ -427,6 +437,7 @@ impl GroomFigures {
             parted_s,
             fraction_s,
             look_s,
+            outside_s,
             stable_ratio,
             parted_ratio,
             style_prep_s,
@@ -471,6 +482,8 @@ impl GroomFigures {
             "fraction_0_1_ratio": fraction_s / shepard_s,
             "look_seconds": look_s,
             "look_ratio": look_s / shepard_s,
+            "outside_skin_seconds": outside_s,
+            "outside_skin_ratio": outside_s / shepard_s,
             "rss_hairs": rss_hairs,
             "peak_rss_bytes": rss,
             "rss_usd_bytes": usd_bytes,
@@ -498,6 +511,7 @@ impl GroomFigures {
             parted_s,
             fraction_s,
             look_s,
+            outside_s,
             stable_ratio,
             parted_ratio,
             style_s,
@@ -563,6 +577,13 @@ impl GroomFigures {
             look_s,
             hair_count as f64 / look_s / 1e6,
             format!("{:.3}× all", look_s / shepard_s)
+        );
+        println!(
+            "{:<40} {:>10.3} {:>12.2} {:>14}",
+            "  hairs out of the skin (outside_skin)",
+            outside_s,
+            hair_count as f64 / outside_s / 1e6,
+            format!("{:.3}× all, target ≤ 1.25×", outside_s / shepard_s)
         );
         println!(
             "{:<40} {:>10.3} {:>12.2} {:>14}",

@@ -43,6 +43,8 @@ struct GpuFigures {
     adapter: String,
     software: bool,
     frame_s: f64,
+    /// Median seconds of the GPU's step alone (upload, dispatch, wait).
+    step_s: f64,
     /// Largest distance between a CPU and a GPU point after the frames,
     /// as a fraction of the Fox's size.
     max_difference: f32,
@@ -118,7 +120,8 @@ fn measure(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<Figures>
     } else {
         (10_000, 48)
     };
-    let points = 16;
+    let count = args.guides.unwrap_or(count);
+    let points = args.points;
     let run = fox_run(count, points, frames + 1)?;
     let params = fox_params(run.size);
     let substeps = params.substeps;
@@ -207,14 +210,16 @@ fn gpu_figures(
     )?;
     let mut gpu = pelage_gpu::GpuStrands::new(&ctx, sim.strands())?;
     let dt = 1.0 / 24.0;
-    let mut times = Vec::new();
+    let (mut times, mut steps) = (Vec::new(), Vec::new());
     for (f, pose) in run.poses.iter().enumerate().skip(1) {
         let start = Instant::now();
         let roots = sim.root_frames(pose);
         let grids = sim.substep_grids(pose);
+        let stepping = Instant::now();
         gpu.step(&ctx, params, dt, f as f32 * dt, &roots, &grids)?;
         gpu.wait(&ctx)?;
         times.push(start.elapsed().as_secs_f64());
+        steps.push(stepping.elapsed().as_secs_f64());
         sim.note_pose(pose);
     }
     let points = gpu.read_positions(&ctx)?;
@@ -227,6 +232,7 @@ fn gpu_figures(
         adapter: ctx.adapter_name(),
         software: ctx.is_software(),
         frame_s: median(times),
+        step_s: median(steps),
         max_difference,
     })
 }
@@ -253,6 +259,7 @@ pub fn run(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<()> {
             "bvh_build_s": f.bvh_build_s,
             "bvh_query_ns": f.bvh_query_ns,
             "gpu_frames_per_s": gpu_fps,
+            "gpu_steps_per_s": f.gpu.as_ref().map(|g| 1.0 / g.step_s),
             "gpu_adapter": f.gpu.as_ref().map(|g| g.adapter.clone()),
             "gpu_software": f.gpu.as_ref().map(|g| g.software),
             "gpu_max_difference": f.gpu.as_ref().map(|g| g.max_difference),
@@ -284,10 +291,11 @@ pub fn run(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<()> {
     );
     match &f.gpu {
         Some(g) => println!(
-            "{:>10}  {:>12.1}  {:>11.2} ms  (on {}{}; CPU and GPU points within {:.2e} of the Fox's size after {} frames)",
+            "{:>10}  {:>12.1}  {:>11.2} ms  (the step alone: {:.2} ms; on {}{}; CPU and GPU points within {:.2e} of the Fox's size after {} frames)",
             "GPU",
             1.0 / g.frame_s,
             g.frame_s * 1e3,
+            g.step_s * 1e3,
             g.adapter,
             if g.software { ", software" } else { "" },
             g.max_difference,

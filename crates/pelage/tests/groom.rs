@@ -656,3 +656,87 @@ fn look_values_out_of_range_are_errors_at_their_line() {
         "{unknown}"
     );
 }
+
+/// How far the deepest point of `curves` (roots left out) is inside the
+/// skin of `mesh`: the exact closest point, signed by the interpolated
+/// vertex normal.
+fn deepest_inside(mesh: &pelage::Mesh, curves: &Curves) -> f32 {
+    let bvh = pelage::mesh::TriangleBvh::new(mesh.positions(), mesh.triangles());
+    (0..curves.curve_count())
+        .flat_map(|c| curves.range(c).skip(1))
+        .map(|i| {
+            let p = curves.points()[i];
+            let hit = bvh.closest(p).unwrap();
+            let t = mesh.triangles()[hit.triangle as usize];
+            let n: Vec3 = (0..3)
+                .map(|k| hit.weights[k] * mesh.normals()[t[k] as usize])
+                .sum();
+            if (p - hit.point).dot(n) < 0.0 {
+                hit.distance_squared.sqrt()
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn outside_skin_pushes_noisy_curly_hair_out_of_spot_keeping_lengths() {
+    let text = |outside: bool| {
+        format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 4000\n\
+             [guides]\ngenerate = {{ count = 100, length = 0.06, comb = [0, -1, 0], gravity = 0.6 }}\n\
+             [[ops]]\ncurl = {{ radius = 0.02, turns = 2 }}\n\
+             [[ops]]\nnoise = {{ amplitude = 0.03, frequency = 20 }}\n\
+             [finish]\npoints = 12\noutside_skin = {outside}\n"
+        )
+    };
+    let grown = |outside: bool| {
+        let groom = groom(&text(outside));
+        let generator = groom.generator(None).unwrap();
+        let part = generator.part(0).unwrap();
+        (groom.mesh().clone(), part)
+    };
+    let (spot, free) = grown(false);
+    let (_, kept) = grown(true);
+    let size = {
+        let (lo, hi) = spot.bounds();
+        (hi - lo).max_element()
+    };
+    let tolerance = 1e-4 * size;
+    let free_depth = deepest_inside(&spot, &free);
+    assert!(
+        free_depth > 10.0 * tolerance,
+        "strong noise and curl should put points inside Spot (deepest {free_depth})"
+    );
+    let depth = deepest_inside(&spot, &kept);
+    assert!(depth <= tolerance, "a point is {depth} inside the skin");
+    // The same hairs, each segment as long as before (within float
+    // rounding) but where a crease leaves no room at its length, and
+    // hairs that were clear of the skin untouched.
+    assert_eq!(free.ids(), kept.ids());
+    let (mut untouched, mut segments, mut shortened) = (0, 0, 0);
+    for c in 0..free.curve_count() {
+        let (a, b) = (&free.points()[free.range(c)], &kept.points()[kept.range(c)]);
+        for i in 1..a.len() {
+            let (la, lb) = ((a[i] - a[i - 1]).length(), (b[i] - b[i - 1]).length());
+            assert!(
+                lb <= la * (1.0 + 1e-3) + 1e-6,
+                "hair {c} segment {i} grew: {la} → {lb}"
+            );
+            segments += 1;
+            if (la - lb).abs() > 1e-3 * la + 1e-6 {
+                shortened += 1;
+            }
+        }
+        untouched += usize::from(a == b);
+    }
+    assert!(
+        shortened * 1000 <= segments,
+        "{shortened} of {segments} segments shortened"
+    );
+    assert!(
+        untouched > 0 && untouched < free.curve_count(),
+        "{untouched} untouched"
+    );
+}

@@ -69,7 +69,7 @@ const MAX_POINTS: u32 = 32u;
 const COLLISION_PASSES: u32 = 3u;
 const CONTACT: f32 = 1.05;
 const KEEP_LENGTH_WITHIN: f32 = 0.9;
-const EXACT_WITHIN: f32 = 2.0;
+const EXACT_WITHIN: f32 = 1.0;
 const NO_TRIANGLE: u32 = 0xffffffffu;
 
 // ---- pelage::mesh::closest_on_triangle ----

@@ -2,26 +2,30 @@
 //! simulated strands out of the body.
 //!
 //! Distances are exact (closest point on a triangle, Ericson §5.1.5) at
-//! the grid nodes within `band` cells of a triangle, signed by the skin's
+//! the grid nodes within a band of the surface, signed by the skin's
 //! vertex normal interpolated at the closest point (the side of the
-//! surface the node is on; a pseudo-normal that tolerates open meshes,
-//! which ray parity would not). Nodes farther away hold `+band` cells:
-//! "clear of the skin". A query interpolates the eight nodes around it
-//! (trilinear) and takes the gradient of that interpolation as the
-//! direction out.
+//! surface the node is on: a pseudo-normal that tolerates open meshes,
+//! which ray parity would not); each of those nodes also keeps its
+//! closest triangle. Nodes farther away hold the band's depth: "clear of
+//! the skin". A query interpolates the eight nodes around it (trilinear);
+//! where that puts it within a cell of the skin, it measures the exact
+//! distance to the eight nodes' closest triangles (the closest of them,
+//! signed the same way) and takes the line to the closest point as the
+//! way out. Interpolation alone would miss parts thinner than two cells
+//! (a leg, an ear), whose nodes all lie outside them. Farther away the
+//! gradient of the interpolation is the way out.
 //!
 //! Why a grid and not closest-point queries over a BVH: a simulation asks
 //! for every point of every strand at every substep (10,000 guides × 16
-//! points × 4 substeps a frame), and only a few thousand triangles move.
-//! Rebuilding the band once a frame and reading eight numbers a query
-//! costs a fraction of a BVH descent a query; `pelage bench dynamics
+//! points × 4 substeps a frame), and a skin has a few thousand triangles.
+//! A grid query costs about a quarter of a BVH descent; its build costs
+//! milliseconds, which the queries repay; `pelage bench dynamics
 //! --strands` measures both in the same run.
 //!
-//! The band is the limit: a point more than `band` cells inside the skin
-//! reads as clear of it. Strands enter the skin only from outside, a
-//! segment at a time, so the band needs to be at least a segment plus the
-//! collision thickness deep; [`SkinSdf::new`] takes the depth it must
-//! cover and sizes the band from it.
+//! The band is the limit: a point deeper inside the skin than the band
+//! reads as clear of it. Strands enter the skin only from outside, by a
+//! segment or by the skin's move between two checks, so
+//! [`SkinSdf::new`] takes the depth the band must cover.
 
 use crate::mesh::closest_on_triangle;
 use glam::Vec3;
@@ -29,7 +33,7 @@ use rayon::prelude::*;
 
 /// Within this many cells of the skin (by the interpolated distance), a
 /// query measures the exact distance to the nearby triangles.
-const EXACT_WITHIN: f32 = 2.0;
+const EXACT_WITHIN: f32 = 1.0;
 
 /// The signed distance to a posed skin on a uniform grid of nodes.
 #[derive(Debug, Clone)]
@@ -51,7 +55,7 @@ pub struct SkinSdf {
 impl SkinSdf {
     /// The grid of the skin `positions` / `triangles` (with per-vertex
     /// `normals` giving each side), nodes `cell` apart, exact within
-    /// `depth` of the surface (at least two cells).
+    /// `depth` of the surface (at least two cells deep).
     pub fn new(
         positions: &[Vec3],
         normals: &[Vec3],

@@ -408,6 +408,61 @@ fn turn(a: Vec3, b: Vec3, r: Vec3) -> Vec3 {
     r * c + k.cross(r) + k * (k.dot(r) / (1.0 + c))
 }
 
+/// How [`follow_outside`] treats the skin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkinContact {
+    /// Distance kept from the skin.
+    pub thickness: f32,
+    /// A point put back at its length is kept there if at least this far
+    /// from the skin; nearer, the push wins over the length.
+    pub keep_length_above: f32,
+    /// Pushes out and back to length, at most.
+    pub passes: usize,
+}
+
+/// Follow-the-leader with the skin: `target` put at `length` from
+/// `leader` on the line between them, then, with a skin, pushed out to
+/// the contact's thickness and put back at its length, up to `passes`
+/// times (the length pass can turn a point back in where the skin is
+/// curved). Returns the point and the way out of the skin where it came
+/// within [`CONTACT`] thicknesses of it (zero otherwise). `fallback`: the
+/// direction when `target` is on `leader`.
+#[inline]
+pub fn follow_outside(
+    leader: Vec3,
+    target: Vec3,
+    length: f32,
+    fallback: Vec3,
+    skin: Option<&SkinSdf>,
+    contact: &SkinContact,
+) -> (Vec3, Vec3) {
+    let mut q = leader + length * (target - leader).normalize_or(fallback);
+    let mut touched = Vec3::ZERO;
+    let Some(skin) = skin else {
+        return (q, touched);
+    };
+    let thickness = contact.thickness;
+    for _ in 0..contact.passes {
+        let (d, out) = skin.sample(q);
+        if out == Vec3::ZERO {
+            break;
+        }
+        if d < thickness * CONTACT {
+            touched = out;
+        }
+        if d >= thickness {
+            break;
+        }
+        let pushed = q + (thickness - d) * out;
+        q = leader + length * (pushed - leader).normalize_or(out);
+        let (d, _) = skin.sample(q);
+        if d < contact.keep_length_above {
+            q = pushed;
+        }
+    }
+    (q, touched)
+}
+
 #[allow(clippy::too_many_arguments)]
 fn substep(
     x: &mut [Vec3],
@@ -432,6 +487,11 @@ fn substep(
         p[i] = x[i] + k.h * vi;
     }
     let frame = root.frame;
+    let contact = SkinContact {
+        thickness: k.thickness,
+        keep_length_above: k.thickness * KEEP_LENGTH_WITHIN,
+        passes: COLLISION_PASSES,
+    };
     for _ in 0..k.iterations {
         if k.follow > 0.0 {
             for i in 1..n {
@@ -457,30 +517,10 @@ fn substep(
         }
         for i in 1..n {
             let before = p[i];
-            let mut q = p[i - 1] + lengths[i] * (p[i] - p[i - 1]).normalize_or(frame.z_axis);
-            if let Some(skin) = skin {
-                // Out of the skin and back to the rest length, a few times:
-                // the length pass can turn a point back in where the skin
-                // is curved; the last move is out, so the skin wins over
-                // a sliver of stretch.
-                for _ in 0..COLLISION_PASSES {
-                    let (d, out) = skin.sample(q);
-                    if out == Vec3::ZERO {
-                        break;
-                    }
-                    if d < k.thickness * CONTACT {
-                        touched[i] = out;
-                    }
-                    if d >= k.thickness {
-                        break;
-                    }
-                    let pushed = q + (k.thickness - d) * out;
-                    q = p[i - 1] + lengths[i] * (pushed - p[i - 1]).normalize_or(out);
-                    let (d, _) = skin.sample(q);
-                    if d < k.thickness * KEEP_LENGTH_WITHIN {
-                        q = pushed;
-                    }
-                }
+            let (q, touch) =
+                follow_outside(p[i - 1], p[i], lengths[i], frame.z_axis, skin, &contact);
+            if touch != Vec3::ZERO {
+                touched[i] = touch;
             }
             p[i] = q;
             correction[i] = q - before;

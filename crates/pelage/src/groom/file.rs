@@ -497,6 +497,12 @@ pub struct FinishSection {
     /// Per-point ribbon normals from rotation-minimizing frames.
     #[serde(default = "yes")]
     pub normals: bool,
+    /// Push hair points out of the skin after the operators (default: on
+    /// for animated grooms, off for still ones).
+    pub outside_skin: Option<bool>,
+    /// How far above the skin `outside_skin` keeps points (default: a
+    /// thousandth of the mesh's size).
+    pub skin_gap: Option<f64>,
 }
 
 fn default_points() -> Spanned<usize> {
@@ -524,6 +530,8 @@ impl Default for FinishSection {
             color: None,
             opacity: None,
             normals: true,
+            outside_skin: None,
+            skin_gap: None,
         }
     }
 }

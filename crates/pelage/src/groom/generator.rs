@@ -13,6 +13,7 @@ use super::ops::{
     CentreGuides, ClumpCentres, OpKey, Opacity, Operator, Preparation, Resampling, Width,
     color_maps_mut, root_to_tip_maps_mut,
 };
+use super::outside_skin::OutsideSkin;
 use super::parts::{Part, PartLayout};
 use super::regions::RegionLookup;
 use super::spec::{GroomSpec, HairIds, RootDistribution, SpecOrigin, setting_error};
@@ -73,6 +74,8 @@ pub struct Generator {
     /// as the whole groom does.
     pub(super) width_scale: f32,
     pub(super) normals: bool,
+    /// The skin hairs are kept out of, after the operators.
+    pub(super) outside_skin: Option<Arc<OutsideSkin>>,
     /// Each hair's values for a hair shader.
     pub(super) look: Option<HairLook>,
     pub(super) seed: u64,
@@ -314,6 +317,14 @@ impl Generator {
             ..
         } = spec;
         let (colors, opacities) = (finish.color.is_some(), finish.opacity.is_some());
+        // The skin's grid depends on the mesh alone: an edit's generator
+        // shares its parent's.
+        let outside_skin = finish.outside_skin.map(|gap| {
+            from.filter(|g| Arc::ptr_eq(&g.mesh, &mesh))
+                .and_then(|g| g.outside_skin.clone())
+                .filter(|o| o.gap() == gap)
+                .unwrap_or_else(|| Arc::new(OutsideSkin::new(&mesh, gap)))
+        });
         let mut base = vec![Operator::Width(Width(finish.width))];
         base.extend(finish.color.map(Operator::Color));
         base.extend(finish.opacity.map(|o| Operator::Opacity(Opacity(o))));
@@ -343,6 +354,7 @@ impl Generator {
                 1.0
             },
             normals: finish.normals,
+            outside_skin,
             look,
             // A frame's generator (`reshaped`) grows parts of the same
             // sizes: it reuses its parent's arrays.

@@ -61,6 +61,11 @@ impl Generator {
                 break;
             }
         }
+        if let Some(skin) = &self.outside_skin {
+            for hair in ws.batch.hairs_mut() {
+                skin.apply(&mut hair.points, context.normal);
+            }
+        }
         context.normal
     }
 
@@ -82,6 +87,11 @@ impl Generator {
         let hairs = &mut ws.group[..roots.len()];
         for op in self.base.iter().chain(&self.ops) {
             op.apply_each(hairs, &ws.contexts, &mut ws.scratch);
+        }
+        if let Some(skin) = &self.outside_skin {
+            for (hair, context) in hairs.iter_mut().zip(&ws.contexts) {
+                skin.apply(&mut hair.points, context.normal);
+            }
         }
     }
 

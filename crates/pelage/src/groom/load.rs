@@ -9,6 +9,7 @@ use super::file::{AnimationModeName, GroomFile, InterpolationKind, MapValue, Mes
 use super::generator::Generator;
 use super::hair_look::HairLook;
 use super::ops::{OpKey, SpecReader, map_on_mesh};
+use super::outside_skin::OutsideSkin;
 use super::spec::{FinishSpec, GroomSpec, HairIds, RegionsSpec, RootsSpec, SpecOrigin};
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
@@ -469,6 +470,15 @@ impl Groom {
             color,
             opacity,
             normals: file.finish.normals,
+            outside_skin: file
+                .finish
+                .outside_skin
+                .unwrap_or(self.animation.is_some())
+                .then(|| {
+                    file.finish
+                        .skin_gap
+                        .map_or_else(|| OutsideSkin::default_gap(&self.mesh), |g| g as f32)
+                }),
         };
         let mut ops = Vec::with_capacity(file.ops.len());
         for (index, spec) in file.ops.iter().enumerate() {

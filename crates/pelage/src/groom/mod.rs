@@ -44,6 +44,7 @@ mod hair_look;
 mod load;
 pub mod ops;
 mod output;
+mod outside_skin;
 pub mod parts;
 mod ramp;
 pub mod regions;
@@ -62,6 +63,7 @@ pub use generator::{Generator, GroomSummary, HAIRS_PER_PART};
 pub use hair_look::HairLook;
 pub use load::{Groom, GroomInputs};
 pub use output::{GroomWriteError, StreamError, part_file, part_name, part_slice, write_assembly};
+pub use outside_skin::OutsideSkin;
 pub use parts::{Part, PartLayout};
 pub use ramp::Ramp;
 pub use report::{

@@ -54,6 +54,7 @@ const GROOM_RULES: &[Rule] = &[
     ),
     Rule::new("interpolation.radius", Bound::more_than(0.0), "a distance"),
     Rule::new("roots.density", Bound::at_least(0.0), "a density"),
+    Rule::new("finish.skin_gap", Bound::at_least(0.0), "a distance"),
     Rule::new(
         "finish.points",
         Bound::Within(2.0, MAX_CURVE_POINTS as f64),

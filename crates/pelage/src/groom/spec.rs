@@ -334,6 +334,10 @@ pub struct FinishSpec {
     pub opacity: Option<RootToTip>,
     /// Per-point ribbon normals from rotation-minimizing frames.
     pub normals: bool,
+    /// Keep hair points this far above the skin after the operators,
+    /// segment lengths kept (`None`: off); see
+    /// [`OutsideSkin`](crate::groom::OutsideSkin).
+    pub outside_skin: Option<f32>,
 }
 
 impl Default for FinishSpec {
@@ -346,6 +350,7 @@ impl Default for FinishSpec {
             color: None,
             opacity: None,
             normals: true,
+            outside_skin: None,
         }
     }
 }
