@@ -681,3 +681,63 @@ fn regrown_velocities_do_not_depend_on_how_the_frames_are_split() {
     }
     assert_ne!(one["2"], one["3"], "the bend speeds up");
 }
+
+/// A groom file on the running Fox, in `mode`, with `extra` sections.
+fn fox_groom(mode: &str, extra: &str) -> pelage::groom::Groom {
+    let fox = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/fox/Fox.gltf");
+    let text = format!(
+        "[mesh]\npath = {fox:?}\n[roots]\ncount = 1500\n\
+         [guides]\ngenerate = {{ count = 150, length = 10.0 }}\n\
+         [animation]\nframes = \"1-6\"\nclip = \"Run\"\nmode = \"{mode}\"\n{extra}"
+    );
+    pelage::groom::Groom::from_text("fox.toml", &text).unwrap()
+}
+
+#[test]
+fn simulated_grooms_regrow_every_frame_from_guides_that_swing_with_the_run() {
+    // Gravity in the Fox's centimetre-like units; no follow, so the fur
+    // lags behind the run.
+    let simulation = "[simulation]\ngravity = [0, -500, 0]\nfollow = 0\npreroll = 6\n";
+    let simulated = fox_groom("simulate", simulation)
+        .animated(None)
+        .unwrap()
+        .unwrap();
+    let deformed = fox_groom("deform", "").animated(None).unwrap().unwrap();
+    let (mut apart, mut tips) = (0.0f32, 0usize);
+    for frame in [1.0, 6.0] {
+        let (a, b) = (
+            simulated.part(0, frame).unwrap(),
+            deformed.part(0, frame).unwrap(),
+        );
+        assert_eq!(a.ids(), b.ids(), "the same hairs");
+        for c in 0..a.curve_count() {
+            let (ra, rb) = (a.range(c), b.range(c));
+            // Roots on the skin in both.
+            assert!((a.points()[ra.start] - b.points()[rb.start]).length() < 1e-3);
+            apart += (a.points()[ra.end - 1] - b.points()[rb.end - 1]).length();
+            tips += 1;
+        }
+    }
+    let mean = apart / tips as f32;
+    assert!(
+        mean > 1.0,
+        "simulated tips are {mean} from the deformed ones on average"
+    );
+    // [simulation] without the mode is a mistake worth saying.
+    let fox = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/fox/Fox.gltf");
+    let text = format!(
+        "[mesh]\npath = {fox:?}\n[roots]\ncount = 100\n[guides]\ngenerate = {{ count = 10, length = 5.0 }}\n\
+         [animation]\nframes = \"1-2\"\n[simulation]\nbend = 0.5\n"
+    );
+    let error = pelage::groom::Groom::from_text("fox.toml", &text)
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("mode = \"simulate\""), "{error}");
+    let text = text
+        .replace("bend = 0.5", "bend = 2")
+        .replace("frames = \"1-2\"", "frames = \"1-2\"\nmode = \"simulate\"");
+    let error = pelage::groom::Groom::from_text("fox.toml", &text)
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("simulation.bend"), "{error}");
+}

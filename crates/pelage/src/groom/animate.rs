@@ -76,6 +76,10 @@ pub enum AnimationMode {
     Deform,
     /// Regrow every frame from animated guides, in rest space.
     Regrow,
+    /// Simulate the guides over the frames (gravity, wind, the skin's
+    /// motion, collisions with it: [`crate::dynamics::GuideSimulation`]),
+    /// then regrow every frame from them.
+    Simulate,
 }
 
 impl AnimationMode {
@@ -84,8 +88,15 @@ impl AnimationMode {
         match name {
             "deform" => Some(Self::Deform),
             "regrow" => Some(Self::Regrow),
+            "simulate" => Some(Self::Simulate),
             _ => None,
         }
+    }
+
+    /// Whether every frame is grown again from the frame's guides
+    /// (regrow and simulate).
+    pub fn regrows(self) -> bool {
+        matches!(self, Self::Regrow | Self::Simulate)
     }
 
     /// The mode's name in groom files.
@@ -93,6 +104,7 @@ impl AnimationMode {
         match self {
             Self::Deform => "deform",
             Self::Regrow => "regrow",
+            Self::Simulate => "simulate",
         }
     }
 }
@@ -224,7 +236,7 @@ impl AnimatedGroom {
                 )),
             ));
         }
-        if animation.mode == AnimationMode::Regrow && guides.is_none() {
+        if animation.mode.regrows() && guides.is_none() {
             return Err(spec.error(
                 "animation.mode",
                 GroomErrorKind::Invalid(
@@ -305,7 +317,9 @@ impl AnimatedGroom {
     fn frame_generator(&self, time: f64, pose: &SkinPose) -> Result<Option<Generator>, GroomError> {
         match self.animation.mode {
             AnimationMode::Deform => Ok(None),
-            AnimationMode::Regrow => self.regrown_generator(time, pose).map(Some),
+            AnimationMode::Regrow | AnimationMode::Simulate => {
+                self.regrown_generator(time, pose).map(Some)
+            }
         }
     }
 
@@ -372,7 +386,7 @@ impl AnimatedGroom {
                     carried
                 }
             },
-            AnimationMode::Regrow => {
+            AnimationMode::Regrow | AnimationMode::Simulate => {
                 // A fresh growth every frame: moved where it lies.
                 let mut grown = generator.part(p)?;
                 let carried = self.binding.carry_in_place(&mut grown, pose);
@@ -720,8 +734,7 @@ impl AnimatedGroom {
         // Regrow: velocities by central differences over the neighbouring
         // time codes, whose growths are kept (three at most) as the
         // frames go by.
-        let regrow_velocities =
-            self.animation.mode == AnimationMode::Regrow && self.animation.velocities;
+        let regrow_velocities = self.animation.mode.regrows() && self.animation.velocities;
         let all_times = self.animation.sample_times();
         for p in parts {
             let mut rest = None;

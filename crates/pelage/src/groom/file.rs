@@ -98,6 +98,9 @@ pub struct GroomFile {
     pub output: OutputSection,
     /// Frames of an animated skin (absent: a still groom).
     pub animation: Option<AnimationSection>,
+    /// `[simulation]`: how `[animation] mode = "simulate"` moves the
+    /// guides.
+    pub simulation: Option<SimulationSection>,
     /// Regions of the skin that do not share guides or clumps (absent:
     /// one region).
     pub regions: Option<RegionsSection>,
@@ -202,6 +205,75 @@ fn default_fps() -> f64 {
     24.0
 }
 
+/// `[simulation]`: the guide strands' settings (docs/dynamics.md).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSection {
+    /// Substeps a frame.
+    #[serde(default = "default_substeps")]
+    pub substeps: u32,
+    /// Follow, bend and length passes a substep.
+    #[serde(default = "default_one")]
+    pub iterations: u32,
+    /// Gravity, scene units per second² (default: 9.81 down −Y, for a
+    /// skin in metres).
+    #[serde(default = "default_gravity")]
+    pub gravity: [f32; 3],
+    /// Velocity decay rate, per second.
+    #[serde(default = "default_damping")]
+    pub damping: f32,
+    /// Bend stiffness, 0 to 1.
+    #[serde(default = "default_bend")]
+    pub bend: f32,
+    /// Pull toward the groomed guide, 0 to 1.
+    #[serde(default = "default_follow")]
+    pub follow: f32,
+    /// Wind velocity, scene units per second.
+    #[serde(default)]
+    pub wind: [f32; 3],
+    /// Air drag toward the wind, per second.
+    #[serde(default)]
+    pub drag: f32,
+    /// Collide with the skin.
+    #[serde(default = "default_true")]
+    pub collide: bool,
+    /// How far from the skin guides are kept (default: 0.2 % of the
+    /// mesh's size).
+    pub thickness: Option<f32>,
+    /// Friction against the skin, 0 to 1.
+    #[serde(default = "default_friction")]
+    pub friction: f32,
+    /// Frames simulated at the first frame's pose before it, for the
+    /// guides to settle.
+    #[serde(default = "default_preroll")]
+    pub preroll: u32,
+}
+
+fn default_substeps() -> u32 {
+    4
+}
+fn default_one() -> u32 {
+    1
+}
+fn default_gravity() -> [f32; 3] {
+    [0.0, -9.81, 0.0]
+}
+fn default_damping() -> f32 {
+    1.0
+}
+fn default_bend() -> f32 {
+    0.3
+}
+fn default_follow() -> f32 {
+    0.05
+}
+fn default_friction() -> f32 {
+    0.3
+}
+fn default_preroll() -> u32 {
+    12
+}
+
 /// `[animation] mode`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -211,6 +283,8 @@ pub enum AnimationModeName {
     Deform,
     /// Regrow every frame from animated guides.
     Regrow,
+    /// Simulate the guides, regrow every frame from them.
+    Simulate,
 }
 
 /// `[mesh]`.

@@ -10,8 +10,10 @@ use super::generator::Generator;
 use super::hair_look::HairLook;
 use super::ops::{OpKey, SpecReader, map_on_mesh};
 use super::outside_skin::OutsideSkin;
+use super::simulate::{SimulationSettings, simulate_guides};
 use super::spec::{FinishSpec, GroomSpec, HairIds, RegionsSpec, RootsSpec, SpecOrigin};
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
+use crate::dynamics::{StrandParams, Wind};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{InterpolationMethod, StyleMeshOptions};
 use crate::mesh::{Mesh, MeshError, MeshErrorKind};
@@ -256,8 +258,44 @@ impl Groom {
                 };
                 Some(guides)
             }
+            AnimationMode::Simulate => Some(simulate_guides(
+                &spec,
+                &animation.skin,
+                &animation.spec,
+                &self.simulation_settings(animation.fps),
+            )?),
         };
         AnimatedGroom::new(spec, animation.skin.clone(), animation.spec.clone(), guides).map(Some)
+    }
+
+    /// `[simulation]` as the solver takes it (its defaults where the file
+    /// has none).
+    fn simulation_settings(&self, fps: f64) -> SimulationSettings {
+        let section =
+            self.file.simulation.clone().unwrap_or_else(|| {
+                toml::from_str("").expect("every [simulation] key has a default")
+            });
+        let (lo, hi) = self.mesh.bounds();
+        let size = (hi - lo).max_element();
+        SimulationSettings {
+            params: StrandParams {
+                substeps: section.substeps,
+                iterations: section.iterations,
+                gravity: Vec3::from(section.gravity),
+                damping: section.damping,
+                bend: section.bend,
+                follow: section.follow,
+                drag: section.drag,
+                wind: (section.wind != [0.0; 3])
+                    .then(|| Wind::new(Vec3::from(section.wind), 0.0, 0.0, 0.0, 1.0, 0)),
+                thickness: section.thickness.unwrap_or(2e-3 * size),
+                friction: section.friction,
+                ..StrandParams::default()
+            },
+            collide: section.collide,
+            preroll: section.preroll,
+            fps,
+        }
     }
 
     /// The number of hairs `[roots] count` asks for (before `strands`
@@ -678,9 +716,21 @@ fn animation_spec(
             GroomErrorKind::Invalid("rest_frame must be a finite number".into()),
         ));
     }
+    if let (Some(_), false) = (
+        &file.simulation,
+        section.is_some_and(|s| s.mode == AnimationModeName::Simulate),
+    ) {
+        return Err(source.error_at(
+            section.map_or(0..0, |s| s.frames.span()),
+            GroomErrorKind::Invalid(
+                "[simulation] moves the guides of an animated groom with mode = \"simulate\" in [animation]: set it, or remove [simulation]".into(),
+            ),
+        ));
+    }
     let mode = match section.map(|s| s.mode).unwrap_or_default() {
         AnimationModeName::Deform => AnimationMode::Deform,
         AnimationModeName::Regrow => AnimationMode::Regrow,
+        AnimationModeName::Simulate => AnimationMode::Simulate,
     };
     let spec = AnimationSpec {
         frames,

@@ -49,6 +49,7 @@ pub mod parts;
 mod ramp;
 pub mod regions;
 mod report;
+mod simulate;
 mod source;
 mod spec;
 mod writing;
@@ -70,6 +71,7 @@ pub use report::{
     GroomReport, GuideNote, GuidesReport, LostGuideNote, PartReport, RegionReport, ReportBuilder,
     Timings,
 };
+pub use simulate::{SimulationSettings, simulate_guides};
 pub use writing::{AssembleError, Assembly, DEFAULT_FPS};
 
 pub use ops::{

@@ -56,6 +56,31 @@ const GROOM_RULES: &[Rule] = &[
     Rule::new("roots.density", Bound::at_least(0.0), "a density"),
     Rule::new("finish.skin_gap", Bound::at_least(0.0), "a distance"),
     Rule::new(
+        "simulation.substeps",
+        Bound::Within(1.0, 64.0),
+        "substeps a frame",
+    ),
+    Rule::new(
+        "simulation.iterations",
+        Bound::Within(1.0, 100.0),
+        "passes a substep",
+    ),
+    Rule::new(
+        "simulation.damping",
+        Bound::at_least(0.0),
+        "a rate per second",
+    ),
+    Rule::new("simulation.bend", Bound::Within(0.0, 1.0), "a fraction"),
+    Rule::new("simulation.follow", Bound::Within(0.0, 1.0), "a fraction"),
+    Rule::new("simulation.drag", Bound::at_least(0.0), "a rate per second"),
+    Rule::new("simulation.thickness", Bound::at_least(0.0), "a distance"),
+    Rule::new("simulation.friction", Bound::Within(0.0, 1.0), "a fraction"),
+    Rule::new(
+        "simulation.preroll",
+        Bound::Within(0.0, MAX_FRAMES as f64),
+        "frames",
+    ),
+    Rule::new(
         "finish.points",
         Bound::Within(2.0, MAX_CURVE_POINTS as f64),
         "points per hair",
