@@ -19,11 +19,6 @@ use glam::Vec3;
 /// grid is built once.
 const NODES_ALONG: f32 = 128.0;
 
-/// How deep into the skin a point is still pushed out, as a fraction of
-/// the mesh's size: deeper than any operator pushes a hair of a sensible
-/// length.
-const DEPTH: f32 = 0.05;
-
 /// The skin a groom's hairs are kept out of.
 #[derive(Debug, Clone)]
 pub struct OutsideSkin {
@@ -32,8 +27,14 @@ pub struct OutsideSkin {
 }
 
 impl OutsideSkin {
-    /// The skin of `mesh` (at rest), keeping hairs `gap` above it.
-    pub fn new(mesh: &Mesh, gap: f32) -> Self {
+    /// The skin of `mesh` (at rest), keeping hairs `gap` above it, for
+    /// hairs whose segments are about `segment` long.
+    ///
+    /// The grid's exact band reaches two segments deep: follow-the-leader
+    /// puts each point at its length from a predecessor outside the skin,
+    /// so no point it places is deeper than a segment, and a hair that an
+    /// operator sent deeper crosses the band on its way in from the root.
+    pub fn new(mesh: &Mesh, gap: f32, segment: f32) -> Self {
         let (lo, hi) = mesh.bounds();
         let size = (hi - lo).max_element().max(f32::MIN_POSITIVE);
         let cell = size / NODES_ALONG;
@@ -42,7 +43,7 @@ impl OutsideSkin {
             mesh.normals(),
             mesh.triangles(),
             cell,
-            (DEPTH * size).max(4.0 * gap),
+            2.0 * segment + gap,
         );
         Self { skin, gap }
     }
