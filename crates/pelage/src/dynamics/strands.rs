@@ -425,7 +425,7 @@ pub struct SkinContact {
 /// the contact's thickness and put back at its length, up to `passes`
 /// times (the length pass can turn a point back in where the skin is
 /// curved). Returns the point and the way out of the skin where it came
-/// within [`CONTACT`] thicknesses of it (zero otherwise). `fallback`: the
+/// within 1.05 thicknesses of it (zero otherwise). `fallback`: the
 /// direction when `target` is on `leader`.
 #[inline]
 pub fn follow_outside(
