@@ -40,7 +40,8 @@ const PYTHON_GROOM: &str = "<python groom>";
 ///
 /// The tables are those of the groom file format (docs/groom-format.md):
 /// `roots`, `guides`, `interpolation`, `ops`, `finish`, `output`,
-/// `animation`. `mesh` is a `Mesh` or a path; `guides` is a table, a
+/// `animation`, `simulation` (with `animation={"mode": "simulate"}`),
+/// `regions`, `look`. `mesh` is a `Mesh` or a path; `guides` is a table, a
 /// path, or `Curves` to bind to the mesh (`{"curves": c, "points": 8}`
 /// binds them with the table's settings).
 #[pyclass(name = "Groom", module = "pelage", frozen)]
@@ -133,7 +134,7 @@ impl PyGroom {
 #[pymethods]
 impl PyGroom {
     #[new]
-    #[pyo3(signature = (*, mesh, guides, roots, ops = None, interpolation = None, finish = None, output = None, animation = None, regions = None, look = None, base_dir = None))]
+    #[pyo3(signature = (*, mesh, guides, roots, ops = None, interpolation = None, finish = None, output = None, animation = None, simulation = None, regions = None, look = None, base_dir = None))]
     #[allow(
         clippy::too_many_arguments,
         reason = "one keyword argument a groom-file table"
@@ -148,6 +149,7 @@ impl PyGroom {
         finish: Option<&Bound<'_, PyAny>>,
         output: Option<&Bound<'_, PyAny>>,
         animation: Option<&Bound<'_, PyAny>>,
+        simulation: Option<&Bound<'_, PyAny>>,
         regions: Option<&Bound<'_, PyAny>>,
         look: Option<&Bound<'_, PyAny>>,
         base_dir: Option<PathBuf>,
@@ -216,6 +218,7 @@ impl PyGroom {
             ("finish", finish),
             ("output", output),
             ("animation", animation),
+            ("simulation", simulation),
             ("regions", regions),
             ("look", look),
         ] {

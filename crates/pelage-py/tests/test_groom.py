@@ -200,6 +200,35 @@ def test_an_animated_groom_writes_every_frame(tmp_path):
         groom.grow_frame(3, part=99)
 
 
+def test_a_simulated_groom_swings_away_from_the_deformed_one():
+    fox = REPO / "crates" / "pelage" / "assets" / "fox" / "Fox.gltf"
+
+    def grown(mode, simulation=None):
+        groom = pelage.Groom(
+            mesh=str(fox),
+            guides={"generate": {"count": 40, "length": 10.0}},
+            roots=300,
+            animation={"frames": "1-4", "clip": "Run", "mode": mode},
+            simulation=simulation,
+        )
+        return groom.grow_frame(4)
+
+    deformed = grown("deform")
+    simulated = grown("simulate", {"gravity": [0, -500, 0], "follow": 0, "preroll": 4})
+    assert np.array_equal(deformed.ids, simulated.ids)
+    tips = lambda c: c.points[c.offsets[1:] - 1]
+    apart = np.linalg.norm(tips(deformed) - tips(simulated), axis=1).mean()
+    assert apart > 1.0, apart
+    with pytest.raises(pelage.PelageError, match=r"simulation\.bend"):
+        pelage.Groom(
+            mesh=str(fox),
+            guides={"generate": {"count": 4, "length": 10.0}},
+            roots=10,
+            animation={"frames": "1-2", "mode": "simulate"},
+            simulation={"bend": 2},
+        )
+
+
 def test_a_still_groom_has_no_frames(groom):
     assert groom.frames is None
     with pytest.raises(ValueError, match="not animated"):

@@ -148,6 +148,7 @@ class Groom:
         finish: Optional[Dict[str, Any]] = None,
         output: Optional[Dict[str, Any]] = None,
         animation: Optional[Dict[str, Any]] = None,
+        simulation: Optional[Dict[str, Any]] = None,
         regions: Optional[Dict[str, Any]] = None,
         look: Optional[Dict[str, Any]] = None,
         base_dir: Optional[_Path] = None,
