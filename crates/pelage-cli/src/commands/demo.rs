@@ -24,9 +24,14 @@ pub struct DemoArgs {
     /// walking, its fur following the skin frame by frame).
     #[arg(value_enum, default_value = "spot")]
     pub which: DemoName,
-    /// Folder the demo writes into (default: pelage-demo, or pelage-fox).
+    /// Folder the demo writes into (default: pelage-demo, pelage-fox, or
+    /// pelage-fox-simulate).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// With `fox`: the Fox running with long fur whose guides are
+    /// simulated (gravity, inertia, collisions with the body).
+    #[arg(long)]
+    pub simulate: bool,
 }
 
 /// The demos.
@@ -40,6 +45,9 @@ pub enum DemoName {
 
 /// The fox demo's groom file, as written for the user.
 pub const FOX_GROOM: &str = include_str!("../demo_fox.toml");
+
+/// `demo fox --simulate`'s groom file.
+pub const FOX_SIMULATE_GROOM: &str = include_str!("../demo_fox_simulate.toml");
 
 /// The demo's groom file, as written for the user.
 pub const DEMO_GROOM: &str = include_str!("../demo.toml");
@@ -73,13 +81,20 @@ fn render_preview(
 
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     if args.which == DemoName::Fox {
+        let folder = if args.simulate {
+            "pelage-fox-simulate"
+        } else {
+            "pelage-fox"
+        };
         return run_fox(
-            &args
-                .out
-                .clone()
-                .unwrap_or_else(|| PathBuf::from("pelage-fox")),
+            &args.out.clone().unwrap_or_else(|| PathBuf::from(folder)),
+            args.simulate,
         );
     }
+    anyhow::ensure!(
+        !args.simulate,
+        "--simulate goes with the fox demo: pelage demo fox --simulate"
+    );
     let out = args
         .out
         .clone()
@@ -160,16 +175,21 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
 /// `pelage demo fox`: the fox groom grown over the walk cycle into one
 /// time-sampled usdc (with the walking skin), rendered to a PNG a frame
 /// and a GIF.
-fn run_fox(out: &std::path::Path) -> anyhow::Result<()> {
+fn run_fox(out: &std::path::Path, simulate: bool) -> anyhow::Result<()> {
     let start = Instant::now();
-    println!(
-        "pelage {} demo — fur on the walking Khronos Fox\n",
-        env!("CARGO_PKG_VERSION")
-    );
+    let (what, groom_text) = if simulate {
+        (
+            "long fur swinging on the running Khronos Fox (simulated guides)",
+            FOX_SIMULATE_GROOM,
+        )
+    } else {
+        ("fur on the walking Khronos Fox", FOX_GROOM)
+    };
+    println!("pelage {} demo — {what}\n", env!("CARGO_PKG_VERSION"));
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create the folder {}", out.display()))?;
     for (name, bytes) in [
-        ("fox.toml", FOX_GROOM.as_bytes()),
+        ("fox.toml", groom_text.as_bytes()),
         ("Fox.gltf", pelage::assets::FOX_GLTF),
         ("fox.png", pelage::assets::FOX_TEXTURE_PNG),
         ("LICENSE-fox.md", pelage::assets::FOX_LICENSE.as_bytes()),
@@ -178,9 +198,27 @@ fn run_fox(out: &std::path::Path) -> anyhow::Result<()> {
     }
     let groom_path = out.join("fox.toml");
     let groom = Groom::load(&groom_path)?;
+    let simulating = Instant::now();
+    if simulate {
+        println!(
+            "simulating {} guides on the running skin …",
+            thousands(groom.guides().len() as u64)
+        );
+    }
     let animated = groom
         .animated(None)?
         .context("the fox groom file has an [animation] section")?;
+    if simulate {
+        println!(
+            "simulated in {:.2} s",
+            simulating.elapsed().as_secs_f64()
+        );
+    }
+    let how = if simulate {
+        "regrown from them over"
+    } else {
+        "carried over"
+    };
     let output = groom.output_path();
     let animation = animated.animation();
     let frames = animation.frames.frames().to_vec();
@@ -189,7 +227,7 @@ fn run_fox(out: &std::path::Path) -> anyhow::Result<()> {
         .clip()
         .map_or(String::new(), |(n, s)| format!(", clip {n:?} ({s:.2} s)"));
     println!(
-        "growing {} hairs from {} guides on {} ({} triangles), carried over frames {}{clip} …",
+        "growing {} hairs from {} guides on {} ({} triangles), {how} frames {}{clip} …",
         thousands(
             animated
                 .generator()
