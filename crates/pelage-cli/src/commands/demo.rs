@@ -209,10 +209,7 @@ fn run_fox(out: &std::path::Path, simulate: bool) -> anyhow::Result<()> {
         .animated(None)?
         .context("the fox groom file has an [animation] section")?;
     if simulate {
-        println!(
-            "simulated in {:.2} s",
-            simulating.elapsed().as_secs_f64()
-        );
+        println!("simulated in {:.2} s", simulating.elapsed().as_secs_f64());
     }
     let how = if simulate {
         "regrown from them over"
