@@ -740,4 +740,11 @@ fn simulated_grooms_regrow_every_frame_from_guides_that_swing_with_the_run() {
         .unwrap_err()
         .to_string();
     assert!(error.contains("simulation.bend"), "{error}");
+    // A gravity far out of range neither panics nor breaks the fur:
+    // follow-the-leader keeps every point at its length from the root.
+    let wild = text.replace("bend = 2", "gravity = [3e38, -3e38, 0]");
+    let groom = pelage::groom::Groom::from_text("fox.toml", &wild).unwrap();
+    let animated = groom.animated(None).unwrap().unwrap();
+    let part = animated.part(0, 2.0).unwrap();
+    assert!(part.points().iter().all(|p| p.is_finite()));
 }

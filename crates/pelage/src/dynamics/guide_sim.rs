@@ -186,8 +186,9 @@ impl GuideSimulation {
     }
 
     /// The guides as they are now: one curve each, with the guides'
-    /// widths and roots.
-    pub fn curves(&self) -> Curves {
+    /// widths and roots. Fails where a point is not finite (settings far
+    /// out of range: a gravity of 1e38).
+    pub fn curves(&self) -> Result<Curves, crate::curves::CurvesError> {
         let n = self.strands.points_per_strand();
         let offsets = (0..=self.roots.len()).map(|i| (i * n) as u32).collect();
         Curves::new(
@@ -196,7 +197,6 @@ impl GuideSimulation {
             offsets,
         )
         .and_then(|c| c.with_roots(self.roots.clone()))
-        .expect("the guides' own layout")
     }
 }
 

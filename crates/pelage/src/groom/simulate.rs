@@ -72,13 +72,23 @@ pub fn simulate_guides(
     for k in 0..settings.preroll {
         sim.advance(&start, dt, k as f32 * dt);
     }
+    let shape = |sim: &GuideSimulation, frame: i32| {
+        sim.curves().map_err(|e| {
+            spec.error(
+                "simulation",
+                GroomErrorKind::Invalid(format!(
+                    "the simulated guides at frame {frame} are not finite ({e}): the [simulation] settings are out of any sensible range"
+                )),
+            )
+        })
+    };
     let mut shapes: Vec<Curves> = Vec::with_capacity((last - first + 1) as usize);
-    shapes.push(sim.curves());
+    shapes.push(shape(&sim, first)?);
     for frame in first + 1..=last {
         let now = pose(frame)?;
         let time = (settings.preroll as i32 + frame - first) as f32 * dt;
         sim.advance(&now, dt, time);
-        shapes.push(sim.curves());
+        shapes.push(shape(&sim, frame)?);
     }
     let shapes = Arc::new(shapes);
     Ok(GuideMotion::Program(Arc::new(move |time: f64| {
