@@ -173,6 +173,13 @@ pub fn last_json_line(stdout: &str, script: &str) -> anyhow::Result<serde_json::
         .with_context(|| format!("unexpected output from {script}: {stdout:?}"))
 }
 
+/// The median of `values` (the upper one of an even count; NaN for none).
+pub fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted.get(sorted.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
 /// Median wall time in seconds of `runs` calls of `f` (after one warm-up
 /// call when `warm_up`), and the last result.
 pub fn median_seconds<T>(runs: usize, warm_up: bool, mut f: impl FnMut() -> T) -> (f64, T) {

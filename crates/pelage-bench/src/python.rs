@@ -13,7 +13,7 @@
 //!   own USD importer reading the same curves from pelage's usdc.
 
 use super::groom::{groom_text, grow_all};
-use super::median_seconds;
+use super::{median, median_seconds};
 use crate::format::thousands;
 use anyhow::Context;
 use clap::Args;
@@ -154,12 +154,6 @@ fn measure_blender(hairs: u64, dir: &Path) -> anyhow::Result<BlenderCurves> {
         usd_import_seconds: report["usd_import_seconds"].as_f64().unwrap_or(f64::NAN),
         version: report["blender"].as_str().unwrap_or("?").to_string(),
     })
-}
-
-fn median(values: &[f64]) -> f64 {
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    sorted.get(sorted.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// Runs the benchmark and prints its table (or its JSON).

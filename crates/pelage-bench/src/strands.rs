@@ -12,6 +12,7 @@
 //! substep, queried per point), on the same points.
 
 use crate::format::thousands;
+use crate::median;
 use glam::Vec3;
 use pelage::anim::{AnimatedSkin, SkinOptions, SkinPose};
 use pelage::dynamics::{GuideSimulation, StrandParams};
@@ -50,21 +51,16 @@ struct GpuFigures {
     max_difference: f32,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// The Fox running, its skin posed for `frames` frames, and `count`
 /// guides of `points` points grown on its first frame.
-pub(crate) struct FoxRun {
-    pub triangles: Vec<[u32; 3]>,
-    pub poses: Vec<SkinPose>,
-    pub guides: Guides,
-    pub size: f32,
+struct FoxRun {
+    triangles: Vec<[u32; 3]>,
+    poses: Vec<SkinPose>,
+    guides: Guides,
+    size: f32,
 }
 
-pub(crate) fn fox_run(count: usize, points: usize, frames: usize) -> anyhow::Result<FoxRun> {
+fn fox_run(count: usize, points: usize, frames: usize) -> anyhow::Result<FoxRun> {
     let dir = std::env::temp_dir().join(format!("pelage-bench-strands-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let path = dir.join("Fox.gltf");
@@ -101,9 +97,9 @@ pub(crate) fn fox_run(count: usize, points: usize, frames: usize) -> anyhow::Res
     })
 }
 
-/// The settings the benchmark (and the GPU test) simulate with: long fur
-/// on a Fox about 1.4 m long in its own units.
-pub(crate) fn fox_params(size: f32) -> StrandParams {
+/// The settings the benchmark simulates with: long fur on a Fox about
+/// 1.4 m long in its own units.
+fn fox_params(size: f32) -> StrandParams {
     StrandParams {
         substeps: 4,
         gravity: Vec3::new(0.0, -9.81 * size / 1.4, 0.0),
@@ -181,10 +177,10 @@ fn measure(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<Figures>
         points_per_guide: points,
         substeps,
         frames,
-        frame_s: median(frame_t),
-        roots_s: median(roots_t),
-        grids_s: median(grids_t),
-        step_s: median(step_t),
+        frame_s: median(&frame_t),
+        roots_s: median(&roots_t),
+        grids_s: median(&grids_t),
+        step_s: median(&step_t),
         grid_build_s,
         grid_query_ns: per_query(grid_all),
         bvh_build_s,
@@ -231,8 +227,8 @@ fn gpu_figures(
     Ok(GpuFigures {
         adapter: ctx.adapter_name(),
         software: ctx.is_software(),
-        frame_s: median(times),
-        step_s: median(steps),
+        frame_s: median(&times),
+        step_s: median(&steps),
         max_difference,
     })
 }

@@ -18,13 +18,11 @@
 //! share buffers, bind groups and the uniform ring.
 
 use crate::layout::{entry, gpu_struct};
-use crate::{GpuContext, GpuError, ShellModel};
+use crate::{GpuContext, GpuError, ShellModel, workgroups};
 use glam::Vec3;
 use pelage::dynamics::{DynamicsParams, MassSpringSystem, Topology};
 use wgpu::util::DeviceExt;
 
-/// Threads a workgroup (the shader's `@workgroup_size`).
-const WORKGROUP: u32 = 64;
 /// Substeps queued in one submission: one uniform slot each.
 const SLOTS: u32 = 64;
 /// Bytes a uniform slot (the dynamic-offset alignment wgpu guarantees).
@@ -101,14 +99,6 @@ pub struct GpuMassSpring {
     bind_groups: [wgpu::BindGroup; 2],
     /// Which of `state` holds the current state.
     current: usize,
-}
-
-/// Workgroups (x, y) covering `n` invocations: past 65,535 along x, the
-/// shaders fold y into the index.
-fn workgroups(n: u32) -> (u32, u32) {
-    let groups = n.div_ceil(WORKGROUP).max(1);
-    let x = groups.min(65_535);
-    (x, groups.div_ceil(x))
 }
 
 fn padded(v: &[Vec3]) -> Vec<[f32; 4]> {
@@ -567,10 +557,7 @@ impl GpuMassSpring {
 
     /// Waits for every queued step to finish.
     pub fn wait(&self, ctx: &GpuContext) -> Result<(), GpuError> {
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| GpuError::Readback(e.into()))
+        ctx.wait()
     }
 
     /// The current tip positions and velocities, read back.

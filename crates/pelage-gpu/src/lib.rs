@@ -134,6 +134,18 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("skin.wgsl", include_str!("shaders/skin.wgsl")),
 ];
 
+/// Threads a workgroup of every compute shader (their
+/// `@workgroup_size(64)`).
+pub(crate) const WORKGROUP: u32 = 64;
+
+/// Workgroups (x, y) covering `n` invocations: past 65,535 along x, the
+/// compute shaders fold y into the index.
+pub(crate) fn workgroups(n: u32) -> (u32, u32) {
+    let groups = n.div_ceil(WORKGROUP).max(1);
+    let x = groups.min(65_535);
+    (x, groups.div_ceil(x))
+}
+
 /// The WGSL source of the named shader (with its prelude).
 pub(crate) fn shader_source(name: &str) -> &'static str {
     SHADERS

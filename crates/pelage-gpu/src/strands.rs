@@ -11,13 +11,11 @@
 //! point-major on the GPU so a workgroup's reads are contiguous.
 
 use crate::layout::{entry, gpu_struct};
-use crate::{GpuContext, GpuError};
+use crate::{GpuContext, GpuError, workgroups};
 use glam::Vec3;
 use pelage::dynamics::{RootFrame, SkinSdf, StrandParams, Strands};
 use wgpu::util::DeviceExt;
 
-/// Threads a workgroup (the shader's `@workgroup_size`).
-const WORKGROUP: u32 = 64;
 /// The most points a strand has on the GPU (the shader's `MAX_POINTS`:
 /// its per-strand arrays live in registers).
 pub const MAX_GPU_STRAND_POINTS: usize = 32;
@@ -397,9 +395,8 @@ impl GpuStrands {
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, self.bind_group.as_ref(), &[]);
-            let groups = self.strands.div_ceil(WORKGROUP).max(1);
-            let x = groups.min(65_535);
-            pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
+            let (x, y) = workgroups(self.strands);
+            pass.dispatch_workgroups(x, y, 1);
         }
         ctx.queue.submit([encoder.finish()]);
         self.last_roots = roots.to_vec();
@@ -437,10 +434,7 @@ impl GpuStrands {
 
     /// Waits for every queued frame to finish.
     pub fn wait(&self, ctx: &GpuContext) -> Result<(), GpuError> {
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| GpuError::Readback(e.into()))
+        ctx.wait()
     }
 
     /// Every point now, strand after strand (as [`Strands::positions`]).

@@ -159,11 +159,7 @@ struct Sample {
 };
 
 fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
-    let l2 = dot(v, v);
-    if l2 > 0.0 && l2 < 3.4e38 {
-        return v * inverseSqrt(l2);
-    }
-    return vec3<f32>(0.0);
+    return normalize_or(v, vec3<f32>(0.0));
 }
 
 // SkinSdf::exact: the closest of the candidate triangles, signed by the
@@ -209,14 +205,8 @@ fn exact(g: Grid, p: vec3<f32>, ids: array<u32, 8>) -> Exact {
     let c0 = triangles[base].xyz;
     let c1 = triangles[base + 1u].xyz;
     let c2 = triangles[base + 2u].xyz;
-    var n = best_w.x * triangles[base + 3u].xyz + best_w.y * triangles[base + 4u].xyz + best_w.z * triangles[base + 5u].xyz;
-    n = normalize_or_zero(n);
-    if all(n == vec3<f32>(0.0)) {
-        n = normalize_or_zero(cross(c1 - c0, c2 - c0));
-        if all(n == vec3<f32>(0.0)) {
-            n = vec3<f32>(0.0, 1.0, 0.0);
-        }
-    }
+    let interpolated = best_w.x * triangles[base + 3u].xyz + best_w.y * triangles[base + 4u].xyz + best_w.z * triangles[base + 5u].xyz;
+    let n = normalize_or(interpolated, normalize_or(cross(c1 - c0, c2 - c0), vec3<f32>(0.0, 1.0, 0.0)));
     let away = p - best_q;
     let sign = select(1.0, -1.0, dot(away, n) < 0.0);
     let d = sqrt(best_d2);
@@ -248,14 +238,23 @@ fn sample(g: Grid, p: vec3<f32>) -> Sample {
         return Sample(g.far, vec3<f32>(0.0));
     }
     let f = gp - vec3<f32>(f32(ix), f32(iy), f32(iz));
-    let c000 = distances[node(g, ix, iy, iz)];
-    let c100 = distances[node(g, ix + 1u, iy, iz)];
-    let c010 = distances[node(g, ix, iy + 1u, iz)];
-    let c110 = distances[node(g, ix + 1u, iy + 1u, iz)];
-    let c001 = distances[node(g, ix, iy, iz + 1u)];
-    let c101 = distances[node(g, ix + 1u, iy, iz + 1u)];
-    let c011 = distances[node(g, ix, iy + 1u, iz + 1u)];
-    let c111 = distances[node(g, ix + 1u, iy + 1u, iz + 1u)];
+    // The eight corner nodes: c000, c100, c010, c110, c001, c101, c011,
+    // c111 (x fastest).
+    let base = node(g, ix, iy, iz);
+    let row = g.nx;
+    let slab = g.nx * g.ny;
+    var corners = array<u32, 8>(
+        base, base + 1u, base + row, base + row + 1u,
+        base + slab, base + slab + 1u, base + slab + row, base + slab + row + 1u,
+    );
+    let c000 = distances[corners[0]];
+    let c100 = distances[corners[1]];
+    let c010 = distances[corners[2]];
+    let c110 = distances[corners[3]];
+    let c001 = distances[corners[4]];
+    let c101 = distances[corners[5]];
+    let c011 = distances[corners[6]];
+    let c111 = distances[corners[7]];
     let x00 = c000 + f.x * (c100 - c000);
     let x10 = c010 + f.x * (c110 - c010);
     let x01 = c001 + f.x * (c101 - c001);
@@ -268,16 +267,10 @@ fn sample(g: Grid, p: vec3<f32>) -> Sample {
     let dy0 = x10 - x00;
     let dy1 = x11 - x01;
     if d < EXACT_WITHIN * g.cell {
-        let ids = array<u32, 8>(
-            nearest[node(g, ix, iy, iz)],
-            nearest[node(g, ix + 1u, iy, iz)],
-            nearest[node(g, ix, iy + 1u, iz)],
-            nearest[node(g, ix + 1u, iy + 1u, iz)],
-            nearest[node(g, ix, iy, iz + 1u)],
-            nearest[node(g, ix + 1u, iy, iz + 1u)],
-            nearest[node(g, ix, iy + 1u, iz + 1u)],
-            nearest[node(g, ix + 1u, iy + 1u, iz + 1u)],
-        );
+        var ids: array<u32, 8>;
+        for (var k = 0u; k < 8u; k++) {
+            ids[k] = nearest[corners[k]];
+        }
         let e = exact(g, p, ids);
         if e.found {
             return e.s;
@@ -318,15 +311,6 @@ struct Root {
     frame: mat3x3<f32>,
 };
 
-fn try_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
-    let l2 = dot(v, v);
-    if l2 > 0.0 && l2 < 3.4e38 {
-        let r = v * inverseSqrt(l2);
-        return r;
-    }
-    return fallback;
-}
-
 // lerp_root.
 fn lerp_root(s: u32, a: f32) -> Root {
     let base = 6u * s;
@@ -338,13 +322,18 @@ fn lerp_root(s: u32, a: f32) -> Root {
     }
     let position = mix(roots[base].xyz, to_p, a);
     let t0 = mix(roots[base + 1u].xyz, to_t, a);
-    let n = try_normalize(mix(roots[base + 2u].xyz, to_n, a), to_n);
-    let t = try_normalize(t0 - n * dot(n, t0), to_t);
+    let n = normalize_or(mix(roots[base + 2u].xyz, to_n, a), to_n);
+    let t = normalize_or(t0 - n * dot(n, t0), to_t);
     return Root(position, mat3x3<f32>(t, cross(n, t), n));
 }
 
+// glam's normalize_or: `v` made unit, or `fallback` where it cannot be.
 fn normalize_or(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
-    return try_normalize(v, fallback);
+    let l2 = dot(v, v);
+    if l2 > 0.0 && l2 < 3.4e38 {
+        return v * inverseSqrt(l2);
+    }
+    return fallback;
 }
 
 @compute @workgroup_size(64)

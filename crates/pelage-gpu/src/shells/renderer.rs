@@ -281,10 +281,7 @@ impl ShellRenderer {
         let resolved = target.resolved.create_view(&Default::default());
         self.encode(ctx, &mut encoder, model, params, view, target, &resolved)?;
         ctx.queue.submit([encoder.finish()]);
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.into()))?;
-        Ok(())
+        ctx.wait()
     }
 
     /// Draws one frame and reads it back.
@@ -502,9 +499,8 @@ impl ShellRenderer {
         });
         pass.set_pipeline(&self.skinning);
         pass.set_bind_group(0, &skin.bind, &[]);
-        let groups = model.vertex_count.div_ceil(64).max(1);
-        let x = groups.min(65_535);
-        pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
+        let (x, y) = crate::workgroups(model.vertex_count);
+        pass.dispatch_workgroups(x, y, 1);
         Ok(())
     }
 

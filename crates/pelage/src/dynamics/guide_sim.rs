@@ -54,7 +54,7 @@ impl GuideSimulation {
             .map(|&r| root_frame(rest, triangles, r))
             .collect();
         let strands = Strands::new(guides.curves().points(), guides.points_per_guide(), &roots)?;
-        let (lo, hi) = bounds(rest.positions());
+        let (lo, hi) = crate::mesh::bounds_of(rest.positions());
         let longest = (hi - lo).max_element().max(f32::MIN_POSITIVE);
         let segment = strands
             .rest_lengths()
@@ -203,11 +203,4 @@ impl GuideSimulation {
 fn root_frame(pose: &SkinPose, triangles: &[[u32; 3]], root: SurfacePoint) -> RootFrame {
     let (position, frame) = pose.frame_at(triangles, root);
     RootFrame { position, frame }
-}
-
-fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
-    points.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    )
 }

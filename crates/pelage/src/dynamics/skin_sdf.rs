@@ -66,14 +66,11 @@ impl SkinSdf {
         assert!(cell > 0.0 && cell.is_finite(), "a positive cell size");
         let band = (depth / cell).ceil().max(2.0) as usize;
         let far = band as f32 * cell;
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for &p in positions {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-        if positions.is_empty() {
-            (lo, hi) = (Vec3::ZERO, Vec3::ZERO);
-        }
+        let (lo, hi) = if positions.is_empty() {
+            (Vec3::ZERO, Vec3::ZERO)
+        } else {
+            crate::mesh::bounds_of(positions)
+        };
         let margin = (band + 1) as f32 * cell;
         let origin = lo - Vec3::splat(margin);
         let extent = hi + Vec3::splat(margin) - origin;
@@ -216,15 +213,21 @@ impl SkinSdf {
             return (self.far, Vec3::ZERO);
         }
         let f = g - Vec3::new(ix as f32, iy as f32, iz as f32);
-        let at = |x: usize, y: usize, z: usize| self.distances[(z * ny + y) * nx + x];
-        let c000 = at(ix, iy, iz);
-        let c100 = at(ix + 1, iy, iz);
-        let c010 = at(ix, iy + 1, iz);
-        let c110 = at(ix + 1, iy + 1, iz);
-        let c001 = at(ix, iy, iz + 1);
-        let c101 = at(ix + 1, iy, iz + 1);
-        let c011 = at(ix, iy + 1, iz + 1);
-        let c111 = at(ix + 1, iy + 1, iz + 1);
+        // The eight corner nodes, in the order c000, c100, c010, c110,
+        // c001, c101, c011, c111 (x fastest).
+        let base = (iz * ny + iy) * nx + ix;
+        let corners = [
+            0,
+            1,
+            nx,
+            nx + 1,
+            nx * ny,
+            nx * ny + 1,
+            nx * ny + nx,
+            nx * ny + nx + 1,
+        ]
+        .map(|o| base + o);
+        let [c000, c100, c010, c110, c001, c101, c011, c111] = corners.map(|i| self.distances[i]);
         let x00 = c000 + f.x * (c100 - c000);
         let x10 = c010 + f.x * (c110 - c010);
         let x01 = c001 + f.x * (c101 - c001);
@@ -243,18 +246,7 @@ impl SkinSdf {
             // a part thinner than two cells (a leg, an ear): the nodes on
             // both sides of it are outside, and so would be every point
             // between them.
-            let node = |x: usize, y: usize, z: usize| (z * ny + y) * nx + x;
-            let ids = [
-                node(ix, iy, iz),
-                node(ix + 1, iy, iz),
-                node(ix, iy + 1, iz),
-                node(ix + 1, iy + 1, iz),
-                node(ix, iy, iz + 1),
-                node(ix + 1, iy, iz + 1),
-                node(ix, iy + 1, iz + 1),
-                node(ix + 1, iy + 1, iz + 1),
-            ]
-            .map(|i| self.nearest[i]);
+            let ids = corners.map(|i| self.nearest[i]);
             if let Some(exact) = self.exact(p, &ids) {
                 return exact;
             }

@@ -409,10 +409,7 @@ impl Mesh {
 
     /// Axis-aligned bounds `(min, max)` of the vertex positions.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.positions.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), &p| (lo.min(p), hi.max(p)),
-        )
+        bounds_of(&self.positions)
     }
 
     /// The mesh's unique undirected edges with the number of triangles using
@@ -491,6 +488,15 @@ fn triangle_areas(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Vec<f32>, usiz
         })
         .collect();
     (areas, degenerate)
+}
+
+/// Axis-aligned bounds `(min, max)` of `points` (inverted, infinite ones
+/// for none): a posed skin's, where there is no [`Mesh`].
+pub(crate) fn bounds_of(points: &[Vec3]) -> (Vec3, Vec3) {
+    points.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    )
 }
 
 /// Vertex normals as the normalised sum of the unnormalised face normals of
