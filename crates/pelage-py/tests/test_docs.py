@@ -1,6 +1,6 @@
 """Every Python snippet of docs/python.md runs as written, in a folder
-holding the files it names (a mesh with UVs, a groom file on it and three
-maps), so the page cannot drift from the package."""
+holding the files it names (a mesh with UVs, a groom file on it, three
+maps and the animated Fox), so the page cannot drift from the package."""
 
 import os
 import pathlib
@@ -14,6 +14,7 @@ import pytest
 from conftest import MESHES, REPO
 
 DOC = REPO / "docs" / "python.md"
+FOX = REPO / "crates" / "pelage" / "assets" / "fox"
 
 
 def snippets():
@@ -34,6 +35,8 @@ def grey_png(path, side=64):
 @pytest.fixture()
 def doc_folder(tmp_path):
     shutil.copy(MESHES / "blub_triangulated.obj", tmp_path / "model.obj")
+    for name in FOX.iterdir():
+        shutil.copy(name, tmp_path / name.name)
     for name in ["density.png", "back.png", "parting.png"]:
         grey_png(tmp_path / name)
     (tmp_path / "fur.toml").write_text(
