@@ -29,6 +29,9 @@ enum Command {
     Render(commands::render::RenderArgs),
     /// Grow a groom file's hairs (guides, operators, parts) and write them.
     Groom(commands::groom::GroomArgs),
+    /// Simulate an animated groom's guides (gravity, wind, collisions) and
+    /// write them with a time sample a frame.
+    Simulate(commands::simulate::SimulateArgs),
     /// Grow guide curves on a mesh, or bind guides from a file to it.
     Guides(commands::guides::GuidesArgs),
     /// Convert curves between formats (USD, .hair, PLY, RIB, pbrt).
@@ -61,6 +64,7 @@ fn main() -> ExitCode {
         Command::Convert(args) => commands::convert::run(&args),
         Command::Guides(args) => commands::guides::run(&args),
         Command::Groom(args) => commands::groom::run(&args),
+        Command::Simulate(args) => commands::simulate::run(&args),
         Command::Shells(args) => commands::shells::run(&args),
         Command::View(args) => commands::view::run(&args),
         Command::Demo(args) => commands::demo::run(&args),

@@ -1476,3 +1476,64 @@ fn groom_fraction_writes_a_subset_of_the_full_groom_with_wider_hairs() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("--fraction"), "{}", stderr(&out));
 }
+
+#[test]
+fn simulate_writes_the_guides_once_into_the_cache_and_for_other_tools() {
+    let dir = tempfile::tempdir().unwrap();
+    let fox = repo("crates/pelage/assets/fox/Fox.gltf");
+    let groom = dir.path().join("fox.toml");
+    std::fs::write(
+        &groom,
+        format!(
+            "[mesh]\npath = {:?}\n[roots]\ncount = 500\n[guides]\ngenerate = {{ count = 60, length = 10.0 }}\n\
+             [animation]\nframes = \"1-4\"\nclip = \"Run\"\nmode = \"simulate\"\n\
+             [simulation]\ngravity = [0, -500, 0]\npreroll = 2\ncache = \"fox.sim.usdc\"\n",
+            fox.display()
+        ),
+    )
+    .unwrap();
+    let file = groom.to_str().unwrap();
+    let first = pelage(&["simulate", file]);
+    assert!(first.status.success(), "{}", stderr(&first));
+    assert!(stdout(&first).contains("written"), "{}", stdout(&first));
+    let again = pelage(&["simulate", file]);
+    assert!(stdout(&again).contains("up to date"), "{}", stdout(&again));
+    // For other tools: time-sampled guide curves Pixar's USD reads.
+    let guides = dir.path().join("guides.usdc");
+    let out = pelage(&["simulate", file, "-o", guides.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("60 guides over frames 1-4"),
+        "{}",
+        stdout(&out)
+    );
+    let (one, four) = (
+        pelage::io::read_usd_curves_at(&guides, Some(1.0)).unwrap(),
+        pelage::io::read_usd_curves_at(&guides, Some(4.0)).unwrap(),
+    );
+    assert_eq!(one.curve_count(), 60);
+    assert_ne!(one.points(), four.points(), "the guides move");
+    if let Some((ok, report)) = usdcheck(&[&guides]) {
+        assert!(ok, "{report}");
+    }
+    // A still groom has nothing to simulate, and says so.
+    let still = dir.path().join("still.toml");
+    std::fs::write(
+        &still,
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\ngenerate = { count = 5, length = 0.05 }\n",
+    )
+    .unwrap();
+    let x = dir.path().join("x.usdc");
+    let out = pelage(&[
+        "simulate",
+        still.to_str().unwrap(),
+        "-o",
+        x.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("mode = \"simulate\""),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -748,3 +748,90 @@ fn simulated_grooms_regrow_every_frame_from_guides_that_swing_with_the_run() {
     let part = animated.part(0, 2.0).unwrap();
     assert!(part.points().iter().all(|p| p.is_finite()));
 }
+
+#[test]
+fn a_simulation_cache_is_written_once_read_after_and_refreshed_when_stale() {
+    use pelage::groom::{CacheUse, Groom};
+    use pelage::settings::SettingsSource;
+    let dir = tempfile::tempdir().unwrap();
+    let fox = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/fox/Fox.gltf");
+    let text = |gravity: i32, cache: bool| {
+        format!(
+            "[mesh]\npath = {fox:?}\n[roots]\ncount = 600\nparts = 2\n\
+             [guides]\ngenerate = {{ count = 80, length = 10.0 }}\n\
+             [animation]\nframes = \"1-6\"\nclip = \"Run\"\nmode = \"simulate\"\n\
+             [simulation]\ngravity = [0, {gravity}, 0]\nfollow = 0\npreroll = 4\n{}",
+            if cache {
+                "cache = \"fox.sim.usdc\"\n"
+            } else {
+                ""
+            }
+        )
+    };
+    let load = |text: String, frames: Option<&str>| {
+        let source = SettingsSource {
+            path: dir.path().join("fox.toml"),
+            text,
+        };
+        let frames = frames.map(|f| pelage::anim::FrameRange::parse(f).unwrap());
+        Groom::from_source_with_frames(source, frames).unwrap()
+    };
+    let written = |groom: &Groom, name: &str| {
+        let path = dir.path().join(name);
+        let animated = groom.animated(None).unwrap().unwrap();
+        animated
+            .write(&path, 0..2, &groom.usd_options(), false, |_| {})
+            .unwrap();
+        std::fs::read(path).unwrap()
+    };
+    let simulated = written(&load(text(-500, false), None), "simulated.usdc");
+    // First run: simulated and cached; the groom is the uncached one.
+    let cached = load(text(-500, true), None);
+    assert_eq!(
+        cached.simulated_guides().unwrap().1,
+        Some(CacheUse::Written)
+    );
+    assert!(dir.path().join("fox.sim.usdc").exists());
+    // Later runs read it, and grow the same bytes.
+    let (guides, used) = cached.simulated_guides().unwrap();
+    assert_eq!(used, Some(CacheUse::Read));
+    assert_eq!(guides.frames(), 1..=6);
+    assert_eq!(written(&cached, "cached.usdc"), simulated);
+    // Other settings: the cache is stale, simulated again.
+    let other = load(text(-300, true), None);
+    assert_eq!(
+        other.simulated_guides().unwrap().1,
+        Some(CacheUse::Replaced)
+    );
+    assert_ne!(written(&other, "other.usdc"), simulated);
+    // A farm task's frames: the whole range is simulated, so frame 5 of a
+    // task that writes 4-6 is frame 5 of the single run.
+    let whole = load(text(-500, false), None)
+        .animated(None)
+        .unwrap()
+        .unwrap();
+    let task = load(text(-500, false), Some("4-6"))
+        .animated(None)
+        .unwrap()
+        .unwrap();
+    assert_eq!(
+        task.part(1, 5.0).unwrap().points(),
+        whole.part(1, 5.0).unwrap().points()
+    );
+    // Written for other tools: Alembic guides, a sample a frame, read
+    // back as they were simulated.
+    let abc = dir.path().join("guides.abc");
+    let options = pelage::io::UsdOptions {
+        time_codes_per_second: 24.0,
+        ..Default::default()
+    };
+    guides.write(&abc, &options).unwrap();
+    for frame in [1, 6] {
+        let read = pelage::io::read_abc_curves_at(&abc, Some(f64::from(frame) / 24.0)).unwrap();
+        assert_eq!(
+            read.points(),
+            guides.at(frame).unwrap().points(),
+            "frame {frame}"
+        );
+    }
+}

@@ -9,6 +9,7 @@ pub mod info;
 pub mod render;
 pub mod sample;
 pub mod shells;
+pub mod simulate;
 pub mod view;
 
 /// `pelage bench`: the harness is its own crate, `pelage-bench`.

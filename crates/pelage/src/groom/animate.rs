@@ -681,8 +681,10 @@ impl AnimatedGroom {
             };
             let file = AtomicFile::create(&output.path)?;
             let layer = match format {
-                CurvesFormat::Usdc => UsdcWriter::new(file, options).map(TimeSampledLayer::Usdc),
-                _ => AbcWriter::new(file, options).map(TimeSampledLayer::Abc),
+                CurvesFormat::Usdc => {
+                    UsdcWriter::new(file, options).map(|w| TimeSampledLayer::Usdc(Box::new(w)))
+                }
+                _ => AbcWriter::new(file, options).map(|w| TimeSampledLayer::Abc(Box::new(w))),
             }
             .map_err(|e| write_error(&output.path, &e))?;
             layers.push(layer);
@@ -879,15 +881,15 @@ pub struct FrameOutput {
 
 /// An open time-sampled output.
 enum TimeSampledLayer {
-    Usdc(UsdcWriter<AtomicFile>),
-    Abc(AbcWriter<AtomicFile>),
+    Usdc(Box<UsdcWriter<AtomicFile>>),
+    Abc(Box<AbcWriter<AtomicFile>>),
 }
 
 impl TimeSampledLayer {
     fn prims(&mut self) -> &mut dyn PrimWriter {
         match self {
-            Self::Usdc(w) => w,
-            Self::Abc(w) => w,
+            Self::Usdc(w) => w.as_mut(),
+            Self::Abc(w) => w.as_mut(),
         }
     }
 

@@ -247,6 +247,10 @@ pub struct SimulationSection {
     /// guides to settle.
     #[serde(default = "default_preroll")]
     pub preroll: u32,
+    /// A `.usdc` file (relative to the groom file) the simulated guides
+    /// are kept in: read when it holds this simulation, else simulated
+    /// and written, so farm tasks simulate once.
+    pub cache: Option<Spanned<String>>,
 }
 
 fn default_substeps() -> u32 {

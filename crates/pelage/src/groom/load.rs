@@ -10,7 +10,9 @@ use super::generator::Generator;
 use super::hair_look::HairLook;
 use super::ops::{OpKey, SpecReader, map_on_mesh};
 use super::outside_skin::OutsideSkin;
-use super::simulate::{SimulationSettings, simulate_guides};
+use super::simulate::{
+    CacheUse, SimulatedGuides, SimulationSettings, cached_simulation, simulate_guides,
+};
 use super::spec::{FinishSpec, GroomSpec, HairIds, RegionsSpec, RootsSpec, SpecOrigin};
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
 use crate::dynamics::{StrandParams, Wind};
@@ -258,26 +260,78 @@ impl Groom {
                 };
                 Some(guides)
             }
-            AnimationMode::Simulate => Some(simulate_guides(
-                &spec,
-                &animation.skin,
-                &animation.spec,
-                &self.simulation_settings(animation.fps),
-            )?),
+            AnimationMode::Simulate => Some(self.simulate(&spec, animation)?.0.motion()),
         };
         AnimatedGroom::new(spec, animation.skin.clone(), animation.spec.clone(), guides).map(Some)
     }
 
+    /// `[simulation] cache`, relative to the groom file's folder.
+    pub fn simulation_cache(&self) -> Option<PathBuf> {
+        let cache = self.file.simulation.as_ref()?.cache.as_ref()?;
+        Some(self.source.folder().join(cache.get_ref()))
+    }
+
+    /// The guides of an animated groom simulated over its frames
+    /// (`[animation] mode = "simulate"`), through `[simulation] cache`
+    /// when the file names one (and what was done with it). An error for
+    /// a still groom or another mode.
+    pub fn simulated_guides(&self) -> Result<(SimulatedGuides, Option<CacheUse>), GroomError> {
+        let Some(animation) = self
+            .animation
+            .as_ref()
+            .filter(|a| a.spec.mode == AnimationMode::Simulate)
+        else {
+            return Err(self.source.error_at(
+                0..0,
+                GroomErrorKind::Invalid(
+                    "only an animated groom with mode = \"simulate\" in [animation] simulates its guides".into(),
+                ),
+            ));
+        };
+        self.simulate(&self.spec()?, animation)
+    }
+
+    /// [`Self::simulated_guides`] of `spec` (the groom's values, with a
+    /// seed given).
+    fn simulate(
+        &self,
+        spec: &GroomSpec,
+        animation: &LoadedAnimation,
+    ) -> Result<(SimulatedGuides, Option<CacheUse>), GroomError> {
+        let settings = self.simulation_settings(animation)?;
+        match self.simulation_cache() {
+            Some(full) => {
+                let (guides, used) = cached_simulation(spec, &animation.skin, &settings, &full)?;
+                Ok((guides, Some(used)))
+            }
+            None => Ok((simulate_guides(spec, &animation.skin, &settings)?, None)),
+        }
+    }
+
     /// `[simulation]` as the solver takes it (its defaults where the file
     /// has none).
-    fn simulation_settings(&self, fps: f64) -> SimulationSettings {
+    fn simulation_settings(
+        &self,
+        animation: &LoadedAnimation,
+    ) -> Result<SimulationSettings, GroomError> {
+        let run = &animation.spec.frames;
+        let (mut first, mut last) = (run.first(), run.last());
+        if let Some(section) = &self.file.animation {
+            let whole = FrameRange::parse(section.frames.get_ref()).map_err(|e| {
+                self.source.error_at(
+                    section.frames.span(),
+                    GroomErrorKind::Invalid(e.to_string()),
+                )
+            })?;
+            (first, last) = (first.min(whole.first()), last.max(whole.last()));
+        }
         let section =
             self.file.simulation.clone().unwrap_or_else(|| {
                 toml::from_str("").expect("every [simulation] key has a default")
             });
         let (lo, hi) = self.mesh.bounds();
         let size = (hi - lo).max_element();
-        SimulationSettings {
+        Ok(SimulationSettings {
             params: StrandParams {
                 substeps: section.substeps,
                 iterations: section.iterations,
@@ -294,8 +348,9 @@ impl Groom {
             },
             collide: section.collide,
             preroll: section.preroll,
-            fps,
-        }
+            fps: animation.fps,
+            frames: first..=last,
+        })
     }
 
     /// The number of hairs `[roots] count` asks for (before `strands`

@@ -71,7 +71,10 @@ pub use report::{
     GroomReport, GuideNote, GuidesReport, LostGuideNote, PartReport, RegionReport, ReportBuilder,
     Timings,
 };
-pub use simulate::{SimulationSettings, simulate_guides};
+pub use simulate::{
+    CacheUse, SIMULATED_GUIDES_NAME, SimulatedGuides, SimulationSettings, cached_simulation,
+    simulate_guides, simulation_key,
+};
 pub use writing::{AssembleError, Assembly, DEFAULT_FPS};
 
 pub use ops::{

@@ -6,17 +6,30 @@
 //! The simulation runs from the first frame written, after `preroll`
 //! frames at that frame's pose for the guides to settle from their
 //! groomed shape, to the last. It is deterministic (the same input gives
-//! the same bits on any thread count), so the tasks of a farm each
-//! simulate it again and agree; sub-frame times (motion blur) read the
-//! guides interpolated linearly between the two frames around them.
+//! the same bits on any thread count), so the tasks of a farm may each
+//! simulate it again and agree; or one simulates it into a cache file
+//! (`[simulation] cache`, [`cached_simulation`]) that the others read.
+//! A cache carries a key of everything the simulation read (the
+//! settings, the guides, the skin at every frame, pelage's version), so
+//! a stale one is simulated again, never used. Sub-frame times (motion
+//! blur) read the guides interpolated linearly between the two frames
+//! around them.
 
-use super::animate::{AnimationSpec, GuideMotion};
+use super::animate::GuideMotion;
 use super::error::{GroomError, GroomErrorKind};
+use super::output::GroomWriteError;
 use super::spec::GroomSpec;
 use crate::Curves;
 use crate::anim::{AnimatedSkin, SkinPose};
 use crate::dynamics::{GuideSimulation, StrandParams};
+use crate::io::{AbcWriter, AtomicFile, CurvesFormat, UsdOptions, UsdcWriter};
+use std::ops::RangeInclusive;
+use std::path::Path;
 use std::sync::Arc;
+
+/// The name of the guides' prim (USD) or object (Alembic) in a file of
+/// simulated guides.
+pub const SIMULATED_GUIDES_NAME: &str = "guides";
 
 /// How a groom's guides are simulated.
 #[derive(Debug, Clone)]
@@ -29,17 +42,266 @@ pub struct SimulationSettings {
     pub preroll: u32,
     /// Frames per second.
     pub fps: f64,
+    /// The frames simulated, first to last: a groom's whole range (the
+    /// file's, and any frame a run writes beyond it), whichever frames a
+    /// run writes, so every task of a farm simulates the same.
+    pub frames: RangeInclusive<i32>,
+}
+
+/// Guides simulated over a groom's frames: their shape on the posed skin
+/// (scene space) at every frame from the first to the last.
+#[derive(Debug, Clone)]
+pub struct SimulatedGuides {
+    first: i32,
+    shapes: Arc<Vec<Curves>>,
+    key: u64,
+}
+
+impl SimulatedGuides {
+    /// The frames simulated, first to last.
+    pub fn frames(&self) -> RangeInclusive<i32> {
+        self.first..=self.first + self.shapes.len() as i32 - 1
+    }
+
+    /// The guides at `frame`, when it was simulated.
+    pub fn at(&self, frame: i32) -> Option<&Curves> {
+        let k = usize::try_from(frame.checked_sub(self.first)?).ok()?;
+        self.shapes.get(k)
+    }
+
+    /// The key of everything the simulation read ([`simulation_key`]).
+    pub fn key(&self) -> u64 {
+        self.key
+    }
+
+    /// The guides as the regrow path reads them, frame by frame.
+    pub fn motion(&self) -> GuideMotion {
+        let (shapes, first) = (self.shapes.clone(), self.first);
+        GuideMotion::Program(Arc::new(move |time: f64| {
+            guides_between(&shapes, time - f64::from(first))
+        }))
+    }
+
+    /// Writes the guides to `path` with a time sample a frame: `.usdc` (or
+    /// `.usd`) as a `BasisCurves` prim with `purpose = "guide"` and the key
+    /// in the layer's `documentation`, or `.abc` as a curves object
+    /// flagged `groom_guide = 1`, both named [`SIMULATED_GUIDES_NAME`].
+    /// Atomically: a reader sees the old file or the whole new one.
+    pub fn write(&self, path: &Path, options: &UsdOptions) -> Result<(), GroomWriteError> {
+        let failed = |e: crate::io::PrimWriteError| {
+            GroomWriteError::Write(crate::io::WriteError {
+                path: path.to_path_buf(),
+                error: std::io::Error::other(e.to_string()),
+            })
+        };
+        let file = AtomicFile::create(path)?;
+        let file = match CurvesFormat::from_path(path) {
+            Some(CurvesFormat::Usdc) => {
+                let mut usd = UsdcWriter::new(file, options).map_err(failed)?;
+                usd.set_documentation(&cache_documentation(self.key));
+                for frame in self.frames() {
+                    let guides = self.at(frame).expect("a simulated frame");
+                    usd.write_guides_at(SIMULATED_GUIDES_NAME, f64::from(frame), guides)
+                        .map_err(failed)?;
+                }
+                usd.finish().map_err(failed)?
+            }
+            Some(CurvesFormat::Abc) => {
+                let mut abc = AbcWriter::new(file, options).map_err(failed)?;
+                for frame in self.frames() {
+                    let guides = self.at(frame).expect("a simulated frame");
+                    abc.write_guides_at(SIMULATED_GUIDES_NAME, f64::from(frame), guides)
+                        .map_err(failed)?;
+                }
+                abc.finish().map_err(failed)?
+            }
+            _ => {
+                return Err(failed(crate::io::PrimWriteError::BadSetting(format!(
+                    "{}: simulated guides are written with time samples to .usdc, .usd or .abc",
+                    path.display()
+                ))));
+            }
+        };
+        file.commit()?;
+        Ok(())
+    }
+}
+
+/// The `documentation` string of a cache of simulated guides with `key`.
+fn cache_documentation(key: u64) -> String {
+    format!(
+        "Guides simulated by pelage {}; simulation key {key:016x}",
+        env!("CARGO_PKG_VERSION")
+    )
+}
+
+/// What [`cached_simulation`] did with the cache file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CacheUse {
+    /// Read it: its key matched.
+    Read,
+    /// There was none: simulated, and wrote it.
+    Written,
+    /// It was stale (another key, or not a cache of these guides):
+    /// simulated again, and replaced it.
+    Replaced,
+}
+
+/// The first and last frame simulated.
+fn frame_span(spec: &GroomSpec, settings: &SimulationSettings) -> Result<(i32, i32), GroomError> {
+    let (first, last) = (*settings.frames.start(), *settings.frames.end());
+    if first > last {
+        return Err(spec.error(
+            "animation.frames",
+            GroomErrorKind::Invalid("no frames to simulate".into()),
+        ));
+    }
+    Ok((first, last))
+}
+
+/// The skin's vertices at `frame`.
+fn skin_at(
+    spec: &GroomSpec,
+    skin: &AnimatedSkin,
+    frame: i32,
+) -> Result<Vec<glam::Vec3>, GroomError> {
+    skin.positions_at(f64::from(frame))
+        .map_err(|e| spec.error("animation", GroomErrorKind::Mesh(e)))
+}
+
+/// A key of everything a simulation of `spec`'s guides reads: pelage's
+/// version, the settings, the frames, the guides and their roots, the
+/// skin's triangles and its vertices at rest and at every frame
+/// (FNV-1a, 64 bits, over their bits). Two runs with the same key
+/// simulate the same bits.
+pub fn simulation_key(
+    spec: &GroomSpec,
+    skin: &AnimatedSkin,
+    settings: &SimulationSettings,
+) -> Result<u64, GroomError> {
+    let (first, last) = frame_span(spec, settings)?;
+    let mut key = Fnv1a::default();
+    key.bytes(env!("CARGO_PKG_VERSION").as_bytes());
+    key.bytes(format!("{settings:?}").as_bytes());
+    key.bytes(&first.to_le_bytes());
+    key.bytes(&last.to_le_bytes());
+    key.bytes(bytemuck::cast_slice(spec.guides.curves().points()));
+    key.bytes(format!("{:?}", spec.guides.roots()).as_bytes());
+    key.bytes(bytemuck::cast_slice(spec.mesh.triangles()));
+    key.bytes(bytemuck::cast_slice(spec.mesh.positions()));
+    for frame in first..=last {
+        key.bytes(bytemuck::cast_slice(&skin_at(spec, skin, frame)?));
+    }
+    Ok(key.0)
+}
+
+/// FNV-1a, 64 bits: small, stable across platforms and versions of Rust
+/// (unlike `std`'s hasher), which a key written to a file needs.
+struct Fnv1a(u64);
+
+impl Default for Fnv1a {
+    fn default() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv1a {
+    fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+}
+
+/// The guides of `spec` simulated as [`simulate_guides`] does, read from
+/// the `.usdc` file `cache` when it holds this simulation (its key
+/// matches), else simulated and written there (atomically: farm tasks
+/// that race to write it write the same bits).
+pub fn cached_simulation(
+    spec: &GroomSpec,
+    skin: &AnimatedSkin,
+    settings: &SimulationSettings,
+    cache: &Path,
+) -> Result<(SimulatedGuides, CacheUse), GroomError> {
+    if CurvesFormat::from_path(cache) != Some(CurvesFormat::Usdc) {
+        return Err(spec.error(
+            "simulation.cache",
+            GroomErrorKind::Invalid(format!(
+                "{}: a simulation cache is a .usdc file",
+                cache.display()
+            )),
+        ));
+    }
+    let key = simulation_key(spec, skin, settings)?;
+    let (first, last) = frame_span(spec, settings)?;
+    let existed = cache.exists();
+    if existed && let Some(shapes) = read_cache(cache, key, (first, last), spec) {
+        let guides = SimulatedGuides {
+            first,
+            shapes: Arc::new(shapes),
+            key,
+        };
+        return Ok((guides, CacheUse::Read));
+    }
+    let guides = simulate_with_key(spec, skin, settings, key)?;
+    let options = UsdOptions {
+        time_codes_per_second: settings.fps,
+        ..UsdOptions::default()
+    };
+    guides.write(cache, &options).map_err(|e| {
+        spec.error(
+            "simulation.cache",
+            GroomErrorKind::Invalid(format!("cannot write the cache: {e}")),
+        )
+    })?;
+    let used = if existed {
+        CacheUse::Replaced
+    } else {
+        CacheUse::Written
+    };
+    Ok((guides, used))
+}
+
+/// The frames of a cache file when it holds the simulation with `key`
+/// of `spec`'s guides over `first..=last`; `None` for any other file.
+fn read_cache(
+    cache: &Path,
+    key: u64,
+    (first, last): (i32, i32),
+    spec: &GroomSpec,
+) -> Option<Vec<Curves>> {
+    let info = crate::io::read_usd_layer_info(cache).ok()?;
+    if info.documentation.as_deref() != Some(cache_documentation(key).as_str()) {
+        return None;
+    }
+    let (guides, n) = (spec.guides.len(), spec.guides.points_per_guide());
+    let file = crate::io::UsdCurvesSequence::open(cache).ok()?;
+    (first..=last)
+        .map(|frame| {
+            let curves = file.at(f64::from(frame)).ok()?;
+            let whole = curves.curve_count() == guides && curves.points().len() == guides * n;
+            whole.then_some(curves)
+        })
+        .collect()
 }
 
 /// The guides of `spec` (bound to its mesh, the skin's rest pose)
-/// simulated over `animation`'s frames on `skin`: a [`GuideMotion`] the
-/// regrow path reads frame by frame.
+/// simulated over `settings.frames` on `skin`.
 pub fn simulate_guides(
     spec: &GroomSpec,
     skin: &AnimatedSkin,
-    animation: &AnimationSpec,
     settings: &SimulationSettings,
-) -> Result<GuideMotion, GroomError> {
+) -> Result<SimulatedGuides, GroomError> {
+    simulate_with_key(spec, skin, settings, simulation_key(spec, skin, settings)?)
+}
+
+/// [`simulate_guides`], its key known.
+fn simulate_with_key(
+    spec: &GroomSpec,
+    skin: &AnimatedSkin,
+    settings: &SimulationSettings,
+    key: u64,
+) -> Result<SimulatedGuides, GroomError> {
     let triangles = spec.mesh.triangles();
     let rest = SkinPose::new(spec.mesh.positions().to_vec(), triangles);
     let mut sim = GuideSimulation::new(
@@ -50,21 +312,9 @@ pub fn simulate_guides(
         settings.collide,
     )
     .map_err(|e| spec.error("simulation", GroomErrorKind::Invalid(e.to_string())))?;
-    let frames = animation.frames.frames();
-    let (first, last) = match (frames.iter().min(), frames.iter().max()) {
-        (Some(&a), Some(&b)) => (a, b),
-        _ => {
-            return Err(spec.error(
-                "animation.frames",
-                GroomErrorKind::Invalid("no frames to simulate".into()),
-            ));
-        }
-    };
+    let (first, last) = frame_span(spec, settings)?;
     let pose = |frame: i32| -> Result<SkinPose, GroomError> {
-        let positions = skin
-            .positions_at(f64::from(frame))
-            .map_err(|e| spec.error("animation", GroomErrorKind::Mesh(e)))?;
-        Ok(SkinPose::new(positions, triangles))
+        Ok(SkinPose::new(skin_at(spec, skin, frame)?, triangles))
     };
     let dt = (1.0 / settings.fps) as f32;
     let start = pose(first)?;
@@ -90,10 +340,11 @@ pub fn simulate_guides(
         sim.advance(&now, dt, time);
         shapes.push(shape(&sim, frame)?);
     }
-    let shapes = Arc::new(shapes);
-    Ok(GuideMotion::Program(Arc::new(move |time: f64| {
-        guides_between(&shapes, time - f64::from(first))
-    })))
+    Ok(SimulatedGuides {
+        first,
+        shapes: Arc::new(shapes),
+        key,
+    })
 }
 
 /// The simulated guides `offset` frames after the first: a frame's own,

@@ -301,6 +301,8 @@ pub struct UsdLayerInfo {
     pub time_codes_per_second: f64,
     /// `startTimeCode` and `endTimeCode`, when authored.
     pub time_range: Option<(f64, f64)>,
+    /// The layer's `documentation` string, when authored.
+    pub documentation: Option<String>,
 }
 
 /// Reads a layer's [`UsdLayerInfo`].
@@ -344,6 +346,10 @@ pub fn read_usd_layer_info(path: &Path) -> Result<UsdLayerInfo, CurvesReadError>
         up_axis: token(data, &root, "upAxis").unwrap_or_else(|| "Y".into()),
         time_codes_per_second: number("timeCodesPerSecond").unwrap_or(24.0),
         time_range: number("startTimeCode").zip(number("endTimeCode")),
+        documentation: match field("documentation") {
+            Some(Value::String(text)) => Some(text),
+            _ => None,
+        },
     })
 }
 

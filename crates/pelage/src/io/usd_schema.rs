@@ -50,6 +50,21 @@ pub trait PrimWriter {
     /// renderers), in Alembic an `ICurves` object flagged
     /// `groom_guide = 1` (Unreal's groom importer).
     fn write_guides(&mut self, name: &str, guides: &Curves) -> Result<(), PrimWriteError>;
+    /// Writes one frame of animated guides (time code `time`), as
+    /// [`Self::write_part_at`] does for a part, flagged as
+    /// [`Self::write_guides`] flags them. Writers without time samples
+    /// refuse.
+    fn write_guides_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        guides: &Curves,
+    ) -> Result<(), PrimWriteError> {
+        let _ = (name, time, guides);
+        Err(PrimWriteError::BadSetting(
+            "this format has no time samples; write animated guides to .usdc or .abc".into(),
+        ))
+    }
     /// Writes one frame of an animated skin (time code `time`), as
     /// [`Self::write_part_at`] does for curves. Writers without animated
     /// meshes refuse.

@@ -184,6 +184,25 @@ impl<W: Write + Seek> AbcWriter<W> {
         Ok(())
     }
 
+    /// Writes one frame of animated guides, as [`Self::write_part_at`]
+    /// does for a part, on an object flagged as [`Self::write_guides`]
+    /// flags it.
+    pub fn write_guides_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        guides: &Curves,
+    ) -> Result<(), PrimWriteError> {
+        PrimWriteError::check_time(name, time)?;
+        let Some(index) = self.next_frame("guides", name, time)? else {
+            return self.start_part_as(name, guides, Some(time), true);
+        };
+        PrimWriteError::check_frame(name, time, &self.parts[index].offsets, guides)?;
+        let samples = self.animated_samples(guides)?;
+        self.push_frame(index, time, samples);
+        Ok(())
+    }
+
     /// The index of the animated object `name` a frame at `time` goes to
     /// (`None`: not written yet). Refuses an object written still, and a
     /// frame not after its last one (`what`, "part" or "mesh", says which
@@ -974,5 +993,14 @@ impl<W: Write + Seek> super::PrimWriter for AbcWriter<W> {
 
     fn write_guides(&mut self, name: &str, guides: &Curves) -> Result<(), PrimWriteError> {
         AbcWriter::write_guides(self, name, guides)
+    }
+
+    fn write_guides_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        guides: &Curves,
+    ) -> Result<(), PrimWriteError> {
+        AbcWriter::write_guides_at(self, name, time, guides)
     }
 }

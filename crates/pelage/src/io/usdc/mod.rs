@@ -69,6 +69,8 @@ pub struct UsdcWriter<W: Write + Seek> {
     /// The hair material's path, once written (before the first part
     /// bound to it).
     material: Option<u32>,
+    /// The layer's `documentation` (default: which pelage wrote it).
+    documentation: Option<String>,
 }
 
 impl<W: Write + Seek> UsdcWriter<W> {
@@ -92,7 +94,15 @@ impl<W: Write + Seek> UsdcWriter<W> {
             names: HashSet::new(),
             animated: BTreeMap::new(),
             material: None,
+            documentation: None,
         })
+    }
+
+    /// Sets the layer's `documentation` string (by default "Written by
+    /// pelage VERSION"): what wrote the file and from what, for a reader
+    /// that checks a cache against its inputs.
+    pub fn set_documentation(&mut self, text: &str) {
+        self.documentation = Some(text.to_string());
     }
 
     /// Writes one part as a `BasisCurves` prim named `name`.
@@ -109,6 +119,40 @@ impl<W: Write + Seek> UsdcWriter<W> {
         let attributes = guide_curves_attributes(name, guides, &self.options)?;
         self.write_prim("BasisCurves", name, &attributes, false)?;
         Ok(())
+    }
+
+    /// Writes one frame of animated guides, as [`Self::write_part_at`]
+    /// does for a part, on a prim with `purpose = "guide"`.
+    pub fn write_guides_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        guides: &Curves,
+    ) -> Result<(), PrimWriteError> {
+        PrimWriteError::check_time(name, time)?;
+        if !self.animated.contains_key(name) {
+            let attributes = guide_curves_attributes(name, guides, &self.options)?;
+            let specs = self.write_prim("BasisCurves", name, &attributes, true)?;
+            let samples = specs
+                .into_iter()
+                .map(|(spec, attribute)| (spec, attribute, Vec::new()))
+                .collect();
+            let part = AnimatedPart {
+                offsets: guides.offsets().to_vec(),
+                samples,
+            };
+            self.animated.insert(name.to_string(), part);
+        }
+        PrimWriteError::check_frame(name, time, &self.animated[name].offsets, guides)?;
+        let (lo, hi) = curve_extent(guides);
+        self.add_samples(
+            name,
+            time,
+            guides.points(),
+            [lo, hi],
+            guides.normals(),
+            guides.velocities(),
+        )
     }
 
     /// Writes one frame of an animated part: the first call for `name`
@@ -641,7 +685,11 @@ impl<W: Write + Seek> UsdcWriter<W> {
             UpAxis::Z => "Z",
         };
         let s = &mut self.structure;
-        let doc = s.string(&format!("Written by pelage {}", env!("CARGO_PKG_VERSION")));
+        let doc = self
+            .documentation
+            .clone()
+            .unwrap_or_else(|| format!("Written by pelage {}", env!("CARGO_PKG_VERSION")));
+        let doc = s.string(&doc);
         let mut stage_fields = vec![
             (
                 s.token("defaultPrim"),
@@ -716,6 +764,15 @@ impl<W: Write + Seek> PrimWriter for UsdcWriter<W> {
 
     fn write_mesh_at(&mut self, name: &str, time: f64, mesh: &Mesh) -> Result<(), PrimWriteError> {
         UsdcWriter::write_mesh_at(self, name, time, mesh)
+    }
+
+    fn write_guides_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        guides: &Curves,
+    ) -> Result<(), PrimWriteError> {
+        UsdcWriter::write_guides_at(self, name, time, guides)
     }
 }
 
