@@ -47,6 +47,12 @@ pub struct DynamicsBenchArgs {
     /// With `--strands`: points a guide (default 16).
     #[arg(long, requires = "strands", default_value_t = 16)]
     pub points: usize,
+    /// With `--strands`, also measure a peer in the same run: `blender`
+    /// simulates as many guides on the Fox running with its own hair
+    /// dynamics (particle hair, the cloth solver, a Collision modifier;
+    /// bpy from PyPI in a cached venv, tools/bpy-python).
+    #[arg(long, value_enum, requires = "strands")]
+    pub peer: Option<super::groom::Peer>,
 }
 
 struct Row {

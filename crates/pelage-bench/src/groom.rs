@@ -41,7 +41,7 @@ pub struct GroomBenchArgs {
 /// A program measured beside pelage.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Peer {
-    /// Blender's geometry nodes, through bpy.
+    /// Blender (its geometry nodes or its hair dynamics), through bpy.
     Blender,
 }
 

@@ -6,6 +6,10 @@
 //! frame. Targets (2 cores): ≥ 24 simulated frames a second at 10,000
 //! guides × 16 points (2,000 in `--quick`).
 //!
+//! With `--peer blender`, Blender's own hair dynamics on the same body,
+//! guide count, points and length, measured in the same run
+//! (`blender_strands.py`): the target is ≥ 10× faster a frame.
+//!
 //! Beside them, the choice of collision structure measured in the same
 //! run: the skin's distance grid (built once a substep, read per point)
 //! against closest-point queries over a triangle BVH (built once a
@@ -38,7 +42,79 @@ struct Figures {
     bvh_build_s: f64,
     bvh_query_ns: f64,
     gpu: Option<GpuFigures>,
+    /// Blender's hair dynamics, or why they were not measured.
+    blender: Result<BlenderStrands, String>,
 }
+
+/// Blender's hair dynamics on the running Fox, measured by Blender.
+struct BlenderStrands {
+    /// Median seconds a frame with hair dynamics.
+    frame_s: f64,
+    /// … and with the hair static (the armature, the collision modifier).
+    static_frame_s: f64,
+    frames: usize,
+    version: String,
+}
+
+impl BlenderStrands {
+    /// What the dynamics add to a frame.
+    fn dynamics_s(&self) -> f64 {
+        (self.frame_s - self.static_frame_s).max(0.0)
+    }
+}
+
+/// Frames Blender simulates: its solver takes about a second a frame at
+/// 10,000 guides on two cores.
+const BLENDER_FRAMES: usize = 8;
+
+/// Runs `blender_strands.py`: `count` guides of `points` points on the
+/// Fox running, `substeps` a frame, with `params`' collision distance.
+fn measure_blender(
+    count: usize,
+    points: usize,
+    substeps: u32,
+    thickness: f32,
+) -> anyhow::Result<BlenderStrands> {
+    use anyhow::Context;
+    let script = include_str!("blender_strands.py");
+    let report = crate::run_bpy_case("blender_strands.py", script, |dir| {
+        let gltf = dir.join("Fox.gltf");
+        std::fs::write(&gltf, pelage::assets::FOX_GLTF)?;
+        let case = serde_json::json!({
+            "gltf": gltf,
+            "guides": count,
+            "points": points,
+            "frames": BLENDER_FRAMES,
+            "substeps": substeps,
+            "length": GUIDE_LENGTH,
+            "thickness": thickness,
+        });
+        std::fs::write(dir.join("case.json"), case.to_string())?;
+        Ok(())
+    })?;
+    let number = |key: &str| {
+        report[key]
+            .as_f64()
+            .with_context(|| format!("{key} in Blender's report"))
+    };
+    let (guides, keys) = (
+        number("guides")? as usize,
+        number("points_per_guide")? as usize,
+    );
+    anyhow::ensure!(
+        guides == count && keys == points,
+        "Blender grew {guides} guides of {keys} points, not {count} of {points}"
+    );
+    Ok(BlenderStrands {
+        frame_s: number("frame_s")?,
+        static_frame_s: number("static_frame_s")?,
+        frames: number("frames")? as usize,
+        version: report["blender"].as_str().unwrap_or("?").to_string(),
+    })
+}
+
+/// Guide length, a fraction of the Fox's size.
+const GUIDE_LENGTH: f32 = 0.06;
 
 struct GpuFigures {
     adapter: String,
@@ -79,7 +155,7 @@ fn fox_run(count: usize, points: usize, frames: usize) -> anyhow::Result<FoxRun>
         &rest,
         &GuideGrowth {
             count,
-            length: Map::Constant(0.06 * size),
+            length: Map::Constant(GUIDE_LENGTH * size),
             points,
             width: 0.002 * size,
             ..Default::default()
@@ -172,7 +248,21 @@ fn measure(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<Figures>
             }
         }
     };
+    let blender = match args.peer {
+        Some(super::groom::Peer::Blender) => {
+            eprintln!("measuring Blender's hair dynamics with bpy (tools/bpy-python)…");
+            measure_blender(
+                run.guides.len(),
+                points,
+                substeps,
+                params.thickness / run.size,
+            )
+            .map_err(|e| format!("{e:#}"))
+        }
+        None => Err("run with --peer blender".to_string()),
+    };
     Ok(Figures {
+        blender,
         guides: run.guides.len(),
         points_per_guide: points,
         substeps,
@@ -259,6 +349,14 @@ pub fn run(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<()> {
             "gpu_adapter": f.gpu.as_ref().map(|g| g.adapter.clone()),
             "gpu_software": f.gpu.as_ref().map(|g| g.software),
             "gpu_max_difference": f.gpu.as_ref().map(|g| g.max_difference),
+            "blender_frame_s": f.blender.as_ref().ok().map(|b| b.frame_s),
+            "blender_static_frame_s": f.blender.as_ref().ok().map(|b| b.static_frame_s),
+            "blender_dynamics_s": f.blender.as_ref().ok().map(|b| b.dynamics_s()),
+            "blender_frames": f.blender.as_ref().ok().map(|b| b.frames),
+            "blender_version": f.blender.as_ref().ok().map(|b| b.version.clone()),
+            "blender_error": f.blender.as_ref().err(),
+            "cpu_speedup_over_blender": f.blender.as_ref().ok().map(|b| b.dynamics_s() / f.frame_s),
+            "gpu_speedup_over_blender": f.blender.as_ref().ok().zip(f.gpu.as_ref()).map(|(b, g)| b.dynamics_s() / g.frame_s),
         });
         println!("{report}");
         return Ok(());
@@ -298,6 +396,29 @@ pub fn run(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<()> {
             f.frames
         ),
         None => println!("{:>10}  {:>12}", "GPU", "—"),
+    }
+    match &f.blender {
+        Ok(b) => {
+            println!(
+                "{:>10}  {:>12.1}  {:>11.2} ms  (Blender {} hair dynamics, the same count, points, length and body, its own roots; a frame {:.2} ms, {:.2} ms of it the skin and static hair; median of {} frames)",
+                "Blender",
+                1.0 / b.dynamics_s().max(f64::MIN_POSITIVE),
+                b.dynamics_s() * 1e3,
+                b.version,
+                b.frame_s * 1e3,
+                b.static_frame_s * 1e3,
+                b.frames
+            );
+            let gpu = f.gpu.as_ref().map_or(String::new(), |g| {
+                format!(", GPU {:.1}×", b.dynamics_s() / g.frame_s)
+            });
+            println!(
+                "{:>10}  CPU {:.1}× Blender's dynamics a frame{gpu}   target ≥ 10×",
+                "",
+                b.dynamics_s() / f.frame_s
+            );
+        }
+        Err(why) => println!("{:>10}  {:>12}  ({why})", "Blender", "—"),
     }
     println!();
     println!("collision structure, on the last frame's points (the grid is what the solver uses):");
