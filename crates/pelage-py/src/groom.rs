@@ -427,6 +427,41 @@ impl PyGroom {
         Ok(PyCurves::new(curves))
     }
 
+    /// Simulates the guides of an animated groom with `mode = "simulate"`
+    /// over its whole frame range (through `[simulation] cache` when it
+    /// names one) and, with `path` (.usdc, .usd or .abc), writes them
+    /// there with a time sample a frame, as `pelage simulate` does.
+    /// Returns `{"frames": (first, last), "guides": n, "cache": "read" |
+    /// "written" | "replaced" | None, "path": path or None}`.
+    #[pyo3(signature = (path = None))]
+    fn simulate<'py>(
+        &self,
+        py: Python<'py>,
+        path: Option<std::path::PathBuf>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (guides, cache) = py
+            .detach(|| self.groom.simulated_guides())
+            .map_err(|e| self.error(e))?;
+        if let Some(path) = &path {
+            let options = self.groom.usd_options();
+            py.detach(|| guides.write(path, &options))
+                .map_err(to_py_err)?;
+        }
+        let frames = guides.frames();
+        let count = guides.at(*frames.start()).map_or(0, |g| g.curve_count());
+        let cache = cache.map(|c| match c {
+            pelage::groom::CacheUse::Read => "read",
+            pelage::groom::CacheUse::Written => "written",
+            pelage::groom::CacheUse::Replaced => "replaced",
+        });
+        let out = pyo3::types::PyDict::new(py);
+        out.set_item("frames", (*frames.start(), *frames.end()))?;
+        out.set_item("guides", count)?;
+        out.set_item("cache", cache)?;
+        out.set_item("path", path)?;
+        Ok(out.into_any())
+    }
+
     /// Iterates over the parts, growing each as it is asked for, so memory
     /// holds one part at a time: `for curves in groom.parts(): ...`.
     #[pyo3(signature = (*, seed = None))]

@@ -200,21 +200,30 @@ def test_an_animated_groom_writes_every_frame(tmp_path):
         groom.grow_frame(3, part=99)
 
 
-def test_a_simulated_groom_swings_away_from_the_deformed_one():
+def test_a_simulated_groom_swings_away_from_the_deformed_one(tmp_path):
     fox = REPO / "crates" / "pelage" / "assets" / "fox" / "Fox.gltf"
 
-    def grown(mode, simulation=None):
-        groom = pelage.Groom(
+    def groom_of(mode, simulation=None):
+        return pelage.Groom(
             mesh=str(fox),
             guides={"generate": {"count": 40, "length": 10.0}},
             roots=300,
             animation={"frames": "1-4", "clip": "Run", "mode": mode},
             simulation=simulation,
         )
-        return groom.grow_frame(4)
 
-    deformed = grown("deform")
-    simulated = grown("simulate", {"gravity": [0, -500, 0], "follow": 0, "preroll": 4})
+    deformed = groom_of("deform").grow_frame(4)
+    swinging = groom_of("simulate", {"gravity": [0, -500, 0], "follow": 0, "preroll": 4})
+    simulated = swinging.grow_frame(4)
+    # The simulated guides, written for other tools: a sample a frame.
+    guides = tmp_path / "guides.usdc"
+    done = swinging.simulate(guides)
+    assert done["frames"] == (1, 4) and done["guides"] == 40 and done["cache"] is None
+    first, last = pelage.read_curves(guides, time=1), pelage.read_curves(guides, time=4)
+    assert len(last.offsets) - 1 == 40
+    assert not np.array_equal(first.points, last.points)
+    with pytest.raises(pelage.PelageError, match="mode = .simulate."):
+        groom_of("deform").simulate(tmp_path / "nothing.usdc")
     assert np.array_equal(deformed.ids, simulated.ids)
     tips = lambda c: c.points[c.offsets[1:] - 1]
     apart = np.linalg.norm(tips(deformed) - tips(simulated), axis=1).mean()
