@@ -134,7 +134,7 @@ impl PyGroom {
 #[pymethods]
 impl PyGroom {
     #[new]
-    #[pyo3(signature = (*, mesh, guides, roots, ops = None, interpolation = None, finish = None, output = None, animation = None, simulation = None, regions = None, look = None, base_dir = None))]
+    #[pyo3(signature = (*, mesh, guides, roots, ops = None, interpolation = None, finish = None, output = None, animation = None, simulation = None, regions = None, look = None, base_dir = None, skin = None))]
     #[allow(
         clippy::too_many_arguments,
         reason = "one keyword argument a groom-file table"
@@ -153,12 +153,22 @@ impl PyGroom {
         regions: Option<&Bound<'_, PyAny>>,
         look: Option<&Bound<'_, PyAny>>,
         base_dir: Option<PathBuf>,
+        skin: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let mut table = toml::Table::new();
         let mut inputs = GroomInputs::default();
-        // The surface: a Mesh value, or what `[mesh]` takes.
+        // The surface: a Mesh value (moved by `skin` when given), or what
+        // `[mesh]` takes.
         if let Ok(m) = mesh.cast::<PyMesh>() {
-            inputs.mesh = Some(m.get().inner.clone());
+            let mesh = m.get().inner.clone();
+            match skin.filter(|s| !s.is_none()) {
+                Some(frames) => inputs.skin = Some(Arc::new(skin_from_frames(&mesh, frames)?)),
+                None => inputs.mesh = Some(mesh),
+            }
+        } else if skin.is_some_and(|s| !s.is_none()) {
+            return Err(PyTypeError::new_err(
+                "skin: give mesh= as a pelage.Mesh (the skin's triangles and UVs) with it",
+            ));
         } else if let Ok(path) = mesh.extract::<PathBuf>() {
             table.insert("mesh".into(), one_key("path", path_value(&path, "mesh")?));
         } else {
@@ -246,22 +256,31 @@ impl PyGroom {
     /// `fraction` (0 to 1) grows that share of the hairs, a subset of the
     /// groom by id with wider hairs (`[output] fraction`).
     #[staticmethod]
-    #[pyo3(signature = (path, *, frames = None, mesh = None, fraction = None))]
+    #[pyo3(signature = (path, *, frames = None, mesh = None, fraction = None, skin = None))]
     fn load(
         py: Python<'_>,
         path: PathBuf,
         frames: Option<&str>,
         mesh: Option<&PyMesh>,
         fraction: Option<f64>,
+        skin: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let frames = frames
             .map(pelage::anim::FrameRange::parse)
             .transpose()
             .map_err(|e| PyValueError::new_err(format!("frames: {e}")))?;
-        let inputs = GroomInputs {
-            mesh: mesh.map(|m| m.inner.clone()),
-            guides: None,
-        };
+        let mut inputs = GroomInputs::default();
+        match (mesh, skin.filter(|s| !s.is_none())) {
+            (Some(mesh), Some(frames)) => {
+                inputs.skin = Some(Arc::new(skin_from_frames(&mesh.inner, frames)?));
+            }
+            (None, Some(_)) => {
+                return Err(PyTypeError::new_err(
+                    "skin: give mesh= as a pelage.Mesh (the skin's triangles and UVs) with it",
+                ));
+            }
+            (mesh, None) => inputs.mesh = mesh.map(|m| m.inner.clone()),
+        }
         let groom = py
             .detach(|| {
                 let source = SettingsSource::read_groom(&path)?;
@@ -287,7 +306,7 @@ impl PyGroom {
     ) -> PyResult<Self> {
         let inputs = GroomInputs {
             mesh: mesh.map(|m| m.inner.clone()),
-            guides: None,
+            ..GroomInputs::default()
         };
         let groom = py
             .detach(|| Groom::from_source_with_inputs(SettingsSource { path, text }, None, inputs))
@@ -732,6 +751,67 @@ fn check_part(p: usize, parts: usize) -> PyResult<()> {
         "part {p}: the groom has {parts} parts (0 to {})",
         parts.saturating_sub(1)
     )))
+}
+
+/// An animated skin from `{frame: (n, 3) array}`: `mesh`'s triangles and
+/// UVs with its vertices at each frame given (a DCC's evaluated mesh),
+/// blended linearly between two frames given and held before the first
+/// and after the last.
+fn skin_from_frames(
+    mesh: &Arc<pelage::Mesh>,
+    frames: &Bound<'_, PyAny>,
+) -> PyResult<pelage::anim::AnimatedSkin> {
+    let shape = "skin: a dict {frame: (n, 3) array of the mesh's vertices at that frame}";
+    let frames = frames
+        .cast::<PyDict>()
+        .map_err(|_| PyTypeError::new_err(shape))?;
+    let mut samples: Vec<(f64, Vec<glam::Vec3>)> = Vec::with_capacity(frames.len());
+    for (frame, positions) in frames.iter() {
+        let frame: f64 = frame.extract().map_err(|_| PyTypeError::new_err(shape))?;
+        if !frame.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "skin: frame {frame} is not a finite number"
+            )));
+        }
+        let what = format!("skin[{frame}]");
+        let points = crate::convert::vec3s(crate::convert::rows::<f32, 3>(&positions, &what)?);
+        if points.len() != mesh.vertex_count() {
+            return Err(PyValueError::new_err(format!(
+                "{what}: {} vertices; the mesh has {} (the skin's topology must not change)",
+                points.len(),
+                mesh.vertex_count()
+            )));
+        }
+        if let Some(bad) = points.iter().position(|p| !p.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "{what}: vertex {bad} is not finite"
+            )));
+        }
+        samples.push((frame, points));
+    }
+    if samples.is_empty() {
+        return Err(PyValueError::new_err("skin: no frames"));
+    }
+    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let samples = Arc::new(samples);
+    Ok(pelage::anim::AnimatedSkin::from_fn(mesh, move |time| {
+        skin_between(&samples, time)
+    }))
+}
+
+/// The skin's vertices at `time` from its frames (ascending).
+fn skin_between(samples: &[(f64, Vec<glam::Vec3>)], time: f64) -> Vec<glam::Vec3> {
+    let after = samples.partition_point(|(frame, _)| *frame <= time);
+    let (a, b) = match after {
+        0 => return samples[0].1.clone(),
+        n if n == samples.len() => return samples[n - 1].1.clone(),
+        n => (&samples[n - 1], &samples[n]),
+    };
+    let w = ((time - a.0) / (b.0 - a.0)) as f32;
+    if w == 0.0 {
+        return a.1.clone();
+    }
+    a.1.iter().zip(&b.1).map(|(p, q)| p.lerp(*q, w)).collect()
 }
 
 /// A groom report as the dict `json.loads` makes of the CLI's `--report`

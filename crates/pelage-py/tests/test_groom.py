@@ -459,3 +459,41 @@ def test_a_groom_too_large_for_memory_raises_memory_error(spot):
 
 def test_the_build_profile_is_exported():
     assert pelage.__build_profile__ in ("debug", "release")
+
+
+def test_a_skin_given_as_frames_moves_the_groom(spot):
+    """A DCC's evaluated mesh at every frame (the add-on's animated
+    export): the fur rides it, and simulates on it."""
+    rest = np.asarray(spot.positions, dtype=np.float32)
+    shift = np.array([0.05, 0.0, 0.0], dtype=np.float32)
+    skin = {f: rest + (f - 1) * shift for f in (1, 2, 3)}
+
+    def groom_of(mode, **extra):
+        return pelage.Groom(
+            mesh=spot,
+            skin=skin,
+            guides={"generate": {"count": 30, "length": 0.05}},
+            roots=400,
+            animation={"frames": "1-3", "mode": mode},
+            **extra,
+        )
+
+    carried = groom_of("deform")
+    first, third = carried.grow_frame(1), carried.grow_frame(3)
+    assert np.array_equal(first.ids, third.ids)
+    assert np.allclose(third.points, first.points + 2 * shift, atol=1e-5)
+    # Between two frames given, the skin is blended: half a shift.
+    assert np.allclose(carried.grow_frame(1.5).points, first.points + 0.5 * shift, atol=1e-5)
+    # Simulated on it: the roots ride the skin, the tips lag.
+    swung = groom_of("simulate", simulation={"gravity": [0, 0, 0], "follow": 0, "preroll": 0}).grow_frame(3)
+    roots = lambda c: c.points[c.offsets[:-1]]
+    assert np.allclose(roots(swung), roots(third), atol=1e-5)
+    tips = lambda c: c.points[c.offsets[1:] - 1]
+    assert np.linalg.norm(tips(swung) - tips(third), axis=1).mean() > 1e-3
+    with pytest.raises(ValueError, match=r"skin\[2(\.0)?\]: 3 vertices"):
+        pelage.Groom(
+            mesh=spot, skin={1: rest, 2: rest[:3]}, guides={"generate": {"count": 3, "length": 0.05}},
+            roots=10, animation={"frames": "1-2"},
+        )
+    with pytest.raises(pelage.PelageError, match=r"\[animation\]"):
+        pelage.Groom(mesh=spot, skin=skin, guides={"generate": {"count": 3, "length": 0.05}}, roots=10)

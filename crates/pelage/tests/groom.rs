@@ -457,7 +457,7 @@ fn a_mesh_and_guides_given_as_values_replace_the_files() {
     );
     let inputs = GroomInputs {
         mesh: Some(blub.clone()),
-        guides: None,
+        ..GroomInputs::default()
     };
     let on_blub = Groom::from_source_with_inputs(source(text), None, inputs).unwrap();
     let curves = on_blub.generator(None).unwrap().part(0).unwrap();
@@ -475,6 +475,7 @@ fn a_mesh_and_guides_given_as_values_replace_the_files() {
     let inputs = GroomInputs {
         mesh: Some(blub.clone()),
         guides: Some(guides.clone()),
+        ..GroomInputs::default()
     };
     let bound = Groom::from_source_with_inputs(source(no_guides), None, inputs).unwrap();
     assert_eq!(bound.guides().len(), 12);
@@ -493,6 +494,7 @@ fn a_mesh_and_guides_given_as_values_replace_the_files() {
     let twice = GroomInputs {
         mesh: Some(blub),
         guides: Some(guides),
+        ..GroomInputs::default()
     };
     let e = Groom::from_source_with_inputs(source(text), None, twice).unwrap_err();
     assert_eq!(e.key.as_deref(), Some("guides"), "{e}");

@@ -152,6 +152,7 @@ class Groom:
         regions: Optional[Dict[str, Any]] = None,
         look: Optional[Dict[str, Any]] = None,
         base_dir: Optional[_Path] = None,
+        skin: Optional[Dict[float, Any]] = None,
     ) -> None: ...
     @staticmethod
     def load(
@@ -160,6 +161,7 @@ class Groom:
         frames: Optional[str] = None,
         mesh: Optional[Mesh] = None,
         fraction: Optional[float] = None,
+        skin: Optional[Dict[float, Any]] = None,
     ) -> "Groom": ...
     @staticmethod
     def from_text(text: str, *, path: _Path = "<groom>", mesh: Optional[Mesh] = None) -> "Groom": ...

@@ -72,6 +72,10 @@ pub struct GroomInputs {
     /// Guide curves to bind to the surface (with `[guides] points` and
     /// `tolerance`), instead of `[guides] file` or `[guides.generate]`.
     pub guides: Option<crate::Curves>,
+    /// An animated skin (a DCC's evaluated mesh at every frame), replacing
+    /// `[mesh]` for an animated groom: the surface is the skin at the rest
+    /// frame. Give it or `mesh`, not both.
+    pub skin: Option<Arc<AnimatedSkin>>,
 }
 
 impl Groom {
@@ -132,22 +136,51 @@ impl Groom {
         };
         // A mesh value replaces `[mesh]`: a groom file written for the
         // command line grows on whatever mesh a DCC hands over.
-        let (mesh, skin) = match (&file.mesh, inputs.mesh, &animation) {
-            (_, Some(_), Some(_)) => {
+        let given_skin = match (inputs.skin, &inputs.mesh, &animation) {
+            (Some(_), Some(_), _) => {
                 return Err(invalid(
-                    "animation",
-                    "an animated groom reads its skin from [mesh] path (glTF, USD or an OBJ sequence); a mesh given as a value does not move",
+                    "mesh",
+                    "the surface is given twice, as a mesh and as a skin; give one",
                 ));
             }
-            (_, Some(mesh), None) => (mesh, None),
-            (None, None, _) => {
+            (Some(_), None, None) => {
+                return Err(invalid(
+                    "animation",
+                    "a skin moves an animated groom: add an [animation] table with its frames",
+                ));
+            }
+            (Some(skin), None, Some((spec, _, _))) => {
+                let mesh = skin.mesh_at(spec.rest_frame).map_err(|e| {
+                    GroomError::new(
+                        source.path.clone(),
+                        None,
+                        Some("skin".into()),
+                        GroomErrorKind::Mesh(e),
+                    )
+                })?;
+                Some((Arc::new(mesh), skin))
+            }
+            (None, _, _) => None,
+        };
+        let (mesh, skin) = match (given_skin, &file.mesh, inputs.mesh, &animation) {
+            (Some((mesh, skin)), ..) => (mesh, Some(skin)),
+            (None, _, Some(_), Some(_)) => {
+                return Err(invalid(
+                    "animation",
+                    "an animated groom reads its skin from [mesh] path (glTF, USD or an OBJ sequence) or from a skin given as a value; a mesh given as a value does not move",
+                ));
+            }
+            (None, _, Some(mesh), None) => (mesh, None),
+            (None, None, None, _) => {
                 return Err(invalid(
                     "mesh",
                     "no mesh: add a [mesh] table with `path = \"model.obj\"`",
                 ));
             }
-            (Some(section), None, None) => (Arc::new(load_mesh_section(&source, section)?), None),
-            (Some(section), None, Some((spec, fps, clip))) => {
+            (None, Some(section), None, None) => {
+                (Arc::new(load_mesh_section(&source, section)?), None)
+            }
+            (None, Some(section), None, Some((spec, fps, clip))) => {
                 let skin = load_skin(&source, section, *fps, clip.as_ref())?;
                 let mesh = skin
                     .mesh_at(spec.rest_frame)
