@@ -110,6 +110,26 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     curl: FloatProperty(name="Curl", description="Curl radius, relative to the length (0: off)", default=0.0, min=0.0, max=2.0)
     noise: FloatProperty(name="Noise", description="Noise amplitude, relative to the length (0: off)", default=0.1, min=0.0, max=2.0)
     seed: IntProperty(name="Seed", default=1, min=0)
+    # Animated export: how the fur moves over the scene's frames.
+    animation_mode: EnumProperty(
+        name="Motion",
+        description="How exported animated fur moves with the surface",
+        items=[
+            ("DEFORM", "Deform", "Grown once at the first frame and carried by the surface: fast, nothing swims"),
+            ("SIMULATE", "Simulate", "The guides simulated on the moving surface (the scene's gravity, "
+                                     "inertia, collisions with the body), the fur regrown from them every frame"),
+        ],
+        default="DEFORM",
+    )
+    sim_follow: FloatProperty(name="Follow", description="Pull toward the groomed shape, 0 to 1 a 60th of a second",
+                              default=0.05, min=0.0, max=1.0)
+    sim_bend: FloatProperty(name="Stiffness", description="Bending stiffness, 0 to 1 a 60th of a second",
+                            default=0.3, min=0.0, max=1.0)
+    sim_damping: FloatProperty(name="Damping", description="Velocity decay per second", default=1.0, min=0.0,
+                               soft_max=20.0)
+    sim_collide: BoolProperty(name="Collide", description="Keep the guides out of the surface", default=True)
+    sim_preroll: IntProperty(name="Pre-roll", description="Frames simulated at the first frame's pose before it",
+                             default=12, min=0, soft_max=100)
     # The look: Principled Hair BSDF (Chiang) values, Cycles' defaults.
     melanin: FloatProperty(name="Melanin", description="Hair pigment, 0 white to 1 black", default=0.8, min=0.0, max=1.0)
     melanin_redness: FloatProperty(name="Redness", description="Share of red pheomelanin in the pigment", default=1.0, min=0.0, max=1.0)
@@ -208,6 +228,55 @@ class _PelageExport(ExportHelper):
         return {"FINISHED"}
 
 
+class _PelageAnimatedExport(ExportHelper):
+    """Grows the active mesh's groom over the scene's frame range and
+    writes it with a time sample a frame."""
+
+    bl_options = {"REGISTER"}
+
+    @classmethod
+    def poll(cls, context):
+        return surface_of(context) is not None
+
+    def execute(self, context):
+        surface = surface_of(context)
+        settings = surface.pelage_fur
+        wm = context.window_manager
+        wm.progress_begin(0, 2)
+        try:
+            groom = fur.animated_groom_for(
+                context, surface, settings, progress=lambda done, total: wm.progress_update(done / total)
+            )
+            summary = groom.write(self.filepath, progress=lambda done, total: wm.progress_update(1 + done / total))
+        except (PelageError, ValueError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        scene = context.scene
+        self.report({"INFO"}, f"pelage: wrote {summary['hairs']:,} hairs over frames "
+                              f"{scene.frame_start}-{scene.frame_end} to {summary['path']}")
+        return {"FINISHED"}
+
+
+class PELAGE_OT_export_animated_usd(_PelageAnimatedExport, bpy.types.Operator):
+    """Grow the active mesh's pelage fur over the scene's frames (deformed or simulated) and write it as binary USD with a time sample a frame"""
+
+    bl_idname = "pelage.export_animated_usd"
+    bl_label = "Export animated USD"
+    filename_ext = ".usdc"
+    filter_glob: StringProperty(default="*.usdc;*.usd", options={"HIDDEN"})
+
+
+class PELAGE_OT_export_animated_alembic(_PelageAnimatedExport, bpy.types.Operator):
+    """Grow the active mesh's pelage fur over the scene's frames (deformed or simulated) and write it as Alembic with a sample a frame"""
+
+    bl_idname = "pelage.export_animated_alembic"
+    bl_label = "Export animated Alembic"
+    filename_ext = ".abc"
+    filter_glob: StringProperty(default="*.abc", options={"HIDDEN"})
+
+
 class PELAGE_OT_export_usd(_PelageExport, bpy.types.Operator):
     """Grow the active mesh's pelage fur and write it as binary USD"""
 
@@ -273,6 +342,16 @@ class PELAGE_PT_fur(bpy.types.Panel):
         row = layout.row(align=True)
         row.operator(PELAGE_OT_export_usd.bl_idname)
         row.operator(PELAGE_OT_export_alembic.bl_idname)
+        motion = layout.box().column(align=True)
+        scene = context.scene
+        motion.label(text=f"Animated: frames {scene.frame_start}-{scene.frame_end}")
+        motion.prop(settings, "animation_mode")
+        if settings.animation_mode == "SIMULATE":
+            for name in ("sim_follow", "sim_bend", "sim_damping", "sim_collide", "sim_preroll"):
+                motion.prop(settings, name)
+        row = motion.row(align=True)
+        row.operator(PELAGE_OT_export_animated_usd.bl_idname, text="USD")
+        row.operator(PELAGE_OT_export_animated_alembic.bl_idname, text="Alembic")
 
 
 CLASSES = (
@@ -281,6 +360,8 @@ CLASSES = (
     PELAGE_OT_shade_hair,
     PELAGE_OT_export_usd,
     PELAGE_OT_export_alembic,
+    PELAGE_OT_export_animated_usd,
+    PELAGE_OT_export_animated_alembic,
     PELAGE_PT_fur,
 )
 

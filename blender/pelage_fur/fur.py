@@ -162,19 +162,25 @@ def guides_from_curves_object(obj, depsgraph=None):
     return pelage.Curves.from_arrays(world, offsets.astype(np.uint32))
 
 
-def groom_from_settings(mesh, settings, guides=None, size=1.0):
+def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animation=None,
+                        simulation=None):
     """A ``pelage.Groom`` on ``mesh`` from the panel's settings: the groom
     file when one is set (its ``[mesh]`` replaced by ``mesh``), else
     roots, the clump, curl and noise operators and the look, shaped by
     ``guides`` (a ``pelage.Curves`` from ``guides_from_curves_object``,
     bound within a 200th of ``size``, the surface's largest dimension)
-    or by guides grown on the surface."""
+    or by guides grown on the surface. With ``skin`` (``{frame:
+    vertices}``, ``mesh`` at the first frame) and ``animation`` (the
+    ``[animation]`` table): animated, simulated with ``simulation``."""
     import pelage
 
     if settings.groom_file:
         import bpy
 
-        return pelage.Groom.load(bpy.path.abspath(settings.groom_file), mesh=mesh)
+        path = bpy.path.abspath(settings.groom_file)
+        if skin is None:
+            return pelage.Groom.load(path, mesh=mesh)
+        return pelage.Groom.load(path, mesh=mesh, skin=skin, frames=animation["frames"])
     ops = []
     if settings.clump > 0:
         clumps = max(1, settings.count // 100)
@@ -195,6 +201,9 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0):
     parting = {"FACE_SETS": {"faces": "groups"}, "MATERIALS": {"faces": "materials"}}
     return pelage.Groom(
         mesh=mesh,
+        skin=skin,
+        animation=animation,
+        simulation=simulation,
         guides=guides,
         regions=parting.get(settings.parting),
         roots=roots,
@@ -323,6 +332,73 @@ def groom_for(surface, settings, mesh, depsgraph):
     if settings.guides_object is not None and not settings.groom_file:
         guides = guides_from_curves_object(settings.guides_object, depsgraph)
     return groom_from_settings(mesh, settings, guides, max(surface.dimensions) or 1.0)
+
+
+def evaluated_positions(obj, depsgraph):
+    """The vertices of ``obj`` as ``depsgraph`` evaluates it (modifiers,
+    shape keys, armature), in pelage's Y-up world, float32 (n, 3)."""
+    evaluated = obj.evaluated_get(depsgraph)
+    mesh = evaluated.to_mesh()
+    try:
+        positions = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", positions)
+        return transform_points(to_pelage_space(obj), positions.reshape(-1, 3))
+    finally:
+        evaluated.to_mesh_clear()
+
+
+def animated_groom_for(context, surface, settings, progress=None):
+    """The panel's groom on ``surface`` as Blender evaluates it over the
+    scene's frame range: the surface at the first frame is the rest pose
+    (roots sampled and guides bound there), its vertices at every frame
+    the skin (armatures, shape keys, modifiers, object motion: whatever
+    Blender shows). ``settings.animation_mode`` deforms the fur with the
+    skin or simulates the guides on it (gravity: the scene's). The scene
+    is left at the frame it was on. ``progress(done, total)`` as frames
+    are read."""
+    scene = context.scene
+    first, last = scene.frame_start, scene.frame_end
+    if last < first:
+        raise ValueError(f"the scene's frame range {first}-{last} is empty")
+    current = scene.frame_current
+    skin = {}
+    try:
+        scene.frame_set(first)
+        depsgraph = context.evaluated_depsgraph_get()
+        mesh, _ = mesh_to_pelage(surface, depsgraph)
+        guides = None
+        if settings.guides_object is not None and not settings.groom_file:
+            guides = guides_from_curves_object(settings.guides_object, depsgraph)
+        for frame in range(first, last + 1):
+            scene.frame_set(frame)
+            skin[frame] = evaluated_positions(surface, context.evaluated_depsgraph_get())
+            if len(skin[frame]) != len(skin[first]):
+                import pelage
+
+                raise pelage.PelageError(
+                    f"{surface.name}: {len(skin[frame])} vertices at frame {frame} and "
+                    f"{len(skin[first])} at frame {first}: animated fur needs a mesh whose "
+                    "topology does not change (no remesh, decimate or booleans that animate)")
+            if progress is not None:
+                progress(frame - first + 1, last - first + 1)
+    finally:
+        scene.frame_set(current)
+    mode = settings.animation_mode.lower()
+    animation = {"frames": f"{first}-{last}", "mode": mode,
+                 "fps": scene.render.fps / scene.render.fps_base}
+    simulation = None
+    if mode == "simulate":
+        gravity = Z_UP_TO_Y_UP @ np.array(scene.gravity, dtype=np.float64)
+        simulation = {
+            "gravity": [float(g) for g in gravity] if scene.use_gravity else [0.0, 0.0, 0.0],
+            "follow": settings.sim_follow,
+            "bend": settings.sim_bend,
+            "damping": settings.sim_damping,
+            "collide": settings.sim_collide,
+            "preroll": settings.sim_preroll,
+        }
+    return groom_from_settings(mesh, settings, guides, max(surface.dimensions) or 1.0,
+                               skin=skin, animation=animation, simulation=simulation)
 
 
 def grow_on_object(context, surface, settings, progress=None):

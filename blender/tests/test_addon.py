@@ -257,10 +257,10 @@ class CheckedLayout:
 
 addon = next(m for name, m in sys.modules.items() if name.endswith("pelage_fur") and hasattr(m, "PELAGE_PT_fur"))
 bpy.context.view_layer.objects.active = grid
-for guides_set in (None, bpy.data.objects["sculpted"]):
-    settings.guides_object = guides_set
+for guides_set, motion in ((None, "DEFORM"), (bpy.data.objects["sculpted"], "SIMULATE")):
+    settings.guides_object, settings.animation_mode = guides_set, motion
     addon.PELAGE_PT_fur.draw(type("Panel", (), {"layout": CheckedLayout()})(), bpy.context)
-settings.guides_object = None
+settings.guides_object, settings.animation_mode = None, "DEFORM"
 print("panel: every drawn setting and button exists")
 
 # The same seed grows the same fur (the operator is deterministic).
@@ -366,5 +366,66 @@ with tempfile.TemporaryDirectory() as folder:
     report["guides"]["dropped"] = [{"guide": 3, "why": "its root is 0.2 from the surface"}]
     assert fur.guide_warnings(report) == ["guide 3 left out: its root is 0.2 from the surface"]
     print("guides left out: reported from the library's report")
+
+# 6. Animated export: the fur over the scene's frames on the surface as
+#    Blender evaluates it (object motion and a keyed twist), deformed or
+#    simulated, one file with a sample a frame.
+clear_scene()
+bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=24, ring_count=12)
+ball = bpy.context.active_object
+ball.pelage_fur.count, ball.pelage_fur.length, ball.pelage_fur.points = 1_500, 0.3, 8
+scene = bpy.context.scene
+scene.frame_start, scene.frame_end = 1, 4
+ball.location = (0.0, 0.0, 0.0)
+ball.keyframe_insert("location", frame=1)
+ball.location = (0.6, 0.0, 0.0)
+ball.keyframe_insert("location", frame=4)
+twist = ball.modifiers.new("twist", "SIMPLE_DEFORM")
+twist.deform_method, twist.deform_axis, twist.angle = "TWIST", "Z", 0.0
+twist.keyframe_insert("angle", frame=1)
+twist.angle = 1.0
+twist.keyframe_insert("angle", frame=4)
+scene.frame_set(2)
+from mathutils import Vector  # noqa: E402
+from mathutils.bvhtree import BVHTree  # noqa: E402
+
+
+def off_surface(curves, frame):
+    """How far the roots of ``curves`` (pelage's Y-up world) lie from the
+    ball as Blender evaluates it at ``frame``: the largest distance."""
+    scene.frame_set(frame)
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    tree = BVHTree.FromObject(ball, depsgraph)
+    to_local = ball.matrix_world.inverted()
+    roots = curves.points[curves.offsets[:-1]]
+    worst = 0.0
+    for x, y, z in roots:
+        _, _, _, distance = tree.find_nearest(to_local @ Vector((x, -z, y)))
+        worst = max(worst, distance)
+    return worst
+
+
+with tempfile.TemporaryDirectory() as folder:
+    moved = os.path.join(folder, "ball.usdc")
+    assert bpy.ops.pelage.export_animated_usd(filepath=moved) == {"FINISHED"}
+    assert scene.frame_current == 2, "the scene is left at its frame"
+    frames = [pelage.read_curves(moved, time=f) for f in (1, 2, 3, 4)]
+    assert all(c.curve_count == 1_500 for c in frames)
+    assert all(np.array_equal(c.ids, frames[0].ids) for c in frames), "the same hairs every frame"
+    for f, curves in zip((1, 2, 3, 4), frames):
+        worst = off_surface(curves, f)
+        assert worst < 1e-4, (f, worst)
+    assert not np.allclose(frames[0].points, frames[3].points)
+    print("animated export: 4 frames in one usdc, the same hairs, roots on the evaluated surface every frame")
+    ball.pelage_fur.animation_mode = "SIMULATE"
+    ball.pelage_fur.sim_follow, ball.pelage_fur.sim_preroll = 0.0, 2
+    swung = os.path.join(folder, "ball.abc")
+    assert bpy.ops.pelage.export_animated_alembic(filepath=swung) == {"FINISHED"}
+    last = pelage.read_curves(swung, time=4 / scene.render.fps)
+    assert off_surface(last, 4) < 1e-4
+    tips = lambda c: c.points[c.offsets[1:] - 1]
+    lag = np.linalg.norm(tips(last) - tips(frames[3]), axis=1).mean()
+    assert lag > 0.01, lag
+    print(f"animated export, simulated: Alembic, roots on the surface, tips {lag:.3f} from the deformed ones")
 
 print("add-on: all checks passed")
