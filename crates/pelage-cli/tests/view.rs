@@ -402,3 +402,71 @@ fn grooming_in_the_window_saves_a_groom_that_grows_as_shown() {
         .to_rgba8();
     assert_ne!(first.as_raw(), last.as_raw());
 }
+
+#[test]
+fn a_simulated_groom_written_with_its_skin_plays_in_the_viewer() {
+    if !has_display() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let fox = Path::new(env!("CARGO_MANIFEST_DIR")).join("../pelage/assets/fox/Fox.gltf");
+    let groom = dir.path().join("fox.toml");
+    std::fs::write(
+        &groom,
+        format!(
+            "[mesh]\npath = {:?}\n[roots]\ncount = 600\n[guides]\ngenerate = {{ count = 60, length = 12.0 }}\n\
+             [animation]\nframes = \"1-6\"\nclip = \"Run\"\nmode = \"simulate\"\n\
+             [simulation]\ngravity = [0, -500, 0]\npreroll = 2\n[output]\nwith_mesh = true\n",
+            fox.display()
+        ),
+    )
+    .unwrap();
+    let written = dir.path().join("fox.usdc");
+    let out = pelage(&[
+        "groom",
+        groom.to_str().unwrap(),
+        "-o",
+        written.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Held at the first sample, then 5 frames (5/24 s) on.
+    let script = dir.path().join("script.toml");
+    std::fs::write(
+        &script,
+        "ui = false\n\
+         [[step]]\ntime = 0\n[[step]]\nwait = 2\n[[step]]\nscreenshot = \"first.png\"\n\
+         [[step]]\ntime = 0.2084\n[[step]]\nwait = 2\n[[step]]\nscreenshot = \"last.png\"\n",
+    )
+    .unwrap();
+    let size = format!("{}x{}", SIZE.0, SIZE.1);
+    let out = Command::new(env!("CARGO_BIN_EXE_pelage"))
+        .current_dir(dir.path())
+        .args([
+            "view",
+            written.to_str().unwrap(),
+            "--script",
+            script.to_str().unwrap(),
+            "--size",
+            &size,
+        ])
+        .env(
+            "XDG_RUNTIME_DIR",
+            std::env::var("XDG_RUNTIME_DIR").unwrap_or("/tmp".into()),
+        )
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("no time samples"), "{stderr}");
+    let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
+    let (first, last) = (read("first.png"), read("last.png"));
+    let total = (SIZE.0 * SIZE.1) as usize;
+    // The file's own skin and its fur run on: the picture changes.
+    let (near, far) = changed_near_and_far(&first, &last, (0.0, 0.0), 0.0);
+    assert!(near + far > total / 50, "{} pixels changed", near + far);
+}

@@ -108,7 +108,7 @@ impl Session {
                 Ok(s.last_simulation_ms)
             }
             Session::Curves(c) => {
-                c.advance();
+                c.advance(dt);
                 Ok(0.0)
             }
             Session::Groom(_) => Ok(0.0),
@@ -679,11 +679,21 @@ impl WindowState {
                             s.shake();
                         }
                     }
-                    Step::Time(seconds) => {
-                        if let Some(s) = self.session.shells() {
-                            s.set_clip_time(seconds);
+                    Step::Time(seconds) => match &mut self.session {
+                        Session::Shells(s) => s.set_clip_time(seconds),
+                        Session::Curves(c) => {
+                            if !c.hold_at(seconds) {
+                                eprintln!(
+                                    "warning: `time`: the curves file has no time samples; ignored"
+                                );
+                            }
                         }
-                    }
+                        Session::Groom(_) => {
+                            eprintln!(
+                                "warning: `time` is for skinned scenes and animated curves files; ignored"
+                            );
+                        }
+                    },
                     Step::Show(show) => match &mut self.session {
                         Session::Curves(c) => {
                             let t = &mut c.controls;

@@ -2,7 +2,9 @@
 //! file grown in memory, drawn by the preview renderer with toggles for the
 //! skin, roots, guides and hairs, a slider for how many hairs to draw, and
 //! a reload whenever the file changes on disk — edit a groom file in one
-//! window, see it regrow in the other.
+//! window, see it regrow in the other. A time-sampled USD file (an
+//! animated or simulated groom as `pelage groom` writes it) plays: a
+//! timeline over its samples, with its own posed skin when it has one.
 
 use anyhow::Context as _;
 use glam::Vec3;
@@ -41,6 +43,21 @@ struct Loaded {
     skin: Skin,
     texture: Option<image::RgbaImage>,
     summary: String,
+    /// A time-sampled file's samples, to play.
+    timeline: Option<Timeline>,
+}
+
+/// A time-sampled USD file, parsed once with every sample.
+struct Timeline {
+    file: pelage::io::UsdCurvesSequence,
+    /// The time codes of its samples, ascending (two at least).
+    times: Vec<f64>,
+    /// Time codes a second.
+    per_second: f64,
+    /// The file's own posed skin (a `Mesh` prim written with the fur).
+    skin: Option<pelage::anim::AnimatedSkin>,
+    /// The time code of the hairs (and skin) loaded.
+    shown: f64,
 }
 
 enum Skin {
@@ -74,6 +91,10 @@ pub struct CurvesControls {
     pub percent: f32,
     /// Reload when the file changes.
     pub watch: bool,
+    /// The time code shown, for a time-sampled file.
+    pub time: f64,
+    /// Play the time-sampled file (looping).
+    pub playing: bool,
 }
 
 /// A groom or curves file being looked at.
@@ -102,6 +123,8 @@ impl CurvesSession {
     ) -> anyhow::Result<Self> {
         let loaded = load(&source)?;
         let status = loaded.summary.clone();
+        let time = loaded.timeline.as_ref().map_or(0.0, |t| t.shown);
+        let playing = loaded.timeline.is_some();
         // A million hairs draw slowly in software: start with at most
         // 200,000 and let the slider bring the rest.
         let count = loaded.hairs.curve_count().max(1) as f32;
@@ -119,6 +142,8 @@ impl CurvesSession {
                 hairs: true,
                 percent: (100.0 * 200_000.0 / count).min(100.0),
                 watch: true,
+                time,
+                playing,
             },
             last_check: Instant::now(),
             status,
@@ -141,8 +166,34 @@ impl CurvesSession {
         }
     }
 
+    /// Plays a time-sampled file `dt` seconds on (looping), then
+    /// [`Self::watch`].
+    pub fn advance(&mut self, dt: f32) {
+        if let (Some(timeline), true) = (&self.loaded.timeline, self.controls.playing) {
+            let (first, last) = (timeline.times[0], timeline.times[timeline.times.len() - 1]);
+            let mut time = self.controls.time + f64::from(dt) * timeline.per_second;
+            if time > last {
+                time = first;
+            }
+            self.controls.time = time;
+        }
+        self.watch();
+    }
+
+    /// Holds a time-sampled file `seconds` after its first sample, paused
+    /// (a script's `time`); false for a file without samples.
+    pub fn hold_at(&mut self, seconds: f32) -> bool {
+        let Some(timeline) = &self.loaded.timeline else {
+            return false;
+        };
+        let (first, last) = (timeline.times[0], timeline.times[timeline.times.len() - 1]);
+        self.controls.time = (first + f64::from(seconds) * timeline.per_second).clamp(first, last);
+        self.controls.playing = false;
+        true
+    }
+
     /// Reloads when the file changed (checked twice a second).
-    pub fn advance(&mut self) {
+    fn watch(&mut self) {
         if !self.controls.watch || self.last_check.elapsed().as_secs_f32() < 0.5 {
             return;
         }
@@ -162,7 +213,27 @@ impl CurvesSession {
         }
     }
 
+    /// Reads the hairs (and the file's skin) at the sample at or before
+    /// `controls.time`, when another is shown.
+    fn seek(&mut self) -> anyhow::Result<()> {
+        let Some(timeline) = &mut self.loaded.timeline else {
+            return Ok(());
+        };
+        let at = timeline.times.partition_point(|&t| t <= self.controls.time);
+        let time = timeline.times[at.saturating_sub(1)];
+        if time == timeline.shown {
+            return Ok(());
+        }
+        self.loaded.hairs = timeline.file.at(time)?;
+        if let Some(skin) = &timeline.skin {
+            self.loaded.skin = Skin::Mesh(Box::new(skin.mesh_at(time)?));
+        }
+        timeline.shown = time;
+        Ok(())
+    }
+
     fn upload(&mut self, ctx: &GpuContext) -> anyhow::Result<()> {
+        self.seek()?;
         let c = self.controls;
         let count = self.loaded.hairs.curve_count();
         let shown = (count as f32 * c.percent / 100.0).round().max(1.0);
@@ -251,6 +322,21 @@ impl CurvesSession {
                 .text(format!("of {count} hairs")),
         );
         ui.checkbox(&mut c.watch, "reload when the file changes");
+        if let Some(timeline) = &self.loaded.timeline {
+            let (first, last) = (timeline.times[0], timeline.times[timeline.times.len() - 1]);
+            ui.horizontal(|ui| {
+                if ui
+                    .button(if c.playing { "Pause" } else { "Play" })
+                    .clicked()
+                {
+                    c.playing = !c.playing;
+                }
+                let slider = ui.add(egui::Slider::new(&mut c.time, first..=last).text("frame"));
+                if slider.dragged() {
+                    c.playing = false;
+                }
+            });
+        }
     }
 }
 
@@ -298,8 +384,15 @@ fn load(source: &CurvesSource) -> anyhow::Result<Loaded> {
     match source {
         CurvesSource::File { path, mesh } => {
             let hairs = pelage::io::read_curves(path).context("cannot load the curves")?;
+            let timeline = timeline_of(path, mesh.is_none())?;
             let (skin, texture) = match mesh.as_deref() {
-                None => (Skin::None, None),
+                None => match timeline.as_ref().and_then(|t| t.skin.as_ref()) {
+                    Some(skin) => (
+                        Skin::Mesh(Box::new(skin.mesh_at(t_first(&timeline))?)),
+                        None,
+                    ),
+                    None => (Skin::None, None),
+                },
                 Some(m) if m == Path::new("spot") => (
                     Skin::Mesh(Box::new(pelage::assets::spot())),
                     Some(spot_texture()?),
@@ -309,13 +402,26 @@ fn load(source: &CurvesSource) -> anyhow::Result<Loaded> {
                     None,
                 ),
             };
-            let summary = format!("{} hairs from {}", hairs.curve_count(), path.display());
+            let summary = match &timeline {
+                Some(t) => format!(
+                    "{} hairs from {}, {} samples",
+                    hairs.curve_count(),
+                    path.display(),
+                    t.times.len()
+                ),
+                None => format!("{} hairs from {}", hairs.curve_count(), path.display()),
+            };
+            let hairs = match &timeline {
+                Some(t) => t.file.at(t.shown)?,
+                None => hairs,
+            };
             Ok(Loaded {
                 hairs,
                 guides: None,
                 skin,
                 texture,
                 summary,
+                timeline,
             })
         }
         CurvesSource::Groom(path) => {
@@ -345,7 +451,46 @@ fn load(source: &CurvesSource) -> anyhow::Result<Loaded> {
                 skin: Skin::Groom(Box::new(groom)),
                 texture,
                 summary,
+                timeline: None,
             })
         }
     }
+}
+
+/// The first sample's time code of a timeline (0 without one).
+fn t_first(timeline: &Option<Timeline>) -> f64 {
+    timeline.as_ref().map_or(0.0, |t| t.times[0])
+}
+
+/// The samples of a time-sampled USD file (none for other files, or a
+/// USD file with one sample); with `own_skin`, its posed skin too.
+fn timeline_of(path: &Path, own_skin: bool) -> anyhow::Result<Option<Timeline>> {
+    let usd = matches!(
+        pelage::io::CurvesFormat::from_path(path),
+        Some(pelage::io::CurvesFormat::Usda | pelage::io::CurvesFormat::Usdc)
+    );
+    if !usd {
+        return Ok(None);
+    }
+    let file = pelage::io::UsdCurvesSequence::open(path).context("cannot load the curves")?;
+    let times = file.times();
+    if times.len() < 2 {
+        return Ok(None);
+    }
+    let per_second = pelage::io::read_usd_layer_info(path)
+        .map(|i| i.time_codes_per_second)
+        .unwrap_or(24.0);
+    // A file without a skin is hairs alone: no error, no skin.
+    let skin = own_skin
+        .then(|| pelage::anim::AnimatedSkin::load(path, &Default::default()).ok())
+        .flatten()
+        .filter(pelage::anim::AnimatedSkin::is_animated);
+    let shown = times[0];
+    Ok(Some(Timeline {
+        file,
+        times,
+        per_second,
+        skin,
+        shown,
+    }))
 }

@@ -19,7 +19,7 @@
 //! [[step]]
 //! show = { skin = false, guides = true, percent = 10 }       # groom views
 //! [[step]]
-//! time = 0.4                         # hold a skinned scene's clip at 0.4 s
+//! time = 0.4                         # hold a skinned scene's clip (or an animated curves file) at 0.4 s
 //!
 //! # `pelage view fur.toml --groom`:
 //! [[step]]
