@@ -255,6 +255,61 @@ impl SkinSdf {
         (d, grad.normalize_or_zero())
     }
 
+    /// Whether `p` is certainly `gap` or more outside the skin, read from
+    /// the grid's nodes alone, without the exact path: the distance to
+    /// the skin changes no faster than the point moves, so a node `d`
+    /// outside keeps every point `r` from it at least `d - r` outside
+    /// (a path from the node to the point that met the skin would be
+    /// longer than `d`). Only nodes inside the exact band count: beyond
+    /// it a node holds `far` on either side. False when unsure, and
+    /// always for a gap wider
+    /// than the exact band's cell (where [`Self::sample`] reads the
+    /// interpolation, which may say less), so that a point it calls clear
+    /// is one [`Self::sample`] finds `gap` or more outside.
+    #[inline]
+    pub fn clear_of(&self, p: Vec3, gap: f32) -> bool {
+        if gap > EXACT_WITHIN * self.cell {
+            return false;
+        }
+        let g = (p - self.origin) / self.cell;
+        let [nx, ny, nz] = self.dims;
+        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0) {
+            return true;
+        }
+        let (ix, iy, iz) = (g.x as usize, g.y as usize, g.z as usize);
+        if ix + 1 >= nx || iy + 1 >= ny || iz + 1 >= nz {
+            // Beyond the grid's margin (more than the band from the
+            // skin's bounds): outside.
+            return true;
+        }
+        let f = g - Vec3::new(ix as f32, iy as f32, iz as f32);
+        let base = (iz * ny + iy) * nx + ix;
+        // The corner nearest the point first: it gives the best bound.
+        let near = [
+            usize::from(f.x >= 0.5),
+            usize::from(f.y >= 0.5),
+            usize::from(f.z >= 0.5),
+        ];
+        for k in 0..8 {
+            let o = [
+                near[0] ^ (k & 1),
+                near[1] ^ ((k >> 1) & 1),
+                near[2] ^ ((k >> 2) & 1),
+            ];
+            let d = self.distances[base + (o[2] * ny + o[1]) * nx + o[0]];
+            // Nodes beyond the band hold `far` on either side of the
+            // skin: they say nothing.
+            if d < gap || d >= self.far {
+                continue;
+            }
+            let r = (f - Vec3::new(o[0] as f32, o[1] as f32, o[2] as f32)).length() * self.cell;
+            if d - r >= gap {
+                return true;
+            }
+        }
+        false
+    }
+
     /// The signed distance to the closest of `triangles` (each tried
     /// once) and the direction out; `None` when none is in the band.
     fn exact(&self, p: Vec3, triangles: &[u32; 8]) -> Option<(f32, Vec3)> {
@@ -336,5 +391,58 @@ mod tests {
         let (inside, in_dir) = sdf.sample(v - 0.03 * n);
         assert!(outside > 0.015 && inside < -0.015, "{outside} {inside}");
         assert!(out_dir.dot(n) > 0.7 && in_dir.dot(n) > 0.7);
+    }
+
+    #[test]
+    fn a_point_the_nodes_call_clear_is_outside_that_far_by_the_exact_path_and_the_mesh() {
+        let spot = crate::assets::spot();
+        let sdf = SkinSdf::new(
+            spot.positions(),
+            spot.normals(),
+            spot.triangles(),
+            0.02,
+            0.06,
+        );
+        let bvh = crate::mesh::TriangleBvh::new(spot.positions(), spot.triangles());
+        // Inside or outside by the mesh's winding number (its triangles'
+        // solid angles seen from `p`, over 4π).
+        let winding = |p: Vec3| {
+            let mut w = 0.0f64;
+            for t in spot.triangles() {
+                let [a, b, c] = t.map(|i| (spot.positions()[i as usize] - p).as_dvec3());
+                let (la, lb, lc) = (a.length(), b.length(), c.length());
+                let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+                w += 2.0 * a.dot(b.cross(c)).atan2(den);
+            }
+            w / (4.0 * std::f64::consts::PI)
+        };
+        let (lo, hi) = spot.bounds();
+        let mut clear = 0;
+        for gap in [0.002f32, 0.01, 0.02] {
+            for i in 0..4000u32 {
+                let t = Vec3::new(
+                    (i as f32 * 0.618_034).fract(),
+                    (i as f32 * 0.754_878).fract(),
+                    (i as f32 * 0.569_840).fract(),
+                );
+                let p = lo - Vec3::splat(0.05) + t * (hi - lo + Vec3::splat(0.1));
+                if !sdf.clear_of(p, gap) {
+                    continue;
+                }
+                clear += 1;
+                let (d, _) = sdf.sample(p);
+                assert!(d >= gap, "{p}: clear of {gap}, but sampled {d}");
+                let from_mesh = bvh.closest(p).unwrap().distance_squared.sqrt();
+                assert!(
+                    from_mesh >= gap,
+                    "{p}: clear of {gap}, {from_mesh} from the mesh"
+                );
+                assert!(winding(p) < 0.5, "{p}: clear of {gap}, but inside the mesh");
+            }
+        }
+        // A shortcut often taken: over a thousand of these points.
+        assert!(clear > 1000, "{clear} clear");
+        // Wider than a cell, it never answers (the interpolation decides).
+        assert!(!sdf.clear_of(hi + Vec3::splat(0.5), 0.03));
     }
 }

@@ -67,7 +67,7 @@ impl OutsideSkin {
         let Some(first) = points
             .iter()
             .skip(1)
-            .position(|&p| self.skin.sample(p).0 < self.gap)
+            .position(|&p| !self.skin.clear_of(p, self.gap) && self.skin.sample(p).0 < self.gap)
             .map(|i| i + 1)
         else {
             return false;
