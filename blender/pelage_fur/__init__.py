@@ -2,8 +2,8 @@
 
 Reads the active object's evaluated mesh (with its active UV map), grows a
 pelage groom on it (a groom file, or the panel's count, length, clump,
-curl and noise), and adds a native hair Curves object parented to the
-mesh, bound to it for Blender's Deform Curves on Surface. The panel lives
+curl and noise), and fills a native hair Curves object parented to the
+mesh (the same one on every grow), bound to it for Blender's Deform Curves on Surface. The panel lives
 in the 3D Viewport's sidebar (N), tab "pelage"; "Export USD" and "Export
 Alembic" write the same groom with pelage's own writers.
 """

@@ -295,15 +295,19 @@ def hair_material():
     return material
 
 
+#: The node group of the fur's Deform Curves on Surface modifier.
+DEFORM_GROUP = "pelage: deform curves on surface"
+
+
 def deform_on_surface_modifier(obj):
     """Adds a geometry-nodes modifier with Blender's Deform Curves on
     Surface node to the curves object ``obj``: the fur follows its surface
     when the surface deforms (armature, shape keys)."""
     import bpy
 
-    tree = bpy.data.node_groups.get("pelage: deform curves on surface")
+    tree = bpy.data.node_groups.get(DEFORM_GROUP)
     if tree is None:
-        tree = bpy.data.node_groups.new("pelage: deform curves on surface", "GeometryNodeTree")
+        tree = bpy.data.node_groups.new(DEFORM_GROUP, "GeometryNodeTree")
         tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
         tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
         group_in = tree.nodes.new("NodeGroupInput")
@@ -401,9 +405,19 @@ def animated_groom_for(context, surface, settings, progress=None):
                                skin=skin, animation=animation, simulation=simulation)
 
 
+def fur_object_of(surface):
+    """The fur a grow made on ``surface`` before (a Curves object parented
+    to it that carries pelage's settings), or None."""
+    import bpy
+
+    return next((o for o in bpy.data.objects
+                 if o.type == "CURVES" and o.parent == surface and "pelage_settings" in o), None)
+
+
 def grow_on_object(context, surface, settings, progress=None):
-    """Grows fur on the mesh object ``surface`` and links a Curves object
-    parented to it. Returns ``(curves_object, pelage_curves, warnings)``:
+    """Grows fur on the mesh object ``surface`` into a Curves object
+    parented to it: the one an earlier grow made, regrown in place, or a
+    new one. Returns ``(curves_object, pelage_curves, warnings)``:
     the guides the groom left out, with why."""
     import bpy
 
@@ -428,16 +442,33 @@ def grow_on_object(context, surface, settings, progress=None):
     # Blender keeps the points of curves parented to it.
     back = np.linalg.inv(to_pelage_space(surface))
     data = curves_to_blender(f"{surface.name} fur", grown, surface, uv_map, back)
-    obj = bpy.data.objects.new(f"{surface.name} fur", data)
-    for collection in surface.users_collection:
-        collection.objects.link(obj)
-    obj.parent = surface
-    # Curves points are in the surface's space: the object sits on it.
-    obj.matrix_parent_inverse.identity()
+    obj = fur_object_of(surface)
+    if obj is None:
+        obj = bpy.data.objects.new(f"{surface.name} fur", data)
+        for collection in surface.users_collection:
+            collection.objects.link(obj)
+        obj.parent = surface
+        # Curves points are in the surface's space: the object sits on it.
+        obj.matrix_parent_inverse.identity()
+    else:
+        # Regrown in place: the object keeps its name, modifiers and
+        # whatever material the user gave it.
+        old = obj.data
+        if len(old.materials) and any(m is not None for m in old.materials):
+            data.materials.clear()
+            for material in old.materials:
+                data.materials.append(material)
+        obj.data = data
+        name = old.name
+        if old.users == 0:
+            bpy.data.hair_curves.remove(old)
+            data.name = name
     if uv_map is not None:
         # The node compares the deformed surface with its rest positions.
         surface.add_rest_position_attribute = True
-        deform_on_surface_modifier(obj)
+        if not any(m.type == "NODES" and m.node_group is not None
+                   and m.node_group.name == DEFORM_GROUP for m in obj.modifiers):
+            deform_on_surface_modifier(obj)
     obj["pelage_settings"] = groom.settings
     if live:
         LIVE[surface.name] = LiveGroom(session, obj.name, max(surface.dimensions) * 0.005 or 1e-3)

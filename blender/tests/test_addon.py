@@ -135,7 +135,7 @@ settings.guides_object = guides_object
 shaping = settings.clump, settings.noise
 settings.clump, settings.noise = 0.0, 0.0  # the guides' shape alone
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
-guided = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+guided = fur_of(grid)
 guided_points, guided_offsets = arrays(guided.data)
 guided_roots = guided_points[guided_offsets[:-1]]
 guided_tips = guided_points[guided_offsets[1:] - 1]
@@ -147,7 +147,6 @@ for root, lean in zip(guide_roots, leans):
     ways /= length[:, None]
     assert np.all(ways @ lean > 0.97), (root, (ways @ lean).min())
     assert np.allclose(length, 0.2, rtol=0.05), length
-bpy.data.objects.remove(guided)
 print("guides from Blender: hairs by each sculpted guide lean its way, at its length")
 
 # A face-set parting: the sculpted guides lean away from x = 0 on each
@@ -164,7 +163,7 @@ grid.data.polygons.foreach_get("center", centres)
 sets.data.foreach_set("value", np.where(centres.reshape(-1, 3)[:, 0] > 0, 2, 1).astype(np.int32))
 settings.parting = "FACE_SETS"
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
-parted = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+parted = fur_of(grid)
 parted_points, parted_offsets = arrays(parted.data)
 starts, ends = parted_points[parted_offsets[:-1]], parted_points[parted_offsets[1:] - 1]
 lean_x = (ends[:, 0] - starts[:, 0]) / np.linalg.norm(ends - starts, axis=1)
@@ -176,7 +175,6 @@ lines = settings.last_grow.split("\n")
 assert lines[0].startswith(f"{len(parted.data.curves):,} hairs"), lines
 per_region = [int(line.split(": ")[1].split(" hairs")[0].replace(",", "")) for line in lines[1:]]
 assert len(per_region) == 2 and sum(per_region) == len(parted.data.curves), lines
-bpy.data.objects.remove(parted)
 grid.data.attributes.remove(grid.data.attributes[".sculpt_face_set"])
 settings.parting = "NONE"
 print("parting: face sets keep each side's hairs leaning its own way by the line")
@@ -196,7 +194,7 @@ live_object = bpy.data.objects.new("live guides", live_curves)
 bpy.context.collection.objects.link(live_object)
 settings.guides_object, settings.live = live_object, True
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
-live_fur = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+live_fur = fur_of(grid)
 before, live_offsets = arrays(live_fur.data)
 # Guide 0 (at (-0.8, -0.8)) combed sideways.
 combed = live_points.copy()
@@ -213,7 +211,6 @@ moved_by = np.array([np.abs(after[a:b] - before[a:b]).max() for a, b in zip(live
 assert far.sum() > 1000 and np.all(moved_by[far] == 0), "hairs far from the stroke keep every bit"
 assert moved_by[~far].max() > 0.05, "hairs by the combed guide follow it"
 assert addon_fur.live_update(grid) is None, "nothing changed since"
-bpy.data.objects.remove(live_fur)
 settings.guides_object, settings.live = None, False
 print(f"live: a combed guide regrew {done['regrown']:,} of {done['hairs']:,} hairs; far ones kept every bit")
 
@@ -223,11 +220,10 @@ half = grid.vertex_groups.new(name="half")
 half.add([v.index for v in grid.data.vertices if v.co.x > 1e-6], 1.0, "REPLACE")
 settings.density_group = "half"
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
-painted = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+painted = fur_of(grid)
 painted_points, painted_offsets = arrays(painted.data)
 share = (painted_points[painted_offsets[:-1], 0] > 0).mean()
 assert share >= 0.95, share
-bpy.data.objects.remove(painted)
 settings.density_group = ""
 print(f"density from a vertex group: {share:.1%} of the roots on the painted half")
 
@@ -263,12 +259,20 @@ for guides_set, motion in ((None, "DEFORM"), (bpy.data.objects["sculpted"], "SIM
 settings.guides_object, settings.animation_mode = None, "DEFORM"
 print("panel: every drawn setting and button exists")
 
-# The same seed grows the same fur (the operator is deterministic).
+# The same seed grows the same fur (the operator is deterministic), and
+# every grow regrows the one fur object in place: the material and the
+# modifier a user gave it stay.
+own = bpy.data.materials.new("my fur")
+fur.data.materials.clear()
+fur.data.materials.append(own)
+fur.modifiers.new("my noise", "NODES")
 bpy.ops.pelage.grow_fur()
-second = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == grid and o != fur][0]
+second = fur_of(grid)
+assert second == fur and second.name == "Grid fur", second.name
 assert np.array_equal(arrays(second.data)[0], points)
-bpy.data.objects.remove(second)
-print("grid: the same settings grow the same points")
+assert list(second.data.materials) == [own], list(second.data.materials)
+assert [m.name for m in second.modifiers] == ["Deform Curves on Surface", "my noise"], list(second.modifiers)
+print("grid: the same settings grow the same points, in place: material and modifiers kept")
 
 # Gravity pulls down in Blender's world (-Z), whatever the object's
 # rotation: a wall (a grid stood up, facing -Y) grows hair that droops.
@@ -427,5 +431,25 @@ with tempfile.TemporaryDirectory() as folder:
     lag = np.linalg.norm(tips(last) - tips(frames[3]), axis=1).mean()
     assert lag > 0.01, lag
     print(f"animated export, simulated: Alembic, roots on the surface, tips {lag:.3f} from the deformed ones")
+
+# 7. The scripting example runs as written, enabling the extension itself
+#    (a script's fresh session has it installed but not enabled).
+import addon_utils  # noqa: E402
+import runpy  # noqa: E402
+
+clear_scene()
+addon_utils.disable("bl_ext.user_default.pelage_fur")
+assert not hasattr(bpy.types.Object, "pelage_fur")
+example = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "examples", "python",
+                       "blender_grow_fur.py")
+with tempfile.TemporaryDirectory() as folder:
+    here = os.getcwd()
+    os.chdir(folder)
+    try:
+        runpy.run_path(example, run_name="__main__")
+    finally:
+        os.chdir(here)
+    assert os.path.exists(os.path.join(folder, "pelage_fur.blend"))
+print("examples/python/blender_grow_fur.py: enables the extension, grows 50,000 hairs, saves")
 
 print("add-on: all checks passed")
