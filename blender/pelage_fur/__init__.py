@@ -203,7 +203,9 @@ class PELAGE_OT_shade_hair(bpy.types.Operator):
 
 
 class _PelageExport(ExportHelper):
-    """Grows the active mesh's groom and writes it with pelage's writer."""
+    """Writes the active mesh's fur as the viewport shows it, with
+    pelage's writer: grown where the fur was grown, carried to this
+    frame."""
 
     bl_options = {"REGISTER"}
 
@@ -213,12 +215,10 @@ class _PelageExport(ExportHelper):
 
     def execute(self, context):
         surface = surface_of(context)
-        depsgraph = context.evaluated_depsgraph_get()
         try:
-            mesh, _ = fur.mesh_to_pelage(surface, depsgraph)
-            groom = fur.groom_for(surface, surface.pelage_fur, mesh, depsgraph)
+            groom = fur.export_groom_for(context, surface, surface.pelage_fur)
             summary = groom.write(self.filepath)
-        except PelageError as error:
+        except (PelageError, ValueError) as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         if summary["report"] is not None:

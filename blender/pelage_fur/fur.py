@@ -351,45 +351,49 @@ def evaluated_positions(obj, depsgraph):
         evaluated.to_mesh_clear()
 
 
-def animated_groom_for(context, surface, settings, progress=None):
-    """The panel's groom on ``surface`` as Blender evaluates it over the
-    scene's frame range: the surface at the first frame is the rest pose
-    (roots sampled and guides bound there), its vertices at every frame
-    the skin (armatures, shape keys, modifiers, object motion: whatever
-    Blender shows). ``settings.animation_mode`` deforms the fur with the
-    skin or simulates the guides on it (gravity: the scene's). The scene
-    is left at the frame it was on. ``progress(done, total)`` as frames
-    are read."""
+def animated_groom_for(context, surface, settings, progress=None, frames=None, rest_frame=None,
+                       mode=None):
+    """The panel's groom on ``surface`` as Blender evaluates it at
+    ``frames`` (``(first, last)``, default the scene's frame range): the
+    surface at ``rest_frame`` (default the first) is the rest pose (roots
+    sampled and guides bound there), its vertices at every frame the skin
+    (armatures, shape keys, modifiers, object motion: whatever Blender
+    shows). ``mode`` ("deform" or "simulate", default the panel's Motion)
+    deforms the fur with the skin or simulates the guides on it (gravity:
+    the scene's). The scene is left at the frame it was on.
+    ``progress(done, total)`` as frames are read."""
     scene = context.scene
-    first, last = scene.frame_start, scene.frame_end
+    first, last = frames if frames is not None else (scene.frame_start, scene.frame_end)
     if last < first:
         raise ValueError(f"the scene's frame range {first}-{last} is empty")
+    rest_frame = first if rest_frame is None else rest_frame
+    wanted = sorted(set(range(first, last + 1)) | {rest_frame})
     current = scene.frame_current
     skin = {}
     try:
-        scene.frame_set(first)
+        scene.frame_set(rest_frame)
         depsgraph = context.evaluated_depsgraph_get()
         mesh, _ = mesh_to_pelage(surface, depsgraph)
         guides = None
         if settings.guides_object is not None and not settings.groom_file:
             guides = guides_from_curves_object(settings.guides_object, depsgraph)
-        for frame in range(first, last + 1):
+        for k, frame in enumerate(wanted):
             scene.frame_set(frame)
             skin[frame] = evaluated_positions(surface, context.evaluated_depsgraph_get())
-            if len(skin[frame]) != len(skin[first]):
+            if len(skin[frame]) != mesh.vertex_count:
                 import pelage
 
                 raise pelage.PelageError(
                     f"{surface.name}: {len(skin[frame])} vertices at frame {frame} and "
-                    f"{len(skin[first])} at frame {first}: animated fur needs a mesh whose "
+                    f"{mesh.vertex_count} at frame {rest_frame}: animated fur needs a mesh whose "
                     "topology does not change (no remesh, decimate or booleans that animate)")
             if progress is not None:
-                progress(frame - first + 1, last - first + 1)
+                progress(k + 1, len(wanted))
     finally:
         scene.frame_set(current)
-    mode = settings.animation_mode.lower()
-    animation = {"frames": f"{first}-{last}", "mode": mode,
-                 "fps": scene.render.fps / scene.render.fps_base}
+    mode = mode or settings.animation_mode.lower()
+    animation = {"frames": f"{first}-{last}" if last > first else f"{first}", "mode": mode,
+                 "rest_frame": rest_frame, "fps": scene.render.fps / scene.render.fps_base}
     simulation = None
     if mode == "simulate":
         gravity = Z_UP_TO_Y_UP @ np.array(scene.gravity, dtype=np.float64)
@@ -403,6 +407,23 @@ def animated_groom_for(context, surface, settings, progress=None):
         }
     return groom_from_settings(mesh, settings, guides, max(surface.dimensions) or 1.0,
                                skin=skin, animation=animation, simulation=simulation)
+
+
+def export_groom_for(context, surface, settings):
+    """The groom an export writes: the fur as the viewport shows it. Grown
+    at one frame and carried by Deform Curves on Surface to the frame on
+    screen, so exported at another frame it is the groom grown at the
+    grow's frame, carried to this one (one time sample); at the grow's
+    frame, or before any grow, grown on the mesh as it is."""
+    fur = fur_object_of(surface)
+    grown_at = fur.get("pelage_frame") if fur is not None else None
+    current = context.scene.frame_current
+    if grown_at is None or grown_at == current:
+        depsgraph = context.evaluated_depsgraph_get()
+        mesh, _ = mesh_to_pelage(surface, depsgraph)
+        return groom_for(surface, settings, mesh, depsgraph)
+    return animated_groom_for(context, surface, settings, frames=(current, current),
+                              rest_frame=int(grown_at), mode="deform")
 
 
 def fur_object_of(surface):
@@ -470,6 +491,8 @@ def grow_on_object(context, surface, settings, progress=None):
                    and m.node_group.name == DEFORM_GROUP for m in obj.modifiers):
             deform_on_surface_modifier(obj)
     obj["pelage_settings"] = groom.settings
+    # The frame grown at: exports at other frames carry the fur from it.
+    obj["pelage_frame"] = context.scene.frame_current
     if live:
         LIVE[surface.name] = LiveGroom(session, obj.name, max(surface.dimensions) * 0.005 or 1e-3)
     report = groom.report()

@@ -410,6 +410,26 @@ def off_surface(curves, frame):
 
 
 with tempfile.TemporaryDirectory() as folder:
+    # Export USD at another frame than the grow's: the fur on screen (grown
+    # at frame 1, carried by Deform Curves on Surface), not a new groom.
+    scene.frame_set(1)
+    assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+    scene.frame_set(3)
+    shown = fur_of(ball)
+    shown_ids = np.empty(len(shown.data.curves), np.int32)
+    shown.data.attributes["hair_id"].data.foreach_get("value", shown_ids)
+    local = evaluated_roots(shown)
+    world = np.array([ball.matrix_world @ Vector(p) for p in local])
+    shown_roots = world @ addon_fur.Z_UP_TO_Y_UP.T
+    still = os.path.join(folder, "still.usdc")
+    assert bpy.ops.pelage.export_usd(filepath=still) == {"FINISHED"}
+    exported = pelage.read_curves(still)
+    assert np.array_equal(exported.ids & 0x7FFFFFFF, shown_ids), "the hairs on screen"
+    apart = np.linalg.norm(exported.points[exported.offsets[:-1]] - shown_roots, axis=1).max()
+    assert apart < 1e-3, apart
+    print(f"export at frame 3: the fur on screen, the same hairs, roots within {apart:.1e} of Blender's")
+    bpy.data.objects.remove(shown)
+    scene.frame_set(2)
     moved = os.path.join(folder, "ball.usdc")
     assert bpy.ops.pelage.export_animated_usd(filepath=moved) == {"FINISHED"}
     assert scene.frame_current == 2, "the scene is left at its frame"
