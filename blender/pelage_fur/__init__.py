@@ -9,12 +9,13 @@ Alembic" write the same groom with pelage's own writers.
 """
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
-from bpy_extras.io_utils import ExportHelper
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, IntProperty,
+                       PointerProperty, StringProperty)
+from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from pelage import PelageError
 
-from . import fur
+from . import fur, stack
 
 
 #: The panel's presets: settings, with lengths and widths as fractions of
@@ -40,6 +41,25 @@ def apply_preset(settings, context):
     size = max(obj.dimensions) or 1.0
     for name, value in values.items():
         setattr(settings, name, value * size if name in SIZED else value)
+
+
+class PelageOpSetting(bpy.types.PropertyGroup):
+    """One setting of a stacked operator: its name, and its value as the
+    groom file writes it."""
+
+    value: StringProperty(
+        name="Value",
+        description="A number, a list ([0.3, 0.2, 0.1]) or a map: vertex:GROUP, attribute:NAME, "
+                    "image.png:r, noise:frequency=8; empty: pelage's default",
+    )
+
+
+class PelageOp(bpy.types.PropertyGroup):
+    """An operator of the stack: its name and its settings."""
+
+    kind: StringProperty(name="Operator")
+    enabled: BoolProperty(name="Enabled", description="Apply this operator", default=True)
+    settings: CollectionProperty(type=PelageOpSetting)
 
 
 class PelageFurSettings(bpy.types.PropertyGroup):
@@ -110,6 +130,12 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     curl: FloatProperty(name="Curl", description="Curl radius, relative to the length (0: off)", default=0.0, min=0.0, max=2.0)
     noise: FloatProperty(name="Noise", description="Noise amplitude, relative to the length (0: off)", default=0.1, min=0.0, max=2.0)
     seed: IntProperty(name="Seed", default=1, min=0)
+    ops: CollectionProperty(
+        type=PelageOp, name="Operators",
+        description="Every pelage operator, applied top to bottom; when it has any, it replaces "
+                    "Clump, Curl and Noise",
+    )
+    active_op: IntProperty(name="Active operator", default=0)
     # Animated export: how the fur moves over the scene's frames.
     animation_mode: EnumProperty(
         name="Motion",
@@ -172,6 +198,153 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
             self.report({"WARNING"}, f"pelage: {warning}")
         self.report({"INFO"}, f"pelage: {grown.curve_count:,} hairs, {grown.point_count:,} points on {surface.name}")
         return {"FINISHED"}
+
+
+_OPERATOR_ITEMS = []
+
+
+def operator_items(_self, _context):
+    """The library's operators, for the Add menu (kept referenced: Blender
+    reads the strings after the call)."""
+    if not _OPERATOR_ITEMS:
+        _OPERATOR_ITEMS.extend((op["name"], op["name"].replace("_", " ").title(), op["summary"])
+                               for op in stack.schema())
+    return _OPERATOR_ITEMS
+
+
+class PELAGE_OT_op_add(bpy.types.Operator):
+    """Add a pelage operator to the end of the stack"""
+
+    bl_idname = "pelage.op_add"
+    bl_label = "Add operator"
+    bl_options = {"REGISTER", "UNDO"}
+    bl_property = "kind"
+
+    kind: EnumProperty(name="Operator", items=operator_items)
+
+    @classmethod
+    def poll(cls, context):
+        return surface_of(context) is not None
+
+    def invoke(self, context, _event):
+        context.window_manager.invoke_search_popup(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        surface = surface_of(context)
+        settings = surface.pelage_fur
+        stack.add_entry(settings.ops, self.kind, max(surface.dimensions) or 1.0)
+        settings.active_op = len(settings.ops) - 1
+        return {"FINISHED"}
+
+
+class PELAGE_OT_op_remove(bpy.types.Operator):
+    """Remove the active operator from the stack"""
+
+    bl_idname = "pelage.op_remove"
+    bl_label = "Remove operator"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        surface = surface_of(context)
+        return surface is not None and len(surface.pelage_fur.ops) > 0
+
+    def execute(self, context):
+        settings = surface_of(context).pelage_fur
+        settings.ops.remove(settings.active_op)
+        settings.active_op = min(settings.active_op, max(0, len(settings.ops) - 1))
+        return {"FINISHED"}
+
+
+class PELAGE_OT_op_move(bpy.types.Operator):
+    """Move the active operator up or down the stack (operators apply top to bottom)"""
+
+    bl_idname = "pelage.op_move"
+    bl_label = "Move operator"
+    bl_options = {"REGISTER", "UNDO"}
+
+    direction: EnumProperty(items=[("UP", "Up", ""), ("DOWN", "Down", "")])
+
+    @classmethod
+    def poll(cls, context):
+        surface = surface_of(context)
+        return surface is not None and len(surface.pelage_fur.ops) > 1
+
+    def execute(self, context):
+        settings = surface_of(context).pelage_fur
+        at = settings.active_op
+        to = at - 1 if self.direction == "UP" else at + 1
+        if 0 <= to < len(settings.ops):
+            settings.ops.move(at, to)
+            settings.active_op = to
+        return {"FINISHED"}
+
+
+class PELAGE_OT_load_groom(bpy.types.Operator, ImportHelper):
+    """Fill the panel from a pelage groom file: roots, grown guides, finish, look and the operator stack"""
+
+    bl_idname = "pelage.load_groom"
+    bl_label = "Load groom file into panel"
+    bl_options = {"REGISTER", "UNDO"}
+    filename_ext = ".toml"
+    filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        return surface_of(context) is not None
+
+    def execute(self, context):
+        surface = surface_of(context)
+        try:
+            left = stack.load_into(surface.pelage_fur, self.filepath, max(surface.dimensions) or 1.0)
+        except (OSError, ValueError) as error:
+            self.report({"ERROR"}, f"{self.filepath}: {error}")
+            return {"CANCELLED"}
+        surface.pelage_fur.groom_file = ""
+        if left:
+            self.report({"WARNING"}, f"pelage: the panel has no place for {', '.join(left)}; "
+                                     "set the file as Groom file to use them")
+        self.report({"INFO"}, f"pelage: loaded {self.filepath}, {len(surface.pelage_fur.ops)} operators")
+        return {"FINISHED"}
+
+
+class PELAGE_OT_save_groom(bpy.types.Operator, ExportHelper):
+    """Save the panel as a pelage groom file (the guides object's curves beside it, as usdc)"""
+
+    bl_idname = "pelage.save_groom"
+    bl_label = "Save panel as groom file"
+    bl_options = {"REGISTER"}
+    filename_ext = ".toml"
+    filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        surface = surface_of(context)
+        return surface is not None and not surface.pelage_fur.groom_file
+
+    def execute(self, context):
+        surface = surface_of(context)
+        try:
+            written = fur.save_groom_file(context, surface, surface.pelage_fur, self.filepath)
+        except (PelageError, OSError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"pelage: wrote {', '.join(written)}")
+        return {"FINISHED"}
+
+
+class PELAGE_UL_ops(bpy.types.UIList):
+    """The operator stack, one row an operator."""
+
+    def draw_item(self, _context, layout, _data, item, _icon, _active_data, _active_property, _index=0):
+        row = layout.row(align=True)
+        row.prop(item, "enabled", text="")
+        row.label(text=item.kind.replace("_", " ").title())
+        filled = [s.name for s in item.settings if s.value.strip() and s.name != "mask"]
+        row.label(text=", ".join(filled))
+        if any(s.name == "mask" and s.value.strip() for s in item.settings):
+            row.label(text="", icon="MOD_MASK")
 
 
 class PELAGE_OT_shade_hair(bpy.types.Operator):
@@ -325,6 +498,23 @@ class PELAGE_PT_fur(bpy.types.Panel):
             # Length, gravity and the guide count shape grown guides only.
             row.enabled = grown_guides or name not in ("guides", "length", "gravity")
             row.prop(settings, name)
+        ops = layout.column(align=True)
+        ops.enabled = not settings.groom_file
+        ops.label(text="Operators (replace Clump, Curl, Noise)" if len(settings.ops) else "Operators")
+        row = ops.row()
+        row.template_list("PELAGE_UL_ops", "", settings, "ops", settings, "active_op", rows=3)
+        buttons = row.column(align=True)
+        buttons.operator(PELAGE_OT_op_add.bl_idname, text="", icon="ADD")
+        buttons.operator(PELAGE_OT_op_remove.bl_idname, text="", icon="REMOVE")
+        buttons.operator(PELAGE_OT_op_move.bl_idname, text="", icon="TRIA_UP").direction = "UP"
+        buttons.operator(PELAGE_OT_op_move.bl_idname, text="", icon="TRIA_DOWN").direction = "DOWN"
+        if 0 <= settings.active_op < len(settings.ops):
+            active = settings.ops[settings.active_op]
+            for setting in active.settings:
+                ops.prop(setting, "value", text=setting.name)
+        files = layout.row(align=True)
+        files.operator(PELAGE_OT_load_groom.bl_idname, text="Load groom", icon="IMPORT")
+        files.operator(PELAGE_OT_save_groom.bl_idname, text="Save groom", icon="EXPORT")
         look = layout.column(align=True)
         look.enabled = not settings.groom_file
         look.label(text="Look (Principled Hair BSDF)")
@@ -355,9 +545,17 @@ class PELAGE_PT_fur(bpy.types.Panel):
 
 
 CLASSES = (
+    PelageOpSetting,
+    PelageOp,
     PelageFurSettings,
     PELAGE_OT_grow_fur,
     PELAGE_OT_shade_hair,
+    PELAGE_OT_op_add,
+    PELAGE_OT_op_remove,
+    PELAGE_OT_op_move,
+    PELAGE_OT_load_groom,
+    PELAGE_OT_save_groom,
+    PELAGE_UL_ops,
     PELAGE_OT_export_usd,
     PELAGE_OT_export_alembic,
     PELAGE_OT_export_animated_usd,

@@ -162,11 +162,29 @@ def guides_from_curves_object(obj, depsgraph=None):
     return pelage.Curves.from_arrays(world, offsets.astype(np.uint32))
 
 
+def slider_ops(settings):
+    """The operators the panel's Clump, Curl and Noise sliders stand for
+    (0 turns one off), sized relative to the length."""
+    import pelage
+
+    ops = []
+    if settings.clump > 0:
+        clumps = max(1, settings.count // 100)
+        ops.append(pelage.ops.clump(count=clumps, rate=settings.clump))
+    if settings.curl > 0:
+        ops.append(pelage.ops.curl(radius=settings.curl * settings.length * 0.05, turns=3))
+    if settings.noise > 0:
+        ops.append(pelage.ops.noise(amplitude=settings.noise * settings.length * 0.2,
+                                    frequency=4.0 / max(settings.length, 1e-6)))
+    return ops
+
+
 def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animation=None,
                         simulation=None):
     """A ``pelage.Groom`` on ``mesh`` from the panel's settings: the groom
     file when one is set (its ``[mesh]`` replaced by ``mesh``), else
-    roots, the clump, curl and noise operators and the look, shaped by
+    roots, the operator stack (or the Clump, Curl and Noise sliders when
+    it is empty) and the look, shaped by
     ``guides`` (a ``pelage.Curves`` from ``guides_from_curves_object``,
     bound within a 200th of ``size``, the surface's largest dimension)
     or by guides grown on the surface. With ``skin`` (``{frame:
@@ -181,15 +199,13 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
         if skin is None:
             return pelage.Groom.load(path, mesh=mesh)
         return pelage.Groom.load(path, mesh=mesh, skin=skin, frames=animation["frames"])
-    ops = []
-    if settings.clump > 0:
-        clumps = max(1, settings.count // 100)
-        ops.append(pelage.ops.clump(count=clumps, rate=settings.clump))
-    if settings.curl > 0:
-        ops.append(pelage.ops.curl(radius=settings.curl * settings.length * 0.05, turns=3))
-    if settings.noise > 0:
-        ops.append(pelage.ops.noise(amplitude=settings.noise * settings.length * 0.2,
-                                    frequency=4.0 / max(settings.length, 1e-6)))
+    if len(settings.ops):
+        # The operator stack, when it has entries, replaces the sliders.
+        from . import stack
+
+        ops = stack.ops_of(settings.ops)
+    else:
+        ops = slider_ops(settings)
     if guides is not None:
         guides = {"curves": guides, "points": max(settings.points, 4), "tolerance": size * 0.005}
     else:
@@ -424,6 +440,42 @@ def export_groom_for(context, surface, settings):
         return groom_for(surface, settings, mesh, depsgraph)
     return animated_groom_for(context, surface, settings, frames=(current, current),
                               rest_frame=int(grown_at), mode="deform")
+
+
+def save_groom_file(context, surface, settings, path):
+    """Writes the panel of ``surface`` as the groom file ``path``: the
+    library's own text for the groom the panel grows (``Groom.settings``:
+    every operator of the stack with its settings and masks, roots,
+    finish, look; no ``[mesh]``, which the object stands for), with a
+    guides object's curves written beside it (``NAME.guides.usdc``, in
+    pelage's Y-up world) and named in ``[guides] file``. Each file is
+    written whole or not at all. Returns the paths written."""
+    import os
+
+    import pelage
+
+    depsgraph = context.evaluated_depsgraph_get()
+    mesh, _ = mesh_to_pelage(surface, depsgraph)
+    groom = groom_for(surface, settings, mesh, depsgraph)
+    text = groom.settings
+    written = [path]
+    if settings.guides_object is not None:
+        guides = guides_from_curves_object(settings.guides_object, depsgraph)
+        guides_path = os.path.splitext(path)[0] + ".guides.usdc"
+        pelage.write_curves(guides, guides_path, basis="linear")
+        written.append(guides_path)
+        if "[guides]\n" not in text:
+            raise pelage.PelageError("the groom's settings have no [guides] table to name the guides file in")
+        text = text.replace("[guides]\n", f'[guides]\nfile = "{os.path.basename(guides_path)}"\n', 1)
+    temporary = f"{path}.tmp-{os.getpid()}"
+    try:
+        with open(temporary, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(temporary, path)
+    finally:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+    return written
 
 
 def fur_object_of(surface):

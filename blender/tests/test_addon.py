@@ -249,6 +249,11 @@ class CheckedLayout:
     def operator(self, idname, **_):
         category, name = idname.split(".")
         assert hasattr(getattr(bpy.ops, category), name), idname
+        return type("OperatorProperties", (), {})()
+
+    def template_list(self, list_type, _list_id, data, name, active_data, active_name, **_):
+        assert hasattr(bpy.types, list_type), list_type
+        assert hasattr(data, name) and hasattr(active_data, active_name), (name, active_name)
 
 
 addon = next(m for name, m in sys.modules.items() if name.endswith("pelage_fur") and hasattr(m, "PELAGE_PT_fur"))
@@ -256,6 +261,9 @@ bpy.context.view_layer.objects.active = grid
 for guides_set, motion in ((None, "DEFORM"), (bpy.data.objects["sculpted"], "SIMULATE")):
     settings.guides_object, settings.animation_mode = guides_set, motion
     addon.PELAGE_PT_fur.draw(type("Panel", (), {"layout": CheckedLayout()})(), bpy.context)
+    # With an operator in the stack: its settings are drawn too.
+    bpy.ops.pelage.op_add(kind="curl")
+settings.ops.clear()
 settings.guides_object, settings.animation_mode = None, "DEFORM"
 print("panel: every drawn setting and button exists")
 
@@ -451,6 +459,51 @@ with tempfile.TemporaryDirectory() as folder:
     lag = np.linalg.norm(tips(last) - tips(frames[3]), axis=1).mean()
     assert lag > 0.01, lag
     print(f"animated export, simulated: Alembic, roots on the surface, tips {lag:.3f} from the deformed ones")
+
+# 8. The operator stack: any of pelage's operators with all its settings
+#    and a mask from a vertex group, reordered and removed; the panel
+#    saved as a groom file and loaded into another object's panel, which
+#    saves the same file.
+clear_scene()
+bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=8, size=2.0)
+stacked = bpy.context.active_object
+panel = stacked.pelage_fur
+panel.count, panel.points = 2_000, 8
+back = stacked.vertex_groups.new(name="back")
+back.add([v.index for v in stacked.data.vertices if v.co.y > 0], 1.0, "REPLACE")
+for kind in ("clump", "curl", "noise", "width"):
+    assert bpy.ops.pelage.op_add(kind=kind) == {"FINISHED"}
+schema = {op["name"]: op["fields"] for op in pelage._pelage.operator_schema()}
+assert [s.name for s in panel.ops[2].settings] == schema["noise"], "every setting of the operator"
+next(x for x in panel.ops[2].settings if x.name == "mask").value = "vertex:back"
+panel.active_op = 1
+assert bpy.ops.pelage.op_move(direction="UP") == {"FINISHED"}
+panel.active_op = 3
+assert bpy.ops.pelage.op_remove() == {"FINISHED"}
+assert [o.kind for o in panel.ops] == ["curl", "clump", "noise"], [o.kind for o in panel.ops]
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+grown_text = fur_of(stacked)["pelage_settings"]
+order = [grown_text.index(f"[ops.{k}]") for k in ("curl", "clump", "noise")]
+assert order == sorted(order) and 'mask = "vertex:back"' in grown_text, grown_text
+
+
+def stack_of(settings):
+    return [(o.kind, o.enabled, [(x.name, x.value) for x in o.settings]) for o in settings.ops]
+
+
+with tempfile.TemporaryDirectory() as folder:
+    saved, again = os.path.join(folder, "panel.toml"), os.path.join(folder, "again.toml")
+    assert bpy.ops.pelage.save_groom(filepath=saved) == {"FINISHED"}
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=8, size=2.0, location=(5, 0, 0))
+    other = bpy.context.active_object
+    other.vertex_groups.new(name="back")
+    assert bpy.ops.pelage.load_groom(filepath=saved) == {"FINISHED"}
+    assert stack_of(other.pelage_fur) == stack_of(panel), (stack_of(other.pelage_fur), stack_of(panel))
+    assert other.pelage_fur.count == 2_000 and other.pelage_fur.points == 8
+    assert bpy.ops.pelage.save_groom(filepath=again) == {"FINISHED"}
+    with open(saved) as a, open(again) as b:
+        assert a.read() == b.read(), "the groom file round-trips through the panel"
+print("operator stack: add, reorder, remove, a vertex-group mask; the groom file round-trips through the panel")
 
 # 7. The scripting example runs as written, enabling the extension itself
 #    (a script's fresh session has it installed but not enabled).
