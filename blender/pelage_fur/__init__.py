@@ -92,7 +92,8 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     )
     density_group: StringProperty(
         name="Density",
-        description="A vertex group (or float attribute) whose weights scale where hairs grow; empty: evenly",
+        description="A vertex group, a float attribute or a colour attribute (NAME, or one channel: "
+                    "NAME:r, NAME:g, NAME:b, NAME:a) whose values scale where hairs grow; empty: evenly",
     )
     parting: EnumProperty(
         name="Parting",

@@ -95,9 +95,10 @@ def mesh_to_pelage(obj, depsgraph):
 
 
 def vertex_maps_of(obj, mesh):
-    """The object's vertex groups and the mesh's float point attributes,
-    by name, one float32 a vertex: what a groom reads as ``"vertex:NAME"``
-    maps (density, lengths, masks). Vertex groups have no bulk accessor
+    """The object's vertex groups, the mesh's float point attributes and
+    its colour attributes (by channel), by name, one float32 a vertex:
+    what a groom reads as ``"vertex:NAME"`` maps (density, lengths,
+    masks). Vertex groups have no bulk accessor
     in Blender's Python API, so their weights take one Python pass over
     the vertices (only when the object has vertex groups)."""
     count = len(mesh.vertices)
@@ -110,12 +111,33 @@ def vertex_maps_of(obj, mesh):
                     weights[element.group, vertex.index] = element.weight
         for group in obj.vertex_groups:
             maps[group.name] = weights[group.index]
+    corner_vertex = None
     for attribute in mesh.attributes:
-        if (attribute.domain == "POINT" and attribute.data_type == "FLOAT"
-                and not attribute.name.startswith(".") and attribute.name not in maps):
+        if attribute.name.startswith(".") or attribute.name in maps:
+            continue
+        if attribute.domain == "POINT" and attribute.data_type == "FLOAT":
             values = np.empty(count, dtype=np.float32)
             attribute.data.foreach_get("value", values)
             maps[attribute.name] = values
+        elif attribute.data_type in ("FLOAT_COLOR", "BYTE_COLOR") and attribute.domain in ("POINT", "CORNER"):
+            # Colour attributes (Vertex Paint's): each channel a map,
+            # NAME:r, NAME:g, NAME:b, NAME:a, and NAME the mean of r, g, b
+            # (a grey painting's value). Paint on face corners is averaged
+            # over each vertex's corners.
+            rgba = np.empty(len(attribute.data) * 4, dtype=np.float32)
+            attribute.data.foreach_get("color", rgba)
+            rgba = rgba.reshape(-1, 4)
+            if attribute.domain == "CORNER":
+                if corner_vertex is None:
+                    corner_vertex = np.empty(len(mesh.loops), dtype=np.int32)
+                    mesh.loops.foreach_get("vertex_index", corner_vertex)
+                sums = np.zeros((count, 4), dtype=np.float64)
+                np.add.at(sums, corner_vertex, rgba)
+                corners = np.bincount(corner_vertex, minlength=count).astype(np.float64)
+                rgba = (sums / np.maximum(corners, 1.0)[:, None]).astype(np.float32)
+            for k, channel in enumerate("rgba"):
+                maps[f"{attribute.name}:{channel}"] = np.ascontiguousarray(rgba[:, k])
+            maps[attribute.name] = rgba[:, :3].mean(axis=1).astype(np.float32)
     return maps
 
 

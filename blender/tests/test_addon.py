@@ -227,6 +227,25 @@ assert share >= 0.95, share
 settings.density_group = ""
 print(f"density from a vertex group: {share:.1%} of the roots on the painted half")
 
+# A colour attribute painted on face corners (Vertex Paint's), red on the
+# other half (x < 0): its red channel as the density.
+paint = grid.data.color_attributes.new("paint", "BYTE_COLOR", "CORNER")
+corner_vertex = np.empty(len(grid.data.loops), np.int32)
+grid.data.loops.foreach_get("vertex_index", corner_vertex)
+xs = np.array([grid.data.vertices[i].co.x for i in corner_vertex])
+rgba = np.zeros((len(corner_vertex), 4), np.float32)
+rgba[:, 0] = (xs < -1e-6).astype(np.float32)
+rgba[:, 3] = 1.0
+paint.data.foreach_set("color", rgba.ravel())
+settings.density_group = "paint:r"
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+red_points, red_offsets = arrays(fur_of(grid).data)
+red_share = (red_points[red_offsets[:-1], 0] < 0).mean()
+assert red_share >= 0.95, red_share
+settings.density_group = ""
+grid.data.color_attributes.remove(paint)
+print(f"density from a colour attribute's red channel: {red_share:.1%} of the roots on the red half")
+
 # The panel draws: every setting it shows exists, every button is an
 # operator (a layout that checks what it is asked to draw).
 class CheckedLayout:
