@@ -49,8 +49,9 @@ class PelageOpSetting(bpy.types.PropertyGroup):
 
     value: StringProperty(
         name="Value",
-        description="A number, a list ([0.3, 0.2, 0.1]) or a map: vertex:GROUP, attribute:NAME, "
-                    "image.png:r, noise:frequency=8; empty: pelage's default",
+        description="A number, a list ([0.3, 0.2, 0.1]) or a map: vertex:GROUP (a vertex group or "
+                    "attribute), image:NAME:r (a Blender image, saved or not), file.png:r, "
+                    "noise:frequency=8; empty: pelage's default",
     )
 
 
@@ -93,7 +94,8 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     density_group: StringProperty(
         name="Density",
         description="A vertex group, a float attribute or a colour attribute (NAME, or one channel: "
-                    "NAME:r, NAME:g, NAME:b, NAME:a) whose values scale where hairs grow; empty: evenly",
+                    "NAME:r, NAME:g, NAME:b, NAME:a), or a Blender image over the UV map "
+                    "(image:NAME:r), whose values scale where hairs grow; empty: evenly",
     )
     parting: EnumProperty(
         name="Parting",

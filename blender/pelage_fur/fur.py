@@ -141,6 +141,82 @@ def vertex_maps_of(obj, mesh):
     return maps
 
 
+#: How the add-on's maps name a Blender image: ``image:NAME`` and
+#: pelage's suffixes (``image:paint:r``, ``image:paint:g:clamp``).
+IMAGE_PREFIX = "image:"
+_IMAGE_FOLDER = []
+
+
+def image_folder():
+    """Where a session's Blender images are written for pelage to read (a
+    temporary folder, kept while Blender runs: a groom's settings name
+    the files)."""
+    import tempfile
+
+    if not _IMAGE_FOLDER:
+        _IMAGE_FOLDER.append(tempfile.mkdtemp(prefix="pelage-images-"))
+    return _IMAGE_FOLDER[0]
+
+
+def png16(path, rows):
+    """Writes ``rows`` (height × width × 4 floats, top row first) as a
+    16-bit RGBA PNG, values clipped to 0–1: what pelage reads as a map
+    with no loss a painter would see."""
+    import struct
+    import zlib
+
+    height, width = rows.shape[:2]
+    data = np.round(np.clip(rows, 0.0, 1.0) * 65535.0).astype(">u2").reshape(height, width * 4)
+    raw = b"".join(b"\0" + row.tobytes() for row in data)
+
+    def chunk(kind, payload):
+        return (struct.pack(">I", len(payload)) + kind + payload
+                + struct.pack(">I", zlib.crc32(kind + payload)))
+
+    header = struct.pack(">IIBBBBB", width, height, 16, 6, 0, 0, 0)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw, 6))
+                + chunk(b"IEND", b""))
+
+
+def blender_image_map(value, folder=None, relative=False):
+    """A map as pelage reads it: ``image:NAME[:SUFFIX...]`` names a Blender
+    image (saved, packed, or painted and never saved), written from its
+    pixels as a 16-bit PNG into ``folder`` (default ``image_folder()``)
+    and named by its path (its file name when ``relative``) with the same
+    suffixes; lists are resolved item by item; any other value as it
+    is."""
+    if isinstance(value, list):
+        return [blender_image_map(v, folder, relative) for v in value]
+    if not isinstance(value, str) or not value.startswith(IMAGE_PREFIX):
+        return value
+    import os
+
+    import bpy
+    import pelage
+
+    parts = value[len(IMAGE_PREFIX):].split(":")
+    for k in range(len(parts), 0, -1):
+        name = ":".join(parts[:k])
+        image = bpy.data.images.get(name)
+        if image is not None:
+            break
+    else:
+        raise pelage.PelageError(f"{value}: this .blend has no image {parts[0]!r}")
+    width, height = image.size
+    if width == 0 or height == 0:
+        raise pelage.PelageError(f"{value}: the image {name!r} has no pixels (its file is missing?)")
+    pixels = np.empty(width * height * 4, dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    # Blender's first row of pixels is the image's bottom.
+    rows = pixels.reshape(height, width, 4)[::-1]
+    file_name = "".join(c if c.isalnum() or c in "-_." else "_" for c in name) + ".png"
+    folder = folder or image_folder()
+    png16(os.path.join(folder, file_name), rows)
+    target = file_name if relative else os.path.join(folder, file_name)
+    return ":".join([target] + parts[k:])
+
+
 #: Blender's face sets: an integer attribute on faces.
 FACE_SETS = ".sculpt_face_set"
 
@@ -202,7 +278,7 @@ def slider_ops(settings):
 
 
 def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animation=None,
-                        simulation=None):
+                        simulation=None, images=None, relative=False):
     """A ``pelage.Groom`` on ``mesh`` from the panel's settings: the groom
     file when one is set (its ``[mesh]`` replaced by ``mesh``), else
     roots, the operator stack (or the Clump, Curl and Noise sliders when
@@ -211,7 +287,9 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
     bound within a 200th of ``size``, the surface's largest dimension)
     or by guides grown on the surface. With ``skin`` (``{frame:
     vertices}``, ``mesh`` at the first frame) and ``animation`` (the
-    ``[animation]`` table): animated, simulated with ``simulation``."""
+    ``[animation]`` table): animated, simulated with ``simulation``.
+    Maps naming Blender images (``image:NAME:r``) are written into
+    ``images`` (``blender_image_map``), by file name when ``relative``."""
     import pelage
 
     if settings.groom_file:
@@ -225,7 +303,8 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
         # The operator stack, when it has entries, replaces the sliders.
         from . import stack
 
-        ops = stack.ops_of(settings.ops)
+        ops = [{kind: {key: blender_image_map(value, images, relative) for key, value in values.items()}
+                for kind, values in op.items()} for op in stack.ops_of(settings.ops)]
     else:
         ops = slider_ops(settings)
     if guides is not None:
@@ -234,11 +313,14 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
         guides = {"generate": {"count": settings.guides, "length": settings.length,
                                "gravity": settings.gravity, "seed": settings.seed}}
     roots = {"count": settings.count, "seed": settings.seed}
-    if settings.density_group:
+    if settings.density_group.startswith(IMAGE_PREFIX):
+        roots["density"] = blender_image_map(settings.density_group, images, relative)
+    elif settings.density_group:
         roots["density"] = f"vertex:{settings.density_group}"
     parting = {"FACE_SETS": {"faces": "groups"}, "MATERIALS": {"faces": "materials"}}
     return pelage.Groom(
         mesh=mesh,
+        base_dir=images if relative else None,
         skin=skin,
         animation=animation,
         simulation=simulation,
@@ -367,13 +449,16 @@ def guide_warnings(report):
     return notes
 
 
-def groom_for(surface, settings, mesh, depsgraph):
+def groom_for(surface, settings, mesh, depsgraph, images=None, relative=False):
     """The groom the panel of ``surface`` describes on its pelage ``mesh``,
-    with the guides object's curves as guides when one is set."""
+    with the guides object's curves as guides when one is set (Blender
+    images its maps name written into ``images``, as
+    ``groom_from_settings`` does)."""
     guides = None
     if settings.guides_object is not None and not settings.groom_file:
         guides = guides_from_curves_object(settings.guides_object, depsgraph)
-    return groom_from_settings(mesh, settings, guides, max(surface.dimensions) or 1.0)
+    return groom_from_settings(mesh, settings, guides, max(surface.dimensions) or 1.0,
+                               images=images, relative=relative)
 
 
 def evaluated_positions(obj, depsgraph):
@@ -470,7 +555,8 @@ def save_groom_file(context, surface, settings, path):
     every operator of the stack with its settings and masks, roots,
     finish, look; no ``[mesh]``, which the object stands for), with a
     guides object's curves written beside it (``NAME.guides.usdc``, in
-    pelage's Y-up world) and named in ``[guides] file``. Each file is
+    pelage's Y-up world) and named in ``[guides] file``, and the Blender
+    images its maps name beside it as 16-bit PNGs. Each file is
     written whole or not at all. Returns the paths written."""
     import os
 
@@ -478,7 +564,9 @@ def save_groom_file(context, surface, settings, path):
 
     depsgraph = context.evaluated_depsgraph_get()
     mesh, _ = mesh_to_pelage(surface, depsgraph)
-    groom = groom_for(surface, settings, mesh, depsgraph)
+    # Blender images the maps name go beside the file, by name.
+    folder = os.path.dirname(os.path.abspath(path))
+    groom = groom_for(surface, settings, mesh, depsgraph, images=folder, relative=True)
     text = groom.settings
     written = [path]
     if settings.guides_object is not None:

@@ -246,6 +246,22 @@ settings.density_group = ""
 grid.data.color_attributes.remove(paint)
 print(f"density from a colour attribute's red channel: {red_share:.1%} of the roots on the red half")
 
+# An image painted in Blender and never saved: its pixels are the map.
+# Red on the bottom half of the image (v < 0.5: the grid's y < 0), so a
+# flipped image would put the roots on the wrong half.
+painting = bpy.data.images.new("painting", 64, 64)
+texels = np.zeros((64, 64, 4), np.float32)
+texels[:32, :, 0] = 1.0  # Blender's first rows are the image's bottom
+texels[:, :, 3] = 1.0
+painting.pixels.foreach_set(texels.ravel())
+settings.density_group = "image:painting:r"
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+image_points, image_offsets = arrays(fur_of(grid).data)
+image_share = (image_points[image_offsets[:-1], 1] < 0).mean()
+assert image_share >= 0.95, image_share
+settings.density_group = ""
+print(f"density from an unsaved Blender image: {image_share:.1%} of the roots where it is painted")
+
 # The panel draws: every setting it shows exists, every button is an
 # operator (a layout that checks what it is asked to draw).
 class CheckedLayout:
