@@ -4,9 +4,10 @@ saved from it.
 
 An entry is an operator's name and one text field a setting, as the
 groom file writes its value: a number, a list (`[0.3, 0.2, 0.1]`), or a
-map (`vertex:GROUP`, `image.png:r`, `noise:frequency=8`; docs/groom-format.md,
-"Maps"; and the add-on's `image:NAME:r` for a Blender image, fur.py). An empty field takes pelage's default.
-The operators and their settings come from the library
+map (`vertex:GROUP`, `image.png:r`, `noise:frequency=8`;
+docs/groom-format.md, "Maps"; and the add-on's `image:NAME:r` for a
+Blender image, fur.py). An empty field takes pelage's default. The
+operators and their settings come from the library
 (`pelage._pelage.operator_schema()`), so an operator added to pelage
 appears here without a change to the add-on.
 """
