@@ -43,12 +43,17 @@ def apply_preset(settings, context):
         setattr(settings, name, value * size if name in SIZED else value)
 
 
+def _setting_changed(settings, context):
+    fur.on_setting_change(settings, context)
+
+
 class PelageOpSetting(bpy.types.PropertyGroup):
     """One setting of a stacked operator: its name, and its value as the
     groom file writes it."""
 
     value: StringProperty(
         name="Value",
+        update=_setting_changed,
         description="A number, a list ([0.3, 0.2, 0.1]) or a map: vertex:GROUP (a vertex group or "
                     "attribute), image:NAME:r (a Blender image, saved or not), file.png:r, "
                     "noise:frequency=8; empty: pelage's default",
@@ -59,7 +64,8 @@ class PelageOp(bpy.types.PropertyGroup):
     """An operator of the stack: its name and its settings."""
 
     kind: StringProperty(name="Operator")
-    enabled: BoolProperty(name="Enabled", description="Apply this operator", default=True)
+    enabled: BoolProperty(name="Enabled", description="Apply this operator", default=True,
+                          update=_setting_changed)
     settings: CollectionProperty(type=PelageOpSetting)
 
 
@@ -91,13 +97,13 @@ class PelageFurSettings(bpy.types.PropertyGroup):
                     "(Add › Curves › Empty Hair, sculpted with Blender's brushes); empty: guides grown here",
         poll=lambda _settings, obj: obj.type == "CURVES",
     )
-    density_group: StringProperty(
+    density_group: StringProperty(update=_setting_changed, 
         name="Density",
         description="A vertex group, a float attribute or a colour attribute (NAME, or one channel: "
                     "NAME:r, NAME:g, NAME:b, NAME:a), or a Blender image over the UV map "
                     "(image:NAME:r), whose values scale where hairs grow; empty: evenly",
     )
-    parting: EnumProperty(
+    parting: EnumProperty(update=_setting_changed, 
         name="Parting",
         description="Regions whose hairs take no shape or clumps from one another's guides",
         items=[
@@ -112,7 +118,7 @@ class PelageFurSettings(bpy.types.PropertyGroup):
         description="Regrow the fur as the guides object is sculpted: the hairs near the stroke only",
         default=False,
     )
-    display_fraction: FloatProperty(
+    display_fraction: FloatProperty(update=_setting_changed, 
         name="Display Fraction",
         description="Share of the hairs a live groom shows (the same hairs as the whole groom); "
                     "exports write them all",
@@ -123,16 +129,16 @@ class PelageFurSettings(bpy.types.PropertyGroup):
         description="What the last grow made (filled by Grow pelage fur)",
         options={"SKIP_SAVE"},
     )
-    count: IntProperty(name="Count", description="Hairs", default=20_000, min=1, soft_max=2_000_000)
-    guides: IntProperty(name="Guides", description="Guide curves grown on the surface", default=200, min=1, soft_max=5_000)
-    length: FloatProperty(name="Length", description="Guide length", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
-    width: FloatProperty(name="Width", description="Hair width at the root", default=0.002, min=0.0, soft_max=0.01, subtype="DISTANCE", precision=4)
-    gravity: FloatProperty(name="Gravity", description="Pull of the guides downward (world -Z)", default=0.3, min=0.0, max=1.0)
-    points: IntProperty(name="Points", description="Points per hair", default=12, min=2, max=64)
-    clump: FloatProperty(name="Clump", description="How far hairs pull toward clump centres (0: off)", default=0.4, min=0.0, max=1.0)
-    curl: FloatProperty(name="Curl", description="Curl radius, relative to the length (0: off)", default=0.0, min=0.0, max=2.0)
-    noise: FloatProperty(name="Noise", description="Noise amplitude, relative to the length (0: off)", default=0.1, min=0.0, max=2.0)
-    seed: IntProperty(name="Seed", default=1, min=0)
+    count: IntProperty(update=_setting_changed, name="Count", description="Hairs", default=20_000, min=1, soft_max=2_000_000)
+    guides: IntProperty(update=_setting_changed, name="Guides", description="Guide curves grown on the surface", default=200, min=1, soft_max=5_000)
+    length: FloatProperty(update=_setting_changed, name="Length", description="Guide length", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
+    width: FloatProperty(update=_setting_changed, name="Width", description="Hair width at the root", default=0.002, min=0.0, soft_max=0.01, subtype="DISTANCE", precision=4)
+    gravity: FloatProperty(update=_setting_changed, name="Gravity", description="Pull of the guides downward (world -Z)", default=0.3, min=0.0, max=1.0)
+    points: IntProperty(update=_setting_changed, name="Points", description="Points per hair", default=12, min=2, max=64)
+    clump: FloatProperty(update=_setting_changed, name="Clump", description="How far hairs pull toward clump centres (0: off)", default=0.4, min=0.0, max=1.0)
+    curl: FloatProperty(update=_setting_changed, name="Curl", description="Curl radius, relative to the length (0: off)", default=0.0, min=0.0, max=2.0)
+    noise: FloatProperty(update=_setting_changed, name="Noise", description="Noise amplitude, relative to the length (0: off)", default=0.1, min=0.0, max=2.0)
+    seed: IntProperty(update=_setting_changed, name="Seed", default=1, min=0)
     ops: CollectionProperty(
         type=PelageOp, name="Operators",
         description="Every pelage operator, applied top to bottom; when it has any, it replaces "
@@ -160,11 +166,11 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     sim_preroll: IntProperty(name="Pre-roll", description="Frames simulated at the first frame's pose before it",
                              default=12, min=0, soft_max=100)
     # The look: Principled Hair BSDF (Chiang) values, Cycles' defaults.
-    melanin: FloatProperty(name="Melanin", description="Hair pigment, 0 white to 1 black", default=0.8, min=0.0, max=1.0)
-    melanin_redness: FloatProperty(name="Redness", description="Share of red pheomelanin in the pigment", default=1.0, min=0.0, max=1.0)
-    roughness: FloatProperty(name="Roughness", description="Longitudinal roughness: how far highlights spread along hairs", default=0.3, min=0.0, max=1.0)
-    radial_roughness: FloatProperty(name="Radial Roughness", description="Azimuthal roughness: how far light spreads around hairs", default=0.3, min=0.0, max=1.0)
-    look_jitter: FloatProperty(name="Variation", description="Per-hair variation of pigment and roughness, a fraction", default=0.1, min=0.0, max=1.0)
+    melanin: FloatProperty(update=_setting_changed, name="Melanin", description="Hair pigment, 0 white to 1 black", default=0.8, min=0.0, max=1.0)
+    melanin_redness: FloatProperty(update=_setting_changed, name="Redness", description="Share of red pheomelanin in the pigment", default=1.0, min=0.0, max=1.0)
+    roughness: FloatProperty(update=_setting_changed, name="Roughness", description="Longitudinal roughness: how far highlights spread along hairs", default=0.3, min=0.0, max=1.0)
+    radial_roughness: FloatProperty(update=_setting_changed, name="Radial Roughness", description="Azimuthal roughness: how far light spreads around hairs", default=0.3, min=0.0, max=1.0)
+    look_jitter: FloatProperty(update=_setting_changed, name="Variation", description="Per-hair variation of pigment and roughness, a fraction", default=0.1, min=0.0, max=1.0)
 
 
 def surface_of(context):

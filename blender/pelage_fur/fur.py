@@ -693,8 +693,9 @@ class LiveGroom:
 #: Live grooms by surface object name.
 LIVE = {}
 #: Surfaces whose live update is scheduled (a stroke's many depsgraph
-#: updates make one regrow).
-PENDING = set()
+#: updates make one regrow), with whether it is a whole regrow (the mesh,
+#: its paint or a setting changed) rather than the guides' own.
+PENDING = {}
 
 
 def live_update(surface):
@@ -731,38 +732,87 @@ def live_update(surface):
     return done
 
 
-def schedule_live_update(name):
-    """Runs ``live_update`` on the surface ``name`` once, shortly: the
-    depsgraph reports a sculpt stroke many times."""
+def live_regrow(surface):
+    """Regrows the live fur of ``surface`` whole, after its mesh (edit
+    mode, sculpting), its paint (vertex groups, colour attributes) or a
+    panel setting changed: the evaluated mesh and the panel's groom, at
+    the display fraction, into the same fur object. Returns ``{"hairs"}``,
+    or None when the surface has no live groom."""
+    import bpy
+    import pelage
+
+    live = LIVE.get(surface.name)
+    obj = bpy.data.objects.get(live.fur_name) if live else None
+    settings = surface.pelage_fur
+    if obj is None or not settings.live or settings.guides_object is None:
+        return None
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    mesh, uv_map = mesh_to_pelage(surface, depsgraph)
+    groom = groom_for(surface, settings, mesh, depsgraph)
+    session = pelage.GroomSession(groom, fraction=settings.display_fraction)
+    grown = session.curves()
+    back = np.linalg.inv(to_pelage_space(surface))
+    old = obj.data
+    data = curves_to_blender(old.name, grown, surface, uv_map, back)
+    if len(old.materials):
+        data.materials.clear()
+        for material in old.materials:
+            data.materials.append(material)
+    obj.data = data
+    name = old.name
+    if old.users == 0:
+        bpy.data.hair_curves.remove(old)
+        data.name = name
+    live.session = session
+    return {"hairs": grown.curve_count}
+
+
+def schedule_live_update(name, whole=False):
+    """Runs ``live_update`` (or ``live_regrow`` when ``whole``) on the
+    surface ``name`` once, shortly: the depsgraph reports a sculpt stroke
+    many times."""
     import bpy
 
     if name in PENDING:
+        PENDING[name] = PENDING[name] or whole
         return
-    PENDING.add(name)
+    PENDING[name] = whole
 
     def run():
         import pelage
 
-        PENDING.discard(name)
+        whole = PENDING.pop(name, False)
         surface = bpy.data.objects.get(name)
         if surface is None:
             return None
         try:
-            done = live_update(surface)
+            done = live_regrow(surface) if whole else live_update(surface)
         except pelage.PelageError as error:
             # A timer has no operator to report through: the panel says it.
             surface.pelage_fur.last_grow = f"live: {error}"
             return None
-        if done is not None:
+        if done is not None and whole:
+            surface.pelage_fur.last_grow = f"live: regrown, {done['hairs']:,} hairs shown"
+        elif done is not None:
             surface.pelage_fur.last_grow = f"live: {done['regrown']:,} of {done['hairs']:,} hairs regrown"
         return None
 
     bpy.app.timers.register(run, first_interval=0.05)
 
 
+def on_setting_change(settings, _context):
+    """A panel setting (or one of the operator stack's, ``settings`` being
+    the property group changed) changed: a live groom regrows whole."""
+    surface = settings.id_data
+    if surface is None or surface.name not in LIVE or not surface.pelage_fur.live:
+        return
+    schedule_live_update(surface.name, whole=True)
+
+
 def on_depsgraph_update(scene, depsgraph):
     """Schedules the live update of every live surface whose guides object
-    (or its curves) the update touched."""
+    (or its curves) the update touched, and a whole regrow of every one
+    whose mesh it touched."""
     import bpy
 
     touched = {update.id.original for update in depsgraph.updates}
@@ -773,5 +823,12 @@ def on_depsgraph_update(scene, depsgraph):
             continue
         settings = surface.pelage_fur
         guides = settings.guides_object
-        if settings.live and guides is not None and (guides in touched or guides.data in touched):
+        if not settings.live or guides is None:
+            continue
+        # The mesh datablock itself (edit mode, sculpting, weight and
+        # vertex paint), not the object evaluated again (an armature
+        # playing moves the fur through Deform Curves on Surface).
+        if surface.data in touched:
+            schedule_live_update(name, whole=True)
+        elif guides in touched or guides.data in touched:
             schedule_live_update(name)

@@ -211,8 +211,36 @@ moved_by = np.array([np.abs(after[a:b] - before[a:b]).max() for a, b in zip(live
 assert far.sum() > 1000 and np.all(moved_by[far] == 0), "hairs far from the stroke keep every bit"
 assert moved_by[~far].max() > 0.05, "hairs by the combed guide follow it"
 assert addon_fur.live_update(grid) is None, "nothing changed since"
-settings.guides_object, settings.live = None, False
 print(f"live: a combed guide regrew {done['regrown']:,} of {done['hairs']:,} hairs; far ones kept every bit")
+# While live, a setting changed regrows the whole groom (at the display
+# fraction), in the same fur object.
+addon_fur.PENDING.pop(grid.name, None)
+settings.count = 2_000
+assert addon_fur.PENDING.get(grid.name) is True, "a setting schedules a whole regrow"
+assert addon_fur.live_regrow(grid) == {"hairs": 2_000}
+assert fur_of(grid) == live_fur and len(live_fur.data.curves) == 2_000
+# So does an edit of the mesh (edit mode, sculpt, paint): the x > 0 half
+# lifted 0.25, the roots there follow it.
+addon_fur.PENDING.pop(grid.name, None)
+flat = np.empty(len(grid.data.vertices) * 3, np.float32)
+grid.data.vertices.foreach_get("co", flat)
+lifted = flat.reshape(-1, 3).copy()
+lifted[lifted[:, 0] > 1e-6, 2] += 0.25
+grid.data.vertices.foreach_set("co", lifted.ravel())
+grid.data.update()
+bpy.context.view_layer.update()
+assert addon_fur.PENDING.get(grid.name) is True, "a mesh edit schedules a whole regrow"
+addon_fur.live_regrow(grid)
+edited, edited_offsets = arrays(live_fur.data)
+edited_roots = edited[edited_offsets[:-1]]
+on_top = edited_roots[:, 0] > 0.26  # beyond the slanted faces by x = 0
+assert on_top.sum() > 100 and np.allclose(edited_roots[on_top, 2], 0.25, atol=1e-5)
+grid.data.vertices.foreach_set("co", flat)
+grid.data.update()
+addon_fur.PENDING.pop(grid.name, None)
+settings.count = 3_000
+print("live: a setting or a mesh edit regrows the whole groom in place")
+settings.guides_object, settings.live = None, False
 
 # A vertex group painted on half the grid (weight 1 for x > 0, none
 # elsewhere) as the density puts the roots on that half.
