@@ -1,6 +1,6 @@
 """Render fur grown by the add-on with Cycles, for the gallery:
 
-    tools/bpy-python blender/render_gallery.py EXTENSION.zip OUT.png [--patches | --no-material]
+    tools/bpy-python blender/render_gallery.py EXTENSION.zip OUT.png [--patches | --no-material | --workflow]
 
 Installs the extension into a fresh user folder, grows fur on Suzanne with
 "Grow pelage fur" (the panel's settings below) and renders 800×600 on the
@@ -11,7 +11,13 @@ here). docs/gallery/blender-addon-suzanne.png is made this way; with
 ``--patches`` the settings come from a groom file whose ``[look]`` melanin
 is a noise map (docs/gallery/blender-look-patches.png); with
 ``--no-material`` the add-on's material is taken off, for the picture
-beside it (docs/gallery/blender-addon-suzanne-no-material.png).
+beside it (docs/gallery/blender-addon-suzanne-no-material.png). With
+``--workflow`` the fur is groomed as docs/blender.md's workflow does it
+(docs/gallery/blender-workflow-suzanne.png): guides in a hair Curves
+object on the surface (placed and combed by this script, as a groomer's
+brushes would: away from a parting down the middle of the head), a
+density painted as a vertex group (none on the face), and face sets,
+one a side, as the parting.
 """
 
 import math
@@ -26,7 +32,8 @@ import mathutils  # noqa: E402
 
 patches = sys.argv[-1] == "--patches"
 bare = sys.argv[-1] == "--no-material"
-args = sys.argv[:-1] if patches or bare else sys.argv
+workflow = sys.argv[-1] == "--workflow"
+args = sys.argv[:-1] if patches or bare or workflow else sys.argv
 zip_path, out = os.path.abspath(args[-2]), os.path.abspath(args[-1])
 assert bpy.ops.extensions.package_install_files(
     filepath=zip_path, repo="user_default", enable_on_install=True
@@ -76,8 +83,61 @@ if patches:
             "melanin_redness = 0.9\nroughness = 0.3\njitter = 0.15\n"
         )
     settings.groom_file = groom
+if workflow:
+    import numpy as np
+
+    # Density painted as a vertex group: none on the face (the front,
+    # below the brow), full elsewhere.
+    painted = head.vertex_groups.new(name="fur")
+    for v in head.data.vertices:
+        face = v.normal.y < -0.55 and v.co.z < 0.25
+        painted.add([v.index], 0.0 if face else 1.0, "REPLACE")
+    # Face sets, one a side of the head: the parting down its middle.
+    sets = head.data.attributes.new(".sculpt_face_set", "INT", "FACE")
+    centres = np.empty(len(head.data.polygons) * 3, np.float32)
+    head.data.polygons.foreach_get("center", centres)
+    sets.data.foreach_set("value", np.where(centres.reshape(-1, 3)[:, 0] < 0, 1, 2).astype(np.int32))
+    # Guides on the surface as Blender evaluates it (subdivided): every
+    # 40th vertex off the face, combed away from the parting and down.
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    evaluated = head.evaluated_get(depsgraph).to_mesh()
+    roots, ways = [], []
+    for v in list(evaluated.vertices)[::40]:
+        if v.normal.y < -0.55 and v.co.z < 0.25:
+            continue
+        side = -1.0 if v.co.x < 0 else 1.0
+        way = mathutils.Vector((side * 0.6, 0.1, -0.3)) + 1.2 * v.normal
+        roots.append(v.co.copy())
+        ways.append(way.normalized())
+    head.evaluated_get(depsgraph).to_mesh_clear()
+    steps = 8
+    guides = bpy.data.hair_curves.new("sculpted guides")
+    guides.add_curves([steps] * len(roots))
+    points = []
+    for root, way in zip(roots, ways):
+        p, w = root.copy(), way.copy()
+        for _ in range(steps):
+            points.extend(p)
+            p = p + 0.018 * w
+            w = (w + mathutils.Vector((0, 0, -0.12))).normalized()  # a droop toward the tip
+    # Curves points are in the object's space: the guides ride the head.
+    guides.position_data.foreach_set("vector", np.array(points, np.float32).ravel())
+    guides_object = bpy.data.objects.new("sculpted guides", guides)
+    scene.collection.objects.link(guides_object)
+    guides_object.matrix_world = head.matrix_world
+    guides_object.hide_render = True
+    settings.guides_object = guides_object
+    settings.density_group = "fur"
+    settings.parting = "FACE_SETS"
+    settings.count = 150_000
+    settings.points = 12
+    settings.clump = 0.3
+    settings.noise = 0.08
+    settings.melanin = 0.3
+    settings.melanin_redness = 0.7
+    settings.outside_skin = True
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
-fur = [o for o in bpy.data.objects if o.type == "CURVES"][0]
+fur = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == head][0]
 assert fur.data.materials[0].name == "pelage hair"
 if bare:
     # The same fur as Cycles draws curves with no material: the other
@@ -87,8 +147,8 @@ if bare:
 camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
 scene.collection.objects.link(camera)
 scene.camera = camera
-camera.location = (1.6, -4.4, 1.1)
-target = mathutils.Vector((0.0, 0.0, 0.05))
+camera.location = (1.6, -4.4, 1.1) if not workflow else (1.0, -3.4, 3.4)
+target = mathutils.Vector((0.0, 0.0, 0.05 if not workflow else 0.2))
 camera.rotation_euler = (target - camera.location).to_track_quat("-Z", "Y").to_euler()
 camera.data.lens = 60
 key = bpy.data.objects.new("key", bpy.data.lights.new("key", "AREA"))

@@ -139,6 +139,12 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     curl: FloatProperty(update=_setting_changed, name="Curl", description="Curl radius, relative to the length (0: off)", default=0.0, min=0.0, max=2.0)
     noise: FloatProperty(update=_setting_changed, name="Noise", description="Noise amplitude, relative to the length (0: off)", default=0.1, min=0.0, max=2.0)
     seed: IntProperty(update=_setting_changed, name="Seed", default=1, min=0)
+    outside_skin: BoolProperty(
+        update=_setting_changed, name="Out of the Skin",
+        description="Push every hair point that noise, curl or a guide put under the skin back out, "
+                    "keeping lengths (pelage's [finish] outside_skin; slower)",
+        default=False,
+    )
     ops: CollectionProperty(
         type=PelageOp, name="Operators",
         description="Every pelage operator, applied top to bottom; when it has any, it replaces "
@@ -502,7 +508,8 @@ class PELAGE_PT_fur(bpy.types.Panel):
         column.prop_search(settings, "density_group", surface_of(context), "vertex_groups")
         column.prop(settings, "parting")
         grown_guides = settings.guides_object is None
-        for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed"):
+        for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed",
+                     "outside_skin"):
             row = column.row()
             # Length, gravity and the guide count shape grown guides only.
             row.enabled = grown_guides or name not in ("guides", "length", "gravity")

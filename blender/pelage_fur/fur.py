@@ -328,7 +328,7 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
         regions=parting.get(settings.parting),
         roots=roots,
         ops=ops,
-        finish={"points": settings.points,
+        finish={"points": settings.points, "outside_skin": settings.outside_skin,
                 "width": {"root": settings.width, "tip": settings.width * 0.1}},
         look={"melanin": settings.melanin, "melanin_redness": settings.melanin_redness,
               "roughness": settings.roughness, "radial_roughness": settings.radial_roughness,
