@@ -659,7 +659,11 @@ def grow_on_object(context, surface, settings, progress=None):
         LIVE[surface.name] = LiveGroom(session, obj.name, max(surface.dimensions) * 0.005 or 1e-3)
     report = groom.report()
     settings.last_grow = "\n".join(grow_summary(report, grown, time.perf_counter() - start))
-    return obj, grown, guide_warnings(report)
+    warnings = guide_warnings(report)
+    if uv_map is None:
+        warnings.append(f"{surface.name} has no UV map: the fur is grown but will not follow the mesh "
+                        "when it deforms (Deform Curves on Surface needs UVs); add a UV map and grow again")
+    return obj, grown, warnings
 
 
 def grow_summary(report, grown, seconds):

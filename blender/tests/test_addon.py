@@ -385,6 +385,24 @@ moved = np.linalg.norm(evaluated_roots(fur), axis=1)
 assert np.allclose(moved, 2 * rest, rtol=1e-3), (moved[:4], rest[:4])
 print("sphere: the fur follows the surface when a shape key doubles it (Deform Curves on Surface)")
 
+# A mesh without a UV map grows, from object-space noise and a vertex
+# group, and the user is told it will not follow deformation.
+clear_scene()
+bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=3)
+bare = bpy.context.active_object
+while bare.data.uv_layers:
+    bare.data.uv_layers.remove(bare.data.uv_layers[0])
+top = bare.vertex_groups.new(name="top")
+top.add([v.index for v in bare.data.vertices if v.co.z > 0], 1.0, "REPLACE")
+bare.pelage_fur.count, bare.pelage_fur.noise, bare.pelage_fur.density_group = 1_500, 0.5, "top"
+_, grown_bare, bare_warnings = addon_fur.grow_on_object(bpy.context, bare, bare.pelage_fur)
+assert grown_bare.curve_count == 1_500
+bare_roots = grown_bare.points[grown_bare.offsets[:-1]]
+assert (bare_roots[:, 1] > 0).mean() >= 0.95, "the painted top (Y-up in pelage's world)"
+assert any("no UV map" in w for w in bare_warnings), bare_warnings
+assert not any(m.type == "NODES" for m in fur_of(bare).modifiers)
+print("no UV map: grown from noise and a vertex group; the user is told it will not follow deformation")
+
 # 3. A groom file drives the add-on; its errors reach the user.
 with tempfile.TemporaryDirectory() as folder:
     good = os.path.join(folder, "fur.toml")
