@@ -185,7 +185,7 @@ def surface_of(context):
 
 
 class PELAGE_OT_grow_fur(bpy.types.Operator):
-    """Grow pelage fur on the active mesh as a hair Curves object"""
+    """Grow pelage fur on the active mesh as a hair Curves object (Esc cancels a long grow)"""
 
     bl_idname = "pelage.grow_fur"
     bl_label = "Grow pelage fur"
@@ -196,6 +196,7 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
         return surface_of(context) is not None
 
     def execute(self, context):
+        # Scripts: on this thread, to the end.
         surface = surface_of(context)
         settings = surface.pelage_fur
         wm = context.window_manager
@@ -209,10 +210,78 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
             return {"CANCELLED"}
         finally:
             wm.progress_end()
+        return self.done(surface, grown, warnings)
+
+    def done(self, surface, grown, warnings):
         for warning in warnings:
             self.report({"WARNING"}, f"pelage: {warning}")
         self.report({"INFO"}, f"pelage: {grown.curve_count:,} hairs, {grown.point_count:,} points on {surface.name}")
         return {"FINISHED"}
+
+    def invoke(self, context, _event):
+        # The panel's button: pelage grows on a worker thread (it lets go
+        # of Python while it works), Blender stays responsive, the status
+        # bar shows the parts done, and Esc stops it between parts with
+        # nothing changed.
+        import threading
+
+        surface = surface_of(context)
+        try:
+            self._prepared = fur.PreparedGrow(context, surface, surface.pelage_fur)
+        except PelageError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self._surface_name = surface.name
+        self._state = {"done": 0, "total": 1, "result": None, "error": None, "cancel": False}
+
+        def progress(done, total):
+            self._state["done"], self._state["total"] = done, total
+            if self._state["cancel"]:
+                raise fur.Cancelled()
+
+        def work():
+            try:
+                self._state["result"] = fur.grow_curves(self._prepared, progress)
+            except BaseException as error:  # reported on the main thread
+                self._state["error"] = error
+
+        self._thread = threading.Thread(target=work, daemon=True)
+        self._thread.start()
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self._state["cancel"] = True
+            return {"RUNNING_MODAL"}
+        if event.type != "TIMER":
+            # The viewport and the panel keep working while pelage grows.
+            return {"PASS_THROUGH"}
+        state = self._state
+        if self._thread.is_alive():
+            context.workspace.status_text_set(
+                f"pelage: growing, part {state['done']} of {state['total']} (Esc cancels)")
+            return {"RUNNING_MODAL"}
+        context.window_manager.event_timer_remove(self._timer)
+        context.workspace.status_text_set(None)
+        error = state["error"]
+        if isinstance(error, fur.Cancelled):
+            self.report({"WARNING"}, "pelage: grow cancelled; the fur is as it was")
+            return {"CANCELLED"}
+        if isinstance(error, PelageError):
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        if error is not None:
+            raise error
+        surface = bpy.data.objects.get(self._surface_name)
+        if surface is None:
+            self.report({"ERROR"}, "pelage: the mesh was deleted while its fur grew")
+            return {"CANCELLED"}
+        grown, session = state["result"]
+        _, warnings = fur.finish_grow(surface, surface.pelage_fur, self._prepared, grown, session)
+        return self.done(surface, grown, warnings)
 
 
 _OPERATOR_ITEMS = []

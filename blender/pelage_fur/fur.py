@@ -597,30 +597,53 @@ def fur_object_of(surface):
                  if o.type == "CURVES" and o.parent == surface and "pelage_settings" in o), None)
 
 
-def grow_on_object(context, surface, settings, progress=None):
-    """Grows fur on the mesh object ``surface`` into a Curves object
-    parented to it: the one an earlier grow made, regrown in place, or a
-    new one. Returns ``(curves_object, pelage_curves, warnings)``:
-    the guides the groom left out, with why."""
-    import bpy
+class Cancelled(Exception):
+    """A grow the user cancelled (Esc): nothing was changed."""
 
-    import time
 
-    start = time.perf_counter()
-    depsgraph = context.evaluated_depsgraph_get()
-    mesh, uv_map = mesh_to_pelage(surface, depsgraph)
-    groom = groom_for(surface, settings, mesh, depsgraph)
-    LIVE.pop(surface.name, None)
-    live = settings.live and settings.guides_object is not None and not settings.groom_file
-    if live:
-        # The live groom: sculpting the guides regrows the hairs near the
-        # stroke (live_update), at the display fraction.
+class PreparedGrow:
+    """What a grow reads from Blender, on the main thread, before pelage
+    grows (``grow_curves``, which touches no Blender data and may run on
+    another thread) and the result goes back into Blender
+    (``finish_grow``)."""
+
+    def __init__(self, context, surface, settings):
+        import time
+
+        self.start = time.perf_counter()
+        depsgraph = context.evaluated_depsgraph_get()
+        mesh, self.uv_map = mesh_to_pelage(surface, depsgraph)
+        self.groom = groom_for(surface, settings, mesh, depsgraph)
+        self.live = settings.live and settings.guides_object is not None and not settings.groom_file
+        self.fraction = settings.display_fraction
+        self.frame = context.scene.frame_current
+
+
+def grow_curves(prepared, progress=None):
+    """Grows the prepared groom: ``(curves, live session or None)``. A live
+    groom is a pelage session at the display fraction (sculpting the
+    guides regrows the hairs near the stroke); otherwise the whole groom,
+    part by part, calling ``progress(done, total)`` after each, which
+    may raise ``Cancelled`` to stop it. Touches no Blender data."""
+    if prepared.live:
         import pelage
 
-        session = pelage.GroomSession(groom, fraction=settings.display_fraction)
-        grown = session.curves()
-    else:
-        grown = groom.grow(progress=progress)
+        session = pelage.GroomSession(prepared.groom, fraction=prepared.fraction)
+        return session.curves(), session
+    return prepared.groom.grow(progress=progress), None
+
+
+def finish_grow(surface, settings, prepared, grown, session):
+    """Puts ``grown`` into the surface's fur object (the one an earlier
+    grow made, regrown in place, or a new one parented to it). Returns
+    ``(curves_object, warnings)``: the guides the groom left out, with
+    why, and a mesh without a UV map."""
+    import time
+
+    import bpy
+
+    LIVE.pop(surface.name, None)
+    uv_map, groom = prepared.uv_map, prepared.groom
     # Back from pelage's Y-up world into the surface's local space, where
     # Blender keeps the points of curves parented to it.
     back = np.linalg.inv(to_pelage_space(surface))
@@ -654,15 +677,26 @@ def grow_on_object(context, surface, settings, progress=None):
             deform_on_surface_modifier(obj)
     obj["pelage_settings"] = groom.settings
     # The frame grown at: exports at other frames carry the fur from it.
-    obj["pelage_frame"] = context.scene.frame_current
-    if live:
+    obj["pelage_frame"] = prepared.frame
+    if session is not None:
         LIVE[surface.name] = LiveGroom(session, obj.name, max(surface.dimensions) * 0.005 or 1e-3)
     report = groom.report()
-    settings.last_grow = "\n".join(grow_summary(report, grown, time.perf_counter() - start))
+    settings.last_grow = "\n".join(grow_summary(report, grown, time.perf_counter() - prepared.start))
     warnings = guide_warnings(report)
     if uv_map is None:
         warnings.append(f"{surface.name} has no UV map: the fur is grown but will not follow the mesh "
                         "when it deforms (Deform Curves on Surface needs UVs); add a UV map and grow again")
+    return obj, warnings
+
+
+def grow_on_object(context, surface, settings, progress=None):
+    """Grows fur on the mesh object ``surface`` into a Curves object
+    parented to it: the one an earlier grow made, regrown in place, or a
+    new one (``PreparedGrow``, ``grow_curves``, ``finish_grow`` in turn,
+    on this thread). Returns ``(curves_object, pelage_curves, warnings)``."""
+    prepared = PreparedGrow(context, surface, settings)
+    grown, session = grow_curves(prepared, progress)
+    obj, warnings = finish_grow(surface, settings, prepared, grown, session)
     return obj, grown, warnings
 
 

@@ -385,6 +385,29 @@ moved = np.linalg.norm(evaluated_roots(fur), axis=1)
 assert np.allclose(moved, 2 * rest, rtol=1e-3), (moved[:4], rest[:4])
 print("sphere: the fur follows the surface when a shape key doubles it (Deform Curves on Surface)")
 
+# A long grow is cancelled between parts (the panel's button grows on a
+# worker thread; Esc makes its progress callback raise): nothing changes.
+sphere.pelage_fur.count = 400_000
+prepared = addon_fur.PreparedGrow(bpy.context, sphere, sphere.pelage_fur)
+shown_before = arrays(fur.data)[0].copy()
+
+
+def cancel_after_first(done, total):
+    assert total > 1, total
+    raise addon_fur.Cancelled()
+
+
+try:
+    addon_fur.grow_curves(prepared, cancel_after_first)
+except addon_fur.Cancelled:
+    pass
+else:
+    raise AssertionError("the grow must stop when its progress callback raises Cancelled")
+assert np.array_equal(arrays(fur_of(sphere).data)[0], shown_before), "the fur is as it was"
+assert hasattr(addon.PELAGE_OT_grow_fur, "modal") and hasattr(addon.PELAGE_OT_grow_fur, "invoke")
+sphere.pelage_fur.count = 2_000
+print("cancel: a 400,000-hair grow stops after its first part, the fur as it was")
+
 # A mesh without a UV map grows, from object-space noise and a vertex
 # group, and the user is told it will not follow deformation.
 clear_scene()
