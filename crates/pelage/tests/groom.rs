@@ -742,3 +742,50 @@ fn outside_skin_pushes_noisy_curly_hair_out_of_spot_keeping_lengths() {
         "{untouched} untouched"
     );
 }
+
+#[test]
+fn a_z_up_usd_guide_file_is_turned_to_the_meshs_y_up() {
+    // Blender's USD export of guides grown on spot: Z up, so a point
+    // (x, y, z) of pelage's Y-up world is written (x, −z, y).
+    let dir = tempfile::tempdir().unwrap();
+    let grown = "[mesh]\npath = \"spot\"\n[roots]\ncount = 100\n\
+                 [guides]\ngenerate = { count = 30, length = 0.05 }\n";
+    let groom = pelage::groom::Groom::from_text(dir.path().join("grown.toml"), grown).unwrap();
+    let guides = groom.guides().curves().clone();
+    let z_up = pelage::groom::AxisTurn::YUpToZUp.curves(guides.clone());
+    let write = |name: &str, up_axis| {
+        let export = pelage::io::CurvesExport {
+            usd: pelage::io::UsdOptions {
+                up_axis,
+                ..Default::default()
+            },
+            mesh: None,
+            guides: None,
+        };
+        pelage::io::write_curves(&dir.path().join(name), [("guides".into(), &z_up)], &export)
+            .unwrap();
+    };
+    write("blender.usda", pelage::io::UpAxis::Z);
+    let from_file = |name: &str| {
+        let text = format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 100\n[guides]\nfile = \"{name}\"\n"
+        );
+        pelage::groom::Groom::from_text(dir.path().join("from_file.toml"), text)
+    };
+    let bound = from_file("blender.usda").unwrap();
+    assert_eq!(bound.guides().len(), 30, "every guide bound");
+    let worst = bound
+        .guides()
+        .curves()
+        .points()
+        .iter()
+        .zip(guides.points())
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-5, "{worst}");
+    // The same points in a file that says nothing of Z up stay as they
+    // are, off the mesh: the turn is what binds them.
+    write("unturned.usda", pelage::io::UpAxis::Y);
+    let e = from_file("unturned.usda").unwrap_err().to_string();
+    assert!(e.contains("no guide is within the tolerance"), "{e}");
+}

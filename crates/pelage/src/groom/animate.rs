@@ -151,6 +151,53 @@ impl AnimationSpec {
     }
 }
 
+/// How a guide file's coordinates turn into its mesh's: a Z-up USD file
+/// (Blender's export) of guides for a Y-up mesh (pelage's world, every
+/// format but a Z-up USD mesh) is turned Y-up, and the other way round.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AxisTurn {
+    /// The same up axis: no turn.
+    #[default]
+    None,
+    /// Z up to Y up: (x, y, z) → (x, z, −y), as Blender's Y-up exports turn it.
+    ZUpToYUp,
+    /// Y up to Z up: (x, y, z) → (x, −z, y).
+    YUpToZUp,
+}
+
+impl AxisTurn {
+    /// The turn from a file whose up axis is `file` to a mesh whose up
+    /// axis is `mesh`.
+    pub fn between(file: crate::io::UpAxis, mesh: crate::io::UpAxis) -> Self {
+        use crate::io::UpAxis::{Y, Z};
+        match (file, mesh) {
+            (Z, Y) => Self::ZUpToYUp,
+            (Y, Z) => Self::YUpToZUp,
+            _ => Self::None,
+        }
+    }
+
+    /// A point turned.
+    pub fn point(self, p: Vec3) -> Vec3 {
+        match self {
+            Self::None => p,
+            Self::ZUpToYUp => Vec3::new(p.x, p.z, -p.y),
+            Self::YUpToZUp => Vec3::new(p.x, -p.z, p.y),
+        }
+    }
+
+    /// Guide `curves` turned: their points, widths and layout (what
+    /// binding reads; other attributes are left behind).
+    pub fn curves(self, curves: Curves) -> Curves {
+        if self == Self::None {
+            return curves;
+        }
+        let points = curves.points().iter().map(|&p| self.point(p)).collect();
+        Curves::new(points, curves.widths().to_vec(), curves.offsets().to_vec())
+            .expect("a turn keeps the layout and finite values")
+    }
+}
+
 /// Guide shapes over time, for [`AnimationMode::Regrow`].
 #[derive(Clone)]
 pub enum GuideMotion {
@@ -163,6 +210,8 @@ pub enum GuideMotion {
         kept: Vec<usize>,
         /// Frames per second: Alembic samples are timed in seconds.
         fps: f64,
+        /// The turn from the file's up axis to the mesh's.
+        turn: AxisTurn,
     },
     /// A program giving every bound guide's points at a frame (one curve
     /// per guide, in order).
@@ -328,9 +377,16 @@ impl AnimatedGroom {
         let rest = &self.spec.guides;
         let n = rest.points_per_guide();
         let (posed, kept): (Curves, Option<&[usize]>) = match &self.guides {
-            Some(GuideMotion::File { path, kept, fps }) => (
-                read_guides_at(path, time, *fps)
-                    .map_err(|e| self.spec.error("guides.file", GroomErrorKind::Guides(e)))?,
+            Some(GuideMotion::File {
+                path,
+                kept,
+                fps,
+                turn,
+            }) => (
+                turn.curves(
+                    read_guides_at(path, time, *fps)
+                        .map_err(|e| self.spec.error("guides.file", GroomErrorKind::Guides(e)))?,
+                ),
                 Some(kept),
             ),
             Some(GuideMotion::Program(f)) => (f(time), None),

@@ -3,7 +3,7 @@
 //! [`Generator`] is built from, keeping where each was written so that
 //! errors found later still name the line.
 
-use super::animate::{AnimatedGroom, AnimationMode, AnimationSpec, GuideMotion};
+use super::animate::{AnimatedGroom, AnimationMode, AnimationSpec, AxisTurn, GuideMotion};
 use super::error::{GroomError, GroomErrorKind};
 use super::file::{AnimationModeName, GroomFile, InterpolationKind, MapValue, MeshSection};
 use super::generator::Generator;
@@ -136,6 +136,7 @@ impl Groom {
         };
         // A mesh value replaces `[mesh]`: a groom file written for the
         // command line grows on whatever mesh a DCC hands over.
+        let mesh_is_value = inputs.skin.is_some() || inputs.mesh.is_some();
         let given_skin = match (inputs.skin, &inputs.mesh, &animation) {
             (Some(_), Some(_), _) => {
                 return Err(invalid(
@@ -191,6 +192,12 @@ impl Groom {
         let rest_time = animation
             .as_ref()
             .map(|(spec, fps, _)| (spec.rest_frame, *fps));
+        // The mesh's up axis: a value's is pelage's world (Y), a file's is
+        // its own (a USD file's upAxis; every other format is Y up).
+        let mesh_up = match (&file.mesh, mesh_is_value) {
+            (Some(section), false) => usd_up_axis(&source.folder().join(section.path.get_ref())),
+            _ => crate::io::UpAxis::Y,
+        };
         let (guides, bind_report) = match inputs.guides {
             Some(_) if file.guides.file.is_some() || file.guides.generate.is_some() => {
                 return Err(invalid(
@@ -199,7 +206,7 @@ impl Groom {
                 ));
             }
             Some(curves) => bind_guides(&source, &file, &mesh, &curves, 0..0)?,
-            None => load_guides(&source, &file, &mesh, rest_time)?,
+            None => load_guides(&source, &file, &mesh, rest_time, mesh_up)?,
         };
         let animation = match (animation, skin) {
             (Some((spec, fps, _)), Some(skin)) => {
@@ -217,6 +224,7 @@ impl Groom {
                         .map(|r| r.dropped.iter().map(|d| d.index).collect())
                         .unwrap_or_default();
                     GuideMotion::File {
+                        turn: AxisTurn::between(usd_up_axis(&path), mesh_up),
                         path,
                         kept: (0..total).filter(|i| !dropped.contains(i)).collect(),
                         fps,
@@ -893,11 +901,30 @@ fn bind_guides(
     Ok((guides, Some(report)))
 }
 
+/// The up axis a file's coordinates have: a USD layer's `upAxis` (Y when
+/// not authored, or when the layer cannot be read: its reader says why
+/// later); every other format Y (pelage's world: OBJ, PLY and glTF are Y
+/// up, Blender's Alembic export turns its Z up into Y).
+fn usd_up_axis(path: &Path) -> crate::io::UpAxis {
+    let usd = matches!(
+        crate::io::CurvesFormat::from_path(path),
+        Some(crate::io::CurvesFormat::Usda | crate::io::CurvesFormat::Usdc)
+    );
+    match usd
+        .then(|| crate::io::read_usd_layer_info(path).ok())
+        .flatten()
+    {
+        Some(info) if info.up_axis.eq_ignore_ascii_case("z") => crate::io::UpAxis::Z,
+        _ => crate::io::UpAxis::Y,
+    }
+}
+
 fn load_guides(
     source: &SettingsSource,
     file: &GroomFile,
     mesh: &Mesh,
     rest_time: Option<(f64, f64)>,
+    mesh_up: crate::io::UpAxis,
 ) -> Result<(Guides, Option<BindReport>), GroomError> {
     let section = &file.guides;
     match (&section.file, &section.generate) {
@@ -909,6 +936,9 @@ fn load_guides(
                 None => crate::io::read_curves(&full),
             }
             .map_err(|e| source.error_at(path.span(), GroomErrorKind::Guides(e)))?;
+            // A Z-up USD file (Blender's export) for a Y-up mesh, or the
+            // other way round, is turned to the mesh's axes.
+            let curves = AxisTurn::between(usd_up_axis(&full), mesh_up).curves(curves);
             bind_guides(source, file, mesh, &curves, path.span())
         }
         (None, Some(generate)) => {

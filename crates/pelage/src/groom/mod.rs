@@ -55,7 +55,8 @@ mod spec;
 mod writing;
 
 pub use animate::{
-    AnimatedGroom, AnimationMode, AnimationProgress, AnimationSpec, FrameOutput, GuideMotion,
+    AnimatedGroom, AnimationMode, AnimationProgress, AnimationSpec, AxisTurn, FrameOutput,
+    GuideMotion,
 };
 pub use clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
 pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
