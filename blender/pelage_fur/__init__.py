@@ -97,28 +97,37 @@ class PelageFurSettings(bpy.types.PropertyGroup):
                     "(Add › Curves › Empty Hair, sculpted with Blender's brushes); empty: guides grown here",
         poll=lambda _settings, obj: obj.type == "CURVES",
     )
-    density_group: StringProperty(update=_setting_changed, 
+    density_group: StringProperty(
+        update=_setting_changed,
         name="Density",
         description="A vertex group, a float attribute or a colour attribute (NAME, or one channel: "
                     "NAME:r, NAME:g, NAME:b, NAME:a), or a Blender image over the UV map "
                     "(image:NAME:r), whose values scale where hairs grow; empty: evenly",
     )
-    parting: EnumProperty(update=_setting_changed, 
+    parting: EnumProperty(
+        update=_setting_changed,
         name="Parting",
         description="Regions whose hairs take no shape or clumps from one another's guides",
         items=[
             ("NONE", "None", "One region: every guide shapes every hair near it"),
             ("FACE_SETS", "Face sets", "Each sculpt face set a region"),
             ("MATERIALS", "Material slots", "Each material slot a region"),
+            ("ATTRIBUTE", "Face attribute", "Each value of an integer face attribute a region"),
         ],
         default="NONE",
+    )
+    parting_attribute: StringProperty(
+        update=_setting_changed,
+        name="Attribute",
+        description="The integer face attribute whose values are the parting's regions",
     )
     live: BoolProperty(
         name="Live",
         description="Regrow the fur as the guides object is sculpted: the hairs near the stroke only",
         default=False,
     )
-    display_fraction: FloatProperty(update=_setting_changed, 
+    display_fraction: FloatProperty(
+        update=_setting_changed,
         name="Display Fraction",
         description="Share of the hairs a live groom shows (the same hairs as the whole groom); "
                     "exports write them all",
@@ -576,6 +585,8 @@ class PELAGE_PT_fur(bpy.types.Panel):
         live.prop(settings, "display_fraction", text="Display")
         column.prop_search(settings, "density_group", surface_of(context), "vertex_groups")
         column.prop(settings, "parting")
+        if settings.parting == "ATTRIBUTE":
+            column.prop_search(settings, "parting_attribute", surface_of(context).data, "attributes")
         grown_guides = settings.guides_object is None
         for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed",
                      "outside_skin"):

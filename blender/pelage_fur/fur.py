@@ -87,7 +87,7 @@ def mesh_to_pelage(obj, depsgraph):
             uvs=corner_uvs,
             name=obj.name,
             vertex_maps=vertex_maps_of(obj, mesh),
-            **face_sets_of(mesh),
+            **face_sets_of(mesh, parting_attribute(obj)),
         )
         return result, (uv_layer.name if uv_layer is not None else None)
     finally:
@@ -221,18 +221,29 @@ def blender_image_map(value, folder=None, relative=False):
 FACE_SETS = ".sculpt_face_set"
 
 
-def face_sets_of(mesh):
-    """The mesh's face sets and material slots, one id a loop triangle, as
-    ``Mesh.from_arrays`` takes them (``face_sets``, ``materials``): the
-    regions of a parting (``regions={"faces": "groups" | "materials"}``).
-    A mesh without face sets has none; every mesh has material slots."""
+def parting_attribute(obj):
+    """The integer face attribute whose values are ``obj``'s parting
+    regions: the one its panel names, else the sculpt face sets."""
+    settings = getattr(obj, "pelage_fur", None)
+    if settings is not None and settings.parting == "ATTRIBUTE" and settings.parting_attribute:
+        return settings.parting_attribute
+    return FACE_SETS
+
+
+def face_sets_of(mesh, groups=FACE_SETS):
+    """The mesh's face groups (the integer face attribute ``groups``: the
+    sculpt face sets unless told) and material slots, one id a loop
+    triangle, as ``Mesh.from_arrays`` takes them (``face_sets``,
+    ``materials``): the regions of a parting (``regions={"faces":
+    "groups" | "materials"}``). A mesh without the attribute has no
+    groups; every mesh has material slots."""
     polygon = np.empty(len(mesh.loop_triangles), dtype=np.int32)
     mesh.loop_triangles.foreach_get("polygon_index", polygon)
     sets = {}
     materials = np.empty(len(mesh.polygons), dtype=np.int32)
     mesh.polygons.foreach_get("material_index", materials)
     sets["materials"] = materials[polygon]
-    attribute = mesh.attributes.get(FACE_SETS)
+    attribute = mesh.attributes.get(groups)
     if attribute is not None and attribute.domain == "FACE" and attribute.data_type == "INT":
         values = np.empty(len(mesh.polygons), dtype=np.int32)
         attribute.data.foreach_get("value", values)
@@ -317,7 +328,8 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
         roots["density"] = blender_image_map(settings.density_group, images, relative)
     elif settings.density_group:
         roots["density"] = f"vertex:{settings.density_group}"
-    parting = {"FACE_SETS": {"faces": "groups"}, "MATERIALS": {"faces": "materials"}}
+    parting = {"FACE_SETS": {"faces": "groups"}, "MATERIALS": {"faces": "materials"},
+               "ATTRIBUTE": {"faces": "groups"}}
     return pelage.Groom(
         mesh=mesh,
         base_dir=images if relative else None,

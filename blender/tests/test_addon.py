@@ -176,8 +176,21 @@ assert lines[0].startswith(f"{len(parted.data.curves):,} hairs"), lines
 per_region = [int(line.split(": ")[1].split(" hairs")[0].replace(",", "")) for line in lines[1:]]
 assert len(per_region) == 2 and sum(per_region) == len(parted.data.curves), lines
 grid.data.attributes.remove(grid.data.attributes[".sculpt_face_set"])
-settings.parting = "NONE"
 print("parting: face sets keep each side's hairs leaning its own way by the line")
+# The same parting from an integer face attribute of the user's own.
+sides = grid.data.attributes.new("sides", "INT", "FACE")
+sides.data.foreach_set("value", np.where(centres.reshape(-1, 3)[:, 0] > 0, 7, 3).astype(np.int32))
+settings.parting, settings.parting_attribute = "ATTRIBUTE", "sides"
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+by_attribute, by_attribute_offsets = arrays(fur_of(grid).data)
+starts = by_attribute[by_attribute_offsets[:-1]]
+ends = by_attribute[by_attribute_offsets[1:] - 1]
+lean_x = (ends[:, 0] - starts[:, 0]) / np.linalg.norm(ends - starts, axis=1)
+by_the_line = np.abs(starts[:, 0]) < 0.2
+assert np.all(lean_x[by_the_line] * np.sign(starts[by_the_line, 0]) > 0.65), lean_x[by_the_line].min()
+grid.data.attributes.remove(grid.data.attributes["sides"])
+settings.parting, settings.parting_attribute = "NONE", ""
+print("parting: an integer face attribute parts the hair as face sets do")
 settings.guides_object = None
 settings.clump, settings.noise = shaping
 
