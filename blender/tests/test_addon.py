@@ -565,7 +565,26 @@ with tempfile.TemporaryDirectory() as folder:
         worst = off_surface(curves, f)
         assert worst < 1e-4, (f, worst)
     assert not np.allclose(frames[0].points, frames[3].points)
-    print("animated export: 4 frames in one usdc, the same hairs, roots on the evaluated surface every frame")
+    # Pixar's USD (usd-core, tools/usdcheck's venv) finds a stage of frames
+    # 1 to 4 with a sample a frame, the points pelage wrote, and no error.
+    import subprocess  # noqa: E402
+
+    usdcheck = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "usdcheck")
+    specs = [f"/groom/part_0000.points@{f}[0]" for f in (1, 2, 3, 4)]
+    told = subprocess.run([usdcheck, "--values", moved, *specs], capture_output=True, text=True)
+    if told.returncode == 2 and os.environ.get("PELAGE_REQUIRE_USDCHECK") != "1":
+        print(f"usd-core unavailable, not checked: {told.stderr.strip()}")
+    else:
+        assert told.returncode == 0, told.stderr
+        lines = told.stdout.splitlines()
+        assert lines[0].startswith("stage 1 to 4 at 24 per second"), lines
+        for f, line in zip((1, 2, 3, 4), lines[1:]):
+            read = [float(x) for x in line.split(" = ")[1].split()]
+            assert np.allclose(read, frames[f - 1].points[0], rtol=0, atol=0), (f, read)
+        valid = subprocess.run([usdcheck, moved], capture_output=True, text=True)
+        assert valid.returncode == 0, valid.stdout + valid.stderr
+    print("animated export: 4 frames in one usdc (usd-core: a sample a frame), the same hairs, "
+          "roots on the evaluated surface every frame")
     ball.pelage_fur.animation_mode = "SIMULATE"
     ball.pelage_fur.sim_follow, ball.pelage_fur.sim_preroll = 0.0, 2
     swung = os.path.join(folder, "ball.abc")
