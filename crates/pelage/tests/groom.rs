@@ -767,9 +767,8 @@ fn a_z_up_usd_guide_file_is_turned_to_the_meshs_y_up() {
     };
     write("blender.usda", pelage::io::UpAxis::Z);
     let from_file = |name: &str| {
-        let text = format!(
-            "[mesh]\npath = \"spot\"\n[roots]\ncount = 100\n[guides]\nfile = \"{name}\"\n"
-        );
+        let text =
+            format!("[mesh]\npath = \"spot\"\n[roots]\ncount = 100\n[guides]\nfile = \"{name}\"\n");
         pelage::groom::Groom::from_text(dir.path().join("from_file.toml"), text)
     };
     let bound = from_file("blender.usda").unwrap();
