@@ -21,16 +21,21 @@ from . import fur, stack
 #: The panel's presets: settings, with lengths and widths as fractions of
 #: the object's largest dimension (so a preset suits a mouse or a bear).
 PRESETS = {
-    "SHORT": dict(count=60_000, guides=300, length=0.03, width=0.0015, gravity=0.2, points=8,
+    "SHORT": dict(count=200_000, guides=300, length=0.03, width=0.0004, gravity=0.2, points=8,
                   clump=0.3, curl=0.0, noise=0.1),
-    "LONG": dict(count=40_000, guides=400, length=0.12, width=0.002, gravity=0.6, points=16,
+    "LONG": dict(count=120_000, guides=400, length=0.12, width=0.0008, gravity=0.6, points=16,
                  clump=0.6, curl=0.0, noise=0.15),
-    "CURLY": dict(count=40_000, guides=300, length=0.06, width=0.002, gravity=0.2, points=24,
+    "CURLY": dict(count=120_000, guides=300, length=0.06, width=0.0006, gravity=0.2, points=24,
                   clump=0.4, curl=0.6, noise=0.05),
-    "STUBBLE": dict(count=150_000, guides=200, length=0.008, width=0.0008, gravity=0.0, points=4,
+    "STUBBLE": dict(count=300_000, guides=200, length=0.008, width=0.0002, gravity=0.0, points=4,
                     clump=0.0, curl=0.0, noise=0.2),
 }
 SIZED = ("length", "width")
+
+
+def _sized(settings, context):
+    settings.sized = True
+    _setting_changed(settings, context)
 
 
 def apply_preset(settings, context):
@@ -140,14 +145,33 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     )
     count: IntProperty(update=_setting_changed, name="Count", description="Hairs", default=20_000, min=1, soft_max=2_000_000)
     guides: IntProperty(update=_setting_changed, name="Guides", description="Guide curves grown on the surface", default=200, min=1, soft_max=5_000)
-    length: FloatProperty(update=_setting_changed, name="Length", description="Guide length", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
-    width: FloatProperty(update=_setting_changed, name="Width", description="Hair width at the root", default=0.002, min=0.0, soft_max=0.01, subtype="DISTANCE", precision=4)
+    length: FloatProperty(update=_sized, name="Length", description="Guide length (first grow: 4% of the object's size)", default=0.05, min=1e-5, soft_max=1.0, subtype="DISTANCE")
+    width: FloatProperty(update=_sized, name="Width", description="Hair width at the root (first grow: 0.06% of the object's size)", default=0.002, min=0.0, soft_max=0.01, subtype="DISTANCE", precision=4)
     gravity: FloatProperty(update=_setting_changed, name="Gravity", description="Pull of the guides downward (world -Z)", default=0.3, min=0.0, max=1.0)
     points: IntProperty(update=_setting_changed, name="Points", description="Points per hair", default=12, min=2, max=64)
     clump: FloatProperty(update=_setting_changed, name="Clump", description="How far hairs pull toward clump centres (0: off)", default=0.4, min=0.0, max=1.0)
     curl: FloatProperty(update=_setting_changed, name="Curl", description="Curl radius, relative to the length (0: off)", default=0.0, min=0.0, max=2.0)
     noise: FloatProperty(update=_setting_changed, name="Noise", description="Noise amplitude, relative to the length (0: off)", default=0.1, min=0.0, max=2.0)
     seed: IntProperty(update=_setting_changed, name="Seed", default=1, min=0)
+    sized: BoolProperty(
+        name="Sized", description="Length and Width were set (by hand, a preset, or sized to the object)",
+        default=False, options={"HIDDEN"},
+    )
+    interpolation: EnumProperty(
+        update=_setting_changed,
+        name="Interpolation",
+        description="How guides shape the hairs between them",
+        items=[
+            ("SHEPARD", "Nearest guides", "The k nearest guide roots, weighted by 1/d² (Sik)"),
+            ("STYLE_MESH", "Style mesh", "Over the surface (Furtility): thin parts do not borrow guides "
+                                         "from their other side"),
+        ],
+        default="SHEPARD",
+    )
+    interpolation_k: IntProperty(
+        update=_setting_changed, name="Guides a Hair", description="Nearest guides that shape a hair",
+        default=4, min=1, max=32,
+    )
     outside_skin: BoolProperty(
         update=_setting_changed, name="Out of the Skin",
         description="Push every hair point that noise, curl or a guide put under the skin back out, "
@@ -587,6 +611,9 @@ class PELAGE_PT_fur(bpy.types.Panel):
         column.prop(settings, "parting")
         if settings.parting == "ATTRIBUTE":
             column.prop_search(settings, "parting_attribute", surface_of(context).data, "attributes")
+        column.prop(settings, "interpolation")
+        if settings.interpolation == "SHEPARD":
+            column.prop(settings, "interpolation_k")
         grown_guides = settings.guides_object is None
         for name in ("count", "guides", "length", "width", "gravity", "points", "clump", "curl", "noise", "seed",
                      "outside_skin"):

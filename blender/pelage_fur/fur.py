@@ -330,8 +330,11 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
         roots["density"] = f"vertex:{settings.density_group}"
     parting = {"FACE_SETS": {"faces": "groups"}, "MATERIALS": {"faces": "materials"},
                "ATTRIBUTE": {"faces": "groups"}}
+    interpolation = ({"method": "style-mesh"} if settings.interpolation == "STYLE_MESH"
+                     else {"method": "shepard", "k": settings.interpolation_k})
     return pelage.Groom(
         mesh=mesh,
+        interpolation=interpolation,
         base_dir=images if relative else None,
         skin=skin,
         animation=animation,
@@ -609,6 +612,23 @@ def fur_object_of(surface):
                  if o.type == "CURVES" and o.parent == surface and "pelage_settings" in o), None)
 
 
+#: What Length and Width start at on an object, fractions of its largest
+#: dimension (``size_defaults``), until the user or a preset sets them.
+SIZED_DEFAULTS = dict(length=0.04, width=0.0006)
+
+
+def size_defaults(surface):
+    """Length and Width sized to ``surface`` (a 15 cm bunny gets 6 mm fur,
+    not 5 cm) the first time it grows, unless they were set."""
+    settings = surface.pelage_fur
+    if settings.sized:
+        return
+    size = max(surface.dimensions) or 1.0
+    settings.length = SIZED_DEFAULTS["length"] * size
+    settings.width = SIZED_DEFAULTS["width"] * size
+    settings.sized = True
+
+
 class Cancelled(Exception):
     """A grow the user cancelled (Esc): nothing was changed."""
 
@@ -623,6 +643,7 @@ class PreparedGrow:
         import time
 
         self.start = time.perf_counter()
+        size_defaults(surface)
         depsgraph = context.evaluated_depsgraph_get()
         mesh, self.uv_map = mesh_to_pelage(surface, depsgraph)
         self.groom = groom_for(surface, settings, mesh, depsgraph)

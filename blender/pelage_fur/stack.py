@@ -125,6 +125,13 @@ def load_into(settings, path, size=1.0):
             value = generate.get(key)
             if isinstance(value, (int, float)):
                 setattr(settings, "guides" if key == "count" else key, value)
+    interpolation = table.get("interpolation", {})
+    if interpolation.get("method") == "style-mesh":
+        settings.interpolation = "STYLE_MESH"
+    elif interpolation.get("method", "shepard") == "shepard":
+        settings.interpolation = "SHEPARD"
+        if isinstance(interpolation.get("k"), int):
+            settings.interpolation_k = interpolation["k"]
     look = table.get("look", {})
     for key, name in (("melanin", "melanin"), ("melanin_redness", "melanin_redness"),
                       ("roughness", "roughness"), ("radial_roughness", "radial_roughness"),
@@ -145,7 +152,7 @@ def load_into(settings, path, size=1.0):
     settings.active_op = max(0, len(settings.ops) - 1)
     if "regions" in table and parting is None:
         left.append("[regions]")
-    for section in ("interpolation", "animation", "simulation", "output"):
+    for section in ("animation", "simulation", "output"):
         if section in table:
             left.append(f"[{section}]")
     return left

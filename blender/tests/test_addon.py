@@ -437,6 +437,10 @@ bare_roots = grown_bare.points[grown_bare.offsets[:-1]]
 assert (bare_roots[:, 1] > 0).mean() >= 0.95, "the painted top (Y-up in pelage's world)"
 assert any("no UV map" in w for w in bare_warnings), bare_warnings
 assert not any(m.type == "NODES" for m in fur_of(bare).modifiers)
+# Length and Width never set: sized to the object on its first grow.
+size = max(bare.dimensions)
+assert abs(bare.pelage_fur.length - 0.04 * size) < 1e-6, (bare.pelage_fur.length, size)
+assert abs(bare.pelage_fur.width - 0.0006 * size) < 1e-7, bare.pelage_fur.width
 print("no UV map: grown from noise and a vertex group; the user is told it will not follow deformation")
 
 # 3. A groom file drives the add-on; its errors reach the user.
@@ -604,7 +608,7 @@ clear_scene()
 bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=8, size=2.0)
 stacked = bpy.context.active_object
 panel = stacked.pelage_fur
-panel.count, panel.points = 2_000, 8
+panel.count, panel.points, panel.interpolation_k = 2_000, 8, 6
 back = stacked.vertex_groups.new(name="back")
 back.add([v.index for v in stacked.data.vertices if v.co.y > 0], 1.0, "REPLACE")
 for kind in ("clump", "curl", "noise", "width"):
@@ -619,6 +623,7 @@ assert bpy.ops.pelage.op_remove() == {"FINISHED"}
 assert [o.kind for o in panel.ops] == ["curl", "clump", "noise"], [o.kind for o in panel.ops]
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
 grown_text = fur_of(stacked)["pelage_settings"]
+assert "[interpolation]" in grown_text and "k = 6" in grown_text, grown_text
 order = [grown_text.index(f"[ops.{k}]") for k in ("curl", "clump", "noise")]
 assert order == sorted(order) and 'mask = "vertex:back"' in grown_text, grown_text
 
@@ -636,9 +641,14 @@ with tempfile.TemporaryDirectory() as folder:
     assert bpy.ops.pelage.load_groom(filepath=saved) == {"FINISHED"}
     assert stack_of(other.pelage_fur) == stack_of(panel), (stack_of(other.pelage_fur), stack_of(panel))
     assert other.pelage_fur.count == 2_000 and other.pelage_fur.points == 8
+    assert other.pelage_fur.interpolation == "SHEPARD" and other.pelage_fur.interpolation_k == 6
     assert bpy.ops.pelage.save_groom(filepath=again) == {"FINISHED"}
     with open(saved) as a, open(again) as b:
         assert a.read() == b.read(), "the groom file round-trips through the panel"
+    # The style mesh (Furtility) from the panel.
+    other.pelage_fur.interpolation = "STYLE_MESH"
+    assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+    assert 'method = "style-mesh"' in fur_of(other)["pelage_settings"]
 print("operator stack: add, reorder, remove, a vertex-group mask; the groom file round-trips through the panel")
 
 # 7. The scripting example runs as written, enabling the extension itself
