@@ -147,6 +147,15 @@ for root, lean in zip(guide_roots, leans):
     ways /= length[:, None]
     assert np.all(ways @ lean > 0.97), (root, (ways @ lean).min())
     assert np.allclose(length, 0.2, rtol=0.05), length
+# The guides pelage binds are the sculpted curves, turned Y up (pelage's
+# world) and resampled: the same roots and tips. (The library holds a
+# hair at a guide's root to that guide exactly: crates/pelage/tests.)
+addon_fur = next(m for name, m in sys.modules.items() if name.endswith("pelage_fur.fur"))
+mesh_value, _ = addon_fur.mesh_to_pelage(grid, bpy.context.evaluated_depsgraph_get())
+bound = addon_fur.groom_for(grid, settings, mesh_value, bpy.context.evaluated_depsgraph_get()).guides
+ends = guide_points.reshape(4, 7, 3)[:, [0, -1]] @ addon_fur.Z_UP_TO_Y_UP.T
+bound_points = bound.points.reshape(4, -1, 3)
+assert np.allclose(bound_points[:, [0, -1]], ends, atol=1e-5), (bound_points[:, [0, -1]], ends)
 print("guides from Blender: hairs by each sculpted guide lean its way, at its length")
 
 # A face-set parting: the sculpted guides lean away from x = 0 on each
