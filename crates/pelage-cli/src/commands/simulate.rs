@@ -8,6 +8,7 @@ use anyhow::bail;
 use clap::Args;
 use pelage::anim::FrameRange;
 use pelage::groom::{AnimationMode, CacheUse, Groom};
+use pelage::io::CurvesFormat;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -40,6 +41,18 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         bail!(
             "{}: name the output (-o guides.usdc), or a cache in the groom file ([simulation] cache = \"guides.usdc\")",
             args.file.display()
+        );
+    }
+    // Refused before the simulation, not after it.
+    if let Some(output) = &args.output
+        && !matches!(
+            CurvesFormat::from_path(output),
+            Some(CurvesFormat::Usdc | CurvesFormat::Abc)
+        )
+    {
+        bail!(
+            "{}: simulated guides are written with time samples to .usdc, .usd or .abc",
+            output.display()
         );
     }
     let (guides, cache) = groom.simulated_guides()?;

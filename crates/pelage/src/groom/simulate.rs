@@ -116,10 +116,9 @@ impl SimulatedGuides {
                 abc.finish().map_err(failed)?
             }
             _ => {
-                return Err(failed(crate::io::PrimWriteError::BadSetting(format!(
-                    "{}: simulated guides are written with time samples to .usdc, .usd or .abc",
-                    path.display()
-                ))));
+                return Err(failed(crate::io::PrimWriteError::BadSetting(
+                    "simulated guides are written with time samples to .usdc, .usd or .abc".into(),
+                )));
             }
         };
         file.commit()?;
