@@ -511,6 +511,14 @@ fn fuzz_groom_toml() {
         "tint = [1, 2]\n",
         "jitter = 2\n",
         "[output]\nguides = true\n",
+        "mode = \"simulate\"\n",
+        "[simulation]\n",
+        "substeps = 4294967297\n",
+        "gravity = [1e39, 0, 0]\n",
+        "cache = \"\"\n",
+        "preroll = -1\n",
+        "outside_skin = true\n",
+        "skin_gap = -1\n",
     ];
     fuzz("groom", &tokens, true, |data| {
         if let Ok(text) = std::str::from_utf8(data) {
