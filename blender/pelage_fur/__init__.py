@@ -518,15 +518,9 @@ class _PelageExport(ExportHelper):
         return {"FINISHED"}
 
 
-class _PelageAnimatedExport(ExportHelper):
+class _PelageAnimatedExport(_PelageExport):
     """Grows the active mesh's groom over the scene's frame range and
     writes it with a time sample a frame."""
-
-    bl_options = {"REGISTER"}
-
-    @classmethod
-    def poll(cls, context):
-        return surface_of(context) is not None
 
     def execute(self, context):
         surface = surface_of(context)

@@ -633,6 +633,12 @@ class Cancelled(Exception):
     """A grow the user cancelled (Esc): nothing was changed."""
 
 
+def is_live(settings):
+    """Whether the panel ``settings`` grow a live groom: Live on, a guides
+    object to sculpt, the panel's own settings (not a groom file)."""
+    return settings.live and settings.guides_object is not None and not settings.groom_file
+
+
 class PreparedGrow:
     """What a grow reads from Blender, on the main thread, before pelage
     grows (``grow_curves``, which touches no Blender data and may run on
@@ -647,7 +653,7 @@ class PreparedGrow:
         depsgraph = context.evaluated_depsgraph_get()
         mesh, self.uv_map = mesh_to_pelage(surface, depsgraph)
         self.groom = groom_for(surface, settings, mesh, depsgraph)
-        self.live = settings.live and settings.guides_object is not None and not settings.groom_file
+        self.live = is_live(settings)
         self.fraction = settings.display_fraction
         self.frame = context.scene.frame_current
 
@@ -664,6 +670,24 @@ def grow_curves(prepared, progress=None):
         session = pelage.GroomSession(prepared.groom, fraction=prepared.fraction)
         return session.curves(), session
     return prepared.groom.grow(progress=progress), None
+
+
+def replace_data(obj, data):
+    """Gives the fur object ``obj`` its regrown curves ``data`` in place:
+    it keeps its name, its modifiers and whatever material the user gave
+    it; the old curves go when nothing else uses them."""
+    import bpy
+
+    old = obj.data
+    if len(old.materials) and any(m is not None for m in old.materials):
+        data.materials.clear()
+        for material in old.materials:
+            data.materials.append(material)
+    obj.data = data
+    name = old.name
+    if old.users == 0:
+        bpy.data.hair_curves.remove(old)
+        data.name = name
 
 
 def finish_grow(surface, settings, prepared, grown, session):
@@ -690,18 +714,7 @@ def finish_grow(surface, settings, prepared, grown, session):
         # Curves points are in the surface's space: the object sits on it.
         obj.matrix_parent_inverse.identity()
     else:
-        # Regrown in place: the object keeps its name, modifiers and
-        # whatever material the user gave it.
-        old = obj.data
-        if len(old.materials) and any(m is not None for m in old.materials):
-            data.materials.clear()
-            for material in old.materials:
-                data.materials.append(material)
-        obj.data = data
-        name = old.name
-        if old.users == 0:
-            bpy.data.hair_curves.remove(old)
-            data.name = name
+        replace_data(obj, data)
     if uv_map is not None:
         # The node compares the deformed surface with its rest positions.
         surface.add_rest_position_attribute = True
@@ -810,30 +823,15 @@ def live_regrow(surface):
     the display fraction, into the same fur object. Returns ``{"hairs"}``,
     or None when the surface has no live groom."""
     import bpy
-    import pelage
 
     live = LIVE.get(surface.name)
     obj = bpy.data.objects.get(live.fur_name) if live else None
-    settings = surface.pelage_fur
-    if obj is None or not settings.live or settings.guides_object is None:
+    if obj is None or not is_live(surface.pelage_fur):
         return None
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    mesh, uv_map = mesh_to_pelage(surface, depsgraph)
-    groom = groom_for(surface, settings, mesh, depsgraph)
-    session = pelage.GroomSession(groom, fraction=settings.display_fraction)
-    grown = session.curves()
+    prepared = PreparedGrow(bpy.context, surface, surface.pelage_fur)
+    grown, session = grow_curves(prepared)
     back = np.linalg.inv(to_pelage_space(surface))
-    old = obj.data
-    data = curves_to_blender(old.name, grown, surface, uv_map, back)
-    if len(old.materials):
-        data.materials.clear()
-        for material in old.materials:
-            data.materials.append(material)
-    obj.data = data
-    name = old.name
-    if old.users == 0:
-        bpy.data.hair_curves.remove(old)
-        data.name = name
+    replace_data(obj, curves_to_blender(obj.data.name, grown, surface, prepared.uv_map, back))
     live.session = session
     return {"hairs": grown.curve_count}
 

@@ -444,22 +444,14 @@ fn a_simulated_groom_written_with_its_skin_plays_in_the_viewer() {
     )
     .unwrap();
     let size = format!("{}x{}", SIZE.0, SIZE.1);
-    let out = Command::new(env!("CARGO_BIN_EXE_pelage"))
-        .current_dir(dir.path())
-        .args([
-            "view",
-            written.to_str().unwrap(),
-            "--script",
-            script.to_str().unwrap(),
-            "--size",
-            &size,
-        ])
-        .env(
-            "XDG_RUNTIME_DIR",
-            std::env::var("XDG_RUNTIME_DIR").unwrap_or("/tmp".into()),
-        )
-        .output()
-        .unwrap();
+    let out = pelage(&[
+        "view",
+        written.to_str().unwrap(),
+        "--script",
+        script.to_str().unwrap(),
+        "--size",
+        &size,
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(!stderr.contains("no time samples"), "{stderr}");

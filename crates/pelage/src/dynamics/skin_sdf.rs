@@ -203,19 +203,12 @@ impl SkinSdf {
     /// direction in which it grows (zero where it is flat), trilinear
     /// between the grid's nodes; `far` outside the grid.
     pub fn sample(&self, p: Vec3) -> (f32, Vec3) {
-        let g = (p - self.origin) / self.cell;
-        let [nx, ny, nz] = self.dims;
-        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0) {
+        let Some((base, f)) = self.cell_of(p) else {
             return (self.far, Vec3::ZERO);
-        }
-        let (ix, iy, iz) = (g.x as usize, g.y as usize, g.z as usize);
-        if ix + 1 >= nx || iy + 1 >= ny || iz + 1 >= nz {
-            return (self.far, Vec3::ZERO);
-        }
-        let f = g - Vec3::new(ix as f32, iy as f32, iz as f32);
+        };
+        let [nx, ny, _] = self.dims;
         // The eight corner nodes, in the order c000, c100, c010, c110,
         // c001, c101, c011, c111 (x fastest).
-        let base = (iz * ny + iy) * nx + ix;
         let corners = [
             0,
             1,
@@ -255,6 +248,23 @@ impl SkinSdf {
         (d, grad.normalize_or_zero())
     }
 
+    /// The grid cell holding `p`: its first node's index and where `p`
+    /// lies in it (0 to 1 on each axis); `None` outside the grid.
+    #[inline]
+    fn cell_of(&self, p: Vec3) -> Option<(usize, Vec3)> {
+        let g = (p - self.origin) / self.cell;
+        let [nx, ny, nz] = self.dims;
+        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0) {
+            return None;
+        }
+        let (ix, iy, iz) = (g.x as usize, g.y as usize, g.z as usize);
+        if ix + 1 >= nx || iy + 1 >= ny || iz + 1 >= nz {
+            return None;
+        }
+        let f = g - Vec3::new(ix as f32, iy as f32, iz as f32);
+        Some(((iz * ny + iy) * nx + ix, f))
+    }
+
     /// Whether `p` is certainly `gap` or more outside the skin, read from
     /// the grid's nodes alone, without the exact path: the distance to
     /// the skin changes no faster than the point moves, so a node `d`
@@ -262,28 +272,21 @@ impl SkinSdf {
     /// (a path from the node to the point that met the skin would be
     /// longer than `d`). Only nodes inside the exact band count: beyond
     /// it a node holds `far` on either side. False when unsure, and
-    /// always for a gap wider
-    /// than the exact band's cell (where [`Self::sample`] reads the
-    /// interpolation, which may say less), so that a point it calls clear
-    /// is one [`Self::sample`] finds `gap` or more outside.
+    /// always for a gap wider than the exact band's cell (where
+    /// [`Self::sample`] reads the interpolation, which may say less), so
+    /// that a point it calls clear is one [`Self::sample`] finds `gap` or
+    /// more outside.
     #[inline]
     pub fn clear_of(&self, p: Vec3, gap: f32) -> bool {
         if gap > EXACT_WITHIN * self.cell {
             return false;
         }
-        let g = (p - self.origin) / self.cell;
-        let [nx, ny, nz] = self.dims;
-        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0) {
+        // Beyond the grid (more than the band from the skin's bounds):
+        // outside.
+        let Some((base, f)) = self.cell_of(p) else {
             return true;
-        }
-        let (ix, iy, iz) = (g.x as usize, g.y as usize, g.z as usize);
-        if ix + 1 >= nx || iy + 1 >= ny || iz + 1 >= nz {
-            // Beyond the grid's margin (more than the band from the
-            // skin's bounds): outside.
-            return true;
-        }
-        let f = g - Vec3::new(ix as f32, iy as f32, iz as f32);
-        let base = (iz * ny + iy) * nx + ix;
+        };
+        let [nx, ny, _] = self.dims;
         // The corner nearest the point first: it gives the best bound.
         let near = [
             usize::from(f.x >= 0.5),
@@ -349,8 +352,8 @@ impl SkinSdf {
 mod tests {
     use super::*;
 
-    #[test]
-    fn distances_to_spot_match_closest_points_inside_the_band() {
+    /// Spot, its grid (cells 0.02, exact 0.06 deep) and a BVH to check it.
+    fn spot_grid() -> (crate::Mesh, SkinSdf, crate::mesh::TriangleBvh) {
         let spot = crate::assets::spot();
         let sdf = SkinSdf::new(
             spot.positions(),
@@ -360,6 +363,12 @@ mod tests {
             0.06,
         );
         let bvh = crate::mesh::TriangleBvh::new(spot.positions(), spot.triangles());
+        (spot, sdf, bvh)
+    }
+
+    #[test]
+    fn distances_to_spot_match_closest_points_inside_the_band() {
+        let (spot, sdf, bvh) = spot_grid();
         let (lo, hi) = spot.bounds();
         let mut checked = 0;
         for i in 0..2000u32 {
@@ -395,15 +404,7 @@ mod tests {
 
     #[test]
     fn a_point_the_nodes_call_clear_is_outside_that_far_by_the_exact_path_and_the_mesh() {
-        let spot = crate::assets::spot();
-        let sdf = SkinSdf::new(
-            spot.positions(),
-            spot.normals(),
-            spot.triangles(),
-            0.02,
-            0.06,
-        );
-        let bvh = crate::mesh::TriangleBvh::new(spot.positions(), spot.triangles());
+        let (spot, sdf, bvh) = spot_grid();
         // Inside or outside by the mesh's winding number (its triangles'
         // solid angles seen from `p`, over 4π).
         let winding = |p: Vec3| {

@@ -386,11 +386,12 @@ fn load(source: &CurvesSource) -> anyhow::Result<Loaded> {
             let hairs = pelage::io::read_curves(path).context("cannot load the curves")?;
             let timeline = timeline_of(path, mesh.is_none())?;
             let (skin, texture) = match mesh.as_deref() {
-                None => match timeline.as_ref().and_then(|t| t.skin.as_ref()) {
-                    Some(skin) => (
-                        Skin::Mesh(Box::new(skin.mesh_at(t_first(&timeline))?)),
-                        None,
-                    ),
+                // The file's own skin, at the sample shown first.
+                None => match timeline
+                    .as_ref()
+                    .and_then(|t| Some((t.skin.as_ref()?, t.shown)))
+                {
+                    Some((skin, time)) => (Skin::Mesh(Box::new(skin.mesh_at(time)?)), None),
                     None => (Skin::None, None),
                 },
                 Some(m) if m == Path::new("spot") => (
@@ -455,11 +456,6 @@ fn load(source: &CurvesSource) -> anyhow::Result<Loaded> {
             })
         }
     }
-}
-
-/// The first sample's time code of a timeline (0 without one).
-fn t_first(timeline: &Option<Timeline>) -> f64 {
-    timeline.as_ref().map_or(0.0, |t| t.times[0])
 }
 
 /// The samples of a time-sampled USD file (none for other files, or a

@@ -174,14 +174,7 @@ impl<W: Write + Seek> AbcWriter<W> {
         time: f64,
         curves: &Curves,
     ) -> Result<(), PrimWriteError> {
-        PrimWriteError::check_time(name, time)?;
-        let Some(index) = self.next_frame("part", name, time)? else {
-            return self.start_part(name, curves, Some(time));
-        };
-        PrimWriteError::check_frame(name, time, &self.parts[index].offsets, curves)?;
-        let samples = self.animated_samples(curves)?;
-        self.push_frame(index, time, samples);
-        Ok(())
+        self.write_curves_at(name, time, curves, false)
     }
 
     /// Writes one frame of animated guides, as [`Self::write_part_at`]
@@ -193,12 +186,25 @@ impl<W: Write + Seek> AbcWriter<W> {
         time: f64,
         guides: &Curves,
     ) -> Result<(), PrimWriteError> {
+        self.write_curves_at(name, time, guides, true)
+    }
+
+    /// [`Self::write_part_at`], or with `guide` [`Self::write_guides_at`]
+    /// (the object flagged `groom_guide`).
+    fn write_curves_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        curves: &Curves,
+        guide: bool,
+    ) -> Result<(), PrimWriteError> {
         PrimWriteError::check_time(name, time)?;
-        let Some(index) = self.next_frame("guides", name, time)? else {
-            return self.start_part_as(name, guides, Some(time), true);
+        let what = if guide { "guides" } else { "part" };
+        let Some(index) = self.next_frame(what, name, time)? else {
+            return self.start_part_as(name, curves, Some(time), guide);
         };
-        PrimWriteError::check_frame(name, time, &self.parts[index].offsets, guides)?;
-        let samples = self.animated_samples(guides)?;
+        PrimWriteError::check_frame(name, time, &self.parts[index].offsets, curves)?;
+        let samples = self.animated_samples(curves)?;
         self.push_frame(index, time, samples);
         Ok(())
     }

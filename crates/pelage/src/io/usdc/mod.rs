@@ -129,30 +129,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
         time: f64,
         guides: &Curves,
     ) -> Result<(), PrimWriteError> {
-        PrimWriteError::check_time(name, time)?;
-        if !self.animated.contains_key(name) {
-            let attributes = guide_curves_attributes(name, guides, &self.options)?;
-            let specs = self.write_prim("BasisCurves", name, &attributes, true)?;
-            let samples = specs
-                .into_iter()
-                .map(|(spec, attribute)| (spec, attribute, Vec::new()))
-                .collect();
-            let part = AnimatedPart {
-                offsets: guides.offsets().to_vec(),
-                samples,
-            };
-            self.animated.insert(name.to_string(), part);
-        }
-        PrimWriteError::check_frame(name, time, &self.animated[name].offsets, guides)?;
-        let (lo, hi) = curve_extent(guides);
-        self.add_samples(
-            name,
-            time,
-            guides.points(),
-            [lo, hi],
-            guides.normals(),
-            guides.velocities(),
-        )
+        self.write_curves_at(name, time, guides, true)
     }
 
     /// Writes one frame of an animated part: the first call for `name`
@@ -166,20 +143,29 @@ impl<W: Write + Seek> UsdcWriter<W> {
         time: f64,
         curves: &Curves,
     ) -> Result<(), PrimWriteError> {
+        self.write_curves_at(name, time, curves, false)
+    }
+
+    /// [`Self::write_part_at`], or with `guide` [`Self::write_guides_at`]:
+    /// the prim is a part's (bound to the hair material when it carries a
+    /// look) or the guides' (`purpose = "guide"`, no material).
+    fn write_curves_at(
+        &mut self,
+        name: &str,
+        time: f64,
+        curves: &Curves,
+        guide: bool,
+    ) -> Result<(), PrimWriteError> {
         PrimWriteError::check_time(name, time)?;
         if !self.animated.contains_key(name) {
-            let attributes = basis_curves_attributes(name, curves, &self.options)?;
-            let material = self.material_for(curves)?;
-            let specs = self.write_prim_bound("BasisCurves", name, &attributes, true, material)?;
-            let samples = specs
-                .into_iter()
-                .map(|(spec, attribute)| (spec, attribute, Vec::new()))
-                .collect();
-            let part = AnimatedPart {
-                offsets: curves.offsets().to_vec(),
-                samples,
+            let (attributes, material) = if guide {
+                (guide_curves_attributes(name, curves, &self.options)?, None)
+            } else {
+                let attributes = basis_curves_attributes(name, curves, &self.options)?;
+                (attributes, self.material_for(curves)?)
             };
-            self.animated.insert(name.to_string(), part);
+            let specs = self.write_prim_bound("BasisCurves", name, &attributes, true, material)?;
+            self.track(name, specs, curves.offsets().to_vec());
         }
         let part = &self.animated[name];
         PrimWriteError::check_frame(name, time, &part.offsets, curves)?;
@@ -208,15 +194,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
         let shape = vec![mesh.vertex_count() as u32, mesh.triangle_count() as u32];
         if !self.animated.contains_key(name) {
             let specs = self.write_prim("Mesh", name, &mesh_attributes(mesh), true)?;
-            let samples = specs
-                .into_iter()
-                .map(|(spec, attribute)| (spec, attribute, Vec::new()))
-                .collect();
-            let part = AnimatedPart {
-                offsets: shape.clone(),
-                samples,
-            };
-            self.animated.insert(name.to_string(), part);
+            self.track(name, specs, shape.clone());
         }
         PrimWriteError::check_mesh_frame(name, time, &self.animated[name].offsets, mesh)?;
         let (lo, hi) = mesh.bounds();
@@ -228,6 +206,17 @@ impl<W: Write + Seek> UsdcWriter<W> {
             Some(mesh.normals()),
             None,
         )
+    }
+
+    /// Keeps the animated prim `name` (its animated attributes' `specs`,
+    /// and `offsets`, what later frames must match) for its samples.
+    fn track(&mut self, name: &str, specs: Vec<(usize, &'static str)>, offsets: Vec<u32>) {
+        let samples = specs
+            .into_iter()
+            .map(|(spec, attribute)| (spec, attribute, Vec::new()))
+            .collect();
+        self.animated
+            .insert(name.to_string(), AnimatedPart { offsets, samples });
     }
 
     /// Adds a frame's points, extent and normals to the animated prim
