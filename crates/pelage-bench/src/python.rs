@@ -116,7 +116,7 @@ fn measure_blender(hairs: u64, dir: &Path) -> anyhow::Result<BlenderCurves> {
     let parts: Vec<_> = (0..generator.parts().len())
         .map(|p| generator.part(p))
         .collect::<Result<_, _>>()?;
-    let curves = pelage::io::join(parts.iter())?;
+    let curves = pelage::curves::join(parts.iter())?;
     drop(parts);
     let report = super::run_bpy_case(
         "blender_curves.py",

@@ -19,7 +19,7 @@ use crate::format::thousands;
 use crate::median;
 use glam::Vec3;
 use pelage::anim::{AnimatedSkin, SkinOptions, SkinPose};
-use pelage::dynamics::{GuideSimulation, StrandParams};
+use pelage::dynamics::{GuideSimulation, GuideStrandParams};
 use pelage::guides::{GuideGrowth, Guides};
 use pelage::map::Map;
 use pelage::mesh::TriangleBvh;
@@ -175,8 +175,8 @@ fn fox_run(count: usize, points: usize, frames: usize) -> anyhow::Result<FoxRun>
 
 /// The settings the benchmark simulates with: long fur on a Fox about
 /// 1.4 m long in its own units.
-fn fox_params(size: f32) -> StrandParams {
-    StrandParams {
+fn fox_params(size: f32) -> GuideStrandParams {
+    GuideStrandParams {
         substeps: 4,
         gravity: Vec3::new(0.0, -9.81 * size / 1.4, 0.0),
         thickness: 0.004 * size,
@@ -283,7 +283,7 @@ fn measure(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<Figures>
 /// the skin's grids and roots made on the CPU and uploaded each frame.
 fn gpu_figures(
     run: &FoxRun,
-    params: &StrandParams,
+    params: &GuideStrandParams,
     cpu: &GuideSimulation,
 ) -> anyhow::Result<GpuFigures> {
     let ctx = pelage_gpu::GpuContext::headless()?;

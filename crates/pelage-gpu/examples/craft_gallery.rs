@@ -64,7 +64,7 @@ fn grow(spec: GroomSpec) -> Result<Curves, GroomError> {
     let parts = (0..generator.parts().len())
         .map(|p| generator.part(p))
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(pelage::io::join(parts.iter()).expect("parts of one groom join"))
+    Ok(pelage::curves::join(parts.iter()).expect("parts of one groom join"))
 }
 
 /// `left` and `right` side by side on one image.

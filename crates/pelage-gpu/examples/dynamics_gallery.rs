@@ -13,7 +13,7 @@
 
 use glam::Vec3;
 use pelage::Mesh;
-use pelage::dynamics::{Brush, DynamicsParams, MassSpringSystem, Solver, Topology, Wind};
+use pelage::dynamics::{DynamicsParams, MassSpringSystem, PushBrush, Solver, Topology, Wind};
 use pelage::shell::math::{ClumpParams, Coupling, CurlParams, ShadingMode};
 use pelage::shell::scene::{DynamicsSettings, Shake};
 use pelage::shell::{ShellScene, ShellTextureParams, ShellTextures, WetnessMask};
@@ -190,7 +190,7 @@ fn main() {
         lateral_stiffness: 3.0,
         restoring: 0.01,
         gravity: Vec3::ZERO,
-        brush: Some(Brush {
+        brush: Some(PushBrush {
             centre: Vec3::new(-0.12, 0.2, 0.05),
             radius: 0.16,
             force: Vec3::new(-0.15, -0.04, 0.0),

@@ -135,7 +135,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let parts = (0..generator.parts().len())
             .map(|p| generator.part(p))
             .collect::<Result<Vec<_>, _>>()?;
-        let curves = pelage::io::join(parts.iter())?;
+        let curves = pelage::curves::join(parts.iter())?;
         let scene = PreviewScene {
             mesh: Some(groom.mesh()),
             points: &[],

@@ -16,6 +16,7 @@ mod context;
 mod dynamics;
 mod layout;
 mod motion;
+mod player;
 mod readback;
 mod renderer;
 mod shells;
@@ -26,11 +27,12 @@ pub use context::GpuContext;
 pub use dynamics::GpuMassSpring;
 pub use motion::{FurMotion, SkinMotion};
 pub use pelage::Curves;
+pub use player::ShellScenePlayer;
 pub use readback::read_texture;
 pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer};
 pub use shells::{
     FinParams, ShellFeatures, ShellLevel, ShellLod, ShellModel, ShellParams, ShellRenderer,
-    ShellScenePlayer, ShellTarget, ShellTargetFormats, ShellUpload, ShellView, vertex_tangents,
+    ShellTarget, ShellTargetFormats, ShellUpload, ShellView, vertex_tangents,
 };
 pub use strands::{GpuStrands, MAX_GPU_STRAND_POINTS};
 /// wgpu itself, so callers (a window, the viewer) build surfaces with the same version.

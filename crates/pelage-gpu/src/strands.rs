@@ -1,4 +1,4 @@
-//! Guide strands on the GPU: a frame of `pelage::dynamics::Strands::step`
+//! Guide strands on the GPU: a frame of `pelage::dynamics::GuideStrands::step`
 //! (Dynamic Follow-The-Leader with bending, follow, wind, collisions with
 //! the skin's distance grids and friction) as one compute dispatch, one
 //! invocation a strand looping over the frame's substeps with the
@@ -13,7 +13,7 @@
 use crate::layout::{entry, gpu_struct};
 use crate::{GpuContext, GpuError, workgroups};
 use glam::Vec3;
-use pelage::dynamics::{RootFrame, SkinSdf, StrandParams, Strands};
+use pelage::dynamics::{GuideStrandParams, GuideStrands, RootFrame, SkinSdf};
 use wgpu::util::DeviceExt;
 
 /// The most points a strand has on the GPU (the shader's `MAX_POINTS`:
@@ -102,7 +102,7 @@ impl Storage {
     }
 }
 
-/// [`Strands`] uploaded to the GPU and stepped there a frame at a time.
+/// [`GuideStrands`] uploaded to the GPU and stepped there a frame at a time.
 #[derive(Debug)]
 pub struct GpuStrands {
     strands: u32,
@@ -141,7 +141,7 @@ fn point_major(values: &[Vec3], w: &[f32], n: usize) -> Vec<[f32; 4]> {
 
 impl GpuStrands {
     /// Uploads `strands` (their state, groomed shapes and roots).
-    pub fn new(ctx: &GpuContext, strands: &Strands) -> Result<Self, GpuError> {
+    pub fn new(ctx: &GpuContext, strands: &GuideStrands) -> Result<Self, GpuError> {
         let n = strands.points_per_strand();
         if n > MAX_GPU_STRAND_POINTS {
             return Err(GpuError::Mismatch(format!(
@@ -255,11 +255,11 @@ impl GpuStrands {
     /// Queues a frame of `dt` seconds ending at `time`: `params.substeps`
     /// substeps while the roots move to `roots`, colliding with `skin`
     /// (one grid a substep, or one for all; empty: no collisions), as
-    /// [`Strands::step`] does.
+    /// [`GuideStrands::step`] does.
     pub fn step(
         &mut self,
         ctx: &GpuContext,
-        params: &StrandParams,
+        params: &GuideStrandParams,
         dt: f32,
         time: f32,
         roots: &[RootFrame],
@@ -437,7 +437,7 @@ impl GpuStrands {
         ctx.wait()
     }
 
-    /// Every point now, strand after strand (as [`Strands::positions`]).
+    /// Every point now, strand after strand (as [`GuideStrands::positions`]).
     pub fn read_positions(&self, ctx: &GpuContext) -> Result<Vec<Vec3>, GpuError> {
         let buffer = &self.positions.buffer;
         let size = buffer.size();

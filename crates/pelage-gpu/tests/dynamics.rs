@@ -8,7 +8,7 @@
 //! failure.
 
 use glam::Vec3;
-use pelage::dynamics::{Brush, DynamicsParams, MassSpringSystem, Solver, Topology, Wind};
+use pelage::dynamics::{DynamicsParams, MassSpringSystem, PushBrush, Solver, Topology, Wind};
 use pelage_gpu::GpuMassSpring;
 mod common;
 
@@ -19,7 +19,7 @@ fn windy_brushed(mesh: &pelage::Mesh) -> DynamicsParams {
     let (lo, hi) = mesh.bounds();
     DynamicsParams {
         wind: Some(Wind::new(Vec3::new(3.0, 0.0, 1.0), 0.8, 1.5, 4.0, 3.0, 7)),
-        brush: Some(Brush {
+        brush: Some(PushBrush {
             centre: mesh.positions()[0],
             radius: 0.3 * (hi - lo).length(),
             force: Vec3::new(0.0, 0.0, 0.02),

@@ -1,5 +1,5 @@
 //! The GPU's frame of guide strands against the CPU's
-//! (`pelage::dynamics::Strands::step`): guides on the running Fox with
+//! (`pelage::dynamics::GuideStrands::step`): guides on the running Fox with
 //! body collisions (a grid a substep), gusting turbulent wind, bending and
 //! follow; after 12 frames 99 % of the points must agree within 1e-4 of
 //! the Fox's size and every point within 5e-3. Float operations are not
@@ -11,7 +11,7 @@
 
 use glam::Vec3;
 use pelage::anim::{AnimatedSkin, SkinOptions, SkinPose};
-use pelage::dynamics::{GuideSimulation, StrandParams, Wind};
+use pelage::dynamics::{GuideSimulation, GuideStrandParams, Wind};
 use pelage::guides::{GuideGrowth, Guides};
 use pelage::map::Map;
 use pelage_gpu::GpuStrands;
@@ -42,7 +42,7 @@ fn gpu_strands_follow_the_cpu_on_the_running_fox() {
         },
     )
     .unwrap();
-    let params = StrandParams {
+    let params = GuideStrandParams {
         substeps: 4,
         gravity: Vec3::new(0.0, -9.81 * size / 1.4, 0.0),
         thickness: 0.004 * size,

@@ -407,7 +407,7 @@ impl PyGroom {
             py.check_signals()?;
         }
         let joined = py
-            .detach(|| pelage::io::join(grown.iter()))
+            .detach(|| pelage::curves::join(grown.iter()))
             .map_err(to_py_err)?;
         Ok(PyCurves::new(joined))
     }
@@ -440,7 +440,7 @@ impl PyGroom {
         let curves = match grown.len() {
             1 => grown.into_iter().next().unwrap_or_default(),
             _ => py
-                .detach(|| pelage::io::join(grown.iter()))
+                .detach(|| pelage::curves::join(grown.iter()))
                 .map_err(to_py_err)?,
         };
         Ok(PyCurves::new(curves))

@@ -10,6 +10,9 @@
 //!   also specified by a texture").
 //! - [`sample`]: hair roots: points distributed by a density map (Sik §3),
 //!   deterministic by `(seed, index)`.
+//! - [`nearest`]: the k nearest of a fixed point set (kd-tree plus exact
+//!   candidate lists for coherent queries): guide roots, clump centres,
+//!   blue-noise spacing.
 //! - [`curves`]: [`Curves`], hair curves as structure of arrays with an
 //!   offsets array (Blender's `CurvesGeometry`, USD `BasisCurves`).
 //! - [`guides`]: [`guides::Guides`], artist guide curves bound to the mesh
@@ -51,6 +54,7 @@ pub mod io;
 pub mod limits;
 pub mod map;
 pub mod mesh;
+pub mod nearest;
 pub mod sample;
 pub mod settings;
 pub mod shell;

@@ -138,7 +138,7 @@ fn usd_written_then_read_back_gives_the_same_curves() {
         true,
     );
     let back = read_curves(&path).unwrap();
-    let joined = pelage::io::join([&groom, &second]).unwrap();
+    let joined = pelage::curves::join([&groom, &second]).unwrap();
     assert_eq!(back.offsets(), joined.offsets());
     for (a, b) in back.points().iter().zip(joined.points()) {
         assert!((*a - *b).abs().max_element() <= 1e-6, "{a} vs {b}");
@@ -158,7 +158,7 @@ fn usdc_holds_the_usda_layer_and_round_trips_every_attribute_to_the_bit() {
     assert!(std::fs::read(&usdc).unwrap().starts_with(b"PXR-USDC"));
 
     // What pelage reads back: every attribute, the same from both files.
-    let joined = pelage::io::join([&groom, &second]).unwrap();
+    let joined = pelage::curves::join([&groom, &second]).unwrap();
     let from_usdc = read_curves(&usdc).unwrap();
     assert!(from_usdc.normals().is_some() && from_usdc.colors().is_some());
     assert!(from_usdc.opacities().is_some() && from_usdc.root_uvs().is_some());
@@ -335,7 +335,7 @@ fn alembic_round_trips_what_it_holds_and_blender_imports_it() {
 
     // Every attribute comes back exactly.
     let back = read_curves(&abc).unwrap();
-    let joined = pelage::io::join([&groom, &second]).unwrap();
+    let joined = pelage::curves::join([&groom, &second]).unwrap();
     assert_eq!(back.offsets(), joined.offsets());
     assert_eq!(back.points(), joined.points());
     assert_eq!(back.widths(), joined.widths());
@@ -967,7 +967,7 @@ fn look_grooms_write_shading_primvars_and_a_materialx_hair_material() {
             // pelage reads its own primvars back, all parts joined (the
             // guides, `purpose = "guide"`, are not hairs).
             let back = read_usd_curves(&path).unwrap();
-            let want = pelage::io::join(parts.iter()).unwrap();
+            let want = pelage::curves::join(parts.iter()).unwrap();
             assert_eq!(back.shading(), want.shading(), "{}", path.display());
             assert_eq!(back.regions(), want.regions());
             let regions = want.regions().unwrap();
@@ -981,7 +981,7 @@ fn look_grooms_write_shading_primvars_and_a_materialx_hair_material() {
             .enumerate()
             .map(|(i, c)| (format!("part_{i}"), c));
         write_curves(&path, named, &groom.export_for(&generator, None)).unwrap();
-        let want = pelage::io::join(parts.iter()).unwrap();
+        let want = pelage::curves::join(parts.iter()).unwrap();
         let back = read_curves(&path).unwrap();
         assert_eq!(back.shading(), want.shading());
         assert_eq!(back.regions(), want.regions());

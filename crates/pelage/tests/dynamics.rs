@@ -260,7 +260,7 @@ fn a_soak_under_the_strongest_wind_gravity_and_push_never_breaks_the_fur() {
         ..Default::default()
     };
     let pushed = DynamicsParams {
-        brush: Some(pelage::dynamics::Brush {
+        brush: Some(pelage::dynamics::PushBrush {
             centre: Vec3::ZERO,
             radius: 0.5,
             force: Vec3::new(4.0, -4.0, 0.0),

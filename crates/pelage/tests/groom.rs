@@ -509,7 +509,7 @@ fn grown(text: &str) -> Curves {
     let parts: Vec<Curves> = (0..generator.parts().len())
         .map(|p| generator.part(p).unwrap())
         .collect();
-    pelage::io::join(parts.iter()).unwrap()
+    pelage::curves::join(parts.iter()).unwrap()
 }
 
 #[test]

@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use pelage::anim::{AnimatedSkin, SkinOptions, SkinPose};
-use pelage::dynamics::{GuideSimulation, StrandParams};
+use pelage::dynamics::{GuideSimulation, GuideStrandParams};
 use pelage::guides::{GuideGrowth, Guides};
 use pelage::map::Map;
 use pelage::mesh::TriangleBvh;
@@ -58,8 +58,8 @@ fn fox_run() -> Run {
     Run { skin, guides, size }
 }
 
-fn params(size: f32, collide_thickness: f32) -> StrandParams {
-    StrandParams {
+fn params(size: f32, collide_thickness: f32) -> GuideStrandParams {
+    GuideStrandParams {
         // The Fox is ~1.4 m long in centimetre-like units.
         gravity: Vec3::new(0.0, -9.81 * size / 1.4, 0.0),
         thickness: collide_thickness,

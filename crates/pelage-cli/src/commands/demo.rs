@@ -152,7 +152,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         groom_path.display(),
         texture_path.display()
     );
-    let curves = pelage::io::join(grown.iter())?;
+    let curves = pelage::curves::join(grown.iter())?;
     let preview = out.join("preview.png");
     match render_preview(&spot, &curves, &preview) {
         Ok(adapter) => println!("preview → {} (rendered on {adapter})", preview.display()),

@@ -212,7 +212,7 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         println!("report → {}", json.display());
     }
     if let Some(png) = &args.preview {
-        let curves = pelage::io::join(shown.iter())?;
+        let curves = pelage::curves::join(shown.iter())?;
         let scene = pelage_gpu::PreviewScene {
             mesh: Some(groom.mesh()),
             points: &[],

@@ -9,7 +9,7 @@
 //! contour runs across the body wherever two faces fold away from each
 //! other, and fins there draw creases of hair.
 
-use super::model::WeldedCorners;
+use super::prepare::WeldedCorners;
 use pelage::Mesh;
 use std::collections::HashSet;
 

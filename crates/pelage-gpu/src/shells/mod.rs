@@ -14,22 +14,31 @@
 //! so the benchmark compares like with like, and built for pelage's
 //! targets or a caller's ([`ShellTargetFormats`], docs/embedding.md).
 //!
-//! - `renderer.rs`: [`ShellRenderer`], its pipelines, the skinning pass
-//!   and what a frame records;
-//! - `model.rs`: [`ShellModel`] (a furry mesh uploaded: welded vertices,
-//!   pose, textures with mips, rig) and [`ShellTarget`] (the images drawn
-//!   into);
+//! The parts, lowest first (each uses only those above it in this list):
+//!
+//! - `prepare.rs`: a mesh prepared on the CPU, without wgpu: welded
+//!   corners, tangents ([`vertex_tangents`]), the shell texture's mips;
 //! - `fins.rs`: the fin records of a mesh's edges;
-//! - `player.rs`: [`ShellScenePlayer`], a scene file drawn frame by frame.
+//! - `model.rs`: [`ShellModel`] (a furry mesh on the GPU: welded vertices,
+//!   pose, textures with mips, rig);
+//! - `renderer.rs`: [`ShellRenderer`], its pipelines, the skinning pass
+//!   and what a frame records, and [`ShellTarget`] (the images drawn into);
+//! - `upload.rs`: [`ShellRenderer::upload_with`], a mesh made a model with
+//!   the renderer's layouts, and a model's tips and wetness changed.
+//!
+//! [`ShellScenePlayer`](crate::ShellScenePlayer), a scene file drawn frame
+//! by frame with its motion, is a layer above (`player.rs` beside
+//! `motion.rs`).
 
 mod fins;
 mod model;
-mod player;
+mod prepare;
 mod renderer;
+mod upload;
 
-pub use model::{ShellModel, ShellTarget, ShellUpload, vertex_tangents};
-pub use player::ShellScenePlayer;
-pub use renderer::{ShellRenderer, ShellTargetFormats};
+pub use model::{ShellModel, ShellUpload};
+pub use prepare::vertex_tangents;
+pub use renderer::{ShellRenderer, ShellTarget, ShellTargetFormats};
 
 use crate::Camera;
 use crate::layout::{gpu_struct, gpu_vertex};

@@ -6,11 +6,11 @@
 //! [`ShellRenderer::render`] into pelage's own [`ShellTarget`].
 
 use crate::layout::{UniformRing, entry};
-use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES};
+use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES, check_size};
 use crate::{GpuContext, GpuError};
 use glam::Mat4;
 
-use super::model::{ShellModel, ShellTarget};
+use super::model::ShellModel;
 use super::{
     PoseVertex, ShellFeatures, ShellLevel, ShellParams, ShellUniforms, ShellView, SurfaceVertex,
     TipOffset,
@@ -515,5 +515,66 @@ impl ShellRenderer {
         self.pose(&ctx.queue, &mut encoder, model, palette)?;
         ctx.queue.submit([encoder.finish()]);
         Ok(())
+    }
+}
+
+/// Colour, depth and resolve targets of one size, reused frame to frame.
+#[derive(Debug)]
+pub struct ShellTarget {
+    pub(super) color: wgpu::TextureView,
+    pub(super) depth: wgpu::TextureView,
+    pub(super) resolved: wgpu::Texture,
+    pub(super) size: (u32, u32),
+}
+
+impl ShellTarget {
+    /// Targets for `width × height` images.
+    pub fn new(
+        ctx: &GpuContext,
+        renderer: &ShellRenderer,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, GpuError> {
+        check_size(ctx, width, height)?;
+        let texture = |samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
+            ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("shell target"),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let formats = renderer.formats;
+        Ok(Self {
+            color: texture(formats.samples, formats.color, attach).create_view(&Default::default()),
+            depth: texture(formats.samples, formats.depth, attach).create_view(&Default::default()),
+            resolved: texture(1, formats.color, attach | wgpu::TextureUsages::COPY_SRC),
+            size: (width, height),
+        })
+    }
+
+    /// The image size.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// The resolved (single-sample) image, e.g. to read back.
+    pub fn resolved(&self) -> &wgpu::Texture {
+        &self.resolved
+    }
+
+    /// A view of the resolved image, to resolve a pass into (the `resolve`
+    /// of [`ShellRenderer::encode`](super::ShellRenderer::encode)).
+    pub fn resolve_view(&self) -> wgpu::TextureView {
+        self.resolved.create_view(&Default::default())
     }
 }

@@ -20,6 +20,9 @@ mod shading;
 
 pub use shading::HairShading;
 
+/// Width given to curves read from a file that has no widths.
+pub const DEFAULT_WIDTH: f32 = 0.01;
+
 use crate::SurfacePoint;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -685,6 +688,61 @@ impl Curves {
                 .reduce(|| (first, first), |(a, b), (c, d)| (a.min(c), b.max(d))),
         )
     }
+}
+
+/// Concatenates curves, keeping only the attributes every part has.
+pub fn join<'c>(parts: impl IntoIterator<Item = &'c Curves>) -> Result<Curves, CurvesError> {
+    let parts: Vec<&Curves> = parts.into_iter().collect();
+    let mut points = Vec::new();
+    let mut widths = Vec::new();
+    let mut offsets = vec![0u32];
+    for c in &parts {
+        let base = points.len() as u32;
+        points.extend_from_slice(c.points());
+        widths.extend_from_slice(c.widths());
+        offsets.extend(c.offsets()[1..].iter().map(|o| o + base));
+    }
+    let mut joined = Curves::new(points, widths, offsets)?;
+    if let Some(colors) = concat_all(&parts, Curves::colors) {
+        joined = joined.with_colors(colors)?;
+    }
+    if let Some(opacities) = concat_all(&parts, Curves::opacities) {
+        joined = joined.with_opacities(opacities)?;
+    }
+    if let Some(normals) = concat_all(&parts, Curves::normals) {
+        joined = joined.with_normals(normals)?;
+    }
+    if let Some(uvs) = concat_all(&parts, Curves::root_uvs) {
+        joined = joined.with_root_uvs(uvs)?;
+    }
+    if let Some(ids) = concat_all(&parts, Curves::ids) {
+        joined = joined.with_ids(ids)?;
+    }
+    if let Some(roots) = concat_all(&parts, Curves::roots) {
+        joined = joined.with_roots(roots)?;
+    }
+    if let Some(regions) = concat_all(&parts, Curves::regions) {
+        joined = joined.with_regions(regions)?;
+    }
+    let shading: Option<Vec<_>> = parts.iter().map(|c| c.shading()).collect();
+    if let Some(shading) = shading.filter(|s| !s.is_empty()) {
+        let mut all = HairShading::with_capacity(joined.curve_count());
+        for part in shading {
+            all.extend_from(part);
+        }
+        joined = joined.with_shading(all)?;
+    }
+    Ok(joined)
+}
+
+/// One attribute of every part, concatenated; `None` unless every part
+/// (and at least one) has it.
+fn concat_all<T: Copy>(
+    parts: &[&Curves],
+    attribute: impl Fn(&Curves) -> Option<&[T]>,
+) -> Option<Vec<T>> {
+    let slices: Option<Vec<&[T]>> = parts.iter().map(|c| attribute(c)).collect();
+    slices.filter(|s| !s.is_empty()).map(|s| s.concat())
 }
 
 #[cfg(test)]

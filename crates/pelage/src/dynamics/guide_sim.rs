@@ -1,4 +1,4 @@
-//! Guides simulated on an animated skin: [`Strands`] whose roots are the
+//! Guides simulated on an animated skin: [`GuideStrands`] whose roots are the
 //! guides' roots on the posed skin (the surface frames of
 //! [`SkinPose::frame_at`], as deform carries hair), colliding with the
 //! skin's [`SkinSdf`], built at every substep from the skin's vertices
@@ -7,7 +7,7 @@
 //! jump over it.
 
 use super::skin_sdf::SkinSdf;
-use super::strands::{RootFrame, StrandError, StrandParams, Strands};
+use super::strands::{GuideStrandParams, GuideStrands, RootFrame, StrandError};
 use crate::Curves;
 use crate::anim::SkinPose;
 use crate::guides::Guides;
@@ -26,8 +26,8 @@ pub struct GuideSimulation {
     triangles: Vec<[u32; 3]>,
     roots: Vec<SurfacePoint>,
     widths: Vec<f32>,
-    strands: Strands,
-    params: StrandParams,
+    strands: GuideStrands,
+    params: GuideStrandParams,
     collide: bool,
     /// Node spacing of the collision grid.
     cell: f32,
@@ -45,7 +45,7 @@ impl GuideSimulation {
         guides: &Guides,
         triangles: &[[u32; 3]],
         rest: &SkinPose,
-        params: StrandParams,
+        params: GuideStrandParams,
         collide: bool,
     ) -> Result<Self, StrandError> {
         let roots: Vec<RootFrame> = guides
@@ -53,7 +53,8 @@ impl GuideSimulation {
             .par_iter()
             .map(|&r| root_frame(rest, triangles, r))
             .collect();
-        let strands = Strands::new(guides.curves().points(), guides.points_per_guide(), &roots)?;
+        let strands =
+            GuideStrands::new(guides.curves().points(), guides.points_per_guide(), &roots)?;
         let (lo, hi) = crate::mesh::bounds_of(rest.positions());
         let longest = (hi - lo).max_element().max(f32::MIN_POSITIVE);
         let segment = strands
@@ -76,12 +77,12 @@ impl GuideSimulation {
     }
 
     /// The strands as simulated so far.
-    pub fn strands(&self) -> &Strands {
+    pub fn strands(&self) -> &GuideStrands {
         &self.strands
     }
 
     /// The settings.
-    pub fn params(&self) -> &StrandParams {
+    pub fn params(&self) -> &GuideStrandParams {
         &self.params
     }
 

@@ -24,6 +24,6 @@ pub mod system;
 
 pub use guide_sim::GuideSimulation;
 pub use skin_sdf::SkinSdf;
-pub use solver::{Brush, DynamicsParams, Solver, Wind, WindNow};
-pub use strands::{MAX_STRAND_POINTS, RootFrame, StrandError, StrandParams, Strands};
+pub use solver::{DynamicsParams, PushBrush, Solver, Wind, WindNow};
+pub use strands::{GuideStrandParams, GuideStrands, MAX_STRAND_POINTS, RootFrame, StrandError};
 pub use system::{MassSpringSystem, Topology};

@@ -23,7 +23,7 @@
 //! --strands` measures both in the same run.
 //!
 //! The band is the limit: a point deeper inside the skin than the band
-//! reads as clear of it. Strands enter the skin only from outside, by a
+//! reads as clear of it. GuideStrands enter the skin only from outside, by a
 //! segment or by the skin's move between two checks, so
 //! [`SkinSdf::new`] takes the depth the band must cover.
 

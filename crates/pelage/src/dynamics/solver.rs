@@ -183,7 +183,7 @@ impl WindNow<'_> {
 /// A local push (the viewer's brush): `force` on every tip within `radius`
 /// of `centre`, fading smoothly to zero at the edge.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Brush {
+pub struct PushBrush {
     /// Where.
     pub centre: Vec3,
     /// How far it reaches.
@@ -212,7 +212,7 @@ pub struct DynamicsParams {
     /// Wind, if any.
     pub wind: Option<Wind>,
     /// A brush, if any.
-    pub brush: Option<Brush>,
+    pub brush: Option<PushBrush>,
 }
 
 impl Default for DynamicsParams {

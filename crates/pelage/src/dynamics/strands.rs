@@ -38,7 +38,7 @@
 //! the substeps or iterations does not change how stiff a groom feels
 //! (a departure from the papers, which use per-iteration factors).
 //!
-//! Strands never read each other, so the step runs them in parallel and
+//! GuideStrands never read each other, so the step runs them in parallel and
 //! the result is bit-identical on any number of threads.
 
 use super::skin_sdf::SkinSdf;
@@ -76,7 +76,7 @@ pub struct RootFrame {
 
 /// The simulation's settings.
 #[derive(Debug, Clone)]
-pub struct StrandParams {
+pub struct GuideStrandParams {
     /// Substeps a frame.
     pub substeps: u32,
     /// Follow, bend and length passes a substep.
@@ -104,7 +104,7 @@ pub struct StrandParams {
     pub friction: f32,
 }
 
-impl Default for StrandParams {
+impl Default for GuideStrandParams {
     fn default() -> Self {
         Self {
             substeps: 4,
@@ -125,7 +125,7 @@ impl Default for StrandParams {
 /// Why strands cannot be simulated.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StrandError {
-    /// Strands need a root and at least one more point.
+    /// GuideStrands need a root and at least one more point.
     #[error("a strand needs 2 to {MAX_STRAND_POINTS} points, not {0}")]
     PointCount(usize),
     /// The arrays do not describe the same strands.
@@ -136,7 +136,7 @@ pub enum StrandError {
 /// Simulated strands: positions and velocities, with each strand's
 /// groomed shape in its root's rest frame.
 #[derive(Debug, Clone)]
-pub struct Strands {
+pub struct GuideStrands {
     points_per_strand: usize,
     positions: Vec<Vec3>,
     velocities: Vec<Vec3>,
@@ -147,8 +147,8 @@ pub struct Strands {
     roots: Vec<RootFrame>,
 }
 
-impl Strands {
-    /// Strands at rest with the points `points` (`points_per_strand` a
+impl GuideStrands {
+    /// GuideStrands at rest with the points `points` (`points_per_strand` a
     /// strand, strand after strand, each starting at its root) and their
     /// roots' rest frames.
     pub fn new(
@@ -262,7 +262,7 @@ impl Strands {
     /// skin standing still); empty for no collisions.
     pub fn step(
         &mut self,
-        params: &StrandParams,
+        params: &GuideStrandParams,
         dt: f32,
         time: f32,
         roots: &[RootFrame],
@@ -317,7 +317,7 @@ impl Strands {
 }
 
 /// What a substep of a step of `dt` computes with, derived once from
-/// [`StrandParams`] (and handed as is to a GPU port).
+/// [`GuideStrandParams`] (and handed as is to a GPU port).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SubstepConstants {
     /// The substep's length.
@@ -342,7 +342,7 @@ pub struct SubstepConstants {
     pub iterations: u32,
 }
 
-impl StrandParams {
+impl GuideStrandParams {
     /// The constants of a substep of a step of `dt` seconds.
     pub fn substep_constants(&self, dt: f32) -> SubstepConstants {
         let substeps = self.substeps.max(1);
@@ -556,11 +556,11 @@ mod tests {
     }
 
     /// One strand of `n` points, `length` long, straight along `dir`.
-    fn straight(n: usize, length: f32, dir: Vec3) -> Strands {
+    fn straight(n: usize, length: f32, dir: Vec3) -> GuideStrands {
         let points: Vec<Vec3> = (0..n)
             .map(|i| dir * length * i as f32 / (n - 1) as f32)
             .collect();
-        Strands::new(&points, n, &[upright()]).unwrap()
+        GuideStrands::new(&points, n, &[upright()]).unwrap()
     }
 
     #[test]
@@ -569,7 +569,7 @@ mod tests {
         let angle = 0.1f32;
         let dir = Vec3::new(angle.sin(), -angle.cos(), 0.0);
         let mut strand = straight(2, length, dir);
-        let params = StrandParams {
+        let params = GuideStrandParams {
             substeps: 1,
             damping: 0.0,
             bend: 0.0,
@@ -603,7 +603,7 @@ mod tests {
     #[test]
     fn segments_keep_their_length_over_a_thousand_steps() {
         let mut strand = straight(16, 1.0, Vec3::X);
-        let params = StrandParams {
+        let params = GuideStrandParams {
             bend: 0.5,
             wind: Some(Wind::new(Vec3::new(0.0, 0.0, 3.0), 0.5, 1.0, 2.0, 2.0, 7)),
             drag: 2.0,
@@ -632,7 +632,7 @@ mod tests {
     #[test]
     fn without_follow_strands_hang_and_with_full_follow_they_keep_their_groom() {
         let dir = Vec3::new(1.0, 0.3, 0.0).normalize();
-        let mut params = StrandParams {
+        let mut params = GuideStrandParams {
             bend: 0.0,
             follow: 0.0,
             damping: 3.0,
@@ -663,7 +663,7 @@ mod tests {
         let mut strand = straight(8, 0.4, Vec3::X);
         // No bending: a bent strand also stores elastic energy, which
         // this sum leaves out.
-        let params = StrandParams {
+        let params = GuideStrandParams {
             bend: 0.0,
             follow: 0.0,
             damping: 0.5,

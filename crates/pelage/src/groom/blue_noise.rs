@@ -9,7 +9,7 @@
 //! thinned against each other.
 
 use super::generator::Generator;
-use super::grow::sorted_by_triangle_with_ids;
+use super::parts::sorted_by_triangle_with_ids;
 use crate::mesh::SurfacePoint;
 use crate::sample::blue_noise::{OVERSAMPLING, eliminate, positions_and_radii};
 use crate::sample::{mix64, salts, sample_range};

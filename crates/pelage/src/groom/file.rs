@@ -13,63 +13,153 @@
 //! One file, past 600 lines: the groom file's schema in one place (about 130
 //! of its lines are tests).
 
+use super::error::{GroomError, GroomErrorKind};
 pub(crate) use super::ops::OpSpec;
 pub use super::ramp::Ramp;
+pub use super::values::{ColorSpec, MapText, MapValue, RootToTipSpec};
+use super::values::{one, zero};
 use crate::io::CurveBasis;
+use crate::limits::*;
+use crate::settings::{Bound, Rule, SettingsSource};
 use serde::Deserialize;
-use serde::de::{self, Deserializer, Visitor};
-use std::fmt;
+use serde::de::{self, Deserializer};
 use toml::Spanned;
 
-/// A map as written in a groom file: a number or a map spec string
-/// (`"density.png:r"`, `"noise:frequency=8"`), with where it was written.
-pub type MapValue = Spanned<MapText>;
-
-/// The text of a map: a number or a spec.
-#[derive(Debug, Clone, PartialEq)]
-pub enum MapText {
-    /// A constant.
-    Number(f32),
-    /// A map spec: image path with suffixes, or `noise:…`.
-    Spec(String),
-}
-
-impl<'de> Deserialize<'de> for MapText {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        struct MapVisitor;
-        impl Visitor<'_> for MapVisitor {
-            type Value = MapText;
-            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a map: a number, an image path such as \"length.png:r\", or \"noise:frequency=8\"")
-            }
-            fn visit_f64<E: de::Error>(self, v: f64) -> Result<MapText, E> {
-                Ok(MapText::Number(v as f32))
-            }
-            fn visit_i64<E: de::Error>(self, v: i64) -> Result<MapText, E> {
-                Ok(MapText::Number(v as f32))
-            }
-            fn visit_u64<E: de::Error>(self, v: u64) -> Result<MapText, E> {
-                Ok(MapText::Number(v as f32))
-            }
-            fn visit_str<E: de::Error>(self, v: &str) -> Result<MapText, E> {
-                Ok(MapText::Spec(v.to_string()))
-            }
-        }
-        deserializer.deserialize_any(MapVisitor)
-    }
-}
-
-fn one() -> MapValue {
-    Spanned::new(0..0, MapText::Number(1.0))
-}
-fn zero() -> MapValue {
-    Spanned::new(0..0, MapText::Number(0.0))
-}
 fn seed_one() -> u64 {
     1
 }
 fn one_f32() -> f32 {
     1.0
+}
+
+/// The documented range of every numeric groom setting that has one
+/// (docs/groom-format.md, docs/limits.md), checked when the file is read.
+/// Map-valued settings are checked here when written as numbers. Each
+/// operator's rules are its module's ([`super::ops::operator_rules`]).
+const GROOM_RULES: &[Rule] = &[
+    Rule::new(
+        "mesh.subdivide",
+        Bound::Within(0.0, MAX_SUBDIVIDE as f64),
+        "each step makes 4 triangles of 1",
+    ),
+    Rule::new(
+        "roots.count",
+        Bound::Within(1.0, MAX_HAIRS as f64),
+        "pelage's hair limit, docs/limits.md",
+    ),
+    Rule::new("roots.parts", Bound::Within(1.0, MAX_PARTS as f64), ""),
+    Rule::new(
+        "output.fraction",
+        Bound::Above(0.0, 1.0),
+        "a share of the hairs",
+    ),
+    Rule::new(
+        "guides.points",
+        Bound::Within(2.0, MAX_CURVE_POINTS as f64),
+        "points per guide",
+    ),
+    Rule::new("guides.tolerance", Bound::at_least(0.0), "a distance"),
+    Rule::new(
+        "guides.generate.count",
+        Bound::Within(1.0, MAX_GUIDES as f64),
+        "pelage's guide limit",
+    ),
+    Rule::new("guides.generate.length", Bound::at_least(0.0), "a length"),
+    Rule::new("guides.generate.density", Bound::at_least(0.0), "a density"),
+    Rule::new(
+        "interpolation.k",
+        Bound::Within(1.0, 1024.0),
+        "guides per hair",
+    ),
+    Rule::new(
+        "interpolation.power",
+        Bound::more_than(0.0),
+        "Shepard's distance exponent",
+    ),
+    Rule::new("interpolation.radius", Bound::more_than(0.0), "a distance"),
+    Rule::new("roots.density", Bound::at_least(0.0), "a density"),
+    Rule::new("finish.skin_gap", Bound::at_least(0.0), "a distance"),
+    Rule::new(
+        "simulation.substeps",
+        Bound::Within(1.0, 64.0),
+        "substeps a frame",
+    ),
+    Rule::new(
+        "simulation.iterations",
+        Bound::Within(1.0, 100.0),
+        "passes a substep",
+    ),
+    Rule::new(
+        "simulation.damping",
+        Bound::at_least(0.0),
+        "a rate per second",
+    ),
+    Rule::new("simulation.bend", Bound::Within(0.0, 1.0), "a fraction"),
+    Rule::new("simulation.follow", Bound::Within(0.0, 1.0), "a fraction"),
+    Rule::new("simulation.drag", Bound::at_least(0.0), "a rate per second"),
+    Rule::new("simulation.thickness", Bound::at_least(0.0), "a distance"),
+    Rule::new("simulation.friction", Bound::Within(0.0, 1.0), "a fraction"),
+    Rule::new(
+        "simulation.preroll",
+        Bound::Within(0.0, MAX_FRAMES as f64),
+        "frames",
+    ),
+    Rule::new(
+        "finish.points",
+        Bound::Within(2.0, MAX_CURVE_POINTS as f64),
+        "points per hair",
+    ),
+    Rule::new("finish.width.root", Bound::at_least(0.0), "a width"),
+    Rule::new("finish.width.tip", Bound::at_least(0.0), "a width"),
+    Rule::new("finish.opacity.root", Bound::Within(0.0, 1.0), "an opacity"),
+    Rule::new("finish.opacity.tip", Bound::Within(0.0, 1.0), "an opacity"),
+    Rule::new("animation.fps", Bound::more_than(0.0), "frames per second"),
+    Rule::new(
+        "look.melanin",
+        Bound::Within(0.0, 1.0),
+        "Cycles' melanin scale",
+    ),
+    Rule::new("look.melanin_redness", Bound::Within(0.0, 1.0), "a share"),
+    Rule::new("look.tint", Bound::at_least(0.0), "a linear colour"),
+    Rule::new("look.roughness", Bound::Within(0.0, 1.0), "a roughness"),
+    Rule::new(
+        "look.radial_roughness",
+        Bound::Within(0.0, 1.0),
+        "a roughness",
+    ),
+    Rule::new("look.jitter", Bound::Within(0.0, 1.0), "a fraction"),
+];
+
+impl SettingsSource {
+    /// Parses and checks the text as a groom file (every key known, every
+    /// number in its range), loading nothing it names.
+    pub fn check_groom(&self) -> Result<(), GroomError> {
+        self.parse().map(drop)
+    }
+
+    /// Parses the text as a groom file.
+    pub(crate) fn parse(&self) -> Result<GroomFile, GroomError> {
+        if let Some((place, message)) = self.single_bracket_list(&["ops"]) {
+            return Err(GroomError::new(
+                self.path.clone(),
+                place.line,
+                place.key,
+                GroomErrorKind::Syntax(message),
+            ));
+        }
+        let file = self.parse_as()?;
+        let mut rules = GROOM_RULES.to_vec();
+        rules.extend(super::ops::operator_rules());
+        self.check(&rules).map_err(|(place, message)| {
+            GroomError::new(
+                self.path.clone(),
+                place.line,
+                place.key,
+                GroomErrorKind::Invalid(message),
+            )
+        })?;
+        Ok(file)
+    }
 }
 
 /// A whole groom file.
@@ -511,51 +601,6 @@ impl Default for InterpolationSection {
             split_shared: false,
         }
     }
-}
-
-/// A quantity from root to tip: `width` and `opacity` (and
-/// `[finish.width]`, `[finish.opacity]`); see [`crate::groom::ops::Width`].
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RootToTipSpec {
-    /// Value at the root (a width in world units, or an opacity).
-    pub root: MapValue,
-    /// Value at the tip.
-    pub tip: MapValue,
-    /// Profile from root to tip.
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Per-hair random variation, a fraction.
-    #[serde(default = "zero")]
-    pub jitter: MapValue,
-    /// Seed of the variation.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-/// `color` (and `[finish.color]`): see [`crate::groom::ops::Color`].
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ColorSpec {
-    /// Linear RGB at the root, each channel a map.
-    pub root: [MapValue; 3],
-    /// Linear RGB at the tip.
-    pub tip: [MapValue; 3],
-    /// Profile from root to tip.
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Per-hair random brightness variation, a fraction.
-    #[serde(default = "zero")]
-    pub jitter: MapValue,
-    /// Seed of the variation.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
 }
 
 /// `[finish]`.

@@ -1,36 +1,28 @@
 //! The generator: a [`GroomSpec`] prepared for growing (the root sampler
 //! and part layout, the interpolator, the operator chain with its clump
-//! centres), and the part-by-part API over it. How a part's hairs grow is
-//! in `grow.rs`; how a hair that overflows is traced to its operator, in
-//! `diagnose.rs`. See the module docs of [`crate::groom`] for the path of
-//! one hair.
+//! centres), what it holds and answers, and each part's roots before any
+//! thinning. Its layers above: `blue_noise.rs` thins a part's roots,
+//! `grow.rs` grows a part's hairs (and traces a hair that overflows to its
+//! operator), `build.rs` builds a generator from a spec. See the module
+//! docs of [`crate::groom`] for the path of one hair.
 
 use super::error::{GroomError, GroomErrorKind};
-use super::grow::{Workspace, sorted_by_triangle, sorted_by_triangle_with_ids};
 use super::hair_look::HairLook;
-use super::load::part_count;
-use super::ops::{
-    CentreGuides, ClumpCentres, OpKey, Opacity, Operator, Preparation, Resampling, Width,
-    color_maps_mut, root_to_tip_maps_mut,
-};
+use super::ops::{Operator, Resampling};
 use super::outside_skin::OutsideSkin;
 use super::parts::{Part, PartLayout};
+use super::parts::{sorted_by_triangle, sorted_by_triangle_with_ids};
 use super::regions::RegionLookup;
-use super::spec::{GroomSpec, HairIds, RootDistribution, SpecOrigin, setting_error};
+use super::spec::{RootDistribution, SpecOrigin, setting_error};
 use crate::curves::{CurveArrays, Curves};
 use crate::guides::Guides;
 use crate::interp::Interpolator;
-use crate::limits;
-use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
 use crate::sample::{DensitySampler, RootCells, mix64, salts, sample_range};
-use glam::Vec3;
 use rayon::prelude::*;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::AtomicUsize;
 use std::sync::{Arc, Mutex};
-
-pub use super::load::HAIRS_PER_PART;
 
 /// What a generated part holds, for progress and summaries.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -47,8 +39,8 @@ pub struct Generator {
     pub(super) mesh: Arc<Mesh>,
     pub(super) guides: Arc<Guides>,
     /// The groom's name and where its settings were written, for errors.
-    name: PathBuf,
-    origin: Option<Arc<SpecOrigin>>,
+    pub(super) name: PathBuf,
+    pub(super) origin: Option<Arc<SpecOrigin>>,
     pub(super) sampler: Arc<DensitySampler>,
     /// With stable ids: the root cells parts are made of.
     pub(super) cells: Option<Arc<RootCells>>,
@@ -69,7 +61,7 @@ pub struct Generator {
     /// the ball around their triangle.
     pub(super) clumps: bool,
     /// Whether clump centres record the guides they depend on.
-    records_centre_guides: bool,
+    pub(super) records_centre_guides: bool,
     /// Every width's factor: `1/√fraction`, so a preview covers the skin
     /// as the whole groom does.
     pub(super) width_scale: f32,
@@ -83,8 +75,8 @@ pub struct Generator {
     pub(super) spare: Arc<Mutex<Vec<CurveArrays>>>,
     /// The part asked for last (`usize::MAX`: none yet), and the roots of
     /// the one after it, sampled ahead.
-    last_part: AtomicUsize,
-    prefetched: Mutex<Option<(usize, PartRoots)>>,
+    pub(super) last_part: AtomicUsize,
+    pub(super) prefetched: Mutex<Option<(usize, PartRoots)>>,
 }
 
 /// What [`Generator::rebuilt`] takes from an earlier generator instead of
@@ -129,393 +121,6 @@ impl std::fmt::Debug for Generator {
 }
 
 impl Generator {
-    /// Prepares `spec` for growing; see [`GroomSpec::generator`].
-    pub fn new(spec: GroomSpec) -> Result<Self, GroomError> {
-        Self::build(spec, Reuse::default())
-    }
-
-    /// A generator for `spec`, which must be this generator's spec with
-    /// other guide shapes (the same guides, roots and everything else):
-    /// the root sampler, part layout and guide weights are shared, only
-    /// the shapes and what the operators grew from them (clump centres)
-    /// are new. Animated grooms regrow each frame this way.
-    pub fn reshaped(&self, spec: GroomSpec) -> Result<Self, GroomError> {
-        Self::build(
-            spec,
-            Reuse {
-                from: Some(self),
-                roots: true,
-                regions: true,
-                weights: true,
-                moved_guides: None,
-                centre_guides: self.records_centre_guides,
-            },
-        )
-    }
-
-    /// A generator for `spec` that takes from `reuse.from` what `reuse`
-    /// says is unchanged (an editable groom's edits: a guide added keeps
-    /// the roots, a painted length keeps roots and weights). The caller
-    /// answers for it: what is reused is not checked against `spec`.
-    pub(crate) fn rebuilt(spec: GroomSpec, reuse: Reuse<'_>) -> Result<Self, GroomError> {
-        Self::build(spec, reuse)
-    }
-
-    fn build(mut spec: GroomSpec, reuse: Reuse<'_>) -> Result<Self, GroomError> {
-        let from = reuse.from;
-        let shared_regions = from.filter(|_| reuse.regions);
-        let shared_roots = from.filter(|_| reuse.roots);
-        let shared_weights = from.filter(|_| reuse.weights && reuse.regions);
-        let moved: Option<Vec<bool>> = reuse.moved_guides.map(|list| {
-            let mut moved = vec![false; spec.guides.len()];
-            for &g in list {
-                if let Some(m) = moved.get_mut(g as usize) {
-                    *m = true;
-                }
-            }
-            moved
-        });
-        let fraction = spec.roots.fraction;
-        if !(fraction > 0.0 && fraction <= 1.0) {
-            return Err(spec.error(
-                "output.fraction",
-                GroomErrorKind::Invalid(format!(
-                    "fraction = {fraction}: the share of the hairs grown is above 0 and at most 1"
-                )),
-            ));
-        }
-        if fraction < 1.0
-            && (spec.roots.ids != HairIds::Stable
-                || spec.roots.distribution != RootDistribution::Random)
-        {
-            return Err(spec.error(
-                "output.fraction",
-                GroomErrorKind::Invalid(
-                    "a fraction grows the first arrivals of the root cells, so that it is a subset of the groom: it needs stable ids and random roots (remove `ids = \"sequential\"` or `distribution = \"blue-noise\"`)".into(),
-                ),
-            ));
-        }
-        let count = spec.roots.count;
-        if count == 0 {
-            return Err(spec.error(
-                "roots.count",
-                GroomErrorKind::Invalid("the hair count must be at least 1".into()),
-            ));
-        }
-        let points = spec.finish.points;
-        if points < 2 {
-            return Err(spec.error(
-                "finish.points",
-                GroomErrorKind::Invalid("hairs need at least 2 points".into()),
-            ));
-        }
-        // Groom files are checked as they are read; grooms built in code
-        // (the Python package, tests) meet the same ceilings here.
-        let ceiling = |key: &str, value: u64, max: u64, what: &str| {
-            limits::check_count(value, max, false, what)
-                .map_err(|m| spec.error(key, GroomErrorKind::Invalid(m)))
-        };
-        ceiling("roots.count", count, limits::MAX_HAIRS, "hairs")?;
-        ceiling(
-            "finish.points",
-            points as u64,
-            limits::MAX_CURVE_POINTS,
-            "points",
-        )?;
-        for (index, op) in spec.ops.iter().enumerate() {
-            let key = OpKey {
-                index,
-                name: op.name(),
-            };
-            for (field, value, most, what) in op.counts() {
-                ceiling(&key.field(field), value, most, what)?;
-            }
-        }
-        bind_maps(&mut spec)?;
-        let regions = match (shared_regions, &spec.regions) {
-            (Some(g), _) => g.regions.clone(),
-            (None, Some(r)) => {
-                Some(Arc::new(r.lookup(&spec.mesh).map_err(|m| {
-                    spec.error("regions", GroomErrorKind::Invalid(m))
-                })?))
-            }
-            (None, None) => None,
-        };
-        let (sampler, cells, layout) = match shared_roots {
-            Some(g) => (g.sampler.clone(), g.cells.clone(), g.layout.clone()),
-            None => {
-                let mesh = &spec.mesh;
-                let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
-                    .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
-                // A fraction grows the first arrivals: a subset of the groom.
-                let grown = spec.roots.grown_count();
-                let parts = part_count(mesh, grown, spec.roots.parts, spec.roots.ids);
-                let (cells, layout) = match spec.roots.ids {
-                    HairIds::Stable => {
-                        let cells = RootCells::new(mesh, &sampler);
-                        let counts = cells.counts(spec.roots.seed, grown);
-                        let layout = PartLayout::from_cells(&cells, &counts, parts);
-                        (Some(Arc::new(cells)), layout)
-                    }
-                    HairIds::Sequential => {
-                        let layout = PartLayout::new(
-                            mesh,
-                            |t| sampler.triangle_probability(t),
-                            count,
-                            parts,
-                        );
-                        (None, layout)
-                    }
-                };
-                (Arc::new(sampler), cells, Arc::new(layout))
-            }
-        };
-        let interpolator = match shared_weights {
-            Some(g) => {
-                if g.guides.len() != spec.guides.len() {
-                    return Err(spec.error(
-                        "guides",
-                        GroomErrorKind::Invalid(format!(
-                            "{} guides where the groom has {}",
-                            spec.guides.len(),
-                            g.guides.len()
-                        )),
-                    ));
-                }
-                g.interpolator.reshaped(&spec.mesh, spec.guides.clone())
-            }
-            None => {
-                let mesh = &spec.mesh;
-                match &regions {
-                    Some(lookup) => {
-                        let guide_regions: Vec<u32> = spec
-                            .guides
-                            .roots()
-                            .iter()
-                            .map(|r| lookup.of(mesh, *r))
-                            .collect();
-                        Interpolator::with_regions(
-                            mesh,
-                            spec.guides.clone(),
-                            &spec.interpolation,
-                            &guide_regions,
-                        )
-                    }
-                    None => Interpolator::new(mesh, spec.guides.clone(), &spec.interpolation),
-                }
-            }
-        };
-        let GroomSpec {
-            name,
-            mesh,
-            guides,
-            roots,
-            ops,
-            finish,
-            origin,
-            look,
-            ..
-        } = spec;
-        let (colors, opacities) = (finish.color.is_some(), finish.opacity.is_some());
-        // The skin's grid depends on the mesh alone: an edit's generator
-        // shares its parent's.
-        let outside_skin = finish.outside_skin.map(|gap| {
-            from.filter(|g| Arc::ptr_eq(&g.mesh, &mesh))
-                .and_then(|g| g.outside_skin.clone())
-                .filter(|o| o.gap() == gap)
-                .unwrap_or_else(|| {
-                    // A hair's segment: the longest guide's length over
-                    // the hair's segments.
-                    let longest = (0..guides.len())
-                        .map(|g| {
-                            guides
-                                .guide(g)
-                                .windows(2)
-                                .map(|w| (w[1] - w[0]).length())
-                                .sum::<f32>()
-                        })
-                        .fold(0.0f32, f32::max);
-                    let segment = longest / (points.max(2) - 1) as f32;
-                    Arc::new(OutsideSkin::new(&mesh, gap, segment))
-                })
-        });
-        let mut base = vec![Operator::Width(Width(finish.width))];
-        base.extend(finish.color.map(Operator::Color));
-        base.extend(finish.opacity.map(|o| Operator::Opacity(Opacity(o))));
-        let mut generator = Self {
-            resampling: Resampling::new(guides.points_per_guide(), points),
-            seed: roots.seed,
-            mesh,
-            guides,
-            name,
-            origin,
-            sampler,
-            cells,
-            distribution: roots.distribution,
-            layout,
-            interpolator,
-            regions,
-            ops: Vec::with_capacity(ops.len()),
-            base,
-            points,
-            colors,
-            opacities,
-            clumps: false,
-            records_centre_guides: reuse.centre_guides,
-            width_scale: if roots.fraction < 1.0 {
-                (1.0 / roots.fraction.sqrt()) as f32
-            } else {
-                1.0
-            },
-            normals: finish.normals,
-            outside_skin,
-            look,
-            // A frame's generator (`reshaped`) grows parts of the same
-            // sizes: it reuses its parent's arrays.
-            spare: shared_roots.map_or_else(Default::default, |g| g.spare.clone()),
-            last_part: AtomicUsize::new(usize::MAX),
-            prefetched: Mutex::new(None),
-        };
-        for (index, op) in ops.into_iter().enumerate() {
-            let key = OpKey {
-                index,
-                name: op.name(),
-            };
-            // Clump centres are grown through the operators before this
-            // one, which are already in `generator.ops`.
-            let op = op.prepare(&Preparation {
-                generator: &generator,
-                key,
-                reshaping: shared_weights.map(|g| (g, moved.as_deref())),
-            })?;
-            generator.colors |= op.adds_colors();
-            generator.opacities |= op.adds_opacities();
-            generator.clumps |= op.searches_neighbours();
-            generator.ops.push(op);
-        }
-        Ok(generator)
-    }
-
-    /// Grows the centre hairs of the clump operator at chain position `k`
-    /// through the operators before it. Centre ids live apart from hair ids
-    /// (top bits set), so their random numbers are their own. Reshaping a
-    /// generator whose centres recorded their guides, only the centres of
-    /// moved guides grow again; the others keep their shapes.
-    pub(super) fn clump_centres(
-        &self,
-        k: usize,
-        roots: &[SurfacePoint],
-        reshaping: Option<(&Generator, Option<&[bool]>)>,
-    ) -> ClumpCentres {
-        let grow_one = |i: usize, ws: &mut Workspace, out: &mut Vec<Vec3>| {
-            let id = (1u64 << 63) | ((k as u64) << 40) | i as u64;
-            self.grow(roots[i], id, &self.ops[..k], ws);
-            match ws.batch.hairs().first() {
-                Some(hair) => out.extend_from_slice(&hair.points),
-                // Cut away entirely: the centre is its interpolated shape.
-                None => self.resampled(&ws.shape, out),
-            }
-        };
-        let mesh = &self.mesh;
-        let positions: Vec<Vec3> = roots.iter().map(|r| r.position(mesh)).collect();
-        // The same centres as the generator reshaped (a painted density
-        // may have moved them).
-        let previous = reshaping.and_then(|(g, moved)| {
-            let centres = match g.ops.get(k)?.unmasked() {
-                Operator::Clump(c) => c.centres(),
-                _ => return None,
-            };
-            (centres.roots() == positions.as_slice()).then_some((centres, moved))
-        });
-        if let Some((old, Some(moved))) = previous
-            && let Some(guides) = old.guides()
-        {
-            let changed: Vec<usize> = (0..roots.len())
-                .filter(|&i| guides.of(i).iter().any(|&g| moved[g as usize]))
-                .collect();
-            let grown: Vec<(usize, Vec<Vec3>)> = changed
-                .par_iter()
-                .map_init(Workspace::default, |ws, &i| {
-                    let mut out = Vec::with_capacity(self.points);
-                    grow_one(i, ws, &mut out);
-                    (i, out)
-                })
-                .collect();
-            let mut shapes = old.shape_array().to_vec();
-            for (i, shape) in grown {
-                shapes[i * self.points..(i + 1) * self.points].copy_from_slice(&shape);
-            }
-            return old.with_shapes(shapes);
-        }
-        let shapes: Vec<Vec<Vec3>> = (0..roots.len())
-            .collect::<Vec<_>>()
-            .par_chunks(256)
-            .map_init(Workspace::default, |ws, chunk| {
-                let mut out = Vec::with_capacity(chunk.len() * self.points);
-                for &i in chunk {
-                    grow_one(i, ws, &mut out);
-                }
-                out
-            })
-            .collect();
-        let normals = roots.iter().map(|r| r.normal(mesh)).collect();
-        let regions: Vec<u32> = roots.iter().map(|r| self.region_of(*r)).collect();
-        let centres =
-            ClumpCentres::on_surface(positions, normals, &regions, shapes.concat(), self.points);
-        let centres = centres.with_surface_roots(roots.to_vec());
-        // Reshaped, the centres depend on the guides they did before.
-        match previous.and_then(|(old, _)| old.guides_shared()) {
-            Some(guides) => centres.with_shared_guides(guides),
-            None if self.records_centre_guides => centres.with_guides(self.centre_guides(k, roots)),
-            None => centres,
-        }
-    }
-
-    /// The guides each centre of the clump at chain position `k` depends
-    /// on: its own weights' guides and, through the clump levels before
-    /// it, those of the centres it follows.
-    fn centre_guides(&self, k: usize, roots: &[SurfacePoint]) -> CentreGuides {
-        let earlier: Vec<&ClumpCentres> = self.ops[..k]
-            .iter()
-            .filter_map(|op| match op.unmasked() {
-                Operator::Clump(c) => Some(c.centres()),
-                _ => None,
-            })
-            .collect();
-        let per_centre: Vec<Vec<u32>> = roots
-            .par_iter()
-            .map_init(
-                || (Vec::new(), crate::interp::NeighbourCache::default()),
-                |(weights, near), root| {
-                    let context = self.root_context(*root);
-                    let hair_root = crate::interp::HairRoot {
-                        position: context.position,
-                        triangle: Some(root.tri),
-                        region: context.region,
-                    };
-                    self.interpolator.weighting().weights(hair_root, weights);
-                    let mut guides: Vec<u32> = weights.iter().map(|w| w.guide).collect();
-                    for level in &earlier {
-                        let followed = level.nearest_near(
-                            context.position,
-                            Some(context.normal),
-                            context.region,
-                            near,
-                            context.skin_triangle,
-                        );
-                        if let (Some((c, _)), Some(g)) = (followed, level.guides()) {
-                            guides.extend_from_slice(g.of(c));
-                        }
-                    }
-                    guides.sort_unstable();
-                    guides.dedup();
-                    guides
-                },
-            )
-            .collect();
-        CentreGuides::new(per_centre)
-    }
-
     /// An error about the setting `key`, at its line when the groom came
     /// from a file.
     pub(super) fn error(&self, key: &str, kind: GroomErrorKind) -> GroomError {
@@ -584,19 +189,6 @@ impl Generator {
         self.points
     }
 
-    /// Roots of part `p`, ordered by triangle (so neighbouring hairs are
-    /// grown together), and their hairs' ids. With stable ids each of the
-    /// part's root cells samples its own hairs from its own stream;
-    /// otherwise the part samples its hairs in its triangles with its own
-    /// stream, numbered from the part's first hair id. Blue-noise roots
-    /// are then thinned from four times as many (`blue_noise.rs`).
-    pub fn part_roots(&self, p: usize) -> (Vec<SurfacePoint>, Vec<u64>) {
-        if self.distribution == RootDistribution::BlueNoise {
-            return super::blue_noise::part_roots(self, p);
-        }
-        self.regular_part_roots(p)
-    }
-
     /// [`Self::part_roots`] before any blue-noise thinning.
     pub(super) fn regular_part_roots(&self, p: usize) -> (Vec<SurfacePoint>, Vec<u64>) {
         let part = &self.layout.parts()[p];
@@ -646,44 +238,6 @@ impl Generator {
         &self.sampler
     }
 
-    /// Grows part `p`: its curves with per-point widths, normals (unless
-    /// turned off), colours and opacities (when the groom has them), roots,
-    /// root UVs (meshes with UVs) and ids. Identical on any thread count:
-    /// workers grow fixed chunks of roots, in order.
-    ///
-    /// # Errors
-    /// When a hair's positions, widths, normals, colours or opacities are
-    /// not finite (an operator's parameters took it past `f32`'s range):
-    /// the error names the operator in the groom file, from growing that
-    /// hair again one operator at a time.
-    pub fn part(&self, p: usize) -> Result<Curves, GroomError> {
-        let (roots, ids) = self
-            .take_prefetched(p)
-            .unwrap_or_else(|| self.part_roots(p));
-        // Parts asked for in order (a whole groom, a farm task's range):
-        // the next part's roots are sampled and sorted beside this part's
-        // growth, on threads that would otherwise wait for its last chunks.
-        let previous = self.last_part.swap(p, Ordering::Relaxed);
-        let prefetch = p + 1 < self.layout.len() && (p == 0 || previous == p - 1);
-        let (curves, next) = rayon::join(
-            || self.grow_part(roots, ids),
-            || prefetch.then(|| self.part_roots(p + 1)),
-        );
-        if let Some(next) = next {
-            *self.prefetched.lock().unwrap_or_else(|e| e.into_inner()) = Some((p + 1, next));
-        }
-        curves
-    }
-
-    /// The roots of part `p` if they were sampled ahead.
-    fn take_prefetched(&self, p: usize) -> Option<PartRoots> {
-        let mut prefetched = self.prefetched.lock().unwrap_or_else(|e| e.into_inner());
-        match prefetched.take() {
-            Some((q, roots)) if q == p => Some(roots),
-            _ => None,
-        }
-    }
-
     /// Hands a grown part back once it is written, so that a later part
     /// reuses its memory instead of asking the kernel for fresh pages
     /// (whose first touch faults and zeroes them: a tenth of a groom's
@@ -698,60 +252,5 @@ impl Generator {
     pub(super) fn spare_arrays(&self) -> CurveArrays {
         let mut spare = self.spare.lock().unwrap_or_else(|e| e.into_inner());
         spare.pop().unwrap_or_default()
-    }
-}
-
-/// Binds every map of the groom to its mesh (per-vertex maps take their
-/// values), or fails naming the setting whose map the mesh cannot serve
-/// (image maps need UVs, per-vertex maps their attribute).
-fn bind_maps(spec: &mut GroomSpec) -> Result<(), GroomError> {
-    let mesh = spec.mesh.clone();
-    let mut failed = None;
-    {
-        let mut bind = |key: String, map: &mut Map| {
-            if failed.is_none()
-                && let Err(e) = map.bind(&mesh)
-            {
-                failed = Some((key, e));
-            }
-        };
-        bind("roots.density".into(), &mut spec.roots.density);
-        let finish = &mut spec.finish;
-        for (key, map) in root_to_tip_maps_mut(&mut finish.width) {
-            bind(format!("finish.width.{key}"), map);
-        }
-        if let Some(color) = &mut finish.color {
-            for (key, map) in color_maps_mut(color) {
-                bind(format!("finish.color.{key}"), map);
-            }
-        }
-        if let Some(opacity) = &mut finish.opacity {
-            for (key, map) in root_to_tip_maps_mut(opacity) {
-                bind(format!("finish.opacity.{key}"), map);
-            }
-        }
-        for (index, op) in spec.ops.iter_mut().enumerate() {
-            let key = OpKey {
-                index,
-                name: op.name(),
-            };
-            for (field, map) in op.maps_mut() {
-                bind(key.field(field), map);
-            }
-        }
-        if let Some(regions) = &mut spec.regions {
-            for map in regions.maps_mut() {
-                bind("regions.map".into(), map);
-            }
-        }
-        if let Some(look) = &mut spec.look {
-            for (key, map) in look.maps_mut() {
-                bind(format!("look.{key}"), map);
-            }
-        }
-    }
-    match failed {
-        Some((key, e)) => Err(spec.error(&key, GroomErrorKind::Map(e))),
-        None => Ok(()),
     }
 }

@@ -5,9 +5,11 @@
 //! into arrays sized in advance; `strands` and `cut` take the general path,
 //! chunk by chunk. Both end in one assembly of the part's [`Curves`].
 
-use super::error::GroomError;
-use super::generator::Generator;
+use super::blue_noise;
+use super::error::{GroomError, GroomErrorKind};
+use super::generator::{Generator, PartRoots};
 use super::ops::{Hair, HairBatch, Operator, RootContext, Scratch};
+use super::spec::RootDistribution;
 use crate::curves::frames::{
     FrameScratch, catmull_rom_tangents, hair_normals, rotation_minimizing_normals,
 };
@@ -17,6 +19,7 @@ use crate::map::MapSite;
 use crate::mesh::SurfacePoint;
 use glam::Vec3;
 use rayon::prelude::*;
+use std::sync::atomic::Ordering;
 
 /// Hairs a worker grows between hand-overs (fixed, so results never depend
 /// on the number of threads).
@@ -43,6 +46,57 @@ pub(super) struct Workspace {
 const GROUP: usize = 8;
 
 impl Generator {
+    /// Roots of part `p`, ordered by triangle (so neighbouring hairs are
+    /// grown together), and their hairs' ids. With stable ids each of the
+    /// part's root cells samples its own hairs from its own stream;
+    /// otherwise the part samples its hairs in its triangles with its own
+    /// stream, numbered from the part's first hair id. Blue-noise roots
+    /// are then thinned from four times as many (`blue_noise.rs`).
+    pub fn part_roots(&self, p: usize) -> (Vec<SurfacePoint>, Vec<u64>) {
+        if self.distribution == RootDistribution::BlueNoise {
+            return blue_noise::part_roots(self, p);
+        }
+        self.regular_part_roots(p)
+    }
+
+    /// Grows part `p`: its curves with per-point widths, normals (unless
+    /// turned off), colours and opacities (when the groom has them), roots,
+    /// root UVs (meshes with UVs) and ids. Identical on any thread count:
+    /// workers grow fixed chunks of roots, in order.
+    ///
+    /// # Errors
+    /// When a hair's positions, widths, normals, colours or opacities are
+    /// not finite (an operator's parameters took it past `f32`'s range):
+    /// the error names the operator in the groom file, from growing that
+    /// hair again one operator at a time.
+    pub fn part(&self, p: usize) -> Result<Curves, GroomError> {
+        let (roots, ids) = self
+            .take_prefetched(p)
+            .unwrap_or_else(|| self.part_roots(p));
+        // Parts asked for in order (a whole groom, a farm task's range):
+        // the next part's roots are sampled and sorted beside this part's
+        // growth, on threads that would otherwise wait for its last chunks.
+        let previous = self.last_part.swap(p, Ordering::Relaxed);
+        let prefetch = p + 1 < self.layout.len() && (p == 0 || previous == p - 1);
+        let (curves, next) = rayon::join(
+            || self.grow_part(roots, ids),
+            || prefetch.then(|| self.part_roots(p + 1)),
+        );
+        if let Some(next) = next {
+            *self.prefetched.lock().unwrap_or_else(|e| e.into_inner()) = Some((p + 1, next));
+        }
+        curves
+    }
+
+    /// The roots of part `p` if they were sampled ahead.
+    fn take_prefetched(&self, p: usize) -> Option<PartRoots> {
+        let mut prefetched = self.prefetched.lock().unwrap_or_else(|e| e.into_inner());
+        match prefetched.take() {
+            Some((q, roots)) if q == p => Some(roots),
+            _ => None,
+        }
+    }
+
     /// Hair `id` grown from `root` through `ops` into `ws.batch`; returns
     /// the skin normal at the root.
     pub(super) fn grow(
@@ -438,94 +492,56 @@ fn concat(chunks: Vec<PartChunk>) -> CurveArrays {
     all
 }
 
-/// [`sorted_by_triangle`] carrying each root's id along (equal roots keep
-/// ascending ids).
-pub(super) fn sorted_by_triangle_with_ids(
-    roots: Vec<SurfacePoint>,
-    ids: Vec<u64>,
-) -> (Vec<SurfacePoint>, Vec<u64>) {
-    sorted_with(roots.into_iter().zip(ids).collect())
-        .into_iter()
-        .unzip()
-}
-
-/// `roots` ordered by (triangle, first barycentric, second barycentric),
-/// the order [`Generator::part_roots`] grows hairs in: the same order as
-/// a comparison sort by that key, found faster. A counting sort by
-/// triangle moves each root once; each triangle's few roots (a dozen or
-/// two) are then sorted among themselves. A comparison sort of the whole
-/// part took a tenth of a groom's time on one core.
-pub(super) fn sorted_by_triangle(roots: Vec<SurfacePoint>) -> Vec<SurfacePoint> {
-    // A zero-sized payload: the pairs are the roots' own size.
-    sorted_with(roots.into_iter().map(|r| (r, ())).collect())
-        .into_iter()
-        .map(|(r, ())| r)
-        .collect()
-}
-
-/// Roots with a payload each, sorted by (triangle, barycentrics, payload).
-fn sorted_with<T: Copy + Default + Ord>(roots: Vec<(SurfacePoint, T)>) -> Vec<(SurfacePoint, T)> {
-    let (Some(lo), Some(hi)) = (
-        roots.iter().map(|r| r.0.tri).min(),
-        roots.iter().map(|r| r.0.tri).max(),
-    ) else {
-        return roots;
-    };
-    // starts[t − lo] .. starts[t − lo + 1]: where triangle t's roots go.
-    let mut starts = vec![0u32; (hi - lo) as usize + 2];
-    for r in &roots {
-        starts[(r.0.tri - lo) as usize + 1] += 1;
-    }
-    for t in 1..starts.len() {
-        starts[t] += starts[t - 1];
-    }
-    let mut next = starts.clone();
-    let mut sorted = vec![(SurfacePoint::default(), T::default()); roots.len()];
-    for r in &roots {
-        let slot = &mut next[(r.0.tri - lo) as usize];
-        sorted[*slot as usize] = *r;
-        *slot += 1;
-    }
-    for range in starts.windows(2) {
-        let triangle = &mut sorted[range[0] as usize..range[1] as usize];
-        if triangle.len() > 1 {
-            triangle.sort_unstable_by_key(|(r, payload)| {
-                (r.bary[0].to_bits(), r.bary[1].to_bits(), *payload)
-            });
+impl Generator {
+    /// Hair `id`, grown from `root`, has a value that is not finite: grows
+    /// it again one operator at a time to say which operator (its place in
+    /// the groom file) took it there, and what went.
+    pub(super) fn non_finite_error(&self, root: SurfacePoint, id: u64) -> GroomError {
+        let mut ws = Workspace::default();
+        let context = self.root_context(root);
+        let hair = ws.batch.reset();
+        self.interpolated(&context, id, &mut ws.interpolation, &mut ws.shape, hair);
+        // The setting of operator `k` of the chain (the finishing ones
+        // first): its line comes from the groom's origin, if it has one.
+        let place = |k: usize| -> String {
+            match k.checked_sub(self.base.len()) {
+                Some(op) => format!("ops[{op}].{}", self.ops[op].name()),
+                None => format!("finish.{}", self.base[k].name()),
+            }
+        };
+        let error = |key: String, what: String| self.error(&key, GroomErrorKind::NotFinite(what));
+        for (k, op) in self.base.iter().chain(&self.ops).enumerate() {
+            op.apply(&mut ws.batch, &context, &mut ws.scratch);
+            if let Some(what) = ws.batch.hairs().iter().find_map(Hair::non_finite) {
+                return error(
+                    place(k),
+                    format!(
+                        "hair {id}'s {what} are no longer finite numbers after this operator: \
+                         its values take the hair past the range of 32-bit floats (about \
+                         ±3.4e38); make them smaller"
+                    ),
+                );
+            }
+            if ws.batch.is_empty() {
+                break;
+            }
         }
-    }
-    sorted
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sample::mix64;
-
-    #[test]
-    fn roots_sorted_by_triangle_match_a_comparison_sort() {
-        // Random roots over a few hundred triangles, with repeated
-        // triangles and first barycentrics (ties broken by the second),
-        // exact duplicates, and a negative zero.
-        let mut roots: Vec<SurfacePoint> = (0..5000u64)
-            .map(|i| {
-                let h = mix64(i);
-                let unit = |h: u64| (h >> 40) as f32 / (1u64 << 24) as f32;
-                let b0 = if i % 7 == 0 { 0.25 } else { unit(h) };
-                SurfacePoint::new((h % 300) as u32 * 77, [b0, unit(mix64(h))])
-            })
-            .collect();
-        roots.extend_from_within(..50);
-        roots.push(SurfacePoint::new(3, [-0.0, 0.5]));
-        roots.push(SurfacePoint::new(3, [0.0, 0.5]));
-        let mut expected = roots.clone();
-        expected.sort_unstable_by_key(|r| (r.tri, r.bary[0].to_bits(), r.bary[1].to_bits()));
-        let got = sorted_by_triangle(roots);
-        let bits = |r: &SurfacePoint| (r.tri, r.bary.map(f32::to_bits));
-        assert_eq!(
-            got.iter().map(bits).collect::<Vec<_>>(),
-            expected.iter().map(bits).collect::<Vec<_>>()
-        );
-        assert!(sorted_by_triangle(Vec::new()).is_empty());
+        // The values are finite, the normals are not: differences of
+        // points near the float range overflow.
+        let farthest = ws
+            .batch
+            .hairs()
+            .iter()
+            .flat_map(|h| h.points.iter())
+            .map(|p| p.abs().max_element())
+            .fold(0.0f32, f32::max);
+        error(
+            "finish.normals".to_string(),
+            format!(
+                "hair {id}'s normals are not finite numbers: its points reach {farthest:e}, \
+                 too far for their differences to fit in 32-bit floats; make the \
+                 operators' values smaller (or set normals = false)"
+            ),
+        )
     }
 }

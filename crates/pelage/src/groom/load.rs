@@ -8,14 +8,15 @@ use super::error::{GroomError, GroomErrorKind};
 use super::file::{AnimationModeName, GroomFile, InterpolationKind, MapValue, MeshSection};
 use super::generator::Generator;
 use super::hair_look::HairLook;
-use super::ops::{OpKey, SpecReader, map_on_mesh};
+use super::ops::{OpKey, SpecReader, map_on_mesh, read_color};
 use super::outside_skin::OutsideSkin;
+use super::parts::part_count;
 use super::simulate::{
     CacheUse, SimulatedGuides, SimulationSettings, cached_simulation, simulate_guides,
 };
-use super::spec::{FinishSpec, GroomSpec, HairIds, RegionsSpec, RootsSpec, SpecOrigin};
+use super::spec::{FinishSpec, GroomSpec, RegionsSpec, RootsSpec, SpecOrigin};
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
-use crate::dynamics::{StrandParams, Wind};
+use crate::dynamics::{GuideStrandParams, Wind};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{InterpolationMethod, StyleMeshOptions};
 use crate::mesh::{Mesh, MeshError, MeshErrorKind};
@@ -25,9 +26,6 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use toml::Spanned;
-
-/// Hairs per part when the groom does not say.
-pub const HAIRS_PER_PART: u64 = 100_000;
 
 /// A groom file loaded: the file, its mesh and guides (and, for an
 /// animated groom, its skin and frames).
@@ -373,7 +371,7 @@ impl Groom {
         let (lo, hi) = self.mesh.bounds();
         let size = (hi - lo).max_element();
         Ok(SimulationSettings {
-            params: StrandParams {
+            params: GuideStrandParams {
                 substeps: section.substeps,
                 iterations: section.iterations,
                 gravity: Vec3::from(section.gravity),
@@ -385,7 +383,7 @@ impl Groom {
                     .then(|| Wind::new(Vec3::from(section.wind), 0.0, 0.0, 0.0, 1.0, 0)),
                 thickness: section.thickness.unwrap_or(2e-3 * size),
                 friction: section.friction,
-                ..StrandParams::default()
+                ..GuideStrandParams::default()
             },
             collide: section.collide,
             preroll: section.preroll,
@@ -586,7 +584,10 @@ impl Groom {
             .color
             .as_ref()
             .map(|c| {
-                SpecReader::new(source, &self.mesh, &mut lines, "finish.color".into()).color(c)
+                read_color(
+                    &mut SpecReader::new(source, &self.mesh, &mut lines, "finish.color".into()),
+                    c,
+                )
             })
             .transpose()?;
         let opacity = file
@@ -724,21 +725,6 @@ impl Groom {
         }
         Generator::new(spec)
     }
-}
-
-/// The number of parts of `count` hairs: `parts` if given, or one per
-/// [`HAIRS_PER_PART`] hairs; at least one, at most one a triangle (a root
-/// cell, with stable ids: a part is a run of cells).
-pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>, ids: HairIds) -> usize {
-    let wanted = match parts {
-        Some(p) => p.max(1) as usize,
-        None => count.div_ceil(HAIRS_PER_PART).max(1) as usize,
-    };
-    let most = match ids {
-        HairIds::Stable => crate::sample::RootCells::count_for(mesh.triangle_count()),
-        HairIds::Sequential => mesh.triangle_count(),
-    };
-    wanted.min(most).max(1)
 }
 
 /// The mesh a `[mesh]` section names, subdivided as asked, with its paint

@@ -2,25 +2,39 @@
 //! part by part (Sik §4, Stubble's generator; the Furtility talk's chain of
 //! groom operators).
 //!
-//! - [`GroomSpec`] (`spec.rs`): the groom as plain Rust values: mesh,
-//!   guides, roots, interpolation, operators, finish. Programs and bindings
-//!   build one directly.
-//! - [`Groom`] (`load.rs`, the schema in `file.rs`): the TOML groom file, one front end
-//!   that produces a `GroomSpec`; every error with file, line and key
-//!   ([`GroomError`], `error.rs`; `source.rs` finds lines and keys).
-//! - [`Generator`]: a spec prepared for generation (root sampler,
-//!   [`PartLayout`], interpolator, operator chain with clump centres);
-//!   [`Generator::part`] grows one part's hairs (`grow.rs`; a hair that
-//!   overflows is traced to its operator in `diagnose.rs`).
-//! - [`ops`]: the operators.
-//! - [`parts`]: the part layout; [`Generator::write`] streams parts to a
-//!   file; [`FarmRun`] (`K/N`) is one run of a farm and
-//!   [`find_part_files`] finds the runs' files, which [`write_assembly`]
-//!   ties together in USD ([`Groom::assemble`] does both).
-//! - [`HairLook`] (`look.rs`): `[look]`, each hair's values for a
-//!   physically based hair shader.
-//! - [`GroomReport`] (`report.rs`): what a groom grew and left out, for
-//!   every front end.
+//! The parts stand in layers, lowest first; each uses only parts of its
+//! own layer listed before it, or of lower layers (`tools/layers-check`
+//! fails on an import circle; ARCHITECTURE.md has the table):
+//!
+//! 1. **Values.** `error.rs` ([`GroomError`]: file, line, key and a typed
+//!    kind), `source.rs` (settings' spans as errors, maps resolved against
+//!    the file's folder), [`Ramp`], `values.rs` (a map as written,
+//!    [`values::MapValue`], and the root-to-tip and colour specs),
+//!    [`regions`], [`HairLook`] (`hair_look.rs`: `[look]`, each hair's
+//!    values for a physically based hair shader), [`OutsideSkin`].
+//! 2. **Operators**: [`ops`], one module an operator, which see the chain
+//!    they are prepared in only through a trait, never the generator.
+//! 3. **Spec**: [`GroomSpec`] (`spec.rs`), the groom as plain Rust values
+//!    (mesh, guides, roots, interpolation, operators, finish), which
+//!    programs and bindings build directly; [`parts`], the part layout.
+//! 4. **Generate**: [`Generator`] (`generator.rs`: what a prepared groom
+//!    holds), `blue_noise.rs` (a part's roots thinned), `grow.rs`
+//!    ([`Generator::part`]: a part's hairs grown; a hair that overflows
+//!    traced to its operator), `build.rs` (a spec made a generator; a
+//!    clump's centres grown through the operators before it).
+//! 5. **Write**: `output.rs` ([`Generator::write`] streams parts to a file,
+//!    [`write_assembly`]), [`FarmRun`] (`farm.rs`, `K/N`, with
+//!    [`find_part_files`]), `clips.rs` (frame files stitched with USD value
+//!    clips).
+//! 6. **Animate**: [`animate`] (a groom carried or regrown over frames),
+//!    `simulate.rs` (guides simulated on the animated skin).
+//! 7. **File**: `file.rs` (the TOML schema and its range rules), [`Groom`]
+//!    (`load.rs`: a file with its mesh and guides, producing a `GroomSpec`
+//!    that keeps where each setting was written), [`GroomReport`]
+//!    (`report.rs`), `export.rs` (what every front end writes with:
+//!    [`Groom::export`], [`Groom::assemble`]).
+//! 8. **Edit**: [`edit`] (the editable groom, its undo stack, regrowing
+//!    only what an edit changed, saving) and [`brush`].
 //!
 //! One hair, as Sik's Fig. 14 draws it: a root sampled in its part → shape
 //! interpolated from the guides → resampled to the finishing point count →
@@ -32,10 +46,12 @@
 pub mod animate;
 mod blue_noise;
 pub mod brush;
+mod build;
 mod clips;
-mod diagnose;
+
 pub mod edit;
 mod error;
+mod export;
 mod farm;
 pub(crate) mod file;
 mod generator;
@@ -52,7 +68,7 @@ mod report;
 mod simulate;
 mod source;
 mod spec;
-mod writing;
+mod values;
 
 pub use animate::{
     AnimatedGroom, AnimationMode, AnimationProgress, AnimationSpec, AxisTurn, FrameOutput,
@@ -60,13 +76,14 @@ pub use animate::{
 };
 pub use clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
 pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
+pub use export::{AssembleError, Assembly, DEFAULT_FPS};
 pub use farm::{FarmError, FarmRun, find_part_files};
-pub use generator::{Generator, GroomSummary, HAIRS_PER_PART};
+pub use generator::{Generator, GroomSummary};
 pub use hair_look::HairLook;
 pub use load::{Groom, GroomInputs};
 pub use output::{GroomWriteError, StreamError, part_file, part_name, part_slice, write_assembly};
 pub use outside_skin::OutsideSkin;
-pub use parts::{Part, PartLayout};
+pub use parts::{HAIRS_PER_PART, Part, PartLayout};
 pub use ramp::Ramp;
 pub use report::{
     GroomReport, GuideNote, GuidesReport, LostGuideNote, PartReport, RegionReport, ReportBuilder,
@@ -76,7 +93,6 @@ pub use simulate::{
     CacheUse, SIMULATED_GUIDES_NAME, SimulatedGuides, SimulationSettings, cached_simulation,
     simulate_guides, simulation_key,
 };
-pub use writing::{AssembleError, Assembly, DEFAULT_FPS};
 
 pub use ops::{
     ClumpParams, CurlParams, FlyawaysParams, FrizzParams, GroomOp, LengthParams, NoiseParams,

@@ -13,7 +13,9 @@
 //! runs of root cells ([`crate::sample::RootCells`]) of about equal hair
 //! counts, and each cell numbers its own hairs.
 
-use crate::mesh::{Mesh, morton};
+use super::spec::HairIds;
+use crate::mesh::{Mesh, SurfacePoint, morton};
+use crate::sample::RootCells;
 use glam::Vec3;
 
 /// One part of the mesh.
@@ -156,9 +158,87 @@ impl PartLayout {
     }
 }
 
+/// Hairs per part when the groom does not say.
+pub const HAIRS_PER_PART: u64 = 100_000;
+
+/// The number of parts of `count` hairs: `parts` if given, or one per
+/// [`HAIRS_PER_PART`] hairs; at least one, at most one a triangle (a root
+/// cell, with stable ids: a part is a run of cells).
+pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>, ids: HairIds) -> usize {
+    let wanted = match parts {
+        Some(p) => p.max(1) as usize,
+        None => count.div_ceil(HAIRS_PER_PART).max(1) as usize,
+    };
+    let most = match ids {
+        HairIds::Stable => RootCells::count_for(mesh.triangle_count()),
+        HairIds::Sequential => mesh.triangle_count(),
+    };
+    wanted.min(most).max(1)
+}
+
+/// [`sorted_by_triangle`] carrying each root's id along (equal roots keep
+/// ascending ids).
+pub(crate) fn sorted_by_triangle_with_ids(
+    roots: Vec<SurfacePoint>,
+    ids: Vec<u64>,
+) -> (Vec<SurfacePoint>, Vec<u64>) {
+    sorted_with(roots.into_iter().zip(ids).collect())
+        .into_iter()
+        .unzip()
+}
+
+/// `roots` ordered by (triangle, first barycentric, second barycentric),
+/// the order [`Generator::part_roots`] grows hairs in: the same order as
+/// a comparison sort by that key, found faster. A counting sort by
+/// triangle moves each root once; each triangle's few roots (a dozen or
+/// two) are then sorted among themselves. A comparison sort of the whole
+/// part took a tenth of a groom's time on one core.
+pub(crate) fn sorted_by_triangle(roots: Vec<SurfacePoint>) -> Vec<SurfacePoint> {
+    // A zero-sized payload: the pairs are the roots' own size.
+    sorted_with(roots.into_iter().map(|r| (r, ())).collect())
+        .into_iter()
+        .map(|(r, ())| r)
+        .collect()
+}
+
+/// Roots with a payload each, sorted by (triangle, barycentrics, payload).
+fn sorted_with<T: Copy + Default + Ord>(roots: Vec<(SurfacePoint, T)>) -> Vec<(SurfacePoint, T)> {
+    let (Some(lo), Some(hi)) = (
+        roots.iter().map(|r| r.0.tri).min(),
+        roots.iter().map(|r| r.0.tri).max(),
+    ) else {
+        return roots;
+    };
+    // starts[t − lo] .. starts[t − lo + 1]: where triangle t's roots go.
+    let mut starts = vec![0u32; (hi - lo) as usize + 2];
+    for r in &roots {
+        starts[(r.0.tri - lo) as usize + 1] += 1;
+    }
+    for t in 1..starts.len() {
+        starts[t] += starts[t - 1];
+    }
+    let mut next = starts.clone();
+    let mut sorted = vec![(SurfacePoint::default(), T::default()); roots.len()];
+    for r in &roots {
+        let slot = &mut next[(r.0.tri - lo) as usize];
+        sorted[*slot as usize] = *r;
+        *slot += 1;
+    }
+    for range in starts.windows(2) {
+        let triangle = &mut sorted[range[0] as usize..range[1] as usize];
+        if triangle.len() > 1 {
+            triangle.sort_unstable_by_key(|(r, payload)| {
+                (r.bary[0].to_bits(), r.bary[1].to_bits(), *payload)
+            });
+        }
+    }
+    sorted
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sample::mix64;
 
     #[test]
     fn parts_cover_every_triangle_and_tile_the_hair_ids() {
@@ -195,5 +275,32 @@ mod tests {
             let volume = |l: Vec3, h: Vec3| (h - l).x * (h - l).y * (h - l).z;
             assert!(volume(b.0, b.1) < 0.6 * volume(lo, hi));
         }
+    }
+
+    #[test]
+    fn roots_sorted_by_triangle_match_a_comparison_sort() {
+        // Random roots over a few hundred triangles, with repeated
+        // triangles and first barycentrics (ties broken by the second),
+        // exact duplicates, and a negative zero.
+        let mut roots: Vec<SurfacePoint> = (0..5000u64)
+            .map(|i| {
+                let h = mix64(i);
+                let unit = |h: u64| (h >> 40) as f32 / (1u64 << 24) as f32;
+                let b0 = if i % 7 == 0 { 0.25 } else { unit(h) };
+                SurfacePoint::new((h % 300) as u32 * 77, [b0, unit(mix64(h))])
+            })
+            .collect();
+        roots.extend_from_within(..50);
+        roots.push(SurfacePoint::new(3, [-0.0, 0.5]));
+        roots.push(SurfacePoint::new(3, [0.0, 0.5]));
+        let mut expected = roots.clone();
+        expected.sort_unstable_by_key(|r| (r.tri, r.bary[0].to_bits(), r.bary[1].to_bits()));
+        let got = sorted_by_triangle(roots);
+        let bits = |r: &SurfacePoint| (r.tri, r.bary.map(f32::to_bits));
+        assert_eq!(
+            got.iter().map(bits).collect::<Vec<_>>(),
+            expected.iter().map(bits).collect::<Vec<_>>()
+        );
+        assert!(sorted_by_triangle(Vec::new()).is_empty());
     }
 }

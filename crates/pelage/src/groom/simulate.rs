@@ -21,7 +21,7 @@ use super::output::GroomWriteError;
 use super::spec::GroomSpec;
 use crate::Curves;
 use crate::anim::{AnimatedSkin, SkinPose};
-use crate::dynamics::{GuideSimulation, StrandParams};
+use crate::dynamics::{GuideSimulation, GuideStrandParams};
 use crate::io::{AbcWriter, AtomicFile, CurvesFormat, UsdOptions, UsdcWriter};
 use std::ops::RangeInclusive;
 use std::path::Path;
@@ -35,7 +35,7 @@ pub const SIMULATED_GUIDES_NAME: &str = "guides";
 #[derive(Debug, Clone)]
 pub struct SimulationSettings {
     /// The solver's settings.
-    pub params: StrandParams,
+    pub params: GuideStrandParams,
     /// Collide with the skin.
     pub collide: bool,
     /// Frames at the first frame's pose before it.

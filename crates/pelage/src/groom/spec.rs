@@ -1,7 +1,7 @@
 //! The groom as plain Rust values: a mesh, guides, where roots grow, how
 //! hairs take the guides' shape, the operator chain and the finish
 //! (Sik §4's generator inputs). [`GroomSpec::generator`] prepares a
-//! [`Generator`] from them; a groom file ([`super::Groom`]) is one front end
+//! [`Generator`](super::Generator) from them; a groom file ([`super::Groom`]) is one front end
 //! that produces a `GroomSpec`, a program (or a binding) is another.
 //!
 //! Everything here is owned or shared (`Arc`), so a spec and the generator
@@ -25,7 +25,6 @@
 //! ```
 
 use super::error::{GroomError, GroomErrorKind};
-use super::generator::Generator;
 use super::hair_look::HairLook;
 pub use super::ops::GroomOp;
 use super::ops::{Color, RootToTip};
@@ -129,19 +128,6 @@ impl GroomSpec {
     pub fn with_name(mut self, name: impl Into<PathBuf>) -> Self {
         self.name = name.into();
         self
-    }
-
-    /// Prepares generation: the root sampler and part layout, the
-    /// interpolator (the style mesh is built here), the operator chain and
-    /// its clump centres.
-    ///
-    /// # Errors
-    /// A count of zero, fewer than 2 points a hair, a map that needs UVs on
-    /// a mesh without them, a density that is zero everywhere; the error
-    /// names the setting (`ops[2].clump.count`), and its line when the
-    /// groom came from a file.
-    pub fn generator(self) -> Result<Generator, GroomError> {
-        Generator::new(self)
     }
 
     /// An error about the setting `key` (`roots.count`, `ops[1].noise`),

@@ -18,12 +18,11 @@
 //! (Frames built from UV tangents would flip across UV seams; the minimal
 //! rotation between two normals has no seams.)
 
-mod nearest;
 mod regional;
 mod shepard;
 mod style_mesh;
 
-pub use nearest::{NearestPoints, Neighbour, NeighbourCache, QueryRegion};
+pub use crate::nearest::{NearestPoints, Neighbour, NeighbourCache, QueryRegion};
 pub use regional::RegionWeights;
 pub(crate) use regional::indices_by_region;
 pub use shepard::Shepard;

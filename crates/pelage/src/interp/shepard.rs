@@ -4,12 +4,12 @@
 //! root takes that guide alone; with a radius, guides farther away are
 //! ignored, and a hair with none inside takes its nearest guide alone.
 //! A run of nearby roots is answered from a candidate list instead of the
-//! tree ([`super::NearestPoints`]), with the same result.
+//! tree ([`crate::nearest::NearestPoints`]), with the same result.
 
-use super::nearest::{NearestPoints, Neighbour, NeighbourCache};
 use super::{GuideWeight, GuideWeights, HairRoot, normalise};
 use crate::guides::Guides;
 use crate::mesh::Mesh;
+use crate::nearest::{NearestPoints, Neighbour, NeighbourCache};
 
 /// Inverse-distance weights over the k nearest guide roots.
 pub struct Shepard {

@@ -86,7 +86,7 @@ pub fn read_curves_ply(path: &Path) -> Result<Curves, CurvesReadError> {
                 ));
             }
         }
-        widths.push(get("width").unwrap_or(super::DEFAULT_WIDTH));
+        widths.push(get("width").unwrap_or(crate::curves::DEFAULT_WIDTH));
     }
     let n = points.len();
     let (mut next, mut has_previous) = (vec![u32::MAX; n], vec![false; n]);

@@ -15,6 +15,8 @@
 //! - [`write_curves_ply`] / [`read_curves_ply`]: curves as PLY polylines.
 //! - [`write_rib`] / [`write_pbrt`]: RenderMan and pbrt-v4 scene text.
 //! - [`PointsPly`]: sampled points with normals, UVs and triangle indices.
+//! - [`Mesh::load`](crate::Mesh::load) / [`Mesh::from_bytes`](crate::Mesh::from_bytes):
+//!   a mesh by format (`mesh_file.rs`), here because USD meshes need the USD reader.
 
 mod abc;
 mod atomic;
@@ -23,10 +25,12 @@ mod curves_file;
 mod curves_ply;
 mod hair;
 mod hair_material;
+mod mesh_file;
 mod points_ply;
 mod read_error;
 mod render_text;
 mod text;
+mod usd_options;
 mod usd_read;
 mod usd_schema;
 mod usda;
@@ -40,25 +44,25 @@ pub use atomic::{
     AtomicFile, check_free_space, check_input, check_output, note_input, protect_inputs,
     remove_temporary_files, write_atomically, write_atomically_with,
 };
-pub use curves_file::{
-    CurvesExport, CurvesFormat, join, read_curves, write_curves, write_streamed,
-};
+pub use curves_file::{CurvesExport, CurvesFormat, read_curves, write_curves, write_streamed};
 pub use curves_ply::{read_curves_ply, write_curves_ply};
 pub use hair::{HairFile, HairWriteError};
+pub(crate) use mesh_file::usd_mesh_error;
 pub use points_ply::{
     PointsPly, ply_element_count, ply_has_faces, read_points_ply, write_points_ply,
 };
 pub use read_error::{CurvesReadError, CurvesReadErrorKind};
 pub use render_text::{bezier_control_points, write_pbrt, write_rib};
+pub use usd_options::{CurveBasis, PrimWriteError, UpAxis, UsdOptions, UsdWrap};
 pub use usd_read::{
-    DEFAULT_WIDTH, UsdCurvesSequence, UsdLayerInfo, read_usd_curves, read_usd_curves_at,
-    read_usd_extent, read_usd_layer_info, usd_curves_from_bytes,
+    UsdCurvesSequence, UsdLayerInfo, read_usd_curves, read_usd_curves_at, read_usd_extent,
+    read_usd_layer_info, usd_curves_from_bytes,
 };
 pub(crate) use usd_read::{UsdSkin, read_usd_skin, usd_skin_from_bytes};
 pub(crate) use usd_schema::curve_extent;
 pub use usd_schema::{PrimWriter, SurfacePoints};
+pub use usda::UsdaWriter;
 pub(crate) use usda::asset_path;
-pub use usda::{CurveBasis, PrimWriteError, UpAxis, UsdOptions, UsdWrap, UsdaWriter};
 pub use usdc::UsdcWriter;
 
 use std::path::PathBuf;

@@ -17,8 +17,7 @@ use glam::{DMat4, DVec3};
 use openusd::sdf::{self, AbstractData, SpecType, Value};
 use std::path::Path;
 
-/// Width given to curves whose file has no widths.
-pub const DEFAULT_WIDTH: f32 = 0.01;
+use crate::curves::DEFAULT_WIDTH;
 
 /// Reads every `BasisCurves` prim of a usda or usdc file into one
 /// [`Curves`] (points in world space).
@@ -175,7 +174,7 @@ fn curves_from_layer(
     // Guides (`purpose = "guide"`) are not hairs: read them only from a
     // file that holds nothing else (a guides file).
     let read = if parts.is_empty() { &guides } else { &parts };
-    super::join(read).map_err(|e| CurvesReadError::whole(path, e.into()))
+    crate::curves::join(read).map_err(|e| CurvesReadError::whole(path, e.into()))
 }
 
 /// Adds the attributes pelage writes, where the prim has them with the

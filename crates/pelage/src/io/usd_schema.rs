@@ -11,7 +11,7 @@
 //! (`uniform`), and every prim has an `extent`
 //! padded by half the widest hair, as `UsdGeomCurves::ComputeExtent` does.
 
-use super::usda::{CurveBasis, PrimWriteError, UsdOptions, UsdWrap};
+use super::usd_options::{CurveBasis, PrimWriteError, UsdOptions, UsdWrap};
 use crate::Curves;
 use crate::mesh::{Mesh, Uvs};
 use glam::{Vec2, Vec3};
@@ -396,20 +396,6 @@ fn check_curve_lengths(
                 (CurveBasis::CatmullRom, UsdWrap::Nonperiodic) => "nonperiodic Catmull-Rom",
             },
         }),
-    }
-}
-
-/// USD prim names: an identifier.
-pub(crate) fn check_name(name: &str) -> Result<(), PrimWriteError> {
-    let mut chars = name.chars();
-    let ok = chars
-        .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
-    if ok {
-        Ok(())
-    } else {
-        Err(PrimWriteError::BadName(name.to_string()))
     }
 }
 

@@ -18,7 +18,7 @@ use std::path::Path;
 
 /// Reads a glTF or GLB from bytes; `base` is the folder external buffers
 /// are resolved against (None for self-contained files).
-pub(super) fn parse(name: &str, bytes: &[u8], base: Option<&Path>) -> Result<Mesh, MeshError> {
+pub(crate) fn parse(name: &str, bytes: &[u8], base: Option<&Path>) -> Result<Mesh, MeshError> {
     parse_with_sources(name, bytes, base).map(|parsed| parsed.mesh)
 }
 

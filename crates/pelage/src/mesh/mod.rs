@@ -21,9 +21,8 @@ mod closest;
 mod error;
 pub(crate) mod gltf;
 mod graph;
-pub(crate) mod load;
-mod obj;
-mod ply;
+pub(crate) mod obj;
+pub(crate) mod ply;
 mod ray;
 mod subdivide;
 mod surface_point;
@@ -33,7 +32,6 @@ pub use closest::{ClosestPoint, TriangleBvh, closest_on_triangle};
 pub use error::{Location, MeshError, MeshErrorKind};
 pub use graph::EdgeGraph;
 pub(crate) use graph::morton;
-pub use load::MeshFormat;
 pub(crate) use ply::scalar as ply_scalar;
 pub use ray::{RayHit, first_hit};
 pub use surface_point::{SurfacePoint, TangentFrame};
@@ -41,6 +39,36 @@ pub use topology::{EdgeList, TopologyReport, VertexAdjacency};
 
 use glam::{Vec2, Vec3};
 use std::sync::{Arc, OnceLock};
+
+/// The mesh file formats pelage reads ([`Mesh::load`] and
+/// [`Mesh::from_bytes`], written in `io/mesh_file.rs`, beside the USD
+/// reader they need).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ.
+    Obj,
+    /// Stanford PLY, ASCII or binary.
+    Ply,
+    /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
+    Gltf,
+    /// USD, text or binary (`.usda`, `.usdc`, `.usd`): every `Mesh` prim,
+    /// at its first time sample.
+    Usd,
+}
+
+impl MeshFormat {
+    /// The format a file name's extension names (case-insensitive).
+    pub fn from_path(path: &std::path::Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "obj" => Some(Self::Obj),
+            "ply" => Some(Self::Ply),
+            "gltf" | "glb" => Some(Self::Gltf),
+            "usda" | "usdc" | "usd" => Some(Self::Usd),
+            _ => None,
+        }
+    }
+}
 
 /// A named scalar per vertex: a PLY vertex property other than position,
 /// normal and UV (`red`, `green`, `blue` and `alpha` scaled to 0–1 when

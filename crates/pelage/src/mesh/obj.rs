@@ -15,7 +15,7 @@ use super::{FaceGroups, Mesh, MeshError, MeshErrorKind, Uvs};
 use glam::{Vec2, Vec3};
 
 /// Parses OBJ text. `name` is what errors call the file.
-pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
+pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
     // Editors on Windows may start the text with a UTF-8 byte-order mark;
     // left in place it would hide the first statement.
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);

@@ -10,7 +10,7 @@ use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
 
 /// Parses a PLY file's bytes. `name` is what errors call the file.
-pub(super) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
+pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
     let parser = Parser::<DefaultElement>::new();
     let ply = parser
         .read_ply(&mut std::io::Cursor::new(bytes))

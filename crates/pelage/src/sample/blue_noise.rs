@@ -19,8 +19,8 @@
 //! removal changes the weights the next choice reads).
 
 use super::{DensitySampler, SurfaceSampler, mix64, salts, sample_range};
-use crate::interp::NearestPoints;
 use crate::mesh::{Mesh, SurfacePoint};
+use crate::nearest::NearestPoints;
 use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::time::Instant;

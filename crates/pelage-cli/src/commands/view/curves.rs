@@ -257,7 +257,7 @@ impl CurvesSession {
             let wide = Curves::new(guides.points().to_vec(), widths, guides.offsets().to_vec())?;
             parts.push(painted(wide, GUIDE_COLOR)?);
         }
-        let curves = pelage::io::join(parts.iter())?;
+        let curves = pelage::curves::join(parts.iter())?;
         let roots: Vec<Vec3> = if c.roots {
             (0..hairs.curve_count())
                 .map(|i| hairs.points()[hairs.range(i).start])
@@ -432,7 +432,7 @@ fn load(source: &CurvesSource) -> anyhow::Result<Loaded> {
             let parts = (0..generator.parts().len())
                 .map(|p| generator.part(p))
                 .collect::<Result<Vec<Curves>, _>>()?;
-            let hairs = pelage::io::join(parts.iter())?;
+            let hairs = pelage::curves::join(parts.iter())?;
             let guides = groom.guides().curves().clone();
             drop(generator);
             let texture = if groom.mesh().name() == pelage::assets::spot().name() {

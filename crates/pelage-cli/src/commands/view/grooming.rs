@@ -352,7 +352,7 @@ impl GroomingSession {
             let n = wide.points().len();
             parts.push(wide.with_colors(vec![GUIDE_COLOR; n])?);
         }
-        let curves = pelage::io::join(parts.iter())?;
+        let curves = pelage::curves::join(parts.iter())?;
         let scene = PreviewScene {
             mesh: Some(self.groom.mesh()).filter(|_| c.skin),
             points: &[],

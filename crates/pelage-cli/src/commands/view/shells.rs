@@ -5,7 +5,7 @@
 //! changes all of it live.
 
 use glam::Vec3;
-use pelage::dynamics::{Brush, Solver, Topology, Wind};
+use pelage::dynamics::{PushBrush, Solver, Topology, Wind};
 use pelage::shell::math::{ClumpParams, Coupling, ShadingMode};
 use pelage::shell::scene::DynamicsSettings;
 use pelage::shell::wetness::{Droplet, DropletStyle, droplets_on_mesh, mask_coordinates};
@@ -92,7 +92,7 @@ pub struct ShellSession {
     rain_owed: f32,
     shake_since: Option<f32>,
     time: f32,
-    brush: Option<Brush>,
+    brush: Option<PushBrush>,
     /// The scene's wind (direction, gusts, turbulence); the panel sets
     /// its speed.
     base_wind: Wind,
@@ -253,7 +253,7 @@ impl ShellSession {
             return false;
         };
         let (lo, hi) = mesh.bounds();
-        let brush = Brush {
+        let brush = PushBrush {
             centre: hit.point.position(&mesh),
             radius: self.controls.brush_radius * (hi - lo).length(),
             force,

@@ -22,8 +22,8 @@
 use crate::curves::Curves;
 use crate::groom::error::GroomError;
 use crate::groom::generator::Generator;
-use crate::groom::grow::sorted_by_triangle_with_ids;
 use crate::groom::ops::{ClumpCentres, Operator};
+use crate::groom::parts::sorted_by_triangle_with_ids;
 use crate::interp::{GuideWeight, HairRoot, HairScratch, NeighbourCache};
 use crate::mesh::SurfacePoint;
 use glam::{Vec2, Vec3};

@@ -3,11 +3,11 @@
 //! hair color").
 
 use super::kind::{OperatorKind, Preparation, SpecReader};
-use super::look::varied;
+use super::root_to_tip::varied;
 use super::{Hair, RootContext, Scratch};
 use crate::groom::error::GroomError;
-use crate::groom::file::{ColorSpec, MapValue};
 use crate::groom::ramp::Ramp;
+use crate::groom::values::{ColorSpec, MapValue};
 use crate::map::Map;
 use glam::Vec3;
 
@@ -61,7 +61,7 @@ impl OperatorKind for Color {
     }
 
     fn read(s: &ColorSpec, r: &mut SpecReader<'_>) -> Result<Color, GroomError> {
-        r.color(s)
+        read_color(r, s)
     }
 
     fn maps(p: &Color) -> Vec<(&'static str, &Map)> {
@@ -87,6 +87,18 @@ impl OperatorKind for Color {
                 .map(|&r| (factor * a.lerp(b, r)).max(Vec3::ZERO)),
         );
     }
+}
+
+/// A colour from root to tip, its maps read where the spec wrote them
+/// (the `color` operator's and `[finish.color]`).
+pub(crate) fn read_color(r: &mut SpecReader<'_>, s: &ColorSpec) -> Result<Color, GroomError> {
+    Ok(Color {
+        root: r.rgb("root", &s.root)?,
+        tip: r.rgb("tip", &s.tip)?,
+        ramp: s.ramp.clone(),
+        jitter: r.map("jitter", &s.jitter)?,
+        seed: s.seed,
+    })
 }
 
 #[cfg(test)]

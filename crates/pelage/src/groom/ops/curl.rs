@@ -4,8 +4,8 @@
 use super::kind::{OperatorKind, Preparation, SpecReader};
 use super::{Hair, RootContext, Scratch, param};
 use crate::groom::error::GroomError;
-use crate::groom::file::MapValue;
 use crate::groom::ramp::Ramp;
+use crate::groom::values::MapValue;
 use crate::map::Map;
 use crate::sample::SampleRng;
 use serde::Deserialize;

@@ -4,7 +4,7 @@
 use super::kind::{OperatorKind, Preparation, SpecReader};
 use super::{HairBatch, RootContext, Scratch, param};
 use crate::groom::error::GroomError;
-use crate::groom::file::MapValue;
+use crate::groom::values::MapValue;
 use crate::map::Map;
 use serde::Deserialize;
 

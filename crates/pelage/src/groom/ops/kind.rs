@@ -10,10 +10,10 @@
 //! line of the registry in `ops/mod.rs`, its tests and its docs
 //! (docs/adding-an-operator.md).
 
+use super::centres::ClumpCentres;
 use super::{Hair, HairBatch, RootContext, Scratch};
 use crate::groom::error::{GroomError, GroomErrorKind};
-use crate::groom::file::{ColorSpec, MapText, MapValue, RootToTipSpec};
-use crate::groom::generator::Generator;
+use crate::groom::values::{MapText, MapValue, RootToTipSpec};
 use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
 use crate::settings::{Rule, SettingsSource};
@@ -192,17 +192,6 @@ impl<'a> SpecReader<'a> {
             seed: s.seed,
         })
     }
-
-    /// A colour from root to tip.
-    pub fn color(&mut self, s: &ColorSpec) -> Result<super::Color, GroomError> {
-        Ok(super::Color {
-            root: self.rgb("root", &s.root)?,
-            tip: self.rgb("tip", &s.tip)?,
-            ramp: s.ramp.clone(),
-            jitter: self.map("jitter", &s.jitter)?,
-            seed: s.seed,
-        })
-    }
 }
 
 /// Resolves a map value and binds it to `mesh` (UVs, vertex
@@ -223,15 +212,31 @@ pub(crate) fn default_map(value: f32) -> MapValue {
     toml::Spanned::new(0..0, MapText::Number(value))
 }
 
-/// What preparing operator `k` of a chain can use: the generator built so
-/// far (the operators before it are prepared), the operator's own random
+/// What preparing an operator can ask of the chain before it: the
+/// generator being built implements this (`groom/build.rs`), so the
+/// operators never name the generator that runs them.
+pub(crate) trait ChainSoFar: Sync {
+    /// The groom's seed.
+    fn seed(&self) -> u64;
+    /// An error about the setting `key`, at its line when the groom came
+    /// from a file.
+    fn error(&self, key: &str, kind: GroomErrorKind) -> GroomError;
+    /// The mesh hairs grow on.
+    fn mesh(&self) -> &Mesh;
+    /// The centre roots of the clump at chain position `k` in the groom
+    /// being reshaped, when nothing but guide shapes changed.
+    fn unchanged_centre_roots(&self, k: usize) -> Option<Vec<SurfacePoint>>;
+    /// Hairs grown from `roots` through the operators before position
+    /// `k`: the centre hairs of a clump level.
+    fn clump_centres(&self, k: usize, roots: &[SurfacePoint]) -> ClumpCentres;
+}
+
+/// What preparing operator `k` of a chain can use: the chain built so far
+/// (the operators before it are prepared), the operator's own random
 /// streams and its errors.
 pub(crate) struct Preparation<'a> {
-    pub(crate) generator: &'a Generator,
+    pub(crate) chain: &'a dyn ChainSoFar,
     pub(crate) key: OpKey,
-    /// The generator this one reshapes (same roots, weights, operators;
-    /// other guide shapes), with the guides that moved (`None`: any).
-    pub(crate) reshaping: Option<(&'a Generator, Option<&'a [bool]>)>,
 }
 
 impl Preparation<'_> {
@@ -240,39 +245,30 @@ impl Preparation<'_> {
     /// operators with the same seed still differ.
     pub fn seed(&self, s: u64) -> u64 {
         use crate::sample::mix64;
-        mix64(self.generator.seed() ^ mix64((self.key.index as u64 + 1) << 32 ^ s))
+        mix64(self.chain.seed() ^ mix64((self.key.index as u64 + 1) << 32 ^ s))
     }
 
     /// An error about one of the operator's settings, at its line.
     pub fn error(&self, field: &str, kind: GroomErrorKind) -> GroomError {
-        self.generator.error(&self.key.field(field), kind)
+        self.chain.error(&self.key.field(field), kind)
     }
 
     /// The mesh hairs grow on.
     pub fn mesh(&self) -> &Mesh {
-        self.generator.mesh()
+        self.chain.mesh()
     }
 
     /// The centre roots of this clump operator in the generator being
     /// reshaped, when nothing but guide shapes changed (the same density,
     /// count and seed sample the same roots).
     pub fn unchanged_centre_roots(&self) -> Option<Vec<SurfacePoint>> {
-        let (previous, Some(_)) = self.reshaping? else {
-            return None;
-        };
-        match previous.operators().get(self.key.index)?.unmasked() {
-            super::Operator::Clump(c) if !c.centres().surface_roots().is_empty() => {
-                Some(c.centres().surface_roots().to_vec())
-            }
-            _ => None,
-        }
+        self.chain.unchanged_centre_roots(self.key.index)
     }
 
     /// Hairs grown from `roots` through the operators before this one: the
     /// centre hairs of a clump level.
-    pub fn centres(&self, roots: &[SurfacePoint]) -> super::ClumpCentres {
-        self.generator
-            .clump_centres(self.key.index, roots, self.reshaping)
+    pub fn centres(&self, roots: &[SurfacePoint]) -> ClumpCentres {
+        self.chain.clump_centres(self.key.index, roots)
     }
 }
 

@@ -4,7 +4,7 @@
 use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
 use super::{Hair, RootContext, Scratch, jittered};
 use crate::groom::error::GroomError;
-use crate::groom::file::MapValue;
+use crate::groom::values::MapValue;
 use crate::map::Map;
 use crate::sample::SampleRng;
 use crate::settings::{Bound, Rule};

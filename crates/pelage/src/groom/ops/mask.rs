@@ -186,7 +186,7 @@ mod tests {
     #[test]
     fn a_masked_first_look_fades_from_the_unmasked_look() {
         use super::super::Opacity;
-        use super::super::look::tests::spec;
+        use super::super::root_to_tip::tests::spec;
         let opacity = || Operator::Opacity(Opacity(spec(0.2, 0.2, 0.0)));
         let mut scratch = Scratch::default();
         for (m, want) in [(0.0, UNMASKED_OPACITY), (0.5, 0.6), (1.0, 0.2)] {

@@ -13,6 +13,7 @@
 //! Points are indexed root to tip; `t = j / (n − 1)` is point `j`'s curve
 //! parameter, the `t` of every root-to-tip [`Ramp`].
 
+mod centres;
 mod clump;
 mod color;
 mod curl;
@@ -21,15 +22,16 @@ mod flyaways;
 mod frizz;
 mod kind;
 mod length;
-mod look;
 mod mask;
 mod noise;
 mod opacity;
+mod root_to_tip;
 mod strands;
 mod twist;
 mod width;
 
-pub use clump::{CentreGuides, Clump, ClumpCentres, ClumpParams};
+pub use centres::{CentreGuides, ClumpCentres};
+pub use clump::{Clump, ClumpParams};
 pub use color::Color;
 pub use curl::{Curl, CurlParams};
 pub use cut::Cut;
@@ -44,12 +46,13 @@ pub use twist::{Twist, TwistParams};
 pub use width::Width;
 
 pub(crate) use color::color_maps_mut;
+pub(crate) use color::read_color;
 pub use kind::OperatorSchema;
-pub(crate) use kind::{OpKey, Preparation, SpecReader, map_on_mesh, schema_of};
-pub(crate) use look::root_to_tip_maps_mut;
+pub(crate) use kind::{ChainSoFar, OpKey, Preparation, SpecReader, map_on_mesh, schema_of};
+pub(crate) use root_to_tip::root_to_tip_maps_mut;
 
 use crate::groom::error::GroomError;
-use crate::groom::file::MapValue;
+use crate::groom::values::MapValue;
 use crate::settings::Rule;
 use kind::{OperatorKind, operators};
 
@@ -71,11 +74,11 @@ operators! {
     /// Each hair becomes a strand of hairs ([`Strands`]).
     Strands(Strands, StrandsParams, strands::StrandsSpec),
     /// Widths root to tip ([`Width`]).
-    Width(Width, RootToTip, crate::groom::file::RootToTipSpec),
+    Width(Width, RootToTip, crate::groom::values::RootToTipSpec),
     /// Colours root to tip ([`Color`]).
-    Color(Color, Color, crate::groom::file::ColorSpec),
+    Color(Color, Color, crate::groom::values::ColorSpec),
     /// Opacities root to tip ([`Opacity`]).
-    Opacity(Opacity, RootToTip, crate::groom::file::RootToTipSpec),
+    Opacity(Opacity, RootToTip, crate::groom::values::RootToTipSpec),
     /// Hairs turned about their root–tip axis ([`Twist`]).
     Twist(Twist, TwistParams, twist::TwistSpec),
     /// A fraction of the hairs lengthened and pushed off their clump

@@ -5,8 +5,8 @@
 use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
 use super::{Hair, RampTables, Resampling, RootContext, Scratch};
 use crate::groom::error::GroomError;
-use crate::groom::file::MapValue;
 use crate::groom::ramp::Ramp;
+use crate::groom::values::MapValue;
 use crate::limits::MAX_CURVE_POINTS;
 use crate::map::{Map, NoiseMap};
 use crate::settings::{Bound, Rule};

@@ -1,10 +1,10 @@
 //! `opacity`: hair opacities from root to tip, as `width` does widths.
 
 use super::kind::{OperatorKind, Preparation, SpecReader};
-use super::look::{root_to_tip, root_to_tip_maps, root_to_tip_maps_mut};
+use super::root_to_tip::{root_to_tip, root_to_tip_maps, root_to_tip_maps_mut};
 use super::{Hair, RootContext, RootToTip, Scratch};
 use crate::groom::error::GroomError;
-use crate::groom::file::{MapValue, RootToTipSpec};
+use crate::groom::values::{MapValue, RootToTipSpec};
 use crate::map::Map;
 use crate::settings::{Bound, Rule};
 
@@ -66,7 +66,7 @@ impl OperatorKind for Opacity {
 
 #[cfg(test)]
 mod tests {
-    use super::super::look::tests::spec;
+    use super::super::root_to_tip::tests::spec;
     use super::super::test_hairs::{root, straight};
     use super::*;
 

@@ -7,7 +7,7 @@
 use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
 use super::{HairBatch, RootContext, Scratch};
 use crate::groom::error::{GroomError, GroomErrorKind};
-use crate::groom::file::MapValue;
+use crate::groom::values::MapValue;
 use crate::limits::MAX_STRANDS;
 use crate::map::Map;
 use crate::sample::SampleRng;

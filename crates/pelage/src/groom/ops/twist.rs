@@ -5,11 +5,11 @@
 //! where they are; the hair's bends wind around its chord.
 
 use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
-use super::look::varied;
+use super::root_to_tip::varied;
 use super::{Hair, RootContext, Scratch};
 use crate::groom::error::GroomError;
-use crate::groom::file::MapValue;
 use crate::groom::ramp::Ramp;
+use crate::groom::values::MapValue;
 use crate::map::Map;
 use glam::{Quat, Vec3};
 use serde::Deserialize;

@@ -1,10 +1,10 @@
 //! `width`: hair widths from root to tip (Sik §4.2.2).
 
 use super::kind::{OperatorKind, Preparation, SpecReader};
-use super::look::{root_to_tip, root_to_tip_maps, root_to_tip_maps_mut};
+use super::root_to_tip::{root_to_tip, root_to_tip_maps, root_to_tip_maps_mut};
 use super::{Hair, RootContext, RootToTip, Scratch};
 use crate::groom::error::GroomError;
-use crate::groom::file::{MapValue, RootToTipSpec};
+use crate::groom::values::{MapValue, RootToTipSpec};
 use crate::map::Map;
 use crate::settings::{Bound, Rule};
 
@@ -63,7 +63,7 @@ impl OperatorKind for Width {
 
 #[cfg(test)]
 mod tests {
-    use super::super::look::tests::spec;
+    use super::super::root_to_tip::tests::spec;
     use super::super::test_hairs::{root, straight};
     use super::*;
 

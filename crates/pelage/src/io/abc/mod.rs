@@ -26,7 +26,8 @@ pub use read::{
     AbcCurvesObject, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at, read_abc_objects,
 };
 
-use super::usd_schema::{check_name, curve_extent};
+use super::usd_options::check_name;
+use super::usd_schema::curve_extent;
 use super::{CurveBasis, PrimWriteError, UsdOptions};
 use crate::{Curves, Mesh};
 use ogawa::{Child, EMPTY_DATA, EMPTY_GROUP, OgawaWriter, murmur3_128};

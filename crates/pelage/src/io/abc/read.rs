@@ -19,9 +19,9 @@
 use super::super::read_error::{
     CurvesReadError, CurvesReadErrorKind as Kind, DecodeBudget, excerpt,
 };
-use super::super::usd_read::DEFAULT_WIDTH;
 use super::ogawa::{Child, EMPTY_DATA};
 use crate::Curves;
+use crate::curves::DEFAULT_WIDTH;
 use crate::curves::HairShading;
 use crate::limits::{MAX_NAME_BYTES, MAX_PATH_BYTES};
 use crate::mesh::Location;
@@ -450,7 +450,7 @@ pub fn abc_curves_from_bytes(
     seconds: Option<f64>,
 ) -> Result<Curves, CurvesReadError> {
     let parts = abc_parts_from_bytes(bytes, path, seconds)?;
-    super::super::join(parts.iter().map(|(_, c)| c))
+    crate::curves::join(parts.iter().map(|(_, c)| c))
         .map_err(|e| CurvesReadError::whole(path, e.into()))
 }
 

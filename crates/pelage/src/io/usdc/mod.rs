@@ -21,10 +21,10 @@ mod read;
 pub(crate) use read::{read_usdc, read_usdc_bytes};
 
 use super::hair_material::{MATERIAL_NAME, NetworkPrim, NetworkValue, hair_material};
+use super::usd_options::check_name;
 use super::usd_schema::{
     PrimWriter, SurfacePoints, UsdAttribute, UsdValues, basis_curves_attributes,
-    binds_hair_material, check_name, curve_extent, guide_curves_attributes, mesh_attributes,
-    points_attributes,
+    binds_hair_material, curve_extent, guide_curves_attributes, mesh_attributes, points_attributes,
 };
 use super::{PrimWriteError, UpAxis, UsdOptions};
 use crate::Curves;

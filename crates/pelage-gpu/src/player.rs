@@ -3,7 +3,9 @@
 use crate::{Camera, FurMotion, GpuContext, GpuError};
 use glam::Vec3;
 
-use super::{ShellFeatures, ShellModel, ShellParams, ShellRenderer, ShellTarget, ShellView};
+use crate::shells::{
+    ShellFeatures, ShellModel, ShellParams, ShellRenderer, ShellTarget, ShellView,
+};
 use pelage::shell::{ShellScene, WetnessMask};
 
 /// A scene file drawn frame by frame: the model uploaded once, the

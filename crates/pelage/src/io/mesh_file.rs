@@ -1,35 +1,13 @@
-//! Loading meshes from files or bytes, by format.
+//! Loading meshes from files or bytes, by format: [`Mesh::load`] and
+//! [`Mesh::from_bytes`].
+//!
+//! The parsers of OBJ, PLY and glTF are the mesh layer's own; reading a
+//! mesh from USD needs this layer's USD reader. The dispatch by format is
+//! therefore written here, above both, so `mesh/` never uses `io/`.
 
-use super::{Mesh, MeshError, MeshErrorKind};
+use super::{CurvesReadError, check_input, read_usd_skin, usd_skin_from_bytes};
+use crate::mesh::{Mesh, MeshError, MeshErrorKind, MeshFormat, gltf, obj, ply};
 use std::path::Path;
-
-/// The mesh file formats pelage reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MeshFormat {
-    /// Wavefront OBJ.
-    Obj,
-    /// Stanford PLY, ASCII or binary.
-    Ply,
-    /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
-    Gltf,
-    /// USD, text or binary (`.usda`, `.usdc`, `.usd`): every `Mesh` prim,
-    /// at its first time sample.
-    Usd,
-}
-
-impl MeshFormat {
-    /// The format a file name's extension names (case-insensitive).
-    pub fn from_path(path: &Path) -> Option<Self> {
-        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-        match ext.as_str() {
-            "obj" => Some(Self::Obj),
-            "ply" => Some(Self::Ply),
-            "gltf" | "glb" => Some(Self::Gltf),
-            "usda" | "usdc" | "usd" => Some(Self::Usd),
-            _ => None,
-        }
-    }
-}
 
 impl Mesh {
     /// Loads a mesh, choosing the reader by the file's extension. Errors
@@ -37,7 +15,7 @@ impl Mesh {
     pub fn load(path: impl AsRef<Path>) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        crate::io::check_input(path, "a mesh file (.obj, .ply, .gltf, .glb, .usd)")
+        check_input(path, "a mesh file (.obj, .ply, .gltf, .glb, .usd)")
             .map_err(|e| MeshError::whole(&name, MeshErrorKind::Io(e)))?;
         let format = MeshFormat::from_path(path).ok_or_else(|| {
             let extension = path
@@ -52,7 +30,7 @@ impl Mesh {
         let bytes =
             std::fs::read(path).map_err(|e| MeshError::whole(&name, MeshErrorKind::Io(e)))?;
         match format {
-            MeshFormat::Gltf => super::gltf::parse(&name, &bytes, path.parent()),
+            MeshFormat::Gltf => gltf::parse(&name, &bytes, path.parent()),
             _ => Self::from_bytes(&name, &bytes, format),
         }
     }
@@ -64,13 +42,12 @@ impl Mesh {
     /// time sample, as [`Mesh::load`] reads them.
     pub fn from_bytes(name: &str, bytes: &[u8], format: MeshFormat) -> Result<Mesh, MeshError> {
         match format {
-            MeshFormat::Obj => super::obj::parse(name, bytes),
-            MeshFormat::Ply => super::ply::parse(name, bytes),
-            MeshFormat::Gltf => super::gltf::parse(name, bytes, None),
+            MeshFormat::Obj => obj::parse(name, bytes),
+            MeshFormat::Ply => ply::parse(name, bytes),
+            MeshFormat::Gltf => gltf::parse(name, bytes, None),
             MeshFormat::Usd => {
                 let path = Path::new(name);
-                let skin =
-                    crate::io::usd_skin_from_bytes(bytes, path).map_err(|e| usd_error(&e))?;
+                let skin = usd_skin_from_bytes(bytes, path).map_err(|e| usd_mesh_error(&e))?;
                 Mesh::new(
                     name.to_string(),
                     skin.positions,
@@ -85,7 +62,7 @@ impl Mesh {
 
 /// A USD file's `Mesh` prims as one mesh, at their first time sample.
 fn read_usd_mesh(path: &Path) -> Result<Mesh, MeshError> {
-    let skin = crate::io::read_usd_skin(path).map_err(|e| usd_error(&e))?;
+    let skin = read_usd_skin(path).map_err(|e| usd_mesh_error(&e))?;
     Mesh::new(
         path.display().to_string(),
         skin.positions,
@@ -96,7 +73,7 @@ fn read_usd_mesh(path: &Path) -> Result<Mesh, MeshError> {
 }
 
 /// A USD reader's error as a mesh error (same file, same place).
-pub(crate) fn usd_error(e: &crate::io::CurvesReadError) -> MeshError {
+pub(crate) fn usd_mesh_error(e: &CurvesReadError) -> MeshError {
     MeshError::new(
         e.source_name(),
         e.location().clone(),
