@@ -34,11 +34,15 @@ SIZED = ("length", "width")
 
 
 def _sized(settings, context):
+    """Marks Length and Width as the user's own (a first grow no longer sizes
+    them to the object), then regrows live fur."""
     settings.sized = True
     _setting_changed(settings, context)
 
 
 def apply_preset(settings, context):
+    """Fills the panel from the chosen preset, its lengths and widths scaled by
+    the active object's size."""
     values = PRESETS.get(settings.preset)
     obj = context.active_object if context is not None else None
     if values is None or obj is None:
@@ -49,6 +53,7 @@ def apply_preset(settings, context):
 
 
 def _setting_changed(settings, context):
+    """Any panel setting's update: schedules a whole regrow of live fur."""
     fur.on_setting_change(settings, context)
 
 
@@ -213,6 +218,8 @@ class PelageFurSettings(bpy.types.PropertyGroup):
 
 
 def surface_of(context):
+    """The active object when it is a mesh (the surface fur grows on), else
+    None."""
     obj = context.active_object
     return obj if obj is not None and obj.type == "MESH" else None
 
@@ -226,9 +233,12 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
+        """Grows on a mesh only."""
         return surface_of(context) is not None
 
     def execute(self, context):
+        """Grows on this thread to the end (scripts), with the window manager's
+        progress."""
         # Scripts: on this thread, to the end.
         surface = surface_of(context)
         settings = surface.pelage_fur
@@ -246,12 +256,15 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
         return self.done(surface, grown, warnings)
 
     def done(self, surface, grown, warnings):
+        """Reports the grow: the guides left out as warnings, then the counts."""
         for warning in warnings:
             self.report({"WARNING"}, f"pelage: {warning}")
         self.report({"INFO"}, f"pelage: {grown.curve_count:,} hairs, {grown.point_count:,} points on {surface.name}")
         return {"FINISHED"}
 
     def invoke(self, context, _event):
+        """Starts the grow on a worker thread and watches it from a timer (the
+        panel's button)."""
         # The panel's button: pelage grows on a worker thread (it lets go
         # of Python while it works), Blender stays responsive, the status
         # bar shows the parts done, and Esc stops it between parts with
@@ -268,11 +281,15 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
         self._state = {"done": 0, "total": 1, "result": None, "error": None, "cancel": False}
 
         def progress(done, total):
+            """The worker's progress: counts the parts done, and stops between
+            parts once Esc was pressed."""
             self._state["done"], self._state["total"] = done, total
             if self._state["cancel"]:
                 raise fur.Cancelled()
 
         def work():
+            """The worker thread: grows the curves, keeping any error for the
+            main thread to report."""
             try:
                 self._state["result"] = fur.grow_curves(self._prepared, progress)
             except BaseException as error:  # reported on the main thread
@@ -286,6 +303,8 @@ class PELAGE_OT_grow_fur(bpy.types.Operator):
         return {"RUNNING_MODAL"}
 
     def modal(self, context, event):
+        """Each timer tick: the status bar's progress, Esc's cancel, and the
+        fur put in place when the worker is done."""
         if event.type == "ESC":
             self._state["cancel"] = True
             return {"RUNNING_MODAL"}
@@ -341,13 +360,17 @@ class PELAGE_OT_op_add(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
+        """Needs a mesh whose stack to add to."""
         return surface_of(context) is not None
 
     def invoke(self, context, _event):
+        """Opens a search over the library's operators."""
         context.window_manager.invoke_search_popup(self)
         return {"RUNNING_MODAL"}
 
     def execute(self, context):
+        """Appends the chosen operator with its schema's starting values and
+        makes it active."""
         surface = surface_of(context)
         settings = surface.pelage_fur
         stack.add_entry(settings.ops, self.kind, max(surface.dimensions) or 1.0)
@@ -364,10 +387,13 @@ class PELAGE_OT_op_remove(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
+        """Needs a stack with an entry to remove."""
         surface = surface_of(context)
         return surface is not None and len(surface.pelage_fur.ops) > 0
 
     def execute(self, context):
+        """Removes the active entry; the one after it (or the last) becomes
+        active."""
         settings = surface_of(context).pelage_fur
         settings.ops.remove(settings.active_op)
         settings.active_op = min(settings.active_op, max(0, len(settings.ops) - 1))
@@ -385,10 +411,13 @@ class PELAGE_OT_op_move(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
+        """Needs a stack of two entries or more."""
         surface = surface_of(context)
         return surface is not None and len(surface.pelage_fur.ops) > 1
 
     def execute(self, context):
+        """Swaps the active entry with its neighbour above or below; it stays
+        active."""
         settings = surface_of(context).pelage_fur
         at = settings.active_op
         to = at - 1 if self.direction == "UP" else at + 1
@@ -409,9 +438,12 @@ class PELAGE_OT_load_groom(bpy.types.Operator, ImportHelper):
 
     @classmethod
     def poll(cls, context):
+        """Needs a mesh whose panel to fill."""
         return surface_of(context) is not None
 
     def execute(self, context):
+        """Reads the groom file into the panel, warning about what the panel
+        has no place for."""
         surface = surface_of(context)
         try:
             left = stack.load_into(surface.pelage_fur, self.filepath, max(surface.dimensions) or 1.0)
@@ -437,10 +469,13 @@ class PELAGE_OT_save_groom(bpy.types.Operator, ExportHelper):
 
     @classmethod
     def poll(cls, context):
+        """Needs a mesh whose panel is the groom (not a Groom file)."""
         surface = surface_of(context)
         return surface is not None and not surface.pelage_fur.groom_file
 
     def execute(self, context):
+        """Writes the groom file, its maps and the guides beside it, and names
+        them."""
         surface = surface_of(context)
         try:
             written = fur.save_groom_file(context, surface, surface.pelage_fur, self.filepath)
@@ -455,6 +490,8 @@ class PELAGE_UL_ops(bpy.types.UIList):
     """The operator stack, one row an operator."""
 
     def draw_item(self, _context, layout, _data, item, _icon, _active_data, _active_property, _index=0):
+        """One operator's row: enabled, its name, the settings given, and a
+        mask icon when masked."""
         row = layout.row(align=True)
         row.prop(item, "enabled", text="")
         row.label(text=item.kind.replace("_", " ").title())
@@ -475,14 +512,17 @@ class PELAGE_OT_shade_hair(bpy.types.Operator):
 
     @staticmethod
     def shadeable(context):
+        """The selected curves objects that carry pelage's per-hair look."""
         return [o for o in context.selected_objects
                 if o.type == "CURVES" and fur.SHADING_FLOATS[0] in o.data.attributes]
 
     @classmethod
     def poll(cls, context):
+        """Needs a selected curves object carrying the look."""
         return bool(cls.shadeable(context))
 
     def execute(self, context):
+        """Gives each such object the pelage hair material in place of its own."""
         material = fur.hair_material()
         objects = self.shadeable(context)
         for obj in objects:
@@ -501,9 +541,12 @@ class _PelageExport(ExportHelper):
 
     @classmethod
     def poll(cls, context):
+        """Exports the fur of a mesh only."""
         return surface_of(context) is not None
 
     def execute(self, context):
+        """Writes the groom as the viewport shows it, reporting guides left out
+        and the count written."""
         surface = surface_of(context)
         try:
             groom = fur.export_groom_for(context, surface, surface.pelage_fur)
@@ -523,6 +566,8 @@ class _PelageAnimatedExport(_PelageExport):
     writes it with a time sample a frame."""
 
     def execute(self, context):
+        """Grows over the scene's frames (deformed or simulated) and writes a
+        sample a frame, with progress."""
         surface = surface_of(context)
         settings = surface.pelage_fur
         wm = context.window_manager
@@ -580,6 +625,8 @@ class PELAGE_OT_export_alembic(_PelageExport, bpy.types.Operator):
 
 
 class PELAGE_PT_fur(bpy.types.Panel):
+    """The pelage fur panel in the 3D view's sidebar: the groom's settings, its
+    operator stack, grow, live, load, save and export."""
     bl_label = "pelage fur"
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
@@ -587,9 +634,12 @@ class PELAGE_PT_fur(bpy.types.Panel):
 
     @classmethod
     def poll(cls, context):
+        """Shown for a mesh only."""
         return surface_of(context) is not None
 
     def draw(self, context):
+        """Lays the panel out: groom file or the panel's own settings, the
+        stack, and the actions."""
         layout = self.layout
         settings = surface_of(context).pelage_fur
         layout.prop(settings, "groom_file")
@@ -682,11 +732,15 @@ CLASSES = (
 
 
 def menu_entry(self, context):
+    """The Object menu's pelage entries: Grow pelage fur and Shade with pelage
+    hair."""
     self.layout.operator(PELAGE_OT_grow_fur.bl_idname, icon="CURVES")
     self.layout.operator(PELAGE_OT_shade_hair.bl_idname, icon="MATERIAL")
 
 
 def register():
+    """Registers the add-on's classes, the surface's settings, the menu entries
+    and the live-regrowth handler."""
     for cls in CLASSES:
         bpy.utils.register_class(cls)
     bpy.types.Object.pelage_fur = PointerProperty(type=PelageFurSettings)
@@ -695,6 +749,7 @@ def register():
 
 
 def unregister():
+    """Undoes ``register``, forgetting every live groom."""
     if fur.on_depsgraph_update in bpy.app.handlers.depsgraph_update_post:
         bpy.app.handlers.depsgraph_update_post.remove(fur.on_depsgraph_update)
     fur.LIVE.clear()

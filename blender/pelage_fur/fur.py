@@ -170,6 +170,7 @@ def png16(path, rows):
     raw = b"".join(b"\0" + row.tobytes() for row in data)
 
     def chunk(kind, payload):
+        """One PNG chunk: length, kind, payload and CRC."""
         return (struct.pack(">I", len(payload)) + kind + payload
                 + struct.pack(">I", zlib.crc32(kind + payload)))
 
@@ -646,6 +647,8 @@ class PreparedGrow:
     (``finish_grow``)."""
 
     def __init__(self, context, surface, settings):
+        """Reads everything the grow needs from Blender, on the main thread:
+        the evaluated mesh, its maps, the guides and the groom."""
         import time
 
         self.start = time.perf_counter()
@@ -679,7 +682,9 @@ def replace_data(obj, data):
     import bpy
 
     old = obj.data
-    if len(old.materials) and any(m is not None for m in old.materials):
+    # Every slot is kept, empty ones too: a material the user linked to the
+    # object (not the data) lives in the object's slot of the same index.
+    if len(old.materials):
         data.materials.clear()
         for material in old.materials:
             data.materials.append(material)
@@ -769,6 +774,7 @@ class LiveGroom:
     fills, and the tolerance its guides are bound with."""
 
     def __init__(self, session, fur_name, tolerance):
+        """A live groom of ``session`` filling the object named ``fur_name``."""
         self.session = session
         self.fur_name = fur_name
         self.tolerance = tolerance
@@ -809,10 +815,9 @@ def live_update(surface):
             data.position_data.foreach_set("vector", points.ravel())
             data.update_tag()
             return done
-    # Hairs added or removed: a new datablock.
-    old = obj.data
-    obj.data = curves_to_blender(old.name, live.session.curves(), surface, old.surface_uv_map or None, back)
-    bpy.data.hair_curves.remove(old)
+    # Hairs added or removed: a new datablock, in place of the old one as
+    # a grow puts it (the user's material and the object's slots kept).
+    replace_data(obj, curves_to_blender(data.name, live.session.curves(), surface, data.surface_uv_map or None, back))
     return done
 
 
@@ -848,6 +853,8 @@ def schedule_live_update(name, whole=False):
     PENDING[name] = whole
 
     def run():
+        """The timer's callback: the scheduled regrow, its errors kept from
+        Blender's timer."""
         import pelage
 
         whole = PENDING.pop(name, False)

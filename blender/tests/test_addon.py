@@ -31,6 +31,19 @@ import pelage  # noqa: E402  (the wheel the extension bundles)
 
 print(f"installed {os.path.basename(zip_path)}: pelage {pelage.__version__} in Blender {bpy.app.version_string}")
 
+# Every function and class of the add-on says what it is for.
+import ast  # noqa: E402
+
+addon_folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "pelage_fur")
+undocumented = [
+    f"{name}:{node.lineno} {node.name}"
+    for name in sorted(os.listdir(addon_folder)) if name.endswith(".py")
+    for node in ast.walk(ast.parse(open(os.path.join(addon_folder, name)).read()))
+    if isinstance(node, (ast.FunctionDef, ast.ClassDef)) and not ast.get_docstring(node)
+]
+assert not undocumented, f"add-on code without a docstring: {undocumented}"
+print("add-on: every function and class has a docstring")
+
 
 def clear_scene():
     for obj in list(bpy.data.objects):
@@ -217,6 +230,10 @@ bpy.context.collection.objects.link(live_object)
 settings.guides_object, settings.live = live_object, True
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
 live_fur = fur_of(grid)
+# A material the user gave the fur object stays through every live regrow.
+live_material = bpy.data.materials.new("my live fur")
+live_fur.data.materials.clear()
+live_fur.data.materials.append(live_material)
 before, live_offsets = arrays(live_fur.data)
 # Guide 0 (at (-0.8, -0.8)) combed sideways.
 combed = live_points.copy()
@@ -233,6 +250,35 @@ moved_by = np.array([np.abs(after[a:b] - before[a:b]).max() for a, b in zip(live
 assert far.sum() > 1000 and np.all(moved_by[far] == 0), "hairs far from the stroke keep every bit"
 assert moved_by[~far].max() > 0.05, "hairs by the combed guide follow it"
 assert addon_fur.live_update(grid) is None, "nothing changed since"
+assert list(live_fur.data.materials) == [live_material], "a live update keeps the user's material"
+# A guide edit that brings other hairs (a count that differs from the fur
+# object's) gives the fur object a new datablock: the material stays.
+
+
+class MoreHairs:
+    """The live session, answering that the edit changed the hair count."""
+
+    def __init__(self, session):
+        self.session = session
+
+    def set_guides(self, guides, tolerance):
+        done = self.session.set_guides(guides, tolerance=tolerance)
+        return None if done is None else dict(done, hairs=done["hairs"] + 1)
+
+    def __getattr__(self, name):
+        return getattr(self.session, name)
+
+
+live_state = addon_fur.LIVE[grid.name]
+live_state.session = MoreHairs(live_state.session)
+combed[0:7] += steps[:, None] * np.array([0.0, 0.5, 0.0])
+live_curves.position_data.foreach_set("vector", combed.astype(np.float32).ravel())
+live_data_before = live_fur.data.name
+assert addon_fur.live_update(grid) is not None
+live_state.session = live_state.session.session
+assert live_fur.data.name == live_data_before, "the new datablock takes the old one's name"
+assert list(live_fur.data.materials) == [live_material], list(live_fur.data.materials)
+print("live: the user's material stays through a live update that replaces the fur's datablock")
 print(f"live: a combed guide regrew {done['regrown']:,} of {done['hairs']:,} hairs; far ones kept every bit")
 # While live, a setting changed regrows the whole groom (at the display
 # fraction), in the same fur object.
@@ -241,6 +287,7 @@ settings.count = 2_000
 assert addon_fur.PENDING.get(grid.name) is True, "a setting schedules a whole regrow"
 assert addon_fur.live_regrow(grid) == {"hairs": 2_000}
 assert fur_of(grid) == live_fur and len(live_fur.data.curves) == 2_000
+assert list(live_fur.data.materials) == [live_material], "a whole live regrow keeps the material"
 # So does an edit of the mesh (edit mode, sculpt, paint): the x > 0 half
 # lifted 0.25, the roots there follow it.
 addon_fur.PENDING.pop(grid.name, None)
