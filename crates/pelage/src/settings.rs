@@ -301,6 +301,20 @@ impl Rule {
         }
     }
 
+    /// Why `value` (written `shown`) breaks the rule, or `None` when it
+    /// keeps it: `"1.5: use 0 to 1 (a fraction)"`. A file's check and a
+    /// value built in a program say the same.
+    pub fn refusal(&self, value: f64, shown: &str) -> Option<String> {
+        if self.bound.admits(value) {
+            return None;
+        }
+        let why = match self.why {
+            "" => String::new(),
+            why => format!(" ({why})"),
+        };
+        Some(format!("{shown}: {}{why}", self.bound))
+    }
+
     /// A rule for a key made at run time (an operator's settings under
     /// `ops.NAME`).
     pub fn owned(key: String, bound: Bound, why: &'static str) -> Self {
@@ -372,13 +386,8 @@ impl SettingsSource {
                 _ => return Ok(()),
             };
             for rule in rules.iter().filter(|r| r.key == path) {
-                if !rule.bound.admits(number) {
-                    let shown = source.text[value.span()].trim().to_string();
-                    let why = match rule.why {
-                        "" => String::new(),
-                        why => format!(" ({why})"),
-                    };
-                    return refuse(format!("{shown}: {}{why}", rule.bound));
+                if let Some(message) = rule.refusal(number, source.text[value.span()].trim()) {
+                    return refuse(message);
                 }
             }
             Ok(())

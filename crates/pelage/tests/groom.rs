@@ -348,6 +348,51 @@ fn normals_are_unit_and_perpendicular_to_the_hair() {
     }
 }
 
+#[test]
+fn operator_settings_out_of_range_built_in_code_are_refused_as_a_file_refuses_them() {
+    let c = Map::Constant;
+    let cases = [
+        (
+            "flyaways = { spread = 0.01, fraction = 1.5 }",
+            GroomOp::Flyaways(FlyawaysParams {
+                fraction: c(1.5),
+                ..FlyawaysParams::new(c(0.01))
+            }),
+        ),
+        ("clump = { count = 0 }", GroomOp::Clump(ClumpParams::new(0))),
+        (
+            "noise = { amplitude = 0.01, frequency = -2 }",
+            GroomOp::Noise(NoiseParams {
+                frequency: c(-2.0),
+                ..NoiseParams::new(c(0.01))
+            }),
+        ),
+        (
+            "length = { scale = -1 }",
+            GroomOp::Length(LengthParams::new(c(-1.0))),
+        ),
+    ];
+    let mesh = Arc::new(pelage::assets::spot());
+    let guides = Arc::new(Guides::grow(&mesh, &GuideGrowth::default()).unwrap());
+    for (table, op) in cases {
+        let text = format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 100\n[[ops]]\n{table}\n"
+        );
+        let from_file = Groom::from_text("fur/t.toml", text)
+            .and_then(|g| g.generator(None).map(drop))
+            .unwrap_err();
+        let spec = GroomSpec::new(mesh.clone(), guides.clone(), RootsSpec::new(100)).with_op(op);
+        let from_code = spec.generator().map(drop).unwrap_err();
+        assert_eq!(from_code.key, from_file.key, "{table}");
+        match (&from_code.kind, &from_file.kind) {
+            (GroomErrorKind::Invalid(code), GroomErrorKind::Invalid(file)) => {
+                assert_eq!(code, file, "{table}")
+            }
+            kinds => panic!("{table}: {kinds:?}"),
+        }
+    }
+}
+
 fn error(text: &str) -> String {
     let e: GroomError = Groom::from_text("fur/test.toml", text)
         .and_then(|g| g.generator(None).map(|_| ()))

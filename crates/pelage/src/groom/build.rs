@@ -471,6 +471,17 @@ impl ChainSoFar for ChainBuild<'_> {
 /// values), or fails naming the setting whose map the mesh cannot serve
 /// (image maps need UVs, per-vertex maps their attribute).
 fn bind_maps(spec: &mut GroomSpec) -> Result<(), GroomError> {
+    // An operator's numbers are held to the ranges a groom file's are, so
+    // a spec built in a program is refused with the file's message.
+    for (index, op) in spec.ops.iter().enumerate() {
+        if let Some((field, message)) = op.out_of_range() {
+            let key = OpKey {
+                index,
+                name: op.name(),
+            };
+            return Err(spec.error(&key.field(field), GroomErrorKind::Invalid(message)));
+        }
+    }
     let mesh = spec.mesh.clone();
     let mut failed = None;
     {

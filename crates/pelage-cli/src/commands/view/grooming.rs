@@ -22,10 +22,9 @@ use std::time::Instant;
 /// saved and written by `pelage groom`).
 pub const PREVIEW_HAIRS: f64 = 50_000.0;
 
-/// The palette's brushes, in key order (1–9, 0, then `-`).
-pub const PALETTE: [&str; 11] = [
-    "comb", "length", "cut", "smooth", "puff", "clump", "spread", "add", "delete", "paint", "part",
-];
+/// The palette's brushes, in key order (1–9, 0, then `-`): the library's
+/// brushes, in its order.
+pub const PALETTE: &[&str] = pelage::groom::brush::Brush::NAMES;
 
 /// The brush settings and what is drawn.
 #[derive(Debug, Clone, PartialEq)]

@@ -516,6 +516,33 @@ macro_rules! operators {
                 }
             }
 
+            /// The first of the operator's numbers that breaks its range
+            /// rule (`RULES`, the same the groom file is checked with): the
+            /// field and the file check's message. Maps given as constants
+            /// and counts are checked; a map read from an image or noise is
+            /// not a number to check.
+            pub(crate) fn out_of_range(&self) -> Option<(&'static str, String)> {
+                let rules: &[Rule] = match self.unmasked() {
+                    GroomOp::Masked(..) => &[],
+                    $( GroomOp::$Variant(_) => <$Op as OperatorKind>::RULES, )*
+                };
+                let constants = self.maps().into_iter().filter_map(|(field, map)| match map {
+                    Map::Constant(v) => Some((field, f64::from(*v), v.to_string())),
+                    _ => None,
+                });
+                let counts = self
+                    .counts()
+                    .into_iter()
+                    .map(|(field, value, _, _)| (field, value as f64, value.to_string()));
+                constants.chain(counts).find_map(|(field, value, shown)| {
+                    rules
+                        .iter()
+                        .filter(|rule| rule.key == field)
+                        .find_map(|rule| rule.refusal(value, &shown))
+                        .map(|message| (field, message))
+                })
+            }
+
             /// Counts with a ceiling: (field, value, most, what).
             pub(crate) fn counts(&self) -> Vec<(&'static str, u64, u64, &'static str)> {
                 match self {

@@ -424,6 +424,27 @@ mod registry_tests {
     use super::*;
 
     #[test]
+    fn every_range_rule_names_a_field_of_its_operator() {
+        // A misspelt rule key would check nothing: no number is ever
+        // written under it.
+        let schema = operator_schema();
+        let rules = operator_rules();
+        assert!(rules.len() >= 10, "{} rules", rules.len());
+        for rule in rules {
+            let parts: Vec<&str> = rule.key.split('.').collect();
+            let [_, name, field] = parts[..] else {
+                panic!("{}: not ops.NAME.FIELD", rule.key);
+            };
+            let fields = &schema.iter().find(|s| s.name == name).unwrap().fields;
+            assert!(
+                fields.contains(&field),
+                "{}: {name} has no field {field:?} (its fields: {fields:?})",
+                rule.key
+            );
+        }
+    }
+
+    #[test]
     fn the_schema_is_read_off_each_operators_spec() {
         let schema = operator_schema();
         let names: Vec<&str> = schema.iter().map(|s| s.name).collect();
