@@ -375,9 +375,7 @@ fn operator_settings_out_of_range_built_in_code_are_refused_as_a_file_refuses_th
     let mesh = Arc::new(pelage::assets::spot());
     let guides = Arc::new(Guides::grow(&mesh, &GuideGrowth::default()).unwrap());
     for (table, op) in cases {
-        let text = format!(
-            "[mesh]\npath = \"spot\"\n[roots]\ncount = 100\n[[ops]]\n{table}\n"
-        );
+        let text = format!("[mesh]\npath = \"spot\"\n[roots]\ncount = 100\n[[ops]]\n{table}\n");
         let from_file = Groom::from_text("fur/t.toml", text)
             .and_then(|g| g.generator(None).map(drop))
             .unwrap_err();

@@ -17,7 +17,8 @@
 //! The parts, lowest first (each uses only those above it in this list):
 //!
 //! - `prepare.rs`: a mesh prepared on the CPU, without wgpu: welded
-//!   corners, tangents ([`vertex_tangents`]), the shell texture's mips;
+//!   corners, pose and surface vertices with tangents ([`vertex_tangents`]),
+//!   skin influences, the shell texture's mips;
 //! - `fins.rs`: the fin records of a mesh's edges;
 //! - `model.rs`: [`ShellModel`] (a furry mesh on the GPU: welded vertices,
 //!   pose, textures with mips, rig);

@@ -3,8 +3,10 @@
 //! per-vertex tangents ([`vertex_tangents`]) and the shell texture's mip
 //! chain. The uploads of `upload.rs` and the fins of `fins.rs` read these.
 
+use super::{PoseVertex, SurfaceVertex};
 use glam::Vec3;
 use pelage::Mesh;
+use pelage::anim::SkinRig;
 use pelage::shell::ShellTextures;
 
 /// Per-vertex `dP/du` (the texture's x direction on the surface), averaged
@@ -93,6 +95,54 @@ impl WeldedCorners {
             }
         }
         out
+    }
+}
+
+impl WeldedCorners {
+    /// Each vertex's rest position, normal and tangent (the strand frame
+    /// the shells stand on).
+    pub(super) fn pose_vertices(&self, mesh: &Mesh) -> Vec<PoseVertex> {
+        let tangents = vertex_tangents(mesh);
+        self.mesh_vertices
+            .iter()
+            .map(|&v| PoseVertex {
+                position: mesh.positions()[v as usize].to_array(),
+                normal: mesh.normals()[v as usize].to_array(),
+                tangent: tangents[v as usize].to_array(),
+            })
+            .collect()
+    }
+
+    /// Each vertex's UV as the wetness mask reads it.
+    pub(super) fn surface_vertices(&self) -> Vec<SurfaceVertex> {
+        self.uvs
+            .iter()
+            .map(|&uv| SurfaceVertex {
+                uv: pelage::shell::wetness::mask_coordinates(uv).to_array(),
+            })
+            .collect()
+    }
+
+    /// Each vertex's four joints and their weights (as bits), as the
+    /// skinning pass reads them.
+    pub(super) fn skin_influences(&self, rig: &SkinRig) -> Vec<[u32; 8]> {
+        self.mesh_vertices
+            .iter()
+            .map(|&v| {
+                let i = rig.influences()[v as usize];
+                let w = i.weights.map(f32::to_bits);
+                [
+                    i.joints[0],
+                    i.joints[1],
+                    i.joints[2],
+                    i.joints[3],
+                    w[0],
+                    w[1],
+                    w[2],
+                    w[3],
+                ]
+            })
+            .collect()
     }
 }
 

@@ -7,12 +7,13 @@
 
 use super::fins::fin_records;
 use super::model::{GpuSkin, ShellModel, ShellUpload};
-use super::prepare::{WeldedCorners, fur_mip_chain, vertex_tangents};
+use super::prepare::{WeldedCorners, fur_mip_chain};
 use super::renderer::ShellRenderer;
-use super::{PoseVertex, SurfaceVertex, TipOffset};
+use super::{PoseVertex, TipOffset};
 use crate::{GpuContext, GpuError};
 use glam::Vec3;
 use pelage::Mesh;
+use pelage::anim::SkinRig;
 use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
 use wgpu::util::DeviceExt;
 
@@ -66,23 +67,8 @@ impl ShellRenderer {
         }
         let device = &ctx.device;
         let welded = WeldedCorners::new(mesh, options.per_corner);
-        let tangents = vertex_tangents(mesh);
-        let pose: Vec<PoseVertex> = welded
-            .mesh_vertices
-            .iter()
-            .map(|&v| PoseVertex {
-                position: mesh.positions()[v as usize].to_array(),
-                normal: mesh.normals()[v as usize].to_array(),
-                tangent: tangents[v as usize].to_array(),
-            })
-            .collect();
-        let surface: Vec<SurfaceVertex> = welded
-            .uvs
-            .iter()
-            .map(|&uv| SurfaceVertex {
-                uv: pelage::shell::wetness::mask_coordinates(uv).to_array(),
-            })
-            .collect();
+        let pose = welded.pose_vertices(mesh);
+        let surface = welded.surface_vertices();
         let storage = wgpu::BufferUsages::STORAGE;
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -118,6 +104,51 @@ impl ShellRenderer {
             storage,
         );
 
+        let mask_size = mask_size.max(1);
+        let shell_textures = self.texture_group(ctx, textures, color, mask_size);
+        let fins = self.fin_group(
+            ctx,
+            mesh,
+            &welded,
+            [&pose_buffer, &surface_buffer, &tip_offsets],
+        );
+        let skin = options
+            .rig
+            .map(|rig| self.skin_group(ctx, rig, &welded, &pose, &pose_buffer));
+        Ok(ShellModel {
+            pose: pose_buffer,
+            surface: surface_buffer,
+            tip_offsets,
+            indices,
+            index_count: welded.indices.len() as u32,
+            vertex_count: vertex_count as u32,
+            corner_count: (mesh.triangle_count() * 3) as u32,
+            corners_of_vertices: welded.corners,
+            mesh_vertices: welded.mesh_vertices,
+            vertex_corners,
+            fins,
+            skin,
+            wetness: shell_textures.wetness,
+            wetness_size: (mask_size, mask_size),
+            textures: shell_textures.bind,
+            layers: textures.layers(),
+            texture_resolution: textures.resolution(),
+            mip_levels: shell_textures.mip_levels,
+            bounds: mesh.bounds(),
+        })
+    }
+
+    /// The model's textures on the GPU and the bind group the shell pass
+    /// reads them through: the shell layers with their mips, the colour
+    /// (sRGB) and a dry wetness mask of `mask_size`².
+    fn texture_group(
+        &self,
+        ctx: &GpuContext,
+        textures: &ShellTextures,
+        color: &image::RgbaImage,
+        mask_size: u32,
+    ) -> ShellTextureGroup {
+        let device = &ctx.device;
         let size = |w, h, layers| wgpu::Extent3d {
             width: w,
             height: h,
@@ -156,7 +187,6 @@ impl ShellRenderer {
             color.as_raw(),
             1,
         );
-        let mask_size = mask_size.max(1);
         let dry = WetnessMask::dry_mask(mask_size, mask_size);
         let wetness = texture(
             "wetness mask",
@@ -197,18 +227,40 @@ impl ShellRenderer {
                 },
             ],
         });
+        ShellTextureGroup {
+            bind,
+            wetness,
+            mip_levels,
+        }
+    }
 
-        let fin_records = fin_records(mesh, &welded);
-        let fins = (!fin_records.is_empty()).then(|| {
-            let records = buffer("shell fins", bytemuck::cast_slice(&fin_records), storage);
+    /// The fins' records on the GPU and the bind group the fin pass reads
+    /// them (and the pose, UVs and tips: `buffers`) through, with their
+    /// count; none on a mesh without interior edges.
+    fn fin_group(
+        &self,
+        ctx: &GpuContext,
+        mesh: &Mesh,
+        welded: &WeldedCorners,
+        buffers: [&wgpu::Buffer; 3],
+    ) -> Option<(wgpu::BindGroup, u32)> {
+        let device = &ctx.device;
+        let [pose_buffer, surface_buffer, tip_offsets] = buffers;
+        let fin_records = fin_records(mesh, welded);
+        (!fin_records.is_empty()).then(|| {
+            let records = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shell fins"),
+                contents: bytemuck::cast_slice(&fin_records),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
             let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("shell fins"),
                 layout: &self.fin_layout,
                 entries: &[
                     (0, &records),
-                    (1, &pose_buffer),
-                    (2, &surface_buffer),
-                    (3, &tip_offsets),
+                    (1, pose_buffer),
+                    (2, surface_buffer),
+                    (3, tip_offsets),
                 ]
                 .map(|(binding, buffer)| wgpu::BindGroupEntry {
                     binding,
@@ -216,81 +268,61 @@ impl ShellRenderer {
                 }),
             });
             (group, fin_records.len() as u32)
-        });
-
-        let skin = options.rig.map(|rig| {
-            let rest = buffer("shell rest pose", bytemuck::cast_slice(&pose), storage);
-            let influences: Vec<[u32; 8]> = welded
-                .mesh_vertices
-                .iter()
-                .map(|&v| {
-                    let i = rig.influences()[v as usize];
-                    let w = i.weights.map(f32::to_bits);
-                    [
-                        i.joints[0],
-                        i.joints[1],
-                        i.joints[2],
-                        i.joints[3],
-                        w[0],
-                        w[1],
-                        w[2],
-                        w[3],
-                    ]
-                })
-                .collect();
-            let influences = buffer(
-                "shell skin influences",
-                bytemuck::cast_slice(&influences),
-                storage,
-            );
-            let palette = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shell skin palette"),
-                size: (64 * rig.palette_len().max(1)) as u64,
-                usage: storage | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("shell skinning"),
-                layout: &self.skin_layout,
-                entries: &[
-                    (0, &palette),
-                    (1, &rest),
-                    (2, &influences),
-                    (3, &pose_buffer),
-                ]
-                .map(|(binding, buffer)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: buffer.as_entire_binding(),
-                }),
-            });
-            GpuSkin {
-                palette,
-                palette_len: rig.palette_len(),
-                bind,
-            }
-        });
-
-        Ok(ShellModel {
-            pose: pose_buffer,
-            surface: surface_buffer,
-            tip_offsets,
-            indices,
-            index_count: welded.indices.len() as u32,
-            vertex_count: vertex_count as u32,
-            corner_count: (mesh.triangle_count() * 3) as u32,
-            corners_of_vertices: welded.corners,
-            mesh_vertices: welded.mesh_vertices,
-            vertex_corners,
-            fins,
-            skin,
-            wetness,
-            wetness_size: (mask_size, mask_size),
-            textures: bind,
-            layers: textures.layers(),
-            texture_resolution: r,
-            mip_levels,
-            bounds: mesh.bounds(),
         })
+    }
+
+    /// What the skinning pass reads for a rigged model: the rest pose,
+    /// each vertex's four joints and weights, the palette (written each
+    /// frame), and the bind group over them and the pose it writes.
+    fn skin_group(
+        &self,
+        ctx: &GpuContext,
+        rig: &SkinRig,
+        welded: &WeldedCorners,
+        pose: &[PoseVertex],
+        pose_buffer: &wgpu::Buffer,
+    ) -> GpuSkin {
+        let device = &ctx.device;
+        let storage = wgpu::BufferUsages::STORAGE;
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let rest = buffer("shell rest pose", bytemuck::cast_slice(pose), storage);
+        let influences = welded.skin_influences(rig);
+        let influences = buffer(
+            "shell skin influences",
+            bytemuck::cast_slice(&influences),
+            storage,
+        );
+        let palette = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shell skin palette"),
+            size: (64 * rig.palette_len().max(1)) as u64,
+            usage: storage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shell skinning"),
+            layout: &self.skin_layout,
+            entries: &[
+                (0, &palette),
+                (1, &rest),
+                (2, &influences),
+                (3, pose_buffer),
+            ]
+            .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }),
+        });
+        GpuSkin {
+            palette,
+            palette_len: rig.palette_len(),
+            bind,
+        }
     }
 
     /// Generates a scene's shell texture and uploads the scene
@@ -390,4 +422,13 @@ impl ShellRenderer {
         );
         Ok(())
     }
+}
+
+/// A model's textures ([`ShellRenderer::texture_group`]): the bind group
+/// of the shell pass, the wetness mask (rewritten when painted) and the
+/// shell layers' mip count.
+struct ShellTextureGroup {
+    bind: wgpu::BindGroup,
+    wetness: wgpu::Texture,
+    mip_levels: u32,
 }

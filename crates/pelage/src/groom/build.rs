@@ -9,12 +9,14 @@ use super::error::{GroomError, GroomErrorKind};
 use super::generator::{Generator, Reuse};
 use super::grow::Workspace;
 use super::ops::{
-    CentreGuides, ChainSoFar, ClumpCentres, OpKey, Opacity, Operator, Preparation, Resampling,
-    Width, color_maps_mut, root_to_tip_maps_mut,
+    CentreGuides, ChainSoFar, ClumpCentres, GroomOp, OpKey, Opacity, Operator, Preparation,
+    Resampling, Width, color_maps_mut, root_to_tip_maps_mut,
 };
 use super::outside_skin::OutsideSkin;
 use super::parts::{PartLayout, part_count};
+use super::regions::RegionLookup;
 use super::spec::{GroomSpec, HairIds, RootDistribution};
+use crate::guides::Guides;
 use crate::interp::Interpolator;
 use crate::limits;
 use crate::map::Map;
@@ -87,62 +89,8 @@ impl Generator {
             }
             moved
         });
-        let fraction = spec.roots.fraction;
-        if !(fraction > 0.0 && fraction <= 1.0) {
-            return Err(spec.error(
-                "output.fraction",
-                GroomErrorKind::Invalid(format!(
-                    "fraction = {fraction}: the share of the hairs grown is above 0 and at most 1"
-                )),
-            ));
-        }
-        if fraction < 1.0
-            && (spec.roots.ids != HairIds::Stable
-                || spec.roots.distribution != RootDistribution::Random)
-        {
-            return Err(spec.error(
-                "output.fraction",
-                GroomErrorKind::Invalid(
-                    "a fraction grows the first arrivals of the root cells, so that it is a subset of the groom: it needs stable ids and random roots (remove `ids = \"sequential\"` or `distribution = \"blue-noise\"`)".into(),
-                ),
-            ));
-        }
-        let count = spec.roots.count;
-        if count == 0 {
-            return Err(spec.error(
-                "roots.count",
-                GroomErrorKind::Invalid("the hair count must be at least 1".into()),
-            ));
-        }
+        check_numbers(&spec)?;
         let points = spec.finish.points;
-        if points < 2 {
-            return Err(spec.error(
-                "finish.points",
-                GroomErrorKind::Invalid("hairs need at least 2 points".into()),
-            ));
-        }
-        // Groom files are checked as they are read; grooms built in code
-        // (the Python package, tests) meet the same ceilings here.
-        let ceiling = |key: &str, value: u64, max: u64, what: &str| {
-            limits::check_count(value, max, false, what)
-                .map_err(|m| spec.error(key, GroomErrorKind::Invalid(m)))
-        };
-        ceiling("roots.count", count, limits::MAX_HAIRS, "hairs")?;
-        ceiling(
-            "finish.points",
-            points as u64,
-            limits::MAX_CURVE_POINTS,
-            "points",
-        )?;
-        for (index, op) in spec.ops.iter().enumerate() {
-            let key = OpKey {
-                index,
-                name: op.name(),
-            };
-            for (field, value, most, what) in op.counts() {
-                ceiling(&key.field(field), value, most, what)?;
-            }
-        }
         bind_maps(&mut spec)?;
         let regions = match (shared_regions, &spec.regions) {
             (Some(g), _) => g.regions.clone(),
@@ -155,68 +103,9 @@ impl Generator {
         };
         let (sampler, cells, layout) = match shared_roots {
             Some(g) => (g.sampler.clone(), g.cells.clone(), g.layout.clone()),
-            None => {
-                let mesh = &spec.mesh;
-                let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
-                    .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
-                // A fraction grows the first arrivals: a subset of the groom.
-                let grown = spec.roots.grown_count();
-                let parts = part_count(mesh, grown, spec.roots.parts, spec.roots.ids);
-                let (cells, layout) = match spec.roots.ids {
-                    HairIds::Stable => {
-                        let cells = RootCells::new(mesh, &sampler);
-                        let counts = cells.counts(spec.roots.seed, grown);
-                        let layout = PartLayout::from_cells(&cells, &counts, parts);
-                        (Some(Arc::new(cells)), layout)
-                    }
-                    HairIds::Sequential => {
-                        let layout = PartLayout::new(
-                            mesh,
-                            |t| sampler.triangle_probability(t),
-                            count,
-                            parts,
-                        );
-                        (None, layout)
-                    }
-                };
-                (Arc::new(sampler), cells, Arc::new(layout))
-            }
+            None => root_sampling(&spec)?,
         };
-        let interpolator = match shared_weights {
-            Some(g) => {
-                if g.guides.len() != spec.guides.len() {
-                    return Err(spec.error(
-                        "guides",
-                        GroomErrorKind::Invalid(format!(
-                            "{} guides where the groom has {}",
-                            spec.guides.len(),
-                            g.guides.len()
-                        )),
-                    ));
-                }
-                g.interpolator.reshaped(&spec.mesh, spec.guides.clone())
-            }
-            None => {
-                let mesh = &spec.mesh;
-                match &regions {
-                    Some(lookup) => {
-                        let guide_regions: Vec<u32> = spec
-                            .guides
-                            .roots()
-                            .iter()
-                            .map(|r| lookup.of(mesh, *r))
-                            .collect();
-                        Interpolator::with_regions(
-                            mesh,
-                            spec.guides.clone(),
-                            &spec.interpolation,
-                            &guide_regions,
-                        )
-                    }
-                    None => Interpolator::new(mesh, spec.guides.clone(), &spec.interpolation),
-                }
-            }
-        };
+        let interpolator = interpolator_for(&spec, shared_weights, regions.as_deref())?;
         let GroomSpec {
             name,
             mesh,
@@ -231,26 +120,9 @@ impl Generator {
         let (colors, opacities) = (finish.color.is_some(), finish.opacity.is_some());
         // The skin's grid depends on the mesh alone: an edit's generator
         // shares its parent's.
-        let outside_skin = finish.outside_skin.map(|gap| {
-            from.filter(|g| Arc::ptr_eq(&g.mesh, &mesh))
-                .and_then(|g| g.outside_skin.clone())
-                .filter(|o| o.gap() == gap)
-                .unwrap_or_else(|| {
-                    // A hair's segment: the longest guide's length over
-                    // the hair's segments.
-                    let longest = (0..guides.len())
-                        .map(|g| {
-                            guides
-                                .guide(g)
-                                .windows(2)
-                                .map(|w| (w[1] - w[0]).length())
-                                .sum::<f32>()
-                        })
-                        .fold(0.0f32, f32::max);
-                    let segment = longest / (points.max(2) - 1) as f32;
-                    Arc::new(OutsideSkin::new(&mesh, gap, segment))
-                })
-        });
+        let outside_skin = finish
+            .outside_skin
+            .map(|gap| outside_skin_for(from, &mesh, &guides, gap, points));
         let mut base = vec![Operator::Width(Width(finish.width))];
         base.extend(finish.color.map(Operator::Color));
         base.extend(finish.opacity.map(|o| Operator::Opacity(Opacity(o))));
@@ -288,24 +160,36 @@ impl Generator {
             last_part: AtomicUsize::new(usize::MAX),
             prefetched: Mutex::new(None),
         };
+        generator.prepare_chain(ops, shared_weights.map(|g| (g, moved.as_deref())))?;
+        Ok(generator)
+    }
+
+    /// Prepares the operator chain in order: each operator sees the ones
+    /// before it (a clump grows its centres through them) and, reshaping,
+    /// the generator reshaped with the guides that moved.
+    fn prepare_chain(
+        &mut self,
+        ops: Vec<GroomOp>,
+        reshaping: Option<(&Generator, Option<&[bool]>)>,
+    ) -> Result<(), GroomError> {
         for (index, op) in ops.into_iter().enumerate() {
             let key = OpKey {
                 index,
                 name: op.name(),
             };
             // Clump centres are grown through the operators before this
-            // one, which are already in `generator.ops`.
+            // one, which are already in `self.ops`.
             let chain = ChainBuild {
-                generator: &generator,
-                reshaping: shared_weights.map(|g| (g, moved.as_deref())),
+                generator: self,
+                reshaping,
             };
             let op = op.prepare(&Preparation { chain: &chain, key })?;
-            generator.colors |= op.adds_colors();
-            generator.opacities |= op.adds_opacities();
-            generator.clumps |= op.searches_neighbours();
-            generator.ops.push(op);
+            self.colors |= op.adds_colors();
+            self.opacities |= op.adds_opacities();
+            self.clumps |= op.searches_neighbours();
+            self.ops.push(op);
         }
-        Ok(generator)
+        Ok(())
     }
 
     /// Grows the centre hairs of the clump operator at chain position `k`
@@ -429,6 +313,181 @@ impl Generator {
     }
 }
 
+/// A spec's root sampler, root cells (stable ids) and part layout.
+type RootSampling = (Arc<DensitySampler>, Option<Arc<RootCells>>, Arc<PartLayout>);
+
+/// The spec's numbers that no file check has held when it was built in
+/// code: a preview fraction, at least one hair of two points, and every
+/// count within its ceiling (docs/limits.md).
+fn check_numbers(spec: &GroomSpec) -> Result<(), GroomError> {
+    let fraction = spec.roots.fraction;
+    if !(fraction > 0.0 && fraction <= 1.0) {
+        return Err(spec.error(
+            "output.fraction",
+            GroomErrorKind::Invalid(format!(
+                "fraction = {fraction}: the share of the hairs grown is above 0 and at most 1"
+            )),
+        ));
+    }
+    if fraction < 1.0
+        && (spec.roots.ids != HairIds::Stable
+            || spec.roots.distribution != RootDistribution::Random)
+    {
+        return Err(spec.error(
+            "output.fraction",
+            GroomErrorKind::Invalid(
+                "a fraction grows the first arrivals of the root cells, so that it is a subset of the groom: it needs stable ids and random roots (remove `ids = \"sequential\"` or `distribution = \"blue-noise\"`)".into(),
+            ),
+        ));
+    }
+    let count = spec.roots.count;
+    if count == 0 {
+        return Err(spec.error(
+            "roots.count",
+            GroomErrorKind::Invalid("the hair count must be at least 1".into()),
+        ));
+    }
+    let points = spec.finish.points;
+    if points < 2 {
+        return Err(spec.error(
+            "finish.points",
+            GroomErrorKind::Invalid("hairs need at least 2 points".into()),
+        ));
+    }
+    // Groom files are checked as they are read; grooms built in code
+    // (the Python package, tests) meet the same ceilings here.
+    let ceiling = |key: &str, value: u64, max: u64, what: &str| {
+        limits::check_count(value, max, false, what)
+            .map_err(|m| spec.error(key, GroomErrorKind::Invalid(m)))
+    };
+    ceiling("roots.count", count, limits::MAX_HAIRS, "hairs")?;
+    ceiling(
+        "finish.points",
+        points as u64,
+        limits::MAX_CURVE_POINTS,
+        "points",
+    )?;
+    for (index, op) in spec.ops.iter().enumerate() {
+        let key = OpKey {
+            index,
+            name: op.name(),
+        };
+        // An operator's numbers are held to the ranges a groom file's are
+        // first, so a spec built in a program is refused with the file's
+        // message.
+        if let Some((field, message)) = op.out_of_range() {
+            return Err(spec.error(&key.field(field), GroomErrorKind::Invalid(message)));
+        }
+        for (field, value, most, what) in op.counts() {
+            ceiling(&key.field(field), value, most, what)?;
+        }
+    }
+    Ok(())
+}
+
+/// The root sampler, the root cells (stable ids) and the part layout of
+/// `spec`.
+fn root_sampling(spec: &GroomSpec) -> Result<RootSampling, GroomError> {
+    let mesh = &spec.mesh;
+    let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
+        .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
+    // A fraction grows the first arrivals: a subset of the groom.
+    let grown = spec.roots.grown_count();
+    let parts = part_count(mesh, grown, spec.roots.parts, spec.roots.ids);
+    let (cells, layout) = match spec.roots.ids {
+        HairIds::Stable => {
+            let cells = RootCells::new(mesh, &sampler);
+            let counts = cells.counts(spec.roots.seed, grown);
+            let layout = PartLayout::from_cells(&cells, &counts, parts);
+            (Some(Arc::new(cells)), layout)
+        }
+        HairIds::Sequential => {
+            let layout = PartLayout::new(
+                mesh,
+                |t| sampler.triangle_probability(t),
+                spec.roots.count,
+                parts,
+            );
+            (None, layout)
+        }
+    };
+    Ok((Arc::new(sampler), cells, Arc::new(layout)))
+}
+
+/// The interpolator of `spec`: the one of `shared` reshaped to the new
+/// guide shapes, or built (per region when the skin is split).
+fn interpolator_for(
+    spec: &GroomSpec,
+    shared: Option<&Generator>,
+    regions: Option<&RegionLookup>,
+) -> Result<Interpolator, GroomError> {
+    Ok(match shared {
+        Some(g) => {
+            if g.guides.len() != spec.guides.len() {
+                return Err(spec.error(
+                    "guides",
+                    GroomErrorKind::Invalid(format!(
+                        "{} guides where the groom has {}",
+                        spec.guides.len(),
+                        g.guides.len()
+                    )),
+                ));
+            }
+            g.interpolator.reshaped(&spec.mesh, spec.guides.clone())
+        }
+        None => {
+            let mesh = &spec.mesh;
+            match regions {
+                Some(lookup) => {
+                    let guide_regions: Vec<u32> = spec
+                        .guides
+                        .roots()
+                        .iter()
+                        .map(|r| lookup.of(mesh, *r))
+                        .collect();
+                    Interpolator::with_regions(
+                        mesh,
+                        spec.guides.clone(),
+                        &spec.interpolation,
+                        &guide_regions,
+                    )
+                }
+                None => Interpolator::new(mesh, spec.guides.clone(), &spec.interpolation),
+            }
+        }
+    })
+}
+
+/// The skin hairs are kept out of: `from`'s when it has the same mesh and
+/// gap (the grid depends on the mesh alone), else built with a hair's
+/// segment (the longest guide over the hair's segments) as its step.
+fn outside_skin_for(
+    from: Option<&Generator>,
+    mesh: &Arc<Mesh>,
+    guides: &Guides,
+    gap: f32,
+    points: usize,
+) -> Arc<OutsideSkin> {
+    from.filter(|g| Arc::ptr_eq(&g.mesh, mesh))
+        .and_then(|g| g.outside_skin.clone())
+        .filter(|o| o.gap() == gap)
+        .unwrap_or_else(|| {
+            // A hair's segment: the longest guide's length over
+            // the hair's segments.
+            let longest = (0..guides.len())
+                .map(|g| {
+                    guides
+                        .guide(g)
+                        .windows(2)
+                        .map(|w| (w[1] - w[0]).length())
+                        .sum::<f32>()
+                })
+                .fold(0.0f32, f32::max);
+            let segment = longest / (points.max(2) - 1) as f32;
+            Arc::new(OutsideSkin::new(mesh, gap, segment))
+        })
+}
+
 /// The chain built so far, as preparing its next operator sees it: the
 /// generator being built and, when reshaping, the generator it reshapes
 /// with the guides that moved (`None`: any).
@@ -471,17 +530,6 @@ impl ChainSoFar for ChainBuild<'_> {
 /// values), or fails naming the setting whose map the mesh cannot serve
 /// (image maps need UVs, per-vertex maps their attribute).
 fn bind_maps(spec: &mut GroomSpec) -> Result<(), GroomError> {
-    // An operator's numbers are held to the ranges a groom file's are, so
-    // a spec built in a program is refused with the file's message.
-    for (index, op) in spec.ops.iter().enumerate() {
-        if let Some((field, message)) = op.out_of_range() {
-            let key = OpKey {
-                index,
-                name: op.name(),
-            };
-            return Err(spec.error(&key.field(field), GroomErrorKind::Invalid(message)));
-        }
-    }
     let mesh = spec.mesh.clone();
     let mut failed = None;
     {
