@@ -9,7 +9,7 @@
 //! 1. **Values.** `error.rs` ([`GroomError`]: file, line, key and a typed
 //!    kind), `source.rs` (settings' spans as errors, maps resolved against
 //!    the file's folder), [`Ramp`], `values.rs` (a map as written,
-//!    [`values::MapValue`], and the root-to-tip and colour specs),
+//!    `MapValue`, and the root-to-tip and colour specs),
 //!    [`regions`], [`HairLook`] (`hair_look.rs`: `[look]`, each hair's
 //!    values for a physically based hair shader), [`OutsideSkin`].
 //! 2. **Operators**: [`ops`], one module an operator, which see the chain
