@@ -17,7 +17,7 @@
 //! One file, past 600 lines: the explicit and implicit compute pipelines
 //! share buffers, bind groups and the uniform ring.
 
-use crate::layout::{entry, gpu_struct};
+use crate::layout::{entry, gpu_struct, group};
 use crate::{GpuContext, GpuError, ShellModel, workgroups};
 use glam::Vec3;
 use pelage::dynamics::{DynamicsParams, MassSpringSystem, Topology};
@@ -527,18 +527,14 @@ impl GpuMassSpring {
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("dynamics coupling"),
             layout: &self.coupling_layout,
-            entries: &[
+            entries: &group::buffers_at([
                 (1, &self.roots),
                 (2, &self.normals),
                 (7, tips),
                 (11, &self.corner_sticks),
                 (12, &model.tip_offsets),
                 (13, &model.vertex_corners),
-            ]
-            .map(|(binding, buffer)| wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }),
+            ]),
         });
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         {

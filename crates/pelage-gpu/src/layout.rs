@@ -203,6 +203,42 @@ impl<T: bytemuck::Pod> UniformRing<T> {
     }
 }
 
+/// Bind-group entries, numbered by position where a group's bindings run
+/// 0, 1, 2, … (as Bevy's `BindGroupEntries::sequential`), or at the
+/// bindings given where a layout skips some.
+pub(crate) mod group {
+    use wgpu::{BindGroupEntry, BindingResource, Buffer};
+
+    /// Binding `i` is `resources[i]`.
+    pub(crate) fn sequential<const N: usize>(
+        resources: [BindingResource<'_>; N],
+    ) -> [BindGroupEntry<'_>; N] {
+        let mut binding = 0;
+        resources.map(|resource| {
+            binding += 1;
+            BindGroupEntry {
+                binding: binding - 1,
+                resource,
+            }
+        })
+    }
+
+    /// Whole buffers, binding `i` being `buffers[i]`.
+    pub(crate) fn buffers<'a, const N: usize>(buffers: [&'a Buffer; N]) -> [BindGroupEntry<'a>; N] {
+        sequential(buffers.map(Buffer::as_entire_binding))
+    }
+
+    /// Whole buffers at the bindings given.
+    pub(crate) fn buffers_at<'a, const N: usize>(
+        buffers: [(u32, &'a Buffer); N],
+    ) -> [BindGroupEntry<'a>; N] {
+        buffers.map(|(binding, buffer)| BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        })
+    }
+}
+
 /// Bind-group layout entries, one constructor a kind of binding, so each
 /// pipeline lists its bindings instead of spelling wgpu's structs out.
 pub(crate) mod entry {

@@ -4,7 +4,7 @@
 //! One file, past 600 lines: the three preview pipelines (skin, points,
 //! curves) share one frame uniform and one pass.
 
-use crate::layout::{UniformRing, entry, gpu_struct, gpu_vertex};
+use crate::layout::{UniformRing, entry, gpu_struct, gpu_vertex, group};
 use crate::readback::{is_bgra, read_texture};
 use crate::{Camera, GpuContext, GpuError};
 use glam::Vec3;
@@ -382,16 +382,10 @@ impl Renderer {
         let skin_texture = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("skin texture"),
             layout: &self.texture_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
-            ],
+            entries: &group::sequential([
+                wgpu::BindingResource::TextureView(&view),
+                wgpu::BindingResource::Sampler(&self.sampler),
+            ]),
         });
         let point_buffer = (!scene.points.is_empty()).then(|| {
             let centres: Vec<PointInstance> = scene

@@ -10,6 +10,7 @@ use super::model::{GpuSkin, ShellModel, ShellUpload};
 use super::prepare::{WeldedCorners, fur_mip_chain};
 use super::renderer::ShellRenderer;
 use super::{PoseVertex, TipOffset};
+use crate::layout::group;
 use crate::{GpuContext, GpuError};
 use glam::Vec3;
 use pelage::Mesh;
@@ -204,28 +205,13 @@ impl ShellRenderer {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shell textures"),
             layout: &self.texture_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&fur_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(&self.fur_sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&color_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Sampler(&self.color_sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(&wetness_view),
-                },
-            ],
+            entries: &group::sequential([
+                wgpu::BindingResource::TextureView(&fur_view),
+                wgpu::BindingResource::Sampler(&self.fur_sampler),
+                wgpu::BindingResource::TextureView(&color_view),
+                wgpu::BindingResource::Sampler(&self.color_sampler),
+                wgpu::BindingResource::TextureView(&wetness_view),
+            ]),
         });
         ShellTextureGroup {
             bind,
@@ -256,16 +242,7 @@ impl ShellRenderer {
             let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("shell fins"),
                 layout: &self.fin_layout,
-                entries: &[
-                    (0, &records),
-                    (1, pose_buffer),
-                    (2, surface_buffer),
-                    (3, tip_offsets),
-                ]
-                .map(|(binding, buffer)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: buffer.as_entire_binding(),
-                }),
+                entries: &group::buffers([&records, pose_buffer, surface_buffer, tip_offsets]),
             });
             (group, fin_records.len() as u32)
         })
@@ -307,16 +284,7 @@ impl ShellRenderer {
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shell skinning"),
             layout: &self.skin_layout,
-            entries: &[
-                (0, &palette),
-                (1, &rest),
-                (2, &influences),
-                (3, pose_buffer),
-            ]
-            .map(|(binding, buffer)| wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }),
+            entries: &group::buffers([&palette, &rest, &influences, pose_buffer]),
         });
         GpuSkin {
             palette,
