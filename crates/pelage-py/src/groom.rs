@@ -11,8 +11,8 @@ use crate::curves::PyCurves;
 use crate::mesh::PyMesh;
 use crate::to_py_err;
 use pelage::groom::{
-    AnimatedGroom, Assembly, FarmRun, Generator, Groom, GroomError, GroomInputs, GroomReport,
-    GroomWriteError, ReportBuilder, Timings,
+    AnimatedGroom, AnimatedPlanError, Assembly, FarmRun, Generator, Groom, GroomError, GroomInputs,
+    GroomReport, GroomWriteError, ReportBuilder, Timings,
 };
 use pelage::settings::SettingsSource;
 use pyo3::exceptions::{PyIndexError, PyMemoryError, PyTypeError, PyValueError};
@@ -552,14 +552,28 @@ impl PyGroom {
         };
         let farm = || self.groom.run_output(&output, run).map_err(part_error);
         let (summary, written, grown) = if let Some(animated) = animated {
-            let (range, path) = farm()?;
+            // The library's plan: a farm run's file is named by its frames,
+            // as the CLI names it and `assemble` finds it.
+            let plan = self
+                .groom
+                .animated_plan(&animated, &output, run, false)
+                .map_err(|e| match e {
+                    AnimatedPlanError::Farm(e) => part_error(e),
+                    e => PyValueError::new_err(e.to_string()),
+                })?;
+            let path = plan.outputs[0].path.clone();
             create_folder(&path)?;
             let options = self.groom.usd_options();
             let with_skin = self.groom.writes_skin_in(run);
             let summary = py.detach(|| {
-                animated.write_until(&path, range, &options, with_skin, &cancel, |p| {
-                    report(p.done, p.total)
-                })
+                animated.write_files_until(
+                    &plan.outputs,
+                    plan.parts.clone(),
+                    &options,
+                    with_skin,
+                    &cancel,
+                    |p| report(p.done, p.total),
+                )
             });
             (summary, path, None)
         } else {

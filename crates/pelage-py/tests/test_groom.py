@@ -120,6 +120,26 @@ def test_progress_is_called_per_part_and_its_exception_is_raised(groom, tmp_path
         groom.grow(progress=stop)
 
 
+def test_an_animated_farms_runs_are_named_by_their_frames_and_assemble(tmp_path):
+    # Each run writes its share of the parts over every frame, named as
+    # `pelage groom --part` names it, so the assembly finds the runs.
+    fox = REPO / "crates" / "pelage" / "assets" / "fox"
+    groom = pelage.Groom(
+        mesh=str(next(fox.glob("*.gl*"))),
+        guides={"generate": {"count": 40, "length": 3.0}},
+        roots={"count": 400, "parts": 2},
+        animation={"frames": "1-3"},
+    )
+    out = tmp_path / "fox.usda"
+    written = [groom.write(out, part=(k, 2))["path"] for k in (1, 2)]
+    assert [p.name for p in written] == ["fox.part-1-of-2.f0001-0003.usdc", "fox.part-2-of-2.f0001-0003.usdc"]
+    assert sum(pelage.read_curves(p, time=2).curve_count for p in written) == 400
+    assembled = groom.assemble(out)
+    assert assembled["files"] == 2, assembled
+    layer = out.read_text()
+    assert all(p.name in layer for p in written), "the stitching layer names both runs' files"
+
+
 def test_farm_runs_write_part_files(groom, tmp_path):
     out = tmp_path / "fur.usda"
     written = [groom.write(out, part=(k, 2))["path"] for k in (1, 2)]

@@ -8,8 +8,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use pelage::anim::FrameRange;
 use pelage::groom::{
-    AnimatedGroom, Assembly, FarmRun, FrameFile, FrameOutput, Groom, ReportBuilder, Timings,
-    frames_file, write_clip_assembly,
+    AnimatedGroom, AnimatedPlanError, Assembly, FarmRun, Groom, ReportBuilder, Timings,
 };
 use pelage::io::CurvesFormat;
 use std::path::{Path, PathBuf};
@@ -251,60 +250,19 @@ fn run_animated(
         );
     }
     let generator = animated.generator();
-    let parts = generator.parts().len();
     let animation = animated.animation();
-    let frames = animation.frames.frames();
-    // Split outputs are binary USD beside a text stitching layer.
-    let data = match output.extension().and_then(|e| e.to_str()) {
-        Some("usda") if args.part.is_some() || args.frame_files => output.with_extension("usdc"),
-        _ => output.to_path_buf(),
-    };
-    let (range, outputs) = match args.part {
-        Some(run) => {
-            let range = run
-                .parts(parts)
-                .with_context(|| format!("--part: {}", args.file.display()))?;
-            let path = frames_file(
-                &data,
-                Some((run.k, run.n)),
-                animation.frames.first(),
-                animation.frames.last(),
-            );
-            let output = FrameOutput {
-                path,
-                times: animation.times_of(frames),
-            };
-            (range, vec![output])
-        }
-        None if args.frame_files => {
-            if output.extension().and_then(|e| e.to_str()) != Some("usda") {
-                bail!(
-                    "{}: with --frame-files the output is the stitching layer: name it .usda",
-                    output.display()
-                );
+    let plan = groom
+        .animated_plan(animated, output, args.part, args.frame_files)
+        .map_err(|e| match e {
+            AnimatedPlanError::Farm(_) => {
+                anyhow::Error::new(e).context(format!("--part: {}", args.file.display()))
             }
-            let outputs = frames
-                .iter()
-                .map(|&f| FrameOutput {
-                    path: frames_file(&data, None, f, f),
-                    times: animation.times_of(&[f]),
-                })
-                .collect();
-            (0..parts, outputs)
-        }
-        None => {
-            let output = FrameOutput {
-                path: output.to_path_buf(),
-                times: animation.times_of(frames),
-            };
-            (0..parts, vec![output])
-        }
-    };
+            e => anyhow::Error::new(e).context("--frame-files"),
+        })?;
+    let range = plan.parts.clone();
+    let outputs = &plan.outputs;
     let path = outputs[0].path.clone();
-    let times: Vec<f64> = outputs
-        .iter()
-        .flat_map(|o| o.times.iter().copied())
-        .collect();
+    let times = plan.times();
     let planned: u64 = generator.parts()[range.clone()]
         .iter()
         .map(|p| p.hair_count)
@@ -338,25 +296,11 @@ fn run_animated(
         bar
     };
     let options = groom.usd_options();
-    if args.frame_files {
-        // A stitching layer of an earlier run would stitch this run's
-        // frames with its own if this run stopped half-way: it goes first,
-        // and comes back, naming this run's frames only, once all of them
-        // are written.
-        match std::fs::remove_file(output) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                bail!(
-                    "{}: cannot remove the earlier stitching layer: {e}",
-                    output.display()
-                )
-            }
-            _ => {}
-        }
-    }
+    plan.remove_stale_stitching()?;
     let growing = Instant::now();
     // In a farm, the first run writes the skin.
     let with_skin = groom.writes_skin_in(args.part);
-    let summary = animated.write_files(&outputs, range.clone(), &options, with_skin, |p| {
+    let summary = animated.write_files(outputs, range.clone(), &options, with_skin, |p| {
         bar.set_message(format!("part {} frame {}", p.part, p.time));
         bar.set_position(p.done as u64);
     })?;
@@ -376,18 +320,7 @@ fn run_animated(
         seconds / times.len() as f64,
         start.elapsed().as_secs_f64() - seconds
     );
-    if args.frame_files {
-        let files: Vec<FrameFile> = outputs
-            .iter()
-            .zip(frames)
-            .map(|(o, &f)| FrameFile {
-                path: o.path.clone(),
-                run: (1, 1),
-                first: f,
-                last: f,
-            })
-            .collect();
-        let stitched = write_clip_assembly(output, &files, &animation.frames)?;
+    if let Some(stitched) = plan.stitch()? {
         println!(
             "{} → {} frame files stitched with value clips ({} prims, time codes {} to {})",
             output.display(),

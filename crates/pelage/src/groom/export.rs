@@ -5,7 +5,8 @@
 //! call these instead of spelling the defaults (24 fps, the basis, the
 //! skin in run 1) each on its own.
 
-use super::clips::{ClipAssembly, find_frame_files, write_clip_assembly};
+use super::animate::{AnimatedGroom, FrameOutput};
+use super::clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
 use super::farm::{FarmError, FarmRun, find_part_files};
 use super::generator::Generator;
 use super::load::Groom;
@@ -78,6 +79,79 @@ impl Groom {
         }
     }
 
+    /// Where a run of the animated groom `animated` writes, beside
+    /// `output`: the parts it grows and its files, each with its time
+    /// codes. One run writes `output` with every frame; run `K/N` of a
+    /// farm writes its share of the parts, every frame, to
+    /// `STEM.part-K-of-N.fA-B.usdc`; `frame_files` writes one file a frame
+    /// (`STEM.fA.usdc`) and `output` (`.usda`) as the layer that stitches
+    /// them ([`AnimatedPlan::stitch`]). Split outputs are binary USD
+    /// beside a text layer, so a `.usda` output's frame files are `.usdc`.
+    /// [`Groom::assemble`] finds a farm's frame files by these names.
+    pub fn animated_plan(
+        &self,
+        animated: &AnimatedGroom,
+        output: &Path,
+        run: Option<FarmRun>,
+        frame_files: bool,
+    ) -> Result<AnimatedPlan, AnimatedPlanError> {
+        let parts = animated.generator().parts().len();
+        let animation = animated.animation();
+        let frames = animation.frames.frames();
+        let usda = output.extension().and_then(|e| e.to_str()) == Some("usda");
+        let data = match usda && (run.is_some() || frame_files) {
+            true => output.with_extension("usdc"),
+            false => output.to_path_buf(),
+        };
+        let one = |path: PathBuf| FrameOutput {
+            path,
+            times: animation.times_of(frames),
+        };
+        match (run, frame_files) {
+            (Some(_), true) => Err(AnimatedPlanError::FramesAndRun),
+            (Some(run), false) => {
+                let (first, last) = (animation.frames.first(), animation.frames.last());
+                Ok(AnimatedPlan {
+                    parts: run.parts(parts).map_err(AnimatedPlanError::Farm)?,
+                    outputs: vec![one(frames_file(&data, Some((run.k, run.n)), first, last))],
+                    stitching: None,
+                })
+            }
+            (None, true) if !usda => Err(AnimatedPlanError::StitchingNotUsda(output.to_path_buf())),
+            (None, true) => {
+                let files: Vec<FrameFile> = frames
+                    .iter()
+                    .map(|&f| FrameFile {
+                        path: frames_file(&data, None, f, f),
+                        run: (1, 1),
+                        first: f,
+                        last: f,
+                    })
+                    .collect();
+                Ok(AnimatedPlan {
+                    parts: 0..parts,
+                    outputs: files
+                        .iter()
+                        .map(|file| FrameOutput {
+                            path: file.path.clone(),
+                            times: animation.times_of(&[file.first]),
+                        })
+                        .collect(),
+                    stitching: Some(Stitching {
+                        layer: output.to_path_buf(),
+                        files,
+                        frames: animation.frames.clone(),
+                    }),
+                })
+            }
+            (None, false) => Ok(AnimatedPlan {
+                parts: 0..parts,
+                outputs: vec![one(output.to_path_buf())],
+                stitching: None,
+            }),
+        }
+    }
+
     /// Ties a farm's files beside `output` together: for a still groom a
     /// USD layer referencing every run's part file with its extent (or,
     /// for an `.abc` output, the runs' Alembic parts joined into one
@@ -115,6 +189,84 @@ impl Groom {
             }
         }
     }
+}
+
+/// Where a run of an animated groom writes ([`Groom::animated_plan`]).
+#[derive(Debug, Clone)]
+pub struct AnimatedPlan {
+    /// The parts the run grows.
+    pub parts: std::ops::Range<usize>,
+    /// Its files, each with its time codes (one, or one a frame).
+    pub outputs: Vec<FrameOutput>,
+    /// With a file a frame: the layer that stitches them.
+    pub stitching: Option<Stitching>,
+}
+
+/// A text layer tying frame files together with USD value clips.
+#[derive(Debug, Clone)]
+pub struct Stitching {
+    /// The layer (`.usda`).
+    pub layer: PathBuf,
+    /// The frame files, in frame order.
+    pub files: Vec<FrameFile>,
+    /// The frames they hold.
+    pub frames: crate::anim::FrameRange,
+}
+
+impl AnimatedPlan {
+    /// Every time code the run writes, file after file.
+    pub fn times(&self) -> Vec<f64> {
+        self.outputs
+            .iter()
+            .flat_map(|o| o.times.iter().copied())
+            .collect()
+    }
+
+    /// After the files are written: writes the layer that stitches them,
+    /// if the plan has one.
+    pub fn stitch(&self) -> Result<Option<ClipAssembly>, WriteError> {
+        self.stitching
+            .as_ref()
+            .map(|s| write_clip_assembly(&s.layer, &s.files, &s.frames))
+            .transpose()
+    }
+
+    /// Removes a stitching layer an earlier run left: it would stitch
+    /// this run's frames with its own if this run stopped half-way. The
+    /// layer comes back, naming this run's frames only, from
+    /// [`Self::stitch`] once all of them are written.
+    pub fn remove_stale_stitching(&self) -> Result<(), WriteError> {
+        let Some(stitching) = &self.stitching else {
+            return Ok(());
+        };
+        match std::fs::remove_file(&stitching.layer) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(WriteError {
+                path: stitching.layer.clone(),
+                error: std::io::Error::new(
+                    e.kind(),
+                    format!("cannot remove the earlier stitching layer: {e}"),
+                ),
+            }),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Why an animated groom's run cannot be planned.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum AnimatedPlanError {
+    /// The farm run does not fit the groom's parts.
+    #[error("{0}")]
+    Farm(FarmError),
+    /// A file a frame was asked for with an output other than `.usda`.
+    #[error("{}: with a file a frame the output is the stitching layer: name it .usda", .0.display())]
+    StitchingNotUsda(PathBuf),
+    /// A farm run and a file a frame at once.
+    #[error(
+        "a farm run writes its share of the parts over every frame; a file a frame is for one run of the whole groom"
+    )]
+    FramesAndRun,
 }
 
 /// What [`Groom::assemble`] wrote.

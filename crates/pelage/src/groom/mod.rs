@@ -76,7 +76,9 @@ pub use animate::{
 };
 pub use clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
 pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
-pub use export::{AssembleError, Assembly, DEFAULT_FPS};
+pub use export::{
+    AnimatedPlan, AnimatedPlanError, AssembleError, Assembly, DEFAULT_FPS, Stitching,
+};
 pub use farm::{FarmError, FarmRun, find_part_files};
 pub use generator::{Generator, GroomSummary};
 pub use hair_look::HairLook;
