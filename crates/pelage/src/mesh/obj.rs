@@ -19,41 +19,7 @@ pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
     // Editors on Windows may start the text with a UTF-8 byte-order mark;
     // left in place it would hide the first statement.
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    // First pass: count vertices, UVs and normals, so that every face index
-    // can be checked at its own line even when it refers forwards; and note
-    // whether the file has groups (`g`), which then take precedence over
-    // objects (`o`).
-    let (mut v_total, mut vt_total, mut vn_total) = (0usize, 0usize, 0usize);
-    let mut uses_g = false;
-    for line in bytes.split(|&b| b == b'\n') {
-        let line = line.trim_ascii_start();
-        match line {
-            [b'v', b' ' | b'\t', ..] => v_total += 1,
-            [b'v', b't', b' ' | b'\t', ..] => vt_total += 1,
-            [b'v', b'n', b' ' | b'\t', ..] => vn_total += 1,
-            [b'g', b' ' | b'\t', ..] => uses_g = true,
-            _ => {}
-        }
-    }
-    let totals = [v_total, vt_total, vn_total];
-
-    let mut positions = Vec::with_capacity(v_total);
-    let mut uv_values = Vec::with_capacity(vt_total);
-    let mut file_normals = Vec::with_capacity(vn_total);
-    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(v_total * 2);
-    let mut uv_triangles: Vec<[u32; 3]> = Vec::new();
-    let mut normal_triangles: Vec<[u32; 3]> = Vec::new();
-    // Whether faces carry UVs / normals, and the line of the first face,
-    // so that a file mixing faces with and without UVs can be reported.
-    let mut face_layout: Option<(bool, bool, usize)> = None;
-    let mut normals_on_all_faces = true;
-    let mut corners: Vec<[Option<u32>; 3]> = Vec::with_capacity(8);
-    // Vertex colours: present on every `v` line or on none.
-    let mut colours: Vec<Vec3> = Vec::new();
-    let mut coloured: Option<bool> = None;
-    // Face sets: each kind's names and the current set of faces to come.
-    let mut sets = [FaceSets::new("groups"), FaceSets::new("materials")];
-
+    let mut reader = ObjReader::new(Counts::of(bytes));
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
         let line_no = i + 1;
         let err = |kind| MeshError::at_line(name, line_no, kind);
@@ -68,173 +34,286 @@ pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
         })?;
         let mut tokens = line.split_ascii_whitespace();
         match tokens.next() {
-            Some("v") => {
-                let [x, y, z] = numbers::<3>(&mut tokens, "a vertex (v x y z)").map_err(err)?;
-                let p = Vec3::new(x, y, z);
-                if !p.is_finite() {
-                    return Err(err(MeshErrorKind::NonFinite {
-                        what: "vertex position",
-                    }));
-                }
-                positions.push(p);
-                let rest: Vec<&str> = tokens.collect();
-                let has_colour = rest.len() >= 3;
-                match coloured {
-                    None => coloured = Some(has_colour),
-                    Some(before) if before != has_colour => {
-                        return Err(err(MeshErrorKind::Unsupported(
-                            "some vertices have colours (v x y z r g b) and some do not; pelage needs colours on all vertices or on none".into(),
-                        )));
-                    }
-                    Some(_) => {}
-                }
-                if has_colour {
-                    let mut rgb = rest[..3].iter().map(|t| number(t));
-                    let mut next = || rgb.next().expect("three tokens").map_err(err);
-                    let c = Vec3::new(next()?, next()?, next()?);
-                    if !c.is_finite() {
-                        return Err(err(MeshErrorKind::NonFinite {
-                            what: "vertex colour",
-                        }));
-                    }
-                    colours.push(c);
-                }
-            }
-            Some("vt") => {
-                let [u] =
-                    numbers::<1>(&mut tokens, "a texture coordinate (vt u v)").map_err(err)?;
-                let v = match tokens.next() {
-                    Some(t) => number(t).map_err(err)?,
-                    None => 0.0,
-                };
-                let uv = Vec2::new(u, v);
-                if !uv.is_finite() {
-                    return Err(err(MeshErrorKind::NonFinite {
-                        what: "texture coordinate",
-                    }));
-                }
-                uv_values.push(uv);
-            }
-            Some("vn") => {
-                let [x, y, z] = numbers::<3>(&mut tokens, "a normal (vn x y z)").map_err(err)?;
-                let n = Vec3::new(x, y, z);
-                if !n.is_finite() {
-                    return Err(err(MeshErrorKind::NonFinite {
-                        what: "vertex normal",
-                    }));
-                }
-                file_normals.push(n);
-            }
+            Some("v") => reader.vertex(tokens),
+            Some("vt") => reader.uv(tokens),
+            Some("vn") => reader.normal(tokens),
             Some(kind @ ("g" | "o" | "usemtl")) => {
-                let set = if kind == "usemtl" { 1 } else { 0 };
-                if kind == "o" && uses_g {
-                    continue;
-                }
-                let name = tokens.collect::<Vec<_>>().join(" ");
-                sets[set].enter(if name.is_empty() { "default" } else { &name });
+                reader.face_set(kind, tokens);
+                Ok(())
             }
-            Some("f") => {
-                corners.clear();
-                for token in tokens {
-                    corners.push(face_corner(token, &totals).map_err(err)?);
-                }
-                if corners.len() < 3 {
-                    return Err(err(MeshErrorKind::Syntax(format!(
-                        "a face needs at least 3 vertices, this one has {}",
-                        corners.len()
-                    ))));
-                }
-                let has_uv = corners.iter().all(|c| c[1].is_some());
-                let has_normal = corners.iter().all(|c| c[2].is_some());
-                if corners.iter().any(|c| c[1].is_some()) && !has_uv {
-                    return Err(err(MeshErrorKind::Syntax(
-                        "some corners of this face have texture coordinates and some do not".into(),
-                    )));
-                }
-                match face_layout {
-                    None => face_layout = Some((has_uv, has_normal, line_no)),
-                    Some((uv_before, _, first_line)) if uv_before != has_uv => {
-                        let (this, earlier) = if has_uv {
-                            ("has", "have none")
-                        } else {
-                            ("has no", "have them")
-                        };
-                        return Err(err(MeshErrorKind::Unsupported(format!(
-                            "this face {this} texture coordinates (vt) and the faces before it (from line {first_line}) {earlier}; pelage needs UVs on all faces or on none"
-                        ))));
-                    }
-                    Some(_) => {}
-                }
-                normals_on_all_faces &= has_normal;
-                // Fan triangulation, as most OBJ readers do for convex polygons.
-                for k in 1..corners.len() - 1 {
-                    for set in &mut sets {
-                        set.add_triangle();
-                    }
-                    let tri = [corners[0], corners[k], corners[k + 1]];
-                    triangles.push(tri.map(|c| c[0].expect("position index is required")));
-                    if has_uv {
-                        uv_triangles.push(tri.map(|c| c[1].expect("checked above")));
-                    }
-                    if has_normal {
-                        normal_triangles.push(tri.map(|c| c[2].expect("checked above")));
-                    }
-                }
+            Some("f") => reader.face(tokens, line_no),
+            _ => Ok(()),
+        }
+        .map_err(err)?;
+    }
+    reader.finish(name)
+}
+
+/// What a first pass over the file finds: how many vertices, UVs and
+/// normals it has, so that every face index can be checked at its own
+/// line even when it refers forwards, and whether it has groups (`g`),
+/// which then take precedence over objects (`o`).
+struct Counts {
+    /// `v`, `vt` and `vn` lines.
+    totals: [usize; 3],
+    uses_g: bool,
+}
+
+impl Counts {
+    fn of(bytes: &[u8]) -> Self {
+        let mut totals = [0usize; 3];
+        let mut uses_g = false;
+        for line in bytes.split(|&b| b == b'\n') {
+            match line.trim_ascii_start() {
+                [b'v', b' ' | b'\t', ..] => totals[0] += 1,
+                [b'v', b't', b' ' | b'\t', ..] => totals[1] += 1,
+                [b'v', b'n', b' ' | b'\t', ..] => totals[2] += 1,
+                [b'g', b' ' | b'\t', ..] => uses_g = true,
+                _ => {}
             }
-            _ => {}
+        }
+        Self { totals, uses_g }
+    }
+}
+
+/// The mesh as read so far, one statement at a time.
+struct ObjReader {
+    counts: Counts,
+    positions: Vec<Vec3>,
+    uv_values: Vec<Vec2>,
+    file_normals: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    uv_triangles: Vec<[u32; 3]>,
+    normal_triangles: Vec<[u32; 3]>,
+    /// Whether faces carry UVs / normals, and the line of the first face,
+    /// so that a file mixing faces with and without UVs can be reported.
+    face_layout: Option<(bool, bool, usize)>,
+    normals_on_all_faces: bool,
+    corners: Vec<[Option<u32>; 3]>,
+    /// Vertex colours: present on every `v` line or on none.
+    colours: Vec<Vec3>,
+    coloured: Option<bool>,
+    /// Face sets: each kind's names and the current set of faces to come.
+    sets: [FaceSets; 2],
+}
+
+impl ObjReader {
+    fn new(counts: Counts) -> Self {
+        let [v, vt, vn] = counts.totals;
+        Self {
+            positions: Vec::with_capacity(v),
+            uv_values: Vec::with_capacity(vt),
+            file_normals: Vec::with_capacity(vn),
+            triangles: Vec::with_capacity(v * 2),
+            uv_triangles: Vec::new(),
+            normal_triangles: Vec::new(),
+            face_layout: None,
+            normals_on_all_faces: true,
+            corners: Vec::with_capacity(8),
+            colours: Vec::new(),
+            coloured: None,
+            sets: [FaceSets::new("groups"), FaceSets::new("materials")],
+            counts,
         }
     }
 
-    if positions.is_empty() {
-        return Err(MeshError::whole(
-            name,
-            MeshErrorKind::Empty("no vertices (no 'v' lines)"),
-        ));
+    /// `v x y z [r g b]`.
+    fn vertex<'a>(
+        &mut self,
+        mut tokens: impl Iterator<Item = &'a str>,
+    ) -> Result<(), MeshErrorKind> {
+        let [x, y, z] = numbers::<3>(&mut tokens, "a vertex (v x y z)")?;
+        let p = Vec3::new(x, y, z);
+        if !p.is_finite() {
+            return Err(MeshErrorKind::NonFinite {
+                what: "vertex position",
+            });
+        }
+        self.positions.push(p);
+        let rest: Vec<&str> = tokens.collect();
+        let has_colour = rest.len() >= 3;
+        match self.coloured {
+            None => self.coloured = Some(has_colour),
+            Some(before) if before != has_colour => {
+                return Err(MeshErrorKind::Unsupported(
+                    "some vertices have colours (v x y z r g b) and some do not; pelage needs colours on all vertices or on none".into(),
+                ));
+            }
+            Some(_) => {}
+        }
+        if has_colour {
+            let [r, g, b] = numbers::<3>(&mut rest.into_iter(), "a vertex colour")?;
+            let c = Vec3::new(r, g, b);
+            if !c.is_finite() {
+                return Err(MeshErrorKind::NonFinite {
+                    what: "vertex colour",
+                });
+            }
+            self.colours.push(c);
+        }
+        Ok(())
     }
-    if triangles.is_empty() {
-        return Err(MeshError::whole(
-            name,
-            MeshErrorKind::Empty("no faces (no 'f' lines)"),
-        ));
+
+    /// `vt u [v]`.
+    fn uv<'a>(&mut self, mut tokens: impl Iterator<Item = &'a str>) -> Result<(), MeshErrorKind> {
+        let [u] = numbers::<1>(&mut tokens, "a texture coordinate (vt u v)")?;
+        let v = match tokens.next() {
+            Some(t) => number(t)?,
+            None => 0.0,
+        };
+        let uv = Vec2::new(u, v);
+        if !uv.is_finite() {
+            return Err(MeshErrorKind::NonFinite {
+                what: "texture coordinate",
+            });
+        }
+        self.uv_values.push(uv);
+        Ok(())
     }
-    let uvs = face_layout
-        .filter(|&(has_uv, _, _)| has_uv)
-        .map(|_| Uvs::PerCorner {
-            values: uv_values,
-            indices: uv_triangles,
-        });
-    // File normals are per corner; pelage keeps one smooth normal per vertex
-    // (hair follows the smooth surface), so corners are averaged. Where they
-    // cancel out, the area-weighted normal is used instead.
-    let normals = normals_on_all_faces.then(|| {
-        let computed = super::area_weighted_normals(&positions, &triangles);
-        let mut sums = vec![Vec3::ZERO; positions.len()];
-        for (tri, ntri) in triangles.iter().zip(&normal_triangles) {
-            for k in 0..3 {
-                sums[tri[k] as usize] += file_normals[ntri[k] as usize].normalize_or_zero();
+
+    /// `vn x y z`.
+    fn normal<'a>(
+        &mut self,
+        mut tokens: impl Iterator<Item = &'a str>,
+    ) -> Result<(), MeshErrorKind> {
+        let [x, y, z] = numbers::<3>(&mut tokens, "a normal (vn x y z)")?;
+        let n = Vec3::new(x, y, z);
+        if !n.is_finite() {
+            return Err(MeshErrorKind::NonFinite {
+                what: "vertex normal",
+            });
+        }
+        self.file_normals.push(n);
+        Ok(())
+    }
+
+    /// `g NAME`, `o NAME` (in a file without `g`) or `usemtl NAME`: the
+    /// faces that follow are in that set.
+    fn face_set<'a>(&mut self, kind: &str, tokens: impl Iterator<Item = &'a str>) {
+        if kind == "o" && self.counts.uses_g {
+            return;
+        }
+        let set = if kind == "usemtl" { 1 } else { 0 };
+        let name = tokens.collect::<Vec<_>>().join(" ");
+        self.sets[set].enter(if name.is_empty() { "default" } else { &name });
+    }
+
+    /// `f a b c …`: a polygon, fan triangulated as most OBJ readers do for
+    /// convex polygons.
+    fn face<'a>(
+        &mut self,
+        tokens: impl Iterator<Item = &'a str>,
+        line_no: usize,
+    ) -> Result<(), MeshErrorKind> {
+        self.corners.clear();
+        for token in tokens {
+            self.corners.push(face_corner(token, &self.counts.totals)?);
+        }
+        let corners = &self.corners;
+        if corners.len() < 3 {
+            return Err(MeshErrorKind::Syntax(format!(
+                "a face needs at least 3 vertices, this one has {}",
+                corners.len()
+            )));
+        }
+        let has_uv = corners.iter().all(|c| c[1].is_some());
+        let has_normal = corners.iter().all(|c| c[2].is_some());
+        if corners.iter().any(|c| c[1].is_some()) && !has_uv {
+            return Err(MeshErrorKind::Syntax(
+                "some corners of this face have texture coordinates and some do not".into(),
+            ));
+        }
+        match self.face_layout {
+            None => self.face_layout = Some((has_uv, has_normal, line_no)),
+            Some((uv_before, _, first_line)) if uv_before != has_uv => {
+                let (this, earlier) = if has_uv {
+                    ("has", "have none")
+                } else {
+                    ("has no", "have them")
+                };
+                return Err(MeshErrorKind::Unsupported(format!(
+                    "this face {this} texture coordinates (vt) and the faces before it (from line {first_line}) {earlier}; pelage needs UVs on all faces or on none"
+                )));
+            }
+            Some(_) => {}
+        }
+        self.normals_on_all_faces &= has_normal;
+        for k in 1..corners.len() - 1 {
+            for set in &mut self.sets {
+                set.add_triangle();
+            }
+            let tri = [corners[0], corners[k], corners[k + 1]];
+            self.triangles
+                .push(tri.map(|c| c[0].expect("position index is required")));
+            if has_uv {
+                self.uv_triangles
+                    .push(tri.map(|c| c[1].expect("checked above")));
+            }
+            if has_normal {
+                self.normal_triangles
+                    .push(tri.map(|c| c[2].expect("checked above")));
             }
         }
-        sums.into_iter()
-            .zip(computed)
-            .map(|(s, c)| s.try_normalize().unwrap_or(c))
-            .collect()
-    });
-    let mut mesh = Mesh::new(name, positions, triangles, normals, uvs)?;
-    if coloured == Some(true) {
-        for (channel, get) in [
-            ("red", (|c: &Vec3| c.x) as fn(&Vec3) -> f32),
-            ("green", |c| c.y),
-            ("blue", |c| c.z),
-        ] {
-            mesh = mesh.with_vertex_attribute(channel, colours.iter().map(get).collect())?;
-        }
+        Ok(())
     }
-    for set in sets {
-        if let Some(groups) = set.finish() {
-            mesh = mesh.with_face_groups(groups)?;
+
+    /// The mesh read, with its UVs, normals, colours and face sets.
+    fn finish(self, name: &str) -> Result<Mesh, MeshError> {
+        if self.positions.is_empty() {
+            return Err(MeshError::whole(
+                name,
+                MeshErrorKind::Empty("no vertices (no 'v' lines)"),
+            ));
         }
+        if self.triangles.is_empty() {
+            return Err(MeshError::whole(
+                name,
+                MeshErrorKind::Empty("no faces (no 'f' lines)"),
+            ));
+        }
+        let uvs = self
+            .face_layout
+            .filter(|&(has_uv, _, _)| has_uv)
+            .map(|_| Uvs::PerCorner {
+                values: self.uv_values,
+                indices: self.uv_triangles,
+            });
+        // File normals are per corner; pelage keeps one smooth normal per
+        // vertex (hair follows the smooth surface), so corners are
+        // averaged. Where they cancel out, the area-weighted normal is
+        // used instead.
+        let normals = self.normals_on_all_faces.then(|| {
+            let computed = super::area_weighted_normals(&self.positions, &self.triangles);
+            let mut sums = vec![Vec3::ZERO; self.positions.len()];
+            for (tri, ntri) in self.triangles.iter().zip(&self.normal_triangles) {
+                for k in 0..3 {
+                    sums[tri[k] as usize] +=
+                        self.file_normals[ntri[k] as usize].normalize_or_zero();
+                }
+            }
+            sums.into_iter()
+                .zip(computed)
+                .map(|(s, c)| s.try_normalize().unwrap_or(c))
+                .collect()
+        });
+        let mut mesh = Mesh::new(name, self.positions, self.triangles, normals, uvs)?;
+        if self.coloured == Some(true) {
+            for (channel, get) in [
+                ("red", (|c: &Vec3| c.x) as fn(&Vec3) -> f32),
+                ("green", |c| c.y),
+                ("blue", |c| c.z),
+            ] {
+                mesh =
+                    mesh.with_vertex_attribute(channel, self.colours.iter().map(get).collect())?;
+            }
+        }
+        for set in self.sets {
+            if let Some(groups) = set.finish() {
+                mesh = mesh.with_face_groups(groups)?;
+            }
+        }
+        Ok(mesh)
     }
-    Ok(mesh)
 }
 
 /// One kind of face set as the file names them: the set each triangle
