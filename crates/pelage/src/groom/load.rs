@@ -517,37 +517,14 @@ impl Groom {
         let source = &self.source;
         // Where the settings the generator checks were written.
         let mut lines = HashMap::new();
-        fn mark(
-            lines: &mut HashMap<String, (usize, usize)>,
-            key: &str,
-            line: Option<(usize, usize)>,
-        ) {
-            if let Some(line) = line {
-                lines.insert(key.to_string(), line);
-            }
+        for (key, span) in [
+            ("roots.count", file.roots.count.span()),
+            ("roots.density", file.roots.density.span()),
+            ("finish.points", file.finish.points.span()),
+            ("finish.width", file.finish.width.root.span()),
+        ] {
+            mark(&mut lines, key, source.line_of(span));
         }
-        let map = |v: &MapValue| map_on_mesh(source, &self.mesh, v);
-
-        mark(
-            &mut lines,
-            "roots.count",
-            source.line_of(file.roots.count.span()),
-        );
-        mark(
-            &mut lines,
-            "roots.density",
-            source.line_of(file.roots.density.span()),
-        );
-        mark(
-            &mut lines,
-            "finish.points",
-            source.line_of(file.finish.points.span()),
-        );
-        mark(
-            &mut lines,
-            "finish.width",
-            source.line_of(file.finish.width.root.span()),
-        );
         if let Some(o) = &file.finish.opacity {
             mark(&mut lines, "finish.opacity", source.line_of(o.root.span()));
         }
@@ -556,7 +533,7 @@ impl Groom {
         }
         let roots = RootsSpec {
             count: *file.roots.count.get_ref(),
-            density: map(&file.roots.density)?,
+            density: map_on_mesh(source, &self.mesh, &file.roots.density)?,
             seed: file.roots.seed,
             parts: file.roots.parts.as_ref().map(|p| *p.get_ref()),
             ids: file.roots.ids,
@@ -577,7 +554,41 @@ impl Groom {
                 split_shared: method.split_shared,
             }),
         };
-        let width = SpecReader::new(source, &self.mesh, &mut lines, "finish.width".into())
+        let finish = self.finish_spec(&mut lines)?;
+        let mut ops = Vec::with_capacity(file.ops.len());
+        for (index, spec) in file.ops.iter().enumerate() {
+            let key = OpKey {
+                index,
+                name: spec.name(),
+            };
+            if let Some(line) = source.line_of_op(index) {
+                lines.insert(key.to_string(), line);
+            }
+            let mut reader = SpecReader::new(source, &self.mesh, &mut lines, key.to_string());
+            ops.push(spec.read(&mut reader)?);
+        }
+        let regions = self.regions_spec(&mut lines)?;
+        self.check_finish_has_no_masks()?;
+        let look = self.look_spec(&mut lines)?;
+        Ok(GroomSpec {
+            name: source.path.clone(),
+            mesh: self.mesh.clone(),
+            guides: self.guides.clone(),
+            roots,
+            interpolation,
+            ops,
+            finish,
+            regions,
+            look,
+            origin: Some(Arc::new(SpecOrigin { lines })),
+        })
+    }
+
+    /// `[finish]`: every hair's starting width, colour and opacity, its
+    /// points and normals, and whether hairs are kept out of the skin.
+    fn finish_spec(&self, lines: &mut Lines) -> Result<FinishSpec, GroomError> {
+        let (file, source) = (&self.file, &self.source);
+        let width = SpecReader::new(source, &self.mesh, lines, "finish.width".into())
             .root_to_tip(&file.finish.width)?;
         let color = file
             .finish
@@ -585,7 +596,7 @@ impl Groom {
             .as_ref()
             .map(|c| {
                 read_color(
-                    &mut SpecReader::new(source, &self.mesh, &mut lines, "finish.color".into()),
+                    &mut SpecReader::new(source, &self.mesh, lines, "finish.color".into()),
                     c,
                 )
             })
@@ -595,8 +606,7 @@ impl Groom {
             .opacity
             .as_ref()
             .map(|o| {
-                SpecReader::new(source, &self.mesh, &mut lines, "finish.opacity".into())
-                    .root_to_tip(o)
+                SpecReader::new(source, &self.mesh, lines, "finish.opacity".into()).root_to_tip(o)
             })
             .transpose()?;
         let finish = FinishSpec {
@@ -615,19 +625,14 @@ impl Groom {
                         .map_or_else(|| OutsideSkin::default_gap(&self.mesh), |g| g as f32)
                 }),
         };
-        let mut ops = Vec::with_capacity(file.ops.len());
-        for (index, spec) in file.ops.iter().enumerate() {
-            let key = OpKey {
-                index,
-                name: spec.name(),
-            };
-            if let Some(line) = source.line_of_op(index) {
-                lines.insert(key.to_string(), line);
-            }
-            let mut reader = SpecReader::new(source, &self.mesh, &mut lines, key.to_string());
-            ops.push(spec.read(&mut reader)?);
-        }
-        let regions = match &file.regions {
+        Ok(finish)
+    }
+
+    /// `[regions]`: a map or the mesh's face sets, one of them.
+    fn regions_spec(&self, lines: &mut Lines) -> Result<Option<RegionsSpec>, GroomError> {
+        let (file, source) = (&self.file, &self.source);
+        let map = |v: &MapValue| map_on_mesh(source, &self.mesh, v);
+        Ok(match &file.regions {
             None => None,
             Some(r) => {
                 let invalid = |span: std::ops::Range<usize>, m: &str| {
@@ -635,11 +640,11 @@ impl Groom {
                 };
                 match (&r.map, &r.faces) {
                     (Some(m), None) => {
-                        mark(&mut lines, "regions", source.line_of(m.span()));
+                        mark(lines, "regions", source.line_of(m.span()));
                         Some(RegionsSpec::from_map(map(m)?, r.scale))
                     }
                     (None, Some(kind)) => {
-                        mark(&mut lines, "regions", source.line_of(kind.span()));
+                        mark(lines, "regions", source.line_of(kind.span()));
                         if !matches!(kind.get_ref().as_str(), "groups" | "materials") {
                             return Err(invalid(
                                 kind.span(),
@@ -664,7 +669,13 @@ impl Groom {
                     }
                 }
             }
-        };
+        })
+    }
+
+    /// `[finish]` sets every hair's starting values: a mask there is an
+    /// error at its line (a masked operator does what it would).
+    fn check_finish_has_no_masks(&self) -> Result<(), GroomError> {
+        let (file, source) = (&self.file, &self.source);
         for (key, mask) in [
             ("finish.width.mask", file.finish.width.mask.as_ref()),
             (
@@ -685,11 +696,17 @@ impl Groom {
                 ));
             }
         }
-        let look = match &file.look {
+        Ok(())
+    }
+
+    /// `[look]`: each hair's values for a hair shader.
+    fn look_spec(&self, lines: &mut Lines) -> Result<Option<HairLook>, GroomError> {
+        let (file, source) = (&self.file, &self.source);
+        Ok(match &file.look {
             None => None,
             Some(l) => {
-                mark(&mut lines, "look", source.line_of(l.melanin.span()));
-                let mut r = SpecReader::new(source, &self.mesh, &mut lines, "look".into());
+                mark(lines, "look", source.line_of(l.melanin.span()));
+                let mut r = SpecReader::new(source, &self.mesh, lines, "look".into());
                 Some(HairLook {
                     melanin: r.map("melanin", &l.melanin)?,
                     melanin_redness: r.map("melanin_redness", &l.melanin_redness)?,
@@ -701,18 +718,6 @@ impl Groom {
                     material: l.material,
                 })
             }
-        };
-        Ok(GroomSpec {
-            name: source.path.clone(),
-            mesh: self.mesh.clone(),
-            guides: self.guides.clone(),
-            roots,
-            interpolation,
-            ops,
-            finish,
-            regions,
-            look,
-            origin: Some(Arc::new(SpecOrigin { lines })),
         })
     }
 
@@ -741,6 +746,17 @@ fn load_mesh_section(source: &SettingsSource, section: &MeshSection) -> Result<M
     section
         .with_layers(mesh, source.folder())
         .map_err(|e| source.error_at(at, GroomErrorKind::Mesh(e)))
+}
+
+/// Where each setting the generator checks was written: key → (line,
+/// column).
+type Lines = HashMap<String, (usize, usize)>;
+
+/// Notes where `key` was written, if it was.
+fn mark(lines: &mut Lines, key: &str, line: Option<(usize, usize)>) {
+    if let Some(line) = line {
+        lines.insert(key.to_string(), line);
+    }
 }
 
 /// Whether a path names a curves file that can hold time samples (USD,
