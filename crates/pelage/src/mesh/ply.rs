@@ -15,86 +15,151 @@ pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
     let ply = parser
         .read_ply(&mut std::io::Cursor::new(bytes))
         .map_err(|e| parse_error(name, e))?;
-
-    let vertices = ply.payload.get("vertex").ok_or_else(|| {
-        MeshError::whole(
-            name,
-            MeshErrorKind::Inconsistent("the file has no 'vertex' element".into()),
-        )
-    })?;
-    let faces = ply.payload.get("face").ok_or_else(|| {
-        MeshError::whole(
-            name,
-            MeshErrorKind::Inconsistent("the file has no 'face' element".into()),
-        )
-    })?;
-    let vertex_props = &ply.header.elements["vertex"].properties;
-    for axis in ["x", "y", "z"] {
-        if !vertex_props.contains_key(axis) {
-            return Err(MeshError::whole(
+    let element = |key: &str| {
+        ply.payload.get(key).ok_or_else(|| {
+            MeshError::whole(
                 name,
-                MeshErrorKind::Inconsistent(format!(
-                    "the 'vertex' element has no '{axis}' property"
-                )),
-            ));
-        }
-    }
-    let has = |p: &str| vertex_props.contains_key(p);
-    let normal_keys = (has("nx") && has("ny") && has("nz")).then_some(["nx", "ny", "nz"]);
-    let uv_keys = [["s", "t"], ["u", "v"], ["texture_u", "texture_v"]]
-        .into_iter()
-        .find(|[a, b]| has(a) && has(b));
-
-    let mut reserved: Vec<&str> = vec!["x", "y", "z"];
-    reserved.extend(normal_keys.iter().flatten());
-    reserved.extend(uv_keys.iter().flatten());
-    let attribute_keys: Vec<(&str, f32)> = vertex_props
-        .iter()
-        .filter(|(key, _)| !reserved.contains(&key.as_str()))
-        .filter_map(|(key, def)| {
-            use ply_rs_bw::ply::{PropertyType, ScalarType};
-            let PropertyType::Scalar(kind) = &def.data_type else {
-                return None;
-            };
-            let colour = matches!(key.as_str(), "red" | "green" | "blue" | "alpha");
-            let scale = match kind {
-                ScalarType::UChar if colour => 1.0 / 255.0,
-                ScalarType::UShort if colour => 1.0 / 65535.0,
-                _ => 1.0,
-            };
-            Some((key.as_str(), scale))
+                MeshErrorKind::Inconsistent(format!("the file has no '{key}' element")),
+            )
         })
-        .collect();
-    let mut attributes: Vec<Vec<f32>> =
-        vec![Vec::with_capacity(vertices.len()); attribute_keys.len()];
-    let mut positions = Vec::with_capacity(vertices.len());
-    let mut normals = normal_keys.map(|_| Vec::with_capacity(vertices.len()));
-    let mut vertex_uvs = uv_keys.map(|_| Vec::with_capacity(vertices.len()));
-    for (i, v) in vertices.iter().enumerate() {
-        let at = |kind| MeshError::at_element(name, "vertex", i, kind);
-        let get = |key: &str| scalar(v.get(key)).ok_or_else(|| at(not_a_number(key)));
-        let p = Vec3::new(get("x")?, get("y")?, get("z")?);
-        if !p.is_finite() {
-            return Err(at(MeshErrorKind::NonFinite {
-                what: "vertex position",
-            }));
+    };
+    let (vertices, faces) = (element("vertex")?, element("face")?);
+    let layout = VertexLayout::of(name, &ply.header.elements["vertex"].properties)?;
+    let read = layout.read(name, vertices)?;
+    let face_props = &ply.header.elements["face"].properties;
+    let (triangles, corner_uvs) = read_faces(name, faces, face_props, read.positions.len())?;
+    let uvs = corner_uvs.or(read.uvs.map(Uvs::PerVertex));
+    // Zero-length normals in the file (some exporters write them for
+    // unused vertices) are replaced by the computed ones.
+    let normals = read.normals.map(|file| {
+        let computed = super::area_weighted_normals(&read.positions, &triangles);
+        file.into_iter()
+            .zip(computed)
+            .map(|(n, c)| {
+                if n.is_finite() {
+                    n.try_normalize().unwrap_or(c)
+                } else {
+                    n
+                }
+            })
+            .collect()
+    });
+    let mut mesh = Mesh::new(name, read.positions, triangles, normals, uvs)?;
+    for ((key, _), values) in layout.attributes.into_iter().zip(read.attributes) {
+        mesh = mesh.with_vertex_attribute(key, values)?;
+    }
+    Ok(mesh)
+}
+
+/// Which of a `vertex` element's properties pelage reads, and as what.
+struct VertexLayout<'a> {
+    normals: Option<[&'static str; 3]>,
+    uvs: Option<[&'static str; 2]>,
+    /// Every other scalar property, with the scale that brings it to a
+    /// number (colours stored as bytes or shorts to 0–1).
+    attributes: Vec<(&'a str, f32)>,
+}
+
+/// A `vertex` element's values.
+struct VertexValues {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+    attributes: Vec<Vec<f32>>,
+}
+
+impl<'a> VertexLayout<'a> {
+    fn of(
+        name: &str,
+        props: &'a ply_rs_bw::ply::KeyMap<ply_rs_bw::ply::PropertyDef>,
+    ) -> Result<Self, MeshError> {
+        for axis in ["x", "y", "z"] {
+            if !props.contains_key(axis) {
+                return Err(MeshError::whole(
+                    name,
+                    MeshErrorKind::Inconsistent(format!(
+                        "the 'vertex' element has no '{axis}' property"
+                    )),
+                ));
+            }
         }
-        positions.push(p);
-        if let (Some(keys), Some(out)) = (normal_keys, normals.as_mut()) {
-            out.push(Vec3::new(get(keys[0])?, get(keys[1])?, get(keys[2])?));
-        }
-        if let (Some([s, t]), Some(out)) = (uv_keys, vertex_uvs.as_mut()) {
-            out.push(Vec2::new(get(s)?, get(t)?));
-        }
-        for ((key, scale), out) in attribute_keys.iter().zip(&mut attributes) {
-            out.push(get(key)? * scale);
-        }
+        let has = |p: &str| props.contains_key(p);
+        let normals = (has("nx") && has("ny") && has("nz")).then_some(["nx", "ny", "nz"]);
+        let uvs = [["s", "t"], ["u", "v"], ["texture_u", "texture_v"]]
+            .into_iter()
+            .find(|[a, b]| has(a) && has(b));
+        let mut reserved: Vec<&str> = vec!["x", "y", "z"];
+        reserved.extend(normals.iter().flatten());
+        reserved.extend(uvs.iter().flatten());
+        let attributes = props
+            .iter()
+            .filter(|(key, _)| !reserved.contains(&key.as_str()))
+            .filter_map(|(key, def)| {
+                use ply_rs_bw::ply::{PropertyType, ScalarType};
+                let PropertyType::Scalar(kind) = &def.data_type else {
+                    return None;
+                };
+                let colour = matches!(key.as_str(), "red" | "green" | "blue" | "alpha");
+                let scale = match kind {
+                    ScalarType::UChar if colour => 1.0 / 255.0,
+                    ScalarType::UShort if colour => 1.0 / 65535.0,
+                    _ => 1.0,
+                };
+                Some((key.as_str(), scale))
+            })
+            .collect();
+        Ok(Self {
+            normals,
+            uvs,
+            attributes,
+        })
     }
 
-    let face_props = &ply.header.elements["face"].properties;
+    /// Every vertex's values, an error naming the vertex where one is not
+    /// a number or a position is not finite.
+    fn read(&self, name: &str, vertices: &[DefaultElement]) -> Result<VertexValues, MeshError> {
+        let n = vertices.len();
+        let mut out = VertexValues {
+            positions: Vec::with_capacity(n),
+            normals: self.normals.map(|_| Vec::with_capacity(n)),
+            uvs: self.uvs.map(|_| Vec::with_capacity(n)),
+            attributes: vec![Vec::with_capacity(n); self.attributes.len()],
+        };
+        for (i, v) in vertices.iter().enumerate() {
+            let at = |kind| MeshError::at_element(name, "vertex", i, kind);
+            let get = |key: &str| scalar(v.get(key)).ok_or_else(|| at(not_a_number(key)));
+            let p = Vec3::new(get("x")?, get("y")?, get("z")?);
+            if !p.is_finite() {
+                return Err(at(MeshErrorKind::NonFinite {
+                    what: "vertex position",
+                }));
+            }
+            out.positions.push(p);
+            if let (Some(keys), Some(normals)) = (self.normals, out.normals.as_mut()) {
+                normals.push(Vec3::new(get(keys[0])?, get(keys[1])?, get(keys[2])?));
+            }
+            if let (Some([s, t]), Some(uvs)) = (self.uvs, out.uvs.as_mut()) {
+                uvs.push(Vec2::new(get(s)?, get(t)?));
+            }
+            for ((key, scale), values) in self.attributes.iter().zip(&mut out.attributes) {
+                values.push(get(key)? * scale);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The faces, fan triangulated, and their per-corner UVs when the element
+/// has a `texcoord` list (MeshLab's); errors name the face.
+fn read_faces(
+    name: &str,
+    faces: &[DefaultElement],
+    props: &ply_rs_bw::ply::KeyMap<ply_rs_bw::ply::PropertyDef>,
+    vertex_count: usize,
+) -> Result<(Vec<[u32; 3]>, Option<Uvs>), MeshError> {
     let index_key = ["vertex_indices", "vertex_index"]
         .into_iter()
-        .find(|k| face_props.contains_key(*k))
+        .find(|k| props.contains_key(*k))
         .ok_or_else(|| {
             MeshError::whole(
                 name,
@@ -103,7 +168,7 @@ pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
                 ),
             )
         })?;
-    let corner_uvs = face_props.contains_key("texcoord");
+    let corner_uvs = props.contains_key("texcoord");
     let mut triangles = Vec::with_capacity(faces.len() * 2);
     let mut uv_values: Vec<Vec2> = Vec::new();
     let mut uv_indices: Vec<[u32; 3]> = Vec::new();
@@ -122,12 +187,12 @@ pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
         }
         let mut resolved = Vec::with_capacity(indices.len());
         for index in indices {
-            if index < 0 || index as usize >= positions.len() {
+            if index < 0 || index as usize >= vertex_count {
                 return Err(at(MeshErrorKind::IndexOutOfRange {
                     what: "vertex",
                     what_plural: "vertices",
                     index,
-                    count: positions.len(),
+                    count: vertex_count,
                     hint: "",
                 }));
             }
@@ -159,35 +224,11 @@ pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
             }
         }
     }
-
-    let uvs = if corner_uvs {
-        Some(Uvs::PerCorner {
-            values: uv_values,
-            indices: uv_indices,
-        })
-    } else {
-        vertex_uvs.map(Uvs::PerVertex)
-    };
-    // Zero-length normals in the file (some exporters write them for
-    // unused vertices) are replaced by the computed ones.
-    let normals = normals.map(|file| {
-        let computed = super::area_weighted_normals(&positions, &triangles);
-        file.into_iter()
-            .zip(computed)
-            .map(|(n, c)| {
-                if n.is_finite() {
-                    n.try_normalize().unwrap_or(c)
-                } else {
-                    n
-                }
-            })
-            .collect()
+    let uvs = corner_uvs.then_some(Uvs::PerCorner {
+        values: uv_values,
+        indices: uv_indices,
     });
-    let mut mesh = Mesh::new(name, positions, triangles, normals, uvs)?;
-    for ((key, _), values) in attribute_keys.into_iter().zip(attributes) {
-        mesh = mesh.with_vertex_attribute(key, values)?;
-    }
-    Ok(mesh)
+    Ok((triangles, uvs))
 }
 
 fn parse_error(name: &str, e: ply_rs_bw::parser::ParseError) -> MeshError {
