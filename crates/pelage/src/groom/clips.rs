@@ -164,63 +164,7 @@ pub fn write_clip_assembly(
     // Per run: its files in frame order, covering every frame once.
     let mut runs: Vec<Vec<(&FrameFile, UsdLayerInfo)>> = Vec::with_capacity(n);
     for k in 1..=n {
-        let mine: Vec<&FrameFile> = files.iter().filter(|f| f.run.0 == k).collect();
-        for &frame in frames.frames() {
-            let holding = mine
-                .iter()
-                .filter(|f| (f.first..=f.last).contains(&frame))
-                .count();
-            if holding != 1 {
-                let what = if n == 1 {
-                    String::new()
-                } else {
-                    format!(" of run {k} of {n}")
-                };
-                return Err(fail(
-                    path,
-                    format!(
-                        "frame {frame}{what} is in {holding} files; every frame must be in exactly one (has that task finished?)"
-                    ),
-                ));
-            }
-        }
-        let mut infos = Vec::with_capacity(mine.len());
-        for f in mine {
-            if !frames
-                .frames()
-                .iter()
-                .any(|&x| (f.first..=f.last).contains(&x))
-            {
-                continue; // frames outside the range asked for
-            }
-            // A file reaching past the frames asked for would carry its
-            // other frames into the stage (and move its end time code).
-            if f.first < frames.first() || f.last > frames.last() {
-                return Err(fail(
-                    &f.path,
-                    format!(
-                        "it holds frames {} to {}, past the frames asked for ({frames}): assemble those frames, or remove the file",
-                        f.first, f.last
-                    ),
-                ));
-            }
-            let info = read_usd_layer_info(&f.path).map_err(|e| fail(&f.path, e.to_string()))?;
-            infos.push((f, info));
-        }
-        if let Some((f, info)) = infos
-            .iter()
-            .find(|(_, i)| i.children != infos[0].1.children)
-        {
-            return Err(fail(
-                &f.path,
-                format!(
-                    "its prims ({}) differ from those of {} of the same run",
-                    info.children.join(", "),
-                    infos[0].0.path.display()
-                ),
-            ));
-        }
-        runs.push(infos);
+        runs.push(run_files(path, files, frames, (k, n))?);
     }
     let head = &runs[0][0].1;
     let (mut start, mut end) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -234,6 +178,97 @@ pub fn write_clip_assembly(
         start = start.min(a);
         end = end.max(b);
     }
+    let (text, prims) = clip_layer(&runs, head, (start, end));
+    write_atomically(path, |out| std::io::Write::write_all(out, text.as_bytes()))?;
+    Ok(ClipAssembly {
+        runs: n,
+        files: runs.iter().map(Vec::len).sum(),
+        prims,
+        time_range: (start, end),
+    })
+}
+
+/// Run `k` of `n`'s frame files in frame order with what each layer
+/// holds: each frame asked for in exactly one file, none reaching past
+/// them, every file with the same prims. Errors name the file (or, for a
+/// frame missing or twice, the layer being written, `path`).
+fn run_files<'f>(
+    path: &Path,
+    files: &'f [FrameFile],
+    frames: &FrameRange,
+    (k, n): (usize, usize),
+) -> Result<Vec<(&'f FrameFile, UsdLayerInfo)>, WriteError> {
+    let fail = |file: &Path, message: String| WriteError {
+        path: file.to_path_buf(),
+        error: std::io::Error::other(message),
+    };
+    let mine: Vec<&FrameFile> = files.iter().filter(|f| f.run.0 == k).collect();
+    for &frame in frames.frames() {
+        let holding = mine
+            .iter()
+            .filter(|f| (f.first..=f.last).contains(&frame))
+            .count();
+        if holding != 1 {
+            let what = if n == 1 {
+                String::new()
+            } else {
+                format!(" of run {k} of {n}")
+            };
+            return Err(fail(
+                path,
+                format!(
+                    "frame {frame}{what} is in {holding} files; every frame must be in exactly one (has that task finished?)"
+                ),
+            ));
+        }
+    }
+    let mut infos = Vec::with_capacity(mine.len());
+    for f in mine {
+        if !frames
+            .frames()
+            .iter()
+            .any(|&x| (f.first..=f.last).contains(&x))
+        {
+            continue; // frames outside the range asked for
+        }
+        // A file reaching past the frames asked for would carry its
+        // other frames into the stage (and move its end time code).
+        if f.first < frames.first() || f.last > frames.last() {
+            return Err(fail(
+                &f.path,
+                format!(
+                    "it holds frames {} to {}, past the frames asked for ({frames}): assemble those frames, or remove the file",
+                    f.first, f.last
+                ),
+            ));
+        }
+        let info = read_usd_layer_info(&f.path).map_err(|e| fail(&f.path, e.to_string()))?;
+        infos.push((f, info));
+    }
+    if let Some((f, info)) = infos
+        .iter()
+        .find(|(_, i)| i.children != infos[0].1.children)
+    {
+        return Err(fail(
+            &f.path,
+            format!(
+                "its prims ({}) differ from those of {} of the same run",
+                info.children.join(", "),
+                infos[0].0.path.display()
+            ),
+        ));
+    }
+    Ok(infos)
+}
+
+/// The stitching layer's text: the stage metadata of the first file
+/// (`head`) over `time_range`, and for each run's prims an `over` with
+/// value clips over the run's files. Returns it and the prims stitched.
+fn clip_layer(
+    runs: &[Vec<(&FrameFile, UsdLayerInfo)>],
+    head: &UsdLayerInfo,
+    (start, end): (f64, f64),
+) -> (String, usize) {
     let root = &head.default_prim;
     let mut text = String::new();
     let fps = head.time_codes_per_second;
@@ -249,7 +284,7 @@ pub fn write_clip_assembly(
         format!("./{}", name.unwrap_or_default())
     };
     let mut prims = 0;
-    for run in &runs {
+    for run in runs {
         let Some((first_file, info)) = run.first() else {
             continue;
         };
@@ -277,13 +312,7 @@ pub fn write_clip_assembly(
         }
     }
     text.push_str("}\n");
-    write_atomically(path, |out| std::io::Write::write_all(out, text.as_bytes()))?;
-    Ok(ClipAssembly {
-        runs: n,
-        files: runs.iter().map(Vec::len).sum(),
-        prims,
-        time_range: (start, end),
-    })
+    (text, prims)
 }
 
 #[cfg(test)]
