@@ -122,12 +122,32 @@ fn pigment_color(sigma: [f32; 3]) -> Vec3 {
 }
 
 /// The hair material: a `Material` with the MaterialX network as its
-/// children.
+/// children: the melanin concentration, the absorption it gives, the tint
+/// and roughnesses, and the Chiang BSDF they feed.
 pub(crate) fn hair_material() -> NetworkPrim {
-    use NetworkValue::{Connect, Float};
+    let mut children = melanin_concentration();
+    children.extend(absorption());
+    children.extend(tint_and_roughness());
+    children.extend(bsdf());
+    NetworkPrim {
+        name: MATERIAL_NAME,
+        type_name: "Material",
+        attributes: vec![NetworkAttribute::new(
+            "outputs:mtlx:surface",
+            "token",
+            NetworkValue::Connect("surface", "outputs:out"),
+        )],
+        children,
+    }
+}
+
+/// `hair_melanin` (0–1, as Blender's Principled Hair takes it) made a
+/// concentration: `−ln(max(1 − m, 1e-4))`.
+fn melanin_concentration() -> Vec<NetworkPrim> {
+    use NetworkValue::Float;
     let float = "float";
     let out = &[("outputs:out", "float")][..];
-    let children = vec![
+    vec![
         reader("melanin", "hair_melanin", 0.8),
         shader(
             "melanin_remaining",
@@ -162,6 +182,14 @@ pub(crate) fn hair_material() -> NetworkPrim {
             ],
             out,
         ),
+    ]
+}
+
+/// The absorption coefficient from the melanin concentration and
+/// `hair_melanin_redness`, with Cycles' pigment colours.
+fn absorption() -> Vec<NetworkPrim> {
+    let float = "float";
+    vec![
         reader("melanin_redness", "hair_melanin_redness", 1.0),
         shader(
             "absorption",
@@ -192,6 +220,14 @@ pub(crate) fn hair_material() -> NetworkPrim {
             ],
             &[("outputs:absorption", "float3")],
         ),
+    ]
+}
+
+/// `hair_tint` and the Chiang roughnesses from `hair_roughness` and
+/// `hair_radial_roughness`.
+fn tint_and_roughness() -> Vec<NetworkPrim> {
+    let float = "float";
+    vec![
         shader(
             "tint",
             "ND_geompropvalue_color3",
@@ -226,6 +262,12 @@ pub(crate) fn hair_material() -> NetworkPrim {
                 ("outputs:roughness_TRT", "float2"),
             ],
         ),
+    ]
+}
+
+/// The Chiang hair BSDF over them, and the surface shader.
+fn bsdf() -> Vec<NetworkPrim> {
+    vec![
         shader(
             "hair_bsdf",
             "ND_chiang_hair_bsdf",
@@ -265,17 +307,7 @@ pub(crate) fn hair_material() -> NetworkPrim {
             vec![wired("inputs:bsdf", "token", "hair_bsdf", "outputs:out")],
             &[("outputs:out", "token")],
         ),
-    ];
-    NetworkPrim {
-        name: MATERIAL_NAME,
-        type_name: "Material",
-        attributes: vec![NetworkAttribute::new(
-            "outputs:mtlx:surface",
-            "token",
-            Connect("surface", "outputs:out"),
-        )],
-        children,
-    }
+    ]
 }
 
 #[cfg(test)]
