@@ -77,15 +77,24 @@ fn validate(document: &gltf::Document) -> Result<(), String> {
 /// elements fit its buffer view at the view's stride, and each use has
 /// the type and component type the specification gives it.
 fn validate_accessors(root: &gltf::json::Root) -> Result<(), String> {
-    use gltf::json::accessor::{ComponentType as C, Type as T};
-    use gltf::json::mesh::Semantic as S;
-    use gltf::json::validation::Checked::Valid;
-    let component = |a: &gltf::json::Accessor| match a.component_type {
-        Valid(c) => Some(c.0),
+    validate_accessor_ranges(root)?;
+    validate_accessor_uses(root)
+}
+
+/// An accessor's component type, when it is one glTF knows.
+fn component_type(a: &gltf::json::Accessor) -> Option<gltf::json::accessor::ComponentType> {
+    match a.component_type {
+        gltf::json::validation::Checked::Valid(c) => Some(c.0),
         _ => None,
-    };
+    }
+}
+
+/// Each accessor's elements fit its buffer view at the view's stride,
+/// and each view its buffer; sparse accessors are refused.
+fn validate_accessor_ranges(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::validation::Checked::Valid;
     for (i, accessor) in root.accessors.iter().enumerate() {
-        let (Some(c), Valid(t)) = (component(accessor), accessor.type_) else {
+        let (Some(c), Valid(t)) = (component_type(accessor), accessor.type_) else {
             continue;
         };
         if accessor.sparse.is_some() {
@@ -127,28 +136,52 @@ fn validate_accessors(root: &gltf::json::Root) -> Result<(), String> {
             ));
         }
     }
+    Ok(())
+}
+
+/// Accessor `index`, which `what` reads, exists and holds one of `types`
+/// of one of `components`.
+fn expect_accessor(
+    root: &gltf::json::Root,
+    what: &str,
+    index: usize,
+    types: &[gltf::json::accessor::Type],
+    components: &[gltf::json::accessor::ComponentType],
+) -> Result<(), String> {
+    use gltf::json::accessor::{ComponentType as C, Type as T};
+    use gltf::json::validation::Checked::Valid;
+    let Some(a) = root.accessors.get(index) else {
+        return Err(format!(
+            "{what} names accessor {index}, which does not exist"
+        ));
+    };
+    let list = |names: Vec<String>| names.join(" or ");
+    let type_name = |t: &T| format!("{t:?}").to_uppercase();
+    let component_name = |c: &C| format!("{c:?}").to_lowercase();
+    match (a.type_, component_type(a)) {
+        (Valid(t), Some(c)) if types.contains(&t) && components.contains(&c) => Ok(()),
+        (t, c) => Err(format!(
+            "{what}: accessor {index} holds {} of {}; glTF allows {} of {}",
+            match t {
+                Valid(t) => type_name(&t),
+                _ => "an unknown type".into(),
+            },
+            c.map_or("an unknown component type".into(), |c| component_name(&c)),
+            list(types.iter().map(type_name).collect()),
+            list(components.iter().map(component_name).collect()),
+        )),
+    }
+}
+
+/// Each use of an accessor (a primitive's indices and attributes, a
+/// skin's inverse bind matrices, an animation's samplers and channels) has
+/// the type and component type the specification gives it.
+fn validate_accessor_uses(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::accessor::{ComponentType as C, Type as T};
+    use gltf::json::mesh::Semantic as S;
+    use gltf::json::validation::Checked::Valid;
     let expect = |what: &str, index: usize, types: &[T], components: &[C]| {
-        let Some(a) = root.accessors.get(index) else {
-            return Err(format!(
-                "{what} names accessor {index}, which does not exist"
-            ));
-        };
-        let list = |names: Vec<String>| names.join(" or ");
-        let type_name = |t: &T| format!("{t:?}").to_uppercase();
-        let component_name = |c: &C| format!("{c:?}").to_lowercase();
-        match (a.type_, component(a)) {
-            (Valid(t), Some(c)) if types.contains(&t) && components.contains(&c) => Ok(()),
-            (t, c) => Err(format!(
-                "{what}: accessor {index} holds {} of {}; glTF allows {} of {}",
-                match t {
-                    Valid(t) => type_name(&t),
-                    _ => "an unknown type".into(),
-                },
-                c.map_or("an unknown component type".into(), |c| component_name(&c)),
-                list(types.iter().map(type_name).collect()),
-                list(components.iter().map(component_name).collect()),
-            )),
-        }
+        expect_accessor(root, what, index, types, components)
     };
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
