@@ -338,9 +338,221 @@ pub(crate) fn parse_with_sources(
     validate(&gltf.document).map_err(whole)?;
     let buffers = gltf::import_buffers(&gltf.document, base, gltf.blob.clone())
         .map_err(|e| whole(format!("cannot load the glTF's buffers: {e}")))?;
-    let doc = &gltf.document;
+    let mut merged = Merged::new();
+    for (mesh, world, node) in mesh_instances(&gltf.document).map_err(whole)? {
+        let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
+        for primitive in mesh.primitives() {
+            let placed = Placed {
+                world,
+                normal_matrix,
+                node,
+                mesh: mesh.index(),
+            };
+            merged.add(name, &primitive, &buffers, placed)?;
+        }
+    }
+    let (mesh, sources) = merged.finish(name)?;
+    Ok(ParsedGltf {
+        mesh,
+        document: gltf.document,
+        buffers,
+        sources,
+    })
+}
 
-    // (mesh, world_from_mesh, node) to merge.
+/// Where a primitive's mesh is placed: its world transform (and the one
+/// for normals), the node that places it and the mesh's index.
+struct Placed {
+    world: Mat4,
+    normal_matrix: Mat3,
+    node: Option<usize>,
+    mesh: usize,
+}
+
+/// Every primitive read so far, merged into one mesh: positions welded
+/// where bit-identical, UVs per corner.
+struct Merged {
+    positions: Vec<Vec3>,
+    normal_sums: Vec<Vec3>,
+    welded: HashMap<[u32; 3], u32>,
+    triangles: Vec<[u32; 3]>,
+    uv_values: Vec<Vec2>,
+    uv_triangles: Vec<[u32; 3]>,
+    /// Whether every primitive so far has normals.
+    all_have_normals: bool,
+    /// Whether the primitives have UVs (all must, or none).
+    uv_presence: Option<bool>,
+    sources: Vec<VertexSource>,
+}
+
+impl Merged {
+    fn new() -> Self {
+        Self {
+            positions: Vec::new(),
+            normal_sums: Vec::new(),
+            welded: HashMap::new(),
+            triangles: Vec::new(),
+            uv_values: Vec::new(),
+            uv_triangles: Vec::new(),
+            all_have_normals: true,
+            uv_presence: None,
+            sources: Vec::new(),
+        }
+    }
+
+    /// Adds a triangle primitive (points and lines carry no surface),
+    /// placed by `placed`: its vertices welded into the merged mesh, its
+    /// normals turned, its UVs flipped to pelage's origin.
+    fn add(
+        &mut self,
+        name: &str,
+        primitive: &gltf::Primitive<'_>,
+        buffers: &[gltf::buffer::Data],
+        placed: Placed,
+    ) -> Result<(), MeshError> {
+        let whole = |msg: String| MeshError::whole(name, MeshErrorKind::Syntax(msg));
+        let what = format!("mesh {} primitive {}", placed.mesh, primitive.index());
+        if !matches!(
+            primitive.mode(),
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            return Ok(()); // points and lines carry no surface
+        }
+        for (_, accessor) in primitive.attributes() {
+            check_accessor(&accessor, buffers).map_err(|m| whole(format!("{what}: {m}")))?;
+        }
+        if let Some(a) = primitive.indices() {
+            check_accessor(&a, buffers).map_err(|m| whole(format!("{what}: {m}")))?;
+        }
+        let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let local: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| whole(format!("{what} has no POSITION attribute")))?
+            .map(Vec3::from)
+            .collect();
+        let normals: Option<Vec<Vec3>> = reader.read_normals().map(|n| n.map(Vec3::from).collect());
+        // glTF puts UV (0, 0) at the image's top-left corner; pelage's
+        // maps (as OBJ, PLY and USD) at its bottom-left: v is flipped,
+        // as Blender's importer does.
+        let uvs: Option<Vec<Vec2>> = reader
+            .read_tex_coords(0)
+            .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
+        match self.uv_presence {
+            None => self.uv_presence = Some(uvs.is_some()),
+            Some(p) if p != uvs.is_some() => {
+                return Err(MeshError::whole(
+                    name,
+                    MeshErrorKind::Unsupported(format!(
+                        "{what} {} TEXCOORD_0 but earlier primitives {}; pelage needs UVs on all primitives or on none",
+                        if uvs.is_some() { "has" } else { "has no" },
+                        if p { "do" } else { "do not" }
+                    )),
+                ));
+            }
+            Some(_) => {}
+        }
+        self.all_have_normals &= normals.is_some();
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..local.len() as u32).collect(),
+        };
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= local.len()) {
+            return Err(MeshError::whole(
+                name,
+                MeshErrorKind::IndexOutOfRange {
+                    what: "vertex",
+                    what_plural: "vertices",
+                    index: i64::from(bad),
+                    count: local.len(),
+                    hint: "",
+                },
+            ));
+        }
+
+        // Weld this primitive's vertices into the merged mesh.
+        let uv_base = self.uv_values.len() as u32;
+        let mut remap = Vec::with_capacity(local.len());
+        for (k, p) in local.iter().enumerate() {
+            let p = placed.world.transform_point3(*p);
+            if !p.is_finite() {
+                let kind = MeshErrorKind::NonFinite {
+                    what: "vertex position",
+                };
+                return Err(MeshError::whole(name, kind));
+            }
+            let next = self.positions.len() as u32;
+            let id = *self
+                .welded
+                .entry(p.to_array().map(f32::to_bits))
+                .or_insert(next);
+            if id == next {
+                self.positions.push(p);
+                self.normal_sums.push(Vec3::ZERO);
+                self.sources.push(VertexSource {
+                    node: placed.node,
+                    mesh: placed.mesh,
+                    primitive: primitive.index(),
+                    vertex: k as u32,
+                });
+            }
+            if let Some(n) = &normals {
+                self.normal_sums[id as usize] += (placed.normal_matrix * n[k]).normalize_or_zero();
+            }
+            remap.push(id);
+        }
+        if let Some(uvs) = uvs {
+            self.uv_values.extend(uvs);
+        }
+        for tri in triangle_indices(primitive.mode(), &indices) {
+            self.triangles.push(tri.map(|i| remap[i as usize]));
+            if self.uv_presence == Some(true) {
+                self.uv_triangles.push(tri.map(|i| uv_base + i));
+            }
+        }
+        Ok(())
+    }
+
+    /// The merged mesh, with per-vertex normals where every primitive had
+    /// them, and each vertex's source.
+    fn finish(self, name: &str) -> Result<(Mesh, Vec<VertexSource>), MeshError> {
+        if self.triangles.is_empty() {
+            return Err(MeshError::whole(
+                name,
+                MeshErrorKind::Empty("no triangle primitives"),
+            ));
+        }
+        let normals = self.all_have_normals.then(|| {
+            let computed = super::area_weighted_normals(&self.positions, &self.triangles);
+            self.normal_sums
+                .into_iter()
+                .zip(computed)
+                .map(|(s, c)| {
+                    if s.is_finite() {
+                        s.try_normalize().unwrap_or(c)
+                    } else {
+                        s
+                    }
+                })
+                .collect()
+        });
+        let uvs = (self.uv_presence == Some(true)).then_some(Uvs::PerCorner {
+            values: self.uv_values,
+            indices: self.uv_triangles,
+        });
+        let mesh = Mesh::new(name, self.positions, self.triangles, normals, uvs)?;
+        Ok((mesh, self.sources))
+    }
+}
+
+/// Every mesh the scenes place, with its world transform and node (or,
+/// in a file without scenes, every mesh as it is). glTF's nodes form
+/// trees: a node with two parents (a file that would be walked once per
+/// path, exponentially many in a lattice) is refused, and a node reached
+/// twice on one path is a cycle (a malformed file that would otherwise be
+/// walked forever); the depth bounds the walk.
+fn mesh_instances(
+    doc: &gltf::Document,
+) -> Result<Vec<(gltf::Mesh<'_>, Mat4, Option<usize>)>, String> {
     let mut instances: Vec<(gltf::Mesh, Mat4, Option<usize>)> = Vec::new();
     let scenes: Vec<gltf::Scene> = match doc.default_scene() {
         Some(s) => vec![s],
@@ -349,19 +561,15 @@ pub(crate) fn parse_with_sources(
     if scenes.is_empty() {
         instances.extend(doc.meshes().map(|m| (m, Mat4::IDENTITY, None)));
     }
-    // glTF's nodes form trees: a node with two parents (a file that would
-    // be walked once per path, exponentially many in a lattice) is refused,
-    // and a node reached twice on one path is a cycle (a malformed file
-    // that would otherwise be walked forever); the depth bounds the walk.
     let node_count = doc.nodes().len();
     let mut has_parent = vec![false; node_count];
     for node in doc.nodes() {
         for child in node.children() {
             if std::mem::replace(&mut has_parent[child.index()], true) {
-                return Err(whole(format!(
+                return Err(format!(
                     "node {} has two parents; glTF's node hierarchy must be a tree",
                     child.index()
-                )));
+                ));
             }
         }
     }
@@ -370,10 +578,10 @@ pub(crate) fn parse_with_sources(
             scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
         while let Some((node, parent, depth)) = stack.pop() {
             if depth > node_count {
-                return Err(whole(format!(
+                return Err(format!(
                     "node {} is its own ancestor: the node hierarchy has a cycle",
                     node.index()
-                )));
+                ));
             }
             let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
             if let Some(mesh) = node.mesh() {
@@ -382,150 +590,7 @@ pub(crate) fn parse_with_sources(
             stack.extend(node.children().map(|c| (c, world, depth + 1)));
         }
     }
-
-    let mut positions: Vec<Vec3> = Vec::new();
-    let mut normal_sums: Vec<Vec3> = Vec::new();
-    let mut welded: HashMap<[u32; 3], u32> = HashMap::new();
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let mut uv_values: Vec<Vec2> = Vec::new();
-    let mut uv_triangles: Vec<[u32; 3]> = Vec::new();
-    let mut all_have_normals = true;
-    let mut uv_presence: Option<bool> = None;
-    let mut sources: Vec<VertexSource> = Vec::new();
-
-    for (mesh, world, node) in instances {
-        let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
-        for primitive in mesh.primitives() {
-            let what = format!("mesh {} primitive {}", mesh.index(), primitive.index());
-            if !matches!(
-                primitive.mode(),
-                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-            ) {
-                continue; // points and lines carry no surface
-            }
-            for (_, accessor) in primitive.attributes() {
-                check_accessor(&accessor, &buffers).map_err(|m| whole(format!("{what}: {m}")))?;
-            }
-            if let Some(a) = primitive.indices() {
-                check_accessor(&a, &buffers).map_err(|m| whole(format!("{what}: {m}")))?;
-            }
-            let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            let local: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| whole(format!("{what} has no POSITION attribute")))?
-                .map(Vec3::from)
-                .collect();
-            let normals: Option<Vec<Vec3>> =
-                reader.read_normals().map(|n| n.map(Vec3::from).collect());
-            // glTF puts UV (0, 0) at the image's top-left corner; pelage's
-            // maps (as OBJ, PLY and USD) at its bottom-left: v is flipped,
-            // as Blender's importer does.
-            let uvs: Option<Vec<Vec2>> = reader
-                .read_tex_coords(0)
-                .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
-            match uv_presence {
-                None => uv_presence = Some(uvs.is_some()),
-                Some(p) if p != uvs.is_some() => {
-                    return Err(MeshError::whole(
-                        name,
-                        MeshErrorKind::Unsupported(format!(
-                            "{what} {} TEXCOORD_0 but earlier primitives {}; pelage needs UVs on all primitives or on none",
-                            if uvs.is_some() { "has" } else { "has no" },
-                            if p { "do" } else { "do not" }
-                        )),
-                    ));
-                }
-                Some(_) => {}
-            }
-            all_have_normals &= normals.is_some();
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..local.len() as u32).collect(),
-            };
-            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= local.len()) {
-                return Err(MeshError::whole(
-                    name,
-                    MeshErrorKind::IndexOutOfRange {
-                        what: "vertex",
-                        what_plural: "vertices",
-                        index: i64::from(bad),
-                        count: local.len(),
-                        hint: "",
-                    },
-                ));
-            }
-
-            // Weld this primitive's vertices into the merged mesh.
-            let uv_base = uv_values.len() as u32;
-            let mut remap = Vec::with_capacity(local.len());
-            for (k, p) in local.iter().enumerate() {
-                let p = world.transform_point3(*p);
-                if !p.is_finite() {
-                    let kind = MeshErrorKind::NonFinite {
-                        what: "vertex position",
-                    };
-                    return Err(MeshError::whole(name, kind));
-                }
-                let next = positions.len() as u32;
-                let id = *welded.entry(p.to_array().map(f32::to_bits)).or_insert(next);
-                if id == next {
-                    positions.push(p);
-                    normal_sums.push(Vec3::ZERO);
-                    sources.push(VertexSource {
-                        node,
-                        mesh: mesh.index(),
-                        primitive: primitive.index(),
-                        vertex: k as u32,
-                    });
-                }
-                if let Some(n) = &normals {
-                    normal_sums[id as usize] += (normal_matrix * n[k]).normalize_or_zero();
-                }
-                remap.push(id);
-            }
-            if let Some(uvs) = uvs {
-                uv_values.extend(uvs);
-            }
-            for tri in triangle_indices(primitive.mode(), &indices) {
-                triangles.push(tri.map(|i| remap[i as usize]));
-                if uv_presence == Some(true) {
-                    uv_triangles.push(tri.map(|i| uv_base + i));
-                }
-            }
-        }
-    }
-
-    if triangles.is_empty() {
-        return Err(MeshError::whole(
-            name,
-            MeshErrorKind::Empty("no triangle primitives"),
-        ));
-    }
-    let normals = all_have_normals.then(|| {
-        let computed = super::area_weighted_normals(&positions, &triangles);
-        normal_sums
-            .into_iter()
-            .zip(computed)
-            .map(|(s, c)| {
-                if s.is_finite() {
-                    s.try_normalize().unwrap_or(c)
-                } else {
-                    s
-                }
-            })
-            .collect()
-    });
-    let uvs = (uv_presence == Some(true)).then_some(Uvs::PerCorner {
-        values: uv_values,
-        indices: uv_triangles,
-    });
-    let mesh = Mesh::new(name, positions, triangles, normals, uvs)?;
-    Ok(ParsedGltf {
-        mesh,
-        document: gltf.document,
-        buffers,
-        sources,
-    })
+    Ok(instances)
 }
 
 /// The gltf crate's readers index buffers without bounds checks of their
