@@ -162,66 +162,10 @@ impl StyleMesh {
         } else {
             &triangle_colours
         };
-        // 3. Style edges and triangles from the colouring: only triangles
-        // on cell borders matter. Sorting, not hashing, dedups them (the
-        // same result, in parallel); a style triangle keeps the corner
-        // order of the first mesh triangle of its guide triple.
-        let border: Vec<u32> = (0..coloured.len() as u32)
-            .into_par_iter()
-            .filter(|&t| {
-                let c = coloured[t as usize];
-                !c.contains(&u32::MAX) && (c[0] != c[1] || c[1] != c[2])
-            })
-            .collect();
-        let mut edges: Vec<[u32; 2]> = border
-            .par_iter()
-            .flat_map_iter(|&t| {
-                let c = coloured[t as usize];
-                [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])]
-                    .into_iter()
-                    .filter(|(a, b)| a != b)
-                    .map(|(a, b)| [a.min(b), a.max(b)])
-            })
-            .collect();
-        edges.par_sort_unstable();
-        edges.dedup();
-        let mut firsts: Vec<([u32; 3], u32)> = border
-            .par_iter()
-            .filter_map(|&t| {
-                let mut key = coloured[t as usize];
-                key.sort_unstable();
-                (key[0] != key[1] && key[1] != key[2]).then_some((key, t))
-            })
-            .collect();
-        firsts.par_sort_unstable();
-        firsts.dedup_by_key(|(key, _)| *key);
-        firsts.par_sort_unstable_by_key(|&(_, t)| t);
-        let mut triangles: Vec<[u32; 3]> =
-            firsts.iter().map(|&(_, t)| coloured[t as usize]).collect();
+        let (edges, mut triangles) = style_primitives(coloured);
         let real_triangles = triangles.len();
 
-        // Gaps: edges in no triangle become segments, lone guides points.
-        let mut covered_edges = HashSet::new();
-        let mut touched = vec![false; guides.len()];
-        for t in &triangles {
-            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-                covered_edges.insert([a.min(b), a.max(b)]);
-            }
-            t.iter().for_each(|&g| touched[g as usize] = true);
-        }
-        for e in &edges {
-            if !covered_edges.contains(e) {
-                triangles.push([e[0], e[1], e[1]]);
-                touched[e[0] as usize] = true;
-                touched[e[1] as usize] = true;
-            }
-        }
-        let lost_set: HashSet<u32> = lost.iter().map(|l| l.guide).collect();
-        for (g, &t) in touched.iter().enumerate() {
-            if !t && !lost_set.contains(&(g as u32)) {
-                triangles.push([g as u32; 3]);
-            }
-        }
+        close_gaps(&mut triangles, &edges, guides.len(), &lost);
         let bvh = TriangleBvh::new(&positions, &triangles);
 
         let corners: Vec<[Vec3; 3]> = triangles
@@ -229,27 +173,7 @@ impl StyleMesh {
             .map(|t| t.map(|g| positions[g as usize]))
             .collect();
         let projections = corners.iter().map(|&c| Projection::new(c)).collect();
-        let mut incident_offsets = vec![0u32; guides.len() + 1];
-        for t in &triangles {
-            for (k, &g) in t.iter().enumerate() {
-                if !t[..k].contains(&g) {
-                    incident_offsets[g as usize + 1] += 1;
-                }
-            }
-        }
-        for g in 0..guides.len() {
-            incident_offsets[g + 1] += incident_offsets[g];
-        }
-        let mut fill = incident_offsets.clone();
-        let mut incident = vec![0u32; *incident_offsets.last().unwrap() as usize];
-        for (i, t) in triangles.iter().enumerate() {
-            for (k, &g) in t.iter().enumerate() {
-                if !t[..k].contains(&g) {
-                    incident[fill[g as usize] as usize] = i as u32;
-                    fill[g as usize] += 1;
-                }
-            }
-        }
+        let (incident_offsets, incident) = incidence(&triangles, guides.len());
 
         Self {
             positions,
@@ -606,4 +530,99 @@ fn split_under(
         marks[g] = (v, l.guide);
     }
     (vertices, triangles)
+}
+/// Style edges and triangles from a colouring (each skin triangle's corner
+/// colours): only triangles on cell borders matter. Sorting, not hashing,
+/// dedups them (the same result, in parallel); a style triangle keeps the
+/// corner order of the first mesh triangle of its guide triple.
+fn style_primitives(coloured: &[[u32; 3]]) -> (Vec<[u32; 2]>, Vec<[u32; 3]>) {
+    let border: Vec<u32> = (0..coloured.len() as u32)
+        .into_par_iter()
+        .filter(|&t| {
+            let c = coloured[t as usize];
+            !c.contains(&u32::MAX) && (c[0] != c[1] || c[1] != c[2])
+        })
+        .collect();
+    let mut edges: Vec<[u32; 2]> = border
+        .par_iter()
+        .flat_map_iter(|&t| {
+            let c = coloured[t as usize];
+            [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])]
+                .into_iter()
+                .filter(|(a, b)| a != b)
+                .map(|(a, b)| [a.min(b), a.max(b)])
+        })
+        .collect();
+    edges.par_sort_unstable();
+    edges.dedup();
+    let mut firsts: Vec<([u32; 3], u32)> = border
+        .par_iter()
+        .filter_map(|&t| {
+            let mut key = coloured[t as usize];
+            key.sort_unstable();
+            (key[0] != key[1] && key[1] != key[2]).then_some((key, t))
+        })
+        .collect();
+    firsts.par_sort_unstable();
+    firsts.dedup_by_key(|(key, _)| *key);
+    firsts.par_sort_unstable_by_key(|&(_, t)| t);
+    let triangles: Vec<[u32; 3]> = firsts.iter().map(|&(_, t)| coloured[t as usize]).collect();
+    (edges, triangles)
+}
+
+/// Closes the style mesh's gaps: edges in no triangle become segments
+/// (`[a, b, b]`), guides in none (and not lost) points (`[g, g, g]`).
+fn close_gaps(
+    triangles: &mut Vec<[u32; 3]>,
+    edges: &[[u32; 2]],
+    guides: usize,
+    lost: &[LostGuide],
+) {
+    let mut covered_edges = HashSet::new();
+    let mut touched = vec![false; guides];
+    for t in triangles.iter() {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            covered_edges.insert([a.min(b), a.max(b)]);
+        }
+        t.iter().for_each(|&g| touched[g as usize] = true);
+    }
+    for e in edges {
+        if !covered_edges.contains(e) {
+            triangles.push([e[0], e[1], e[1]]);
+            touched[e[0] as usize] = true;
+            touched[e[1] as usize] = true;
+        }
+    }
+    let lost_set: HashSet<u32> = lost.iter().map(|l| l.guide).collect();
+    for (g, &t) in touched.iter().enumerate() {
+        if !t && !lost_set.contains(&(g as u32)) {
+            triangles.push([g as u32; 3]);
+        }
+    }
+}
+
+/// Per guide, the primitives it is a corner of, in compressed rows.
+fn incidence(triangles: &[[u32; 3]], guides: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut incident_offsets = vec![0u32; guides + 1];
+    for t in triangles {
+        for (k, &g) in t.iter().enumerate() {
+            if !t[..k].contains(&g) {
+                incident_offsets[g as usize + 1] += 1;
+            }
+        }
+    }
+    for g in 0..guides {
+        incident_offsets[g + 1] += incident_offsets[g];
+    }
+    let mut fill = incident_offsets.clone();
+    let mut incident = vec![0u32; *incident_offsets.last().unwrap() as usize];
+    for (i, t) in triangles.iter().enumerate() {
+        for (k, &g) in t.iter().enumerate() {
+            if !t[..k].contains(&g) {
+                incident[fill[g as usize] as usize] = i as u32;
+                fill[g as usize] += 1;
+            }
+        }
+    }
+    (incident_offsets, incident)
 }
