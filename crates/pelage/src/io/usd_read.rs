@@ -646,88 +646,23 @@ fn skin_from_layer(path: &Path, data: &dyn AbstractData) -> Result<UsdSkin, Curv
         let counts = ints("faceVertexCounts")?;
         let indices = ints("faceVertexIndices")?;
         let base = positions.len() as u32;
-        let mut corner = 0usize;
-        let corner_base = uv_values.len() as u32;
-        let mut prim_triangles = Vec::new();
-        let mut prim_corners = Vec::new();
-        for (f, &c) in counts.iter().enumerate() {
-            if c < 3 {
-                return Err(fail(format!("face {f} has {c} vertices")));
-            }
-            let c = c as usize;
-            let face = indices
-                .get(corner..corner + c)
-                .ok_or_else(|| fail(format!("faceVertexIndices end inside face {f}")))?;
-            for (k, &i) in face.iter().enumerate() {
-                if i < 0 || i as usize >= points.len() {
-                    return Err(fail(format!(
-                        "face {f} corner {k} names point {i} of {}",
-                        points.len()
-                    )));
-                }
-            }
-            for k in 1..c - 1 {
-                prim_triangles.push([face[0], face[k], face[k + 1]].map(|i| base + i as u32));
-                prim_corners.push([corner, corner + k, corner + k + 1]);
-            }
-            corner += c;
-        }
-        if corner != indices.len() {
-            return Err(fail(format!(
-                "faceVertexCounts add up to {corner} but there are {} indices",
-                indices.len()
-            )));
-        }
-        // UVs: faceVarying (optionally indexed) or vertex.
-        let st = ["primvars:st", "primvars:UVMap", "primvars:uv"]
-            .into_iter()
-            .find_map(|name| {
-                let value = attribute(data, &prim, name)?;
-                let values: Vec<glam::Vec2> = match value {
-                    Value::Vec2fVec(v) => v.iter().map(|t| glam::Vec2::new(t.x, t.y)).collect(),
-                    _ => return None,
-                };
-                let interpolation = metadata_token(data, &prim, name, "interpolation");
-                let indices = match attribute(data, &prim, &format!("{name}:indices")) {
-                    Some(Value::IntVec(v)) => Some(v),
-                    _ => None,
-                };
-                Some((values, interpolation, indices))
-            });
-        let has_uvs = match st {
-            Some((values, interpolation, st_indices)) => {
-                let lookup = |k: usize| -> Option<u32> {
-                    let i = match &st_indices {
-                        Some(ix) => usize::try_from(*ix.get(k)?).ok()?,
-                        None => k,
-                    };
-                    (i < values.len()).then_some(i as u32)
-                };
-                match interpolation.as_deref() {
-                    Some("faceVarying") => {
-                        for corners in &prim_corners {
-                            let tri = corners.map(lookup).map(|i| i.map(|i| corner_base + i));
-                            let [Some(a), Some(b), Some(c)] = tri else {
-                                return Err(fail("primvars:st has too few values".into()));
-                            };
-                            uv_triangles.push([a, b, c]);
-                        }
-                        uv_values.extend(values);
-                        true
-                    }
-                    Some("vertex") | Some("varying") if values.len() == points.len() => {
-                        let start = uv_values.len() as u32;
-                        for t in &prim_triangles {
-                            uv_triangles.push(t.map(|i| i - base + start));
-                        }
-                        uv_values.extend(values);
-                        true
-                    }
-                    _ => false,
-                }
-            }
-            None => false,
-        };
+        let (prim_triangles, prim_corners) =
+            prim_faces(&counts, &indices, points.len(), base).map_err(fail)?;
+        let has_uvs = prim_uvs(
+            data,
+            &prim,
+            &prim_triangles,
+            &prim_corners,
+            base,
+            points.len(),
+        )
+        .map_err(fail)?
+        .map(|(values, triangles)| {
+            let start = uv_values.len() as u32;
+            uv_triangles.extend(triangles.into_iter().map(|t| t.map(|i| start + i)));
+            uv_values.extend(values);
+        })
+        .is_some();
         all_have_uvs &= has_uvs;
         positions.extend_from_slice(&points);
         triangles.extend(prim_triangles);
@@ -746,6 +681,107 @@ fn skin_from_layer(path: &Path, data: &dyn AbstractData) -> Result<UsdSkin, Curv
         times,
         prims,
     })
+}
+
+/// A prim's triangles (point indices) and each one's face-corner indices.
+type PrimFaces = (Vec<[u32; 3]>, Vec<[usize; 3]>);
+
+/// A prim's UV values and each triangle's indices into them.
+type PrimUvs = (Vec<glam::Vec2>, Vec<[u32; 3]>);
+
+/// A `Mesh` prim's faces fan triangulated (point indices offset by
+/// `base`), with the face-corner indices of each triangle's corners;
+/// an error says which face is malformed.
+fn prim_faces(
+    counts: &[i32],
+    indices: &[i32],
+    points: usize,
+    base: u32,
+) -> Result<PrimFaces, String> {
+    let mut corner = 0usize;
+    let mut prim_triangles = Vec::new();
+    let mut prim_corners = Vec::new();
+    for (f, &c) in counts.iter().enumerate() {
+        if c < 3 {
+            return Err(format!("face {f} has {c} vertices"));
+        }
+        let c = c as usize;
+        let face = indices
+            .get(corner..corner + c)
+            .ok_or_else(|| format!("faceVertexIndices end inside face {f}"))?;
+        for (k, &i) in face.iter().enumerate() {
+            if i < 0 || i as usize >= points {
+                return Err(format!("face {f} corner {k} names point {i} of {points}"));
+            }
+        }
+        for k in 1..c - 1 {
+            prim_triangles.push([face[0], face[k], face[k + 1]].map(|i| base + i as u32));
+            prim_corners.push([corner, corner + k, corner + k + 1]);
+        }
+        corner += c;
+    }
+    if corner != indices.len() {
+        return Err(format!(
+            "faceVertexCounts add up to {corner} but there are {} indices",
+            indices.len()
+        ));
+    }
+    Ok((prim_triangles, prim_corners))
+}
+
+/// A `Mesh` prim's UVs, faceVarying (optionally indexed) or vertex: the
+/// values and each triangle's indices into them (from 0), or `None` when
+/// the prim has none pelage reads.
+fn prim_uvs(
+    data: &dyn AbstractData,
+    prim: &sdf::Path,
+    prim_triangles: &[[u32; 3]],
+    prim_corners: &[[usize; 3]],
+    base: u32,
+    points: usize,
+) -> Result<Option<PrimUvs>, String> {
+    let st = ["primvars:st", "primvars:UVMap", "primvars:uv"]
+        .into_iter()
+        .find_map(|name| {
+            let value = attribute(data, prim, name)?;
+            let values: Vec<glam::Vec2> = match value {
+                Value::Vec2fVec(v) => v.iter().map(|t| glam::Vec2::new(t.x, t.y)).collect(),
+                _ => return None,
+            };
+            let interpolation = metadata_token(data, prim, name, "interpolation");
+            let indices = match attribute(data, prim, &format!("{name}:indices")) {
+                Some(Value::IntVec(v)) => Some(v),
+                _ => None,
+            };
+            Some((values, interpolation, indices))
+        });
+    let Some((values, interpolation, st_indices)) = st else {
+        return Ok(None);
+    };
+    let lookup = |k: usize| -> Option<u32> {
+        let i = match &st_indices {
+            Some(ix) => usize::try_from(*ix.get(k)?).ok()?,
+            None => k,
+        };
+        (i < values.len()).then_some(i as u32)
+    };
+    let triangles = match interpolation.as_deref() {
+        Some("faceVarying") => {
+            let mut triangles = Vec::with_capacity(prim_corners.len());
+            for corners in prim_corners {
+                let [Some(a), Some(b), Some(c)] = corners.map(lookup) else {
+                    return Err("primvars:st has too few values".into());
+                };
+                triangles.push([a, b, c]);
+            }
+            triangles
+        }
+        Some("vertex") | Some("varying") if values.len() == points => {
+            prim_triangles.iter().map(|t| t.map(|i| i - base)).collect()
+        }
+        _ => return Ok(None),
+    };
+    Ok(Some((values, triangles)))
 }
 
 fn token(data: &dyn AbstractData, path: &sdf::Path, field: &str) -> Option<String> {
