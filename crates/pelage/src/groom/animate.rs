@@ -715,36 +715,7 @@ impl AnimatedGroom {
         cancel: &AtomicBool,
         progress: &mut dyn FnMut(AnimationProgress),
     ) -> Result<GroomSummary, GroomWriteError> {
-        let write_error = |path: &Path, e: &dyn std::fmt::Display| {
-            GroomWriteError::Write(crate::io::WriteError {
-                path: path.to_path_buf(),
-                error: std::io::Error::other(e.to_string()),
-            })
-        };
-        let mut layers = Vec::with_capacity(outputs.len());
-        for output in outputs {
-            let format = match CurvesFormat::from_path(&output.path) {
-                Some(f @ (CurvesFormat::Usdc | CurvesFormat::Abc)) => f,
-                _ => {
-                    return Err(GroomWriteError::Groom(self.spec.error(
-                        "output.path",
-                        GroomErrorKind::Invalid(format!(
-                            "{}: animated grooms are written with time samples to .usdc, .usd or .abc",
-                            output.path.display()
-                        )),
-                    )));
-                }
-            };
-            let file = AtomicFile::create(&output.path)?;
-            let layer = match format {
-                CurvesFormat::Usdc => {
-                    UsdcWriter::new(file, options).map(|w| TimeSampledLayer::Usdc(Box::new(w)))
-                }
-                _ => AbcWriter::new(file, options).map(|w| TimeSampledLayer::Abc(Box::new(w))),
-            }
-            .map_err(|e| write_error(&output.path, &e))?;
-            layers.push(layer);
-        }
+        let mut layers = self.open_layers(outputs, options)?;
         // Poses once for every time of every file (files may share times).
         let mut times: Vec<f64> = outputs
             .iter()
@@ -775,15 +746,7 @@ impl AnimatedGroom {
             _ => Vec::new(),
         };
         if with_skin {
-            for (output, layer) in outputs.iter().zip(&mut layers) {
-                for &time in &output.times {
-                    let mesh = self.posed_mesh(&poses[index(time)])?;
-                    layer
-                        .prims()
-                        .write_mesh_at("skin", time, &mesh)
-                        .map_err(|e| write_error(&output.path, &e))?;
-                }
-            }
+            self.write_skins(outputs, &mut layers, &times, &poses)?;
         }
         let mut summary = GroomSummary::default();
         let total = parts.len() * outputs.iter().map(|o| o.times.len()).sum::<usize>();
@@ -803,59 +766,16 @@ impl AnimatedGroom {
                     let k = index(time);
                     let generator = generators[k].as_ref().unwrap_or(&self.generator);
                     let velocities = if regrow_velocities {
-                        // The neighbours among all the groom's time codes,
-                        // not this run's: a farm task's or a window's edge
-                        // grows its neighbour, so every split writes what
-                        // one run writes.
-                        let i = all_times.partition_point(|&x| x < time);
-                        let a = if i > 0 { all_times[i - 1] } else { time };
-                        let b = all_times.get(i + 1).copied().unwrap_or(time);
-                        for t in [a, time, b] {
-                            if !grown.iter().any(|(x, _)| *x == t) {
-                                let c = self.regrown_part(p, t, &times, &poses, &generators)?;
-                                grown.push((t, c));
-                            }
-                        }
-                        grown.retain(|(x, _)| *x >= a);
-                        let span = (b - a) as f32;
-                        let per_second = if span > 0.0 {
-                            options.time_codes_per_second as f32 / span
-                        } else {
-                            0.0
+                        let window = Window {
+                            times: &times,
+                            poses: &poses,
+                            generators: &generators,
+                            time_codes_per_second: options.time_codes_per_second,
                         };
-                        let slot = |t: f64| {
-                            grown
-                                .iter()
-                                .position(|(x, _)| *x == t)
-                                .expect("grown above")
-                        };
-                        let velocities = grown[slot(a)]
-                            .1
-                            .points()
-                            .iter()
-                            .zip(grown[slot(b)].1.points())
-                            .map(|(x, y)| (*y - *x) * per_second)
-                            .collect();
-                        // Lent to `out` for the write, given back after it.
-                        let now = slot(time);
-                        out = std::mem::take(&mut grown[now].1);
-                        Some(velocities)
+                        Some(self.regrow_at(p, time, &all_times, window, &mut grown, &mut out)?)
                     } else {
                         self.part_at(p, time, &poses[k], generator, &mut rest, &mut out)?;
-                        match (velocity_poses.get(k), &rest) {
-                            (Some((minus, plus, per_second)), Some((curves, frames))) => Some(
-                                self.velocities((curves, frames), (minus, plus), *per_second)
-                                    .ok_or_else(|| {
-                                        GroomWriteError::Groom(self.spec.error(
-                                            "animation",
-                                            GroomErrorKind::NotFinite(format!(
-                                                "part {p} at frame {time}: the skin's pose near it moved a hair to a value that is not finite"
-                                            )),
-                                        ))
-                                    })?,
-                            ),
-                            _ => None,
-                        }
+                        self.deform_velocities(p, time, velocity_poses.get(k), &rest)?
                     };
                     if velocities.is_some() {
                         out.set_velocities(velocities).map_err(|e| {
@@ -908,6 +828,136 @@ impl AnimatedGroom {
         }
         Ok(summary)
     }
+
+    /// A time-sampled layer for each output (`.usdc` or `.abc`), each to a
+    /// temporary file committed when the window is written.
+    fn open_layers(
+        &self,
+        outputs: &[FrameOutput],
+        options: &UsdOptions,
+    ) -> Result<Vec<TimeSampledLayer>, GroomWriteError> {
+        let mut layers = Vec::with_capacity(outputs.len());
+        for output in outputs {
+            let format = match CurvesFormat::from_path(&output.path) {
+                Some(f @ (CurvesFormat::Usdc | CurvesFormat::Abc)) => f,
+                _ => {
+                    return Err(GroomWriteError::Groom(self.spec.error(
+                        "output.path",
+                        GroomErrorKind::Invalid(format!(
+                            "{}: animated grooms are written with time samples to .usdc, .usd or .abc",
+                            output.path.display()
+                        )),
+                    )));
+                }
+            };
+            let file = AtomicFile::create(&output.path)?;
+            let layer = match format {
+                CurvesFormat::Usdc => {
+                    UsdcWriter::new(file, options).map(|w| TimeSampledLayer::Usdc(Box::new(w)))
+                }
+                _ => AbcWriter::new(file, options).map(|w| TimeSampledLayer::Abc(Box::new(w))),
+            }
+            .map_err(|e| write_error(&output.path, &e))?;
+            layers.push(layer);
+        }
+        Ok(layers)
+    }
+
+    /// The posed skin at every time of every output, as a `skin` mesh.
+    fn write_skins(
+        &self,
+        outputs: &[FrameOutput],
+        layers: &mut [TimeSampledLayer],
+        times: &[f64],
+        poses: &[SkinPose],
+    ) -> Result<(), GroomWriteError> {
+        let index = |t: f64| times.partition_point(|&x| x < t);
+        for (output, layer) in outputs.iter().zip(layers.iter_mut()) {
+            for &time in &output.times {
+                let mesh = self.posed_mesh(&poses[index(time)])?;
+                layer
+                    .prims()
+                    .write_mesh_at("skin", time, &mesh)
+                    .map_err(|e| write_error(&output.path, &e))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Part `p` regrown at `time` with its velocities by central
+    /// differences over the neighbouring time codes among all the groom's
+    /// (not this run's: a farm task's or a window's edge grows its
+    /// neighbour, so every split writes what one run writes). The growths
+    /// are kept in `grown` (three at most) as the frames go by; this
+    /// time's is lent to `out` for the write.
+    fn regrow_at(
+        &self,
+        p: usize,
+        time: f64,
+        all_times: &[f64],
+        window: Window<'_>,
+        grown: &mut Vec<(f64, Curves)>,
+        out: &mut Curves,
+    ) -> Result<Vec<Vec3>, GroomError> {
+        let i = all_times.partition_point(|&x| x < time);
+        let a = if i > 0 { all_times[i - 1] } else { time };
+        let b = all_times.get(i + 1).copied().unwrap_or(time);
+        for t in [a, time, b] {
+            if !grown.iter().any(|(x, _)| *x == t) {
+                let c = self.regrown_part(p, t, window.times, window.poses, window.generators)?;
+                grown.push((t, c));
+            }
+        }
+        grown.retain(|(x, _)| *x >= a);
+        let span = (b - a) as f32;
+        let per_second = if span > 0.0 {
+            window.time_codes_per_second as f32 / span
+        } else {
+            0.0
+        };
+        let slot = |t: f64| {
+            grown
+                .iter()
+                .position(|(x, _)| *x == t)
+                .expect("grown above")
+        };
+        let velocities = grown[slot(a)]
+            .1
+            .points()
+            .iter()
+            .zip(grown[slot(b)].1.points())
+            .map(|(x, y)| (*y - *x) * per_second)
+            .collect();
+        // Lent to `out` for the write, given back after it.
+        let now = slot(time);
+        *out = std::mem::take(&mut grown[now].1);
+        Ok(velocities)
+    }
+
+    /// A deform part's velocities at `time` from the skin a little before
+    /// and after it (`None` without them).
+    fn deform_velocities(
+        &self,
+        p: usize,
+        time: f64,
+        poses: Option<&(SkinPose, SkinPose, f32)>,
+        rest: &Option<(Curves, RestFrames)>,
+    ) -> Result<Option<Vec<Vec3>>, GroomWriteError> {
+        Ok(match (poses, rest) {
+            (Some((minus, plus, per_second)), Some((curves, frames))) => Some(
+                self.velocities((curves, frames), (minus, plus), *per_second)
+                    .ok_or_else(|| {
+                        GroomWriteError::Groom(self.spec.error(
+                            "animation",
+                            GroomErrorKind::NotFinite(format!(
+                                "part {p} at frame {time}: the skin's pose near it moved a hair to a value that is not finite"
+                            )),
+                        ))
+                    })?,
+            ),
+            _ => None,
+        })
+    }
 }
 
 /// Guide curves from a time-sampled file at time code `time`: USD at that
@@ -933,6 +983,24 @@ pub struct FrameOutput {
     pub path: PathBuf,
     /// Its time codes, ascending.
     pub times: Vec<f64>,
+}
+
+/// The poses and generators of a window's times, in time order, and the
+/// time codes a second they are written at.
+#[derive(Clone, Copy)]
+struct Window<'a> {
+    times: &'a [f64],
+    poses: &'a [SkinPose],
+    generators: &'a [Option<Generator>],
+    time_codes_per_second: f64,
+}
+
+/// A writer's refusal of a prim, as the error of writing `path`.
+fn write_error(path: &Path, e: &dyn std::fmt::Display) -> GroomWriteError {
+    GroomWriteError::Write(crate::io::WriteError {
+        path: path.to_path_buf(),
+        error: std::io::Error::other(e.to_string()),
+    })
 }
 
 /// An open time-sampled output.
