@@ -17,7 +17,7 @@
 //! One file, past 600 lines: the explicit and implicit compute pipelines
 //! share buffers, bind groups and the uniform ring.
 
-use crate::layout::{entry, gpu_struct, group};
+use crate::layout::{compute_pipeline, entry, gpu_struct, group};
 use crate::{GpuContext, GpuError, ShellModel, workgroups};
 use glam::Vec3;
 use pelage::dynamics::{DynamicsParams, MassSpringSystem, Topology};
@@ -129,95 +129,7 @@ impl GpuMassSpring {
                 "{n} masses need {bytes} bytes a state buffer; the adapter binds at most {limit}"
             )));
         }
-        let storage = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
-            // wgpu refuses empty bindings: a system without tip-tip springs
-            // still binds one (unread) element.
-            let contents = if contents.is_empty() {
-                &[0u8; 16][..]
-            } else {
-                contents
-            };
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE | usage,
-            })
-        };
-        let copy_dst = wgpu::BufferUsages::COPY_DST;
-        let roots = storage(
-            "dynamics roots",
-            bytemuck::cast_slice(&roots_and_lengths(system)),
-            copy_dst,
-        );
-        let normals = storage(
-            "dynamics normals",
-            bytemuck::cast_slice(&padded(system.normals())),
-            copy_dst,
-        );
-        let root_velocities = storage(
-            "dynamics root velocities",
-            bytemuck::cast_slice(&padded(system.root_velocities())),
-            copy_dst,
-        );
-        let (offsets, index) = system.tip_spring_adjacency();
-        let springs = system.tip_tip_springs();
-        let ends: Vec<[u32; 2]> = (0..n)
-            .flat_map(|i| {
-                index[offsets[i] as usize..offsets[i + 1] as usize]
-                    .iter()
-                    .map(move |&s| {
-                        let spring = springs[s as usize];
-                        let other = if spring.a as usize == i {
-                            spring.b
-                        } else {
-                            spring.a
-                        };
-                        [other, spring.rest.to_bits()]
-                    })
-            })
-            .collect();
-        let spring_offsets = storage(
-            "dynamics spring offsets",
-            bytemuck::cast_slice(offsets),
-            wgpu::BufferUsages::empty(),
-        );
-        let spring_ends = storage(
-            "dynamics spring ends",
-            bytemuck::cast_slice(&ends),
-            wgpu::BufferUsages::empty(),
-        );
-        let permutation = storage(
-            "dynamics noise permutation",
-            bytemuck::cast_slice(&[0u32; 512]),
-            copy_dst,
-        );
-        let state_usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
-        let state = [0, 1].map(|_| {
-            (
-                storage(
-                    "dynamics tips",
-                    bytemuck::cast_slice(&padded(system.tips())),
-                    state_usage,
-                ),
-                storage(
-                    "dynamics velocities",
-                    bytemuck::cast_slice(&padded(system.velocities())),
-                    state_usage,
-                ),
-            )
-        });
-        let corner_sticks = storage(
-            "dynamics corner sticks",
-            bytemuck::cast_slice(system.corner_sticks()),
-            wgpu::BufferUsages::empty(),
-        );
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("dynamics steps"),
-            size: SLOT_BYTES * u64::from(SLOTS),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-
+        let buffers = SystemBuffers::new(device, system);
         let compute = wgpu::ShaderStages::COMPUTE;
         let uniform = wgpu::BufferBindingType::Uniform;
         let mut entries = vec![entry::buffer(0, compute, uniform, true)];
@@ -227,63 +139,25 @@ impl GpuMassSpring {
             label: Some("dynamics"),
             entries: &entries,
         });
-        let bind_groups =
-            [0usize, 1].map(|k| {
-                let (tips_in, velocities_in) = &state[k];
-                let (tips_out, velocities_out) = &state[1 - k];
-                let buffers = [
-                    &roots,
-                    &normals,
-                    &root_velocities,
-                    &spring_offsets,
-                    &spring_ends,
-                    &permutation,
-                    tips_in,
-                    velocities_in,
-                    tips_out,
-                    velocities_out,
-                ];
-                let mut entries = vec![wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &uniforms,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<StepUniform>() as u64),
-                    }),
-                }];
-                entries.extend(buffers.iter().enumerate().map(|(b, buffer)| {
-                    wgpu::BindGroupEntry {
-                        binding: b as u32 + 1,
-                        resource: buffer.as_entire_binding(),
-                    }
-                }));
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("dynamics"),
-                    layout: &layout,
-                    entries: &entries,
-                })
-            });
+        let bind_groups = [0usize, 1].map(|k| buffers.step_group(device, &layout, k));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("dynamics.wgsl"),
             source: wgpu::ShaderSource::Wgsl(crate::shader_source("dynamics.wgsl").into()),
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("dynamics"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = |label: &str, entry_point: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry_point),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let explicit = pipeline("dynamics explicit substep", "explicit_substep");
-        let implicit = pipeline("dynamics implicit step", "implicit_unjoined_step");
+        let explicit = compute_pipeline(
+            device,
+            "dynamics explicit substep",
+            &module,
+            "explicit_substep",
+            &[&layout],
+        );
+        let implicit = compute_pipeline(
+            device,
+            "dynamics implicit step",
+            &module,
+            "implicit_unjoined_step",
+            &[&layout],
+        );
         let coupling_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dynamics coupling"),
             entries: &[
@@ -295,20 +169,23 @@ impl GpuMassSpring {
                 entry::storage(13, compute, true),
             ],
         });
-        let coupling = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("dynamics corner tip offsets"),
-            layout: Some(
-                &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("dynamics coupling"),
-                    bind_group_layouts: &[Some(&coupling_layout)],
-                    immediate_size: 0,
-                }),
-            ),
-            module: &module,
-            entry_point: Some("corner_tip_offsets"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let coupling = compute_pipeline(
+            device,
+            "dynamics corner tip offsets",
+            &module,
+            "corner_tip_offsets",
+            &[&coupling_layout],
+        );
+        let SystemBuffers {
+            roots,
+            normals,
+            root_velocities,
+            permutation,
+            state,
+            corner_sticks,
+            uniforms,
+            ..
+        } = buffers;
         Ok(Self {
             tips,
             silva: system.topology() == Topology::SilvaStrands,
@@ -599,5 +476,171 @@ impl GpuMassSpring {
         let (tips, velocities) = self.read_state(ctx)?;
         system.set_state(&tips, &velocities);
         Ok(())
+    }
+}
+
+/// A mass-spring system's buffers on the GPU: roots with rest lengths,
+/// normals, root velocities, the tip-tip springs (CSR), the wind's
+/// permutation, two states to ping-pong, the corner sticks and the step
+/// uniforms.
+struct SystemBuffers {
+    roots: wgpu::Buffer,
+    normals: wgpu::Buffer,
+    root_velocities: wgpu::Buffer,
+    spring_offsets: wgpu::Buffer,
+    spring_ends: wgpu::Buffer,
+    permutation: wgpu::Buffer,
+    state: [(wgpu::Buffer, wgpu::Buffer); 2],
+    corner_sticks: wgpu::Buffer,
+    uniforms: wgpu::Buffer,
+}
+
+impl SystemBuffers {
+    fn new(device: &wgpu::Device, system: &MassSpringSystem) -> Self {
+        let n = system.mass_count();
+        let storage = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
+            // wgpu refuses empty bindings: a system without tip-tip springs
+            // still binds one (unread) element.
+            let contents = if contents.is_empty() {
+                &[0u8; 16][..]
+            } else {
+                contents
+            };
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE | usage,
+            })
+        };
+        let copy_dst = wgpu::BufferUsages::COPY_DST;
+        let roots = storage(
+            "dynamics roots",
+            bytemuck::cast_slice(&roots_and_lengths(system)),
+            copy_dst,
+        );
+        let normals = storage(
+            "dynamics normals",
+            bytemuck::cast_slice(&padded(system.normals())),
+            copy_dst,
+        );
+        let root_velocities = storage(
+            "dynamics root velocities",
+            bytemuck::cast_slice(&padded(system.root_velocities())),
+            copy_dst,
+        );
+        let (offsets, index) = system.tip_spring_adjacency();
+        let springs = system.tip_tip_springs();
+        let ends: Vec<[u32; 2]> = (0..n)
+            .flat_map(|i| {
+                index[offsets[i] as usize..offsets[i + 1] as usize]
+                    .iter()
+                    .map(move |&s| {
+                        let spring = springs[s as usize];
+                        let other = if spring.a as usize == i {
+                            spring.b
+                        } else {
+                            spring.a
+                        };
+                        [other, spring.rest.to_bits()]
+                    })
+            })
+            .collect();
+        let spring_offsets = storage(
+            "dynamics spring offsets",
+            bytemuck::cast_slice(offsets),
+            wgpu::BufferUsages::empty(),
+        );
+        let spring_ends = storage(
+            "dynamics spring ends",
+            bytemuck::cast_slice(&ends),
+            wgpu::BufferUsages::empty(),
+        );
+        let permutation = storage(
+            "dynamics noise permutation",
+            bytemuck::cast_slice(&[0u32; 512]),
+            copy_dst,
+        );
+        let state_usage = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        let state = [0, 1].map(|_| {
+            (
+                storage(
+                    "dynamics tips",
+                    bytemuck::cast_slice(&padded(system.tips())),
+                    state_usage,
+                ),
+                storage(
+                    "dynamics velocities",
+                    bytemuck::cast_slice(&padded(system.velocities())),
+                    state_usage,
+                ),
+            )
+        });
+        let corner_sticks = storage(
+            "dynamics corner sticks",
+            bytemuck::cast_slice(system.corner_sticks()),
+            wgpu::BufferUsages::empty(),
+        );
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("dynamics steps"),
+            size: SLOT_BYTES * u64::from(SLOTS),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self {
+            roots,
+            normals,
+            root_velocities,
+            spring_offsets,
+            spring_ends,
+            permutation,
+            state,
+            corner_sticks,
+            uniforms,
+        }
+    }
+
+    /// The step's bind group reading state `k` and writing the other.
+    fn step_group(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        k: usize,
+    ) -> wgpu::BindGroup {
+        let (tips_in, velocities_in) = &self.state[k];
+        let (tips_out, velocities_out) = &self.state[1 - k];
+        let buffers = [
+            &self.roots,
+            &self.normals,
+            &self.root_velocities,
+            &self.spring_offsets,
+            &self.spring_ends,
+            &self.permutation,
+            tips_in,
+            velocities_in,
+            tips_out,
+            velocities_out,
+        ];
+        let mut entries = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &self.uniforms,
+                offset: 0,
+                size: wgpu::BufferSize::new(std::mem::size_of::<StepUniform>() as u64),
+            }),
+        }];
+        entries.extend(
+            buffers
+                .iter()
+                .enumerate()
+                .map(|(b, buffer)| wgpu::BindGroupEntry {
+                    binding: b as u32 + 1,
+                    resource: buffer.as_entire_binding(),
+                }),
+        );
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dynamics"),
+            layout,
+            entries: &entries,
+        })
     }
 }

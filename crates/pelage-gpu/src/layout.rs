@@ -203,6 +203,31 @@ impl<T: bytemuck::Pod> UniformRing<T> {
     }
 }
 
+/// A compute pipeline of `module`'s `entry_point` over bind groups of
+/// `layouts` (group `i` is `layouts[i]`), its layout made for it.
+pub(crate) fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    entry_point: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::ComputePipeline {
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().copied().map(Some).collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        module,
+        entry_point: Some(entry_point),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
 /// Bind-group entries, numbered by position where a group's bindings run
 /// 0, 1, 2, … (as Bevy's `BindGroupEntries::sequential`), or at the
 /// bindings given where a layout skips some.

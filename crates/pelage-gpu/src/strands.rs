@@ -10,7 +10,7 @@
 //! points, which is what grows with the groom. Points are kept
 //! point-major on the GPU so a workgroup's reads are contiguous.
 
-use crate::layout::{entry, gpu_struct};
+use crate::layout::{compute_pipeline, entry, gpu_struct};
 use crate::{GpuContext, GpuError, workgroups};
 use glam::Vec3;
 use pelage::dynamics::{GuideStrandParams, GuideStrands, RootFrame, SkinSdf};
@@ -213,23 +213,13 @@ impl GpuStrands {
                 label: Some("strands.wgsl"),
                 source: wgpu::ShaderSource::Wgsl(crate::shader_source("strands.wgsl").into()),
             });
-        let pipeline_layout = ctx
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("strands"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
-        let pipeline = ctx
-            .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("strands frame"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some("strands_frame"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+        let pipeline = compute_pipeline(
+            &ctx.device,
+            "strands frame",
+            &module,
+            "strands_frame",
+            &[&layout],
+        );
         Ok(Self {
             strands: count,
             points: n as u32,

@@ -5,7 +5,7 @@
 //! caller's (docs/embedding.md); [`ShellRenderer::draw`] and
 //! [`ShellRenderer::render`] into pelage's own [`ShellTarget`].
 
-use crate::layout::{UniformRing, entry};
+use crate::layout::{UniformRing, compute_pipeline, entry};
 use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES, check_size};
 use crate::{GpuContext, GpuError};
 use glam::Mat4;
@@ -219,20 +219,13 @@ impl ShellRenderer {
             label: Some("skin.wgsl"),
             source: wgpu::ShaderSource::Wgsl(crate::shader_source("skin.wgsl").into()),
         });
-        let skinning = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("shell skinning"),
-            layout: Some(
-                &device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("shell skinning"),
-                    bind_group_layouts: &[Some(&skin_layout)],
-                    immediate_size: 0,
-                }),
-            ),
-            module: &skin_module,
-            entry_point: Some("skin"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let skinning = compute_pipeline(
+            device,
+            "shell skinning",
+            &skin_module,
+            "skin",
+            &[&skin_layout],
+        );
         let uniforms = UniformRing::new(device, "shell uniforms", &uniform_layout);
         Self {
             skin_pipeline: pipeline(Kind::Skin),
