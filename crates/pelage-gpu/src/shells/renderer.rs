@@ -143,77 +143,12 @@ impl ShellRenderer {
             label: Some("shells.wgsl"),
             source: wgpu::ShaderSource::Wgsl(crate::shader_source("shells.wgsl").into()),
         });
-        let constants = [
-            ("CURL", f64::from(u8::from(features.curl))),
-            ("CLUMP", f64::from(u8::from(features.clump))),
-        ];
-        let vertex_buffers = [
-            Some(PoseVertex::layout(wgpu::VertexStepMode::Vertex)),
-            Some(SurfaceVertex::layout(wgpu::VertexStepMode::Vertex)),
-            Some(TipOffset::layout(wgpu::VertexStepMode::Vertex)),
-        ];
-        #[derive(PartialEq)]
-        enum Kind {
-            Skin,
-            Layers,
-            Fins,
-        }
-        let pipeline = |kind: Kind| {
-            let compilation_options = wgpu::PipelineCompilationOptions {
-                constants: &constants,
-                ..Default::default()
+        let pass_pipeline = |kind| {
+            let layout = match kind {
+                PassKind::Fins => &fin_pipeline_layout,
+                _ => &layout,
             };
-            let (label, vs, fs, layout, buffers): (_, _, _, _, &[_]) = match kind {
-                Kind::Skin => ("shell skin", "vs_skin", "fs_skin", &layout, &vertex_buffers),
-                Kind::Layers => (
-                    "shell layers",
-                    "vs_layer",
-                    "fs_layer",
-                    &layout,
-                    &vertex_buffers,
-                ),
-                Kind::Fins => ("shell fins", "vs_fin", "fs_fin", &fin_pipeline_layout, &[]),
-            };
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(vs),
-                    compilation_options: compilation_options.clone(),
-                    buffers,
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: (features.cull_back && kind != Kind::Fins)
-                        .then_some(wgpu::Face::Back),
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: formats.depth,
-                    depth_write_enabled: Some(kind == Kind::Skin),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: wgpu::MultisampleState {
-                    count: formats.samples,
-                    mask: !0,
-                    alpha_to_coverage_enabled: false,
-                },
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fs),
-                    compilation_options,
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: formats.color,
-                        blend: (kind != Kind::Skin).then_some(wgpu::BlendState::ALPHA_BLENDING),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            shell_pipeline(device, kind, &module, layout, formats, features)
         };
         let skin_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("skin.wgsl"),
@@ -228,9 +163,9 @@ impl ShellRenderer {
         );
         let uniforms = UniformRing::new(device, "shell uniforms", &uniform_layout);
         Self {
-            skin_pipeline: pipeline(Kind::Skin),
-            layer_pipeline: pipeline(Kind::Layers),
-            fin_pipeline: pipeline(Kind::Fins),
+            skin_pipeline: pass_pipeline(PassKind::Skin),
+            layer_pipeline: pass_pipeline(PassKind::Layers),
+            fin_pipeline: pass_pipeline(PassKind::Fins),
             skinning,
             uniforms,
             texture_layout,
@@ -509,6 +444,86 @@ impl ShellRenderer {
         ctx.queue.submit([encoder.finish()]);
         Ok(())
     }
+}
+
+/// The three draws of a shell frame.
+#[derive(Clone, Copy, PartialEq)]
+enum PassKind {
+    /// The skin, with depth write.
+    Skin,
+    /// The instanced layers, blended in order.
+    Layers,
+    /// The fins on the edges seen edge-on.
+    Fins,
+}
+
+/// The render pipeline of one draw, specialised by `features` (override
+/// constants) for `formats`.
+fn shell_pipeline(
+    device: &wgpu::Device,
+    kind: PassKind,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    formats: ShellTargetFormats,
+    features: ShellFeatures,
+) -> wgpu::RenderPipeline {
+    let constants = [
+        ("CURL", f64::from(u8::from(features.curl))),
+        ("CLUMP", f64::from(u8::from(features.clump))),
+    ];
+    let vertex_buffers = [
+        Some(PoseVertex::layout(wgpu::VertexStepMode::Vertex)),
+        Some(SurfaceVertex::layout(wgpu::VertexStepMode::Vertex)),
+        Some(TipOffset::layout(wgpu::VertexStepMode::Vertex)),
+    ];
+    let compilation_options = wgpu::PipelineCompilationOptions {
+        constants: &constants,
+        ..Default::default()
+    };
+    let (label, vs, fs, buffers): (_, _, _, &[_]) = match kind {
+        PassKind::Skin => ("shell skin", "vs_skin", "fs_skin", &vertex_buffers),
+        PassKind::Layers => ("shell layers", "vs_layer", "fs_layer", &vertex_buffers),
+        PassKind::Fins => ("shell fins", "vs_fin", "fs_fin", &[]),
+    };
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(vs),
+            compilation_options: compilation_options.clone(),
+            buffers,
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: (features.cull_back && kind != PassKind::Fins).then_some(wgpu::Face::Back),
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: formats.depth,
+            depth_write_enabled: Some(kind == PassKind::Skin),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState {
+            count: formats.samples,
+            mask: !0,
+            alpha_to_coverage_enabled: false,
+        },
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fs),
+            compilation_options,
+            targets: &[Some(wgpu::ColorTargetState {
+                format: formats.color,
+                blend: (kind != PassKind::Skin).then_some(wgpu::BlendState::ALPHA_BLENDING),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// Colour, depth and resolve targets of one size, reused frame to frame.
