@@ -431,6 +431,28 @@ impl<W: Write + Seek> AbcWriter<W> {
                 normals,
             ));
         }
+        let arbitrary = self.arbitrary_params(curves, guide)?;
+        if !arbitrary.is_empty() {
+            properties.push(Property::compound(".arbGeomParams", "", arbitrary));
+        }
+        self.parts.push(Part {
+            name: name.to_string(),
+            object: CURVES_OBJECT,
+            geom: Property::compound(".geom", CURVES_GEOM, properties),
+            offsets: curves.offsets().to_vec(),
+            times: time.into_iter().collect(),
+        });
+        Ok(())
+    }
+
+    /// A part's `.arbGeomParams`: colours, opacities, ids, regions (Unreal's
+    /// groom groups), the guide flag, root UVs and the hair-shading values,
+    /// each where the curves have it.
+    fn arbitrary_params(
+        &mut self,
+        curves: &Curves,
+        guide: bool,
+    ) -> Result<Vec<Property>, PrimWriteError> {
         let mut arbitrary = Vec::new();
         if let Some(colors) = curves.colors() {
             let sample = self.array_sample(bytemuck::cast_slice(colors), colors.len())?;
@@ -551,17 +573,7 @@ impl<W: Write + Seek> AbcWriter<W> {
                 vec![sample],
             ));
         }
-        if !arbitrary.is_empty() {
-            properties.push(Property::compound(".arbGeomParams", "", arbitrary));
-        }
-        self.parts.push(Part {
-            name: name.to_string(),
-            object: CURVES_OBJECT,
-            geom: Property::compound(".geom", CURVES_GEOM, properties),
-            offsets: curves.offsets().to_vec(),
-            times: time.into_iter().collect(),
-        });
-        Ok(())
+        Ok(arbitrary)
     }
 
     /// Writes the skin as an `IPolyMesh` object named `name`: positions,
