@@ -779,6 +779,7 @@ fn read_curves_object(
 ) -> Result<(Curves, bool), CurvesReadError> {
     let what = |p: &str| format!("{path}/.geom/{p}");
     let mut guide = false;
+    let at_child = geom;
     let fail = |message: String| file.fail(geom, message);
     let geom = Compound::read(file, geom, indexed, &what(""))?;
     let property = |name: &str, pod: &[u8], extent: u8| -> Result<Option<&[u8]>, CurvesReadError> {
@@ -910,91 +911,109 @@ fn read_curves_object(
     }
     if let Some(arbitrary) = geom.get(".arbGeomParams").filter(|p| p.0.kind == 0) {
         let arb = Compound::read(file, arbitrary.1, indexed, &what(".arbGeomParams"))?;
-        let sample =
-            |name: &str, pods: &[u8], extent: u8| -> Result<Option<(u8, &[u8])>, CurvesReadError> {
-                match arb.get(name) {
-                    Some(p) if p.0.kind != 0 && pods.contains(&p.0.pod) && p.0.extent == extent => {
-                        Ok(Some((p.0.pod, first_sample(file, p, &what(name))?)))
-                    }
-                    _ => Ok(None),
-                }
-            };
-        if let Some((_, b)) = sample("groom_color", &[10], 3)?.filter(|(_, b)| b.len() == n * 12) {
-            let colors = floats(b)
-                .collect::<Vec<_>>()
-                .chunks_exact(3)
-                .map(Vec3::from_slice)
-                .collect();
-            curves = curves
-                .with_colors(colors)
-                .map_err(|e| fail(format!("{path}: {e}")))?;
-        }
-        if let Some((_, b)) = sample("groom_opacity", &[10], 1)?.filter(|(_, b)| b.len() == n * 4) {
-            curves = curves
-                .with_opacities(floats(b).collect())
-                .map_err(|e| fail(format!("{path}: {e}")))?;
-        }
         guide = arb.get("groom_guide").is_some();
-        let curve_count = curves.curve_count();
-        if let Some((_, b)) =
-            sample("groom_group_id", &[6], 1)?.filter(|(_, b)| b.len() == curve_count * 4)
-        {
-            let regions: Option<Vec<u32>> = b
-                .chunks_exact(4)
-                .map(|c| u32::try_from(i32::from_le_bytes(c.try_into().expect("4"))).ok())
-                .collect();
-            if let Some(regions) = regions {
-                curves = curves
-                    .with_regions(regions)
-                    .map_err(|e| fail(format!("{path}: {e}")))?;
+        curves = with_arbitrary_params(file, at_child, &arb, path, curves)?;
+    }
+    Ok((curves, guide))
+}
+
+/// The curves with the `.arbGeomParams` pelage writes, where they have
+/// the type and length it writes: colours, opacities, Unreal's groom
+/// groups as regions, ids, root UVs and the hair-shading values (all six,
+/// or none). Errors are the curves' refusals, at `geom`.
+fn with_arbitrary_params(
+    file: &Ogawa,
+    geom: Child,
+    arb: &Compound,
+    path: &str,
+    mut curves: Curves,
+) -> Result<Curves, CurvesReadError> {
+    let what = |p: &str| format!("{path}/.geom/{p}");
+    let fail = |message: String| file.fail(geom, message);
+    let n = curves.points().len();
+    let sample =
+        |name: &str, pods: &[u8], extent: u8| -> Result<Option<(u8, &[u8])>, CurvesReadError> {
+            match arb.get(name) {
+                Some(p) if p.0.kind != 0 && pods.contains(&p.0.pod) && p.0.extent == extent => {
+                    Ok(Some((p.0.pod, first_sample(file, p, &what(name))?)))
+                }
+                _ => Ok(None),
             }
-        }
-        if let Some((pod, b)) = sample("groom_id", &[6, 8], 1)? {
-            let ids: Option<Vec<u64>> = if pod == 6 {
-                b.chunks_exact(4)
-                    .map(|c| u64::try_from(i32::from_le_bytes(c.try_into().expect("4"))).ok())
-                    .collect()
-            } else {
-                b.chunks_exact(8)
-                    .map(|c| u64::try_from(i64::from_le_bytes(c.try_into().expect("8"))).ok())
-                    .collect()
-            };
-            if let Some(ids) = ids.filter(|ids| ids.len() == curve_count) {
-                curves = curves
-                    .with_ids(ids)
-                    .map_err(|e| fail(format!("{path}: {e}")))?;
-            }
-        }
-        if let Some((_, b)) =
-            sample("groom_root_uv", &[10], 2)?.filter(|(_, b)| b.len() == curve_count * 8)
-        {
-            let uvs = floats(b)
-                .collect::<Vec<_>>()
-                .chunks_exact(2)
-                .map(Vec2::from_slice)
-                .collect();
-            curves = curves
-                .with_root_uvs(uvs)
-                .map_err(|e| fail(format!("{path}: {e}")))?;
-        }
-        // Hair-shading values where all six are there, as pelage writes
-        // them.
-        let per_curve = |name: &str, extent: u8| -> Result<Option<Vec<f32>>, CurvesReadError> {
-            Ok(sample(name, &[10], extent)?
-                .filter(|(_, b)| b.len() == curve_count * 4 * extent as usize)
-                .map(|(_, b)| floats(b).collect()))
         };
-        let mut found: [Option<Vec<f32>>; 5] = Default::default();
-        for (slot, name) in found.iter_mut().zip(HairShading::FLOAT_NAMES) {
-            *slot = per_curve(name, 1)?;
-        }
-        let tint = per_curve(HairShading::TINT, 3)?
-            .map(|t| t.chunks_exact(3).map(Vec3::from_slice).collect());
-        if let Some(shading) = HairShading::from_found(found, tint) {
+    if let Some((_, b)) = sample("groom_color", &[10], 3)?.filter(|(_, b)| b.len() == n * 12) {
+        let colors = floats(b)
+            .collect::<Vec<_>>()
+            .chunks_exact(3)
+            .map(Vec3::from_slice)
+            .collect();
+        curves = curves
+            .with_colors(colors)
+            .map_err(|e| fail(format!("{path}: {e}")))?;
+    }
+    if let Some((_, b)) = sample("groom_opacity", &[10], 1)?.filter(|(_, b)| b.len() == n * 4) {
+        curves = curves
+            .with_opacities(floats(b).collect())
+            .map_err(|e| fail(format!("{path}: {e}")))?;
+    }
+    let curve_count = curves.curve_count();
+    if let Some((_, b)) =
+        sample("groom_group_id", &[6], 1)?.filter(|(_, b)| b.len() == curve_count * 4)
+    {
+        let regions: Option<Vec<u32>> = b
+            .chunks_exact(4)
+            .map(|c| u32::try_from(i32::from_le_bytes(c.try_into().expect("4"))).ok())
+            .collect();
+        if let Some(regions) = regions {
             curves = curves
-                .with_shading(shading)
+                .with_regions(regions)
                 .map_err(|e| fail(format!("{path}: {e}")))?;
         }
     }
-    Ok((curves, guide))
+    if let Some((pod, b)) = sample("groom_id", &[6, 8], 1)? {
+        let ids: Option<Vec<u64>> = if pod == 6 {
+            b.chunks_exact(4)
+                .map(|c| u64::try_from(i32::from_le_bytes(c.try_into().expect("4"))).ok())
+                .collect()
+        } else {
+            b.chunks_exact(8)
+                .map(|c| u64::try_from(i64::from_le_bytes(c.try_into().expect("8"))).ok())
+                .collect()
+        };
+        if let Some(ids) = ids.filter(|ids| ids.len() == curve_count) {
+            curves = curves
+                .with_ids(ids)
+                .map_err(|e| fail(format!("{path}: {e}")))?;
+        }
+    }
+    if let Some((_, b)) =
+        sample("groom_root_uv", &[10], 2)?.filter(|(_, b)| b.len() == curve_count * 8)
+    {
+        let uvs = floats(b)
+            .collect::<Vec<_>>()
+            .chunks_exact(2)
+            .map(Vec2::from_slice)
+            .collect();
+        curves = curves
+            .with_root_uvs(uvs)
+            .map_err(|e| fail(format!("{path}: {e}")))?;
+    }
+    // Hair-shading values where all six are there, as pelage writes
+    // them.
+    let per_curve = |name: &str, extent: u8| -> Result<Option<Vec<f32>>, CurvesReadError> {
+        Ok(sample(name, &[10], extent)?
+            .filter(|(_, b)| b.len() == curve_count * 4 * extent as usize)
+            .map(|(_, b)| floats(b).collect()))
+    };
+    let mut found: [Option<Vec<f32>>; 5] = Default::default();
+    for (slot, name) in found.iter_mut().zip(HairShading::FLOAT_NAMES) {
+        *slot = per_curve(name, 1)?;
+    }
+    let tint =
+        per_curve(HairShading::TINT, 3)?.map(|t| t.chunks_exact(3).map(Vec3::from_slice).collect());
+    if let Some(shading) = HairShading::from_found(found, tint) {
+        curves = curves
+            .with_shading(shading)
+            .map_err(|e| fail(format!("{path}: {e}")))?;
+    }
+    Ok(curves)
 }
