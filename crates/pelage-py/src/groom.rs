@@ -12,7 +12,7 @@ use crate::mesh::PyMesh;
 use crate::to_py_err;
 use pelage::groom::{
     AnimatedGroom, AnimatedPlanError, Assembly, FarmRun, Generator, Groom, GroomError, GroomInputs,
-    GroomReport, GroomWriteError, ReportBuilder, Timings,
+    GroomReport, GroomWriteError, PreflightError, ReportBuilder, Timings,
 };
 use pelage::settings::SettingsSource;
 use pyo3::exceptions::{PyIndexError, PyMemoryError, PyTypeError, PyValueError};
@@ -550,7 +550,6 @@ impl PyGroom {
                 .map_err(|e| self.error(e))?
                 .map(Arc::new),
         };
-        let farm = || self.groom.run_output(&output, run).map_err(part_error);
         let (summary, written, grown) = if let Some(animated) = animated {
             // The library's plan: a farm run's file is named by its frames,
             // as the CLI names it and `assemble` finds it.
@@ -577,8 +576,13 @@ impl PyGroom {
             });
             (summary, path, None)
         } else {
+            // The CLI's pre-flight: a format pelage writes, a path it may
+            // write, room for the run, all before preparing anything.
+            let (range, path) = self.groom.preflight(&output, run).map_err(|e| match e {
+                PreflightError::Farm(e) => part_error(e),
+                e => to_py_err(e),
+            })?;
             let generator = self.generator(py, seed)?;
-            let (range, path) = farm()?;
             create_folder(&path)?;
             let export = self.groom.export_for(&generator, run);
             let total = range.len();

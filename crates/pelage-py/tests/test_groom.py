@@ -140,6 +140,19 @@ def test_an_animated_farms_runs_are_named_by_their_frames_and_assemble(tmp_path)
     assert all(p.name in layer for p in written), "the stitching layer names both runs' files"
 
 
+def test_write_refuses_what_the_cli_refuses_before_growing(groom, tmp_path):
+    # The library's pre-flight, the same as `pelage groom`'s: a format
+    # pelage writes and a path it may write, before any hair grows.
+    grown = []
+    with pytest.raises(pelage.PelageError, match=r"fur\.xyz: unknown curves format"):
+        groom.write(tmp_path / "fur.xyz", progress=lambda done, total: grown.append(done))
+    folder = tmp_path / "fur.usdc"
+    folder.mkdir()
+    with pytest.raises(pelage.PelageError, match="it is a folder"):
+        groom.write(folder, progress=lambda done, total: grown.append(done))
+    assert grown == [], "refused before growing"
+
+
 def test_farm_runs_write_part_files(groom, tmp_path):
     out = tmp_path / "fur.usda"
     written = [groom.write(out, part=(k, 2))["path"] for k in (1, 2)]

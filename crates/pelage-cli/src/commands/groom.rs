@@ -8,9 +8,9 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use pelage::anim::FrameRange;
 use pelage::groom::{
-    AnimatedGroom, AnimatedPlanError, Assembly, FarmRun, Groom, ReportBuilder, Timings,
+    AnimatedGroom, AnimatedPlanError, Assembly, FarmRun, Groom, PreflightError, ReportBuilder,
+    Timings,
 };
-use pelage::io::CurvesFormat;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -108,21 +108,12 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     // pelage cannot write, or a disk too small for it, before preparing
     // anything (preparing a billion hairs' roots takes seconds).
     let parts = groom.part_count();
-    let (range, path) = groom
-        .run_output(&output, args.part)
-        .with_context(|| format!("--part: {}", args.file.display()))?;
-    if CurvesFormat::from_path(&path).is_none() {
-        bail!("{}: {}", path.display(), CurvesFormat::UNKNOWN_FOR_WRITING);
-    }
-    pelage::io::check_output(&path)?;
-    let count = groom.grown_count();
-    let share = count as u128 * range.len() as u128 / parts.max(1) as u128;
-    // Positions alone (12 bytes a point) are a floor of any format's size.
-    let points = groom.points_per_hair() as u64;
-    pelage::io::check_free_space(
-        &path,
-        (share as u64).saturating_mul(points).saturating_mul(12),
-    )?;
+    let (range, path) = groom.preflight(&output, args.part).map_err(|e| match e {
+        PreflightError::Farm(_) => {
+            anyhow::Error::new(e).context(format!("--part: {}", args.file.display()))
+        }
+        e => anyhow::Error::new(e),
+    })?;
     let generator = groom.generator(args.seed)?;
     let prepared = start.elapsed();
     let lost = generator.lost_guides();

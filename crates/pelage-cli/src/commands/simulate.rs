@@ -45,14 +45,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     // Refused before the simulation, not after it.
     if let Some(output) = &args.output
-        && !matches!(
-            CurvesFormat::from_path(output),
-            Some(CurvesFormat::Usdc | CurvesFormat::Abc)
-        )
+        && !CurvesFormat::from_path(output).is_some_and(CurvesFormat::writes_time_samples)
     {
         bail!(
-            "{}: simulated guides are written with time samples to .usdc, .usd or .abc",
-            output.display()
+            "{}: simulated guides are {}",
+            output.display(),
+            CurvesFormat::NO_TIME_SAMPLES
         );
     }
     let (guides, cache) = groom.simulated_guides()?;

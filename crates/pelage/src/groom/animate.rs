@@ -839,13 +839,14 @@ impl AnimatedGroom {
         let mut layers = Vec::with_capacity(outputs.len());
         for output in outputs {
             let format = match CurvesFormat::from_path(&output.path) {
-                Some(f @ (CurvesFormat::Usdc | CurvesFormat::Abc)) => f,
+                Some(f) if f.writes_time_samples() => f,
                 _ => {
                     return Err(GroomWriteError::Groom(self.spec.error(
                         "output.path",
                         GroomErrorKind::Invalid(format!(
-                            "{}: animated grooms are written with time samples to .usdc, .usd or .abc",
-                            output.path.display()
+                            "{}: animated grooms are {}",
+                            output.path.display(),
+                            CurvesFormat::NO_TIME_SAMPLES
                         )),
                     )));
                 }

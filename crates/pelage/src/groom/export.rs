@@ -79,6 +79,33 @@ impl Groom {
         }
     }
 
+    /// Pre-flight of a still groom's run, before anything is prepared
+    /// (preparing a billion hairs' roots takes seconds): the parts `run`
+    /// grows and its file beside `output`, refused when pelage cannot
+    /// write that format or that path (a folder, an input), or when the
+    /// disk cannot hold the run's positions alone (12 bytes a point, a
+    /// floor of any format's size).
+    pub fn preflight(
+        &self,
+        output: &Path,
+        run: Option<FarmRun>,
+    ) -> Result<(std::ops::Range<usize>, PathBuf), PreflightError> {
+        let (range, path) = self.run_output(output, run).map_err(PreflightError::Farm)?;
+        if CurvesFormat::from_path(&path).is_none() {
+            return Err(PreflightError::UnknownFormat(path));
+        }
+        crate::io::check_output(&path).map_err(PreflightError::Output)?;
+        let parts = self.part_count().max(1) as u128;
+        let share = self.grown_count() as u128 * range.len() as u128 / parts;
+        let points = self.points_per_hair() as u64;
+        crate::io::check_free_space(
+            &path,
+            (share as u64).saturating_mul(points).saturating_mul(12),
+        )
+        .map_err(PreflightError::Output)?;
+        Ok((range, path))
+    }
+
     /// Where a run of the animated groom `animated` writes, beside
     /// `output`: the parts it grows and its files, each with its time
     /// codes. One run writes `output` with every frame; run `K/N` of a
@@ -250,6 +277,21 @@ impl AnimatedPlan {
             _ => Ok(()),
         }
     }
+}
+
+/// Why a still groom's run is refused before it grows ([`Groom::preflight`]).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PreflightError {
+    /// The farm run does not fit the groom's parts.
+    #[error("{0}")]
+    Farm(FarmError),
+    /// The output's extension names no format pelage writes.
+    #[error("{}: {}", .0.display(), CurvesFormat::UNKNOWN_FOR_WRITING)]
+    UnknownFormat(PathBuf),
+    /// The output cannot be written there, or the disk cannot hold it.
+    #[error("{0}")]
+    Output(WriteError),
 }
 
 /// Why an animated groom's run cannot be planned.

@@ -77,7 +77,8 @@ pub use animate::{
 pub use clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
 pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
 pub use export::{
-    AnimatedPlan, AnimatedPlanError, AssembleError, Assembly, DEFAULT_FPS, Stitching,
+    AnimatedPlan, AnimatedPlanError, AssembleError, Assembly, DEFAULT_FPS, PreflightError,
+    Stitching,
 };
 pub use farm::{FarmError, FarmRun, find_part_files};
 pub use generator::{Generator, GroomSummary};

@@ -116,9 +116,10 @@ impl SimulatedGuides {
                 abc.finish().map_err(failed)?
             }
             _ => {
-                return Err(failed(crate::io::PrimWriteError::BadSetting(
-                    "simulated guides are written with time samples to .usdc, .usd or .abc".into(),
-                )));
+                return Err(failed(crate::io::PrimWriteError::BadSetting(format!(
+                    "simulated guides are {}",
+                    CurvesFormat::NO_TIME_SAMPLES
+                ))));
             }
         };
         file.commit()?;

@@ -38,6 +38,18 @@ impl CurvesFormat {
     /// writes (every front end says the same).
     pub const UNKNOWN_FOR_WRITING: &'static str = "unknown curves format; pelage writes .usdc (or .usd), .usda, .abc, .hair, .ply, .rib and .pbrt";
 
+    /// What to say of an output that must hold time samples (an animated
+    /// groom, simulated guides) and cannot.
+    pub const NO_TIME_SAMPLES: &'static str = "written with time samples to .usdc, .usd or .abc";
+
+    /// Whether pelage writes time samples in this format (an animated
+    /// groom, simulated guides): binary USD and Alembic. Text USD could
+    /// hold them, but a groom's frames in text would be too large to
+    /// read back.
+    pub fn writes_time_samples(self) -> bool {
+        matches!(self, Self::Usdc | Self::Abc)
+    }
+
     /// The extension files of this format are written with.
     pub fn extension(self) -> &'static str {
         match self {
