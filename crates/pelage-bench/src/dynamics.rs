@@ -111,9 +111,6 @@ const SOLVERS: [Solver; 2] = [
 
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
-    if args.strands {
-        return super::strands::run(args);
-    }
     let gpu = if args.no_gpu {
         None
     } else {

@@ -293,9 +293,6 @@ pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
     if let Some(hairs) = args.rss_child {
         return rss_child(hairs);
     }
-    if args.edit {
-        return super::groom_edit::run(args);
-    }
     let figures = measure(args)?;
     if args.json {
         println!("{}", figures.to_json());

@@ -84,8 +84,12 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Render(a) => render::run(a),
         BenchWhat::Io(a) => io::run(a),
         BenchWhat::Interp(a) => interp::run(a),
+        // `--edit` and `--strands` are benchmarks of their own, under the
+        // arguments of the one they extend.
+        BenchWhat::Groom(a) if a.edit && a.rss_child.is_none() => groom_edit::run(a),
         BenchWhat::Groom(a) => groom::run(a),
         BenchWhat::Shells(a) => shells::run(a),
+        BenchWhat::Dynamics(a) if a.strands => strands::run(a),
         BenchWhat::Dynamics(a) => dynamics::run(a),
         BenchWhat::Animation(a) => animation::run(a),
         BenchWhat::Python(a) => python::run(a),

@@ -608,35 +608,23 @@ impl SystemBuffers {
     ) -> wgpu::BindGroup {
         let (tips_in, velocities_in) = &self.state[k];
         let (tips_out, velocities_out) = &self.state[1 - k];
-        let buffers = [
-            &self.roots,
-            &self.normals,
-            &self.root_velocities,
-            &self.spring_offsets,
-            &self.spring_ends,
-            &self.permutation,
-            tips_in,
-            velocities_in,
-            tips_out,
-            velocities_out,
-        ];
-        let mut entries = vec![wgpu::BindGroupEntry {
-            binding: 0,
-            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        let entries = group::sequential([
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                 buffer: &self.uniforms,
                 offset: 0,
                 size: wgpu::BufferSize::new(std::mem::size_of::<StepUniform>() as u64),
             }),
-        }];
-        entries.extend(
-            buffers
-                .iter()
-                .enumerate()
-                .map(|(b, buffer)| wgpu::BindGroupEntry {
-                    binding: b as u32 + 1,
-                    resource: buffer.as_entire_binding(),
-                }),
-        );
+            self.roots.as_entire_binding(),
+            self.normals.as_entire_binding(),
+            self.root_velocities.as_entire_binding(),
+            self.spring_offsets.as_entire_binding(),
+            self.spring_ends.as_entire_binding(),
+            self.permutation.as_entire_binding(),
+            tips_in.as_entire_binding(),
+            velocities_in.as_entire_binding(),
+            tips_out.as_entire_binding(),
+            velocities_out.as_entire_binding(),
+        ]);
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("dynamics"),
             layout,

@@ -535,23 +535,16 @@ impl Renderer {
         };
         let frame_offset = self.frame.write(&ctx.queue, &uniforms);
 
-        let target_texture =
-            |samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("preview target"),
-                    size: wgpu::Extent3d {
-                        width,
-                        height,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: samples,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-            };
+        let target_texture = |samples, format, usage| {
+            target_texture(
+                device,
+                "preview target",
+                (width, height),
+                samples,
+                format,
+                usage,
+            )
+        };
         let multisampled =
             target_texture(SAMPLES, self.format, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let depth = target_texture(
@@ -611,6 +604,32 @@ impl Renderer {
         }
         Ok(())
     }
+}
+
+/// A 2-D texture of `size` to draw into (a colour or depth attachment,
+/// multisampled with `samples`, or the resolved image).
+pub(crate) fn target_texture(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height): (u32, u32),
+    samples: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
 }
 
 pub(crate) fn check_size(ctx: &GpuContext, width: u32, height: u32) -> Result<(), GpuError> {

@@ -6,7 +6,7 @@
 //! [`ShellRenderer::render`] into pelage's own [`ShellTarget`].
 
 use crate::layout::{UniformRing, compute_pipeline, entry};
-use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES, check_size};
+use crate::renderer::{COLOR_FORMAT, DEPTH_FORMAT, SAMPLES, check_size, target_texture};
 use crate::{GpuContext, GpuError};
 use glam::Mat4;
 
@@ -544,21 +544,15 @@ impl ShellTarget {
         height: u32,
     ) -> Result<Self, GpuError> {
         check_size(ctx, width, height)?;
-        let texture = |samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
-            ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("shell target"),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: samples,
-                dimension: wgpu::TextureDimension::D2,
+        let texture = |samples, format, usage| {
+            target_texture(
+                &ctx.device,
+                "shell target",
+                (width, height),
+                samples,
                 format,
                 usage,
-                view_formats: &[],
-            })
+            )
         };
         let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let formats = renderer.formats;

@@ -522,8 +522,9 @@ macro_rules! operators {
             /// and counts are checked; a map read from an image or noise is
             /// not a number to check.
             pub(crate) fn out_of_range(&self) -> Option<(&'static str, String)> {
-                let rules: &[Rule] = match self.unmasked() {
-                    GroomOp::Masked(..) => &[],
+                let rules: &[Rule] = match self {
+                    // The mask is a map without a range: the operator's own.
+                    GroomOp::Masked(op, _) => return op.out_of_range(),
                     $( GroomOp::$Variant(_) => <$Op as OperatorKind>::RULES, )*
                 };
                 let constants = self.maps().into_iter().filter_map(|(field, map)| match map {
