@@ -29,6 +29,10 @@ pub struct AnimationBenchArgs {
     /// A reduced run (200,000 hairs).
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -38,6 +42,13 @@ pub struct AnimationBenchArgs {
     /// in a cached venv by tools/bpy-python).
     #[arg(long, value_enum)]
     pub peer: Option<super::groom::Peer>,
+}
+
+impl AnimationBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
 }
 
 /// Blender's per-frame deform, measured by Blender itself in this run.
@@ -156,11 +167,9 @@ pub fn run(args: &AnimationBenchArgs) -> anyhow::Result<()> {
 /// the twisted skin, beside growing from scratch (and Blender with
 /// `--peer blender`).
 fn measure(args: &AnimationBenchArgs) -> anyhow::Result<AnimationFigures> {
-    let (hairs, runs) = if args.quick {
-        (200_000u64, 3)
-    } else {
-        (1_600_000, 5)
-    };
+    let (hairs, runs) = args
+        .scale()
+        .pick((1_600_000u64, 5), (200_000, 3), (5_000, 1));
     let threads = rayon::current_num_threads();
     let groom = Groom::from_text("<bench>", groom_text(hairs, "shepard"))?;
     let spec = groom.spec()?;

@@ -23,18 +23,25 @@ pub struct BlenderBenchArgs {
     /// A reduced run (20,000 hairs, 10 edits).
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
 }
 
+impl BlenderBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
+}
+
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &BlenderBenchArgs) -> anyhow::Result<()> {
-    let (hairs, edits) = if args.quick {
-        (20_000, 10)
-    } else {
-        (100_000, 20)
-    };
+    let (hairs, edits) = args.scale().pick((100_000, 20), (20_000, 10), (2_000, 2));
     let report = super::run_bpy_case("blender_live.py", include_str!("blender_live.py"), |dir| {
         let case = serde_json::json!({
             "addon_dir": super::addon_dir()?,

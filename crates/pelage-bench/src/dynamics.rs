@@ -28,6 +28,10 @@ pub struct DynamicsBenchArgs {
     /// A reduced run: spot only.
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -53,6 +57,13 @@ pub struct DynamicsBenchArgs {
     /// bpy from PyPI in a cached venv, tools/bpy-python).
     #[arg(long, value_enum, requires = "strands")]
     pub peer: Option<super::groom::Peer>,
+}
+
+impl DynamicsBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
 }
 
 struct Row {
@@ -136,7 +147,8 @@ pub fn run(args: &DynamicsBenchArgs) -> anyhow::Result<()> {
 fn measure(args: &DynamicsBenchArgs, gpu: Option<&GpuContext>) -> anyhow::Result<Vec<Row>> {
     let spot = pelage::assets::spot();
     let mut meshes: Vec<(String, Mesh)> = vec![("spot".into(), spot.subdivided(0))];
-    if !args.quick {
+    let steps = if args.smoke { 1 } else { args.steps };
+    if !args.scale().reduced() {
         let blub = super::test_meshes().join("blub_triangulated.obj");
         if let Ok(mesh) = Mesh::load(&blub) {
             meshes.push(("blub".into(), mesh));
@@ -162,14 +174,14 @@ fn measure(args: &DynamicsBenchArgs, gpu: Option<&GpuContext>) -> anyhow::Result
                     if matches!(solver, Solver::Implicit { .. }) && at_rest.joins_tips() {
                         continue;
                     }
-                    gpu_ms[k] = Some(gpu_step_ms(ctx, &at_rest, &params, dt, solver, args.steps)?);
+                    gpu_ms[k] = Some(gpu_step_ms(ctx, &at_rest, &params, dt, solver, steps)?);
                 }
             }
             let mut ms = [0.0; 2];
             for (k, solver) in SOLVERS.into_iter().enumerate() {
                 let mut system = at_rest.clone();
                 let mut step = 0;
-                let (seconds, ()) = median_seconds(args.steps.max(1), true, || {
+                let (seconds, ()) = median_seconds(steps.max(1), true, || {
                     system.step(dt, &params, solver, step as f32 * dt);
                     step += 1;
                 });

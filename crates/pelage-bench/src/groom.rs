@@ -19,6 +19,10 @@ pub struct GroomBenchArgs {
     /// A reduced run (200,000 hairs; 1 M for the memory figure).
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -36,6 +40,13 @@ pub struct GroomBenchArgs {
     /// Internal: stream this many hairs to USD and print the peak RSS.
     #[arg(long, hide = true)]
     pub rss_child: Option<u64>,
+}
+
+impl GroomBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
 }
 
 /// A program measured beside pelage.
@@ -305,11 +316,11 @@ pub fn run(args: &GroomBenchArgs) -> anyhow::Result<()> {
 /// Grows the benchmark's grooms (and Blender's case with `--peer
 /// blender`) and measures the memory of a large one in a child process.
 fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
-    let (hairs, rss_hairs, runs) = if args.quick {
-        (200_000u64, 1_000_000u64, 3)
-    } else {
-        (1_600_000, 10_000_000, 3)
-    };
+    let (hairs, rss_hairs, runs) = args.scale().pick(
+        (1_600_000u64, 10_000_000u64, 3),
+        (200_000, 1_000_000, 3),
+        (5_000, 20_000, 1),
+    );
     let threads = rayon::current_num_threads();
     let shepard = Groom::from_text("<bench>", groom_text(hairs, "shepard"))?;
     let style = Groom::from_text("<bench>", groom_text(hairs, "style-mesh"))?;
@@ -317,7 +328,7 @@ fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
     let (prep_s, _) = median_seconds(runs, false, || shepard.generator(None).map(|_| ()));
     let (shepard_s, counted) = median_seconds(runs, true, || grow_all(&shepard));
     let (hair_count, point_count) = counted?;
-    let blender_hairs = if args.quick { 200_000 } else { 1_000_000 };
+    let blender_hairs = args.scale().pick(1_000_000, 200_000, 5_000);
     let blender = Groom::from_text("<bench>", blender_case_text(blender_hairs))?;
     let (blender_s, blender_counted) = median_seconds(runs, false, || grow_all(&blender));
     blender_counted?;

@@ -111,11 +111,11 @@ fn comb(groom: &mut EditableGroom, dabs: &[Dab]) -> anyhow::Result<(f64, usize, 
 }
 
 fn measure(args: &GroomBenchArgs) -> anyhow::Result<EditFigures> {
-    let (hairs, peer_hairs, runs, dab_count) = if args.quick {
-        (200_000u64, 200_000u64, 3, 7)
-    } else {
-        (1_600_000, 1_000_000, 3, 9)
-    };
+    let (hairs, peer_hairs, runs, dab_count) = args.scale().pick(
+        (1_600_000u64, 1_000_000u64, 3, 9),
+        (200_000, 200_000, 3, 7),
+        (5_000, 5_000, 1, 3),
+    );
     let groom = Groom::from_text("<bench>", groom_text(hairs, "shepard"))?;
     eprintln!("growing {} hairs to groom…", thousands(hairs));
     let start = Instant::now();

@@ -26,9 +26,20 @@ pub struct InterpBenchArgs {
     /// A reduced run (spot ×2, 1,000 guides, 100,000 hairs).
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+impl InterpBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
 }
 
 fn ns_per_hair(method: &dyn GuideWeights, roots: &[HairRoot], runs: usize) -> f64 {
@@ -47,11 +58,11 @@ fn ns_per_hair(method: &dyn GuideWeights, roots: &[HairRoot], runs: usize) -> f6
 
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &InterpBenchArgs) -> anyhow::Result<()> {
-    let (levels, guide_count, hair_count, runs) = if args.quick {
-        (2, 1_000, 100_000u64, 3)
-    } else {
-        (4, 5_000, 1_000_000, 5)
-    };
+    let (levels, guide_count, hair_count, runs) = args.scale().pick(
+        (4, 5_000, 1_000_000u64, 5),
+        (2, 1_000, 100_000, 3),
+        (0, 100, 2_000, 1),
+    );
     let mesh = pelage::assets::spot().subdivided(levels);
     let guides = Guides::grow(
         &mesh,

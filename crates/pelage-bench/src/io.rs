@@ -31,6 +31,10 @@ pub struct IoBenchArgs {
     /// A reduced run (200,000 hairs only).
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -50,6 +54,13 @@ pub struct IoBenchArgs {
     /// the demo groom and usd-core's usdc of the same layer.
     #[arg(long, value_enum)]
     pub peer: Option<super::groom::Peer>,
+}
+
+impl IoBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
 }
 
 /// The formats measured, in the order of the table.
@@ -262,11 +273,9 @@ fn blender_imports() -> anyhow::Result<BlenderImports> {
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &IoBenchArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
-    let sizes: Vec<u64> = if args.quick {
-        vec![200_000]
-    } else {
-        vec![200_000, args.hairs]
-    };
+    let sizes: Vec<u64> = args
+        .scale()
+        .pick(vec![200_000, args.hairs], vec![200_000], vec![5_000]);
     let mut runs = Vec::new();
     for format in FORMATS {
         for &hairs in &sizes {

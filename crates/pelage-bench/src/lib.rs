@@ -77,6 +77,51 @@ pub fn tools_dir() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools")
 }
 
+/// How big a run is: the full figures, `--quick` (a reduced run whose
+/// figures still mean something), or `--smoke` (the smallest run that
+/// goes through every row and prints every key; CI runs it in a debug
+/// build to prove each benchmark still works, and its figures mean
+/// nothing).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scale {
+    /// The documented figures.
+    Full,
+    /// `--quick`.
+    Quick,
+    /// `--smoke`.
+    Smoke,
+}
+
+impl Scale {
+    /// The scale the two flags ask for (`--smoke` wins).
+    pub fn of(quick: bool, smoke: bool) -> Self {
+        match (quick, smoke) {
+            (_, true) => Scale::Smoke,
+            (true, false) => Scale::Quick,
+            (false, false) => Scale::Full,
+        }
+    }
+
+    /// One of three values, by scale.
+    pub fn pick<T>(self, full: T, quick: T, smoke: T) -> T {
+        match self {
+            Scale::Full => full,
+            Scale::Quick => quick,
+            Scale::Smoke => smoke,
+        }
+    }
+
+    /// Whether the run is reduced (`--quick` or `--smoke`).
+    pub fn reduced(self) -> bool {
+        self != Scale::Full
+    }
+
+    /// The flag that asks for it, as the report's heading prints it.
+    pub fn flag(self) -> &'static str {
+        self.pick("", " --quick", " --smoke")
+    }
+}
+
 /// Runs the benchmark `args` names.
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     match &args.what {

@@ -26,6 +26,10 @@ pub struct PythonBenchArgs {
     /// A reduced run (200,000 hairs; 100,000 into Blender).
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -38,6 +42,13 @@ pub struct PythonBenchArgs {
     /// in a cached venv by tools/bpy-python).
     #[arg(long)]
     pub blender: bool,
+}
+
+impl PythonBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
 }
 
 /// The interpreter the bench runs `python_grow.py` with.
@@ -158,8 +169,9 @@ fn measure_blender(hairs: u64, dir: &Path) -> anyhow::Result<BlenderCurves> {
 
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &PythonBenchArgs) -> anyhow::Result<()> {
-    let hairs: u64 = if args.quick { 200_000 } else { 1_600_000 };
-    let (rounds, runs): (usize, usize) = if args.quick { (3, 3) } else { (5, 3) };
+    let scale = args.scale();
+    let hairs: u64 = scale.pick(1_600_000, 200_000, 5_000);
+    let (rounds, runs): (usize, usize) = scale.pick((5, 3), (3, 3), (1, 1));
     let dir = std::env::temp_dir().join(format!("pelage-bench-python-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let result = (|| -> anyhow::Result<()> {
@@ -202,7 +214,7 @@ pub fn run(args: &PythonBenchArgs) -> anyhow::Result<()> {
         });
         let blender = match args.blender {
             true => {
-                let hairs = if args.quick { 100_000 } else { 1_000_000 };
+                let hairs = scale.pick(1_000_000, 100_000, 2_000);
                 eprintln!(
                     "making Blender Curves from {} hairs with bpy (tools/bpy-python)…",
                     thousands(hairs)

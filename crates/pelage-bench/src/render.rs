@@ -17,9 +17,20 @@ pub struct RenderBenchArgs {
     /// A reduced run (100 k curves only, 3 frames each).
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+impl RenderBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
 }
 
 /// Runs the benchmark and prints its table (or its JSON).
@@ -27,8 +38,9 @@ pub fn run(args: &RenderBenchArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::headless()?;
     let renderer = Renderer::new(&ctx);
     let spot = pelage::assets::spot();
-    let (width, height) = (1280, 720);
-    let runs = if args.quick { 3 } else { 5 };
+    let scale = args.scale();
+    let (width, height) = scale.pick((1280, 720), (1280, 720), (320, 180));
+    let runs = scale.pick(5, 3, 1);
     let style = PreviewStyle::default();
     let sampler =
         DensitySampler::new(&spot, &Map::Constant(1.0), DensitySamplerOptions::default())?;
@@ -48,7 +60,7 @@ pub fn run(args: &RenderBenchArgs) -> anyhow::Result<()> {
         skin_texture: None,
     };
     let (_, skin_s) = frame(&skin_scene)?;
-    let counts: &[u64] = if args.quick {
+    let counts: &[u64] = if scale.reduced() {
         &[100_000]
     } else {
         &[100_000, 1_000_000]

@@ -28,6 +28,10 @@ pub struct SamplerBenchArgs {
     /// A reduced run that finishes in under 30 s.
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -37,8 +41,21 @@ pub struct SamplerBenchArgs {
     pub meshes: Option<PathBuf>,
 }
 
+impl SamplerBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
+}
+
 struct Plan {
     samples: usize,
+    /// Side of the Perlin density textures (the paper's 1024²).
+    texture: u32,
+    /// Blue-noise samples.
+    blue_noise: u64,
+    /// Density means against rejection sampling.
+    means: Vec<f32>,
     runs: usize,
     resolutions: Vec<u32>,
     grids: Vec<u32>,
@@ -134,7 +151,6 @@ fn mb(bytes: usize) -> String {
 /// What the tables share: the plan, the meshes, the headline's texture,
 /// and the report and JSON each table adds to.
 struct SamplerRun {
-    quick: bool,
     plan: Plan,
     threads: usize,
     blub: Mesh,
@@ -167,23 +183,40 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
 impl SamplerRun {
     /// The plan (`--quick` or full), the meshes, and the report's heading.
     fn new(args: &SamplerBenchArgs) -> anyhow::Result<Self> {
-        let plan = if args.quick {
-            Plan {
-                samples: 2_000_000,
-                runs: 3,
-                resolutions: vec![1024],
-                grids: vec![0, 100],
-                models: vec![("blub ×1", 1)],
-            }
-        } else {
+        let plan = args.scale().pick(
             Plan {
                 samples: 10_000_000,
+                texture: 1024,
+                // Elimination holds every candidate's neighbours: a count
+                // that runs in seconds, not the random rate's ten million.
+                blue_noise: 1_000_000,
+                means: vec![1.0, 0.5, 0.25, 0.1],
                 runs: 5,
                 resolutions: vec![512, 1024, 2048],
                 grids: vec![0, 13, 25, 50, 100, 200, 400],
                 models: vec![("blub ×1", 1), ("spot ×2", 2), ("spot ×4", 4)],
-            }
-        };
+            },
+            Plan {
+                samples: 2_000_000,
+                texture: 1024,
+                blue_noise: 200_000,
+                means: vec![1.0, 0.1],
+                runs: 3,
+                resolutions: vec![1024],
+                grids: vec![0, 100],
+                models: vec![("blub ×1", 1)],
+            },
+            Plan {
+                samples: 20_000,
+                texture: 64,
+                blue_noise: 2_000,
+                means: vec![1.0, 0.1],
+                runs: 1,
+                resolutions: vec![64],
+                grids: vec![0, 100],
+                models: vec![("blub ×1", 1)],
+            },
+        );
         let threads = rayon::current_num_threads();
         let blub_path = args
             .meshes
@@ -200,7 +233,7 @@ impl SamplerRun {
         let _ = writeln!(
             report,
             "pelage bench sampler{} — {threads} threads, {} samples per rate, median of {} runs",
-            if args.quick { " --quick" } else { "" },
+            args.scale().flag(),
             thousands(plan.samples as u64),
             plan.runs
         );
@@ -209,13 +242,13 @@ impl SamplerRun {
             "blub ×1: {} triangles. Paper: one core of a 3.07 GHz PC (2012); bunny 69k triangles.",
             thousands(blub.triangle_count() as u64)
         );
+        let perlin_1024 = perlin_texture(plan.texture, 0.5);
         Ok(Self {
-            quick: args.quick,
             plan,
             threads,
             blub,
             spot,
-            perlin_1024: perlin_texture(1024, 0.5),
+            perlin_1024,
             report,
             json,
         })
@@ -321,9 +354,7 @@ impl SamplerRun {
     /// mesh) against random samples of the same count, mesh and density,
     /// on every thread, with where the blue noise's time goes.
     fn blue_noise(&mut self, sampler: &DensitySampler) {
-        // Elimination holds every candidate's neighbours: a count that
-        // runs in seconds, not the random rate's ten million.
-        let n: u64 = if self.quick { 200_000 } else { 1_000_000 };
+        let n = self.plan.blue_noise;
         let runs = self.plan.runs;
         let (random_s, _) = median_seconds(runs, true, || {
             pelage::sample::sample_range(sampler, 1, 0..n).len()
@@ -727,14 +758,9 @@ impl SamplerRun {
     /// Figs. 8–9: against rejection sampling at several density means.
     fn against_rejection(&mut self) -> anyhow::Result<()> {
         // Figs. 8–9: against rejection sampling at several density means.
-        let means: &[f32] = if self.quick {
-            &[1.0, 0.1]
-        } else {
-            &[1.0, 0.5, 0.25, 0.1]
-        };
         let mut rows = Vec::new();
-        for &mean in means {
-            let map = perlin_texture(1024, mean);
+        for mean in self.plan.means.clone() {
+            let map = perlin_texture(self.plan.texture, mean);
             let (cdf_pre, cdf) = median_seconds(self.plan.runs, false, || {
                 DensitySampler::new(
                     &self.blub,
@@ -750,7 +776,7 @@ impl SamplerRun {
             let rejection = RejectionSampler::new(&self.blub, &map)?;
             let cdf_rate = rate(&cdf, self.plan.samples, self.plan.runs, 1)?;
             let alias_rate = rate(&alias, self.plan.samples, self.plan.runs, 1)?;
-            let rejection_n = (self.plan.samples / 4).max(100_000);
+            let rejection_n = (self.plan.samples / 4).max(self.plan.samples.min(100_000));
             let rejection_rate = rate(&rejection, rejection_n, self.plan.runs, 1)?;
             // Including preprocess, for one million samples (the paper's solid lines).
             let with_pre = |pre: f64, r: f64| 1e6 / (pre + 1e6 / r);

@@ -24,6 +24,10 @@ pub struct ShellsBenchArgs {
     /// 16 layers, 800×600.
     #[arg(long)]
     pub quick: bool,
+    /// The smallest run, through every row and key; its figures mean
+    /// nothing (CI runs it in a debug build: tools/bench-smoke).
+    #[arg(long)]
+    pub smoke: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -34,6 +38,13 @@ pub struct ShellsBenchArgs {
     /// level of detail; skinned; a crowd; fins), not Table 1's matrix.
     #[arg(long)]
     pub game: bool,
+}
+
+impl ShellsBenchArgs {
+    /// The run's size, from `--quick` and `--smoke`.
+    pub fn scale(&self) -> super::Scale {
+        super::Scale::of(self.quick, self.smoke)
+    }
 }
 
 /// Silva Table 1: (model, triangles, fps at 16 layers 800×600, 1680×1050,
@@ -60,8 +71,10 @@ struct Row {
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::headless()?;
+    let frames = if args.smoke { 1 } else { args.frames };
+    let reduced = args.scale().reduced();
     if args.game {
-        let game = super::shells_game::measure(&ctx, args.quick, args.frames)?;
+        let game = super::shells_game::measure(&ctx, reduced, frames)?;
         if args.json {
             let mut report = game_json(&game);
             report["adapter"] = ctx.adapter_name().into();
@@ -70,15 +83,15 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         } else {
             println!(
                 "pelage bench shells --game — median of {} frames, on {}\n",
-                args.frames.max(1),
+                frames.max(1),
                 ctx.adapter_name()
             );
             print_game(&game);
         }
         return Ok(());
     }
-    let rows = measure(&ctx, args)?;
-    let game = super::shells_game::measure(&ctx, args.quick, args.frames)?;
+    let rows = measure(&ctx, args, frames)?;
+    let game = super::shells_game::measure(&ctx, reduced, frames)?;
     if args.json {
         print_json(&ctx, &rows, &game);
     } else {
@@ -88,7 +101,7 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
 }
 
 /// Plain, curl and curl + clump frames on each mesh, layer count and size.
-fn measure(ctx: &GpuContext, args: &ShellsBenchArgs) -> anyhow::Result<Vec<Row>> {
+fn measure(ctx: &GpuContext, args: &ShellsBenchArgs, frames: usize) -> anyhow::Result<Vec<Row>> {
     let renderers = [
         ShellFeatures::PLAIN,
         ShellFeatures {
@@ -104,7 +117,7 @@ fn measure(ctx: &GpuContext, args: &ShellsBenchArgs) -> anyhow::Result<Vec<Row>>
         ("spot".into(), spot.subdivided(0)),
         ("spot ×2".into(), spot.subdivided(2)),
     ];
-    let (layer_counts, sizes): (&[u32], &[(u32, u32)]) = if args.quick {
+    let (layer_counts, sizes): (&[u32], &[(u32, u32)]) = if args.scale().reduced() {
         (&[16], &[(800, 600)])
     } else {
         let blub = super::test_meshes().join("blub_triangulated.obj");
@@ -173,7 +186,7 @@ fn measure(ctx: &GpuContext, args: &ShellsBenchArgs) -> anyhow::Result<Vec<Row>>
                     Ok(renderers[k].draw(ctx, &models[k], &params, &view, &targets[k])?)
                 };
                 let medians = super::interleaved(
-                    args.frames,
+                    frames,
                     &mut [&mut || draw(0), &mut || draw(1), &mut || draw(2)],
                 )?;
                 let ms = [medians[0], medians[1], medians[2]];
@@ -240,8 +253,9 @@ fn print_table(
 ) {
     let headline = headline(rows);
     println!(
-        "pelage bench shells — median of {} frames, on {}",
-        args.frames.max(1),
+        "pelage bench shells{} — median of {} frames, on {}",
+        args.scale().flag(),
+        if args.smoke { 1 } else { args.frames.max(1) },
         ctx.adapter_name()
     );
     println!(

@@ -187,11 +187,7 @@ fn fox_params(size: f32) -> GuideStrandParams {
 }
 
 fn measure(args: &super::dynamics::DynamicsBenchArgs) -> anyhow::Result<Figures> {
-    let (count, frames) = if args.quick {
-        (2_000, 24)
-    } else {
-        (10_000, 48)
-    };
+    let (count, frames) = args.scale().pick((10_000, 48), (2_000, 24), (100, 2));
     let count = args.guides.unwrap_or(count);
     let points = args.points;
     let run = fox_run(count, points, frames + 1)?;
