@@ -15,27 +15,6 @@ appears here without a change to the add-on.
 import json
 import tomllib
 
-#: What an operator's required settings start at, so a new entry grows
-#: something visible; lengths as fractions of the object's largest
-#: dimension (``SIZED``).
-STARTS = {
-    "noise": {"amplitude": 0.004},
-    "frizz": {"amplitude": 0.002},
-    "clump": {"count": 200, "rate": 0.5},
-    "curl": {"radius": 0.002, "turns": 3},
-    "cut": {"at": 0.8},
-    "length": {"scale": 1.0},
-    "strands": {"count": 3, "tip_spread": 0.002},
-    "width": {"root": 0.002, "tip": 0.0002},
-    "color": {"root": [0.1, 0.07, 0.05], "tip": [0.5, 0.4, 0.3]},
-    "opacity": {"root": 1.0, "tip": 0.5},
-    "twist": {"angle": 90},
-    "flyaways": {"spread": 0.01},
-}
-SIZED = {("noise", "amplitude"), ("frizz", "amplitude"), ("curl", "radius"),
-         ("strands", "tip_spread"), ("width", "root"), ("width", "tip"), ("flyaways", "spread")}
-
-
 def schema():
     """The library's operators: ``[{"name", "summary", "fields",
     "required"}]``, in the order pelage lists them."""
@@ -68,21 +47,25 @@ def text_of(value):
 def add_entry(stack, kind, size=1.0, values=None):
     """Appends operator ``kind`` to ``stack`` (a collection of
     ``PelageOp``): one setting a field of the library's schema, with
-    ``values`` (groom-file values by field), else the start values for
-    its required settings. Returns the entry."""
+    ``values`` (groom-file values by field), else where the library's
+    schema starts each setting (so a new entry grows something visible;
+    a start that is a length scaled by ``size``, the object's largest
+    dimension). Returns the entry."""
     found = next((op for op in schema() if op["name"] == kind), None)
     if found is None:
         raise ValueError(f"pelage has no operator {kind!r}")
     entry = stack.add()
     entry.kind = kind
+    declared = {s["name"]: s for s in found["settings"]}
     for field in found["fields"]:
         setting = entry.settings.add()
         setting.name = field
         if values is not None:
             value = values.get(field)
         else:
-            value = STARTS.get(kind, {}).get(field)
-            if value is not None and (kind, field) in SIZED:
+            setting_schema = declared.get(field, {})
+            value = setting_schema.get("start")
+            if value is not None and setting_schema.get("start_is_length"):
                 value = value * size
         setting.value = "" if value is None else text_of(value)
     if values is not None:

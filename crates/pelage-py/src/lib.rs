@@ -77,10 +77,14 @@ fn _pelage(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// Every groom operator's settings as the library defines them: a list of
-/// dicts with `name`, `summary`, `fields` (every key, `mask` included)
-/// and `required`. `pelage.ops` builds these tables; a test holds its
-/// functions to this schema.
+/// Every groom operator's settings as the library declares them: a list
+/// of dicts with `name`, `summary`, `fields` (every key, `mask` included),
+/// `required`, and `settings` (each but `mask`: `name`, `doc`,
+/// `required`, `start`, where a front end starts it: a number, three for
+/// a colour, or `None`, and `start_is_length`, whether the start is a
+/// world length to scale by the mesh's size). `pelage.ops` builds these
+/// tables (a test holds its functions to this schema); the Blender panel
+/// starts a new operator's settings from it.
 #[pyfunction]
 fn operator_schema(py: Python<'_>) -> PyResult<Vec<Bound<'_, pyo3::types::PyDict>>> {
     pelage::groom::ops::operator_schema()
@@ -91,6 +95,37 @@ fn operator_schema(py: Python<'_>) -> PyResult<Vec<Bound<'_, pyo3::types::PyDict
             d.set_item("summary", op.summary)?;
             d.set_item("fields", op.fields)?;
             d.set_item("required", op.required)?;
+            let settings = op
+                .settings
+                .iter()
+                .map(|s| {
+                    let setting = pyo3::types::PyDict::new(py);
+                    setting.set_item("name", s.name)?;
+                    let doc: Vec<&str> = s.doc.iter().map(|line| line.trim()).collect();
+                    setting.set_item("doc", doc.join(" "))?;
+                    setting.set_item("required", s.required)?;
+                    use pelage::groom::ops::Start;
+                    // A whole number stays one (a count reads no `200.0`).
+                    let number = |x: f64| -> PyResult<Py<PyAny>> {
+                        Ok(if x.fract() == 0.0 && x.abs() < 1e15 {
+                            (x as i64).into_pyobject(py)?.into_any().unbind()
+                        } else {
+                            x.into_pyobject(py)?.into_any().unbind()
+                        })
+                    };
+                    match s.start {
+                        None => setting.set_item("start", py.None())?,
+                        Some(Start::Number(x) | Start::Length(x)) => {
+                            setting.set_item("start", number(x)?)?
+                        }
+                        Some(Start::Rgb(rgb)) => setting.set_item("start", rgb.to_vec())?,
+                    }
+                    let length = matches!(s.start, Some(Start::Length(_)));
+                    setting.set_item("start_is_length", length)?;
+                    Ok(setting)
+                })
+                .collect::<PyResult<Vec<_>>>()?;
+            d.set_item("settings", settings)?;
             Ok(d)
         })
         .collect()

@@ -386,8 +386,8 @@ def test_vertex_maps_and_face_sets_given_with_the_mesh_drive_density_and_regions
 
 def test_the_ops_builders_match_the_librarys_operator_schema():
     """`pelage.ops` is written by hand; this holds it to the operators the
-    library defines (their serde definitions), so a new operator or key
-    without its builder fails here."""
+    library declares, so a new operator or key without its builder fails
+    here."""
     import inspect
 
     schema = pelage._pelage.operator_schema()
@@ -404,6 +404,26 @@ def test_the_ops_builders_match_the_librarys_operator_schema():
         required = [k for k, p in params.items() if p.default is inspect.Parameter.empty]
         assert sorted(required) == sorted(op["required"]), op["name"]
         assert builders[op["name"]].__doc__.strip() == op["summary"], op["name"]
+
+
+def test_every_operator_grows_from_the_starts_its_schema_gives(spot):
+    """The Blender panel starts a new operator from the schema's starts:
+    built from them alone (lengths as they are, spot is about 1 across),
+    every operator grows."""
+    schema = pelage._pelage.operator_schema()
+    for op in schema:
+        settings = {s["name"]: s for s in op["settings"]}
+        assert [s["name"] for s in op["settings"]] + ["mask"] == op["fields"]
+        starts = {k: s["start"] for k, s in settings.items() if s["start"] is not None}
+        assert set(op["required"]) <= set(starts), op["name"]
+        assert all(s["doc"] for s in op["settings"]), op["name"]
+        groom = small_groom(spot, count=200, ops=[{op["name"]: starts}])
+        assert groom.grow().curve_count > 0, op["name"]
+    clump = next(op for op in schema if op["name"] == "clump")
+    count = next(s for s in clump["settings"] if s["name"] == "count")
+    assert count["start"] == 200 and isinstance(count["start"], int)
+    width = next(op for op in schema if op["name"] == "width")
+    assert all(s["start_is_length"] for s in width["settings"] if s["required"])
 
 
 def _interrupt_after(seconds):

@@ -9,8 +9,8 @@ use super::error::{GroomError, GroomErrorKind};
 use super::generator::{Generator, Reuse};
 use super::grow::Workspace;
 use super::ops::{
-    CentreGuides, ChainSoFar, ClumpCentres, GroomOp, OpKey, Opacity, Operator, Preparation,
-    Resampling, Width, color_maps_mut, root_to_tip_maps_mut,
+    CentreGuides, ChainSoFar, ClumpCentres, GroomOp, OpKey, Opacity, Operator, OperatorSettings,
+    Preparation, Resampling, Width,
 };
 use super::outside_skin::OutsideSkin;
 use super::parts::{PartLayout, part_count};
@@ -542,16 +542,16 @@ fn bind_maps(spec: &mut GroomSpec) -> Result<(), GroomError> {
         };
         bind("roots.density".into(), &mut spec.roots.density);
         let finish = &mut spec.finish;
-        for (key, map) in root_to_tip_maps_mut(&mut finish.width) {
+        for (key, map) in finish.width.maps_mut() {
             bind(format!("finish.width.{key}"), map);
         }
         if let Some(color) = &mut finish.color {
-            for (key, map) in color_maps_mut(color) {
+            for (key, map) in color.maps_mut() {
                 bind(format!("finish.color.{key}"), map);
             }
         }
         if let Some(opacity) = &mut finish.opacity {
-            for (key, map) in root_to_tip_maps_mut(opacity) {
+            for (key, map) in opacity.maps_mut() {
                 bind(format!("finish.opacity.{key}"), map);
             }
         }

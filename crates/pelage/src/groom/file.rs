@@ -15,8 +15,8 @@
 
 use super::error::{GroomError, GroomErrorKind};
 pub(crate) use super::ops::OpSpec;
-pub use super::ramp::Ramp;
-pub use super::values::{ColorSpec, MapText, MapValue, RootToTipSpec};
+pub use super::ops::{ColorSpec, RootToTipSpec};
+pub use super::values::{MapText, MapValue};
 use super::values::{one, zero};
 use crate::io::CurveBasis;
 use crate::limits::*;
@@ -638,9 +638,9 @@ fn default_width() -> RootToTipSpec {
     RootToTipSpec {
         root: Spanned::new(0..0, MapText::Number(0.002)),
         tip: Spanned::new(0..0, MapText::Number(0.0002)),
-        ramp: Ramp::default(),
-        jitter: zero(),
-        seed: 0,
+        ramp: None,
+        jitter: None,
+        seed: None,
         mask: None,
     }
 }
@@ -685,6 +685,7 @@ pub struct OutputSection {
 mod tests {
     use super::*;
     use crate::groom::GroomError;
+    use crate::groom::ramp::Ramp;
     use crate::settings::SettingsSource;
 
     fn parse(text: &str) -> Result<GroomFile, GroomError> {
@@ -784,12 +785,13 @@ mod tests {
         let OpSpec::Noise(a) = &f.ops[0] else {
             panic!()
         };
-        assert_eq!(a.ramp, Ramp::Smooth);
+        assert_eq!(a.ramp, Some(Ramp::Smooth));
         let OpSpec::Noise(b) = &f.ops[1] else {
             panic!()
         };
-        assert!((b.ramp.at(0.25) - 0.5).abs() < 1e-6);
-        assert!((b.ramp.at(1.0) - 0.5).abs() < 1e-6);
+        let ramp = b.ramp.as_ref().unwrap();
+        assert!((ramp.at(0.25) - 0.5).abs() < 1e-6);
+        assert!((ramp.at(1.0) - 0.5).abs() < 1e-6);
         assert_eq!(Ramp::Power(2.0).at(0.5), 0.25);
         assert_eq!(Ramp::Power(0.0).at(0.3), 1.0);
     }

@@ -8,7 +8,7 @@ use super::error::{GroomError, GroomErrorKind};
 use super::file::{AnimationModeName, GroomFile, InterpolationKind, MapValue, MeshSection};
 use super::generator::Generator;
 use super::hair_look::HairLook;
-use super::ops::{OpKey, SpecReader, map_on_mesh, read_color};
+use super::ops::{Color, OpKey, OperatorSettings, RootToTip, SpecReader, map_on_mesh};
 use super::outside_skin::OutsideSkin;
 use super::parts::part_count;
 use super::simulate::{
@@ -588,16 +588,18 @@ impl Groom {
     /// points and normals, and whether hairs are kept out of the skin.
     fn finish_spec(&self, lines: &mut Lines) -> Result<FinishSpec, GroomError> {
         let (file, source) = (&self.file, &self.source);
-        let width = SpecReader::new(source, &self.mesh, lines, "finish.width".into())
-            .root_to_tip(&file.finish.width)?;
+        let width = RootToTip::read(
+            &file.finish.width,
+            &mut SpecReader::new(source, &self.mesh, lines, "finish.width".into()),
+        )?;
         let color = file
             .finish
             .color
             .as_ref()
             .map(|c| {
-                read_color(
-                    &mut SpecReader::new(source, &self.mesh, lines, "finish.color".into()),
+                Color::read(
                     c,
+                    &mut SpecReader::new(source, &self.mesh, lines, "finish.color".into()),
                 )
             })
             .transpose()?;
@@ -606,7 +608,10 @@ impl Groom {
             .opacity
             .as_ref()
             .map(|o| {
-                SpecReader::new(source, &self.mesh, lines, "finish.opacity".into()).root_to_tip(o)
+                RootToTip::read(
+                    o,
+                    &mut SpecReader::new(source, &self.mesh, lines, "finish.opacity".into()),
+                )
             })
             .transpose()?;
         let finish = FinishSpec {

@@ -36,7 +36,6 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use super::ramp::Ramp;
 pub use super::regions::{RegionSource, RegionsSpec};
 
 /// A whole groom, as values. Build one with [`GroomSpec::new`] and the
@@ -337,19 +336,6 @@ impl Default for FinishSpec {
             opacity: None,
             normals: true,
             outside_skin: None,
-        }
-    }
-}
-
-impl RootToTip {
-    /// From `root` to `tip`, linearly, no jitter, seed 0.
-    pub fn new(root: Map, tip: Map) -> Self {
-        Self {
-            root,
-            tip,
-            ramp: Ramp::default(),
-            jitter: Map::Constant(0.0),
-            seed: 0,
         }
     }
 }

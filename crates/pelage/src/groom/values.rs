@@ -1,10 +1,8 @@
 //! The values every part of a groom is written in: a map as a groom file
 //! or a program gives it ([`MapValue`]: a number, an image or a noise spec,
-//! with where it was written), and the root-to-tip quantities and colours
-//! that `width`, `opacity`, `color` and `[finish]` share. The lowest layer
-//! of `groom/`: the operators, the spec and the file all read these.
+//! with where it was written). The lowest layer of `groom/`: the
+//! operators, the spec and the file all read it.
 
-use super::ramp::Ramp;
 use serde::Deserialize;
 use serde::de::{self, Deserializer, Visitor};
 use std::fmt;
@@ -53,49 +51,4 @@ pub(crate) fn one() -> MapValue {
 }
 pub(crate) fn zero() -> MapValue {
     Spanned::new(0..0, MapText::Number(0.0))
-}
-
-/// A quantity from root to tip: `width` and `opacity` (and
-/// `[finish.width]`, `[finish.opacity]`); see [`crate::groom::ops::Width`].
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RootToTipSpec {
-    /// Value at the root (a width in world units, or an opacity).
-    pub root: MapValue,
-    /// Value at the tip.
-    pub tip: MapValue,
-    /// Profile from root to tip.
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Per-hair random variation, a fraction.
-    #[serde(default = "zero")]
-    pub jitter: MapValue,
-    /// Seed of the variation.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-/// `color` (and `[finish.color]`): see [`crate::groom::ops::Color`].
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ColorSpec {
-    /// Linear RGB at the root, each channel a map.
-    pub root: [MapValue; 3],
-    /// Linear RGB at the tip.
-    pub tip: [MapValue; 3],
-    /// Profile from root to tip.
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Per-hair random brightness variation, a fraction.
-    #[serde(default = "zero")]
-    pub jitter: MapValue,
-    /// Seed of the variation.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
 }

@@ -745,19 +745,15 @@ struct Keep {
 
 /// Whether an operator's or the finish's map reads layer `name`.
 fn reads_elsewhere(spec: &mut GroomSpec, name: &str) -> bool {
-    use super::ops::{color_maps_mut, root_to_tip_maps_mut};
+    use super::ops::OperatorSettings;
     let reads = |map: &Map| matches!(map, Map::Vertex(v) if v.name == name);
     let finish = &mut spec.finish;
-    let mut any = root_to_tip_maps_mut(&mut finish.width)
-        .into_iter()
-        .any(|(_, m)| reads(m));
+    let mut any = finish.width.maps_mut().into_iter().any(|(_, m)| reads(m));
     if let Some(color) = &mut finish.color {
-        any |= color_maps_mut(color).into_iter().any(|(_, m)| reads(m));
+        any |= color.maps_mut().into_iter().any(|(_, m)| reads(m));
     }
     if let Some(opacity) = &mut finish.opacity {
-        any |= root_to_tip_maps_mut(opacity)
-            .into_iter()
-            .any(|(_, m)| reads(m));
+        any |= opacity.maps_mut().into_iter().any(|(_, m)| reads(m));
     }
     any || spec
         .ops

@@ -9,81 +9,39 @@
 //! for the next nearest).
 
 use super::centres::ClumpCentres;
-use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::kind::{OperatorKind, Preparation};
+use super::settings::{Start, operator_settings};
 use super::{Hair, RampTables, RootContext, Scratch};
 use crate::groom::error::{GroomError, GroomErrorKind};
 use crate::groom::ramp::Ramp;
-use crate::groom::values::MapValue;
 use crate::interp::NeighbourCache;
 use crate::limits::MAX_CLUMPS;
 use crate::map::Map;
 use crate::sample::{DensitySampler, DensitySamplerOptions, sample_range};
-use crate::settings::{Bound, Rule};
-use serde::Deserialize;
-use toml::Spanned;
+use crate::settings::Bound;
 
-/// `clump` as a groom file writes it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct ClumpSpec {
-    /// Number of clumps over the whole mesh.
-    pub count: Spanned<u64>,
-    /// Density of clump centres.
-    #[serde(default = "uniform")]
-    pub density: MapValue,
-    /// How far hairs move to their centre hair (0 to 1).
-    #[serde(default = "default_rate")]
-    pub rate: MapValue,
-    /// Root-to-tip profile of the rate.
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Clump radius: hairs this far from their centre's root are not
-    /// pulled, nearer ones in proportion (default: no limit).
-    pub size: Option<MapValue>,
-    /// Seed of the clump centres.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-fn uniform() -> MapValue {
-    default_map(1.0)
-}
-
-fn default_rate() -> MapValue {
-    default_map(0.8)
-}
-
-/// `clump`: see [`Clump`].
-#[derive(Debug, Clone)]
-pub struct ClumpParams {
-    /// Number of clumps over the whole mesh.
-    pub count: u64,
-    /// Density of clump centres.
-    pub density: Map,
-    /// How far hairs move to their centre hair (0 to 1).
-    pub rate: Map,
-    /// Root-to-tip profile of the rate.
-    pub ramp: Ramp,
-    /// Clump radius (`None`: no limit).
-    pub size: Option<Map>,
-    /// Seed of the clump centres.
-    pub seed: u64,
-}
-
-impl ClumpParams {
-    /// `count` clumps, uniform centres, rate 0.8, linear ramp, no size
-    /// limit, seed 0.
-    pub fn new(count: u64) -> Self {
-        Self {
-            count,
-            density: Map::Constant(1.0),
-            rate: Map::Constant(0.8),
-            ramp: Ramp::default(),
-            size: None,
-            seed: 0,
+operator_settings! {
+    /// `clump` as a groom file writes it.
+    pub(crate) spec ClumpSpec;
+    /// `clump`: see [`Clump`].
+    params ClumpParams {
+        required {
+            /// Number of clumps over the whole mesh.
+            count: count(u64), start Start::Number(200.0),
+                rule Bound::Within(1.0, MAX_CLUMPS as f64), "pelage's clump limit";
+        }
+        optional {
+            /// Density of clump centres.
+            density: map = 1.0, rule Bound::at_least(0.0), "a density";
+            /// How far hairs move to their centre hair (0 to 1).
+            rate: map = 0.8, start Start::Number(0.5);
+            /// Root-to-tip profile of the rate.
+            ramp: value(Ramp) = Ramp::default();
+            /// Clump radius: hairs this far from their centre's root are
+            /// not pulled, nearer ones in proportion (`None`: no limit).
+            size: maybe_map = None;
+            /// Seed of the clump centres.
+            seed: value(u64) = 0;
         }
     }
 }
@@ -156,44 +114,8 @@ impl Clump {
 impl OperatorKind for Clump {
     const NAME: &'static str = "clump";
     const SUMMARY: &'static str = "Pulls hairs toward `count` clump centre hairs (`rate` 0 to 1).";
-    type Spec = ClumpSpec;
     type Params = ClumpParams;
-    const RULES: &'static [Rule] = &[
-        Rule::new(
-            "count",
-            Bound::Within(1.0, MAX_CLUMPS as f64),
-            "pelage's clump limit",
-        ),
-        Rule::new("density", Bound::at_least(0.0), "a density"),
-    ];
     const SEARCHES_NEIGHBOURS: bool = true;
-
-    fn mask(spec: &ClumpSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &ClumpSpec, r: &mut SpecReader<'_>) -> Result<ClumpParams, GroomError> {
-        Ok(ClumpParams {
-            count: r.value("count", &s.count),
-            density: r.map("density", &s.density)?,
-            rate: r.map("rate", &s.rate)?,
-            ramp: s.ramp.clone(),
-            size: s.size.as_ref().map(|m| r.map("size", m)).transpose()?,
-            seed: s.seed,
-        })
-    }
-
-    fn maps(p: &ClumpParams) -> Vec<(&'static str, &Map)> {
-        let mut maps = vec![("density", &p.density), ("rate", &p.rate)];
-        maps.extend(p.size.as_ref().map(|m| ("size", m)));
-        maps
-    }
-
-    fn maps_mut(p: &mut ClumpParams) -> Vec<(&'static str, &mut Map)> {
-        let mut maps = vec![("density", &mut p.density), ("rate", &mut p.rate)];
-        maps.extend(p.size.as_mut().map(|m| ("size", m)));
-        maps
-    }
 
     fn counts(p: &ClumpParams) -> Vec<(&'static str, u64, u64, &'static str)> {
         vec![("count", p.count, MAX_CLUMPS, "clumps")]

@@ -1,59 +1,34 @@
 //! `curl`: a helix around the hair's path, the shape of Silva et al.
 //! Eq. 4 (`K_α h` for the radius, `ω` for the turns).
 
-use super::kind::{OperatorKind, Preparation, SpecReader};
+use super::kind::{OperatorKind, Preparation};
+use super::settings::{Start, operator_settings};
 use super::{Hair, RootContext, Scratch, param};
 use crate::groom::error::GroomError;
 use crate::groom::ramp::Ramp;
-use crate::groom::values::MapValue;
 use crate::map::Map;
 use crate::sample::SampleRng;
-use serde::Deserialize;
 use std::f32::consts::TAU;
 
 /// Each hair's phase.
 const PHASE_SALT: u64 = 0xC0_11;
 
-/// `curl` as a groom file writes it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct CurlSpec {
-    /// Helix radius at the tip (world units): Silva's K_α.
-    pub radius: MapValue,
-    /// Turns along the hair: Silva's ω / 2π.
-    pub turns: MapValue,
-    /// Root-to-tip profile of the radius (Silva: linear).
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Seed of each hair's phase.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-/// `curl`: see [`Curl`].
-#[derive(Debug, Clone)]
-pub struct CurlParams {
-    /// Helix radius at the tip (world units): Silva's K_α.
-    pub radius: Map,
-    /// Turns along the hair: Silva's ω / 2π.
-    pub turns: Map,
-    /// Root-to-tip profile of the radius.
-    pub ramp: Ramp,
-    /// Seed of each hair's phase.
-    pub seed: u64,
-}
-
-impl CurlParams {
-    /// A curl of `radius` and `turns`, linear ramp, seed 0.
-    pub fn new(radius: Map, turns: Map) -> Self {
-        Self {
-            radius,
-            turns,
-            ramp: Ramp::default(),
-            seed: 0,
+operator_settings! {
+    /// `curl` as a groom file writes it.
+    pub(crate) spec CurlSpec;
+    /// `curl`: see [`Curl`].
+    params CurlParams {
+        required {
+            /// Helix radius at the tip (world units): Silva's K_α.
+            radius: map, start Start::Length(0.002);
+            /// Turns along the hair: Silva's ω / 2π.
+            turns: map, start Start::Number(3.0);
+        }
+        optional {
+            /// Root-to-tip profile of the radius (Silva: linear).
+            ramp: value(Ramp) = Ramp::default();
+            /// Seed of each hair's phase.
+            seed: value(u64) = 0;
         }
     }
 }
@@ -88,30 +63,8 @@ impl OperatorKind for Curl {
     const NAME: &'static str = "curl";
     const SUMMARY: &'static str =
         "A helix of `radius` around each hair's path, `turns` times root to tip.";
-    type Spec = CurlSpec;
     type Params = CurlParams;
     const SALTS: &'static [(&'static str, u64)] = &[("PHASE", PHASE_SALT)];
-
-    fn mask(spec: &CurlSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &CurlSpec, r: &mut SpecReader<'_>) -> Result<CurlParams, GroomError> {
-        Ok(CurlParams {
-            radius: r.map("radius", &s.radius)?,
-            turns: r.map("turns", &s.turns)?,
-            ramp: s.ramp.clone(),
-            seed: s.seed,
-        })
-    }
-
-    fn maps(p: &CurlParams) -> Vec<(&'static str, &Map)> {
-        vec![("radius", &p.radius), ("turns", &p.turns)]
-    }
-
-    fn maps_mut(p: &mut CurlParams) -> Vec<(&'static str, &mut Map)> {
-        vec![("radius", &mut p.radius), ("turns", &mut p.turns)]
-    }
 
     fn prepare(p: CurlParams, cx: &Preparation<'_>) -> Result<Self, GroomError> {
         Ok(Curl::new(p.radius, p.turns, p.ramp, cx.seed(p.seed)))

@@ -1,40 +1,31 @@
 //! `cut` (Sik §4.2.2: "the texture value specifies a curve parameter at
 //! which the curve is cut").
 
-use super::kind::{OperatorKind, Preparation, SpecReader};
+use super::kind::{OperatorKind, Preparation};
+use super::settings::{Start, operator_settings};
 use super::{HairBatch, RootContext, Scratch, param};
 use crate::groom::error::GroomError;
-use crate::groom::values::MapValue;
 use crate::map::Map;
-use serde::Deserialize;
 
-/// `cut` as a groom file writes it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct CutSpec {
-    /// Curve parameter (0 to 1) at which each hair is cut; 0 removes it.
-    pub at: MapValue,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-/// `cut`: each hair ends at curve parameter `at` (0 to 1, read from the
-/// map at its root) and keeps its point count: the kept part is resampled
-/// to as many evenly spaced parameters, so a short hair is as smooth as a
-/// long one. Widths, colours and opacities are cut with it. `at ≤ 0`
-/// removes the hair: paint black to make a bald patch.
-#[derive(Debug, Clone)]
-pub struct Cut {
-    at: Map,
+operator_settings! {
+    /// `cut` as a groom file writes it.
+    pub(crate) spec CutSpec;
+    /// `cut`: each hair ends at curve parameter `at` (0 to 1, read from the
+    /// map at its root) and keeps its point count: the kept part is
+    /// resampled to as many evenly spaced parameters, so a short hair is
+    /// as smooth as a long one. Widths, colours and opacities are cut with
+    /// it. `at ≤ 0` removes the hair: paint black to make a bald patch.
+    params Cut {
+        required {
+            /// Curve parameter (0 to 1) at which each hair is cut; 0
+            /// removes it.
+            at: map, start Start::Number(0.8);
+        }
+        optional {}
+    }
 }
 
 impl Cut {
-    /// A cut operator.
-    pub fn new(at: Map) -> Self {
-        Self { at }
-    }
-
     /// The curve parameter map.
     pub fn at(&self) -> &Map {
         &self.at
@@ -89,25 +80,8 @@ impl Cut {
 impl OperatorKind for Cut {
     const NAME: &'static str = "cut";
     const SUMMARY: &'static str = "Cuts every hair at curve parameter `at` (0 to 1).";
-    type Spec = CutSpec;
     type Params = Cut;
     const KEEPS_ONE_HAIR: bool = false;
-
-    fn mask(spec: &CutSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &CutSpec, r: &mut SpecReader<'_>) -> Result<Cut, GroomError> {
-        Ok(Cut::new(r.map("at", &s.at)?))
-    }
-
-    fn maps(p: &Cut) -> Vec<(&'static str, &Map)> {
-        vec![("at", &p.at)]
-    }
-
-    fn maps_mut(p: &mut Cut) -> Vec<(&'static str, &mut Map)> {
-        vec![("at", &mut p.at)]
-    }
 
     fn prepare(p: Cut, _: &Preparation<'_>) -> Result<Self, GroomError> {
         Ok(p)

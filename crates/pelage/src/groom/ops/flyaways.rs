@@ -6,17 +6,15 @@
 //! (its own noise, `frequency` wiggles root to tip). Put it after `clump`
 //! so the strays leave the clumps; the other hairs are untouched.
 
-use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::kind::{OperatorKind, Preparation};
 use super::noise::VectorNoise;
+use super::settings::{Start, operator_settings};
 use super::{Hair, RootContext, Scratch, param};
 use crate::groom::error::GroomError;
 use crate::groom::ramp::Ramp;
-use crate::groom::values::MapValue;
-use crate::map::Map;
 use crate::sample::SampleRng;
-use crate::settings::{Bound, Rule};
+use crate::settings::Bound;
 use glam::Vec3;
-use serde::Deserialize;
 
 /// Whether a hair flies away, its push direction and its place in the
 /// noise field.
@@ -24,78 +22,27 @@ const HAIR_SALT: u64 = 0xF1_7A4A;
 /// The noise field the strays wander by.
 const FIELD_SALT: u64 = 0xF1_7F1E;
 
-/// `flyaways` as a groom file writes it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct FlyawaysSpec {
-    /// How far the tip is pushed off (world units).
-    pub spread: MapValue,
-    /// Share of the hairs that fly away (0 to 1).
-    #[serde(default = "default_fraction")]
-    pub fraction: MapValue,
-    /// Length factor of a stray (1: as long as the others).
-    #[serde(default = "default_length")]
-    pub length: MapValue,
-    /// Wiggles of a stray's own noise along it.
-    #[serde(default = "default_frequency")]
-    pub frequency: MapValue,
-    /// Root-to-tip profile of the push.
-    #[serde(default = "default_ramp")]
-    pub ramp: Ramp,
-    /// Seed.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-fn default_fraction() -> MapValue {
-    default_map(0.02)
-}
-
-fn default_length() -> MapValue {
-    default_map(1.3)
-}
-
-fn default_frequency() -> MapValue {
-    default_map(2.0)
-}
-
-/// Strays leave the groom late: `t²`.
-fn default_ramp() -> Ramp {
-    Ramp::Power(2.0)
-}
-
-/// `flyaways`: see [`Flyaways`].
-#[derive(Debug, Clone)]
-pub struct FlyawaysParams {
-    /// How far the tip is pushed off (world units).
-    pub spread: Map,
-    /// Share of the hairs that fly away (0 to 1).
-    pub fraction: Map,
-    /// Length factor of a stray.
-    pub length: Map,
-    /// Wiggles of a stray's own noise along it.
-    pub frequency: Map,
-    /// Root-to-tip profile of the push.
-    pub ramp: Ramp,
-    /// Seed.
-    pub seed: u64,
-}
-
-impl FlyawaysParams {
-    /// Strays pushed `spread` off at the tip; a groom file's defaults for
-    /// the rest (2 % of the hairs, 1.3 times as long, frequency 2, ramp
-    /// t², seed 0).
-    pub fn new(spread: Map) -> Self {
-        Self {
-            spread,
-            fraction: Map::Constant(0.02),
-            length: Map::Constant(1.3),
-            frequency: Map::Constant(2.0),
-            ramp: default_ramp(),
-            seed: 0,
+operator_settings! {
+    /// `flyaways` as a groom file writes it.
+    pub(crate) spec FlyawaysSpec;
+    /// `flyaways`: see [`Flyaways`].
+    params FlyawaysParams {
+        required {
+            /// How far the tip is pushed off (world units).
+            spread: map, start Start::Length(0.01);
+        }
+        optional {
+            /// Share of the hairs that fly away (0 to 1).
+            fraction: map = 0.02, rule Bound::Within(0.0, 1.0), "a fraction of the hairs";
+            /// Length factor of a stray (1: as long as the others).
+            length: map = 1.3, rule Bound::at_least(0.0), "a factor";
+            /// Wiggles of a stray's own noise along it.
+            frequency: map = 2.0, rule Bound::at_least(0.0), "cycles per hair";
+            /// Root-to-tip profile of the push (strays leave the groom
+            /// late: `t²`).
+            ramp: value(Ramp) = Ramp::Power(2.0);
+            /// Seed.
+            seed: value(u64) = 0;
         }
     }
 }
@@ -119,51 +66,8 @@ impl Flyaways {
 impl OperatorKind for Flyaways {
     const NAME: &'static str = "flyaways";
     const SUMMARY: &'static str = "A `fraction` of the hairs lengthened and pushed `spread` off their clump, each its own way.";
-    type Spec = FlyawaysSpec;
     type Params = FlyawaysParams;
-    const RULES: &'static [Rule] = &[
-        Rule::new(
-            "fraction",
-            Bound::Within(0.0, 1.0),
-            "a fraction of the hairs",
-        ),
-        Rule::new("length", Bound::at_least(0.0), "a factor"),
-        Rule::new("frequency", Bound::at_least(0.0), "cycles per hair"),
-    ];
     const SALTS: &'static [(&'static str, u64)] = &[("HAIR", HAIR_SALT), ("FIELD", FIELD_SALT)];
-
-    fn mask(spec: &FlyawaysSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &FlyawaysSpec, r: &mut SpecReader<'_>) -> Result<FlyawaysParams, GroomError> {
-        Ok(FlyawaysParams {
-            spread: r.map("spread", &s.spread)?,
-            fraction: r.map("fraction", &s.fraction)?,
-            length: r.map("length", &s.length)?,
-            frequency: r.map("frequency", &s.frequency)?,
-            ramp: s.ramp.clone(),
-            seed: s.seed,
-        })
-    }
-
-    fn maps(p: &FlyawaysParams) -> Vec<(&'static str, &Map)> {
-        vec![
-            ("spread", &p.spread),
-            ("fraction", &p.fraction),
-            ("length", &p.length),
-            ("frequency", &p.frequency),
-        ]
-    }
-
-    fn maps_mut(p: &mut FlyawaysParams) -> Vec<(&'static str, &mut Map)> {
-        vec![
-            ("spread", &mut p.spread),
-            ("fraction", &mut p.fraction),
-            ("length", &mut p.length),
-            ("frequency", &mut p.frequency),
-        ]
-    }
 
     fn prepare(mut params: FlyawaysParams, cx: &Preparation<'_>) -> Result<Self, GroomError> {
         params.seed = cx.seed(params.seed);
@@ -208,6 +112,7 @@ mod tests {
     use super::super::test_hairs::{batch, root, straight};
     use super::super::{Masked, Operator};
     use super::*;
+    use crate::map::Map;
 
     fn flyaways(fraction: f32) -> Flyaways {
         let params = FlyawaysParams {

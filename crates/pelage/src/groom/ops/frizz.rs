@@ -2,78 +2,40 @@
 //! frequency (the per-hair noise of XGen's and Houdini's frizz), unlike
 //! `noise`, whose field neighbouring hairs share.
 
-use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::kind::{OperatorKind, Preparation};
 use super::noise::VectorNoise;
+use super::settings::{Start, operator_settings};
 use super::{Hair, RootContext, Scratch, param};
 use crate::groom::error::GroomError;
 use crate::groom::ramp::Ramp;
-use crate::groom::values::MapValue;
 use crate::map::Map;
 use crate::sample::SampleRng;
-use crate::settings::{Bound, Rule};
+use crate::settings::Bound;
 use glam::Vec3;
-use serde::Deserialize;
 
 /// The noise field frizz follows.
 const FIELD_SALT: u64 = 0xF122;
 /// Whether a hair frizzes, and its offset into the field.
 const HAIR_SALT: u64 = 0xF122_F122;
 
-/// `frizz` as a groom file writes it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct FrizzSpec {
-    /// Largest displacement (world units).
-    pub amplitude: MapValue,
-    /// Wiggles along one hair.
-    #[serde(default = "default_frequency")]
-    pub frequency: MapValue,
-    /// Share of hairs that frizz (0 to 1).
-    #[serde(default = "every_hair")]
-    pub fraction: MapValue,
-    /// Root-to-tip profile.
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Seed.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-fn default_frequency() -> MapValue {
-    default_map(6.0)
-}
-
-fn every_hair() -> MapValue {
-    default_map(1.0)
-}
-
-/// `frizz`: see [`Frizz`].
-#[derive(Debug, Clone)]
-pub struct FrizzParams {
-    /// Largest displacement (world units).
-    pub amplitude: Map,
-    /// Wiggles along one hair.
-    pub frequency: Map,
-    /// Share of hairs that frizz (0 to 1).
-    pub fraction: Map,
-    /// Root-to-tip profile.
-    pub ramp: Ramp,
-    /// Seed.
-    pub seed: u64,
-}
-
-impl FrizzParams {
-    /// Frizz of `amplitude` on every hair; frequency 6, linear ramp, seed 0.
-    pub fn new(amplitude: Map) -> Self {
-        Self {
-            amplitude,
-            frequency: Map::Constant(6.0),
-            fraction: Map::Constant(1.0),
-            ramp: Ramp::default(),
-            seed: 0,
+operator_settings! {
+    /// `frizz` as a groom file writes it.
+    pub(crate) spec FrizzSpec;
+    /// `frizz`: see [`Frizz`].
+    params FrizzParams {
+        required {
+            /// Largest displacement (world units).
+            amplitude: map, start Start::Length(0.002);
+        }
+        optional {
+            /// Wiggles along one hair.
+            frequency: map = 6.0, rule Bound::at_least(0.0), "cycles per unit";
+            /// Share of hairs that frizz (0 to 1).
+            fraction: map = 1.0, rule Bound::Within(0.0, 1.0), "a fraction of the hairs";
+            /// Root-to-tip profile.
+            ramp: value(Ramp) = Ramp::default();
+            /// Seed.
+            seed: value(u64) = 0;
         }
     }
 }
@@ -110,47 +72,8 @@ impl OperatorKind for Frizz {
     const NAME: &'static str = "frizz";
     const SUMMARY: &'static str =
         "Per-hair random high-frequency displacement on a `fraction` of hairs.";
-    type Spec = FrizzSpec;
     type Params = FrizzParams;
-    const RULES: &'static [Rule] = &[
-        Rule::new("frequency", Bound::at_least(0.0), "cycles per unit"),
-        Rule::new(
-            "fraction",
-            Bound::Within(0.0, 1.0),
-            "a fraction of the hairs",
-        ),
-    ];
     const SALTS: &'static [(&'static str, u64)] = &[("FIELD", FIELD_SALT), ("HAIR", HAIR_SALT)];
-
-    fn mask(spec: &FrizzSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &FrizzSpec, r: &mut SpecReader<'_>) -> Result<FrizzParams, GroomError> {
-        Ok(FrizzParams {
-            amplitude: r.map("amplitude", &s.amplitude)?,
-            frequency: r.map("frequency", &s.frequency)?,
-            fraction: r.map("fraction", &s.fraction)?,
-            ramp: s.ramp.clone(),
-            seed: s.seed,
-        })
-    }
-
-    fn maps(p: &FrizzParams) -> Vec<(&'static str, &Map)> {
-        vec![
-            ("amplitude", &p.amplitude),
-            ("frequency", &p.frequency),
-            ("fraction", &p.fraction),
-        ]
-    }
-
-    fn maps_mut(p: &mut FrizzParams) -> Vec<(&'static str, &mut Map)> {
-        vec![
-            ("amplitude", &mut p.amplitude),
-            ("frequency", &mut p.frequency),
-            ("fraction", &mut p.fraction),
-        ]
-    }
 
     fn prepare(p: FrizzParams, cx: &Preparation<'_>) -> Result<Self, GroomError> {
         Ok(Frizz::new(

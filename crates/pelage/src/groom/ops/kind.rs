@@ -11,14 +11,11 @@
 //! (docs/adding-an-operator.md).
 
 use super::centres::ClumpCentres;
+use super::settings::{OperatorSettings, SettingSchema, Start};
 use super::{Hair, HairBatch, RootContext, Scratch};
 use crate::groom::error::{GroomError, GroomErrorKind};
-use crate::groom::values::{MapText, MapValue, RootToTipSpec};
-use crate::map::Map;
 use crate::mesh::{Mesh, SurfacePoint};
-use crate::settings::{Rule, SettingsSource};
-use serde::Deserialize as _;
-use std::collections::HashMap;
+use crate::settings::Rule;
 
 /// One operator: implemented by its prepared form (the value the
 /// generator runs), which names the operator's other two forms.
@@ -28,14 +25,20 @@ pub(crate) trait OperatorKind: Sized {
     /// One line saying what it does, for `--help`-like listings and the
     /// Python builders' docstrings.
     const SUMMARY: &'static str;
-    /// The `[[ops]]` table as written (serde, unknown keys refused).
-    type Spec: serde::de::DeserializeOwned + std::fmt::Debug + Clone;
-    /// The operator as plain values (maps read, not yet prepared).
-    type Params: std::fmt::Debug + Clone;
+    /// The operator as plain values (maps read, not yet prepared): its
+    /// settings, declared once with `operator_settings!`, which also
+    /// writes the `[[ops]]` table as a groom file writes it.
+    type Params: OperatorSettings;
 
     /// The documented ranges of the operator's numeric settings, keyed by
-    /// field name (`count`), checked when a groom file is read.
-    const RULES: &'static [Rule] = &[];
+    /// field name (`count`), checked when a groom file is read: its
+    /// settings' (an operator whose settings another shares, as `width`
+    /// and `opacity` share theirs, says its own).
+    const RULES: &'static [Rule] = <Self::Params as OperatorSettings>::RULES;
+    /// Where front ends start its settings, by setting, over the
+    /// declaration's starts (an operator whose settings another shares
+    /// says its own).
+    const STARTS: &'static [(&'static str, Start)] = &[];
     /// The salts of the operator's random streams (kept apart from every
     /// other stream's: a test compares them all).
     const SALTS: &'static [(&'static str, u64)] = &[];
@@ -49,18 +52,6 @@ pub(crate) trait OperatorKind: Sized {
     /// Whether it searches for hairs near the root (roots then carry the
     /// ball around their skin triangle).
     const SEARCHES_NEIGHBOURS: bool = false;
-
-    /// The spec's `mask`, if it has one.
-    fn mask(spec: &Self::Spec) -> Option<&MapValue>;
-
-    /// The parameters a groom file's spec says, maps read on the mesh.
-    fn read(spec: &Self::Spec, reader: &mut SpecReader<'_>) -> Result<Self::Params, GroomError>;
-
-    /// Every map the parameters hold, with its field name.
-    fn maps(params: &Self::Params) -> Vec<(&'static str, &Map)>;
-
-    /// Every map the parameters hold, to change (binding them to a mesh).
-    fn maps_mut(params: &mut Self::Params) -> Vec<(&'static str, &mut Map)>;
 
     /// Counts with a ceiling (field, value, most, what is counted),
     /// checked before anything is prepared.
@@ -128,90 +119,6 @@ impl std::fmt::Display for OpKey {
     }
 }
 
-/// Reads a spec's values from a groom file: maps resolved against the
-/// file's folder and bound to the mesh, and where each setting was written
-/// noted for errors the generator finds later.
-pub(crate) struct SpecReader<'a> {
-    source: &'a SettingsSource,
-    mesh: &'a Mesh,
-    lines: &'a mut HashMap<String, (usize, usize)>,
-    /// The setting's key: `ops[2].clump` or `finish.width`.
-    prefix: String,
-}
-
-impl<'a> SpecReader<'a> {
-    pub(crate) fn new(
-        source: &'a SettingsSource,
-        mesh: &'a Mesh,
-        lines: &'a mut HashMap<String, (usize, usize)>,
-        prefix: String,
-    ) -> Self {
-        Self {
-            source,
-            mesh,
-            lines,
-            prefix,
-        }
-    }
-
-    /// Notes where `field` was written.
-    pub fn mark(&mut self, field: &str, span: std::ops::Range<usize>) {
-        if let Some(line) = self.source.line_of(span) {
-            self.lines.insert(format!("{}.{field}", self.prefix), line);
-        }
-    }
-
-    /// A spanned number, its line noted.
-    pub fn value<T: Copy>(&mut self, field: &str, value: &toml::Spanned<T>) -> T {
-        self.mark(field, value.span());
-        *value.get_ref()
-    }
-
-    /// A map, read and bound to the mesh, both errors at its line.
-    pub fn map(&mut self, field: &str, value: &MapValue) -> Result<Map, GroomError> {
-        self.mark(field, value.span());
-        map_on_mesh(self.source, self.mesh, value)
-    }
-
-    /// Three maps (a colour's channels).
-    pub fn rgb(&mut self, field: &str, value: &[MapValue; 3]) -> Result<[Map; 3], GroomError> {
-        Ok([
-            self.map(field, &value[0])?,
-            self.map(field, &value[1])?,
-            self.map(field, &value[2])?,
-        ])
-    }
-
-    /// A root-to-tip quantity (`width`, `opacity`).
-    pub fn root_to_tip(&mut self, s: &RootToTipSpec) -> Result<super::RootToTip, GroomError> {
-        Ok(super::RootToTip {
-            root: self.map("root", &s.root)?,
-            tip: self.map("tip", &s.tip)?,
-            ramp: s.ramp.clone(),
-            jitter: self.map("jitter", &s.jitter)?,
-            seed: s.seed,
-        })
-    }
-}
-
-/// Resolves a map value and binds it to `mesh` (UVs, vertex
-/// attributes), both errors at the value's line.
-pub(crate) fn map_on_mesh(
-    source: &SettingsSource,
-    mesh: &Mesh,
-    value: &MapValue,
-) -> Result<Map, GroomError> {
-    let mut map = source.map(value)?;
-    map.bind(mesh)
-        .map_err(|e| source.error_at(value.span(), GroomErrorKind::Map(e)))?;
-    Ok(map)
-}
-
-/// A constant map as a groom file's default (no line of its own).
-pub(crate) fn default_map(value: f32) -> MapValue {
-    toml::Spanned::new(0..0, MapText::Number(value))
-}
-
 /// What preparing an operator can ask of the chain before it: the
 /// generator being built implements this (`groom/build.rs`), so the
 /// operators never name the generator that runs them.
@@ -273,105 +180,58 @@ impl Preparation<'_> {
 }
 
 /// One operator's settings as a groom file spells them.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct OperatorSchema {
     /// The operator's name (`clump`).
     pub name: &'static str,
     /// One line saying what it does.
     pub summary: &'static str,
-    /// Every key its table takes, `mask` included, in declaration order.
+    /// Every key its table takes, `mask` last, in declaration order.
     pub fields: Vec<&'static str>,
     /// The keys it cannot do without.
     pub required: Vec<&'static str>,
+    /// Every setting but `mask`, as declared (docs, starting values).
+    pub settings: Vec<SettingSchema>,
 }
 
-/// The schema of operator `K`, from its spec's serde definition: the keys
-/// are those serde asks a deserializer for; the required ones are found by
-/// reading tables that lack them, one missing key at a time.
+/// The schema of operator `K`, from its settings' declaration.
 pub(crate) fn schema_of<K: OperatorKind>() -> OperatorSchema {
-    use serde::de::value::Error;
-    use serde::de::{Deserializer, Error as _, Visitor};
-    struct FieldNames(&'static [&'static str]);
-    impl<'de> Deserializer<'de> for &mut FieldNames {
-        type Error = Error;
-        fn deserialize_any<V: Visitor<'de>>(self, _: V) -> Result<V::Value, Error> {
-            Err(Error::custom("an operator's spec is a struct"))
-        }
-        fn deserialize_struct<V: Visitor<'de>>(
-            self,
-            _: &'static str,
-            fields: &'static [&'static str],
-            _: V,
-        ) -> Result<V::Value, Error> {
-            self.0 = fields;
-            Err(Error::custom("fields read"))
-        }
-        serde::forward_to_deserialize_any! {
-            bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string
-            bytes byte_buf option unit unit_struct newtype_struct seq tuple
-            tuple_struct map enum identifier ignored_any
-        }
-    }
-    let mut names = FieldNames(&[]);
-    let _ = K::Spec::deserialize(&mut names);
-    let fields = names.0.to_vec();
-    // Add what the last read said was missing, until a table reads.
-    let mut required: Vec<(&'static str, &'static str)> = Vec::new();
-    for _ in 0..=fields.len() {
-        let text = |extra: Option<(&str, &str)>| {
-            required
-                .iter()
-                .copied()
-                .chain(extra)
-                .map(|(k, v)| format!("{k} = {v}\n"))
-                .collect::<String>()
-        };
-        let missing = |text: &str| -> Option<&'static str> {
-            let message = toml::from_str::<K::Spec>(text).err()?.to_string();
-            fields
-                .iter()
-                .copied()
-                .find(|f| message.contains(&format!("missing field `{f}`")))
-        };
-        let Some(field) = missing(&text(None)) else {
-            break;
-        };
-        // A number stands for a map or a count, three for a colour: the
-        // first that reads past this key (a wrong type stops the read at it).
-        let reads_past = |t: &str| match toml::from_str::<K::Spec>(t) {
-            Ok(_) => true,
-            Err(e) => {
-                let message = e.to_string();
-                message.contains("missing field")
-                    && !message.contains(&format!("missing field `{field}`"))
-            }
-        };
-        let value = ["1", "[1, 1, 1]"]
-            .into_iter()
-            .find(|v| reads_past(&text(Some((field, v)))))
-            .unwrap_or("1");
-        required.push((field, value));
-    }
+    let settings = <K::Params as OperatorSettings>::SETTINGS;
     OperatorSchema {
         name: K::NAME,
         summary: K::SUMMARY,
-        fields,
-        required: required.into_iter().map(|(k, _)| k).collect(),
+        fields: settings.iter().map(|s| s.name).chain(["mask"]).collect(),
+        required: settings
+            .iter()
+            .filter(|s| s.required)
+            .map(|s| s.name)
+            .collect(),
+        settings: settings
+            .iter()
+            .map(|s| SettingSchema {
+                start: K::STARTS
+                    .iter()
+                    .find(|(name, _)| *name == s.name)
+                    .map(|(_, start)| *start)
+                    .or(s.start),
+                ..s.clone()
+            })
+            .collect(),
     }
 }
 
 /// Derives the chain's enums and their dispatch from the list of
-/// operators: `Variant(Prepared, Params, Spec)`, one a line, in the
+/// operators: `Variant(Prepared, Params)`, one a line, in the
 /// registry (`ops/mod.rs`). The variant's name, in kebab case, is the
 /// operator's name in groom files.
 macro_rules! operators {
-    ($( $(#[$doc:meta])* $Variant:ident($Op:ty, $Params:ty, $Spec:ty) ),* $(,)?) => {
+    ($( $(#[$doc:meta])* $Variant:ident($Op:ty, $Params:ty) ),* $(,)?) => {
         /// One operator as a groom file writes it: `[[ops]]` followed by
         /// `NAME = { … }` or `[ops.NAME]`.
         #[derive(Debug, Clone, serde::Deserialize)]
         #[serde(rename_all = "kebab-case")]
         pub(crate) enum OpSpec {
-            $( $(#[$doc])* $Variant($Spec), )*
+            $( $(#[$doc])* $Variant(<$Params as OperatorSettings>::Spec), )*
         }
 
         /// One operator of the chain, with its settings, as plain values.
@@ -401,9 +261,9 @@ macro_rules! operators {
         /// Every operator's name, in the registry's order.
         pub const OPERATOR_NAMES: &[&str] = &[$( <$Op as OperatorKind>::NAME ),*];
 
-        /// Every operator's settings as a groom file spells them, read off
-        /// their serde definitions: what front ends (the Python builders,
-        /// the Blender panel) must offer.
+        /// Every operator's settings as a groom file spells them, from
+        /// their declarations: what front ends (the Python builders, the
+        /// Blender panel) must offer.
         pub fn operator_schema() -> Vec<OperatorSchema> {
             vec![$( schema_of::<$Op>() ),*]
         }
@@ -448,7 +308,7 @@ macro_rules! operators {
             /// The operator's `mask`, if it has one.
             pub(crate) fn mask(&self) -> Option<&MapValue> {
                 match self {
-                    $( OpSpec::$Variant(s) => <$Op as OperatorKind>::mask(s), )*
+                    $( OpSpec::$Variant(s) => <$Params as OperatorSettings>::mask(s), )*
                 }
             }
 
@@ -459,7 +319,7 @@ macro_rules! operators {
                 reader: &mut SpecReader<'_>,
             ) -> Result<GroomOp, GroomError> {
                 let op = match self {
-                    $( OpSpec::$Variant(s) => GroomOp::$Variant(<$Op as OperatorKind>::read(s, reader)?), )*
+                    $( OpSpec::$Variant(s) => GroomOp::$Variant(<$Params as OperatorSettings>::read(s, reader)?), )*
                 };
                 Ok(match self.mask() {
                     Some(mask) => op.masked(reader.map("mask", mask)?),
@@ -499,7 +359,7 @@ macro_rules! operators {
                         maps.push(("mask", mask));
                         maps
                     }
-                    $( GroomOp::$Variant(p) => <$Op as OperatorKind>::maps(p), )*
+                    $( GroomOp::$Variant(p) => <$Params as OperatorSettings>::maps(p), )*
                 }
             }
 
@@ -512,7 +372,7 @@ macro_rules! operators {
                         maps.push(("mask", mask));
                         maps
                     }
-                    $( GroomOp::$Variant(p) => <$Op as OperatorKind>::maps_mut(p), )*
+                    $( GroomOp::$Variant(p) => <$Params as OperatorSettings>::maps_mut(p), )*
                 }
             }
 

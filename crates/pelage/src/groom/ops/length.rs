@@ -1,57 +1,31 @@
 //! `length`: hairs scaled about their root, with per-hair variation (the
 //! length control of every groom tool).
 
-use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::kind::{OperatorKind, Preparation};
+use super::settings::{Start, operator_settings};
 use super::{Hair, RootContext, Scratch, jittered};
 use crate::groom::error::GroomError;
-use crate::groom::values::MapValue;
 use crate::map::Map;
 use crate::sample::SampleRng;
-use crate::settings::{Bound, Rule};
-use serde::Deserialize;
+use crate::settings::Bound;
 
 /// The per-hair jitter.
 const JITTER_SALT: u64 = 0x1E_4674;
 
-/// `length` as a groom file writes it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct LengthSpec {
-    /// Length factor.
-    pub scale: MapValue,
-    /// Per-hair random variation, a fraction (0.2 = ±20 %).
-    #[serde(default = "no_jitter")]
-    pub jitter: MapValue,
-    /// Seed of the variation.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-fn no_jitter() -> MapValue {
-    default_map(0.0)
-}
-
-/// `length`: see [`Length`].
-#[derive(Debug, Clone)]
-pub struct LengthParams {
-    /// Length factor.
-    pub scale: Map,
-    /// Per-hair random variation, a fraction (0.2 = ±20 %).
-    pub jitter: Map,
-    /// Seed of the variation.
-    pub seed: u64,
-}
-
-impl LengthParams {
-    /// Lengths times `scale`, no jitter, seed 0.
-    pub fn new(scale: Map) -> Self {
-        Self {
-            scale,
-            jitter: Map::Constant(0.0),
-            seed: 0,
+operator_settings! {
+    /// `length` as a groom file writes it.
+    pub(crate) spec LengthSpec;
+    /// `length`: see [`Length`].
+    params LengthParams {
+        required {
+            /// Length factor.
+            scale: map, start Start::Number(1.0), rule Bound::at_least(0.0), "a factor";
+        }
+        optional {
+            /// Per-hair random variation, a fraction (0.2 = ±20 %).
+            jitter: map = 0.0;
+            /// Seed of the variation.
+            seed: value(u64) = 0;
         }
     }
 }
@@ -93,30 +67,8 @@ impl OperatorKind for Length {
     const NAME: &'static str = "length";
     const SUMMARY: &'static str =
         "Scales hair length by `scale`, ± `jitter` (a fraction) per hair.";
-    type Spec = LengthSpec;
     type Params = LengthParams;
-    const RULES: &'static [Rule] = &[Rule::new("scale", Bound::at_least(0.0), "a factor")];
     const SALTS: &'static [(&'static str, u64)] = &[("JITTER", JITTER_SALT)];
-
-    fn mask(spec: &LengthSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &LengthSpec, r: &mut SpecReader<'_>) -> Result<LengthParams, GroomError> {
-        Ok(LengthParams {
-            scale: r.map("scale", &s.scale)?,
-            jitter: r.map("jitter", &s.jitter)?,
-            seed: s.seed,
-        })
-    }
-
-    fn maps(p: &LengthParams) -> Vec<(&'static str, &Map)> {
-        vec![("scale", &p.scale), ("jitter", &p.jitter)]
-    }
-
-    fn maps_mut(p: &mut LengthParams) -> Vec<(&'static str, &mut Map)> {
-        vec![("scale", &mut p.scale), ("jitter", &mut p.jitter)]
-    }
 
     fn prepare(p: LengthParams, cx: &Preparation<'_>) -> Result<Self, GroomError> {
         Ok(Length::new(p.scale, p.jitter, cx.seed(p.seed)))

@@ -26,6 +26,7 @@ mod mask;
 mod noise;
 mod opacity;
 mod root_to_tip;
+pub(crate) mod settings;
 mod strands;
 mod twist;
 mod width;
@@ -45,11 +46,12 @@ pub use strands::{Strands, StrandsParams};
 pub use twist::{Twist, TwistParams};
 pub use width::Width;
 
-pub(crate) use color::color_maps_mut;
-pub(crate) use color::read_color;
+pub use color::ColorSpec;
 pub use kind::OperatorSchema;
-pub(crate) use kind::{ChainSoFar, OpKey, Preparation, SpecReader, map_on_mesh, schema_of};
-pub(crate) use root_to_tip::root_to_tip_maps_mut;
+pub(crate) use kind::{ChainSoFar, OpKey, Preparation, schema_of};
+pub use root_to_tip::{RootToTip, RootToTipSpec};
+pub(crate) use settings::{OperatorSettings, SpecReader, map_on_mesh};
+pub use settings::{SettingSchema, Start};
 
 use crate::groom::error::GroomError;
 use crate::groom::values::MapValue;
@@ -60,30 +62,30 @@ use kind::{OperatorKind, operators};
 // and `Operator` and their dispatch are derived from it (`kind.rs`).
 operators! {
     /// Perlin displacement ([`Noise`]).
-    Noise(Noise, NoiseParams, noise::NoiseSpec),
+    Noise(Noise, NoiseParams),
     /// Per-hair random high-frequency displacement ([`Frizz`]).
-    Frizz(Frizz, FrizzParams, frizz::FrizzSpec),
+    Frizz(Frizz, FrizzParams),
     /// Pull hairs toward clump centre hairs ([`Clump`]).
-    Clump(Clump, ClumpParams, clump::ClumpSpec),
+    Clump(Clump, ClumpParams),
     /// Helix around the hair's path ([`Curl`]).
-    Curl(Curl, CurlParams, curl::CurlSpec),
+    Curl(Curl, CurlParams),
     /// Cut at a curve parameter ([`Cut`]).
-    Cut(Cut, Cut, cut::CutSpec),
+    Cut(Cut, Cut),
     /// Scale the length ([`Length`]).
-    Length(Length, LengthParams, length::LengthSpec),
+    Length(Length, LengthParams),
     /// Each hair becomes a strand of hairs ([`Strands`]).
-    Strands(Strands, StrandsParams, strands::StrandsSpec),
+    Strands(Strands, StrandsParams),
     /// Widths root to tip ([`Width`]).
-    Width(Width, RootToTip, crate::groom::values::RootToTipSpec),
+    Width(Width, RootToTip),
     /// Colours root to tip ([`Color`]).
-    Color(Color, Color, crate::groom::values::ColorSpec),
+    Color(Color, Color),
     /// Opacities root to tip ([`Opacity`]).
-    Opacity(Opacity, RootToTip, crate::groom::values::RootToTipSpec),
+    Opacity(Opacity, RootToTip),
     /// Hairs turned about their root–tip axis ([`Twist`]).
-    Twist(Twist, TwistParams, twist::TwistSpec),
+    Twist(Twist, TwistParams),
     /// A fraction of the hairs lengthened and pushed off their clump
     /// ([`Flyaways`]).
-    Flyaways(Flyaways, FlyawaysParams, flyaways::FlyawaysSpec),
+    Flyaways(Flyaways, FlyawaysParams),
 }
 
 use crate::curves::frames::{catmull_rom_tangents, rotation_minimizing_normals};
@@ -369,21 +371,6 @@ pub(crate) fn jittered(jitter: f32, rng: &mut SampleRng) -> f32 {
     }
 }
 
-/// A root-to-tip quantity: `root + ramp(t) · (tip − root)`.
-#[derive(Debug, Clone)]
-pub struct RootToTip {
-    /// Value at the root.
-    pub root: Map,
-    /// Value at the tip.
-    pub tip: Map,
-    /// Profile.
-    pub ramp: Ramp,
-    /// Per-hair random variation, a fraction.
-    pub jitter: Map,
-    /// Seed of the variation.
-    pub seed: u64,
-}
-
 #[cfg(test)]
 pub(crate) mod test_hairs {
     use super::*;
@@ -442,6 +429,47 @@ mod registry_tests {
                 rule.key
             );
         }
+    }
+
+    #[test]
+    fn every_required_setting_starts_where_a_groom_file_reads_it() {
+        // Front ends start a new operator from the schema (the Blender
+        // panel): a required setting without a start, or one a groom file
+        // refuses (`count = 200.0`), would leave the entry unusable.
+        for op in operator_schema() {
+            let mut keys = Vec::new();
+            for setting in &op.settings {
+                let start = match setting.start {
+                    Some(Start::Number(x) | Start::Length(x)) => format!("{x:?}"),
+                    Some(Start::Rgb([r, g, b])) => format!("[{r:?}, {g:?}, {b:?}]"),
+                    None if setting.required => {
+                        panic!("{}.{} is required and has no start", op.name, setting.name)
+                    }
+                    None => continue,
+                };
+                // As the Python binding hands it over: whole numbers whole.
+                let start = start.strip_suffix(".0").unwrap_or(&start).to_string();
+                keys.push(format!("{} = {start}", setting.name));
+            }
+            let text = format!(
+                "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[[ops]]\n{} = {{ {} }}\n",
+                op.name,
+                keys.join(", ")
+            );
+            let source = crate::settings::SettingsSource {
+                path: "ops.toml".into(),
+                text,
+            };
+            source
+                .check_groom()
+                .unwrap_or_else(|e| panic!("{}: {e}", op.name));
+        }
+        let width = operator_schema().into_iter().find(|s| s.name == "width");
+        let root = &width.unwrap().settings[0];
+        assert_eq!(
+            (root.name, root.start),
+            ("root", Some(Start::Length(0.002)))
+        );
     }
 
     #[test]

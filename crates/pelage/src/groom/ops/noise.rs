@@ -2,75 +2,36 @@
 //! noise added to the hair curve's vertices"): every hair displaced by one
 //! smooth vector field in space, so neighbouring hairs wave alike.
 
-use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::kind::{OperatorKind, Preparation};
+use super::settings::{Start, operator_settings};
 use super::{Hair, RampTables, Resampling, RootContext, Scratch};
 use crate::groom::error::GroomError;
 use crate::groom::ramp::Ramp;
-use crate::groom::values::MapValue;
 use crate::limits::MAX_CURVE_POINTS;
 use crate::map::{Map, NoiseMap};
-use crate::settings::{Bound, Rule};
+use crate::settings::Bound;
 use glam::Vec3;
-use serde::Deserialize;
 
-/// `noise` as a groom file writes it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct NoiseSpec {
-    /// Largest displacement (world units).
-    pub amplitude: MapValue,
-    /// Noise cycles per world unit.
-    #[serde(default = "default_frequency")]
-    pub frequency: MapValue,
-    /// Root-to-tip profile of the amplitude.
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Noise vectors sampled along each hair, interpolated between (0:
-    /// one at every point).
-    #[serde(default = "default_vectors")]
-    pub vectors: usize,
-    /// Seed of the noise field.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-fn default_frequency() -> MapValue {
-    default_map(10.0)
-}
-
-fn default_vectors() -> usize {
-    5
-}
-
-/// `noise`: see [`Noise`].
-#[derive(Debug, Clone)]
-pub struct NoiseParams {
-    /// Largest displacement (world units).
-    pub amplitude: Map,
-    /// Noise cycles per world unit.
-    pub frequency: Map,
-    /// Root-to-tip profile of the amplitude.
-    pub ramp: Ramp,
-    /// Noise vectors sampled along each hair, interpolated between (0: one
-    /// at every point).
-    pub vectors: usize,
-    /// Seed of the noise field.
-    pub seed: u64,
-}
-
-impl NoiseParams {
-    /// Noise of `amplitude`; a groom file's defaults for the rest
-    /// (frequency 10, linear ramp, 5 vectors, seed 0).
-    pub fn new(amplitude: Map) -> Self {
-        Self {
-            amplitude,
-            frequency: Map::Constant(10.0),
-            ramp: Ramp::default(),
-            vectors: default_vectors(),
-            seed: 0,
+operator_settings! {
+    /// `noise` as a groom file writes it.
+    pub(crate) spec NoiseSpec;
+    /// `noise`: see [`Noise`].
+    params NoiseParams {
+        required {
+            /// Largest displacement (world units).
+            amplitude: map, start Start::Length(0.004);
+        }
+        optional {
+            /// Noise cycles per world unit.
+            frequency: map = 10.0, rule Bound::at_least(0.0), "cycles per unit";
+            /// Root-to-tip profile of the amplitude.
+            ramp: value(Ramp) = Ramp::default();
+            /// Noise vectors sampled along each hair, interpolated between
+            /// (0: one at every point).
+            vectors: value(usize) = 5,
+                rule Bound::Within(0.0, MAX_CURVE_POINTS as f64), "noise vectors per hair";
+            /// Seed of the noise field.
+            seed: value(u64) = 0;
         }
     }
 }
@@ -79,41 +40,7 @@ impl OperatorKind for Noise {
     const NAME: &'static str = "noise";
     const SUMMARY: &'static str =
         "Perlin displacement of every point, `amplitude` world units at most.";
-    type Spec = NoiseSpec;
     type Params = NoiseParams;
-    const RULES: &'static [Rule] = &[
-        Rule::new(
-            "vectors",
-            Bound::Within(0.0, MAX_CURVE_POINTS as f64),
-            "noise vectors per hair",
-        ),
-        Rule::new("frequency", Bound::at_least(0.0), "cycles per unit"),
-    ];
-
-    fn mask(spec: &NoiseSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &NoiseSpec, r: &mut SpecReader<'_>) -> Result<NoiseParams, GroomError> {
-        Ok(NoiseParams {
-            amplitude: r.map("amplitude", &s.amplitude)?,
-            frequency: r.map("frequency", &s.frequency)?,
-            ramp: s.ramp.clone(),
-            vectors: s.vectors,
-            seed: s.seed,
-        })
-    }
-
-    fn maps(p: &NoiseParams) -> Vec<(&'static str, &Map)> {
-        vec![("amplitude", &p.amplitude), ("frequency", &p.frequency)]
-    }
-
-    fn maps_mut(p: &mut NoiseParams) -> Vec<(&'static str, &mut Map)> {
-        vec![
-            ("amplitude", &mut p.amplitude),
-            ("frequency", &mut p.frequency),
-        ]
-    }
 
     fn prepare(p: NoiseParams, cx: &Preparation<'_>) -> Result<Self, GroomError> {
         Ok(Noise::new(

@@ -1,11 +1,10 @@
 //! `opacity`: hair opacities from root to tip, as `width` does widths.
 
-use super::kind::{OperatorKind, Preparation, SpecReader};
-use super::root_to_tip::{root_to_tip, root_to_tip_maps, root_to_tip_maps_mut};
+use super::kind::{OperatorKind, Preparation};
+use super::root_to_tip::root_to_tip;
+use super::settings::Start;
 use super::{Hair, RootContext, RootToTip, Scratch};
 use crate::groom::error::GroomError;
-use crate::groom::values::{MapValue, RootToTipSpec};
-use crate::map::Map;
 use crate::settings::{Bound, Rule};
 
 /// The per-hair jitter.
@@ -18,30 +17,15 @@ pub struct Opacity(pub RootToTip);
 impl OperatorKind for Opacity {
     const NAME: &'static str = "opacity";
     const SUMMARY: &'static str = "Opacities from `root` to `tip`.";
-    type Spec = RootToTipSpec;
     type Params = RootToTip;
     const RULES: &'static [Rule] = &[
         Rule::new("root", Bound::Within(0.0, 1.0), "an opacity"),
         Rule::new("tip", Bound::Within(0.0, 1.0), "an opacity"),
     ];
+    const STARTS: &'static [(&'static str, Start)] =
+        &[("root", Start::Number(1.0)), ("tip", Start::Number(0.5))];
     const SALTS: &'static [(&'static str, u64)] = &[("JITTER", JITTER_SALT)];
     const ADDS_OPACITIES: bool = true;
-
-    fn mask(spec: &RootToTipSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &RootToTipSpec, r: &mut SpecReader<'_>) -> Result<RootToTip, GroomError> {
-        r.root_to_tip(s)
-    }
-
-    fn maps(p: &RootToTip) -> Vec<(&'static str, &Map)> {
-        root_to_tip_maps(p)
-    }
-
-    fn maps_mut(p: &mut RootToTip) -> Vec<(&'static str, &mut Map)> {
-        root_to_tip_maps_mut(p)
-    }
 
     fn prepare(p: RootToTip, _: &Preparation<'_>) -> Result<Self, GroomError> {
         Ok(Opacity(p))

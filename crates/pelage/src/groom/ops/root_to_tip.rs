@@ -3,9 +3,35 @@
 //! attributes at hair root and tip and we interpolate them to every hair
 //! vertex. Again we add some noise to hair color").
 
-use super::{RampTables, RootContext, RootToTip, jittered};
-use crate::map::Map;
+use super::settings::operator_settings;
+use super::{RampTables, RootContext, jittered};
+use crate::groom::ramp::Ramp;
 use crate::sample::SampleRng;
+
+operator_settings! {
+    /// A quantity from root to tip as a groom file writes it: `width` and
+    /// `opacity` (and `[finish.width]`, `[finish.opacity]`); see
+    /// [`crate::groom::ops::Width`].
+    pub spec RootToTipSpec;
+    /// A root-to-tip quantity: `root + ramp(t) · (tip − root)`, times
+    /// `1 ± jitter` per hair.
+    params RootToTip {
+        required {
+            /// Value at the root (a width in world units, or an opacity).
+            root: map;
+            /// Value at the tip.
+            tip: map;
+        }
+        optional {
+            /// Profile from root to tip.
+            ramp: value(Ramp) = Ramp::default();
+            /// Per-hair random variation, a fraction.
+            jitter: map = 0.0;
+            /// Seed of the variation.
+            seed: value(u64) = 0;
+        }
+    }
+}
 
 /// Evaluates a [`RootToTip`] along a hair into `out` (resized to the
 /// hair's point count).
@@ -36,24 +62,10 @@ pub(super) fn varied(jitter: f32, seed: u64, hair_id: u64) -> f32 {
     }
 }
 
-/// The maps of a root-to-tip setting, by name.
-pub(crate) fn root_to_tip_maps(s: &RootToTip) -> Vec<(&'static str, &Map)> {
-    vec![("root", &s.root), ("tip", &s.tip), ("jitter", &s.jitter)]
-}
-
-/// The maps of a root-to-tip setting, to change.
-pub(crate) fn root_to_tip_maps_mut(s: &mut RootToTip) -> Vec<(&'static str, &mut Map)> {
-    vec![
-        ("root", &mut s.root),
-        ("tip", &mut s.tip),
-        ("jitter", &mut s.jitter),
-    ]
-}
-
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::groom::ramp::Ramp;
+    use crate::map::Map;
 
     /// A root-to-tip quantity of constants.
     pub fn spec(root: f32, tip: f32, jitter: f32) -> RootToTip {

@@ -4,72 +4,39 @@
 //! spread of hair roots and tips from the basic hair, twisting of hair
 //! around the basic hair".
 
-use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::kind::{OperatorKind, Preparation};
+use super::settings::{Start, operator_settings};
 use super::{HairBatch, RootContext, Scratch};
 use crate::groom::error::{GroomError, GroomErrorKind};
-use crate::groom::values::MapValue;
 use crate::limits::MAX_STRANDS;
 use crate::map::Map;
 use crate::sample::SampleRng;
-use crate::settings::{Bound, Rule};
-use serde::Deserialize;
+use crate::settings::Bound;
 use std::f32::consts::TAU;
-use toml::Spanned;
 
 /// Where each strand hair sits around its base hair.
 const SPREAD_SALT: u64 = 0x57_2A4D;
 
-/// `strands` as a groom file writes it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct StrandsSpec {
-    /// Hairs per strand.
-    pub count: Spanned<u32>,
-    /// Spread around the base hair at the root (world units).
-    #[serde(default = "nothing")]
-    pub root_spread: MapValue,
-    /// Spread at the tip.
-    pub tip_spread: MapValue,
-    /// Turns of the strand's hairs around the base hair, root to tip.
-    #[serde(default = "nothing")]
-    pub twist: MapValue,
-    /// Seed.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-fn nothing() -> MapValue {
-    default_map(0.0)
-}
-
-/// `strands`: see [`Strands`].
-#[derive(Debug, Clone)]
-pub struct StrandsParams {
-    /// Hairs per strand (at least 1).
-    pub count: u32,
-    /// Spread around the base hair at the root (world units).
-    pub root_spread: Map,
-    /// Spread at the tip.
-    pub tip_spread: Map,
-    /// Turns of the strand's hairs around the base hair, root to tip.
-    pub twist: Map,
-    /// Seed.
-    pub seed: u64,
-}
-
-impl StrandsParams {
-    /// Strands of `count` hairs spreading to `tip_spread`; no root spread,
-    /// no twist, seed 0.
-    pub fn new(count: u32, tip_spread: Map) -> Self {
-        Self {
-            count,
-            root_spread: Map::Constant(0.0),
-            tip_spread,
-            twist: Map::Constant(0.0),
-            seed: 0,
+operator_settings! {
+    /// `strands` as a groom file writes it.
+    pub(crate) spec StrandsSpec;
+    /// `strands`: see [`Strands`].
+    params StrandsParams {
+        required {
+            /// Hairs per strand.
+            count: count(u32), start Start::Number(3.0),
+                rule Bound::Within(1.0, MAX_STRANDS as f64), "hairs per strand";
+            /// Spread at the tip (world units).
+            tip_spread: map, start Start::Length(0.002);
+        }
+        optional {
+            /// Spread around the base hair at the root (world units).
+            root_spread: map = 0.0;
+            /// Turns of the strand's hairs around the base hair, root to
+            /// tip.
+            twist: map = 0.0;
+            /// Seed.
+            seed: value(u64) = 0;
         }
     }
 }
@@ -143,45 +110,9 @@ impl Strands {
 impl OperatorKind for Strands {
     const NAME: &'static str = "strands";
     const SUMMARY: &'static str = "Each hair becomes a strand of `count` hairs.";
-    type Spec = StrandsSpec;
     type Params = StrandsParams;
-    const RULES: &'static [Rule] = &[Rule::new(
-        "count",
-        Bound::Within(1.0, MAX_STRANDS as f64),
-        "hairs per strand",
-    )];
     const SALTS: &'static [(&'static str, u64)] = &[("SPREAD", SPREAD_SALT)];
     const KEEPS_ONE_HAIR: bool = false;
-
-    fn mask(spec: &StrandsSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &StrandsSpec, r: &mut SpecReader<'_>) -> Result<StrandsParams, GroomError> {
-        Ok(StrandsParams {
-            count: r.value("count", &s.count),
-            root_spread: r.map("root_spread", &s.root_spread)?,
-            tip_spread: r.map("tip_spread", &s.tip_spread)?,
-            twist: r.map("twist", &s.twist)?,
-            seed: s.seed,
-        })
-    }
-
-    fn maps(p: &StrandsParams) -> Vec<(&'static str, &Map)> {
-        vec![
-            ("root_spread", &p.root_spread),
-            ("tip_spread", &p.tip_spread),
-            ("twist", &p.twist),
-        ]
-    }
-
-    fn maps_mut(p: &mut StrandsParams) -> Vec<(&'static str, &mut Map)> {
-        vec![
-            ("root_spread", &mut p.root_spread),
-            ("tip_spread", &mut p.tip_spread),
-            ("twist", &mut p.twist),
-        ]
-    }
 
     fn counts(p: &StrandsParams) -> Vec<(&'static str, u64, u64, &'static str)> {
         vec![("count", u64::from(p.count), MAX_STRANDS, "hairs a strand")]

@@ -4,66 +4,35 @@
 //! the line from the root through the tip. The root and the tip stay
 //! where they are; the hair's bends wind around its chord.
 
-use super::kind::{OperatorKind, Preparation, SpecReader, default_map};
+use super::kind::{OperatorKind, Preparation};
 use super::root_to_tip::varied;
+use super::settings::{Start, operator_settings};
 use super::{Hair, RootContext, Scratch};
 use crate::groom::error::GroomError;
 use crate::groom::ramp::Ramp;
-use crate::groom::values::MapValue;
-use crate::map::Map;
 use glam::{Quat, Vec3};
-use serde::Deserialize;
 
 /// The per-hair jitter of the angle.
 const JITTER_SALT: u64 = 0x7_3157;
 
-/// `twist` as a groom file writes it.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct TwistSpec {
-    /// Angle at the tip, in degrees (positive: counter-clockwise looking
-    /// from the tip down to the root).
-    pub angle: MapValue,
-    /// Root-to-tip profile of the angle.
-    #[serde(default)]
-    pub ramp: Ramp,
-    /// Per-hair random variation of the angle, a fraction (0.2 = ±20 %).
-    #[serde(default = "no_jitter")]
-    pub jitter: MapValue,
-    /// Seed of the variation.
-    #[serde(default)]
-    pub seed: u64,
-    /// Where the operator acts: its effect is faded by this map (0: none,
-    /// 1: full).
-    pub mask: Option<MapValue>,
-}
-
-fn no_jitter() -> MapValue {
-    default_map(0.0)
-}
-
-/// `twist`: see [`Twist`].
-#[derive(Debug, Clone)]
-pub struct TwistParams {
-    /// Angle at the tip, in degrees.
-    pub angle: Map,
-    /// Root-to-tip profile of the angle.
-    pub ramp: Ramp,
-    /// Per-hair random variation, a fraction.
-    pub jitter: Map,
-    /// Seed of the variation.
-    pub seed: u64,
-}
-
-impl TwistParams {
-    /// A twist of `angle` degrees at the tip, linear ramp, no jitter,
-    /// seed 0.
-    pub fn new(angle: Map) -> Self {
-        Self {
-            angle,
-            ramp: Ramp::default(),
-            jitter: Map::Constant(0.0),
-            seed: 0,
+operator_settings! {
+    /// `twist` as a groom file writes it.
+    pub(crate) spec TwistSpec;
+    /// `twist`: see [`Twist`].
+    params TwistParams {
+        required {
+            /// Angle at the tip, in degrees (positive: counter-clockwise
+            /// looking from the tip down to the root).
+            angle: map, start Start::Number(90.0);
+        }
+        optional {
+            /// Root-to-tip profile of the angle.
+            ramp: value(Ramp) = Ramp::default();
+            /// Per-hair random variation of the angle, a fraction (0.2 =
+            /// ±20 %).
+            jitter: map = 0.0;
+            /// Seed of the variation.
+            seed: value(u64) = 0;
         }
     }
 }
@@ -76,30 +45,8 @@ impl OperatorKind for Twist {
     const NAME: &'static str = "twist";
     const SUMMARY: &'static str =
         "Turns each hair about its root–tip axis, `angle` degrees at the tip.";
-    type Spec = TwistSpec;
     type Params = TwistParams;
     const SALTS: &'static [(&'static str, u64)] = &[("JITTER", JITTER_SALT)];
-
-    fn mask(spec: &TwistSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &TwistSpec, r: &mut SpecReader<'_>) -> Result<TwistParams, GroomError> {
-        Ok(TwistParams {
-            angle: r.map("angle", &s.angle)?,
-            ramp: s.ramp.clone(),
-            jitter: r.map("jitter", &s.jitter)?,
-            seed: s.seed,
-        })
-    }
-
-    fn maps(p: &TwistParams) -> Vec<(&'static str, &Map)> {
-        vec![("angle", &p.angle), ("jitter", &p.jitter)]
-    }
-
-    fn maps_mut(p: &mut TwistParams) -> Vec<(&'static str, &mut Map)> {
-        vec![("angle", &mut p.angle), ("jitter", &mut p.jitter)]
-    }
 
     fn prepare(mut p: TwistParams, cx: &Preparation<'_>) -> Result<Self, GroomError> {
         p.seed = cx.seed(p.seed);
@@ -132,6 +79,7 @@ mod tests {
     use super::super::test_hairs::root;
     use super::super::{Hair, param};
     use super::*;
+    use crate::map::Map;
 
     /// A hair bowed sideways (+X) between a root at the origin and a tip
     /// on +Z: every point but the ends lies off the axis.

@@ -1,11 +1,10 @@
 //! `width`: hair widths from root to tip (Sik §4.2.2).
 
-use super::kind::{OperatorKind, Preparation, SpecReader};
-use super::root_to_tip::{root_to_tip, root_to_tip_maps, root_to_tip_maps_mut};
+use super::kind::{OperatorKind, Preparation};
+use super::root_to_tip::root_to_tip;
+use super::settings::Start;
 use super::{Hair, RootContext, RootToTip, Scratch};
 use crate::groom::error::GroomError;
-use crate::groom::values::{MapValue, RootToTipSpec};
-use crate::map::Map;
 use crate::settings::{Bound, Rule};
 
 /// The per-hair jitter.
@@ -18,29 +17,16 @@ pub struct Width(pub RootToTip);
 impl OperatorKind for Width {
     const NAME: &'static str = "width";
     const SUMMARY: &'static str = "Widths (diameters) from `root` to `tip`.";
-    type Spec = RootToTipSpec;
     type Params = RootToTip;
     const RULES: &'static [Rule] = &[
         Rule::new("root", Bound::at_least(0.0), "a width"),
         Rule::new("tip", Bound::at_least(0.0), "a width"),
     ];
+    const STARTS: &'static [(&'static str, Start)] = &[
+        ("root", Start::Length(0.002)),
+        ("tip", Start::Length(0.0002)),
+    ];
     const SALTS: &'static [(&'static str, u64)] = &[("JITTER", JITTER_SALT)];
-
-    fn mask(spec: &RootToTipSpec) -> Option<&MapValue> {
-        spec.mask.as_ref()
-    }
-
-    fn read(s: &RootToTipSpec, r: &mut SpecReader<'_>) -> Result<RootToTip, GroomError> {
-        r.root_to_tip(s)
-    }
-
-    fn maps(p: &RootToTip) -> Vec<(&'static str, &Map)> {
-        root_to_tip_maps(p)
-    }
-
-    fn maps_mut(p: &mut RootToTip) -> Vec<(&'static str, &mut Map)> {
-        root_to_tip_maps_mut(p)
-    }
 
     fn prepare(p: RootToTip, _: &Preparation<'_>) -> Result<Self, GroomError> {
         Ok(Width(p))
