@@ -847,7 +847,7 @@ fn groom_error(error: GroomError, from_values: bool) -> PyErr {
         return to_py_err(error);
     }
     let mut message = String::from("groom");
-    if let Some(key) = &error.key {
+    if let Some(key) = &error.at.key {
         message.push_str(": ");
         message.push_str(key);
     }

@@ -47,6 +47,7 @@ pub mod anim;
 pub mod assets;
 pub mod curves;
 pub mod dynamics;
+pub mod error;
 pub mod groom;
 pub mod guides;
 pub mod interp;

@@ -118,19 +118,44 @@ pub const MAX_UDIM_PIXELS: u64 = 1 << 28;
 /// limit of 1,024 open files.
 pub const MAX_OPEN_FRAME_FILES: usize = 64;
 
+/// A count refused by [`check_count`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum CountError {
+    /// Zero where at least one is needed.
+    #[error("0 {what}: use at least 1")]
+    Zero {
+        /// What is counted.
+        what: String,
+    },
+    /// More than pelage's limit.
+    #[error(
+        "{} {what} is more than pelage's limit of {} (docs/limits.md says why and how to raise it)",
+        grouped(*value as f64),
+        grouped(*max as f64)
+    )]
+    OverLimit {
+        /// The count.
+        value: u64,
+        /// The limit.
+        max: u64,
+        /// What is counted.
+        what: String,
+    },
+}
+
 /// A count that must lie in `1..=max` (or `0..=max` when `zero_ok`);
 /// the error says what is wrong without naming the setting, which the
 /// caller adds ("roots.count: …").
-pub fn check_count(value: u64, max: u64, zero_ok: bool, what: &str) -> Result<(), String> {
+pub fn check_count(value: u64, max: u64, zero_ok: bool, what: &str) -> Result<(), CountError> {
     if value == 0 && !zero_ok {
-        return Err(format!("0 {what}: use at least 1"));
+        return Err(CountError::Zero { what: what.into() });
     }
     if value > max {
-        return Err(format!(
-            "{} {what} is more than pelage's limit of {} (docs/limits.md says why and how to raise it)",
-            grouped(value as f64),
-            grouped(max as f64)
-        ));
+        return Err(CountError::OverLimit {
+            value,
+            max,
+            what: what.into(),
+        });
     }
     Ok(())
 }
@@ -164,13 +189,24 @@ mod tests {
         assert!(check_count(10, 10, false, "hairs").is_ok());
         let err = check_count(11, 10, false, "hairs").unwrap_err();
         assert!(
-            err.starts_with("11 hairs is more than pelage's limit of 10"),
+            matches!(
+                err,
+                CountError::OverLimit {
+                    value: 11,
+                    max: 10,
+                    ..
+                }
+            ),
             "{err}"
         );
-        assert_eq!(
-            check_count(0, 10, false, "hairs").unwrap_err(),
-            "0 hairs: use at least 1"
+        assert!(
+            err.to_string()
+                .starts_with("11 hairs is more than pelage's limit of 10"),
+            "{err}"
         );
+        let zero = check_count(0, 10, false, "hairs").unwrap_err();
+        assert!(matches!(zero, CountError::Zero { .. }));
+        assert_eq!(zero.to_string(), "0 hairs: use at least 1");
         assert!(check_count(0, 10, true, "steps").is_ok());
     }
 

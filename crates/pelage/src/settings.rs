@@ -4,6 +4,7 @@
 //! wraps these places in its own error type ([`crate::groom::GroomError`],
 //! [`crate::shell::SceneError`]).
 
+use crate::error::Where;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -14,17 +15,6 @@ pub struct SettingsSource {
     pub path: PathBuf,
     /// Its text.
     pub text: String,
-}
-
-/// Where in a settings file something is: line and column (1-based) and
-/// the dotted key written there, with its table. Both `None` for a
-/// default value, which has no place in the file.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Place {
-    /// Line and column.
-    pub line: Option<(usize, usize)>,
-    /// The key, with its table (`roots.count`).
-    pub key: Option<String>,
 }
 
 impl SettingsSource {
@@ -51,7 +41,7 @@ impl SettingsSource {
     /// (`[[ops]]`, `[[droplets]]`): TOML then reads it as one table and
     /// serde's complaint ("invalid type: map, expected a sequence", or
     /// "duplicate key" for the second) does not say what to write.
-    pub fn single_bracket_list(&self, lists: &[&str]) -> Option<(Place, String)> {
+    pub fn single_bracket_list(&self, lists: &[&str]) -> Option<(Where, String)> {
         let mut offset = 0;
         for line in self.text.split_inclusive('\n') {
             let code = line.split('#').next().unwrap_or("").trim();
@@ -77,7 +67,7 @@ impl SettingsSource {
 
     /// Parses the text with serde; a failure comes with its place (unknown
     /// keys, wrong types, unknown enum values with the accepted ones).
-    pub fn deserialize<T: serde::de::DeserializeOwned>(&self) -> Result<T, (Place, String)> {
+    pub fn deserialize<T: serde::de::DeserializeOwned>(&self) -> Result<T, (Where, String)> {
         toml::from_str(&self.text).map_err(|e| {
             let place = e.span().map(|s| self.place(s)).unwrap_or_default();
             (place, e.message().to_string())
@@ -86,16 +76,13 @@ impl SettingsSource {
 
     /// The place of a span of the text; nowhere for a default value (the
     /// empty span at 0).
-    pub fn place(&self, span: Range<usize>) -> Place {
+    pub fn place(&self, span: Range<usize>) -> Where {
         if span == (0..0) {
-            return Place::default();
+            return Where::default();
         }
         let start = span.start.min(self.text.len());
         let line_start = self.text[..start].rfind('\n').map_or(0, |i| i + 1);
-        Place {
-            line: self.line_of(span),
-            key: key_at(&self.text, line_start, start),
-        }
+        Where::at(self.line_of(span), key_at(&self.text, line_start, start))
     }
 
     /// Line and column (1-based) of a span of the text; `None` for a
@@ -333,7 +320,7 @@ impl SettingsSource {
     /// those `rules` name must lie in their bounds. Call after
     /// [`Self::deserialize`] succeeded; the error is the first offending
     /// value's place and what is wrong with it.
-    pub fn check(&self, rules: &[Rule]) -> Result<(), (Place, String)> {
+    pub fn check(&self, rules: &[Rule]) -> Result<(), (Where, String)> {
         use toml::de::{DeTable, DeValue};
         let Ok(table) = DeTable::parse(&self.text) else {
             // Serde parsed the same text: nothing to check here.
@@ -344,7 +331,7 @@ impl SettingsSource {
             rules: &[Rule],
             path: &str,
             value: &toml::Spanned<DeValue<'_>>,
-        ) -> Result<(), (Place, String)> {
+        ) -> Result<(), (Where, String)> {
             let refuse = |message: String| Err((source.place(value.span()), message));
             let number = match value.get_ref() {
                 DeValue::Table(table) => {
@@ -416,7 +403,7 @@ mod tests {
     #[test]
     fn numbers_outside_their_rule_are_refused_at_their_place() {
         let (place, message) = source("[roots]\ncount = 101\n").check(RULES).unwrap_err();
-        assert_eq!(place.line, Some((2, 9)));
+        assert_eq!(place.line_column(), Some((2, 9)));
         assert_eq!(place.key.as_deref(), Some("roots.count"));
         assert_eq!(message, "101: use 1 to 100 (a test ceiling)");
         // Array tables: the rule holds for every entry.
@@ -452,7 +439,7 @@ mod tests {
     fn a_list_written_as_one_table_says_how_to_write_it() {
         let text = "[mesh]\npath = \"spot\"\n[ops]  # operators\nclump = {}\n";
         let (place, message) = source(text).single_bracket_list(&["ops"]).unwrap();
-        assert_eq!(place.line, Some((3, 1)));
+        assert_eq!(place.line_column(), Some((3, 1)));
         assert!(message.contains("write [[ops]]"), "{message}");
         assert!(source("[[ops]]\n").single_bracket_list(&["ops"]).is_none());
     }

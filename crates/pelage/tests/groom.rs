@@ -206,15 +206,18 @@ fn a_groom_built_in_code_equals_the_same_groom_file() {
     // (and, from a file, by line).
     let mut zero = every_operator_in_code();
     zero.roots.count = 0;
-    let err = zero.generator().unwrap_err().to_string();
+    let err = zero.generator().unwrap_err();
+    assert!(matches!(err.kind, GroomErrorKind::OutOfRange(_)), "{err}");
+    assert_eq!(err.at.key.as_deref(), Some("roots.count"));
     assert_eq!(
-        err,
+        err.to_string(),
         "<groom>: roots.count: the hair count must be at least 1"
     );
     let mut no_strand = every_operator_in_code();
     no_strand.ops[9] = GroomOp::Strands(StrandsParams::new(0, Map::Constant(0.1)));
-    let err = no_strand.generator().unwrap_err().to_string();
-    assert!(err.starts_with("<groom>: ops[9].strands.count: "), "{err}");
+    let err = no_strand.generator().unwrap_err();
+    assert!(matches!(err.kind, GroomErrorKind::OutOfRange(_)), "{err}");
+    assert_eq!(err.at.key.as_deref(), Some("ops[9].strands.count"), "{err}");
 }
 
 #[test]
@@ -381,9 +384,9 @@ fn operator_settings_out_of_range_built_in_code_are_refused_as_a_file_refuses_th
             .unwrap_err();
         let spec = GroomSpec::new(mesh.clone(), guides.clone(), RootsSpec::new(100)).with_op(op);
         let from_code = spec.generator().map(drop).unwrap_err();
-        assert_eq!(from_code.key, from_file.key, "{table}");
+        assert_eq!(from_code.at.key, from_file.at.key, "{table}");
         match (&from_code.kind, &from_file.kind) {
-            (GroomErrorKind::Invalid(code), GroomErrorKind::Invalid(file)) => {
+            (GroomErrorKind::OutOfRange(code), GroomErrorKind::OutOfRange(file)) => {
                 assert_eq!(code, file, "{table}")
             }
             kinds => panic!("{table}: {kinds:?}"),
@@ -392,10 +395,13 @@ fn operator_settings_out_of_range_built_in_code_are_refused_as_a_file_refuses_th
 }
 
 fn error(text: &str) -> String {
-    let e: GroomError = Groom::from_text("fur/test.toml", text)
+    typed_error(text).to_string()
+}
+
+fn typed_error(text: &str) -> GroomError {
+    Groom::from_text("fur/test.toml", text)
         .and_then(|g| g.generator(None).map(|_| ()))
-        .unwrap_err();
-    e.to_string()
+        .unwrap_err()
 }
 
 #[test]
@@ -421,8 +427,16 @@ fn errors_name_the_file_line_and_key() {
         "{method}"
     );
 
-    let guides = error("[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\npoints = 4\n");
-    assert!(guides.contains("guides: give exactly one of"), "{guides}");
+    let guides =
+        typed_error("[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\npoints = 4\n");
+    assert!(
+        matches!(guides.kind, GroomErrorKind::Conflict(_)),
+        "{guides}"
+    );
+    assert!(
+        guides.to_string().contains("guides: give exactly one of"),
+        "{guides}"
+    );
 
     let zero = error(
         "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[guides]\ngenerate = { count = 5, length = 0.1 }\n[[ops]]\nstrands = { count = 0, tip_spread = 0.1 }\n",
@@ -540,10 +554,12 @@ fn a_mesh_and_guides_given_as_values_replace_the_files() {
         ..GroomInputs::default()
     };
     let e = Groom::from_source_with_inputs(source(text), None, twice).unwrap_err();
-    assert_eq!(e.key.as_deref(), Some("guides"), "{e}");
+    assert_eq!(e.at.key.as_deref(), Some("guides"), "{e}");
+    assert!(matches!(e.kind, GroomErrorKind::Conflict(_)), "{e}");
     let e = Groom::from_source_with_inputs(source(no_guides), None, GroomInputs::default())
         .unwrap_err();
-    assert_eq!(e.key.as_deref(), Some("mesh"), "{e}");
+    assert_eq!(e.at.key.as_deref(), Some("mesh"), "{e}");
+    assert!(matches!(e.kind, GroomErrorKind::Conflict(_)), "{e}");
 }
 
 /// The groom's hairs, all parts joined.
@@ -828,6 +844,10 @@ fn a_z_up_usd_guide_file_is_turned_to_the_meshs_y_up() {
     // The same points in a file that says nothing of Z up stay as they
     // are, off the mesh: the turn is what binds them.
     write("unturned.usda", pelage::io::UpAxis::Y);
-    let e = from_file("unturned.usda").unwrap_err().to_string();
-    assert!(e.contains("no guide is within the tolerance"), "{e}");
+    let e = from_file("unturned.usda").unwrap_err();
+    assert!(matches!(e.kind, GroomErrorKind::Mismatch(_)), "{e}");
+    assert!(
+        e.to_string().contains("no guide is within the tolerance"),
+        "{e}"
+    );
 }

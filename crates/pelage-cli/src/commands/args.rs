@@ -15,7 +15,7 @@ pub fn count_up_to<T: TryFrom<u64>>(
             .replace('_', "")
             .parse()
             .map_err(|_| format!("{s:?} is not a whole number"))?;
-        limits::check_count(v, max, false, what)?;
+        limits::check_count(v, max, false, what).map_err(|e| e.to_string())?;
         T::try_from(v).map_err(|_| format!("{v} {what} is too many for this machine"))
     }
 }

@@ -362,9 +362,11 @@ fn assemble(groom: &Groom, output: &Path) -> anyhow::Result<()> {
             "{} → {} part files {}, extent ({:.4}, {:.4}, {:.4}) to ({:.4}, {:.4}, {:.4})",
             output.display(),
             files.len(),
-            match pelage::io::CurvesFormat::from_path(output) {
-                Some(pelage::io::CurvesFormat::Abc) => "joined",
-                _ => "referenced",
+            match pelage::io::CurvesFormat::from_path(output)
+                .is_some_and(pelage::io::CurvesFormat::assembly_joins_parts)
+            {
+                true => "joined",
+                false => "referenced",
             },
             lo.x,
             lo.y,

@@ -85,7 +85,7 @@ pub(crate) fn find_clip<'a>(
 impl GltfAnimation {
     /// The animation called `name` (or the first one when `None`) of the
     /// parsed file. Errors are messages for the mesh's error.
-    pub fn new(parsed: &ParsedGltf, name: Option<&str>) -> Result<Self, String> {
+    pub(crate) fn new(parsed: &ParsedGltf, name: Option<&str>) -> Result<Self, String> {
         let doc = &parsed.document;
         let buffers = &parsed.buffers;
         let animation = match name {

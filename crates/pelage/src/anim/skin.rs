@@ -169,7 +169,7 @@ impl AnimatedSkin {
                 (parsed.mesh, Motion::Gltf(Box::new(animation)))
             }
         } else if matches!(ext.as_str(), "usda" | "usdc" | "usd") {
-            let skin = crate::io::read_usd_skin(path).map_err(|e| crate::io::usd_mesh_error(&e))?;
+            let skin = crate::io::read_usd_skin(path).map_err(crate::io::usd_mesh_error)?;
             let mesh = Mesh::new(
                 &name,
                 skin.positions.clone(),

@@ -278,7 +278,7 @@ impl AnimatedGroom {
         if rest.len() != mesh.vertex_count() {
             return Err(spec.error(
                 "animation",
-                GroomErrorKind::Invalid(format!(
+                GroomErrorKind::Mismatch(format!(
                     "the skin has {} vertices at its rest frame but the groom's mesh has {}",
                     rest.len(),
                     mesh.vertex_count()
@@ -288,7 +288,7 @@ impl AnimatedGroom {
         if animation.mode.regrows() && guides.is_none() {
             return Err(spec.error(
                 "animation.mode",
-                GroomErrorKind::Invalid(
+                GroomErrorKind::Conflict(
                     "regrow needs animated guides: a time-sampled USD or Alembic guide file ([guides] file)"
                         .into(),
                 ),
@@ -301,7 +301,7 @@ impl AnimatedGroom {
         {
             return Err(spec.error(
                 "animation.motion_blur",
-                GroomErrorKind::Invalid(format!(
+                GroomErrorKind::OutOfRange(format!(
                     "shutter offset {bad}: offsets are fractions of a frame, between -1 and 1"
                 )),
             ));
@@ -399,7 +399,7 @@ impl AnimatedGroom {
             let Some(c) = index(i).filter(|&c| c < posed.curve_count()) else {
                 return Err(self.spec.error(
                     "guides.file",
-                    GroomErrorKind::Invalid(format!(
+                    GroomErrorKind::Mismatch(format!(
                         "at frame {time} the guides have {} curves; the rest frame bound {} of them",
                         posed.curve_count(),
                         rest.len()
@@ -413,7 +413,10 @@ impl AnimatedGroom {
         rest.with_points(points).map_err(|e| {
             self.spec.error(
                 "guides.file",
-                GroomErrorKind::Invalid(format!("at frame {time}: {e}")),
+                GroomErrorKind::CurvesAtFrame {
+                    frame: time,
+                    error: e,
+                },
             )
         })
     }
@@ -530,7 +533,7 @@ impl AnimatedGroom {
         if self.animation.mode != AnimationMode::Deform {
             return Err(self.spec.error(
                 "animation.mode",
-                GroomErrorKind::Invalid(
+                GroomErrorKind::Conflict(
                     "a regrown groom's velocities come from its neighbouring frames: write it (AnimatedGroom::write) to get them".into(),
                 ),
             ));
@@ -781,9 +784,11 @@ impl AnimatedGroom {
                         out.set_velocities(velocities).map_err(|e| {
                             GroomWriteError::Groom(self.spec.error(
                                 "animation",
-                                GroomErrorKind::Invalid(format!(
-                                    "part {p} at frame {time}: {e}; write velocities = false"
-                                )),
+                                GroomErrorKind::Velocities {
+                                    part: p,
+                                    frame: time,
+                                    error: e,
+                                },
                             ))
                         })?;
                     }
@@ -796,7 +801,7 @@ impl AnimatedGroom {
                         layer
                             .prims()
                             .write_part_at(&part_name(p), time, &out)
-                            .map_err(|e| write_error(&output.path, &e))?;
+                            .map_err(|e| write_error(&output.path, e))?;
                     }
                     if regrow_velocities
                         && let Some(entry) = grown.iter_mut().find(|(x, _)| *x == time)
@@ -821,7 +826,7 @@ impl AnimatedGroom {
         }
         let mut files = Vec::with_capacity(layers.len());
         for (output, layer) in outputs.iter().zip(layers) {
-            files.push(layer.finish().map_err(|e| write_error(&output.path, &e))?);
+            files.push(layer.finish().map_err(|e| write_error(&output.path, e))?);
         }
         for file in files {
             file.commit()?;
@@ -843,7 +848,7 @@ impl AnimatedGroom {
                 _ => {
                     return Err(GroomWriteError::Groom(self.spec.error(
                         "output.path",
-                        GroomErrorKind::Invalid(format!(
+                        GroomErrorKind::Conflict(format!(
                             "{}: animated grooms are {}",
                             output.path.display(),
                             CurvesFormat::NO_TIME_SAMPLES
@@ -858,7 +863,7 @@ impl AnimatedGroom {
                 }
                 _ => AbcWriter::new(file, options).map(|w| TimeSampledLayer::Abc(Box::new(w))),
             }
-            .map_err(|e| write_error(&output.path, &e))?;
+            .map_err(|e| write_error(&output.path, e))?;
             layers.push(layer);
         }
         Ok(layers)
@@ -879,7 +884,7 @@ impl AnimatedGroom {
                 layer
                     .prims()
                     .write_mesh_at("skin", time, &mesh)
-                    .map_err(|e| write_error(&output.path, &e))?;
+                    .map_err(|e| write_error(&output.path, e))?;
             }
         }
         Ok(())
@@ -996,11 +1001,15 @@ struct Window<'a> {
     time_codes_per_second: f64,
 }
 
-/// A writer's refusal of a prim, as the error of writing `path`.
-fn write_error(path: &Path, e: &dyn std::fmt::Display) -> GroomWriteError {
+/// A writer's refusal of a prim, as the error of writing `path` (the
+/// refusal kept typed inside: `error.get_ref()` downcasts to it).
+fn write_error(
+    path: &Path,
+    e: impl Into<Box<dyn std::error::Error + Send + Sync>>,
+) -> GroomWriteError {
     GroomWriteError::Write(crate::io::WriteError {
         path: path.to_path_buf(),
-        error: std::io::Error::other(e.to_string()),
+        error: std::io::Error::other(e),
     })
 }
 

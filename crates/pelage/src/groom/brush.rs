@@ -31,6 +31,8 @@ use crate::sample::{mix64, open_unit_pair};
 use glam::Vec3;
 use std::sync::Arc;
 
+pub use super::error::BrushRefusal;
+
 /// How a brush's effect fades from its centre (distance 0) to its rim
 /// (distance 1).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -235,7 +237,11 @@ impl Brush {
 ///
 /// # Errors
 /// A paint layer the mesh does not have; deleting every guide.
-pub fn dab_edit(groom: &EditableGroom, brush: &Brush, dab: &Dab) -> Result<Option<Edit>, String> {
+pub fn dab_edit(
+    groom: &EditableGroom,
+    brush: &Brush,
+    dab: &Dab,
+) -> Result<Option<Edit>, BrushRefusal> {
     let dabs = dab.sides();
     match brush {
         Brush::Comb
@@ -265,7 +271,7 @@ impl EditableGroom {
     /// What [`dab_edit`] and [`EditableGroom::apply`] refuse; a `part`
     /// brush on a groom whose regions are face sets.
     pub fn brush(&mut self, brush: &Brush, dab: &Dab) -> Result<Option<Regrowth>, GroomError> {
-        let invalid = |spec: &GroomSpec, m: String| spec.error("brush", GroomErrorKind::Invalid(m));
+        let invalid = |spec: &GroomSpec, kind: GroomErrorKind| spec.error("brush", kind);
         let setup = match brush {
             Brush::Paint { layer, .. } => self
                 .layer_setup(layer)
@@ -274,7 +280,7 @@ impl EditableGroom {
             _ => None,
         };
         let edit_on = |groom: &EditableGroom| {
-            dab_edit(groom, brush, dab).map_err(|m| invalid(groom.spec(), m))
+            dab_edit(groom, brush, dab).map_err(|m| invalid(groom.spec(), GroomErrorKind::Brush(m)))
         };
         match setup {
             None => match edit_on(self)? {
@@ -289,11 +295,11 @@ impl EditableGroom {
     }
 
     /// The groom with paint layer `layer` added, when the mesh lacks it.
-    fn layer_setup(&self, layer: &str) -> Result<Option<GroomSpec>, String> {
+    fn layer_setup(&self, layer: &str) -> Result<Option<GroomSpec>, GroomErrorKind> {
         if self.mesh().vertex_attribute(layer).is_some() {
             return Ok(None);
         }
-        check_layer_name(layer)?;
+        check_layer_name(layer).map_err(GroomErrorKind::Brush)?;
         let mut spec = self.spec().clone();
         let mesh = self.mesh();
         let values = if layer == "density" {
@@ -303,7 +309,7 @@ impl EditableGroom {
                 .roots
                 .density
                 .on_mesh(mesh)
-                .map_err(|e| e.to_string())?;
+                .map_err(GroomErrorKind::Map)?;
             let values = vertex_points(mesh)
                 .into_iter()
                 .map(|p| p.map_or(0.0, |p| density.eval(p)))
@@ -316,13 +322,13 @@ impl EditableGroom {
         spec.mesh = Arc::new(
             Mesh::clone(mesh)
                 .with_vertex_attribute(layer, values)
-                .map_err(|e| e.to_string())?,
+                .map_err(GroomErrorKind::Mesh)?,
         );
         Ok(Some(spec))
     }
 
     /// The groom with a `region` layer its regions read, when it has none.
-    fn region_setup(&self) -> Result<Option<GroomSpec>, String> {
+    fn region_setup(&self) -> Result<Option<GroomSpec>, GroomErrorKind> {
         let reads_layer = |spec: &GroomSpec| match &spec.regions {
             Some(RegionsSpec {
                 source:
@@ -339,10 +345,7 @@ impl EditableGroom {
         };
         match reads_layer(self.spec()) {
             Some(true) if self.mesh().vertex_attribute(REGION_LAYER).is_some() => Ok(None),
-            None => Err(
-                "this groom's regions are the mesh's face sets; the part brush paints a 'region' layer: set [regions] map = \"vertex:region\" to paint partings"
-                    .into(),
-            ),
+            None => Err(GroomErrorKind::Brush(BrushRefusal::RegionsAreFaceSets)),
             _ => {
                 let mut spec = self.spec().clone();
                 if self.mesh().vertex_attribute(REGION_LAYER).is_none() {
@@ -352,7 +355,7 @@ impl EditableGroom {
                                 REGION_LAYER,
                                 vec![0.0; self.mesh().vertex_count()],
                             )
-                            .map_err(|e| e.to_string())?,
+                            .map_err(GroomErrorKind::Mesh)?,
                     );
                 }
                 spec.regions = Some(RegionsSpec::from_map(
@@ -366,7 +369,7 @@ impl EditableGroom {
 }
 
 /// Layer names are written as PLY properties and `vertex:NAME` maps.
-fn check_layer_name(name: &str) -> Result<(), String> {
+fn check_layer_name(name: &str) -> Result<(), BrushRefusal> {
     let ok = !name.is_empty()
         && name.len() <= 64
         && name.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
@@ -378,9 +381,7 @@ fn check_layer_name(name: &str) -> Result<(), String> {
     if ok {
         Ok(())
     } else {
-        Err(format!(
-            "paint layer '{name}': use letters, digits and '_' (not x, y, z, nx, ny, nz, s, t, u, v)"
-        ))
+        Err(BrushRefusal::LayerName(name.to_string()))
     }
 }
 
@@ -685,7 +686,7 @@ fn add_guides(groom: &EditableGroom, count: u32, dabs: &[Dab]) -> Option<Edit> {
 }
 
 /// Deletes the guides rooted under the dabs (never the last one).
-fn delete_guides(groom: &EditableGroom, dabs: &[Dab]) -> Result<Option<Edit>, String> {
+fn delete_guides(groom: &EditableGroom, dabs: &[Dab]) -> Result<Option<Edit>, BrushRefusal> {
     let guides = groom.guides();
     let keep: Vec<u32> = (0..guides.len() as u32)
         .filter(|&g| {
@@ -697,7 +698,7 @@ fn delete_guides(groom: &EditableGroom, dabs: &[Dab]) -> Result<Option<Edit>, St
         return Ok(None);
     }
     if keep.is_empty() {
-        return Err("the dab would delete every guide; a groom needs at least one".into());
+        return Err(BrushRefusal::DeletesEveryGuide);
     }
     Ok(Some(Edit::ReplaceGuides(Arc::new(guides.subset(&keep)))))
 }
@@ -708,10 +709,10 @@ fn paint(
     layer: &str,
     dabs: &[Dab],
     blend: impl Fn(f32, f32) -> f32,
-) -> Result<Option<Edit>, String> {
+) -> Result<Option<Edit>, BrushRefusal> {
     let mesh = groom.mesh();
     let Some(values) = groom.layer(layer) else {
-        return Err(format!("the mesh has no paint layer '{layer}'"));
+        return Err(BrushRefusal::NoPaintLayer(layer.to_string()));
     };
     let mut painted: Vec<(u32, f32)> = Vec::new();
     let mut current = values.to_vec();

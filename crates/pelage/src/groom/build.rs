@@ -94,11 +94,9 @@ impl Generator {
         bind_maps(&mut spec)?;
         let regions = match (shared_regions, &spec.regions) {
             (Some(g), _) => g.regions.clone(),
-            (None, Some(r)) => {
-                Some(Arc::new(r.lookup(&spec.mesh).map_err(|m| {
-                    spec.error("regions", GroomErrorKind::Invalid(m))
-                })?))
-            }
+            (None, Some(r)) => Some(Arc::new(
+                r.lookup(&spec.mesh).map_err(|m| spec.error("regions", m))?,
+            )),
             (None, None) => None,
         };
         let (sampler, cells, layout) = match shared_roots {
@@ -324,7 +322,7 @@ fn check_numbers(spec: &GroomSpec) -> Result<(), GroomError> {
     if !(fraction > 0.0 && fraction <= 1.0) {
         return Err(spec.error(
             "output.fraction",
-            GroomErrorKind::Invalid(format!(
+            GroomErrorKind::OutOfRange(format!(
                 "fraction = {fraction}: the share of the hairs grown is above 0 and at most 1"
             )),
         ));
@@ -335,7 +333,7 @@ fn check_numbers(spec: &GroomSpec) -> Result<(), GroomError> {
     {
         return Err(spec.error(
             "output.fraction",
-            GroomErrorKind::Invalid(
+            GroomErrorKind::Conflict(
                 "a fraction grows the first arrivals of the root cells, so that it is a subset of the groom: it needs stable ids and random roots (remove `ids = \"sequential\"` or `distribution = \"blue-noise\"`)".into(),
             ),
         ));
@@ -344,21 +342,21 @@ fn check_numbers(spec: &GroomSpec) -> Result<(), GroomError> {
     if count == 0 {
         return Err(spec.error(
             "roots.count",
-            GroomErrorKind::Invalid("the hair count must be at least 1".into()),
+            GroomErrorKind::OutOfRange("the hair count must be at least 1".into()),
         ));
     }
     let points = spec.finish.points;
     if points < 2 {
         return Err(spec.error(
             "finish.points",
-            GroomErrorKind::Invalid("hairs need at least 2 points".into()),
+            GroomErrorKind::OutOfRange("hairs need at least 2 points".into()),
         ));
     }
     // Groom files are checked as they are read; grooms built in code
     // (the Python package, tests) meet the same ceilings here.
     let ceiling = |key: &str, value: u64, max: u64, what: &str| {
         limits::check_count(value, max, false, what)
-            .map_err(|m| spec.error(key, GroomErrorKind::Invalid(m)))
+            .map_err(|e| spec.error(key, GroomErrorKind::Count(e)))
     };
     ceiling("roots.count", count, limits::MAX_HAIRS, "hairs")?;
     ceiling(
@@ -376,7 +374,7 @@ fn check_numbers(spec: &GroomSpec) -> Result<(), GroomError> {
         // first, so a spec built in a program is refused with the file's
         // message.
         if let Some((field, message)) = op.out_of_range() {
-            return Err(spec.error(&key.field(field), GroomErrorKind::Invalid(message)));
+            return Err(spec.error(&key.field(field), GroomErrorKind::OutOfRange(message)));
         }
         for (field, value, most, what) in op.counts() {
             ceiling(&key.field(field), value, most, what)?;
@@ -426,7 +424,7 @@ fn interpolator_for(
             if g.guides.len() != spec.guides.len() {
                 return Err(spec.error(
                     "guides",
-                    GroomErrorKind::Invalid(format!(
+                    GroomErrorKind::Mismatch(format!(
                         "{} guides where the groom has {}",
                         spec.guides.len(),
                         g.guides.len()

@@ -1,77 +1,28 @@
 //! [`GroomError`]: what went wrong with a groom, and where: the file (or
 //! the groom's name), line, column and setting.
 
+use crate::error::{Located, Where};
 use crate::map::MapError;
-use std::fmt;
 use std::path::PathBuf;
 
 /// A groom file could not be read, parsed or set up. Displays as
-/// `FILE:LINE:COLUMN: KEY: what is wrong`.
+/// `FILE:LINE:COLUMN: KEY: what is wrong` ([`Located`]).
 ///
 /// The error underneath, when there is one (a [`MapError`], a
-/// [`crate::mesh::MeshError`], an I/O error …), is in its
-/// [`kind`](GroomErrorDetails::kind) and its message in this one's.
-#[derive(Debug)]
-pub struct GroomError(Box<GroomErrorDetails>);
+/// [`crate::mesh::MeshError`], an I/O error …), is in its kind and its
+/// message in this one's.
+pub type GroomError = Located<GroomErrorKind>;
 
-impl fmt::Display for GroomError {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        self.0.fmt(f)
-    }
-}
-
-/// Prints its cause in its message and returns none as `source()`:
-/// front ends print each cause once by walking the chain. The cause stays
-/// in its kind for programs that inspect it.
-impl std::error::Error for GroomError {}
-
-/// Where and what a [`GroomError`] is.
-#[derive(Debug)]
-pub struct GroomErrorDetails {
-    /// The groom file.
-    pub path: PathBuf,
-    /// Line and column (1-based), where the problem is in the file.
-    pub line: Option<(usize, usize)>,
-    /// The key there, with its table (`roots.count`).
-    pub key: Option<String>,
-    /// What is wrong.
-    pub kind: GroomErrorKind,
-}
-
-impl GroomError {
-    /// An error in the groom file at `path`.
+impl Located<GroomErrorKind> {
+    /// An error in the groom file at `path`, at a line and column (both
+    /// 1-based) and the key there, where known.
     pub fn new(
         path: PathBuf,
         line: Option<(usize, usize)>,
         key: Option<String>,
         kind: GroomErrorKind,
     ) -> Self {
-        Self(Box::new(GroomErrorDetails {
-            path,
-            line,
-            key,
-            kind,
-        }))
-    }
-}
-
-impl std::ops::Deref for GroomError {
-    type Target = GroomErrorDetails;
-    fn deref(&self) -> &GroomErrorDetails {
-        &self.0
-    }
-}
-
-impl fmt::Display for GroomErrorDetails {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(f, "{}", self.path.display())?;
-        if let Some((line, column)) = self.line {
-            write!(f, ":{line}:{column}")?;
-        }
-        if let Some(key) = &self.key {
-            write!(f, ": {key}")?;
-        }
-        write!(f, ": {}", self.kind)
+        Located::with(path, Where::at(line, key), kind)
     }
 }
 
@@ -86,9 +37,63 @@ pub enum GroomErrorKind {
     /// Not valid TOML, an unknown key, or a value of the wrong type.
     #[error("{0}")]
     Syntax(String),
-    /// A value that parses but cannot be used.
+    /// A value outside what its setting allows: a range rule's refusal
+    /// (the same for a groom file and for values built in a program), a
+    /// share of the hairs, a frame rate, a shutter offset, a point count.
     #[error("{0}")]
-    Invalid(String),
+    OutOfRange(String),
+    /// A count that is zero or over pelage's limit (docs/limits.md).
+    #[error("{0}")]
+    Count(crate::limits::CountError),
+    /// Settings that cannot be used together, or a setting a feature
+    /// needs and does not have (regrow without time-sampled guides,
+    /// grooming by hand with sequential ids, a still format for an
+    /// animated groom).
+    #[error("{0}")]
+    Conflict(String),
+    /// Counts that must agree and do not (the skin's vertices and the
+    /// mesh's, the guides at a frame and at rest, values and vertices).
+    #[error("{0}")]
+    Mismatch(String),
+    /// Something the groom names that is not there (a paint layer, the
+    /// face sets its regions are read from).
+    #[error("{0}")]
+    Missing(String),
+    /// A frame range that cannot be read.
+    #[error("{0}")]
+    Frames(crate::anim::FrameRangeError),
+    /// Curves that cannot be made from the values given (guides moved to
+    /// points that are not finite).
+    #[error("{0}")]
+    Curves(crate::curves::CurvesError),
+    /// The guides at a frame cannot be made.
+    #[error("at frame {frame}: {error}")]
+    CurvesAtFrame {
+        /// The frame.
+        frame: f64,
+        /// Why.
+        error: crate::curves::CurvesError,
+    },
+    /// A part's velocities cannot be set.
+    #[error("part {part} at frame {frame}: {error}; write velocities = false")]
+    Velocities {
+        /// The part.
+        part: usize,
+        /// The frame.
+        frame: f64,
+        /// Why.
+        error: crate::curves::CurvesError,
+    },
+    /// The guides cannot be simulated as set.
+    #[error("{0}")]
+    Strands(crate::dynamics::StrandError),
+    /// The simulation cache cannot be written (the writer's error, kept
+    /// typed inside).
+    #[error("cannot write the cache: {0}")]
+    Cache(Box<dyn std::error::Error + Send + Sync>),
+    /// A brush cannot make its edit.
+    #[error("{0}")]
+    Brush(BrushRefusal),
     /// A map that cannot be read or used.
     #[error("{0}")]
     Map(MapError),
@@ -107,4 +112,24 @@ pub enum GroomErrorKind {
     /// A hair grew values that are not finite numbers.
     #[error("{0}")]
     NotFinite(String),
+}
+
+/// Why a brush cannot make its edit.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum BrushRefusal {
+    /// The dab would leave the groom without guides.
+    #[error("the dab would delete every guide; a groom needs at least one")]
+    DeletesEveryGuide,
+    /// A paint brush on a layer the mesh does not have.
+    #[error("the mesh has no paint layer '{0}'")]
+    NoPaintLayer(String),
+    /// A paint layer's name that is not a name (or is a reserved one).
+    #[error("paint layer '{0}': use letters, digits and '_' (not x, y, z, nx, ny, nz, s, t, u, v)")]
+    LayerName(String),
+    /// The part brush on a groom whose regions are face sets.
+    #[error(
+        "this groom's regions are the mesh's face sets; the part brush paints a 'region' layer: set [regions] map = \"vertex:region\" to paint partings"
+    )]
+    RegionsAreFaceSets,
 }

@@ -185,7 +185,8 @@ impl Groom {
     /// archive), for an animated one a layer stitching the frame files
     /// with value clips.
     pub fn assemble(&self, output: &Path) -> Result<Assembly, AssembleError> {
-        let alembic = CurvesFormat::from_path(output) == Some(CurvesFormat::Abc);
+        let alembic =
+            CurvesFormat::from_path(output).is_some_and(CurvesFormat::assembly_joins_parts);
         match self.animation() {
             Some(_) if alembic => Err(AssembleError::AlembicFrames(output.to_path_buf())),
             Some(animation) => {

@@ -176,8 +176,8 @@ pub fn find_part_files(output: &Path) -> Result<Vec<PathBuf>, FarmError> {
             _ => runs = Some(n),
         }
     }
-    let alembic_output =
-        crate::io::CurvesFormat::from_path(output) == Some(crate::io::CurvesFormat::Abc);
+    let alembic_output = crate::io::CurvesFormat::from_path(output)
+        .is_some_and(crate::io::CurvesFormat::assembly_joins_parts);
     let n = runs.ok_or_else(|| FarmError::NoParts {
         stem: stem.clone(),
         folder: folder.clone(),

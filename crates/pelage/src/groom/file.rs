@@ -140,10 +140,9 @@ impl SettingsSource {
     /// Parses the text as a groom file.
     pub(crate) fn parse(&self) -> Result<GroomFile, GroomError> {
         if let Some((place, message)) = self.single_bracket_list(&["ops"]) {
-            return Err(GroomError::new(
+            return Err(GroomError::with(
                 self.path.clone(),
-                place.line,
-                place.key,
+                place,
                 GroomErrorKind::Syntax(message),
             ));
         }
@@ -151,11 +150,10 @@ impl SettingsSource {
         let mut rules = GROOM_RULES.to_vec();
         rules.extend(super::ops::operator_rules());
         self.check(&rules).map_err(|(place, message)| {
-            GroomError::new(
+            GroomError::with(
                 self.path.clone(),
-                place.line,
-                place.key,
-                GroomErrorKind::Invalid(message),
+                place,
+                GroomErrorKind::OutOfRange(message),
             )
         })?;
         Ok(file)

@@ -129,7 +129,7 @@ impl Groom {
                 source.path.clone(),
                 None,
                 Some(key.to_string()),
-                GroomErrorKind::Invalid(message.to_string()),
+                GroomErrorKind::Conflict(message.to_string()),
             )
         };
         // A mesh value replaces `[mesh]`: a groom file written for the
@@ -272,7 +272,7 @@ impl Groom {
         if let Some(guides) = self.file.output.guides.as_ref().filter(|g| *g.get_ref()) {
             return Err(self.source.error_at(
                 guides.span(),
-                GroomErrorKind::Invalid(
+                GroomErrorKind::Conflict(
                     "guides are written with still grooms; an animated groom's are not (set guides = false)".into(),
                 ),
             ));
@@ -292,7 +292,7 @@ impl Groom {
                         .map_or(0..0, |a| a.frames.span());
                     return Err(self.source.error_at(
                         span,
-                        GroomErrorKind::Invalid(
+                        GroomErrorKind::Conflict(
                             "mode = \"regrow\" needs time-sampled guides: a USD or Alembic guide file in [guides] file".into(),
                         ),
                     ));
@@ -322,7 +322,7 @@ impl Groom {
         else {
             return Err(self.source.error_at(
                 0..0,
-                GroomErrorKind::Invalid(
+                GroomErrorKind::Conflict(
                     "only an animated groom with mode = \"simulate\" in [animation] simulates its guides".into(),
                 ),
             ));
@@ -357,10 +357,8 @@ impl Groom {
         let (mut first, mut last) = (run.first(), run.last());
         if let Some(section) = &self.file.animation {
             let whole = FrameRange::parse(section.frames.get_ref()).map_err(|e| {
-                self.source.error_at(
-                    section.frames.span(),
-                    GroomErrorKind::Invalid(e.to_string()),
-                )
+                self.source
+                    .error_at(section.frames.span(), GroomErrorKind::Frames(e))
             })?;
             (first, last) = (first.min(whole.first()), last.max(whole.last()));
         }
@@ -414,7 +412,7 @@ impl Groom {
                 self.source.path.clone(),
                 None,
                 Some("--fraction".into()),
-                GroomErrorKind::Invalid(format!(
+                GroomErrorKind::OutOfRange(format!(
                     "{fraction}: give the share of the hairs to grow, above 0 and at most 1"
                 )),
             ));
@@ -641,7 +639,7 @@ impl Groom {
             None => None,
             Some(r) => {
                 let invalid = |span: std::ops::Range<usize>, m: &str| {
-                    source.error_at(span, GroomErrorKind::Invalid(m.into()))
+                    source.error_at(span, GroomErrorKind::Conflict(m.into()))
                 };
                 match (&r.map, &r.faces) {
                     (Some(m), None) => {
@@ -667,7 +665,7 @@ impl Groom {
                     (None, None) => {
                         return Err(source.error_at(
                             0..0,
-                            GroomErrorKind::Invalid(
+                            GroomErrorKind::Conflict(
                                 "[regions] needs map = \"…\" or faces = \"groups\"".into(),
                             ),
                         ));
@@ -695,7 +693,7 @@ impl Groom {
             if let Some(mask) = mask {
                 return Err(source.error_at(
                     mask.span(),
-                    GroomErrorKind::Invalid(format!(
+                    GroomErrorKind::Conflict(format!(
                         "{key}: masks fade operators; [finish] sets every hair's starting values (add a masked width, color or opacity operator instead)"
                     )),
                 ));
@@ -788,9 +786,8 @@ fn animation_spec(
     let section = file.animation.as_ref();
     let frames = match (frames, section) {
         (Some(f), _) => f,
-        (None, Some(s)) => FrameRange::parse(s.frames.get_ref()).map_err(|e| {
-            source.error_at(s.frames.span(), GroomErrorKind::Invalid(e.to_string()))
-        })?,
+        (None, Some(s)) => FrameRange::parse(s.frames.get_ref())
+            .map_err(|e| source.error_at(s.frames.span(), GroomErrorKind::Frames(e)))?,
         (None, None) => return Ok(None),
     };
     let fps = section.map_or(24.0, |s| s.fps);
@@ -798,7 +795,7 @@ fn animation_spec(
         let span = section.map_or(0..0, |s| s.frames.span());
         return Err(source.error_at(
             span,
-            GroomErrorKind::Invalid(format!("fps = {fps}: it must be a positive number")),
+            GroomErrorKind::OutOfRange(format!("fps = {fps}: it must be a positive number")),
         ));
     }
     // The rest frame never depends on which frames a run writes (farm
@@ -806,7 +803,7 @@ fn animation_spec(
     // file's frames, else frame 1.
     let file_first = match section {
         Some(s) => FrameRange::parse(s.frames.get_ref())
-            .map_err(|e| source.error_at(s.frames.span(), GroomErrorKind::Invalid(e.to_string())))?
+            .map_err(|e| source.error_at(s.frames.span(), GroomErrorKind::Frames(e)))?
             .first(),
         None => 1,
     };
@@ -816,7 +813,7 @@ fn animation_spec(
     if !rest_frame.is_finite() {
         return Err(source.error_at(
             section.map_or(0..0, |s| s.frames.span()),
-            GroomErrorKind::Invalid("rest_frame must be a finite number".into()),
+            GroomErrorKind::NotFinite("rest_frame must be a finite number".into()),
         ));
     }
     if let (Some(_), false) = (
@@ -825,7 +822,7 @@ fn animation_spec(
     ) {
         return Err(source.error_at(
             section.map_or(0..0, |s| s.frames.span()),
-            GroomErrorKind::Invalid(
+            GroomErrorKind::Conflict(
                 "[simulation] moves the guides of an animated groom with mode = \"simulate\" in [animation]: set it, or remove [simulation]".into(),
             ),
         ));
@@ -869,7 +866,7 @@ fn load_skin(
         "spot" => match clip {
             Some(clip) => Err(source.error_at(
                 clip.span(),
-                GroomErrorKind::Invalid(format!(
+                GroomErrorKind::Conflict(format!(
                     "clip {:?}: the embedded spot has no clips to play; clips are glTF animations (a .gltf or .glb skin): remove `clip`",
                     clip.get_ref()
                 )),
@@ -900,9 +897,9 @@ fn bind_guides(
                 source.path.clone(),
                 None,
                 Some("guides".into()),
-                GroomErrorKind::Invalid(message.into()),
+                GroomErrorKind::Mismatch(message.into()),
             ),
-            s => source.error_at(s, GroomErrorKind::Invalid(message.into())),
+            s => source.error_at(s, GroomErrorKind::Mismatch(message.into())),
         });
     }
     Ok((guides, Some(report)))
@@ -977,7 +974,7 @@ fn load_guides(
             source.path.clone(),
             None,
             Some("guides".into()),
-            GroomErrorKind::Invalid(
+            GroomErrorKind::Conflict(
                 "give exactly one of `file = \"guides.usda\"` or a [guides.generate] table".into(),
             ),
         )),

@@ -75,7 +75,7 @@ pub use animate::{
     GuideMotion,
 };
 pub use clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
-pub use error::{GroomError, GroomErrorDetails, GroomErrorKind};
+pub use error::{GroomError, GroomErrorKind};
 pub use export::{
     AnimatedPlan, AnimatedPlanError, AssembleError, Assembly, DEFAULT_FPS, PreflightError,
     Stitching,

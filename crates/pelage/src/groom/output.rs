@@ -83,10 +83,7 @@ impl Generator {
             summary.points += c.points().len() as u64;
         };
         let format = CurvesFormat::from_path(path);
-        let streamed = matches!(
-            format,
-            Some(CurvesFormat::Usda | CurvesFormat::Usdc | CurvesFormat::Abc)
-        );
+        let streamed = format.is_some_and(CurvesFormat::streams_parts);
         if !streamed {
             let mut grown = Vec::new();
             for p in parts {
@@ -406,7 +403,7 @@ pub fn write_alembic_assembly(
         path: path.to_path_buf(),
         error: std::io::Error::other(message),
     };
-    if CurvesFormat::from_path(path) != Some(CurvesFormat::Abc) {
+    if !CurvesFormat::from_path(path).is_some_and(CurvesFormat::assembly_joins_parts) {
         return Err(fail(
             "Alembic part files are joined into an Alembic file: name it .abc".into(),
         ));
@@ -419,8 +416,7 @@ pub fn write_alembic_assembly(
             abc.write_mesh("skin", mesh).map_err(other)?;
         }
         for file in part_files {
-            let objects =
-                read_abc_objects(file).map_err(|e| std::io::Error::other(e.to_string()))?;
+            let objects = read_abc_objects(file).map_err(std::io::Error::other)?;
             // Guides (run 1's) first, as one run writes them before its parts.
             let (guides, hairs): (Vec<_>, Vec<_>) = objects.into_iter().partition(|o| o.2);
             for (name, curves, _) in &guides {

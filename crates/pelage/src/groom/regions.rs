@@ -9,6 +9,7 @@
 //! at theirs. Interpolation then uses only the guides of the hair's
 //! region ([`crate::interp::RegionWeights`]), and clumps only its centres.
 
+use super::error::GroomErrorKind;
 use crate::map::{Map, MapSite};
 use crate::mesh::{Mesh, SurfacePoint};
 
@@ -63,9 +64,9 @@ impl RegionsSpec {
     }
 
     /// The regions ready for lookups on `mesh` (the spec's maps bound to
-    /// it). Fails with a message when the mesh has no face sets of the
-    /// kind asked for.
-    pub fn lookup(&self, mesh: &Mesh) -> Result<RegionLookup, String> {
+    /// it). Fails ([`GroomErrorKind::Missing`]) when the mesh has no face
+    /// sets of the kind asked for.
+    pub fn lookup(&self, mesh: &Mesh) -> Result<RegionLookup, GroomErrorKind> {
         Ok(match &self.source {
             RegionSource::Map { map, scale } => RegionLookup::Map {
                 map: map.clone(),
@@ -74,7 +75,7 @@ impl RegionsSpec {
             RegionSource::Faces(kind) => {
                 let groups = mesh.face_groups(kind).ok_or_else(|| {
                     let kinds = mesh.face_group_kinds();
-                    if kinds.is_empty() {
+                    GroomErrorKind::Missing(if kinds.is_empty() {
                         format!(
                             "the mesh has no face sets ('{kind}'); OBJ files name them with g (groups) and usemtl (materials), or use a region map"
                         )
@@ -83,7 +84,7 @@ impl RegionsSpec {
                             "the mesh has no face sets of kind '{kind}'; it has {}",
                             kinds.join(", ")
                         )
-                    }
+                    })
                 })?;
                 RegionLookup::Faces {
                     of_triangle: groups.of_triangle.clone(),
@@ -171,7 +172,8 @@ mod tests {
             .unwrap();
         assert_eq!(big.of(&mesh, SurfacePoint::new(0, [0.3, 0.3])), MAX_REGION);
         let err = RegionsSpec::from_faces("groups").lookup(&mesh).unwrap_err();
-        assert!(err.contains("no face sets"), "{err}");
+        assert!(matches!(err, GroomErrorKind::Missing(_)), "{err}");
+        assert!(err.to_string().contains("no face sets"), "{err}");
         let grouped = mesh
             .with_face_groups(crate::mesh::FaceGroups {
                 kind: "groups".into(),

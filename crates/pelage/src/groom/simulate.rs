@@ -91,7 +91,7 @@ impl SimulatedGuides {
         let failed = |e: crate::io::PrimWriteError| {
             GroomWriteError::Write(crate::io::WriteError {
                 path: path.to_path_buf(),
-                error: std::io::Error::other(e.to_string()),
+                error: std::io::Error::other(e),
             })
         };
         let file = AtomicFile::create(path)?;
@@ -153,7 +153,7 @@ fn frame_span(spec: &GroomSpec, settings: &SimulationSettings) -> Result<(i32, i
     if first > last {
         return Err(spec.error(
             "animation.frames",
-            GroomErrorKind::Invalid("no frames to simulate".into()),
+            GroomErrorKind::Conflict("no frames to simulate".into()),
         ));
     }
     Ok((first, last))
@@ -226,7 +226,7 @@ pub fn cached_simulation(
     if CurvesFormat::from_path(cache) != Some(CurvesFormat::Usdc) {
         return Err(spec.error(
             "simulation.cache",
-            GroomErrorKind::Invalid(format!(
+            GroomErrorKind::Conflict(format!(
                 "{}: a simulation cache is a .usdc file",
                 cache.display()
             )),
@@ -248,12 +248,9 @@ pub fn cached_simulation(
         time_codes_per_second: settings.fps,
         ..UsdOptions::default()
     };
-    guides.write(cache, &options).map_err(|e| {
-        spec.error(
-            "simulation.cache",
-            GroomErrorKind::Invalid(format!("cannot write the cache: {e}")),
-        )
-    })?;
+    guides
+        .write(cache, &options)
+        .map_err(|e| spec.error("simulation.cache", GroomErrorKind::Cache(Box::new(e))))?;
     let used = if existed {
         CacheUse::Replaced
     } else {
@@ -311,7 +308,7 @@ fn simulate_with_key(
         settings.params.clone(),
         settings.collide,
     )
-    .map_err(|e| spec.error("simulation", GroomErrorKind::Invalid(e.to_string())))?;
+    .map_err(|e| spec.error("simulation", GroomErrorKind::Strands(e)))?;
     let (first, last) = frame_span(spec, settings)?;
     let pose = |frame: i32| -> Result<SkinPose, GroomError> {
         Ok(SkinPose::new(skin_at(spec, skin, frame)?, triangles))
@@ -326,7 +323,7 @@ fn simulate_with_key(
         sim.curves().map_err(|e| {
             spec.error(
                 "simulation",
-                GroomErrorKind::Invalid(format!(
+                GroomErrorKind::NotFinite(format!(
                     "the simulated guides at frame {frame} are not finite ({e}): the [simulation] settings are out of any sensible range"
                 )),
             )

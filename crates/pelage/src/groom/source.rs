@@ -20,20 +20,14 @@ impl SettingsSource {
     /// key.
     pub fn parse_as<T: serde::de::DeserializeOwned>(&self) -> Result<T, GroomError> {
         self.deserialize().map_err(|(place, message)| {
-            GroomError::new(
-                self.path.clone(),
-                place.line,
-                place.key,
-                GroomErrorKind::Syntax(message),
-            )
+            GroomError::with(self.path.clone(), place, GroomErrorKind::Syntax(message))
         })
     }
 
     /// A [`GroomError`] at a span of the text: its line and column, and the
     /// key written there (with its table).
     pub fn error_at(&self, span: std::ops::Range<usize>, kind: GroomErrorKind) -> GroomError {
-        let place = self.place(span);
-        GroomError::new(self.path.clone(), place.line, place.key, kind)
+        GroomError::with(self.path.clone(), self.place(span), kind)
     }
 
     /// Resolves a map value, reporting a bad spec or unreadable image at its
@@ -43,7 +37,7 @@ impl SettingsSource {
             MapText::Number(n) if n.is_finite() => Ok(Map::Constant(*n)),
             MapText::Number(n) => Err(self.error_at(
                 value.span(),
-                GroomErrorKind::Invalid(format!("{n} is not a finite number")),
+                GroomErrorKind::NotFinite(format!("{n} is not a finite number")),
             )),
             MapText::Spec(spec) => Map::parse_with_base(spec, Some(self.folder()))
                 .map_err(|e| self.error_at(value.span(), GroomErrorKind::Map(e))),

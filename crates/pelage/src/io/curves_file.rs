@@ -50,6 +50,21 @@ impl CurvesFormat {
         matches!(self, Self::Usdc | Self::Abc)
     }
 
+    /// Whether a groom's parts go into the file one at a time (a prim or
+    /// object each, one part in memory at a time): USD and Alembic. The
+    /// other formats hold one set of curves, so the parts are joined
+    /// first.
+    pub fn streams_parts(self) -> bool {
+        matches!(self, Self::Usda | Self::Usdc | Self::Abc)
+    }
+
+    /// Whether a farm's runs are assembled by joining their objects into
+    /// one file of this format (Alembic, which has no references) rather
+    /// than by a USD layer that references each run's file.
+    pub fn assembly_joins_parts(self) -> bool {
+        matches!(self, Self::Abc)
+    }
+
     /// The extension files of this format are written with.
     pub fn extension(self) -> &'static str {
         match self {
@@ -124,9 +139,10 @@ pub fn write_curves<'c>(
     parts: impl IntoIterator<Item = (String, &'c Curves)>,
     export: &CurvesExport,
 ) -> Result<(), WriteError> {
-    let fail = |message: String| WriteError {
+    // The refusal kept typed inside the I/O error (`get_ref` downcasts).
+    let fail = |refusal: Box<dyn std::error::Error + Send + Sync>| WriteError {
         path: path.to_path_buf(),
-        error: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
+        error: std::io::Error::new(std::io::ErrorKind::InvalidInput, refusal),
     };
     let format = CurvesFormat::from_path(path)
         .ok_or_else(|| fail(CurvesFormat::UNKNOWN_FOR_WRITING.into()))?;
@@ -141,10 +157,9 @@ pub fn write_curves<'c>(
         }
         CurvesFormat::Hair | CurvesFormat::Ply => {
             // One array for the whole file: join the parts.
-            let joined =
-                join(parts.into_iter().map(|(_, c)| c)).map_err(|e| fail(e.to_string()))?;
+            let joined = join(parts.into_iter().map(|(_, c)| c)).map_err(|e| fail(e.into()))?;
             if format == CurvesFormat::Hair {
-                let hair = HairFile::from_curves(&joined).map_err(|e| fail(e.to_string()))?;
+                let hair = HairFile::from_curves(&joined).map_err(|e| fail(e.into()))?;
                 hair.write(path)
             } else {
                 write_atomically(path, |out| write_curves_ply(out, &joined))

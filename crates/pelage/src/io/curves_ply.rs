@@ -9,7 +9,8 @@
 
 use super::read_error::{CurvesReadError, CurvesReadErrorKind as Kind};
 use crate::Curves;
-use crate::mesh::{Location, ply_scalar};
+use crate::error::Where;
+use crate::mesh::ply_scalar;
 use glam::Vec3;
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
@@ -78,10 +79,7 @@ pub fn read_curves_ply(path: &Path) -> Result<Curves, CurvesReadError> {
             _ => {
                 return Err(CurvesReadError::new(
                     path,
-                    Location::Element {
-                        kind: "vertex",
-                        index: i,
-                    },
+                    Where::element("vertex", i),
                     Kind::Syntax("x, y and z must be numbers".into()),
                 ));
             }
@@ -92,14 +90,7 @@ pub fn read_curves_ply(path: &Path) -> Result<Curves, CurvesReadError> {
     let (mut next, mut has_previous) = (vec![u32::MAX; n], vec![false; n]);
     for (e, edge) in edges.iter().enumerate() {
         let at = |message: String| {
-            CurvesReadError::new(
-                path,
-                Location::Element {
-                    kind: "edge",
-                    index: e,
-                },
-                Kind::Inconsistent(message),
-            )
+            CurvesReadError::new(path, Where::element("edge", e), Kind::Inconsistent(message))
         };
         let index = |k: &str| match edge.get(k) {
             Some(Property::Int(i)) => Some(*i as i64),

@@ -47,7 +47,7 @@ impl Mesh {
             MeshFormat::Gltf => gltf::parse(name, bytes, None),
             MeshFormat::Usd => {
                 let path = Path::new(name);
-                let skin = usd_skin_from_bytes(bytes, path).map_err(|e| usd_mesh_error(&e))?;
+                let skin = usd_skin_from_bytes(bytes, path).map_err(usd_mesh_error)?;
                 Mesh::new(
                     name.to_string(),
                     skin.positions,
@@ -62,7 +62,7 @@ impl Mesh {
 
 /// A USD file's `Mesh` prims as one mesh, at their first time sample.
 fn read_usd_mesh(path: &Path) -> Result<Mesh, MeshError> {
-    let skin = read_usd_skin(path).map_err(|e| usd_mesh_error(&e))?;
+    let skin = read_usd_skin(path).map_err(usd_mesh_error)?;
     Mesh::new(
         path.display().to_string(),
         skin.positions,
@@ -72,11 +72,8 @@ fn read_usd_mesh(path: &Path) -> Result<Mesh, MeshError> {
     )
 }
 
-/// A USD reader's error as a mesh error (same file, same place).
-pub(crate) fn usd_mesh_error(e: &CurvesReadError) -> MeshError {
-    MeshError::new(
-        e.source_name(),
-        e.location().clone(),
-        MeshErrorKind::Syntax(e.kind().to_string()),
-    )
+/// A USD reader's error as a mesh error (same file, same place, its kind
+/// kept typed inside).
+pub(crate) fn usd_mesh_error(e: CurvesReadError) -> MeshError {
+    e.map_kind(|kind| MeshErrorKind::Read(Box::new(kind)))
 }

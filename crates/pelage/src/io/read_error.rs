@@ -2,11 +2,10 @@
 //! the line, field or element that is wrong.
 
 use crate::curves::CurvesError;
+use crate::error::{Located, Where};
 use crate::limits::{DECODED_BYTES_FLOOR, DECODED_BYTES_PER_FILE_BYTE, grouped};
-use crate::mesh::Location;
 use std::borrow::Cow;
 use std::cell::Cell;
-use std::fmt;
 use std::path::Path;
 
 /// Bytes of file data (a name, a path) an error message quotes at most.
@@ -76,7 +75,7 @@ impl DecodeBudget {
 
     /// Takes `bytes` from the budget, or says why not (the caller adds
     /// the file and place).
-    pub fn charge(&self, bytes: u64) -> Result<(), String> {
+    pub(crate) fn charge(&self, bytes: u64) -> Result<(), String> {
         match self.left.get().checked_sub(bytes) {
             Some(left) => {
                 self.left.set(left);
@@ -124,15 +123,14 @@ pub enum CurvesReadErrorKind {
 }
 
 /// A curves file could not be read. Displays as
-/// `FILE[:LINE | : ELEMENT N]: what is wrong`.
-#[derive(Debug)]
-pub struct CurvesReadError(Box<(String, Location, CurvesReadErrorKind)>);
+/// `FILE[:LINE | : ELEMENT N]: what is wrong` ([`Located`]).
+pub type CurvesReadError = Located<CurvesReadErrorKind>;
 
-impl CurvesReadError {
+impl Located<CurvesReadErrorKind> {
     /// An error at `location` of the file at `path`. A message that
     /// quotes the file is shortened to excerpts: a hostile name can be
     /// megabytes.
-    pub fn new(path: &Path, location: Location, kind: CurvesReadErrorKind) -> Self {
+    pub fn new(path: &Path, location: Where, kind: CurvesReadErrorKind) -> Self {
         use CurvesReadErrorKind as K;
         let kind = match kind {
             K::Syntax(m) => K::Syntax(shortened(m)),
@@ -140,40 +138,14 @@ impl CurvesReadError {
             K::Unsupported(m) => K::Unsupported(shortened(m)),
             other => other,
         };
-        Self(Box::new((path.display().to_string(), location, kind)))
+        Located::with(path, location, kind)
     }
 
     /// An error about the whole file.
     pub fn whole(path: &Path, kind: CurvesReadErrorKind) -> Self {
-        Self::new(path, Location::Whole, kind)
-    }
-
-    /// The file.
-    pub fn source_name(&self) -> &str {
-        &self.0.0
-    }
-
-    /// Where in it.
-    pub fn location(&self) -> &Location {
-        &self.0.1
-    }
-
-    /// What is wrong.
-    pub fn kind(&self) -> &CurvesReadErrorKind {
-        &self.0.2
+        Self::new(path, Where::whole(), kind)
     }
 }
-
-impl fmt::Display for CurvesReadError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}{}: {}", self.0.0, self.0.1, self.0.2)
-    }
-}
-
-/// Prints its cause in its message and returns none as `source()`:
-/// front ends print each cause once by walking the chain. The cause stays
-/// in its kind for programs that inspect it.
-impl std::error::Error for CurvesReadError {}
 
 #[cfg(test)]
 mod tests {

@@ -12,7 +12,7 @@
 
 use super::read_error::{CurvesReadError, CurvesReadErrorKind as Kind};
 use crate::Curves;
-use crate::mesh::Location;
+use crate::error::Where;
 use glam::{DMat4, DVec3};
 use openusd::sdf::{self, AbstractData, SpecType, Value};
 use std::path::Path;
@@ -377,7 +377,7 @@ fn open_layer_with(
     } else {
         Err(CurvesReadError::new(
             path,
-            Location::Line(1),
+            Where::line(1),
             Kind::Syntax("not a USD file: it starts with neither '#usda' nor 'PXR-USDC'".into()),
         ))
     }
@@ -400,7 +400,7 @@ fn layer_from_bytes(
     } else {
         Err(CurvesReadError::new(
             path,
-            Location::Line(1),
+            Where::line(1),
             Kind::Syntax("not a USD file: it starts with neither '#usda' nor 'PXR-USDC'".into()),
         ))
     }
@@ -421,11 +421,7 @@ fn parse_error(path: &Path, error: &dyn std::fmt::Display) -> CurvesReadError {
             Some((column, message)) if column.parse::<usize>().is_ok() => message,
             _ => rest,
         };
-        return CurvesReadError::new(
-            path,
-            Location::Line(line),
-            Kind::Syntax(message.to_string()),
-        );
+        return CurvesReadError::new(path, Where::line(line), Kind::Syntax(message.to_string()));
     }
     CurvesReadError::whole(path, Kind::Syntax(text))
 }
@@ -538,7 +534,7 @@ impl UsdSkin {
     /// The merged vertex positions at time code `time`: each prim's
     /// samples interpolated linearly (held before the first and after the
     /// last).
-    pub fn positions_at(&self, time: f64) -> Result<Vec<glam::Vec3>, String> {
+    pub(crate) fn positions_at(&self, time: f64) -> Result<Vec<glam::Vec3>, String> {
         let mut out = Vec::with_capacity(self.positions.len());
         for samples in &self.prims {
             let after = samples.partition_point(|(t, _)| *t <= time);

@@ -1,33 +1,8 @@
 //! Errors of the mesh layer: each names the file (or mesh) and, where there
 //! is one, the line or element that is wrong.
 
-use std::fmt;
-
-/// Where in a mesh file (or in-memory mesh) a problem was found.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Location {
-    /// The whole file or mesh.
-    Whole,
-    /// A 1-based line of a text file.
-    Line(usize),
-    /// An element by kind and 0-based index, e.g. `vertex 12`, `triangle 3`.
-    Element {
-        /// The element's kind: "vertex", "triangle", "face", "uv", …
-        kind: &'static str,
-        /// Its 0-based index.
-        index: usize,
-    },
-}
-
-impl fmt::Display for Location {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Location::Whole => Ok(()),
-            Location::Line(line) => write!(f, ":{line}"),
-            Location::Element { kind, index } => write!(f, ": {kind} {index}"),
-        }
-    }
-}
+use crate::error::{Located, Where};
+use std::path::PathBuf;
 
 /// What is wrong with a mesh.
 #[derive(Debug, thiserror::Error)]
@@ -81,6 +56,10 @@ pub enum MeshErrorKind {
     /// The file is inconsistent with itself (counts that do not add up, …).
     #[error("{0}")]
     Inconsistent(String),
+    /// A reader of another layer refused the file (a USD stage's skin read
+    /// by the curves reader): its error, kept typed inside.
+    #[error("{0}")]
+    Read(Box<dyn std::error::Error + Send + Sync>),
 }
 
 /// "there is 1 vertex" / "there are 3 vertices".
@@ -92,81 +71,34 @@ fn count_of(count: usize, singular: &str, plural: &str) -> String {
 }
 
 /// A mesh could not be loaded or built. Displays as
-/// `FILE[:LINE | : ELEMENT N]: what is wrong`.
-///
-/// Boxed inside, so `Result<Mesh, MeshError>` stays small on the happy path.
-#[derive(Debug)]
-pub struct MeshError(Box<MeshErrorInner>);
+/// `FILE[:LINE | : ELEMENT N]: what is wrong` ([`Located`]; the source is
+/// a path, or a name such as `embedded spot` for a mesh not read from a
+/// file).
+pub type MeshError = Located<MeshErrorKind>;
 
-#[derive(Debug)]
-struct MeshErrorInner {
-    source_name: String,
-    location: Location,
-    kind: MeshErrorKind,
-}
-
-impl MeshError {
-    /// An error at `location` of `source_name` (a path, or a name such as
-    /// `embedded spot` for meshes not read from a file).
-    pub fn new(source_name: impl Into<String>, location: Location, kind: MeshErrorKind) -> Self {
-        Self(Box::new(MeshErrorInner {
-            source_name: source_name.into(),
-            location,
-            kind,
-        }))
+impl Located<MeshErrorKind> {
+    /// An error at `location` of `source_name`.
+    pub fn new(source_name: impl Into<PathBuf>, location: Where, kind: MeshErrorKind) -> Self {
+        Located::with(source_name, location, kind)
     }
 
     /// An error about the whole file or mesh.
-    pub fn whole(source_name: impl Into<String>, kind: MeshErrorKind) -> Self {
-        Self::new(source_name, Location::Whole, kind)
+    pub fn whole(source_name: impl Into<PathBuf>, kind: MeshErrorKind) -> Self {
+        Self::new(source_name, Where::whole(), kind)
     }
 
     /// An error at a 1-based line of a text file.
-    pub fn at_line(source_name: impl Into<String>, line: usize, kind: MeshErrorKind) -> Self {
-        Self::new(source_name, Location::Line(line), kind)
+    pub fn at_line(source_name: impl Into<PathBuf>, line: usize, kind: MeshErrorKind) -> Self {
+        Self::new(source_name, Where::line(line), kind)
     }
 
     /// An error at an element (`vertex 12`, `triangle 3`).
     pub fn at_element(
-        source_name: impl Into<String>,
+        source_name: impl Into<PathBuf>,
         element: &'static str,
         index: usize,
         kind: MeshErrorKind,
     ) -> Self {
-        let location = Location::Element {
-            kind: element,
-            index,
-        };
-        Self::new(source_name, location, kind)
-    }
-
-    /// The file path or mesh name.
-    pub fn source_name(&self) -> &str {
-        &self.0.source_name
-    }
-
-    /// Where in it.
-    pub fn location(&self) -> &Location {
-        &self.0.location
-    }
-
-    /// What is wrong.
-    pub fn kind(&self) -> &MeshErrorKind {
-        &self.0.kind
+        Self::new(source_name, Where::element(element, index), kind)
     }
 }
-
-impl fmt::Display for MeshError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{}{}: {}",
-            self.0.source_name, self.0.location, self.0.kind
-        )
-    }
-}
-
-/// Prints its cause in its message and returns none as `source()`:
-/// front ends print each cause once by walking the chain. The cause stays
-/// in its kind for programs that inspect it.
-impl std::error::Error for MeshError {}

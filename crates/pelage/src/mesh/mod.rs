@@ -29,7 +29,7 @@ mod surface_point;
 mod topology;
 
 pub use closest::{ClosestPoint, TriangleBvh, closest_on_triangle};
-pub use error::{Location, MeshError, MeshErrorKind};
+pub use error::{MeshError, MeshErrorKind};
 pub use graph::EdgeGraph;
 pub(crate) use graph::morton;
 pub(crate) use ply::scalar as ply_scalar;

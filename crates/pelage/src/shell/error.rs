@@ -1,29 +1,15 @@
 //! [`SceneError`]: a shell scene file that cannot be read, parsed or set
 //! up, with its place in the file (`FILE:LINE:COL: KEY: what`).
 
-use crate::settings::{Place, SettingsSource};
-use std::fmt;
+use crate::error::{Located, Where};
+use crate::settings::SettingsSource;
 use std::ops::Range;
 use std::path::PathBuf;
 
 /// A shell scene could not be read, parsed or set up. Displays as
-/// `FILE:LINE:COLUMN: KEY: what is wrong`; the error underneath, if any,
-/// is in its kind and its message in this one's.
-///
-/// Boxed inside, so results stay small on the happy path.
-#[derive(Debug)]
-pub struct SceneError(Box<SceneErrorDetails>);
-
-/// Where and what a [`SceneError`] is.
-#[derive(Debug)]
-pub struct SceneErrorDetails {
-    /// The scene file (or a name such as `<spot>`).
-    pub path: PathBuf,
-    /// Where in the file, when there is a place.
-    pub place: Place,
-    /// What is wrong.
-    pub kind: SceneErrorKind,
-}
+/// `FILE:LINE:COLUMN: KEY: what is wrong` ([`Located`]); the error
+/// underneath, if any, is in its kind and its message in this one's.
+pub type SceneError = Located<SceneErrorKind>;
 
 /// What is wrong with a shell scene.
 #[derive(Debug, thiserror::Error)]
@@ -36,9 +22,25 @@ pub enum SceneErrorKind {
     /// unknown name lists the accepted ones).
     #[error("{0}")]
     Syntax(String),
-    /// A value that parses but cannot be used.
+    /// A value outside what its setting allows (a range rule's refusal,
+    /// a length that is not positive, texels over pelage's limit).
     #[error("{0}")]
-    Invalid(String),
+    OutOfRange(String),
+    /// Settings that cannot be used together (a clip without a skin, the
+    /// implicit solver on the GPU for tips that are joined).
+    #[error("{0}")]
+    Conflict(String),
+    /// Something the scene needs that is not there (the mesh's UVs).
+    #[error("{0}")]
+    Missing(String),
+    /// Droplets that cannot be placed on the mesh.
+    #[error("droplets[{index}]: cannot place droplets: {error}")]
+    Droplets {
+        /// The `[[droplets]]` entry.
+        index: usize,
+        /// Why.
+        error: crate::sample::SampleError,
+    },
     /// The mesh could not be loaded.
     #[error("{0}")]
     Mesh(crate::mesh::MeshError),
@@ -52,10 +54,10 @@ pub enum SceneErrorKind {
     },
 }
 
-impl SceneError {
+impl Located<SceneErrorKind> {
     /// An error at `place` of the file at `path`.
-    pub fn new(path: PathBuf, place: Place, kind: SceneErrorKind) -> Self {
-        Self(Box::new(SceneErrorDetails { path, place, kind }))
+    pub fn new(path: PathBuf, place: Where, kind: SceneErrorKind) -> Self {
+        Located::with(path, place, kind)
     }
 
     /// An error at a span of `source`'s text.
@@ -63,28 +65,3 @@ impl SceneError {
         Self::new(source.path.clone(), source.place(span), kind)
     }
 }
-
-impl std::ops::Deref for SceneError {
-    type Target = SceneErrorDetails;
-    fn deref(&self) -> &SceneErrorDetails {
-        &self.0
-    }
-}
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(f, "{}", self.path.display())?;
-        if let Some((line, column)) = self.place.line {
-            write!(f, ":{line}:{column}")?;
-        }
-        if let Some(key) = &self.place.key {
-            write!(f, ": {key}")?;
-        }
-        write!(f, ": {}", self.kind)
-    }
-}
-
-/// Prints its cause in its message and returns none as `source()`:
-/// front ends print each cause once by walking the chain. The cause stays
-/// in its kind for programs that inspect it.
-impl std::error::Error for SceneError {}

@@ -24,7 +24,7 @@ mod skinned;
 pub mod textures;
 pub mod wetness;
 
-pub use error::{SceneError, SceneErrorDetails, SceneErrorKind};
+pub use error::{SceneError, SceneErrorKind};
 pub use math::{ClumpParams, Coupling, CurlParams, KajiyaKay, Strand, WetTexel};
 pub use scene::{SceneCamera, ShellScene};
 pub use skinned::ShellAnimation;

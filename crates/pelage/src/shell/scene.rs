@@ -231,7 +231,11 @@ impl ShellScene {
             SceneError::new(source.path.clone(), place, SceneErrorKind::Syntax(message))
         })?;
         source.check(SCENE_RULES).map_err(|(place, message)| {
-            SceneError::new(source.path.clone(), place, SceneErrorKind::Invalid(message))
+            SceneError::new(
+                source.path.clone(),
+                place,
+                SceneErrorKind::OutOfRange(message),
+            )
         })?;
         Ok(file)
     }
@@ -493,9 +497,14 @@ const SCENE_RULES: &[Rule] = &[
     Rule::new("dynamics.shake.duration", Bound::at_least(0.0), "seconds"),
 ];
 
-/// An error at a span of the scene file: a value that cannot be used.
-fn invalid(source: &SettingsSource, span: std::ops::Range<usize>, message: String) -> SceneError {
-    SceneError::at(source, span, SceneErrorKind::Invalid(message))
+/// An error of `kind` at a span of the scene file.
+fn invalid(
+    source: &SettingsSource,
+    kind: impl FnOnce(String) -> SceneErrorKind,
+    span: std::ops::Range<usize>,
+    message: String,
+) -> SceneError {
+    SceneError::at(source, span, kind(message))
 }
 
 /// A count that must lie in `range`: `default` when not given, an error
@@ -512,6 +521,7 @@ fn count_in(
         Some(v) if range.contains(v.get_ref()) => Ok(*v.get_ref()),
         Some(v) => Err(invalid(
             source,
+            SceneErrorKind::OutOfRange,
             v.span(),
             format!(
                 "{} {unit}: use {} to {}",
@@ -544,6 +554,7 @@ fn mesh_and_color(
         (None, Some(clip)) => {
             return Err(invalid(
                 source,
+                SceneErrorKind::Conflict,
                 clip.span(),
                 "a clip is played by a skinned mesh: add [mesh] path = \"character.gltf\"".into(),
             ));
@@ -552,6 +563,7 @@ fn mesh_and_color(
             if section.path.get_ref() == "spot" {
                 return Err(invalid(
                     source,
+                    SceneErrorKind::Conflict,
                     clip.span(),
                     "a clip is played from a glTF or GLB skin; the embedded spot has none".into(),
                 ));
@@ -584,6 +596,7 @@ fn mesh_and_color(
         let span = file.mesh.as_ref().map_or(0..0, |m| m.path.span());
         return Err(invalid(
             source,
+            SceneErrorKind::Missing,
             span,
             format!(
                 "the mesh {} has no UVs; shell fur reads its textures and wetness mask at the mesh's UVs",
@@ -617,6 +630,7 @@ fn fur_settings(
         Some(l) if !(l.get_ref().is_finite() && *l.get_ref() > 0.0) => {
             return Err(invalid(
                 source,
+                SceneErrorKind::OutOfRange,
                 l.span(),
                 format!("{} is not a positive length", l.get_ref()),
             ));
@@ -654,6 +668,7 @@ fn texture_params(
         let span = t.resolution.as_ref().map_or(0..0, |r| r.span());
         return Err(invalid(
             source,
+            SceneErrorKind::OutOfRange,
             span,
             format!(
                 "{resolution}² texels × {layers} layers is {} texels; pelage's limit is {} (4 bytes each): lower the resolution or the layers (docs/limits.md)",
@@ -705,12 +720,8 @@ fn droplets(
                 wetness: style.wetness,
             }],
             (None, Some(count), None) => {
-                droplets_on_mesh(mesh, count, style, seed).map_err(|e| {
-                    invalid(
-                        source,
-                        0..0,
-                        format!("droplets[{i}]: cannot place droplets: {e}"),
-                    )
+                droplets_on_mesh(mesh, count, style, seed).map_err(|error| {
+                    SceneError::at(source, 0..0, SceneErrorKind::Droplets { index: i, error })
                 })?
             }
             (None, None, Some(path)) => {
@@ -733,6 +744,7 @@ fn droplets(
                 let span = d.image.as_ref().map_or(0..0, |p| p.span());
                 return Err(invalid(
                     source,
+                    SceneErrorKind::Conflict,
                     span,
                     format!(
                         "droplets[{i}]: give exactly one of `at = [u, v]`, `count = N` or `image = \"FILE\"`"
@@ -770,6 +782,7 @@ fn dynamics_settings(
         let span = d.gpu.as_ref().map_or(0..0, |g| g.span());
         return Err(invalid(
             source,
+            SceneErrorKind::Conflict,
             span,
             format!(
                 "the GPU steps {} with the explicit solver only (their implicit step solves all tips at once, on the CPU): set solver = \"explicit\", or gpu = false",
@@ -906,8 +919,14 @@ mod tests {
 
     #[test]
     fn errors_name_the_file_line_and_key() {
-        let e = scene("[fur]\nlayers = 0\n").unwrap_err().to_string();
+        let e = scene("[fur]\nlayers = 0\n").unwrap_err();
+        assert!(matches!(e.kind, SceneErrorKind::OutOfRange(_)), "{e}");
+        assert_eq!(e.at.line_column(), Some((2, 10)));
+        assert_eq!(e.at.key.as_deref(), Some("fur.layers"));
+        let e = e.to_string();
         assert!(e.starts_with("fur.toml:2:10: fur.layers: 0 layers"), "{e}");
+        let e = scene("[animation]\nclip = \"run\"\n").unwrap_err();
+        assert!(matches!(e.kind, SceneErrorKind::Conflict(_)), "{e}");
         let e = scene("[curl]\nradus = 1\n").unwrap_err().to_string();
         assert!(
             e.starts_with("fur.toml:2:1: curl.radus: unknown field"),

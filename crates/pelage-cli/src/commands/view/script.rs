@@ -196,7 +196,7 @@ impl Script {
                 path.to_path_buf(),
                 None,
                 None,
-                pelage::groom::GroomErrorKind::Invalid(format!("cannot read the script: {e}")),
+                pelage::groom::GroomErrorKind::Missing(format!("cannot read the script: {e}")),
             )
         })?;
         Self::parse(&source)
@@ -224,7 +224,7 @@ impl Script {
                     source.path.clone(),
                     None,
                     Some("step.brush.name".into()),
-                    pelage::groom::GroomErrorKind::Invalid(format!(
+                    pelage::groom::GroomErrorKind::Syntax(format!(
                         "no brush '{}': use one of {}",
                         b.name,
                         super::grooming::PALETTE.join(", ")
@@ -240,7 +240,7 @@ impl Script {
                     source.path.clone(),
                     None,
                     Some("step.brush.falloff".into()),
-                    pelage::groom::GroomErrorKind::Invalid(format!(
+                    pelage::groom::GroomErrorKind::Syntax(format!(
                         "falloff '{f}': use smooth, linear or constant"
                     )),
                 ));

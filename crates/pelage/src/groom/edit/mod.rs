@@ -141,7 +141,7 @@ impl EditableGroom {
         if spec.roots.ids != HairIds::Stable {
             return Err(spec.error(
                 "roots.ids",
-                GroomErrorKind::Invalid(
+                GroomErrorKind::Conflict(
                     "grooming by hand needs stable hair ids: remove `ids = \"sequential\"`".into(),
                 ),
             ));
@@ -149,7 +149,7 @@ impl EditableGroom {
         if spec.roots.distribution != RootDistribution::Random {
             return Err(spec.error(
                 "roots.distribution",
-                GroomErrorKind::Invalid(
+                GroomErrorKind::Conflict(
                     "grooming by hand needs random roots: blue-noise roots move as a whole when one changes; groom with `distribution = \"random\"` and switch back to write".into(),
                 ),
             ));
@@ -525,7 +525,7 @@ impl EditableGroom {
     ) -> Result<(Edit, Regrowth), GroomError> {
         let current = &self.spec.guides;
         let n = current.points_per_guide();
-        let invalid = |m: String| Err(self.spec.error("guides", GroomErrorKind::Invalid(m)));
+        let invalid = |m: String| Err(self.spec.error("guides", GroomErrorKind::Mismatch(m)));
         if points.len() != guides.len() * n {
             return invalid(format!(
                 "{} points for {} guides of {n} points",
@@ -551,10 +551,9 @@ impl EditableGroom {
             }
             all[range].copy_from_slice(new);
         }
-        let reshaped = current.with_points(all).map_err(|e| {
-            self.spec
-                .error("guides", GroomErrorKind::Invalid(e.to_string()))
-        })?;
+        let reshaped = current
+            .with_points(all)
+            .map_err(|e| self.spec.error("guides", GroomErrorKind::Curves(e)))?;
         let mut spec = self.spec.clone();
         spec.guides = Arc::new(reshaped);
         moved.sort_unstable();
@@ -586,28 +585,33 @@ impl EditableGroom {
         values: Vec<f32>,
     ) -> Result<(Edit, Regrowth), GroomError> {
         let mesh = &self.spec.mesh;
-        let invalid = |m: String| Err(self.spec.error("mesh", GroomErrorKind::Invalid(m)));
+        let refuse = |kind: GroomErrorKind| Err(self.spec.error("mesh", kind));
         let Some(current) = mesh.vertex_attribute(&layer) else {
-            return invalid(format!(
+            return refuse(GroomErrorKind::Missing(format!(
                 "the mesh has no paint layer '{layer}' (it has: {})",
                 layer_names(mesh)
-            ));
+            )));
         };
         if vertices.len() != values.len() {
-            return invalid(format!(
+            return refuse(GroomErrorKind::Mismatch(format!(
                 "{} values for {} vertices",
                 values.len(),
                 vertices.len()
-            ));
+            )));
         }
         if let Some(v) = vertices
             .iter()
             .find(|v| **v as usize >= mesh.vertex_count())
         {
-            return invalid(format!("vertex {v} of {}", mesh.vertex_count()));
+            return refuse(GroomErrorKind::OutOfRange(format!(
+                "vertex {v} of {}",
+                mesh.vertex_count()
+            )));
         }
         if values.iter().any(|v| !v.is_finite()) {
-            return invalid(format!("values painted on '{layer}' must be finite"));
+            return refuse(GroomErrorKind::NotFinite(format!(
+                "values painted on '{layer}' must be finite"
+            )));
         }
         let mut all = current.values.to_vec();
         let before: Vec<f32> = vertices.iter().map(|&v| all[v as usize]).collect();
@@ -625,10 +629,7 @@ impl EditableGroom {
         };
         let new_mesh = Mesh::clone(mesh)
             .with_vertex_attribute(layer.clone(), all)
-            .map_err(|e| {
-                self.spec
-                    .error("mesh", GroomErrorKind::Invalid(e.to_string()))
-            })?;
+            .map_err(|e| self.spec.error("mesh", GroomErrorKind::Mesh(e)))?;
         let mut spec = self.spec.clone();
         spec.mesh = Arc::new(new_mesh);
         let reads = |map: &Map| matches!(map, Map::Vertex(v) if v.name == layer);
@@ -696,7 +697,7 @@ impl EditableGroom {
         if generator.root_cells().is_none() {
             return Err(spec.error(
                 "roots.ids",
-                GroomErrorKind::Invalid("grooming by hand needs stable hair ids".into()),
+                GroomErrorKind::Conflict("grooming by hand needs stable hair ids".into()),
             ));
         }
         let previous_spec = std::mem::replace(&mut self.spec, spec);
@@ -780,7 +781,7 @@ fn check_fraction(spec: &GroomSpec, fraction: f64) -> Result<(), GroomError> {
     } else {
         Err(spec.error(
             "fraction",
-            GroomErrorKind::Invalid(format!(
+            GroomErrorKind::OutOfRange(format!(
                 "the preview fraction is {fraction}; use a share of the hairs in (0, 1]"
             )),
         ))

@@ -125,7 +125,7 @@ impl OperatorKind for Clump {
         if p.count == 0 {
             return Err(cx.error(
                 "count",
-                GroomErrorKind::Invalid("a clump operator needs at least 1 clump".into()),
+                GroomErrorKind::OutOfRange("a clump operator needs at least 1 clump".into()),
             ));
         }
         // Reshaping a groom whose guides alone moved: the same centres.

@@ -122,7 +122,7 @@ impl OperatorKind for Strands {
         if p.count == 0 {
             return Err(cx.error(
                 "count",
-                GroomErrorKind::Invalid("a strand needs at least 1 hair".into()),
+                GroomErrorKind::OutOfRange("a strand needs at least 1 hair".into()),
             ));
         }
         Ok(Strands::new(

@@ -23,8 +23,8 @@ use super::ogawa::{Child, EMPTY_DATA};
 use crate::Curves;
 use crate::curves::DEFAULT_WIDTH;
 use crate::curves::HairShading;
+use crate::error::Where;
 use crate::limits::{MAX_NAME_BYTES, MAX_PATH_BYTES};
-use crate::mesh::Location;
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::cell::Cell;
 use std::path::Path;
@@ -47,10 +47,7 @@ impl<'a> Ogawa<'a> {
     fn fail(&self, at: u64, message: String) -> CurvesReadError {
         CurvesReadError::new(
             self.path,
-            Location::Element {
-                kind: "byte",
-                index: at as usize,
-            },
+            Where::element("byte", at as usize),
             Kind::Inconsistent(message),
         )
     }

@@ -18,9 +18,9 @@
 //! decoded (pelage reads the first frame of an animation).
 
 use super::crate_file::MIN_COMPRESSED_ARRAY_SIZE;
+use crate::error::Where;
 use crate::io::read_error::{CurvesReadError, CurvesReadErrorKind as Kind, DecodeBudget, excerpt};
 use crate::limits::MAX_PATH_BYTES;
-use crate::mesh::Location;
 use openusd::gf;
 use openusd::sdf::{self, AbstractData, SpecType, Value};
 use openusd::tf::Token;
@@ -44,10 +44,7 @@ impl<'a> Crate<'a> {
     fn fail(&self, at: usize, message: String) -> CurvesReadError {
         CurvesReadError::new(
             self.path,
-            Location::Element {
-                kind: "byte",
-                index: at,
-            },
+            Where::element("byte", at),
             Kind::Inconsistent(message),
         )
     }
