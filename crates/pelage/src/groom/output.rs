@@ -281,7 +281,11 @@ pub fn write_assembly(
             })
             .map_err(|e| fail(file, format!("cannot read the part file: {e}")))?;
         if binary {
-            let bounds = read_usd_extent(file).map_err(|e| fail(path, e.to_string()))?;
+            // The reader's error names the part file; it travels typed.
+            let bounds = read_usd_extent(file).map_err(|e| WriteError {
+                path: path.to_path_buf(),
+                error: std::io::Error::other(e),
+            })?;
             extents.push(bounds);
             continue;
         }

@@ -120,6 +120,15 @@ pub enum CurvesReadErrorKind {
     /// The arrays read do not make valid curves (NaN, …).
     #[error(transparent)]
     Curves(#[from] CurvesError),
+    /// The arrays of one object (a prim, an Alembic object) do not make
+    /// valid curves.
+    #[error("{object}: {error}")]
+    CurvesOf {
+        /// The object's path in the file.
+        object: String,
+        /// Why.
+        error: CurvesError,
+    },
 }
 
 /// A curves file could not be read. Displays as
@@ -136,6 +145,10 @@ impl Located<CurvesReadErrorKind> {
             K::Syntax(m) => K::Syntax(shortened(m)),
             K::Inconsistent(m) => K::Inconsistent(shortened(m)),
             K::Unsupported(m) => K::Unsupported(shortened(m)),
+            K::CurvesOf { object, error } => K::CurvesOf {
+                object: excerpt(&object).into_owned(),
+                error,
+            },
             other => other,
         };
         Located::with(path, location, kind)

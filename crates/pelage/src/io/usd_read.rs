@@ -162,8 +162,12 @@ fn curves_from_layer(
             .collect();
         let curves = Curves::new(points, prim_widths, offsets)
             .map_err(|e| CurvesReadError::whole(path, e.into()))?;
-        let curves = with_primvars(curves, data, prim, transform)
-            .map_err(|e| fail(Kind::Inconsistent(at(&e.to_string()))))?;
+        let curves = with_primvars(curves, data, prim, transform).map_err(|error| {
+            fail(Kind::CurvesOf {
+                object: prim.as_str().to_string(),
+                error,
+            })
+        })?;
         let guide =
             matches!(attribute(data, prim, "purpose"), Some(Value::Token(t)) if t == "guide");
         match guide {

@@ -45,11 +45,12 @@ struct Ogawa<'a> {
 
 impl<'a> Ogawa<'a> {
     fn fail(&self, at: u64, message: String) -> CurvesReadError {
-        CurvesReadError::new(
-            self.path,
-            Where::element("byte", at as usize),
-            Kind::Inconsistent(message),
-        )
+        self.refuse(at, Kind::Inconsistent(message))
+    }
+
+    /// An error of `kind` at byte `at`.
+    fn refuse(&self, at: u64, kind: Kind) -> CurvesReadError {
+        CurvesReadError::new(self.path, Where::element("byte", at as usize), kind)
     }
 
     /// Takes `bytes` of decoded values from the read's budget.
@@ -778,6 +779,15 @@ fn read_curves_object(
     let mut guide = false;
     let at_child = geom;
     let fail = |message: String| file.fail(geom, message);
+    let curves_of = |object: &str, error| {
+        file.refuse(
+            geom,
+            Kind::CurvesOf {
+                object: object.to_string(),
+                error,
+            },
+        )
+    };
     let geom = Compound::read(file, geom, indexed, &what(""))?;
     let property = |name: &str, pod: &[u8], extent: u8| -> Result<Option<&[u8]>, CurvesReadError> {
         let Some(p) = geom.get(name) else {
@@ -887,7 +897,7 @@ fn read_curves_object(
         }
     };
     let mut curves =
-        Curves::new(points, widths, offsets).map_err(|e| fail(format!("{path}: {e}")))?;
+        Curves::new(points, widths, offsets).map_err(|error| curves_of(path, error))?;
     let n = curves.points().len();
     if let Some(b) = property("N", &[10], 3)?.filter(|b| b.len() == n * 12) {
         let normals = floats(b)
@@ -904,7 +914,7 @@ fn read_curves_object(
             .collect();
         curves = curves
             .with_normals(normals)
-            .map_err(|e| fail(format!("{path}: {e}")))?;
+            .map_err(|error| curves_of(path, error))?;
     }
     if let Some(arbitrary) = geom.get(".arbGeomParams").filter(|p| p.0.kind == 0) {
         let arb = Compound::read(file, arbitrary.1, indexed, &what(".arbGeomParams"))?;
@@ -926,7 +936,15 @@ fn with_arbitrary_params(
     mut curves: Curves,
 ) -> Result<Curves, CurvesReadError> {
     let what = |p: &str| format!("{path}/.geom/{p}");
-    let fail = |message: String| file.fail(geom, message);
+    let curves_of = |object: &str, error| {
+        file.refuse(
+            geom,
+            Kind::CurvesOf {
+                object: object.to_string(),
+                error,
+            },
+        )
+    };
     let n = curves.points().len();
     let sample =
         |name: &str, pods: &[u8], extent: u8| -> Result<Option<(u8, &[u8])>, CurvesReadError> {
@@ -945,12 +963,12 @@ fn with_arbitrary_params(
             .collect();
         curves = curves
             .with_colors(colors)
-            .map_err(|e| fail(format!("{path}: {e}")))?;
+            .map_err(|error| curves_of(path, error))?;
     }
     if let Some((_, b)) = sample("groom_opacity", &[10], 1)?.filter(|(_, b)| b.len() == n * 4) {
         curves = curves
             .with_opacities(floats(b).collect())
-            .map_err(|e| fail(format!("{path}: {e}")))?;
+            .map_err(|error| curves_of(path, error))?;
     }
     let curve_count = curves.curve_count();
     if let Some((_, b)) =
@@ -963,7 +981,7 @@ fn with_arbitrary_params(
         if let Some(regions) = regions {
             curves = curves
                 .with_regions(regions)
-                .map_err(|e| fail(format!("{path}: {e}")))?;
+                .map_err(|error| curves_of(path, error))?;
         }
     }
     if let Some((pod, b)) = sample("groom_id", &[6, 8], 1)? {
@@ -979,7 +997,7 @@ fn with_arbitrary_params(
         if let Some(ids) = ids.filter(|ids| ids.len() == curve_count) {
             curves = curves
                 .with_ids(ids)
-                .map_err(|e| fail(format!("{path}: {e}")))?;
+                .map_err(|error| curves_of(path, error))?;
         }
     }
     if let Some((_, b)) =
@@ -992,7 +1010,7 @@ fn with_arbitrary_params(
             .collect();
         curves = curves
             .with_root_uvs(uvs)
-            .map_err(|e| fail(format!("{path}: {e}")))?;
+            .map_err(|error| curves_of(path, error))?;
     }
     // Hair-shading values where all six are there, as pelage writes
     // them.
@@ -1010,7 +1028,7 @@ fn with_arbitrary_params(
     if let Some(shading) = HairShading::from_found(found, tint) {
         curves = curves
             .with_shading(shading)
-            .map_err(|e| fail(format!("{path}: {e}")))?;
+            .map_err(|error| curves_of(path, error))?;
     }
     Ok(curves)
 }
