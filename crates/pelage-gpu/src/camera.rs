@@ -68,6 +68,13 @@ impl Camera {
         proj * view
     }
 
+    /// Pixels per unit of size at unit view depth, on an image `height`
+    /// pixels high: a thing `w` wide at depth `z` is `w · f / z` pixels.
+    /// From the field of view alone, whichever way the camera looks.
+    pub fn focal_length_px(&self, height: u32) -> f32 {
+        0.5 * height as f32 / (0.5 * self.fov_y_degrees.to_radians()).tan()
+    }
+
     /// The view's up direction: world +y, or, looking straight down or up
     /// (where +y is the view direction and says nothing about roll), the
     /// world −z or +z, so a top-down view shows +x to the right and −z up,

@@ -526,7 +526,7 @@ impl Renderer {
             // Points are pulled towards the camera by 0.2 % of clip w.
             point_depth_pull: 0.002,
             skin_color: if scene.textured { [1.0; 3] } else { style.skin },
-            focal_length_px: 0.5 * height as f32 * clip_from_world.y_axis.y,
+            focal_length_px: camera.focal_length_px(height),
             point_color: style.point,
             hair_specular: style.hair_specular,
             hair_color: style.hair,

@@ -176,9 +176,18 @@ fn covered_pixels(image: &image::RgbaImage) -> f64 {
 }
 
 fn render_curve(curves: &pelage::Curves, style: &PreviewStyle) -> Option<image::RgbaImage> {
+    render_curve_from(Vec3::new(0.0, 0.0, 10.0), curves, style)
+}
+
+/// `curves` seen from `eye`, looking at the origin.
+fn render_curve_from(
+    eye: Vec3,
+    curves: &pelage::Curves,
+    style: &PreviewStyle,
+) -> Option<image::RgbaImage> {
     let (ctx, renderer) = gpu()?;
     let camera = Camera {
-        eye: Vec3::new(0.0, 0.0, 10.0),
+        eye,
         target: Vec3::ZERO,
         fov_y_degrees: 30.0,
     };
@@ -215,6 +224,27 @@ fn a_ribbon_covers_its_width_times_its_length() {
     assert!(
         (covered - expected).abs() < 0.15 * expected,
         "covered {covered:.0} px², expected {expected:.0}"
+    );
+}
+
+#[test]
+fn a_ribbon_seen_from_straight_above_is_as_wide_as_from_the_side() {
+    // Looking straight down, world +y is the view direction: the hairs'
+    // width in pixels must not be read off it (they vanished).
+    let black = PreviewStyle {
+        hair: [0.0, 0.0, 0.0],
+        hair_specular: 0.0,
+        ..Default::default()
+    };
+    let curve = straight_curve(0.05);
+    let Some(above) = render_curve_from(Vec3::new(0.0, 10.0, 0.0), &curve, &black) else {
+        return;
+    };
+    let expected = 2.0 * pixels_per_unit() * 0.05 * pixels_per_unit();
+    let covered = covered_pixels(&above);
+    assert!(
+        (covered - expected).abs() < 0.15 * expected,
+        "covered {covered:.0} px² from above, expected {expected:.0}"
     );
 }
 
