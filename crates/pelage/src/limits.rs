@@ -113,6 +113,12 @@ pub const DECODED_BYTES_PER_FILE_BYTE: u64 = 8;
 /// further bounded by [`MAX_IMAGE_PIXELS`]): 256 M, 1 GB of texels.
 pub const MAX_UDIM_PIXELS: u64 = 1 << 28;
 
+/// The largest collision thickness of simulated guides, as a share of
+/// the skin's size (its bounding box's longest side): the skin's distance
+/// grid reaches that far past the surface, so a thickness of many sizes
+/// asks for a grid of billions of cells. The default is 0.2 %.
+pub const MAX_THICKNESS_OF_SKIN: f32 = 0.1;
+
 /// Frame files a run keeps open at once while it writes an animation as
 /// one file a frame; the rest wait, so a long range stays under the usual
 /// limit of 1,024 open files.

@@ -161,3 +161,30 @@ fn one_and_two_threads_simulate_the_same_bits() {
         "1 and 2 threads differ"
     );
 }
+
+#[test]
+fn a_thickness_of_many_skins_is_refused_before_any_grid_is_built() {
+    // A thickness sets how far past the surface the skin's distance grid
+    // reaches: 1e30 indexed past it (a panic), 1e10 asked for hundreds of
+    // gigabytes. Built in code, it is refused as it is from a file.
+    let run = fox_run();
+    let triangles = run.skin.mesh_at(1.0).unwrap().triangles().to_vec();
+    let pose = SkinPose::new(run.skin.positions_at(1.0).unwrap(), &triangles);
+    for thickness in [1e30, 1e10, f32::NAN, 0.2 * run.size] {
+        let refused = GuideSimulation::new(
+            &run.guides,
+            &triangles,
+            &pose,
+            params(run.size, thickness),
+            true,
+        )
+        .map(drop)
+        .unwrap_err();
+        assert!(
+            matches!(refused, pelage::dynamics::StrandError::Thickness { .. }),
+            "{thickness}: {refused}"
+        );
+    }
+    let kept = params(run.size, 0.05 * run.size);
+    assert!(GuideSimulation::new(&run.guides, &triangles, &pose, kept, true).is_ok());
+}

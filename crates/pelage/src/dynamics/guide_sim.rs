@@ -57,6 +57,13 @@ impl GuideSimulation {
             GuideStrands::new(guides.curves().points(), guides.points_per_guide(), &roots)?;
         let (lo, hi) = crate::mesh::bounds_of(rest.positions());
         let longest = (hi - lo).max_element().max(f32::MIN_POSITIVE);
+        let most = crate::limits::MAX_THICKNESS_OF_SKIN * longest;
+        if params.thickness.is_nan() || params.thickness > most {
+            return Err(StrandError::Thickness {
+                thickness: params.thickness,
+                most,
+            });
+        }
         let segment = strands
             .rest_lengths()
             .iter()

@@ -131,6 +131,16 @@ pub enum StrandError {
     /// The arrays do not describe the same strands.
     #[error("{0}")]
     Shape(String),
+    /// A collision thickness past pelage's limit for this skin.
+    #[error(
+        "a collision thickness of {thickness} is more than a tenth of the skin's size ({most} here): guides are kept this far off the skin (docs/limits.md)"
+    )]
+    Thickness {
+        /// The thickness asked for.
+        thickness: f32,
+        /// The most this skin allows.
+        most: f32,
+    },
 }
 
 /// Simulated strands: positions and velocities, with each strand's

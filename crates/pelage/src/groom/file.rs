@@ -327,7 +327,7 @@ pub struct SimulationSection {
     pub collide: bool,
     /// How far from the skin guides are kept (default: 0.2 % of the
     /// mesh's size).
-    pub thickness: Option<f32>,
+    pub thickness: Option<Spanned<f32>>,
     /// Friction against the skin, 0 to 1.
     #[serde(default = "default_friction")]
     pub friction: f32,

@@ -379,7 +379,22 @@ impl Groom {
                 drag: section.drag,
                 wind: (section.wind != [0.0; 3])
                     .then(|| Wind::new(Vec3::from(section.wind), 0.0, 0.0, 0.0, 1.0, 0)),
-                thickness: section.thickness.unwrap_or(2e-3 * size),
+                thickness: match &section.thickness {
+                    Some(t) => {
+                        let most = crate::limits::MAX_THICKNESS_OF_SKIN * size;
+                        if t.get_ref().is_nan() || *t.get_ref() > most {
+                            return Err(self.source.error_at(
+                                t.span(),
+                                GroomErrorKind::OutOfRange(format!(
+                                    "{}: at most {most} here, a tenth of the skin's size; guides are kept this far off the skin (the default is 0.2 % of its size; docs/limits.md)",
+                                    t.get_ref()
+                                )),
+                            ));
+                        }
+                        *t.get_ref()
+                    }
+                    None => 2e-3 * size,
+                },
                 friction: section.friction,
                 ..GuideStrandParams::default()
             },
