@@ -851,3 +851,36 @@ fn a_z_up_usd_guide_file_is_turned_to_the_meshs_y_up() {
         "{e}"
     );
 }
+
+#[test]
+fn a_tiny_fraction_widens_its_one_hair_by_the_share_actually_kept() {
+    // A fraction of a hair still grows one; its width is scaled by the
+    // share kept (1 of 1,000), not by 1/√F, which for 1e-300 was infinite.
+    let full = groom(
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 1000\n[guides]\ngenerate = { count = 5, length = 0.1 }\n[output]\nfraction = 1\n",
+    );
+    let whole = full.spec().unwrap().generator().unwrap();
+    let base = whole.part(0).unwrap().widths()[0];
+    for fraction in ["1e-9", "1e-300"] {
+        let text = format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 1000\n[guides]\ngenerate = {{ count = 5, length = 0.1 }}\n[output]\nfraction = {fraction}\n"
+        );
+        let generator = groom(&text).spec().unwrap().generator().unwrap();
+        let kept: Vec<pelage::Curves> = (0..generator.parts().len())
+            .map(|p| generator.part(p).unwrap())
+            .collect();
+        let hairs: usize = kept.iter().map(|c| c.curve_count()).sum();
+        assert_eq!(hairs, 1, "{fraction}");
+        let widths: Vec<f32> = kept.iter().flat_map(|c| c.widths().to_vec()).collect();
+        assert!(
+            widths.iter().all(|w| w.is_finite()),
+            "{fraction}: {widths:?}"
+        );
+        let expected = base * 1000f32.sqrt();
+        assert!(
+            (widths[0] - expected).abs() < 1e-4 * expected,
+            "{fraction}: {} where {expected}",
+            widths[0]
+        );
+    }
+}

@@ -144,10 +144,11 @@ impl Generator {
             opacities,
             clumps: false,
             records_centre_guides: reuse.centre_guides,
-            width_scale: if roots.fraction < 1.0 {
-                (1.0 / roots.fraction.sqrt()) as f32
-            } else {
-                1.0
+            // By the share actually kept: a fraction of a hair still
+            // grows one (1e-300 would make widths infinite).
+            width_scale: match roots.grown_count() {
+                grown if grown < roots.count => (roots.count as f64 / grown as f64).sqrt() as f32,
+                _ => 1.0,
             },
             normals: finish.normals,
             outside_skin,

@@ -62,8 +62,9 @@ pub struct Generator {
     pub(super) clumps: bool,
     /// Whether clump centres record the guides they depend on.
     pub(super) records_centre_guides: bool,
-    /// Every width's factor: `1/√fraction`, so a preview covers the skin
-    /// as the whole groom does.
+    /// Every width's factor: `√(count / grown)`, one over the square root
+    /// of the share of the hairs actually grown, so a preview covers the
+    /// skin as the whole groom does.
     pub(super) width_scale: f32,
     pub(super) normals: bool,
     /// The skin hairs are kept out of, after the operators.
