@@ -112,6 +112,17 @@ impl SettingsSource {
             .0;
         Some((line + 1, 1))
     }
+
+    /// Line and column of table `name`'s `[name]` header (`None` when the
+    /// file writes it inline or not at all).
+    pub fn line_of_table(&self, name: &str) -> Option<(usize, usize)> {
+        let header = format!("[{name}]");
+        let line = self
+            .text
+            .lines()
+            .position(|l| l.split('#').next().unwrap_or("").trim() == header)?;
+        Some((line + 1, 1))
+    }
 }
 
 /// `line` with every byte inside a quoted string replaced by `x`: the same

@@ -332,8 +332,14 @@ fn check_numbers(spec: &GroomSpec) -> Result<(), GroomError> {
         && (spec.roots.ids != HairIds::Stable
             || spec.roots.distribution != RootDistribution::Random)
     {
+        // Blamed on the roots setting that rules a fraction out: the
+        // fraction itself may come from a flag, not the file.
+        let key = match spec.roots.ids {
+            HairIds::Stable => "roots.distribution",
+            HairIds::Sequential => "roots.ids",
+        };
         return Err(spec.error(
-            "output.fraction",
+            key,
             GroomErrorKind::Conflict(
                 "a fraction grows the first arrivals of the root cells, so that it is a subset of the groom: it needs stable ids and random roots (remove `ids = \"sequential\"` or `distribution = \"blue-noise\"`)".into(),
             ),

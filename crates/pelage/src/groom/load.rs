@@ -835,8 +835,12 @@ fn animation_spec(
         &file.simulation,
         section.is_some_and(|s| s.mode == AnimationModeName::Simulate),
     ) {
-        return Err(source.error_at(
-            section.map_or(0..0, |s| s.frames.span()),
+        // The table at fault is [simulation] (or the mode it lacks), not
+        // the frames.
+        return Err(GroomError::new(
+            source.path.clone(),
+            source.line_of_table("simulation"),
+            Some("simulation".into()),
             GroomErrorKind::Conflict(
                 "[simulation] moves the guides of an animated groom with mode = \"simulate\" in [animation]: set it, or remove [simulation]".into(),
             ),
