@@ -3,9 +3,11 @@
 //! full regrow after random edits of every kind.
 
 use glam::Vec3;
-use pelage::groom::brush::{Brush, Dab, Falloff, height_above_skin};
+use pelage::groom::brush::{Brush, BrushRefusal, Dab, Falloff, height_above_skin};
 use pelage::groom::edit::{Edit, EditableGroom};
-use pelage::groom::{ClumpParams, GroomOp, GroomSpec, LengthParams, NoiseParams, RootsSpec};
+use pelage::groom::{
+    ClumpParams, GroomErrorKind, GroomOp, GroomSpec, LengthParams, NoiseParams, RootsSpec,
+};
 use pelage::guides::{GuideGrowth, Guides};
 use pelage::map::{Map, VertexMap};
 use pelage::mesh::Mesh;
@@ -523,8 +525,38 @@ fn bad_edits_are_refused_and_change_nothing() {
         )
         .unwrap_err();
     assert!(e.to_string().contains("letters, digits"), "{e}");
+    // A strength that would make guides no later dab can move, and an
+    // add past the guide limit (it hung), are refused, typed.
+    let root0 = root(&groom, 0);
+    let huge = Dab {
+        strength: 1e30,
+        ..dab(root0, 0.1)
+    };
+    let e = groom.brush(&Brush::Length, &huge).unwrap_err();
+    assert!(
+        matches!(e.kind, GroomErrorKind::Brush(BrushRefusal::Dab(_))),
+        "{e}"
+    );
+    let e = groom
+        .brush(&Brush::Add { count: u32::MAX }, &dab(root0, 0.1))
+        .unwrap_err();
+    assert!(
+        matches!(
+            e.kind,
+            GroomErrorKind::Brush(BrushRefusal::TooManyGuides { have: 60, .. })
+        ),
+        "{e}"
+    );
+    let nowhere = dab(Vec3::splat(f32::NAN), 0.1);
+    assert!(groom.brush(&Brush::Comb, &nowhere).is_err());
     assert_eq!(bits(&groom.curves()), before);
     assert_eq!(groom.history_len(), (0, 0));
+    // The groom still takes a sensible dab.
+    let grow = Dab {
+        strength: 0.5,
+        ..dab(root0, 0.1)
+    };
+    assert!(groom.brush(&Brush::Length, &grow).unwrap().is_some());
     let sequential = {
         let mut s = spec(100);
         s.roots.ids = pelage::groom::HairIds::Sequential;

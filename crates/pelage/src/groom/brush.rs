@@ -31,7 +31,7 @@ use crate::sample::{mix64, open_unit_pair};
 use glam::Vec3;
 use std::sync::Arc;
 
-pub use super::error::BrushRefusal;
+pub use super::error::{BrushRefusal, MAX_BRUSH_STRENGTH};
 
 /// How a brush's effect fades from its centre (distance 0) to its rim
 /// (distance 1).
@@ -231,6 +231,29 @@ impl Brush {
     }
 }
 
+/// A dab every brush can use: finite, with a positive radius and a
+/// strength within ±[`MAX_BRUSH_STRENGTH`] (a strength of 1e30 made guides
+/// no later dab could move).
+fn check_dab(dab: &Dab) -> Result<(), BrushRefusal> {
+    let refuse = |what: String| Err(BrushRefusal::Dab(what));
+    if !dab.center.is_finite() || !dab.direction.is_finite() {
+        return refuse(format!(
+            "a dab at {} moving by {}: both must be finite",
+            dab.center, dab.direction
+        ));
+    }
+    if !(dab.radius.is_finite() && dab.radius > 0.0) {
+        return refuse(format!("radius {}: use a positive distance", dab.radius));
+    }
+    if dab.strength.is_nan() || dab.strength.abs() > MAX_BRUSH_STRENGTH {
+        return refuse(format!(
+            "strength {}: use -{MAX_BRUSH_STRENGTH} to {MAX_BRUSH_STRENGTH}",
+            dab.strength
+        ));
+    }
+    Ok(())
+}
+
 /// The edit `brush` makes with `dab` on `groom` (`None`: the dab touches
 /// nothing). Pure: the groom is not changed. Paint brushes need their
 /// layer on the mesh; [`EditableGroom::brush`] adds it first.
@@ -242,6 +265,7 @@ pub fn dab_edit(
     brush: &Brush,
     dab: &Dab,
 ) -> Result<Option<Edit>, BrushRefusal> {
+    check_dab(dab)?;
     let dabs = dab.sides();
     match brush {
         Brush::Comb
@@ -251,7 +275,14 @@ pub fn dab_edit(
         | Brush::Puff
         | Brush::Clump
         | Brush::Spread => Ok(shape_guides(groom, brush, &dabs)),
-        Brush::Add { count } => Ok(add_guides(groom, *count, &dabs)),
+        Brush::Add { count } => {
+            let (have, most) = (groom.guides().len(), crate::limits::MAX_GUIDES);
+            let adding = u64::from(*count) * dabs.len() as u64;
+            if have as u64 + adding > most {
+                return Err(BrushRefusal::TooManyGuides { have, adding, most });
+            }
+            Ok(add_guides(groom, *count, &dabs))
+        }
         Brush::Delete => delete_guides(groom, &dabs),
         Brush::Paint { layer, value } => paint(groom, layer, &dabs, |old, w| {
             old + w.clamp(0.0, 1.0) * (value - old)

@@ -114,6 +114,11 @@ pub enum GroomErrorKind {
     NotFinite(String),
 }
 
+/// The largest strength a dab takes, either way: the length brush scales
+/// guides by `1 + strength` at a dab's centre, so a strength of 10 makes
+/// them eleven times as long in one dab.
+pub const MAX_BRUSH_STRENGTH: f32 = 10.0;
+
 /// Why a brush cannot make its edit.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
@@ -127,6 +132,23 @@ pub enum BrushRefusal {
     /// A paint layer's name that is not a name (or is a reserved one).
     #[error("paint layer '{0}': use letters, digits and '_' (not x, y, z, nx, ny, nz, s, t, u, v)")]
     LayerName(String),
+    /// A dab whose centre, radius, strength or direction cannot be used
+    /// (not finite, a radius that is not positive, a strength past
+    /// ±[`MAX_BRUSH_STRENGTH`]).
+    #[error("{0}")]
+    Dab(String),
+    /// The add brush would take the groom past pelage's guide limit.
+    #[error(
+        "adding {adding} guides to {have} would pass pelage's limit of {most} guides (docs/limits.md)"
+    )]
+    TooManyGuides {
+        /// Guides the groom has.
+        have: usize,
+        /// Guides the dab would add (at most).
+        adding: u64,
+        /// The limit.
+        most: u64,
+    },
     /// The part brush on a groom whose regions are face sets.
     #[error(
         "this groom's regions are the mesh's face sets; the part brush paints a 'region' layer: set [regions] map = \"vertex:region\" to paint partings"

@@ -121,6 +121,10 @@ pub struct BrushStep {
     pub count: Option<u32>,
 }
 
+/// The most dabs a scripted stroke takes: each is an edit and a
+/// regrowth, so 10^8 of them ran for hours.
+pub const MAX_STROKE_DABS: u32 = 10_000;
+
 fn default_dabs() -> u32 {
     8
 }
@@ -246,6 +250,21 @@ impl Script {
                 ));
             }
         }
+        for step in &steps {
+            if let Step::Brush(b) = step
+                && b.dabs > MAX_STROKE_DABS
+            {
+                return Err(GroomError::new(
+                    source.path.clone(),
+                    None,
+                    Some("step.brush.dabs".into()),
+                    pelage::groom::GroomErrorKind::OutOfRange(format!(
+                        "{} dabs in one stroke: use at most {MAX_STROKE_DABS} (a stroke's dabs are regrown one by one)",
+                        b.dabs
+                    )),
+                ));
+            }
+        }
         Ok(Self { ui: file.ui, steps })
     }
 
@@ -330,5 +349,19 @@ quit = true
             .unwrap_err()
             .to_string();
         assert!(err.contains("shots/act.toml:2:"), "{err}");
+    }
+
+    #[test]
+    fn a_stroke_of_a_hundred_million_dabs_is_refused() {
+        let err = parse("[[step]]\nbrush = { name = \"comb\", from = [1, 2], dabs = 100000000 }\n")
+            .unwrap_err();
+        assert!(
+            matches!(err.kind, pelage::groom::GroomErrorKind::OutOfRange(_)),
+            "{err}"
+        );
+        assert_eq!(err.at.key.as_deref(), Some("step.brush.dabs"));
+        assert!(
+            parse("[[step]]\nbrush = { name = \"comb\", from = [1, 2], dabs = 100 }\n").is_ok()
+        );
     }
 }
