@@ -580,8 +580,10 @@ def save_groom_file(context, surface, settings, path):
 
     depsgraph = context.evaluated_depsgraph_get()
     mesh, _ = mesh_to_pelage(surface, depsgraph)
-    # Blender images the maps name go beside the file, by name.
+    # Blender images the maps name go beside the file, by name; a folder
+    # typed in the file browser that is not there yet is made.
     folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
     groom = groom_for(surface, settings, mesh, depsgraph, images=folder, relative=True)
     text = groom.settings
     written = [path]

@@ -701,6 +701,12 @@ with tempfile.TemporaryDirectory() as folder:
     assert bpy.ops.pelage.save_groom(filepath=again) == {"FINISHED"}
     with open(saved) as a, open(again) as b:
         assert a.read() == b.read(), "the groom file round-trips through the panel"
+    # Into a folder that is not there yet (typed in Blender's file
+    # browser): made, not a raw error about a temporary file.
+    nested = os.path.join(folder, "new", "deeper", "panel.toml")
+    assert bpy.ops.pelage.save_groom(filepath=nested) == {"FINISHED"}
+    with open(saved) as a, open(nested) as b:
+        assert a.read() == b.read(), "a save into a new folder writes the same file"
     # The style mesh (Furtility) from the panel.
     other.pelage_fur.interpolation = "STYLE_MESH"
     assert bpy.ops.pelage.grow_fur() == {"FINISHED"}

@@ -741,3 +741,35 @@ fn guide_curves_from_a_dcc_move_only_the_guides_whose_points_moved() {
         .expect("guides replaced");
     assert_eq!(groom.guides().len(), grown.len() - 1);
 }
+
+#[test]
+fn saving_to_a_path_that_is_no_file_writes_nothing() {
+    let groom = EditableGroom::new(spec(200), 1.0).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let listing = || {
+        let mut names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        names.sort();
+        names
+    };
+    // A folder, and paths that name no file: refused before the guides
+    // are written beside them.
+    let folder = dir.path().join("sub");
+    std::fs::create_dir(&folder).unwrap();
+    for path in [folder.clone(), folder.join(".."), "".into()] {
+        assert!(groom.save(&path, None).is_err(), "{}", path.display());
+    }
+    // (The folder's save wrote `sub.guides.usdc` beside it before.)
+    assert_eq!(listing(), ["sub"], "{:?}", listing());
+    // A pipe (as a device would be) is not renamed over.
+    let pipe = dir.path().join("fur.toml");
+    let made = std::process::Command::new("mkfifo").arg(&pipe).status();
+    if made.is_ok_and(|s| s.success()) {
+        let e = groom.save(&pipe, None).unwrap_err();
+        assert!(e.to_string().contains("not a regular file"), "{e}");
+        assert!(!std::fs::metadata(&pipe).unwrap().is_file());
+        assert_eq!(listing().len(), 2, "{:?}", listing());
+    }
+}

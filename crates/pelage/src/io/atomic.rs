@@ -246,15 +246,32 @@ fn free_space(path: &Path) -> Option<u64> {
     }
 }
 
-/// Whether `path` may be written: not a folder, and (under
-/// [`protect_inputs`]) not a file this process read. [`AtomicFile::create`]
-/// checks it; long work checks it before it starts, so a mistaken output
-/// is refused at once rather than after minutes of growing.
+/// Whether `path` may be written: a file name, not a folder, not a
+/// device, pipe or socket (a rename would put a regular file in its
+/// place), and (under [`protect_inputs`]) not a file this process read.
+/// [`AtomicFile::create`] checks it; long work checks it before it
+/// starts, so a mistaken output is refused at once rather than after
+/// minutes of growing.
 pub fn check_output(path: &Path) -> Result<(), WriteError> {
     let fail = |kind, message: &str| WriteError {
         path: path.to_path_buf(),
         error: std::io::Error::new(kind, message),
     };
+    if path.file_name().is_none() {
+        return Err(fail(
+            std::io::ErrorKind::InvalidInput,
+            "the path names no file; give a file name",
+        ));
+    }
+    if let Ok(meta) = std::fs::metadata(path)
+        && !meta.is_file()
+        && !meta.is_dir()
+    {
+        return Err(fail(
+            std::io::ErrorKind::InvalidInput,
+            "it is not a regular file (a device, a pipe or a socket): writing would replace it; give a file name",
+        ));
+    }
     if path.is_dir() {
         return Err(fail(
             std::io::ErrorKind::IsADirectory,

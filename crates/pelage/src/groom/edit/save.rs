@@ -68,9 +68,16 @@ impl EditableGroom {
         groom_path: &Path,
         original: Option<&SettingsSource>,
     ) -> Result<SavedGroom, SaveError> {
+        // Every path checked before any file is written: a groom path
+        // that names no file left a stray guides file beside it.
+        crate::io::check_output(groom_path)?;
         let guides_path = sibling(groom_path, "guides.usdc");
         let layers_path =
             (!self.mesh().vertex_attributes().is_empty()).then(|| layers_file_name(groom_path));
+        crate::io::check_output(&guides_path)?;
+        if let Some(path) = &layers_path {
+            crate::io::check_output(path)?;
+        }
         let folder = groom_path.parent().unwrap_or(Path::new("."));
         write_curves(
             &guides_path,
