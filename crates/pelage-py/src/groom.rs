@@ -458,6 +458,10 @@ impl PyGroom {
         py: Python<'py>,
         path: Option<std::path::PathBuf>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        // Refused before the simulation, not after it.
+        if let Some(path) = &path {
+            pelage::io::check_writable(path).map_err(to_py_err)?;
+        }
         let (guides, cache) = py
             .detach(|| self.groom.simulated_guides())
             .map_err(|e| self.error(e))?;

@@ -53,6 +53,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             CurvesFormat::NO_TIME_SAMPLES
         );
     }
+    if let Some(output) = &args.output {
+        pelage::io::check_writable(output)?;
+    }
     let (guides, cache) = groom.simulated_guides()?;
     let frames = guides.frames();
     let count = guides.at(*frames.start()).map_or(0, |g| g.curve_count());

@@ -243,6 +243,9 @@ pub fn cached_simulation(
         };
         return Ok((guides, CacheUse::Read));
     }
+    // The cache must take the result: checked before the simulation.
+    crate::io::check_writable(cache)
+        .map_err(|e| spec.error("simulation.cache", GroomErrorKind::Cache(Box::new(e))))?;
     let guides = simulate_with_key(spec, skin, settings, key)?;
     let options = UsdOptions {
         time_codes_per_second: settings.fps,

@@ -287,6 +287,14 @@ pub fn check_output(path: &Path) -> Result<(), WriteError> {
     Ok(())
 }
 
+/// Whether `path` can be written now: [`check_output`] holds and its
+/// folder takes a file (a temporary file is made beside it and removed).
+/// Long work (a simulation) calls it before it starts, so an output in a
+/// folder that is not there is refused at once, not after minutes.
+pub fn check_writable(path: &Path) -> Result<(), WriteError> {
+    AtomicFile::create(path).map(drop)
+}
+
 /// A file being written atomically, for writers that hold their output
 /// (several files open at once): a buffered temporary file beside the
 /// target, renamed over it by [`Self::commit`]; dropped uncommitted, the

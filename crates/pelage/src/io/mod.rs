@@ -41,8 +41,8 @@ pub use abc::{
     read_abc_objects,
 };
 pub use atomic::{
-    AtomicFile, check_free_space, check_input, check_output, note_input, protect_inputs,
-    remove_temporary_files, write_atomically, write_atomically_with,
+    AtomicFile, check_free_space, check_input, check_output, check_writable, note_input,
+    protect_inputs, remove_temporary_files, write_atomically, write_atomically_with,
 };
 pub use curves_file::{CurvesExport, CurvesFormat, read_curves, write_curves, write_streamed};
 pub use curves_ply::{read_curves_ply, write_curves_ply};
