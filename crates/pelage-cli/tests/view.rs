@@ -462,3 +462,46 @@ fn a_simulated_groom_written_with_its_skin_plays_in_the_viewer() {
     let (near, far) = changed_near_and_far(&first, &last, (0.0, 0.0), 0.0);
     assert!(near + far > total / 50, "{} pixels changed", near + far);
 }
+
+#[test]
+fn a_scripted_step_that_fails_ends_the_run_with_its_error() {
+    if !has_display() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let groom = "[mesh]\npath = \"spot\"\n[roots]\ncount = 500\n\
+        [guides]\ngenerate = { count = 20, length = 0.1 }\n";
+    let groom_path = dir.path().join("fur.toml");
+    std::fs::write(&groom_path, groom).unwrap();
+    let (cx, cy) = (SIZE.0 as f32 / 2.0, SIZE.1 as f32 / 2.0);
+    let size = format!("{}x{}", SIZE.0, SIZE.1);
+    // A save into a folder, and a brush with a negative radius: each used
+    // to close the window and exit 0, skipping the steps after it.
+    for (step, says) in [
+        ("save = \"sub\"".to_string(), "sub"),
+        (
+            format!("brush = {{ name = \"length\", from = [{cx}, {cy}], radius = -1.0 }}"),
+            "radius -1",
+        ),
+    ] {
+        std::fs::create_dir_all(dir.path().join("sub")).unwrap();
+        let script = format!(
+            "ui = false\n[[step]]\nwait = 1\n[[step]]\n{step}\n[[step]]\nscreenshot = \"after.png\"\n"
+        );
+        let script_path = dir.path().join("steps.toml");
+        std::fs::write(&script_path, script).unwrap();
+        let out = pelage(&[
+            "view",
+            groom_path.to_str().unwrap(),
+            "--groom",
+            "--script",
+            script_path.to_str().unwrap(),
+            "--size",
+            &size,
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{step}: {stderr}");
+        assert!(stderr.contains(says), "{step}: {stderr}");
+        assert!(!dir.path().join("after.png").exists(), "{step}");
+    }
+}

@@ -451,8 +451,9 @@ impl WindowState {
         Ok(())
     }
 
-    /// A scripted stroke: dabs along the pixels from `from` to `to`.
-    fn scripted_stroke(&mut self, step: &super::script::BrushStep) {
+    /// A scripted stroke: dabs along the pixels from `from` to `to`. A dab
+    /// the brush refuses (a bad radius, a layer name) fails the script.
+    fn scripted_stroke(&mut self, step: &super::script::BrushStep) -> anyhow::Result<()> {
         let pixels: Vec<Vec2> = {
             let (from, to) = (
                 Vec2::from(step.from),
@@ -466,7 +467,7 @@ impl WindowState {
         let rays: Vec<(Vec3, Vec3)> = pixels.iter().map(|p| self.ray(*p)).collect();
         let Some(g) = self.session.grooming() else {
             eprintln!("warning: `brush` is for `--groom`; ignored");
-            return;
+            return Ok(());
         };
         let c = &mut g.controls;
         c.brush = PALETTE
@@ -491,19 +492,27 @@ impl WindowState {
         }
         g.begin_stroke();
         let mut missed = true;
+        let mut refused = None;
         for (origin, direction) in rays {
             match g.stroke_to(origin, direction) {
                 Ok(hit) => missed &= !hit,
-                Err(e) => g.status = crate::one_line(&e),
+                Err(e) => {
+                    refused = Some(e);
+                    break;
+                }
             }
         }
         g.end_stroke();
+        if let Some(e) = refused {
+            return Err(e.context(format!("the {} stroke at pixel {:?}", step.name, step.from)));
+        }
         if missed {
             eprintln!(
                 "warning: the {} stroke at pixel {:?} missed the mesh",
                 step.name, step.from
             );
         }
+        Ok(())
     }
 
     /// The ray through a window pixel (x right, y down).
@@ -717,7 +726,13 @@ impl WindowState {
                             eprintln!("warning: `show` is for groom and curves views; ignored");
                         }
                     },
-                    Step::Brush(b) => self.scripted_stroke(&b),
+                    Step::Brush(b) => {
+                        if let Err(e) = self.scripted_stroke(&b) {
+                            self.script_error = Some(e);
+                            open = false;
+                            break;
+                        }
+                    }
                     Step::Undo(n) | Step::Redo(n) => {
                         let undo = matches!(step, Step::Undo(_));
                         if let Some(g) = self.session.grooming() {
@@ -794,6 +809,11 @@ impl WindowState {
         }
         self.last_frame = Some(now);
         let open = self.script_steps();
+        // A failed step ends the script with its error (it closed the
+        // window, and a closed window's run would exit 0).
+        if let Some(err) = self.script_error.take() {
+            return Err(err);
+        }
         if !open && self.screenshot_requests.is_empty() {
             return Ok(false);
         }

@@ -245,13 +245,9 @@ impl GroomingSession {
                 self.dirty = true;
             }
             Ok(None) => {}
-            Err(e) => {
-                self.status = format!(
-                    "{}: {}",
-                    brush.name(),
-                    crate::one_line(&anyhow::Error::from(e))
-                )
-            }
+            // The window shows a refusal in its status line; a script
+            // stops on it.
+            Err(e) => return Err(anyhow::Error::from(e).context(brush.name())),
         }
         Ok(())
     }
