@@ -275,9 +275,10 @@ impl PyGroomSession {
     }
 
     /// Writes the groom file `path` with its guides (`NAME.guides.usdc`)
-    /// and paint layers (`NAME.layers.ply`) beside it; `pelage groom
+    /// and paint layers (`NAME.layers.ply`) beside it, and a mesh given as
+    /// arrays (`NAME.mesh.obj`, which `[mesh] path` names); `pelage groom
     /// path` grows the groom as the session has it (in full). Returns the
-    /// paths written.
+    /// paths written (`mesh`: None when the mesh came from a file).
     fn save<'py>(&self, py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
         let saved = py
             .detach(|| self.with(|g| g.save(&path, Some(&self.source))))
@@ -286,6 +287,7 @@ impl PyGroomSession {
         d.set_item("groom", saved.groom)?;
         d.set_item("guides", saved.guides)?;
         d.set_item("layers", saved.layers)?;
+        d.set_item("mesh", saved.mesh)?;
         Ok(d)
     }
 

@@ -77,6 +77,19 @@ def test_painted_density_and_a_parting_are_saved_and_grow_again(filed_groom, tmp
     assert worst < 1e-4
 
 
+def test_a_session_on_a_mesh_from_arrays_saves_a_groom_that_loads(spot, tmp_path):
+    """The mesh given as arrays (no file to name) is written beside the
+    groom file, which `Groom.load` (and `pelage groom`) reads again; it
+    used to save `path = "<python mesh>"`, which nothing could load."""
+    arrays = pelage.Mesh.from_arrays(spot.positions, spot.triangles)
+    groom = small_groom(arrays, count=500)
+    s = pelage.GroomSession(groom)
+    saved = s.save(tmp_path / "values.toml")
+    assert saved["mesh"] is not None and str(saved["mesh"]).endswith("values.mesh.obj")
+    again = pelage.Groom.load(saved["groom"])
+    assert again.grow().curve_count == s.curves().curve_count
+
+
 def test_bad_brushes_say_what_to_do(filed_groom):
     s = pelage.GroomSession(filed_groom)
     with pytest.raises(ValueError, match="no brush 'kamm'.*comb"):

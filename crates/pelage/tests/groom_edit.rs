@@ -773,3 +773,82 @@ fn saving_to_a_path_that_is_no_file_writes_nothing() {
         assert_eq!(listing().len(), 2, "{:?}", listing());
     }
 }
+
+#[test]
+fn a_groom_of_a_mesh_given_as_values_saves_a_file_that_grows_again() {
+    // A mesh from arrays (a DCC's, Python's) has no file for `[mesh]
+    // path` to name: it is written beside the groom file, and the saved
+    // groom grows the session's hairs.
+    let spot = pelage::assets::spot();
+    let values = Mesh::new(
+        "<python mesh>",
+        spot.positions().to_vec(),
+        spot.triangles().to_vec(),
+        Some(spot.normals().to_vec()),
+        spot.uvs().cloned(),
+    )
+    .unwrap();
+    let mesh = Arc::new(values);
+    let growth = GuideGrowth {
+        count: 40,
+        length: Map::Constant(0.08),
+        points: 6,
+        ..Default::default()
+    };
+    let guides = Guides::grow(&mesh, &growth).unwrap();
+    // (Without the file it came from, a save keeps the settings groom
+    // files hold beside the guides: no operators.)
+    let spec = GroomSpec::new(mesh, guides, RootsSpec::new(600));
+    let groom = EditableGroom::new(spec, 1.0).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let saved = groom.save(&dir.path().join("fur.toml"), None).unwrap();
+    let mesh_file = saved.mesh.clone().expect("the mesh is written beside");
+    let text = std::fs::read_to_string(&saved.groom).unwrap();
+    assert!(text.contains("path = \"fur.mesh.obj\""), "{text}");
+    let again = pelage::groom::Groom::load(&saved.groom).unwrap();
+    assert_eq!(again.mesh().triangle_count(), spot.triangle_count());
+    assert!(mesh_file.exists());
+    let grown: Vec<Curves> = {
+        let g = again.generator(None).unwrap();
+        (0..g.parts().len()).map(|p| g.part(p).unwrap()).collect()
+    };
+    let hairs: usize = grown.iter().map(|c| c.curve_count()).sum();
+    let session = groom.curves();
+    assert_eq!(hairs, session.curve_count());
+    let by_id: std::collections::HashMap<u64, usize> = session
+        .ids()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .map(|(i, id)| (*id, i))
+        .collect();
+    let mut worst = 0.0f32;
+    for part in &grown {
+        for i in 0..part.curve_count() {
+            let j = by_id[&part.ids().unwrap()[i]];
+            for (a, b) in part.points()[part.range(i)]
+                .iter()
+                .zip(&session.points()[session.range(j)])
+            {
+                worst = worst.max(a.distance(*b));
+            }
+        }
+    }
+    assert!(
+        worst < 1e-4,
+        "the saved groom's hairs are {worst} from the session's"
+    );
+    // The embedded spot is named as `spot`, not by its display name.
+    let on_spot = EditableGroom::new(spec_on_spot(), 1.0).unwrap();
+    let saved = on_spot.save(&dir.path().join("spot.toml"), None).unwrap();
+    assert!(saved.mesh.is_none());
+    let text = std::fs::read_to_string(&saved.groom).unwrap();
+    assert!(text.contains("path = \"spot\""), "{text}");
+    pelage::groom::Groom::load(&saved.groom).unwrap();
+}
+
+fn spec_on_spot() -> GroomSpec {
+    let mesh = Arc::new(pelage::assets::spot());
+    let guides = Guides::grow(&mesh, &GuideGrowth::default()).unwrap();
+    GroomSpec::new(mesh, guides, RootsSpec::new(300))
+}

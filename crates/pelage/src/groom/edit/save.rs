@@ -20,6 +20,10 @@ pub struct SavedGroom {
     pub guides: PathBuf,
     /// The mesh with its paint layers (PLY), when it has any.
     pub layers: Option<PathBuf>,
+    /// The mesh itself (OBJ: positions, UVs, normals), when it was not
+    /// read from a file the groom file could name (a mesh given as
+    /// values).
+    pub mesh: Option<PathBuf>,
 }
 
 /// Why a groom could not be saved.
@@ -78,6 +82,23 @@ impl EditableGroom {
         if let Some(path) = &layers_path {
             crate::io::check_output(path)?;
         }
+        // A mesh given as values has no file for `[mesh] path` to name:
+        // it is written beside the groom file.
+        let names_its_mesh = original.is_some_and(|s| {
+            s.text
+                .parse::<toml::Table>()
+                .ok()
+                .and_then(|t| t.get("mesh")?.get("path").cloned())
+                .is_some()
+        });
+        let mesh_name = self.mesh().name();
+        let mesh_path = (!names_its_mesh
+            && mesh_name != crate::assets::SPOT_NAME
+            && !Path::new(mesh_name).is_file())
+        .then(|| sibling(groom_path, "mesh.obj"));
+        if let Some(path) = &mesh_path {
+            crate::io::check_output(path)?;
+        }
         let folder = groom_path.parent().unwrap_or(Path::new("."));
         write_curves(
             &guides_path,
@@ -86,6 +107,9 @@ impl EditableGroom {
         )?;
         if let Some(path) = &layers_path {
             write_atomically(path, |out| write_layers_ply(out, self.mesh()))?;
+        }
+        if let Some(path) = &mesh_path {
+            write_atomically(path, |out| write_mesh_obj(out, self.mesh()))?;
         }
         let fail = |message: String| SaveError::Groom {
             path: groom_path.to_path_buf(),
@@ -122,7 +146,14 @@ impl EditableGroom {
             }
             (Some(_), _) => {}
             (None, _) => {
-                mesh.insert("path".into(), self.mesh().name().to_string().into());
+                let path = match &mesh_path {
+                    Some(p) => name_of(p),
+                    None if mesh_name == crate::assets::SPOT_NAME => "spot".into(),
+                    None => Path::new(mesh_name)
+                        .canonicalize()
+                        .map_or_else(|_| mesh_name.to_string(), |p| p.to_string_lossy().into()),
+                };
+                mesh.insert("path".into(), path.into());
             }
         }
         match &layers_path {
@@ -169,6 +200,7 @@ impl EditableGroom {
             groom: groom_path.to_path_buf(),
             guides: guides_path,
             layers: layers_path,
+            mesh: mesh_path,
         })
     }
 }
@@ -183,6 +215,45 @@ fn same_folder(a: &Path, b: &Path) -> bool {
         p.canonicalize().unwrap_or_else(|_| p.to_path_buf())
     };
     canonical(a) == canonical(b)
+}
+
+/// The mesh as an OBJ file: positions, normals and UVs (per vertex or
+/// per corner), each triangle's corners `v/vt/vn`, so a mesh given as
+/// values loads back as it was.
+fn write_mesh_obj(out: &mut impl Write, mesh: &crate::Mesh) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "# Written by pelage: the mesh a hand-groomed file grows on"
+    )?;
+    for p in mesh.positions() {
+        writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+    }
+    for n in mesh.normals() {
+        writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
+    }
+    let corner_uvs: Option<Vec<[u32; 3]>> = match mesh.uvs() {
+        None => None,
+        Some(crate::mesh::Uvs::PerVertex(values)) => {
+            for uv in values {
+                writeln!(out, "vt {} {}", uv.x, uv.y)?;
+            }
+            Some(mesh.triangles().to_vec())
+        }
+        Some(crate::mesh::Uvs::PerCorner { values, indices }) => {
+            for uv in values {
+                writeln!(out, "vt {} {}", uv.x, uv.y)?;
+            }
+            Some(indices.clone())
+        }
+    };
+    for (t, tri) in mesh.triangles().iter().enumerate() {
+        let corner = |k: usize| match &corner_uvs {
+            Some(uv) => format!("{0}/{1}/{0}", tri[k] + 1, uv[t][k] + 1),
+            None => format!("{0}//{0}", tri[k] + 1),
+        };
+        writeln!(out, "f {} {} {}", corner(0), corner(1), corner(2))?;
+    }
+    Ok(())
 }
 
 /// The mesh as a binary PLY with every paint layer as a float vertex
