@@ -835,3 +835,49 @@ fn a_simulation_cache_is_written_once_read_after_and_refreshed_when_stale() {
         );
     }
 }
+
+#[test]
+fn a_painted_and_parted_groom_animates_with_its_layers() {
+    // A mesh given with a paint layer and face sets, moved by a skin: the
+    // animated path used to drop both ("no vertex attribute 'belly'").
+    let spot = pelage::assets::spot();
+    let belly: Vec<f32> = spot
+        .positions()
+        .iter()
+        .map(|p| if p.y < 0.0 { 1.0 } else { 0.2 })
+        .collect();
+    let sides: Vec<u32> = (0..spot.triangle_count() as u32).map(|t| t % 2).collect();
+    let mesh = Arc::new(
+        spot.with_vertex_attribute("belly", belly)
+            .unwrap()
+            .with_face_groups(pelage::mesh::FaceGroups {
+                kind: "groups".into(),
+                names: vec!["left".into(), "right".into()],
+                of_triangle: sides,
+            })
+            .unwrap(),
+    );
+    let rest: Vec<Vec3> = mesh.positions().to_vec();
+    let skin = AnimatedSkin::from_fn(&mesh, move |f| rest.iter().map(|&p| bend(p, f)).collect());
+    let text = "[roots]\ncount = 2000\ndensity = \"vertex:belly\"\n\
+        [guides]\ngenerate = { count = 30, length = 0.08 }\n\
+        [regions]\nfaces = \"groups\"\n\
+        [animation]\nframes = \"1-3\"\n";
+    let source = pelage::settings::SettingsSource {
+        path: "painted.toml".into(),
+        text: text.into(),
+    };
+    let inputs = pelage::groom::GroomInputs {
+        skin: Some(Arc::new(skin)),
+        ..Default::default()
+    };
+    let groom = pelage::groom::Groom::from_source_with_inputs(source, None, inputs).unwrap();
+    assert!(groom.mesh().vertex_attribute("belly").is_some());
+    let animated = groom.animated(None).unwrap().expect("an animated groom");
+    for frame in [1.0, 2.0, 3.0] {
+        let hairs: usize = (0..animated.generator().parts().len())
+            .map(|p| animated.part(p, frame).unwrap().curve_count())
+            .sum();
+        assert!(hairs > 1000, "frame {frame}: {hairs} hairs");
+    }
+}

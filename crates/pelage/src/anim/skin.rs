@@ -7,7 +7,7 @@
 use super::gltf_skin::GltfAnimation;
 use super::rig::SkinRig;
 use crate::io::UsdSkin;
-use crate::mesh::{Mesh, MeshError, MeshErrorKind, Uvs};
+use crate::mesh::{FaceGroups, Mesh, MeshError, MeshErrorKind, Uvs, VertexAttribute};
 use glam::{Mat4, Vec3};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -54,6 +54,10 @@ pub struct AnimatedSkin {
     triangles: Vec<[u32; 3]>,
     vertex_count: usize,
     uvs: Option<Uvs>,
+    /// The base mesh's paint layers and face sets: every frame's mesh
+    /// has them (a painted or parted groom animates).
+    vertex_attributes: Vec<VertexAttribute>,
+    face_groups: Vec<FaceGroups>,
     fps: f64,
     subdivide: u32,
     motion: Motion,
@@ -203,6 +207,12 @@ impl AnimatedSkin {
             triangles: mesh.triangles().to_vec(),
             vertex_count: mesh.vertex_count(),
             uvs: mesh.uvs().cloned(),
+            vertex_attributes: mesh.vertex_attributes().to_vec(),
+            face_groups: mesh
+                .face_group_kinds()
+                .into_iter()
+                .filter_map(|kind| mesh.face_groups(kind).cloned())
+                .collect(),
             fps: 24.0,
             subdivide: 0,
             motion,
@@ -260,16 +270,23 @@ impl AnimatedSkin {
         }
     }
 
-    /// The base mesh's triangles and UVs at the positions `positions` (as
-    /// many as its vertices), not subdivided.
+    /// The base mesh's triangles, UVs, paint layers and face sets at the
+    /// positions `positions` (as many as its vertices), not subdivided.
     pub fn base_mesh_at(&self, positions: Vec<Vec3>) -> Result<Mesh, MeshError> {
-        Mesh::new(
+        let mut mesh = Mesh::new(
             &self.name,
             positions,
             self.triangles.clone(),
             None,
             self.uvs.clone(),
-        )
+        )?;
+        for a in &self.vertex_attributes {
+            mesh = mesh.with_vertex_attribute(a.name.clone(), a.values.to_vec())?;
+        }
+        for groups in &self.face_groups {
+            mesh = mesh.with_face_groups(groups.clone())?;
+        }
+        Ok(mesh)
     }
 
     /// The time codes a USD skin is sampled at (empty for other skins).
@@ -350,13 +367,7 @@ impl AnimatedSkin {
 
     /// The skin at `frame`, whole (UVs included, subdivided as asked).
     pub fn mesh_at(&self, frame: f64) -> Result<Mesh, MeshError> {
-        let base = Mesh::new(
-            &self.name,
-            self.base_positions(frame)?,
-            self.triangles.clone(),
-            None,
-            self.uvs.clone(),
-        )?;
+        let base = self.base_mesh_at(self.base_positions(frame)?)?;
         Ok(match self.subdivide {
             0 => base,
             n => base.subdivided(n),

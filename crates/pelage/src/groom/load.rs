@@ -184,6 +184,15 @@ impl Groom {
                 let mesh = skin
                     .mesh_at(spec.rest_frame)
                     .map_err(|e| source.error_at(section.path.span(), GroomErrorKind::Mesh(e)))?;
+                // `[mesh] layers` paint the rest mesh the groom grows on,
+                // as they paint a still one.
+                let at = section
+                    .layers
+                    .as_ref()
+                    .map_or(section.path.span(), |l| l.span());
+                let mesh = section
+                    .with_layers(mesh, source.folder())
+                    .map_err(|e| source.error_at(at, GroomErrorKind::Mesh(e)))?;
                 (Arc::new(mesh), Some(Arc::new(skin)))
             }
         };
