@@ -514,6 +514,25 @@ def test_the_build_profile_is_exported():
     assert pelage.__build_profile__ in ("debug", "release")
 
 
+def test_a_painted_mesh_moved_by_a_skin_writes_animated(spot, tmp_path):
+    """Vertex maps and face sets of the mesh a skin moves are kept: the
+    animated write used to fail with "no vertex attribute 'belly'"."""
+    rest = np.asarray(spot.positions, dtype=np.float32)
+    belly = (rest[:, 1] < 0).astype(np.float32)
+    painted = pelage.Mesh.from_arrays(rest, spot.triangles, vertex_maps={"belly": belly})
+    skin = {f: rest + (f - 1) * np.array([0.02, 0, 0], dtype=np.float32) for f in (1, 2, 3)}
+    groom = pelage.Groom(
+        mesh=painted,
+        skin=skin,
+        guides={"generate": {"count": 30, "length": 0.05}},
+        roots={"count": 500, "density": "vertex:belly"},
+        animation={"frames": "1-3"},
+    )
+    out = tmp_path / "a.usdc"
+    groom.write(out)
+    assert out.exists() and groom.grow_frame(2).curve_count > 100
+
+
 def test_a_skin_given_as_frames_moves_the_groom(spot):
     """A DCC's evaluated mesh at every frame (the add-on's animated
     export): the fur rides it, and simulates on it."""
