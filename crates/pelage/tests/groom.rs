@@ -884,3 +884,44 @@ fn a_tiny_fraction_widens_its_one_hair_by_the_share_actually_kept() {
         );
     }
 }
+
+#[test]
+fn paint_layers_of_vertices_alone_are_read_and_another_meshs_are_refused_by_their_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let spot = pelage::assets::spot();
+    let n = spot.vertex_count();
+    // Vertices only, no faces: the layers are all a layers file needs.
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\nproperty float belly\nend_header\n"
+    );
+    for p in spot.positions() {
+        ply.push_str(&format!(
+            "{} {} {} {}\n",
+            p.x,
+            p.y,
+            p.z,
+            if p.y < 0.0 { 1 } else { 0 }
+        ));
+    }
+    std::fs::write(dir.path().join("layers.ply"), ply).unwrap();
+    let text = "[mesh]\npath = \"spot\"\nlayers = \"layers.ply\"\n[roots]\ncount = 500\ndensity = \"vertex:belly\"\n[guides]\ngenerate = { count = 5, length = 0.05 }\n";
+    std::fs::write(dir.path().join("fur.toml"), text).unwrap();
+    let groom = Groom::load(&dir.path().join("fur.toml")).unwrap();
+    assert!(groom.mesh().vertex_attribute("belly").is_some());
+    // A header declaring another mesh's vertices is refused before a
+    // vertex is read (the body here is not even there).
+    std::fs::write(
+        dir.path().join("layers.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 30000000\nproperty float x\nproperty float y\nproperty float z\nproperty float belly\nend_header\n",
+    )
+    .unwrap();
+    let e = Groom::load(&dir.path().join("fur.toml"))
+        .map(drop)
+        .unwrap_err();
+    assert!(matches!(e.kind, GroomErrorKind::Mesh(_)), "{e}");
+    assert!(
+        e.to_string()
+            .contains("30000000 vertices where the mesh has"),
+        "{e}"
+    );
+}

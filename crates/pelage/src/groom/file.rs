@@ -426,20 +426,33 @@ impl MeshSection {
         let Some(layers) = &self.layers else {
             return Ok(mesh);
         };
+        use crate::mesh::{MeshError, MeshErrorKind};
         let path = folder.join(layers.get_ref());
-        let painted = crate::Mesh::load(&path)?;
-        if painted.vertex_count() != mesh.vertex_count() {
-            return Err(crate::mesh::MeshError::whole(
-                path.display().to_string(),
-                crate::mesh::MeshErrorKind::Inconsistent(format!(
-                    "the paint layers have {} vertices where the mesh has {}: they were painted on another mesh (or another subdivision)",
-                    painted.vertex_count(),
+        let name = path.display().to_string();
+        let other_mesh = |count: u64| {
+            MeshError::whole(
+                &name,
+                MeshErrorKind::Inconsistent(format!(
+                    "the paint layers have {count} vertices where the mesh has {}: they were painted on another mesh (or another subdivision)",
                     mesh.vertex_count()
                 )),
-            ));
+            )
+        };
+        let io = |e| MeshError::whole(&name, MeshErrorKind::Io(e));
+        crate::io::check_input(&path, "a paint layers file (PLY)").map_err(io)?;
+        // The header's count first: a file painted on another mesh is
+        // refused before its vertices are read (30 M of them took 7.5 GB).
+        let declared = crate::io::ply_element_count(&path, "vertex").map_err(io)?;
+        if declared != mesh.vertex_count() as u64 {
+            return Err(other_mesh(declared));
         }
-        for layer in painted.vertex_attributes() {
-            mesh = mesh.with_vertex_attribute(layer.name.clone(), layer.values.to_vec())?;
+        let bytes = std::fs::read(&path).map_err(io)?;
+        let (count, painted) = crate::mesh::ply::vertex_layers(&name, &bytes)?;
+        if count != mesh.vertex_count() {
+            return Err(other_mesh(count as u64));
+        }
+        for (layer, values) in painted {
+            mesh = mesh.with_vertex_attribute(layer, values)?;
         }
         Ok(mesh)
     }

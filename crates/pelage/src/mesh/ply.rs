@@ -51,6 +51,34 @@ pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
     Ok(mesh)
 }
 
+/// The scalar vertex properties of a PLY file other than positions,
+/// normals and UVs (its paint layers), by name, with the vertex count;
+/// faces are not needed (a layers file may hold vertices alone).
+pub(crate) fn vertex_layers(
+    name: &str,
+    bytes: &[u8],
+) -> Result<(usize, Vec<(String, Vec<f32>)>), MeshError> {
+    let parser = Parser::<DefaultElement>::new();
+    let ply = parser
+        .read_ply(&mut std::io::Cursor::new(bytes))
+        .map_err(|e| parse_error(name, e))?;
+    let vertices = ply.payload.get("vertex").ok_or_else(|| {
+        MeshError::whole(
+            name,
+            MeshErrorKind::Inconsistent("the file has no 'vertex' element".into()),
+        )
+    })?;
+    let layout = VertexLayout::of(name, &ply.header.elements["vertex"].properties)?;
+    let read = layout.read(name, vertices)?;
+    let layers = layout
+        .attributes
+        .into_iter()
+        .map(|(key, _)| key.to_string())
+        .zip(read.attributes)
+        .collect();
+    Ok((read.positions.len(), layers))
+}
+
 /// Which of a `vertex` element's properties pelage reads, and as what.
 struct VertexLayout<'a> {
     normals: Option<[&'static str; 3]>,
