@@ -447,11 +447,11 @@ impl MeshSection {
             return Err(other_mesh(declared));
         }
         let bytes = std::fs::read(&path).map_err(io)?;
-        let (count, painted) = crate::mesh::ply::vertex_layers(&name, &bytes)?;
-        if count != mesh.vertex_count() {
-            return Err(other_mesh(count as u64));
+        let painted = crate::mesh::ply::vertex_layers(&name, &bytes)?;
+        if painted.count != mesh.vertex_count() {
+            return Err(other_mesh(painted.count as u64));
         }
-        for (layer, values) in painted {
+        for (layer, values) in painted.layers {
             mesh = mesh.with_vertex_attribute(layer, values)?;
         }
         Ok(mesh)

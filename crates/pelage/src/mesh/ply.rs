@@ -51,13 +51,18 @@ pub(crate) fn parse(name: &str, bytes: &[u8]) -> Result<Mesh, MeshError> {
     Ok(mesh)
 }
 
-/// The scalar vertex properties of a PLY file other than positions,
-/// normals and UVs (its paint layers), by name, with the vertex count;
-/// faces are not needed (a layers file may hold vertices alone).
-pub(crate) fn vertex_layers(
-    name: &str,
-    bytes: &[u8],
-) -> Result<(usize, Vec<(String, Vec<f32>)>), MeshError> {
+/// A PLY file's paint layers: its vertex count, and every scalar vertex
+/// property but positions, normals and UVs, by name.
+pub(crate) struct VertexLayers {
+    /// Vertices in the file.
+    pub count: usize,
+    /// Each layer's name and one value a vertex.
+    pub layers: Vec<(String, Vec<f32>)>,
+}
+
+/// The paint layers of a PLY file; faces are not needed (a layers file
+/// may hold vertices alone).
+pub(crate) fn vertex_layers(name: &str, bytes: &[u8]) -> Result<VertexLayers, MeshError> {
     let parser = Parser::<DefaultElement>::new();
     let ply = parser
         .read_ply(&mut std::io::Cursor::new(bytes))
@@ -76,7 +81,10 @@ pub(crate) fn vertex_layers(
         .map(|(key, _)| key.to_string())
         .zip(read.attributes)
         .collect();
-    Ok((read.positions.len(), layers))
+    Ok(VertexLayers {
+        count: read.positions.len(),
+        layers,
+    })
 }
 
 /// Which of a `vertex` element's properties pelage reads, and as what.
