@@ -20,6 +20,7 @@ use crate::dynamics::{GuideStrandParams, Wind};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{InterpolationMethod, StyleMeshOptions};
 use crate::mesh::{Mesh, MeshError, MeshErrorKind};
+use crate::sample::SampleError;
 use crate::settings::SettingsSource;
 use glam::Vec3;
 use std::collections::HashMap;
@@ -994,7 +995,16 @@ fn load_guides(
                 seed: generate.seed,
             };
             let guides = Guides::grow(mesh, &growth).map_err(|e| {
-                source.error_at(generate.length.span(), GroomErrorKind::GuideGrowth(e))
+                // A mesh with no area has nowhere for a guide: its fault,
+                // not the guides' length.
+                let span = match (&e, &file.mesh) {
+                    (
+                        crate::guides::GuideError::Sample(SampleError::ZeroDensity { .. }),
+                        Some(m),
+                    ) => m.path.span(),
+                    _ => generate.length.span(),
+                };
+                source.error_at(span, GroomErrorKind::GuideGrowth(e))
             })?;
             Ok((guides, None))
         }
