@@ -390,12 +390,16 @@ impl PyGroom {
         let parts = generator.parts().len();
         if let Some(p) = part {
             check_part(p, parts)?;
-            let hairs = generator.parts()[p].hair_count;
+            let hairs = generator.parts()[p]
+                .hair_count
+                .saturating_mul(generator.most_hairs_per_root());
             check_memory(hairs, generator.points_per_hair(), "this part")?;
             let curves = py.detach(|| generator.part(p)).map_err(|e| self.error(e))?;
             return Ok(PyCurves::grown_by(curves, generator));
         }
-        let hairs: u64 = generator.parts().iter().map(|p| p.hair_count).sum();
+        // Counted after `strands`, which multiplies the hairs of a root.
+        let roots: u64 = generator.parts().iter().map(|p| p.hair_count).sum();
+        let hairs = roots.saturating_mul(generator.most_hairs_per_root());
         check_memory(hairs, generator.points_per_hair(), "the whole groom")?;
         let mut grown = Vec::with_capacity(parts);
         for p in 0..parts {
@@ -724,7 +728,7 @@ const BYTES_PER_HAIR: u64 = 4 + 8 + 8 + 4 + 8;
 
 /// Refuses to grow `hairs` hairs into memory where they cannot fit: an
 /// allocation that fails aborts the interpreter, a `MemoryError` does not.
-fn check_memory(hairs: u64, points: usize, what: &str) -> PyResult<()> {
+pub(crate) fn check_memory(hairs: u64, points: usize, what: &str) -> PyResult<()> {
     let need =
         hairs.saturating_mul((points as u64).saturating_mul(BYTES_PER_POINT) + BYTES_PER_HAIR);
     let Some(available) = available_memory() else {

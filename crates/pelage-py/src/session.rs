@@ -59,6 +59,22 @@ impl PyGroomSession {
     #[pyo3(signature = (groom, *, fraction = 1.0))]
     fn new(py: Python<'_>, groom: &PyGroom, fraction: f64) -> PyResult<Self> {
         let spec = groom.groom().spec().map_err(to_py_err)?;
+        // A session holds every hair: refused as `grow()` is (a failed
+        // allocation would abort the interpreter).
+        let per_root: u64 = spec
+            .ops
+            .iter()
+            .map(|op| match op.unmasked() {
+                pelage::groom::GroomOp::Strands(s) => u64::from(s.count.max(1)),
+                _ => 1,
+            })
+            .fold(1, u64::saturating_mul);
+        let hairs = (spec.roots.count as f64 * fraction.clamp(0.0, 1.0)).ceil() as u64;
+        crate::groom::check_memory(
+            hairs.saturating_mul(per_root),
+            spec.finish.points,
+            "a grooming session",
+        )?;
         let editable = py
             .detach(|| EditableGroom::new(spec, fraction))
             .map_err(to_py_err)?;

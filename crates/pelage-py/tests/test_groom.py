@@ -508,6 +508,19 @@ def test_a_groom_too_large_for_memory_raises_memory_error(spot):
     )
     with pytest.raises(MemoryError, match=r"1,000,000,000 hairs .* groom.parts\(\)"):
         big.grow()
+    # Counted after `strands`: a million roots of 1,024 hairs each is a
+    # billion hairs (the estimate counted the roots), and a grooming
+    # session, which holds every hair, is refused as grow() is.
+    stranded = pelage.Groom(
+        mesh=spot,
+        guides={"generate": {"count": 20, "length": 0.05}},
+        roots=1_000_000,
+        ops=[{"strands": {"count": 1024, "tip_spread": 0.01}}],
+    )
+    with pytest.raises(MemoryError, match=r"1,024,000,000 hairs"):
+        stranded.grow()
+    with pytest.raises(MemoryError, match=r"grooming session"):
+        pelage.GroomSession(big)
 
 
 def test_the_build_profile_is_exported():

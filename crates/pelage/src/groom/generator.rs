@@ -185,6 +185,19 @@ impl Generator {
         &self.ops
     }
 
+    /// The most hairs one root grows: each `strands` operator multiplies
+    /// them by its count (`cut` may remove some). What memory estimates
+    /// multiply a part's root count by.
+    pub fn most_hairs_per_root(&self) -> u64 {
+        self.ops
+            .iter()
+            .map(|op| match op.unmasked() {
+                Operator::Strands(s) => u64::from(s.count()),
+                _ => 1,
+            })
+            .fold(1u64, u64::saturating_mul)
+    }
+
     /// Points per hair.
     pub fn points_per_hair(&self) -> usize {
         self.points
