@@ -791,6 +791,25 @@ fn skin_from_frames(
     let frames = frames
         .cast::<PyDict>()
         .map_err(|_| PyTypeError::new_err(shape))?;
+    // Counted before any frame is copied: a million frames aborted the
+    // interpreter.
+    let most = pelage::limits::MAX_FRAMES;
+    if frames.len() as u64 > most {
+        return Err(PyValueError::new_err(format!(
+            "skin: {} frames; pelage's limit is {} (docs/limits.md)",
+            pelage::limits::grouped(frames.len() as f64),
+            pelage::limits::grouped(most as f64)
+        )));
+    }
+    let bytes = (frames.len() as u64).saturating_mul(mesh.vertex_count() as u64 * 12);
+    if available_memory().is_some_and(|available| bytes > available) {
+        return Err(PyMemoryError::new_err(format!(
+            "skin: {} frames of {} vertices take {:.1} GB, more than this machine has available",
+            frames.len(),
+            mesh.vertex_count(),
+            bytes as f64 / 1e9
+        )));
+    }
     let mut samples: Vec<(f64, Vec<glam::Vec3>)> = Vec::with_capacity(frames.len());
     for (frame, positions) in frames.iter() {
         let frame: f64 = frame.extract().map_err(|_| PyTypeError::new_err(shape))?;

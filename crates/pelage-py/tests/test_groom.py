@@ -582,3 +582,11 @@ def test_a_skin_given_as_frames_moves_the_groom(spot):
         )
     with pytest.raises(pelage.PelageError, match=r"\[animation\]"):
         pelage.Groom(mesh=spot, skin=skin, guides={"generate": {"count": 3, "length": 0.05}}, roots=10)
+    # Past the frame limit, refused before a frame is copied (a million
+    # frames aborted the interpreter); the same array shared costs nothing.
+    many = dict.fromkeys(range(100_001), rest)
+    with pytest.raises(ValueError, match=r"skin: 100,001 frames; pelage's limit is 100,000"):
+        pelage.Groom(
+            mesh=spot, skin=many, guides={"generate": {"count": 3, "length": 0.05}},
+            roots=10, animation={"frames": "1-2"},
+        )
