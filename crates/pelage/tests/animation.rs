@@ -881,3 +881,40 @@ fn a_painted_and_parted_groom_animates_with_its_layers() {
         assert!(hairs > 1000, "frame {frame}: {hairs} hairs");
     }
 }
+
+#[test]
+fn a_regrown_groom_of_one_frame_writes_no_velocities_rather_than_zeros() {
+    // One time code has no neighbour to differ from: the velocities were
+    // written as zeros (a simulated groom of one frame is regrown so).
+    let mesh = spot();
+    let spec = groom(&mesh);
+    let guides = spec.guides.clone();
+    let moving = moved_guides(&guides, move |p, _| p);
+    let groom = AnimatedGroom::new(
+        spec,
+        sliding(&mesh, Vec3::new(0.01, 0.0, 0.0)),
+        animation("2", AnimationMode::Regrow),
+        Some(GuideMotion::Program(Arc::new(moving))),
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("one.usdc");
+    groom
+        .write(&path, 0..1, &Default::default(), false, |_| {})
+        .unwrap();
+    let text_path = dir.path().join("one.usda");
+    let Some((ok, out)) = support::usdcheck(&[
+        "--convert".as_ref(),
+        path.as_os_str(),
+        text_path.as_os_str(),
+    ]) else {
+        return;
+    };
+    assert!(ok, "{out}");
+    let text = std::fs::read_to_string(&text_path).unwrap();
+    assert!(text.contains("points.timeSamples"), "the frame is written");
+    assert!(
+        !text.contains("velocities"),
+        "velocities of one frame written"
+    );
+}

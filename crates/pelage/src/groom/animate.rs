@@ -758,8 +758,11 @@ impl AnimatedGroom {
         // Regrow: velocities by central differences over the neighbouring
         // time codes, whose growths are kept (three at most) as the
         // frames go by.
-        let regrow_velocities = self.animation.mode.regrows() && self.animation.velocities;
         let all_times = self.animation.sample_times();
+        // One time code has no neighbour to differ from: its velocities
+        // are left out, not written as zeros.
+        let regrow_velocities =
+            self.animation.mode.regrows() && self.animation.velocities && all_times.len() > 1;
         for p in parts {
             let mut rest = None;
             let mut counted = false;
