@@ -10,8 +10,9 @@
 //! surface, guides and hair count. Targets: ≤ 100 ms an edit at 100,000
 //! hairs, ≥ 5× faster than the peer.
 //!
-//! Needs pelage in bpy's venv: `tools/python-wheel --release --into
-//! ~/.cache/pelage/bpy-venv/bin/python`.
+//! Needs pelage in bpy's venv: the first run puts a release wheel there
+//! (`tools/python-wheel --release --into` bpy's Python), as `--peer
+//! blender` sets bpy up.
 
 use crate::format::thousands;
 use anyhow::Context;
@@ -39,8 +40,43 @@ impl BlenderBenchArgs {
     }
 }
 
+/// Puts pelage into bpy's venv when it is not there (a release wheel,
+/// built once; minutes the first time).
+fn ensure_pelage_in_bpy() -> anyhow::Result<()> {
+    let bpy_python = super::tools_dir().join("bpy-python");
+    let run = |args: &[&str]| {
+        std::process::Command::new(&bpy_python)
+            .args(args)
+            .output()
+            .with_context(|| format!("cannot run {}", bpy_python.display()))
+    };
+    if run(&["-c", "import pelage"])?.status.success() {
+        return Ok(());
+    }
+    let which = run(&["-c", "import sys; print(sys.executable)"])?;
+    anyhow::ensure!(
+        which.status.success(),
+        "bpy could not be set up: {}",
+        String::from_utf8_lossy(&which.stderr).trim()
+    );
+    let python = String::from_utf8_lossy(&which.stdout).trim().to_string();
+    eprintln!("installing pelage into bpy's venv ({python}): a release wheel, built once…");
+    // Its stdout (the wheel's path) would come before the JSON.
+    let status = std::process::Command::new(super::tools_dir().join("python-wheel"))
+        .args(["--release", "--into", &python])
+        .stdout(std::process::Stdio::null())
+        .status()
+        .context("cannot run tools/python-wheel")?;
+    anyhow::ensure!(
+        status.success(),
+        "tools/python-wheel --release --into {python} failed"
+    );
+    Ok(())
+}
+
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &BlenderBenchArgs) -> anyhow::Result<()> {
+    ensure_pelage_in_bpy()?;
     let (hairs, edits) = args.scale().pick((100_000, 20), (20_000, 10), (2_000, 2));
     let report = super::run_bpy_case("blender_live.py", include_str!("blender_live.py"), |dir| {
         let case = serde_json::json!({
@@ -52,9 +88,7 @@ pub fn run(args: &BlenderBenchArgs) -> anyhow::Result<()> {
         std::fs::write(dir.join("case.json"), case.to_string())?;
         Ok(())
     })
-    .context(
-        "the Blender case did not run (it needs pelage in bpy's venv: tools/python-wheel --release --into ~/.cache/pelage/bpy-venv/bin/python)",
-    )?;
+    .context("the Blender case did not run")?;
     let number = |key: &str| {
         report[key]
             .as_f64()
