@@ -57,6 +57,12 @@ def _setting_changed(settings, context):
     fur.on_setting_change(settings, context)
 
 
+def _live_toggled(settings, context):
+    """Live ticked or unticked: arms the surface's grown fur (without a
+    Grow) or stops following the guides."""
+    fur.on_live_toggled(settings, context)
+
+
 class PelageOpSetting(bpy.types.PropertyGroup):
     """One setting of a stacked operator: its name, and its value as the
     groom file writes it."""
@@ -132,6 +138,7 @@ class PelageFurSettings(bpy.types.PropertyGroup):
         description="The integer face attribute whose values are the parting's regions",
     )
     live: BoolProperty(
+        update=_live_toggled,
         name="Live",
         description="Regrow the fur as the guides object is sculpted: the hairs near the stroke only",
         default=False,

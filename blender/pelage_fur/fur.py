@@ -832,14 +832,18 @@ def live_regrow(surface):
     import bpy
 
     live = LIVE.get(surface.name)
-    obj = bpy.data.objects.get(live.fur_name) if live else None
+    # Live ticked after a Grow: the fur that grow made becomes live.
+    obj = bpy.data.objects.get(live.fur_name) if live else fur_object_of(surface)
     if obj is None or not is_live(surface.pelage_fur):
         return None
     prepared = PreparedGrow(bpy.context, surface, surface.pelage_fur)
     grown, session = grow_curves(prepared)
     back = np.linalg.inv(to_pelage_space(surface))
     replace_data(obj, curves_to_blender(obj.data.name, grown, surface, prepared.uv_map, back))
-    live.session = session
+    if live is None:
+        LIVE[surface.name] = LiveGroom(session, obj.name, max(surface.dimensions) * 0.005 or 1e-3)
+    else:
+        live.session = session
     return {"hairs": grown.curve_count}
 
 
@@ -876,6 +880,21 @@ def schedule_live_update(name, whole=False):
         return None
 
     bpy.app.timers.register(run, first_interval=0.05)
+
+
+def on_live_toggled(settings, _context):
+    """Live ticked: a surface with pelage fur grown but no live groom gets
+    one (a whole regrow, scheduled), so sculpting the guides regrows the
+    fur without another Grow. Unticked: the live groom is let go."""
+    surface = settings.id_data
+    if surface is None:
+        return
+    if not settings.live:
+        LIVE.pop(surface.name, None)
+        PENDING.pop(surface.name, None)
+        return
+    if surface.name not in LIVE and is_live(settings) and fur_object_of(surface) is not None:
+        schedule_live_update(surface.name, whole=True)
 
 
 def on_setting_change(settings, _context):

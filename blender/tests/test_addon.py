@@ -309,6 +309,24 @@ grid.data.update()
 addon_fur.PENDING.pop(grid.name, None)
 settings.count = 3_000
 print("live: a setting or a mesh edit regrows the whole groom in place")
+# Live ticked after a Grow (not before it) arms the fur that grow made:
+# no second Grow is needed for a comb to regrow the hairs near it.
+settings.live = False
+assert grid.name not in addon_fur.LIVE, "unticked, the live groom is let go"
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+settings.live = True
+assert addon_fur.PENDING.get(grid.name) is True, "ticking Live schedules arming it"
+armed = addon_fur.live_regrow(grid)
+addon_fur.PENDING.pop(grid.name, None)
+assert armed is not None and grid.name in addon_fur.LIVE, armed
+combed = live_points.copy()
+combed[0:7] += steps[:, None] * np.array([0.0, 1.0, 0.0])
+live_curves.position_data.foreach_set("vector", combed.astype(np.float32).ravel())
+again = addon_fur.live_update(grid)
+assert again is not None and 0 < again["regrown"] < again["hairs"], again
+live_curves.position_data.foreach_set("vector", live_points.astype(np.float32).ravel())
+print("live: ticked after a Grow, a comb regrows the hairs near it")
+addon_fur.PENDING.pop(grid.name, None)
 settings.guides_object, settings.live = None, False
 
 # A vertex group painted on half the grid (weight 1 for x > 0, none
