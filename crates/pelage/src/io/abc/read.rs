@@ -48,6 +48,23 @@ impl<'a> Ogawa<'a> {
         self.refuse(at, Kind::Inconsistent(message))
     }
 
+    /// The arrays of object `object` (at byte `at`) that do not make
+    /// curves, kept typed.
+    fn curves_of(
+        &self,
+        at: u64,
+        object: &str,
+        error: crate::curves::CurvesError,
+    ) -> CurvesReadError {
+        self.refuse(
+            at,
+            Kind::CurvesOf {
+                object: object.to_string(),
+                error,
+            },
+        )
+    }
+
     /// An error of `kind` at byte `at`.
     fn refuse(&self, at: u64, kind: Kind) -> CurvesReadError {
         CurvesReadError::new(self.path, Where::element("byte", at as usize), kind)
@@ -779,15 +796,7 @@ fn read_curves_object(
     let mut guide = false;
     let at_child = geom;
     let fail = |message: String| file.fail(geom, message);
-    let curves_of = |object: &str, error| {
-        file.refuse(
-            geom,
-            Kind::CurvesOf {
-                object: object.to_string(),
-                error,
-            },
-        )
-    };
+    let object_at = geom;
     let geom = Compound::read(file, geom, indexed, &what(""))?;
     let property = |name: &str, pod: &[u8], extent: u8| -> Result<Option<&[u8]>, CurvesReadError> {
         let Some(p) = geom.get(name) else {
@@ -896,8 +905,8 @@ fn read_curves_object(
             }
         }
     };
-    let mut curves =
-        Curves::new(points, widths, offsets).map_err(|error| curves_of(path, error))?;
+    let mut curves = Curves::new(points, widths, offsets)
+        .map_err(|error| file.curves_of(object_at, path, error))?;
     let n = curves.points().len();
     if let Some(b) = property("N", &[10], 3)?.filter(|b| b.len() == n * 12) {
         let normals = floats(b)
@@ -914,7 +923,7 @@ fn read_curves_object(
             .collect();
         curves = curves
             .with_normals(normals)
-            .map_err(|error| curves_of(path, error))?;
+            .map_err(|error| file.curves_of(object_at, path, error))?;
     }
     if let Some(arbitrary) = geom.get(".arbGeomParams").filter(|p| p.0.kind == 0) {
         let arb = Compound::read(file, arbitrary.1, indexed, &what(".arbGeomParams"))?;
@@ -936,15 +945,6 @@ fn with_arbitrary_params(
     mut curves: Curves,
 ) -> Result<Curves, CurvesReadError> {
     let what = |p: &str| format!("{path}/.geom/{p}");
-    let curves_of = |object: &str, error| {
-        file.refuse(
-            geom,
-            Kind::CurvesOf {
-                object: object.to_string(),
-                error,
-            },
-        )
-    };
     let n = curves.points().len();
     let sample =
         |name: &str, pods: &[u8], extent: u8| -> Result<Option<(u8, &[u8])>, CurvesReadError> {
@@ -963,12 +963,12 @@ fn with_arbitrary_params(
             .collect();
         curves = curves
             .with_colors(colors)
-            .map_err(|error| curves_of(path, error))?;
+            .map_err(|error| file.curves_of(geom, path, error))?;
     }
     if let Some((_, b)) = sample("groom_opacity", &[10], 1)?.filter(|(_, b)| b.len() == n * 4) {
         curves = curves
             .with_opacities(floats(b).collect())
-            .map_err(|error| curves_of(path, error))?;
+            .map_err(|error| file.curves_of(geom, path, error))?;
     }
     let curve_count = curves.curve_count();
     if let Some((_, b)) =
@@ -981,7 +981,7 @@ fn with_arbitrary_params(
         if let Some(regions) = regions {
             curves = curves
                 .with_regions(regions)
-                .map_err(|error| curves_of(path, error))?;
+                .map_err(|error| file.curves_of(geom, path, error))?;
         }
     }
     if let Some((pod, b)) = sample("groom_id", &[6, 8], 1)? {
@@ -997,7 +997,7 @@ fn with_arbitrary_params(
         if let Some(ids) = ids.filter(|ids| ids.len() == curve_count) {
             curves = curves
                 .with_ids(ids)
-                .map_err(|error| curves_of(path, error))?;
+                .map_err(|error| file.curves_of(geom, path, error))?;
         }
     }
     if let Some((_, b)) =
@@ -1010,7 +1010,7 @@ fn with_arbitrary_params(
             .collect();
         curves = curves
             .with_root_uvs(uvs)
-            .map_err(|error| curves_of(path, error))?;
+            .map_err(|error| file.curves_of(geom, path, error))?;
     }
     // Hair-shading values where all six are there, as pelage writes
     // them.
@@ -1028,7 +1028,7 @@ fn with_arbitrary_params(
     if let Some(shading) = HairShading::from_found(found, tint) {
         curves = curves
             .with_shading(shading)
-            .map_err(|error| curves_of(path, error))?;
+            .map_err(|error| file.curves_of(geom, path, error))?;
     }
     Ok(curves)
 }
