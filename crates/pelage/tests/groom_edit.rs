@@ -852,3 +852,27 @@ fn spec_on_spot() -> GroomSpec {
     let guides = Guides::grow(&mesh, &GuideGrowth::default()).unwrap();
     GroomSpec::new(mesh, guides, RootsSpec::new(300))
 }
+
+#[test]
+fn the_first_paint_dab_reports_no_more_regrown_hairs_than_the_groom_has() {
+    // Its layer is added and painted as one step; the two regrowths were
+    // summed (101,774 regrown of 100,000).
+    let mut groom = EditableGroom::new(spec(2_000), 1.0).unwrap();
+    let at = root(&groom, 3);
+    let r = groom
+        .brush(
+            &Brush::Paint {
+                layer: "density".into(),
+                value: 0.0,
+            },
+            &dab(at, 0.3),
+        )
+        .unwrap()
+        .expect("the dab paints");
+    assert!(
+        r.regrown_roots <= r.hairs,
+        "{} of {}",
+        r.regrown_roots,
+        r.hairs
+    );
+}

