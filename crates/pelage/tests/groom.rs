@@ -925,3 +925,26 @@ fn paint_layers_of_vertices_alone_are_read_and_another_meshs_are_refused_by_thei
         "{e}"
     );
 }
+
+#[test]
+fn guides_of_one_point_each_are_said_to_be_too_short_not_too_far() {
+    let spot = pelage::assets::spot();
+    let roots: Vec<glam::Vec3> = spot.positions().iter().step_by(300).copied().collect();
+    let n = roots.len();
+    let curves = pelage::Curves::new(roots, vec![0.01; n], (0..=n as u32).collect()).unwrap();
+    let source = pelage::settings::SettingsSource {
+        path: "dots.toml".into(),
+        text: "[roots]\ncount = 100\n[guides]\npoints = 4\n".into(),
+    };
+    let inputs = pelage::groom::GroomInputs {
+        mesh: Some(std::sync::Arc::new(spot)),
+        guides: Some(curves),
+        ..Default::default()
+    };
+    let e = Groom::from_source_with_inputs(source, None, inputs)
+        .map(drop)
+        .unwrap_err();
+    assert!(matches!(e.kind, GroomErrorKind::Mismatch(_)), "{e}");
+    assert!(e.to_string().contains("fewer than two points"), "{e}");
+    assert!(!e.to_string().contains("tolerance"), "{e}");
+}

@@ -920,7 +920,18 @@ fn bind_guides(
     let section = &file.guides;
     let (guides, report) = Guides::bind(mesh, curves, section.points, section.tolerance);
     if guides.is_empty() {
-        let message = "no guide is within the tolerance of the mesh; check that the guides belong to this mesh, or raise [guides] tolerance";
+        // Said as the guides were left out: a curve of one point is no
+        // matter of tolerance.
+        let short = report
+            .dropped
+            .iter()
+            .filter(|d| matches!(d.reason, crate::guides::DropReason::TooFewPoints(_)))
+            .count();
+        let message = if short == report.dropped.len() && short > 0 {
+            "every guide has fewer than two points: a guide needs a root and a tip (draw or grow the guides longer)"
+        } else {
+            "no guide is within the tolerance of the mesh; check that the guides belong to this mesh, or raise [guides] tolerance"
+        };
         return Err(match span {
             std::ops::Range { start: 0, end: 0 } => GroomError::new(
                 source.path.clone(),

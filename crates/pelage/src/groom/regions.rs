@@ -77,7 +77,7 @@ impl RegionsSpec {
                     let kinds = mesh.face_group_kinds();
                     GroomErrorKind::Missing(if kinds.is_empty() {
                         format!(
-                            "the mesh has no face sets ('{kind}'); OBJ files name them with g (groups) and usemtl (materials), or use a region map"
+                            "the mesh has no face sets ('{kind}'): OBJ files name them with g (groups) and usemtl (materials), Blender's are its Sculpt mode face sets and material slots; or use a region map"
                         )
                     } else {
                         format!(
