@@ -45,6 +45,11 @@ impl ShellsBenchArgs {
     pub fn scale(&self) -> super::Scale {
         super::Scale::of(self.quick, self.smoke)
     }
+
+    /// Frames per median: one in a smoke run.
+    fn frames(&self) -> usize {
+        self.scale().pick(self.frames, self.frames, 1).max(1)
+    }
 }
 
 /// Silva Table 1: (model, triangles, fps at 16 layers 800×600, 1680×1050,
@@ -71,7 +76,7 @@ struct Row {
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::headless()?;
-    let frames = if args.smoke { 1 } else { args.frames };
+    let frames = args.frames();
     let reduced = args.scale().reduced();
     if args.game {
         let game = super::shells_game::measure(&ctx, reduced, frames)?;
@@ -83,7 +88,7 @@ pub fn run(args: &ShellsBenchArgs) -> anyhow::Result<()> {
         } else {
             println!(
                 "pelage bench shells --game — median of {} frames, on {}\n",
-                frames.max(1),
+                frames,
                 ctx.adapter_name()
             );
             print_game(&game);
@@ -255,7 +260,7 @@ fn print_table(
     println!(
         "pelage bench shells{} — median of {} frames, on {}",
         args.scale().flag(),
-        if args.smoke { 1 } else { args.frames.max(1) },
+        args.frames(),
         ctx.adapter_name()
     );
     println!(

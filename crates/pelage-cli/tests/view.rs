@@ -336,16 +336,7 @@ fn grooming_in_the_window_saves_a_groom_that_grows_as_shown() {
     );
     let script_path = dir.path().join("groom.toml");
     std::fs::write(&script_path, script).unwrap();
-    let size = format!("{}x{}", SIZE.0, SIZE.1);
-    let out = pelage(&[
-        "view",
-        groom_path.to_str().unwrap(),
-        "--groom",
-        "--script",
-        script_path.to_str().unwrap(),
-        "--size",
-        &size,
-    ]);
+    let out = groom_by_script(&groom_path, &script_path);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stdout}\n{stderr}");
@@ -463,6 +454,20 @@ fn a_simulated_groom_written_with_its_skin_plays_in_the_viewer() {
     assert!(near + far > total / 50, "{} pixels changed", near + far);
 }
 
+/// `pelage view GROOM --groom --script SCRIPT` at the tests' size.
+fn groom_by_script(groom: &Path, script: &Path) -> Output {
+    let size = format!("{}x{}", SIZE.0, SIZE.1);
+    pelage(&[
+        "view",
+        groom.to_str().unwrap(),
+        "--groom",
+        "--script",
+        script.to_str().unwrap(),
+        "--size",
+        &size,
+    ])
+}
+
 #[test]
 fn a_scripted_step_that_fails_ends_the_run_with_its_error() {
     if !has_display() {
@@ -474,7 +479,6 @@ fn a_scripted_step_that_fails_ends_the_run_with_its_error() {
     let groom_path = dir.path().join("fur.toml");
     std::fs::write(&groom_path, groom).unwrap();
     let (cx, cy) = (SIZE.0 as f32 / 2.0, SIZE.1 as f32 / 2.0);
-    let size = format!("{}x{}", SIZE.0, SIZE.1);
     // A save into a folder, and a brush with a negative radius: each used
     // to close the window and exit 0, skipping the steps after it.
     for (step, says) in [
@@ -490,15 +494,7 @@ fn a_scripted_step_that_fails_ends_the_run_with_its_error() {
         );
         let script_path = dir.path().join("steps.toml");
         std::fs::write(&script_path, script).unwrap();
-        let out = pelage(&[
-            "view",
-            groom_path.to_str().unwrap(),
-            "--groom",
-            "--script",
-            script_path.to_str().unwrap(),
-            "--size",
-            &size,
-        ]);
+        let out = groom_by_script(&groom_path, &script_path);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{step}: {stderr}");
         assert!(stderr.contains(says), "{step}: {stderr}");

@@ -61,17 +61,9 @@ impl PyGroomSession {
         let spec = groom.groom().spec().map_err(to_py_err)?;
         // A session holds every hair: refused as `grow()` is (a failed
         // allocation would abort the interpreter).
-        let per_root: u64 = spec
-            .ops
-            .iter()
-            .map(|op| match op.unmasked() {
-                pelage::groom::GroomOp::Strands(s) => u64::from(s.count.max(1)),
-                _ => 1,
-            })
-            .fold(1, u64::saturating_mul);
         let hairs = (spec.roots.count as f64 * fraction.clamp(0.0, 1.0)).ceil() as u64;
         crate::groom::check_memory(
-            hairs.saturating_mul(per_root),
+            hairs.saturating_mul(spec.most_hairs_per_root()),
             spec.finish.points,
             "a grooming session",
         )?;

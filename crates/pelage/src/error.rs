@@ -121,23 +121,12 @@ impl<K> Located<K> {
         let LocatedError { source, at, kind } = *self.0;
         Located::with(source, at, f(kind))
     }
-
-    /// Its parts.
-    pub fn into_parts(self) -> LocatedError<K> {
-        *self.0
-    }
 }
 
 impl<K> std::ops::Deref for Located<K> {
     type Target = LocatedError<K>;
     fn deref(&self) -> &LocatedError<K> {
         &self.0
-    }
-}
-
-impl<K> std::ops::DerefMut for Located<K> {
-    fn deref_mut(&mut self) -> &mut LocatedError<K> {
-        &mut self.0
     }
 }
 

@@ -46,6 +46,8 @@
 pub mod anim;
 pub mod assets;
 pub mod curves;
+#[cfg(test)]
+mod docs_tests;
 pub mod dynamics;
 pub mod error;
 pub mod groom;

@@ -500,16 +500,9 @@ fn written_velocities_are(groom: &AnimatedGroom, expected: Vec3) {
     groom
         .write(&path, 0..1, &Default::default(), false, |_| {})
         .unwrap();
-    let text_path = dir.path().join("sliding.usda");
-    let Some((ok, out)) = support::usdcheck(&[
-        "--convert".as_ref(),
-        path.as_os_str(),
-        text_path.as_os_str(),
-    ]) else {
+    let Some(text) = usda_of(&path) else {
         return;
     };
-    assert!(ok, "{out}");
-    let text = std::fs::read_to_string(&text_path).unwrap();
     let at = text
         .find("vector3f[] velocities.timeSamples")
         .unwrap_or_else(|| {
@@ -601,7 +594,9 @@ fn the_running_fox_velocities_match_its_motion_over_a_short_step() {
 
 /// usd-core's text of `path`'s time-sampled velocities, frame by frame
 /// (`None` without usd-core).
-fn velocity_samples(path: &std::path::Path) -> Option<std::collections::BTreeMap<String, String>> {
+/// The text of the binary USD file `path`, converted by Pixar's library
+/// (beside it, `.usda`); `None` where usdcheck is unavailable.
+fn usda_of(path: &std::path::Path) -> Option<String> {
     let text_path = path.with_extension("usda");
     let (ok, out) = support::usdcheck(&[
         "--convert".as_ref(),
@@ -609,7 +604,11 @@ fn velocity_samples(path: &std::path::Path) -> Option<std::collections::BTreeMap
         text_path.as_os_str(),
     ])?;
     assert!(ok, "{out}");
-    let text = std::fs::read_to_string(&text_path).unwrap();
+    Some(std::fs::read_to_string(&text_path).unwrap())
+}
+
+fn velocity_samples(path: &std::path::Path) -> Option<std::collections::BTreeMap<String, String>> {
+    let text = usda_of(path)?;
     let at = text
         .find("vector3f[] velocities.timeSamples")
         .expect("velocities");
@@ -902,16 +901,9 @@ fn a_regrown_groom_of_one_frame_writes_no_velocities_rather_than_zeros() {
     groom
         .write(&path, 0..1, &Default::default(), false, |_| {})
         .unwrap();
-    let text_path = dir.path().join("one.usda");
-    let Some((ok, out)) = support::usdcheck(&[
-        "--convert".as_ref(),
-        path.as_os_str(),
-        text_path.as_os_str(),
-    ]) else {
+    let Some(text) = usda_of(&path) else {
         return;
     };
-    assert!(ok, "{out}");
-    let text = std::fs::read_to_string(&text_path).unwrap();
     assert!(text.contains("points.timeSamples"), "the frame is written");
     assert!(
         !text.contains("velocities"),

@@ -53,6 +53,38 @@ fn root(groom: &EditableGroom, g: usize) -> Vec3 {
     groom.guides().guide(g)[0]
 }
 
+/// Every part `groom` grows.
+fn grown_parts(groom: &pelage::groom::Groom) -> Vec<Curves> {
+    let g = groom.generator(None).unwrap();
+    (0..g.parts().len()).map(|p| g.part(p).unwrap()).collect()
+}
+
+/// The hairs of `parts` and the farthest any of their points is from the
+/// same point of the hair of the same id in `session`.
+fn farthest_by_id(parts: &[Curves], session: &Curves) -> (usize, f32) {
+    let by_id: std::collections::HashMap<u64, usize> = session
+        .ids()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .map(|(i, id)| (*id, i))
+        .collect();
+    let (mut hairs, mut worst) = (0, 0.0f32);
+    for part in parts {
+        for i in 0..part.curve_count() {
+            let j = by_id[&part.ids().unwrap()[i]];
+            for (a, b) in part.points()[part.range(i)]
+                .iter()
+                .zip(&session.points()[session.range(j)])
+            {
+                worst = worst.max(a.distance(*b));
+            }
+            hairs += 1;
+        }
+    }
+    (hairs, worst)
+}
+
 fn lengths(points: &[Vec3]) -> Vec<f32> {
     points.windows(2).map(|s| s[0].distance(s[1])).collect()
 }
@@ -624,30 +656,8 @@ path = "fur.usdc"
     );
 
     let again = pelage::groom::Groom::load(&saved.groom).unwrap();
-    let generator = again.generator(None).unwrap();
     let session = groom.curves();
-    let by_id: std::collections::HashMap<u64, usize> = session
-        .ids()
-        .unwrap()
-        .iter()
-        .enumerate()
-        .map(|(i, id)| (*id, i))
-        .collect();
-    let mut total = 0;
-    let mut worst = 0.0f32;
-    for p in 0..generator.parts().len() {
-        let part = generator.part(p).unwrap();
-        for i in 0..part.curve_count() {
-            let j = by_id[&part.ids().unwrap()[i]];
-            for (a, b) in part.points()[part.range(i)]
-                .iter()
-                .zip(&session.points()[session.range(j)])
-            {
-                worst = worst.max(a.distance(*b));
-            }
-            total += 1;
-        }
-    }
+    let (total, worst) = farthest_by_id(&grown_parts(&again), &session);
     assert_eq!(total, session.curve_count(), "the same hairs");
     // The guides went through a file and were bound again: float
     // rounding, not a visible change.
@@ -808,32 +818,9 @@ fn a_groom_of_a_mesh_given_as_values_saves_a_file_that_grows_again() {
     let again = pelage::groom::Groom::load(&saved.groom).unwrap();
     assert_eq!(again.mesh().triangle_count(), spot.triangle_count());
     assert!(mesh_file.exists());
-    let grown: Vec<Curves> = {
-        let g = again.generator(None).unwrap();
-        (0..g.parts().len()).map(|p| g.part(p).unwrap()).collect()
-    };
-    let hairs: usize = grown.iter().map(|c| c.curve_count()).sum();
     let session = groom.curves();
+    let (hairs, worst) = farthest_by_id(&grown_parts(&again), &session);
     assert_eq!(hairs, session.curve_count());
-    let by_id: std::collections::HashMap<u64, usize> = session
-        .ids()
-        .unwrap()
-        .iter()
-        .enumerate()
-        .map(|(i, id)| (*id, i))
-        .collect();
-    let mut worst = 0.0f32;
-    for part in &grown {
-        for i in 0..part.curve_count() {
-            let j = by_id[&part.ids().unwrap()[i]];
-            for (a, b) in part.points()[part.range(i)]
-                .iter()
-                .zip(&session.points()[session.range(j)])
-            {
-                worst = worst.max(a.distance(*b));
-            }
-        }
-    }
     assert!(
         worst < 1e-4,
         "the saved groom's hairs are {worst} from the session's"

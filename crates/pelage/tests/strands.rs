@@ -188,33 +188,3 @@ fn a_thickness_of_many_skins_is_refused_before_any_grid_is_built() {
     let kept = params(run.size, 0.05 * run.size);
     assert!(GuideSimulation::new(&run.guides, &triangles, &pose, kept, true).is_ok());
 }
-
-#[test]
-fn the_parameters_table_says_the_librarys_defaults() {
-    let text = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/dynamics.md"),
-    )
-    .unwrap();
-    let table = text
-        .split("### Parameters (`GuideStrandParams`)")
-        .nth(1)
-        .unwrap();
-    let default = |key: &str| -> f32 {
-        let row = table
-            .lines()
-            .find(|l| l.starts_with(&format!("| `{key}` |")))
-            .unwrap_or_else(|| panic!("dynamics.md: no row for {key}"));
-        let cell = row.split('|').nth(2).unwrap().trim();
-        cell.parse()
-            .unwrap_or_else(|_| panic!("dynamics.md {key}: {cell:?} is not a number"))
-    };
-    let p = GuideStrandParams::default();
-    assert_eq!(default("substeps"), p.substeps as f32);
-    assert_eq!(default("iterations"), p.iterations as f32);
-    assert_eq!(default("damping"), p.damping);
-    assert_eq!(default("bend"), p.bend);
-    assert_eq!(default("follow"), p.follow);
-    assert_eq!(default("ftl_damping"), p.ftl_damping);
-    assert_eq!(default("thickness"), p.thickness);
-    assert_eq!(default("friction"), p.friction);
-}

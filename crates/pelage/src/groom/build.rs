@@ -104,6 +104,7 @@ impl Generator {
             None => root_sampling(&spec)?,
         };
         let interpolator = interpolator_for(&spec, shared_weights, regions.as_deref())?;
+        let hairs_per_root = spec.most_hairs_per_root();
         let GroomSpec {
             name,
             mesh,
@@ -146,6 +147,7 @@ impl Generator {
             records_centre_guides: reuse.centre_guides,
             // By the share actually kept: a fraction of a hair still
             // grows one (1e-300 would make widths infinite).
+            hairs_per_root,
             width_scale: match roots.grown_count() {
                 grown if grown < roots.count => (roots.count as f64 / grown as f64).sqrt() as f32,
                 _ => 1.0,

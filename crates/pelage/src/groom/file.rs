@@ -827,31 +827,14 @@ mod tests {
 #[cfg(test)]
 mod docs_tests {
     use super::SimulationSection;
-
-    /// The default column of `key`'s row in the table under `heading` of a
-    /// page in docs/.
-    pub(crate) fn documented_default(page: &str, heading: &str, key: &str) -> String {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../docs")
-            .join(page);
-        let text = std::fs::read_to_string(&path).unwrap();
-        let section = text
-            .split(heading)
-            .nth(1)
-            .unwrap_or_else(|| panic!("{}: no heading {heading}", path.display()));
-        let row = section
-            .lines()
-            .find(|l| l.starts_with(&format!("| `{key}` |")))
-            .unwrap_or_else(|| panic!("{page} {heading}: no row for {key}"));
-        row.split('|').nth(2).unwrap().trim().to_string()
-    }
+    use crate::docs_tests::{documented_default, documented_number};
 
     #[test]
     fn the_simulation_table_says_the_defaults_a_groom_file_gets() {
         let s: SimulationSection = toml::from_str("").unwrap();
         let page = "groom-format.md";
         let heading = "### `[simulation]`";
-        let number = |key: &str| -> f32 { documented_default(page, heading, key).parse().unwrap() };
+        let number = |key: &str| documented_number(page, heading, key);
         assert_eq!(number("substeps"), s.substeps as f32);
         assert_eq!(number("iterations"), s.iterations as f32);
         assert_eq!(number("damping"), s.damping);

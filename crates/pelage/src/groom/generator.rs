@@ -62,6 +62,8 @@ pub struct Generator {
     pub(super) clumps: bool,
     /// Whether clump centres record the guides they depend on.
     pub(super) records_centre_guides: bool,
+    /// [`crate::groom::GroomSpec::most_hairs_per_root`] of the spec it was built from.
+    pub(super) hairs_per_root: u64,
     /// Every width's factor: `√(count / grown)`, one over the square root
     /// of the share of the hairs actually grown, so a preview covers the
     /// skin as the whole groom does.
@@ -185,17 +187,9 @@ impl Generator {
         &self.ops
     }
 
-    /// The most hairs one root grows: each `strands` operator multiplies
-    /// them by its count (`cut` may remove some). What memory estimates
-    /// multiply a part's root count by.
+    /// The most hairs one root grows ([`crate::groom::GroomSpec::most_hairs_per_root`]).
     pub fn most_hairs_per_root(&self) -> u64 {
-        self.ops
-            .iter()
-            .map(|op| match op.unmasked() {
-                Operator::Strands(s) => u64::from(s.count()),
-                _ => 1,
-            })
-            .fold(1u64, u64::saturating_mul)
+        self.hairs_per_root
     }
 
     /// Points per hair.

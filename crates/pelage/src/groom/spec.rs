@@ -129,6 +129,19 @@ impl GroomSpec {
         self
     }
 
+    /// The most hairs one root grows: each `strands` operator multiplies
+    /// them by its count (`cut` may remove some). What memory estimates
+    /// multiply the root count by.
+    pub fn most_hairs_per_root(&self) -> u64 {
+        self.ops
+            .iter()
+            .map(|op| match op.unmasked() {
+                super::ops::GroomOp::Strands(s) => u64::from(s.count.max(1)),
+                _ => 1,
+            })
+            .fold(1, u64::saturating_mul)
+    }
+
     /// An error about the setting `key` (`roots.count`, `ops[1].noise`),
     /// at its line when the groom came from a file.
     pub(crate) fn error(&self, key: &str, kind: GroomErrorKind) -> GroomError {

@@ -46,9 +46,17 @@ impl<'de> Deserialize<'de> for MapText {
     }
 }
 
-pub(crate) fn one() -> MapValue {
-    Spanned::new(0..0, MapText::Number(1.0))
+/// A constant map as a groom file's default (no line of its own).
+pub(crate) fn default_map(value: f32) -> MapValue {
+    Spanned::new(0..0, MapText::Number(value))
 }
+
+/// `default_map(1.0)`, for serde's `default = "one"`.
+pub(crate) fn one() -> MapValue {
+    default_map(1.0)
+}
+
+/// `default_map(0.0)`, for serde's `default = "zero"`.
 pub(crate) fn zero() -> MapValue {
-    Spanned::new(0..0, MapText::Number(0.0))
+    default_map(0.0)
 }

@@ -82,15 +82,21 @@ impl EditableGroom {
         if let Some(path) = &layers_path {
             crate::io::check_output(path)?;
         }
+        let fail = |message: String| SaveError::Groom {
+            path: groom_path.to_path_buf(),
+            message,
+        };
+        // Read before anything is written, and once.
+        let mut table: toml::Table = match original {
+            Some(source) => source
+                .text
+                .parse()
+                .map_err(|e: toml::de::Error| fail(e.message().to_string()))?,
+            None => toml::Table::new(),
+        };
         // A mesh given as values has no file for `[mesh] path` to name:
         // it is written beside the groom file.
-        let names_its_mesh = original.is_some_and(|s| {
-            s.text
-                .parse::<toml::Table>()
-                .ok()
-                .and_then(|t| t.get("mesh")?.get("path").cloned())
-                .is_some()
-        });
+        let names_its_mesh = table.get("mesh").and_then(|m| m.get("path")).is_some();
         let mesh_name = self.mesh().name();
         let mesh_path = (!names_its_mesh
             && mesh_name != crate::assets::SPOT_NAME
@@ -111,17 +117,6 @@ impl EditableGroom {
         if let Some(path) = &mesh_path {
             write_atomically(path, |out| write_mesh_obj(out, self.mesh()))?;
         }
-        let fail = |message: String| SaveError::Groom {
-            path: groom_path.to_path_buf(),
-            message,
-        };
-        let mut table: toml::Table = match original {
-            Some(source) => source
-                .text
-                .parse()
-                .map_err(|e: toml::de::Error| fail(e.message().to_string()))?,
-            None => toml::Table::new(),
-        };
         let section = |table: &mut toml::Table, name: &str| -> toml::Table {
             match table.remove(name) {
                 Some(toml::Value::Table(t)) => t,

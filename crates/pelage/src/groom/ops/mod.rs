@@ -410,6 +410,22 @@ pub(crate) mod test_hairs {
 mod registry_tests {
     use super::*;
 
+    /// Panics unless a groom file whose one operator is `name` with
+    /// `keys` (`"count = 3"`, …) reads.
+    fn reads_as_the_only_operator(name: &str, keys: &[String]) {
+        let text = format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[[ops]]\n{name} = {{ {} }}\n",
+            keys.join(", ")
+        );
+        let source = crate::settings::SettingsSource {
+            path: "ops.toml".into(),
+            text,
+        };
+        source
+            .check_groom()
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+
     #[test]
     fn every_range_rule_names_a_field_of_its_operator() {
         // A misspelt rule key would check nothing: no number is ever
@@ -451,18 +467,7 @@ mod registry_tests {
                 let start = start.strip_suffix(".0").unwrap_or(&start).to_string();
                 keys.push(format!("{} = {start}", setting.name));
             }
-            let text = format!(
-                "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[[ops]]\n{} = {{ {} }}\n",
-                op.name,
-                keys.join(", ")
-            );
-            let source = crate::settings::SettingsSource {
-                path: "ops.toml".into(),
-                text,
-            };
-            source
-                .check_groom()
-                .unwrap_or_else(|e| panic!("{}: {e}", op.name));
+            reads_as_the_only_operator(op.name, &keys);
         }
         let width = operator_schema().into_iter().find(|s| s.name == "width");
         let root = &width.unwrap().settings[0];
@@ -501,18 +506,7 @@ mod registry_tests {
                     _ => format!("{k} = 1"),
                 })
                 .collect();
-            let text = format!(
-                "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\n[[ops]]\n{} = {{ {} }}\n",
-                op.name,
-                keys.join(", ")
-            );
-            let source = crate::settings::SettingsSource {
-                path: "ops.toml".into(),
-                text,
-            };
-            source
-                .check_groom()
-                .unwrap_or_else(|e| panic!("{}: {e}", op.name));
+            reads_as_the_only_operator(op.name, &keys);
         }
     }
 }

@@ -22,7 +22,7 @@
 //! both use. Every operator also takes `mask`.
 
 use crate::groom::error::GroomError;
-use crate::groom::values::{MapText, MapValue};
+use crate::groom::values::{MapValue, default_map};
 use crate::map::Map;
 use crate::mesh::Mesh;
 use crate::settings::SettingsSource;
@@ -156,11 +156,6 @@ pub(crate) fn map_on_mesh(
     map.bind(mesh)
         .map_err(|e| source.error_at(value.span(), crate::groom::error::GroomErrorKind::Map(e)))?;
     Ok(map)
-}
-
-/// A constant map as a groom file's default (no line of its own).
-pub(crate) fn default_map(value: f32) -> MapValue {
-    toml::Spanned::new(0..0, MapText::Number(value))
 }
 
 /// The spec's type of a setting of a kind.

@@ -58,11 +58,6 @@ pub struct Strands {
 }
 
 impl Strands {
-    /// Hairs each hair becomes.
-    pub fn count(&self) -> u32 {
-        self.count
-    }
-
     /// A strands operator (`count` at least 1).
     pub fn new(count: u32, root_spread: Map, tip_spread: Map, twist: Map, seed: u64) -> Self {
         Self {
