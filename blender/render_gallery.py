@@ -1,6 +1,6 @@
 """Render fur grown by the add-on with Cycles, for the gallery:
 
-    tools/bpy-python blender/render_gallery.py EXTENSION.zip OUT.png [--patches | --no-material | --workflow]
+    tools/bpy-python blender/render_gallery.py EXTENSION.zip OUT.png [--patches | --no-material | --workflow | --fox]
 
 Installs the extension into a fresh user folder, grows fur on Suzanne with
 "Grow pelage fur" (the panel's settings below) and renders 800×600 on the
@@ -17,7 +17,11 @@ beside it (docs/gallery/blender-addon-suzanne-no-material.png). With
 object on the surface (placed and combed by this script, as a groomer's
 brushes would: away from a parting down the middle of the head), a
 density painted as a vertex group (none on the face), and face sets,
-one a side, as the parting.
+one a side, as the parting. With ``--fox`` the surface is the Khronos Fox
+imported with Blender's glTF importer, posed at frame 9 of its Walk, with
+the Short preset grown on it at that frame: the fur is grown on the rest
+pose and carried to the pose by Deform Curves on Surface
+(docs/gallery/blender-fox-posed.png).
 """
 
 import math
@@ -33,7 +37,8 @@ import mathutils  # noqa: E402
 patches = sys.argv[-1] == "--patches"
 bare = sys.argv[-1] == "--no-material"
 workflow = sys.argv[-1] == "--workflow"
-args = sys.argv[:-1] if patches or bare or workflow else sys.argv
+posed_fox = sys.argv[-1] == "--fox"
+args = sys.argv[:-1] if patches or bare or workflow or posed_fox else sys.argv
 zip_path, out = os.path.abspath(args[-2]), os.path.abspath(args[-1])
 assert bpy.ops.extensions.package_install_files(
     filepath=zip_path, repo="user_default", enable_on_install=True
@@ -42,6 +47,53 @@ assert bpy.ops.extensions.package_install_files(
 for obj in list(bpy.data.objects):
     bpy.data.objects.remove(obj)
 scene = bpy.context.scene
+
+if posed_fox:
+    here = os.path.dirname(os.path.abspath(__file__))
+    bpy.ops.import_scene.gltf(filepath=os.path.join(here, "..", "crates", "pelage", "assets", "fox", "Fox.gltf"))
+    fox = next(o for o in bpy.data.objects if o.type == "MESH")
+    rig = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    walk = bpy.data.actions["Walk"]
+    rig.animation_data.action = walk
+    if hasattr(rig.animation_data, "action_slot") and walk.slots:
+        rig.animation_data.action_slot = walk.slots[0]
+    scene.frame_set(9)
+    bpy.context.view_layer.objects.active = fox
+    fox.pelage_fur.preset = "SHORT"
+    fox.pelage_fur.count = 150_000
+    fox.pelage_fur.melanin, fox.pelage_fur.melanin_redness = 0.45, 0.95
+    assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+    fur = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == fox][0]
+    # Framed from the side on the posed fox's bounds, in its world.
+    corners = [fox.matrix_world @ mathutils.Vector(c) for c in fox.bound_box]
+    low = mathutils.Vector([min(c[i] for c in corners) for i in range(3)])
+    high = mathutils.Vector([max(c[i] for c in corners) for i in range(3)])
+    centre, size = (low + high) / 2, max(high - low)
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    camera.location = centre + size * mathutils.Vector((1.5, -1.0, 0.45))
+    camera.rotation_euler = (centre - camera.location).to_track_quat("-Z", "Y").to_euler()
+    camera.data.lens = 55
+    for name, energy, offset in (("key", 1500, (-1.2, -1.5, 1.8)), ("rim", 1000, (1.0, 1.8, 1.2))):
+        light = bpy.data.objects.new(name, bpy.data.lights.new(name, "AREA"))
+        light.data.energy, light.data.size = energy * size * size, size
+        light.location = centre + size * mathutils.Vector(offset)
+        light.rotation_euler = (centre - light.location).to_track_quat("-Z", "Y").to_euler()
+        scene.collection.objects.link(light)
+    world = bpy.data.worlds.new("world")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.05, 0.06, 0.08, 1)
+    scene.world = world
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = 32
+    scene.cycles.use_denoising = False
+    scene.render.resolution_x, scene.render.resolution_y = 800, 600
+    scene.render.filepath = out
+    bpy.ops.render.render(write_still=True)
+    print(f"rendered {out}: {len(fur.data.curves):,} curves on the Fox at Walk frame 9")
+    sys.exit(0)
 
 bpy.ops.mesh.primitive_monkey_add(size=1.6)
 head = bpy.context.active_object

@@ -54,11 +54,26 @@ def transform_points(matrix, points):
     return p @ m[:3, :3].T + m[:3, 3]
 
 
-def mesh_to_pelage(obj, depsgraph):
+def use_rest_positions(obj):
+    """Asks Blender to keep ``obj``'s vertices as they are before shape
+    keys and modifiers (armature included) in its evaluated mesh, as the
+    ``rest_position`` attribute: the rest pose that Deform Curves on
+    Surface carries the fur from, and the one pelage grows on."""
+    if not obj.add_rest_position_attribute:
+        obj.add_rest_position_attribute = True
+
+
+def mesh_to_pelage(obj, depsgraph, rest=False):
     """The evaluated mesh of ``obj`` (modifiers applied), triangulated, as a
     ``pelage.Mesh`` in pelage's Y-up world (``to_pelage_space``), with the
     active UV map's UVs per triangle corner. Returns ``(mesh, uv_map_name
-    or None)``."""
+    or None)``.
+
+    With ``rest``, the vertices are the rest pose where Blender keeps one
+    (``use_rest_positions``): where they were before the armature and the
+    shape keys moved them, at whatever frame the scene is on. Fur grown
+    there is what Deform Curves on Surface expects; fur grown on a posed
+    frame would be deformed twice."""
     import pelage
 
     evaluated = obj.evaluated_get(depsgraph)
@@ -66,7 +81,11 @@ def mesh_to_pelage(obj, depsgraph):
     try:
         mesh.calc_loop_triangles()
         positions = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
-        mesh.vertices.foreach_get("co", positions)
+        rest_positions = mesh.attributes.get("rest_position") if rest else None
+        if rest_positions is not None:
+            rest_positions.data.foreach_get("vector", positions)
+        else:
+            mesh.vertices.foreach_get("co", positions)
         positions = transform_points(to_pelage_space(obj), positions.reshape(-1, 3))
         count = len(mesh.loop_triangles)
         if count == 0:
@@ -252,15 +271,28 @@ def face_sets_of(mesh, groups=FACE_SETS):
     return sets
 
 
-def guides_from_curves_object(obj, depsgraph=None):
+def follows_its_surface(obj):
+    """Whether the Curves object ``obj`` has a geometry-nodes modifier
+    with Deform Curves on Surface: its own curves are then in its
+    surface's rest pose, and the evaluated ones posed."""
+    return any(m.type == "NODES" and m.node_group is not None
+               and any(n.bl_idname == "GeometryNodeDeformCurvesOnSurface" for n in m.node_group.nodes)
+               for m in obj.modifiers)
+
+
+def guides_from_curves_object(obj, depsgraph=None, rest=False):
     """The curves of the hair Curves object ``obj`` as a ``pelage.Curves``
     in pelage's Y-up world (``to_pelage_space``), to be bound to the
     surface as guides; any point count (pelage resamples them). Evaluated
     (its modifiers applied) with a ``depsgraph``; without, the curves as
     Blender's sculpt brushes leave them, read with no scene evaluation (a
-    live update's)."""
+    live update's). With ``rest``, guides that Deform Curves on Surface
+    carries are read unevaluated, in the surface's rest pose, as the
+    fur is grown there (``mesh_to_pelage``)."""
     import pelage
 
+    if rest and follows_its_surface(obj):
+        depsgraph = None
     data = obj.evaluated_get(depsgraph).data if depsgraph is not None else obj.data
     if len(data.curves) == 0:
         raise pelage.PelageError(f"{obj.name}: the guides object has no curves; add some with Blender's hair brushes")
@@ -465,14 +497,14 @@ def guide_warnings(report):
     return notes
 
 
-def groom_for(surface, settings, mesh, depsgraph, images=None, relative=False):
+def groom_for(surface, settings, mesh, depsgraph, images=None, relative=False, rest=False):
     """The groom the panel of ``surface`` describes on its pelage ``mesh``,
-    with the guides object's curves as guides when one is set (Blender
-    images its maps name written into ``images``, as
-    ``groom_from_settings`` does)."""
+    with the guides object's curves as guides when one is set (at rest
+    with ``rest``, as ``mesh`` is then; Blender images its maps name
+    written into ``images``, as ``groom_from_settings`` does)."""
     guides = None
     if settings.guides_object is not None and not settings.groom_file:
-        guides = guides_from_curves_object(settings.guides_object, depsgraph)
+        guides = guides_from_curves_object(settings.guides_object, depsgraph, rest=rest)
     return groom_from_settings(mesh, settings, guides, max(surface.dimensions) or 1.0,
                                images=images, relative=relative)
 
@@ -490,12 +522,22 @@ def evaluated_positions(obj, depsgraph):
         evaluated.to_mesh_clear()
 
 
+def grows_at_rest(surface):
+    """Whether fur on ``surface`` is grown on its rest pose: when it has a
+    UV map, so that Deform Curves on Surface carries the fur to the pose
+    on screen (without one the fur stays where it was grown, and is grown
+    on the mesh as it is)."""
+    return surface.data.uv_layers.active is not None
+
+
 def animated_groom_for(context, surface, settings, progress=None, frames=None, rest_frame=None,
                        mode=None):
     """The panel's groom on ``surface`` as Blender evaluates it at
     ``frames`` (``(first, last)``, default the scene's frame range): the
-    surface at ``rest_frame`` (default the first) is the rest pose (roots
-    sampled and guides bound there), its vertices at every frame the skin
+    surface's rest pose (before armature and shape keys, as Deform Curves
+    on Surface carries the viewport's fur from) where the object is at
+    ``rest_frame`` (default the first) is where roots are sampled and
+    guides bound, its vertices at every frame the skin
     (armatures, shape keys, modifiers, object motion: whatever Blender
     shows). ``mode`` ("deform" or "simulate", default the panel's Motion)
     deforms the fur with the skin or simulates the guides on it (gravity:
@@ -509,13 +551,14 @@ def animated_groom_for(context, surface, settings, progress=None, frames=None, r
     wanted = sorted(set(range(first, last + 1)) | {rest_frame})
     current = scene.frame_current
     skin = {}
+    use_rest_positions(surface)
     try:
         scene.frame_set(rest_frame)
         depsgraph = context.evaluated_depsgraph_get()
-        mesh, _ = mesh_to_pelage(surface, depsgraph)
+        mesh, _ = mesh_to_pelage(surface, depsgraph, rest=True)
         guides = None
         if settings.guides_object is not None and not settings.groom_file:
-            guides = guides_from_curves_object(settings.guides_object, depsgraph)
+            guides = guides_from_curves_object(settings.guides_object, depsgraph, rest=True)
         for k, frame in enumerate(wanted):
             scene.frame_set(frame)
             skin[frame] = evaluated_positions(surface, context.evaluated_depsgraph_get())
@@ -549,18 +592,23 @@ def animated_groom_for(context, surface, settings, progress=None, frames=None, r
 
 
 def export_groom_for(context, surface, settings):
-    """The groom an export writes: the fur as the viewport shows it. Grown
-    at one frame and carried by Deform Curves on Surface to the frame on
-    screen, so exported at another frame it is the groom grown at the
-    grow's frame, carried to this one (one time sample); at the grow's
-    frame, or before any grow, grown on the mesh as it is."""
+    """The groom an export writes: the fur as the viewport shows it (or
+    would, grown now). Grown on the rest pose where the object was at the
+    grow's frame, and carried by Deform Curves on Surface to the frame on
+    screen: on another frame or a posed surface it is that groom carried
+    to this one (one time sample); at the grow's frame on a surface at
+    rest, or before any grow, grown on the mesh as it is."""
     fur = fur_object_of(surface)
-    grown_at = fur.get("pelage_frame") if fur is not None else None
     current = context.scene.frame_current
-    if grown_at is None or grown_at == current:
+    grown_at = fur.get("pelage_frame", current) if fur is not None else current
+    if grown_at == current:
+        rest = grows_at_rest(surface)
+        if rest:
+            use_rest_positions(surface)
         depsgraph = context.evaluated_depsgraph_get()
-        mesh, _ = mesh_to_pelage(surface, depsgraph)
-        return groom_for(surface, settings, mesh, depsgraph)
+        mesh, _ = mesh_to_pelage(surface, depsgraph, rest=rest)
+        if not rest or np.array_equal(mesh.positions, evaluated_positions(surface, depsgraph)):
+            return groom_for(surface, settings, mesh, depsgraph, rest=rest)
     return animated_groom_for(context, surface, settings, frames=(current, current),
                               rest_frame=int(grown_at), mode="deform")
 
@@ -578,17 +626,20 @@ def save_groom_file(context, surface, settings, path):
 
     import pelage
 
+    rest = grows_at_rest(surface)
+    if rest:
+        use_rest_positions(surface)
     depsgraph = context.evaluated_depsgraph_get()
-    mesh, _ = mesh_to_pelage(surface, depsgraph)
+    mesh, _ = mesh_to_pelage(surface, depsgraph, rest=rest)
     # Blender images the maps name go beside the file, by name; a folder
     # typed in the file browser that is not there yet is made.
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
-    groom = groom_for(surface, settings, mesh, depsgraph, images=folder, relative=True)
+    groom = groom_for(surface, settings, mesh, depsgraph, images=folder, relative=True, rest=rest)
     text = groom.settings
     written = [path]
     if settings.guides_object is not None:
-        guides = guides_from_curves_object(settings.guides_object, depsgraph)
+        guides = guides_from_curves_object(settings.guides_object, depsgraph, rest=rest)
         guides_path = os.path.splitext(path)[0] + ".guides.usdc"
         pelage.write_curves(guides, guides_path, basis="linear")
         written.append(guides_path)
@@ -655,9 +706,14 @@ class PreparedGrow:
 
         self.start = time.perf_counter()
         size_defaults(surface)
+        # On the rest pose whatever frame is on screen: Deform Curves on
+        # Surface carries the fur from there to the pose.
+        rest = grows_at_rest(surface)
+        if rest:
+            use_rest_positions(surface)
         depsgraph = context.evaluated_depsgraph_get()
-        mesh, self.uv_map = mesh_to_pelage(surface, depsgraph)
-        self.groom = groom_for(surface, settings, mesh, depsgraph)
+        mesh, self.uv_map = mesh_to_pelage(surface, depsgraph, rest=rest)
+        self.groom = groom_for(surface, settings, mesh, depsgraph, rest=rest)
         self.live = is_live(settings)
         self.fraction = settings.display_fraction
         self.frame = context.scene.frame_current
@@ -707,6 +763,8 @@ def finish_grow(surface, settings, prepared, grown, session):
     import bpy
 
     LIVE.pop(surface.name, None)
+    # This grow is the regrow a live update scheduled before it would do.
+    PENDING.pop(surface.name, None)
     uv_map, groom = prepared.uv_map, prepared.groom
     # Back from pelage's Y-up world into the surface's local space, where
     # Blender keeps the points of curves parented to it.
@@ -724,12 +782,13 @@ def finish_grow(surface, settings, prepared, grown, session):
         replace_data(obj, data)
     if uv_map is not None:
         # The node compares the deformed surface with its rest positions.
-        surface.add_rest_position_attribute = True
+        use_rest_positions(surface)
         if not any(m.type == "NODES" and m.node_group is not None
                    and m.node_group.name == DEFORM_GROUP for m in obj.modifiers):
             deform_on_surface_modifier(obj)
     obj["pelage_settings"] = groom.settings
-    # The frame grown at: exports at other frames carry the fur from it.
+    # Where the object was when grown (the rest pose is moved by the
+    # object's own transform): exports at other frames start from there.
     obj["pelage_frame"] = prepared.frame
     if session is not None:
         LIVE[surface.name] = LiveGroom(session, obj.name, max(surface.dimensions) * 0.005 or 1e-3)
@@ -780,6 +839,11 @@ class LiveGroom:
         self.session = session
         self.fur_name = fur_name
         self.tolerance = tolerance
+        # Set while the depsgraph has yet to see the fur this groom just
+        # filled: a new or replaced datablock makes the next update touch
+        # every ID (the mesh and the guides among them), which is no edit
+        # of the user's and must not regrow the groom again.
+        self.settling = True
 
 
 #: Live grooms by surface object name.
@@ -820,6 +884,7 @@ def live_update(surface):
     # Hairs added or removed: a new datablock, in place of the old one as
     # a grow puts it (the user's material and the object's slots kept).
     replace_data(obj, curves_to_blender(data.name, live.session.curves(), surface, data.surface_uv_map or None, back))
+    live.settling = True
     return done
 
 
@@ -843,7 +908,7 @@ def live_regrow(surface):
     if live is None:
         LIVE[surface.name] = LiveGroom(session, obj.name, max(surface.dimensions) * 0.005 or 1e-3)
     else:
-        live.session = session
+        live.session, live.settling = session, True
     return {"hairs": grown.curve_count}
 
 
@@ -921,6 +986,10 @@ def on_depsgraph_update(scene, depsgraph):
         settings = surface.pelage_fur
         guides = settings.guides_object
         if not settings.live or guides is None:
+            continue
+        live = LIVE[name]
+        if live.settling:
+            live.settling = False
             continue
         # The mesh datablock itself (edit mode, sculpting, weight and
         # vertex paint), not the object evaluated again (an armature

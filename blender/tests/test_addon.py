@@ -229,6 +229,7 @@ live_object = bpy.data.objects.new("live guides", live_curves)
 bpy.context.collection.objects.link(live_object)
 settings.guides_object, settings.live = live_object, True
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+assert grid.name not in addon_fur.PENDING, "a Grow with Live on sets off no second regrow"
 live_fur = fur_of(grid)
 # A material the user gave the fur object stays through every live regrow.
 live_material = bpy.data.materials.new("my live fur")
@@ -285,7 +286,12 @@ print(f"live: a combed guide regrew {done['regrown']:,} of {done['hairs']:,} hai
 addon_fur.PENDING.pop(grid.name, None)
 settings.count = 2_000
 assert addon_fur.PENDING.get(grid.name) is True, "a setting schedules a whole regrow"
+addon_fur.PENDING.pop(grid.name)  # as the scheduled timer does
 assert addon_fur.live_regrow(grid) == {"hairs": 2_000}
+# Blender's redraw after the regrow (its new datablock touches every ID)
+# is not an edit: it schedules nothing.
+bpy.context.view_layer.update()
+assert grid.name not in addon_fur.PENDING, addon_fur.PENDING
 assert fur_of(grid) == live_fur and len(live_fur.data.curves) == 2_000
 assert list(live_fur.data.materials) == [live_material], "a whole live regrow keeps the material"
 # So does an edit of the mesh (edit mode, sculpt, paint): the x > 0 half
@@ -730,6 +736,133 @@ with tempfile.TemporaryDirectory() as folder:
     assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
     assert 'method = "style-mesh"' in fur_of(other)["pelage_settings"]
 print("operator stack: add, reorder, remove, a vertex-group mask; the groom file round-trips through the panel")
+
+# 9. docs/blender.md's workflow, top to bottom, on a character that
+#    moves: the Khronos Fox imported with Blender's glTF importer and
+#    posed at frame 9 of its Walk, far from its rest pose. Guides in an
+#    Empty Hair object, Grow (the Short preset), Live, Paint, Save and
+#    Load, Export still and animated; after each, the fur's roots lie on
+#    the posed skin. The fur is grown on the rest pose and carried to the
+#    pose once by Deform Curves on Surface (grown on the posed skin, it
+#    was deformed twice and floated 12 % of the fox's size off it).
+clear_scene()
+fox_path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "crates", "pelage", "assets",
+                        "fox", "Fox.gltf")
+bpy.ops.import_scene.gltf(filepath=fox_path)
+fox = next(o for o in bpy.data.objects if o.type == "MESH")
+rig = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+walk = bpy.data.actions["Walk"]
+rig.animation_data.action = walk
+if hasattr(rig.animation_data, "action_slot") and walk.slots:
+    rig.animation_data.action_slot = walk.slots[0]
+scene = bpy.context.scene
+scene.frame_start, scene.frame_end = 8, 10
+scene.frame_set(9)
+fox_size = max(fox.dimensions)
+
+
+def fox_off_skin(roots_world_z_up, frame=None):
+    """The largest distance of roots (Blender's world) from the fox's
+    skin as it is posed at ``frame`` (default the one on screen), as a
+    share of the fox's size."""
+    if frame is not None:
+        scene.frame_set(frame)
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    tree = BVHTree.FromObject(fox, depsgraph)
+    to_local = fox.matrix_world.inverted()
+    worst = max(tree.find_nearest(to_local @ Vector(p))[3] for p in roots_world_z_up)
+    return worst * max(fox.matrix_world.to_scale()) / fox_size
+
+
+def shown_off_skin():
+    """How far the roots of the fur on screen lie from the posed skin."""
+    local = evaluated_roots(addon_fur.fur_object_of(fox))
+    return fox_off_skin([fox.matrix_world @ Vector(p) for p in local])
+
+
+def written_off_skin(curves, frame=None):
+    """How far the roots of curves pelage wrote lie from the skin."""
+    y_up_to_z_up = np.linalg.inv(addon_fur.Z_UP_TO_Y_UP)
+    return fox_off_skin(curves.points[curves.offsets[:-1]] @ y_up_to_z_up.T, frame)
+
+
+# 1. Guides: Add › Curves › Empty Hair on the fox; curves where the
+#    brushes would put them (in the rest pose, as sculpt mode edits them):
+#    every 25th vertex, along its normal, 5 % of the fox's size.
+bpy.context.view_layer.objects.active = fox
+fox.select_set(True)
+assert bpy.ops.object.curves_empty_hair_add() == {"FINISHED"}
+fox_guides = bpy.context.active_object
+assert fox_guides.type == "CURVES" and fox_guides.data.surface == fox
+to_guides = fox_guides.matrix_world.inverted() @ fox.matrix_world
+guide_roots = [(to_guides @ v.co, (to_guides.to_3x3() @ v.normal).normalized()) for v in list(fox.data.vertices)[::25]]
+fox_guides.data.add_curves([6] * len(guide_roots))
+guide_points = np.array([root + t * 0.05 * fox_size * normal for root, normal in guide_roots
+                         for t in np.linspace(0.0, 1.0, 6).tolist()], np.float32)
+fox_guides.data.position_data.foreach_set("vector", guide_points.ravel())
+bpy.context.view_layer.objects.active = fox
+panel = fox.pelage_fur
+panel.preset = "SHORT"
+panel.count, panel.guides_object = 20_000, fox_guides
+# 2. Grow, at the posed frame.
+assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
+worst = shown_off_skin()
+assert worst < 1e-3, f"fur grown at a posed frame lies {worst:.1%} of the fox's size off its skin"
+# 3. Live, ticked after the grow; a guide combed sideways regrows the
+#    hairs near it, and they stay on the posed skin.
+panel.live = True
+assert addon_fur.live_regrow(fox) is not None and fox.name in addon_fur.LIVE
+addon_fur.PENDING.pop(fox.name, None)
+combed = guide_points.copy().reshape(-1, 6, 3)
+combed[0] += np.linspace(0.0, 0.04 * fox_size, 6)[:, None] * np.array([1.0, 0.0, 0.0])
+fox_guides.data.position_data.foreach_set("vector", combed.ravel())
+combed_done = addon_fur.live_update(fox)
+assert combed_done is not None and 0 < combed_done["regrown"] < combed_done["hairs"], combed_done
+live_worst = shown_off_skin()
+assert live_worst < 1e-3, live_worst
+# 4. Paint: a vertex group over the fox's front half (in its rest pose) as
+#    the density; with Live on, the whole groom regrows there.
+front = fox.vertex_groups.new(name="front")
+middle = np.median([v.co.z for v in fox.data.vertices])
+front.add([v.index for v in fox.data.vertices if v.co.z > middle], 1.0, "REPLACE")
+panel.density_group = "front"
+assert addon_fur.PENDING.get(fox.name) is True, "painting schedules a whole regrow"
+addon_fur.live_regrow(fox)
+addon_fur.PENDING.pop(fox.name, None)
+grown_live = addon_fur.LIVE[fox.name].session.curves()
+rest_roots = addon_fur.transform_points(np.linalg.inv(addon_fur.to_pelage_space(fox)),
+                                        grown_live.points[grown_live.offsets[:-1]])
+front_share = (rest_roots[:, 2] > middle - 0.02 * fox_size).mean()
+assert front_share > 0.95, front_share
+assert shown_off_skin() < 1e-3
+panel.live = False
+# 5. Save the panel as a groom file (the guides beside it), and load it
+#    into the panel again.
+with tempfile.TemporaryDirectory() as folder:
+    fox_file = os.path.join(folder, "fox.toml")
+    assert bpy.ops.pelage.save_groom(filepath=fox_file) == {"FINISHED"}
+    saved_guides = pelage.read_curves(os.path.join(folder, "fox.guides.usdc"))
+    assert saved_guides.curve_count == len(guide_roots)
+    assert written_off_skin(saved_guides) > 0.01, "saved guides are in the rest pose, not the posed one"
+    assert bpy.ops.pelage.load_groom(filepath=fox_file) == {"FINISHED"}
+    again_file = os.path.join(folder, "again.toml")
+    assert bpy.ops.pelage.save_groom(filepath=again_file) == {"FINISHED"}
+    with open(fox_file) as a, open(again_file) as b:
+        assert a.read() == b.read().replace("again.guides.usdc", "fox.guides.usdc"), "the file round-trips"
+    # 6. Export the fur on screen, and the frame range animated.
+    posed_file = os.path.join(folder, "posed.usdc")
+    assert bpy.ops.pelage.export_usd(filepath=posed_file) == {"FINISHED"}
+    exported_worst = written_off_skin(pelage.read_curves(posed_file))
+    assert exported_worst < 1e-3, exported_worst
+    walking = os.path.join(folder, "walking.usdc")
+    assert bpy.ops.pelage.export_animated_usd(filepath=walking) == {"FINISHED"}
+    for frame in (8, 9, 10):
+        on_frame = written_off_skin(pelage.read_curves(walking, time=frame), frame)
+        assert on_frame < 1e-3, (frame, on_frame)
+scene.frame_set(9)
+print(f"docs/blender.md's workflow on the Fox at Walk frame 9: guides, grow, live comb "
+      f"({combed_done['regrown']:,} hairs), paint ({front_share:.1%} where painted), save and load, export "
+      f"still and animated; roots within {max(worst, live_worst, exported_worst):.1e} of its size of the posed skin")
 
 # 7. The scripting example runs as written, enabling the extension itself
 #    (a script's fresh session has it installed but not enabled).
