@@ -11,6 +11,13 @@
 //!   rest (operators still in rest space), and carried to the frame.
 //!   A hair at a guide's root reproduces that guide in every frame.
 //!
+//! Either way, with `[finish] outside_skin` (on by default for animated
+//! grooms) every frame's hairs are then kept out of that frame's posed
+//! skin ([`OutsideSkin::posed`]), as the still groom's are kept out of the
+//! rest pose: carried rigidly by their roots, hairs go into the body
+//! where it bends, and hairs between guides that collided can pass where
+//! the guides did not.
+//!
 //! Output is one file with time samples (usdc or Alembic): parts are
 //! written one after the other, each with all its frames, so memory holds
 //! one part (and the skin's poses) whatever the frame count.
@@ -49,6 +56,7 @@
 use super::error::{GroomError, GroomErrorKind};
 use super::generator::{Generator, GroomSummary};
 use super::output::{GroomWriteError, part_name};
+use super::outside_skin::OutsideSkin;
 use super::spec::GroomSpec;
 use crate::Curves;
 use crate::anim::{AnimatedSkin, FrameRange, RestFrames, SkinBinding, SkinPose};
@@ -56,6 +64,7 @@ use crate::guides::{Guides, resample_by_arc_length};
 use crate::io::{AbcWriter, AtomicFile, CurvesFormat, PrimWriter, UsdOptions, UsdcWriter};
 use crate::limits::MAX_OPEN_FRAME_FILES;
 use glam::Vec3;
+use rayon::prelude::*;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -248,6 +257,9 @@ pub struct AnimatedGroom {
     animation: AnimationSpec,
     binding: SkinBinding,
     guides: Option<GuideMotion>,
+    /// The gap every posed skin keeps hairs out by, and a hair's segment
+    /// (`None`: the groom's `outside_skin` is off).
+    keep_out: Option<(f32, f32)>,
 }
 
 impl std::fmt::Debug for AnimatedGroom {
@@ -313,6 +325,21 @@ impl AnimatedGroom {
             SkinPose::new(mesh.positions().to_vec(), mesh.triangles()),
         );
         let generator = Generator::new(spec.clone())?;
+        let keep_out = spec.finish.outside_skin.map(|gap| {
+            // A hair's segment: the longest guide over the hair's
+            // segments (the band a pushed hair crosses).
+            let guides = &spec.guides;
+            let longest = (0..guides.len())
+                .map(|g| {
+                    guides
+                        .guide(g)
+                        .windows(2)
+                        .map(|w| (w[1] - w[0]).length())
+                        .sum::<f32>()
+                })
+                .fold(0.0f32, f32::max);
+            (gap, longest / (spec.finish.points.max(2) - 1) as f32)
+        });
         Ok(Self {
             spec,
             generator,
@@ -320,6 +347,21 @@ impl AnimatedGroom {
             animation,
             binding,
             guides,
+            keep_out,
+        })
+    }
+
+    /// The skin in `pose` that this groom's hairs are kept out of, when
+    /// its `outside_skin` is on and the pose is not the rest pose (where
+    /// the hairs were kept out of the skin as they grew, and are carried
+    /// by the identity).
+    pub fn outside_skin(&self, pose: &SkinPose) -> Option<OutsideSkin> {
+        if pose.positions() == self.binding.rest().positions() {
+            return None;
+        }
+        self.keep_out.map(|(gap, segment)| {
+            let skin = (pose.positions(), pose.normals(), self.binding.triangles());
+            OutsideSkin::posed(skin, gap, segment)
         })
     }
 
@@ -422,13 +464,16 @@ impl AnimatedGroom {
     }
 
     /// Part `p` at `time` on `pose`: grown at rest by `generator` (the
-    /// rest generator in deform mode, the frame's in regrow mode) and
-    /// carried to the pose. `rest` caches the rest growth in deform mode.
+    /// rest generator in deform mode, the frame's in regrow mode), carried
+    /// to the pose and kept out of its skin (`outside`, this pose's
+    /// [`Self::outside_skin`]). `rest` caches the rest growth in deform
+    /// mode.
+    #[allow(clippy::too_many_arguments)]
     fn part_at(
         &self,
         p: usize,
         time: f64,
-        pose: &SkinPose,
+        (pose, outside): (&SkinPose, Option<&OutsideSkin>),
         generator: &Generator,
         rest: &mut Option<(Curves, RestFrames)>,
         out: &mut Curves,
@@ -461,6 +506,10 @@ impl AnimatedGroom {
                     "part {p} at frame {time}: the skin's pose moved a hair to a value that is not finite"
                 )),
             ));
+        }
+        if let Some(outside) = outside {
+            let triangles = self.binding.triangles();
+            outside.apply_all(out, |root| pose.frame_at(triangles, root).1.z_axis);
         }
         Ok(())
     }
@@ -539,9 +588,11 @@ impl AnimatedGroom {
             ));
         }
         let pose = self.pose(time)?;
+        let outside = self.outside_skin(&pose);
         let mut rest = None;
         let mut out = Curves::default();
-        self.part_at(p, time, &pose, &self.generator, &mut rest, &mut out)?;
+        let at = (&pose, outside.as_ref());
+        self.part_at(p, time, at, &self.generator, &mut rest, &mut out)?;
         let (minus, plus, per_second) = self.velocity_poses(time, &pose, fps);
         let (curves, frames) = rest.as_ref().expect("deform grows at rest");
         let velocities = self
@@ -560,26 +611,29 @@ impl AnimatedGroom {
     }
 
     /// Part `p` regrown at `time` and carried there: with the window's
-    /// pose and generator when `time` is one of `times`, else its own.
-    fn regrown_part(
-        &self,
-        p: usize,
-        time: f64,
-        times: &[f64],
-        poses: &[SkinPose],
-        generators: &[Option<Generator>],
-    ) -> Result<Curves, GroomError> {
+    /// pose, skin and generator when `time` is one of its times, else its
+    /// own.
+    fn regrown_part(&self, p: usize, time: f64, window: &Window<'_>) -> Result<Curves, GroomError> {
         let mut out = Curves::default();
-        match times.iter().position(|&t| t == time) {
+        match window.times.iter().position(|&t| t == time) {
             Some(k) => {
-                let generator = generators[k].as_ref().unwrap_or(&self.generator);
-                self.part_at(p, time, &poses[k], generator, &mut None, &mut out)?;
+                let generator = window.generators[k].as_ref().unwrap_or(&self.generator);
+                let at = (&window.poses[k], window.outsides[k].as_ref());
+                self.part_at(p, time, at, generator, &mut None, &mut out)?;
             }
             None => {
                 let pose = self.pose(time)?;
+                let outside = self.outside_skin(&pose);
                 let regrown = self.frame_generator(time, &pose)?;
                 let generator = regrown.as_ref().unwrap_or(&self.generator);
-                self.part_at(p, time, &pose, generator, &mut None, &mut out)?;
+                self.part_at(
+                    p,
+                    time,
+                    (&pose, outside.as_ref()),
+                    generator,
+                    &mut None,
+                    &mut out,
+                )?;
             }
         }
         Ok(out)
@@ -608,10 +662,18 @@ impl AnimatedGroom {
     /// Part `p` at time code `time`, alone (tests, previews).
     pub fn part(&self, p: usize, time: f64) -> Result<Curves, GroomError> {
         let pose = self.pose(time)?;
+        let outside = self.outside_skin(&pose);
         let regrown = self.frame_generator(time, &pose)?;
         let generator = regrown.as_ref().unwrap_or(&self.generator);
         let mut out = Curves::default();
-        self.part_at(p, time, &pose, generator, &mut None, &mut out)?;
+        self.part_at(
+            p,
+            time,
+            (&pose, outside.as_ref()),
+            generator,
+            &mut None,
+            &mut out,
+        )?;
         Ok(out)
     }
 
@@ -736,6 +798,10 @@ impl AnimatedGroom {
             .zip(&poses)
             .map(|(&t, pose)| self.frame_generator(t, pose))
             .collect::<Result<Vec<_>, _>>()?;
+        let outsides: Vec<Option<OutsideSkin>> = poses
+            .par_iter()
+            .map(|pose| self.outside_skin(pose))
+            .collect();
         // Deform: each time's skin a little before and after it, to carry
         // the hairs there for their velocities.
         // A skin with no sample past its first or last time (an OBJ
@@ -775,12 +841,14 @@ impl AnimatedGroom {
                         let window = Window {
                             times: &times,
                             poses: &poses,
+                            outsides: &outsides,
                             generators: &generators,
                             time_codes_per_second: options.time_codes_per_second,
                         };
                         Some(self.regrow_at(p, time, &all_times, window, &mut grown, &mut out)?)
                     } else {
-                        self.part_at(p, time, &poses[k], generator, &mut rest, &mut out)?;
+                        let at = (&poses[k], outsides[k].as_ref());
+                        self.part_at(p, time, at, generator, &mut rest, &mut out)?;
                         self.deform_velocities(p, time, velocity_poses.get(k), &rest)?
                     };
                     if velocities.is_some() {
@@ -913,7 +981,7 @@ impl AnimatedGroom {
         let b = all_times.get(i + 1).copied().unwrap_or(time);
         for t in [a, time, b] {
             if !grown.iter().any(|(x, _)| *x == t) {
-                let c = self.regrown_part(p, t, window.times, window.poses, window.generators)?;
+                let c = self.regrown_part(p, t, &window)?;
                 grown.push((t, c));
             }
         }
@@ -1000,6 +1068,8 @@ pub struct FrameOutput {
 struct Window<'a> {
     times: &'a [f64],
     poses: &'a [SkinPose],
+    /// Each pose's skin to keep hairs out of.
+    outsides: &'a [Option<OutsideSkin>],
     generators: &'a [Option<Generator>],
     time_codes_per_second: f64,
 }

@@ -8,16 +8,27 @@
 //! are left bit for bit as they were.
 //!
 //! The skin is the groom's mesh at rest, as a [`SkinSdf`]: exact near the
-//! skin, and thin parts (ears, tails) seen as such.
+//! skin, and thin parts (ears, tails) seen as such. An animated groom
+//! keeps its hairs out of each frame's posed skin the same way
+//! ([`OutsideSkin::posed`]): carried by their roots' frames, or regrown
+//! from guides that collided, hairs still go into the body where it
+//! bends (a shoulder, a haunch) or between the guides.
 
-use crate::Mesh;
 use crate::dynamics::SkinSdf;
 use crate::dynamics::strands::{SkinContact, follow_outside};
+use crate::mesh::SurfacePoint;
+use crate::{Curves, Mesh};
 use glam::Vec3;
+use rayon::prelude::*;
 
 /// Grid nodes along the mesh's longest side: fine, since a still groom's
 /// grid is built once.
 const NODES_ALONG: f32 = 128.0;
+
+/// Grid nodes along a posed skin's longest side: an animated groom keeps
+/// a grid for every frame a write holds, and a query within a cell of the
+/// skin is exact at any cell size (it measures the nearby triangles).
+const POSED_NODES_ALONG: f32 = 64.0;
 
 /// The skin a groom's hairs are kept out of.
 #[derive(Debug, Clone)]
@@ -35,16 +46,47 @@ impl OutsideSkin {
     /// so no point it places is deeper than a segment, and a hair that an
     /// operator sent deeper crosses the band on its way in from the root.
     pub fn new(mesh: &Mesh, gap: f32, segment: f32) -> Self {
-        let (lo, hi) = mesh.bounds();
-        let size = (hi - lo).max_element().max(f32::MIN_POSITIVE);
-        let cell = size / NODES_ALONG;
-        let skin = SkinSdf::new(
-            mesh.positions(),
-            mesh.normals(),
-            mesh.triangles(),
-            cell,
-            2.0 * segment + gap,
+        Self::with_cells(
+            (mesh.positions(), mesh.normals(), mesh.triangles()),
+            NODES_ALONG,
+            gap,
+            2.0 * segment,
+        )
+    }
+
+    /// The skin in one pose (`positions` and their `normals`, on
+    /// `triangles`), as [`Self::new`] keeps hairs out of it. The band is
+    /// as deep as there: however a pose folds the skin over a hair, the
+    /// first of its points inside lies within a segment of the one before
+    /// it, outside.
+    pub fn posed(
+        (positions, normals, triangles): (&[Vec3], &[Vec3], &[[u32; 3]]),
+        gap: f32,
+        segment: f32,
+    ) -> Self {
+        Self::with_cells(
+            (positions, normals, triangles),
+            POSED_NODES_ALONG,
+            gap,
+            2.0 * segment,
+        )
+    }
+
+    /// The grid, `nodes_along` nodes along its longest side, exact
+    /// `depth + gap` deep.
+    fn with_cells(
+        (positions, normals, triangles): (&[Vec3], &[Vec3], &[[u32; 3]]),
+        nodes_along: f32,
+        gap: f32,
+        depth: f32,
+    ) -> Self {
+        let (lo, hi) = positions.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
         );
+        let size = (hi - lo).max_element().max(f32::MIN_POSITIVE);
+        let cell = size / nodes_along;
+        let skin = SkinSdf::new(positions, normals, triangles, cell, depth + gap);
         Self { skin, gap }
     }
 
@@ -97,5 +139,36 @@ impl OutsideSkin {
             points[i] = q;
         }
         true
+    }
+
+    /// [`Self::apply`] to every hair of `curves`, in parallel;
+    /// `normal_at(root)` is the skin normal at a hair's root (curves
+    /// without roots take their first segment's direction). Returns how
+    /// many hairs moved.
+    pub fn apply_all(
+        &self,
+        curves: &mut Curves,
+        normal_at: impl Fn(SurfacePoint) -> Vec3 + Sync,
+    ) -> usize {
+        let (points, _, offsets, roots) = curves.carry_view();
+        let mut hairs = Vec::with_capacity(offsets.len().saturating_sub(1));
+        let mut rest = points;
+        for w in offsets.windows(2) {
+            let (hair, after) = std::mem::take(&mut rest).split_at_mut((w[1] - w[0]) as usize);
+            hairs.push(hair);
+            rest = after;
+        }
+        hairs
+            .into_par_iter()
+            .enumerate()
+            .map(|(c, hair)| {
+                let normal = match roots {
+                    Some(roots) => normal_at(roots[c]),
+                    None if hair.len() > 1 => (hair[1] - hair[0]).normalize_or(Vec3::Y),
+                    None => Vec3::Y,
+                };
+                usize::from(self.apply(hair, normal))
+            })
+            .sum()
     }
 }
