@@ -102,8 +102,10 @@ impl PyGroom {
         if let Some(a) = self.animated.get() {
             return Ok(a.clone());
         }
-        let animated = py
-            .detach(|| self.groom.animated(None))
+        let interrupt = Interrupt::default();
+        let animated = py.detach(|| self.groom.animated_until(None, &|| interrupt.seen()));
+        interrupt.raise()?;
+        let animated = animated
             .map_err(|e| self.error(e))?
             .ok_or_else(|| {
                 PyValueError::new_err(
@@ -434,13 +436,15 @@ impl PyGroom {
             Some(p) => check_part(p, parts).map(|()| p..p + 1)?,
             None => 0..parts,
         };
-        let grown = py
-            .detach(|| {
-                range
-                    .map(|p| animated.part(p, time))
-                    .collect::<Result<Vec<_>, _>>()
-            })
-            .map_err(|e| self.error(e))?;
+        let mut grown = Vec::with_capacity(range.len());
+        for p in range {
+            grown.push(
+                py.detach(|| animated.part(p, time))
+                    .map_err(|e| self.error(e))?,
+            );
+            // Ctrl-C between parts (the interpreter only sees it here).
+            py.check_signals()?;
+        }
         let curves = match grown.len() {
             1 => grown.into_iter().next().unwrap_or_default(),
             _ => py
@@ -466,9 +470,10 @@ impl PyGroom {
         if let Some(path) = &path {
             pelage::io::check_writable(path).map_err(to_py_err)?;
         }
-        let (guides, cache) = py
-            .detach(|| self.groom.simulated_guides())
-            .map_err(|e| self.error(e))?;
+        let interrupt = Interrupt::default();
+        let simulated = py.detach(|| self.groom.simulated_guides_until(&|| interrupt.seen()));
+        interrupt.raise()?;
+        let (guides, cache) = simulated.map_err(|e| self.error(e))?;
         if let Some(path) = &path {
             let options = self.groom.usd_options();
             py.detach(|| guides.write(path, &options))
@@ -553,10 +558,12 @@ impl PyGroom {
         let animated = match (self.groom.animation(), seed) {
             (None, _) => None,
             (Some(_), None) => Some(self.animated(py)?),
-            (Some(_), Some(_)) => py
-                .detach(|| self.groom.animated(seed))
-                .map_err(|e| self.error(e))?
-                .map(Arc::new),
+            (Some(_), Some(_)) => {
+                let interrupt = Interrupt::default();
+                let animated = py.detach(|| self.groom.animated_until(seed, &|| interrupt.seen()));
+                interrupt.raise()?;
+                animated.map_err(|e| self.error(e))?.map(Arc::new)
+            }
         };
         let (summary, written, grown) = if let Some(animated) = animated {
             // The library's plan: a farm run's file is named by its frames,
@@ -972,4 +979,32 @@ fn to_toml(value: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
         "{key}: cannot use a {} as a groom setting (use dicts, lists, numbers, strings)",
         value.get_type().name()?
     )))
+}
+
+/// A Ctrl-C seen while the library works without the interpreter (a
+/// simulation, frame after frame): signals reach Python code only while
+/// it runs, so [`Self::seen`] attaches to look, and keeps the
+/// `KeyboardInterrupt` for [`Self::raise`] once the work has returned.
+#[derive(Default)]
+struct Interrupt(std::sync::Mutex<Option<PyErr>>);
+
+impl Interrupt {
+    /// Whether a signal handler raised (the library's `stop`).
+    fn seen(&self) -> bool {
+        Python::attach(|py| match py.check_signals() {
+            Ok(()) => false,
+            Err(e) => {
+                self.0.lock().expect("not poisoned").get_or_insert(e);
+                true
+            }
+        })
+    }
+
+    /// The interrupt seen, raised.
+    fn raise(self) -> PyResult<()> {
+        match self.0.into_inner().expect("not poisoned") {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
 }

@@ -465,6 +465,40 @@ def test_ctrl_c_stops_write_and_grow_between_parts(spot, tmp_path):
     timer.join()
 
 
+def test_ctrl_c_stops_a_simulation_in_simulate_write_and_grow_frame(tmp_path):
+    """Ctrl-C while the guides are simulated (before any frame is grown)
+    stops simulate(), an animated write() and grow_frame() within a frame
+    of the simulation, and simulate() writes no file."""
+    import time
+
+    fox = REPO / "crates" / "pelage" / "assets" / "fox" / "Fox.gltf"
+
+    def simulated():
+        return pelage.Groom(
+            mesh=str(fox),
+            guides={"generate": {"count": 600, "length": 10.0}},
+            roots=200,
+            animation={"frames": "1-40", "clip": "Run", "mode": "simulate"},
+            simulation={"gravity": [0, -500, 0], "preroll": 8},
+        )
+
+    started = time.perf_counter()
+    simulated().simulate()
+    whole = time.perf_counter() - started
+    guides = tmp_path / "guides.usdc"
+    for run in [lambda g: g.simulate(guides), lambda g: g.write(tmp_path / "fox.usdc"),
+                lambda g: g.grow_frame(20)]:
+        groom = simulated()
+        timer = _interrupt_after(whole / 5)
+        started = time.perf_counter()
+        with pytest.raises(KeyboardInterrupt):
+            run(groom)
+        stopped = time.perf_counter() - started
+        timer.join()
+        assert stopped < whole * 0.6, f"stopped after {stopped:.2f} s of {whole:.2f}"
+    assert [p.name for p in tmp_path.iterdir()] == []
+
+
 def test_an_exception_in_progress_stops_the_write(spot, tmp_path):
     groom = small_groom(spot, count=20_000, roots={"count": 20_000, "seed": 3, "parts": 16})
     calls = []

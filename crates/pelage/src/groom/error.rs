@@ -94,6 +94,9 @@ pub enum GroomErrorKind {
     /// A brush cannot make its edit.
     #[error("{0}")]
     Brush(BrushRefusal),
+    /// Stopped by its caller (a Ctrl-C) before the work was done.
+    #[error("stopped {0}")]
+    Stopped(String),
     /// A map that cannot be read or used.
     #[error("{0}")]
     Map(MapError),

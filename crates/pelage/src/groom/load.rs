@@ -12,7 +12,7 @@ use super::ops::{Color, OpKey, OperatorSettings, RootToTip, SpecReader, map_on_m
 use super::outside_skin::OutsideSkin;
 use super::parts::part_count;
 use super::simulate::{
-    CacheUse, SimulatedGuides, SimulationSettings, cached_simulation, simulate_guides,
+    CacheUse, SimulatedGuides, SimulationSettings, cached_simulation_until, simulate_guides_until,
 };
 use super::spec::{FinishSpec, GroomSpec, RegionsSpec, RootsSpec, SpecOrigin};
 use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
@@ -276,6 +276,17 @@ impl Groom {
     /// The groom bound to its animated skin (`None` for a still groom);
     /// `seed` overrides the file's.
     pub fn animated(&self, seed: Option<u64>) -> Result<Option<AnimatedGroom>, GroomError> {
+        self.animated_until(seed, &|| false)
+    }
+
+    /// [`Self::animated`], asking `stop` after every frame a simulated
+    /// groom's guides are simulated whether to give up (a Ctrl-C): then a
+    /// [`GroomErrorKind::Stopped`] error.
+    pub fn animated_until(
+        &self,
+        seed: Option<u64>,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Option<AnimatedGroom>, GroomError> {
         let Some(animation) = &self.animation else {
             return Ok(None);
         };
@@ -309,7 +320,7 @@ impl Groom {
                 };
                 Some(guides)
             }
-            AnimationMode::Simulate => Some(self.simulate(&spec, animation)?.0.motion()),
+            AnimationMode::Simulate => Some(self.simulate(&spec, animation, stop)?.0.motion()),
         };
         AnimatedGroom::new(spec, animation.skin.clone(), animation.spec.clone(), guides).map(Some)
     }
@@ -325,6 +336,16 @@ impl Groom {
     /// when the file names one (and what was done with it). An error for
     /// a still groom or another mode.
     pub fn simulated_guides(&self) -> Result<(SimulatedGuides, Option<CacheUse>), GroomError> {
+        self.simulated_guides_until(&|| false)
+    }
+
+    /// [`Self::simulated_guides`], asking `stop` after every simulated
+    /// frame whether to give up (a Ctrl-C): then a
+    /// [`GroomErrorKind::Stopped`] error, and no cache written.
+    pub fn simulated_guides_until(
+        &self,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<(SimulatedGuides, Option<CacheUse>), GroomError> {
         let Some(animation) = self
             .animation
             .as_ref()
@@ -337,7 +358,7 @@ impl Groom {
                 ),
             ));
         };
-        self.simulate(&self.spec()?, animation)
+        self.simulate(&self.spec()?, animation, stop)
     }
 
     /// [`Self::simulated_guides`] of `spec` (the groom's values, with a
@@ -346,14 +367,16 @@ impl Groom {
         &self,
         spec: &GroomSpec,
         animation: &LoadedAnimation,
+        stop: &dyn Fn() -> bool,
     ) -> Result<(SimulatedGuides, Option<CacheUse>), GroomError> {
         let settings = self.simulation_settings(animation)?;
+        let skin = &animation.skin;
         match self.simulation_cache() {
             Some(full) => {
-                let (guides, used) = cached_simulation(spec, &animation.skin, &settings, &full)?;
+                let (guides, used) = cached_simulation_until(spec, skin, &settings, &full, stop)?;
                 Ok((guides, Some(used)))
             }
-            None => Ok((simulate_guides(spec, &animation.skin, &settings)?, None)),
+            None => Ok((simulate_guides_until(spec, skin, &settings, stop)?, None)),
         }
     }
 

@@ -94,7 +94,7 @@ pub use report::{
 };
 pub use simulate::{
     CacheUse, SIMULATED_GUIDES_NAME, SimulatedGuides, SimulationSettings, cached_simulation,
-    simulate_guides, simulation_key,
+    cached_simulation_until, simulate_guides, simulate_guides_until, simulation_key,
 };
 
 pub use ops::{

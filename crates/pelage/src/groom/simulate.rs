@@ -223,6 +223,19 @@ pub fn cached_simulation(
     settings: &SimulationSettings,
     cache: &Path,
 ) -> Result<(SimulatedGuides, CacheUse), GroomError> {
+    cached_simulation_until(spec, skin, settings, cache, &|| false)
+}
+
+/// [`cached_simulation`], asking `stop` after every simulated frame
+/// whether to give up (a Ctrl-C): then a [`GroomErrorKind::Stopped`]
+/// error, and the cache is left as it was.
+pub fn cached_simulation_until(
+    spec: &GroomSpec,
+    skin: &AnimatedSkin,
+    settings: &SimulationSettings,
+    cache: &Path,
+    stop: &dyn Fn() -> bool,
+) -> Result<(SimulatedGuides, CacheUse), GroomError> {
     if CurvesFormat::from_path(cache) != Some(CurvesFormat::Usdc) {
         return Err(spec.error(
             "simulation.cache",
@@ -246,7 +259,7 @@ pub fn cached_simulation(
     // The cache must take the result: checked before the simulation.
     crate::io::check_writable(cache)
         .map_err(|e| spec.error("simulation.cache", GroomErrorKind::Cache(Box::new(e))))?;
-    let guides = simulate_with_key(spec, skin, settings, key)?;
+    let guides = simulate_with_key(spec, skin, settings, key, stop)?;
     let options = UsdOptions {
         time_codes_per_second: settings.fps,
         ..UsdOptions::default()
@@ -292,15 +305,29 @@ pub fn simulate_guides(
     skin: &AnimatedSkin,
     settings: &SimulationSettings,
 ) -> Result<SimulatedGuides, GroomError> {
-    simulate_with_key(spec, skin, settings, simulation_key(spec, skin, settings)?)
+    simulate_guides_until(spec, skin, settings, &|| false)
 }
 
-/// [`simulate_guides`], its key known.
+/// [`simulate_guides`], asking `stop` after every simulated frame (and
+/// preroll step) whether to give up: then a [`GroomErrorKind::Stopped`]
+/// error.
+pub fn simulate_guides_until(
+    spec: &GroomSpec,
+    skin: &AnimatedSkin,
+    settings: &SimulationSettings,
+    stop: &dyn Fn() -> bool,
+) -> Result<SimulatedGuides, GroomError> {
+    let key = simulation_key(spec, skin, settings)?;
+    simulate_with_key(spec, skin, settings, key, stop)
+}
+
+/// [`simulate_guides_until`], its key known.
 fn simulate_with_key(
     spec: &GroomSpec,
     skin: &AnimatedSkin,
     settings: &SimulationSettings,
     key: u64,
+    stop: &dyn Fn() -> bool,
 ) -> Result<SimulatedGuides, GroomError> {
     let triangles = spec.mesh.triangles();
     let rest = SkinPose::new(spec.mesh.positions().to_vec(), triangles);
@@ -316,10 +343,19 @@ fn simulate_with_key(
     let pose = |frame: i32| -> Result<SkinPose, GroomError> {
         Ok(SkinPose::new(skin_at(spec, skin, frame)?, triangles))
     };
+    let stopped = |frame: i32| {
+        spec.error(
+            "simulation",
+            GroomErrorKind::Stopped(format!("simulating the guides, at frame {frame}")),
+        )
+    };
     let dt = (1.0 / settings.fps) as f32;
     let start = pose(first)?;
     sim.reset(&start);
     for k in 0..settings.preroll {
+        if stop() {
+            return Err(stopped(first));
+        }
         sim.advance(&start, dt, k as f32 * dt);
     }
     let shape = |sim: &GuideSimulation, frame: i32| {
@@ -335,6 +371,9 @@ fn simulate_with_key(
     let mut shapes: Vec<Curves> = Vec::with_capacity((last - first + 1) as usize);
     shapes.push(shape(&sim, first)?);
     for frame in first + 1..=last {
+        if stop() {
+            return Err(stopped(frame));
+        }
         let now = pose(frame)?;
         let time = (settings.preroll as i32 + frame - first) as f32 * dt;
         sim.advance(&now, dt, time);
