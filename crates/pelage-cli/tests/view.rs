@@ -501,3 +501,45 @@ fn a_scripted_step_that_fails_ends_the_run_with_its_error() {
         assert!(!dir.path().join("after.png").exists(), "{step}");
     }
 }
+
+#[test]
+fn the_guides_under_the_brush_are_highlighted_where_the_pointer_is() {
+    if !has_display() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let groom = "[mesh]\npath = \"spot\"\n[roots]\ncount = 500\n\
+        [guides]\ngenerate = { count = 300, length = 0.1 }\n";
+    let groom_path = dir.path().join("fur.toml");
+    std::fs::write(&groom_path, groom).unwrap();
+    let (cx, cy) = (SIZE.0 as f32 / 2.0, SIZE.1 as f32 / 2.0);
+    let script = format!(
+        "ui = false\n[[step]]\nshow = {{ hairs = false }}\n[[step]]\nwait = 1\n\
+         [[step]]\nscreenshot = \"before.png\"\n[[step]]\npointer = [{cx}, {cy}]\n\
+         [[step]]\nwait = 1\n[[step]]\nscreenshot = \"after.png\"\n"
+    );
+    let script_path = dir.path().join("steps.toml");
+    std::fs::write(&script_path, script).unwrap();
+    let out = groom_by_script(&groom_path, &script_path);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The highlight is green; the other guides orange, the skin white and
+    // black.
+    let green = |name: &str| {
+        let image = image::open(dir.path().join(name)).unwrap().to_rgb8();
+        image
+            .pixels()
+            .filter(|p| {
+                i32::from(p[1]) > i32::from(p[0]) + 40 && i32::from(p[1]) > i32::from(p[2]) + 40
+            })
+            .count()
+    };
+    let (before, after) = (green("before.png"), green("after.png"));
+    assert!(
+        after >= before + 10,
+        "{before} green pixels before, {after} after"
+    );
+}

@@ -83,7 +83,9 @@ impl PyGroomSession {
     /// `constant`) and `mirror_x`. `paint` takes `layer` (default
     /// "density") and `value`; `part` takes `region`; `add` takes `count`.
     /// Returns `{"regrown": roots regrown, "hairs": hairs now}`, or None
-    /// when the dab touched nothing.
+    /// when the dab touched nothing; a guide brush (comb to spread) that
+    /// reached no guide also warns (`UserWarning`), saying how far the
+    /// nearest guide was.
     #[pyo3(signature = (name, *, at, radius, strength = 1.0, direction = (0.0, 0.0, 0.0), falloff = "smooth", mirror_x = false, layer = None, value = None, region = None, count = None))]
     #[allow(clippy::too_many_arguments)]
     fn brush<'py>(
@@ -143,9 +145,33 @@ impl PyGroomSession {
                 "at, direction and strength must be finite numbers",
             ));
         }
-        let done = py
-            .detach(|| self.with(|g| g.brush(&brush, &dab)))
+        let (done, missed) = py
+            .detach(|| {
+                self.with(|g| {
+                    let done = g.brush(&brush, &dab)?;
+                    // A guide brush that reached no guide: by how much.
+                    let missed = (done.is_none() && brush.shapes_guides())
+                        .then(|| pelage::groom::brush::nearest_guide_distance(g, dab.center));
+                    Ok::<_, pelage::groom::GroomError>((done, missed))
+                })
+            })
             .map_err(to_py_err)?;
+        if let Some(nearest) = missed {
+            let how_far = nearest.map_or("the groom has no guides".to_string(), |d| {
+                format!("the nearest guide point is {d:.4} away")
+            });
+            let message = std::ffi::CString::new(format!(
+                "{name}: no guide within the brush's radius {radius} of {:?} ({how_far}); the dab changed nothing",
+                at
+            ))
+            .expect("no NUL in the message");
+            PyErr::warn(
+                py,
+                &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+                &message,
+                1,
+            )?;
+        }
         done.map(|r| regrowth_dict(py, r)).transpose()
     }
 

@@ -90,6 +90,22 @@ def test_a_session_on_a_mesh_from_arrays_saves_a_groom_that_loads(spot, tmp_path
     assert again.grow().curve_count == s.curves().curve_count
 
 
+def test_a_dab_that_reaches_no_guide_says_so(filed_groom):
+    """A comb where no guide is (a dab far off the groom) changes nothing
+    and warns, saying how far the nearest guide was; a dab on a guide
+    does not warn."""
+    import warnings
+
+    s = pelage.GroomSession(filed_groom)
+    with pytest.warns(UserWarning, match=r"comb: no guide within the brush's radius 0.01 .*nearest guide point is \d"):
+        assert s.brush("comb", at=(50.0, 50.0, 50.0), radius=0.01, direction=(0.0, 0.03, 0.0)) is None
+    assert s.history == (0, 0)
+    root = tuple(float(x) for x in s.guides().points[0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert s.brush("comb", at=root, radius=0.1, direction=(0.0, 0.03, 0.0)) is not None
+
+
 def test_bad_brushes_say_what_to_do(filed_groom):
     s = pelage.GroomSession(filed_groom)
     with pytest.raises(ValueError, match="no brush 'kamm'.*comb"):

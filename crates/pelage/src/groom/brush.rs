@@ -213,6 +213,22 @@ impl Brush {
         })
     }
 
+    /// Whether the brush shapes the guides it reaches
+    /// ([`guides_reached`]): comb, length, cut, smooth, puff, clump and
+    /// spread.
+    pub fn shapes_guides(&self) -> bool {
+        matches!(
+            self,
+            Brush::Comb
+                | Brush::Length
+                | Brush::Cut
+                | Brush::Smooth
+                | Brush::Puff
+                | Brush::Clump
+                | Brush::Spread
+        )
+    }
+
     /// The brush's name.
     pub fn name(&self) -> &'static str {
         match self {
@@ -399,8 +415,10 @@ impl EditableGroom {
     }
 }
 
-/// Layer names are written as PLY properties and `vertex:NAME` maps.
-fn check_layer_name(name: &str) -> Result<(), BrushRefusal> {
+/// A paint layer's name, refused unless it can be written as a PLY
+/// property and read back as a `vertex:NAME` map (a letter or `_`, then
+/// letters, digits and `_`, at most 64, not a coordinate's name).
+pub fn check_layer_name(name: &str) -> Result<(), BrushRefusal> {
     let ok = !name.is_empty()
         && name.len() <= 64
         && name.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
@@ -435,6 +453,37 @@ fn vertex_points(mesh: &Mesh) -> Vec<Option<SurfacePoint>> {
     out
 }
 
+/// The guides a dab of a brush that shapes guides (comb, length, cut,
+/// smooth, puff, clump, spread) reaches: those with a point within it
+/// or, mirrored, within its mirror. They are the ones it may move; a dab
+/// that reaches none changes nothing.
+pub fn guides_reached(groom: &EditableGroom, dab: &Dab) -> Vec<usize> {
+    reached(groom, &dab.sides())
+}
+
+/// How far the nearest guide point is from `at`, or `None` without guides:
+/// what a dab that [`guides_reached`] nothing missed by.
+pub fn nearest_guide_distance(groom: &EditableGroom, at: Vec3) -> Option<f32> {
+    groom
+        .guides()
+        .curves()
+        .points()
+        .iter()
+        .map(|p| p.distance(at))
+        .min_by(f32::total_cmp)
+}
+
+/// The guides with a point within any of `dabs`.
+fn reached(groom: &EditableGroom, dabs: &[Dab]) -> Vec<usize> {
+    let guides = groom.guides();
+    (0..guides.len())
+        .filter(|&g| {
+            let guide = guides.guide(g);
+            dabs.iter().any(|d| guide.iter().any(|p| d.contains(*p)))
+        })
+        .collect()
+}
+
 /// The guide brushes that move points: one `MoveGuides` with the guides
 /// whose points changed.
 fn shape_guides(groom: &EditableGroom, brush: &Brush, dabs: &[Dab]) -> Option<Edit> {
@@ -444,18 +493,11 @@ fn shape_guides(groom: &EditableGroom, brush: &Brush, dabs: &[Dab]) -> Option<Ed
     let n = guides.points_per_guide();
     let mut changed = Vec::new();
     let mut points = Vec::new();
-    let mut current: Vec<Vec<Vec3>> = Vec::new();
-    let mut touched = Vec::new();
-    for g in 0..guides.len() {
-        let guide = guides.guide(g);
-        if dabs.iter().any(|d| guide.iter().any(|p| d.contains(*p))) {
-            touched.push(g);
-            current.push(guide.to_vec());
-        }
-    }
+    let touched = reached(groom, dabs);
     if touched.is_empty() {
         return None;
     }
+    let mut current: Vec<Vec<Vec3>> = touched.iter().map(|&g| guides.guide(g).to_vec()).collect();
     for dab in dabs {
         // Clump and spread pull toward the mean of the guides under the
         // dab, point by point, weighted by their roots' weights.

@@ -502,7 +502,7 @@ impl WindowState {
                 }
             }
         }
-        g.end_stroke();
+        let edits = g.end_stroke();
         if let Some(e) = refused {
             return Err(e.context(format!("the {} stroke at pixel {:?}", step.name, step.from)));
         }
@@ -510,6 +510,12 @@ impl WindowState {
             eprintln!(
                 "warning: the {} stroke at pixel {:?} missed the mesh",
                 step.name, step.from
+            );
+        } else if edits == 0 {
+            // The dab's own words: no guide within reach, and how far.
+            eprintln!(
+                "warning: the {} stroke at pixel {:?} changed nothing: {}",
+                step.name, step.from, g.status
             );
         }
         Ok(())
@@ -607,6 +613,12 @@ impl WindowState {
         let delta = position - self.pointer.position;
         self.pointer.position = position;
         let Some(start) = self.pointer.pressed_at else {
+            if matches!(&self.session, Session::Groom(_)) {
+                let (origin, direction) = self.ray(position);
+                if let Some(g) = self.session.grooming() {
+                    g.hover(origin, direction);
+                }
+            }
             return;
         };
         if (position - start).length() > 3.0 {
@@ -726,6 +738,7 @@ impl WindowState {
                             eprintln!("warning: `show` is for groom and curves views; ignored");
                         }
                     },
+                    Step::Pointer(at) => self.mouse_moved(Vec2::from(at)),
                     Step::Brush(b) => {
                         if let Err(e) = self.scripted_stroke(&b) {
                             self.script_error = Some(e);

@@ -85,9 +85,15 @@ pub struct GroomingSession {
     /// The slider's share of the hairs, in percent: the groom grows it
     /// when the slider is released.
     percent_slider: f32,
+    /// The guides a dab of the brush where the pointer is would move
+    /// (drawn in [`REACHED_COLOR`]).
+    reached: Vec<usize>,
 }
 
 const GUIDE_COLOR: Vec3 = Vec3::new(1.0, 0.3, 0.0);
+/// The guides under the brush (those a dab there would move): green, and
+/// twice as wide, apart from the orange guides and any skin.
+const REACHED_COLOR: Vec3 = Vec3::new(0.1, 1.0, 0.2);
 
 impl GroomingSession {
     /// Opens the groom file `path` for grooming.
@@ -147,6 +153,7 @@ impl GroomingSession {
             status,
             dab_ms: Vec::new(),
             percent_slider: percent,
+            reached: Vec::new(),
         })
     }
 
@@ -172,6 +179,37 @@ impl GroomingSession {
         }
     }
 
+    /// The pointer's ray moved over the window: the guides a dab of a
+    /// guide brush there would move are drawn highlighted (none off the
+    /// mesh, or for the other brushes).
+    pub fn hover(&mut self, origin: Vec3, direction: Vec3) {
+        let brush = self.brush();
+        let reached = match pelage::mesh::first_hit(self.groom.mesh(), origin, direction) {
+            Some(hit) if brush.shapes_guides() => {
+                let dab = self.dab_at(hit.point.position(self.groom.mesh()), Vec3::ZERO);
+                pelage::groom::brush::guides_reached(&self.groom, &dab)
+            }
+            _ => Vec::new(),
+        };
+        if reached != self.reached {
+            self.reached = reached;
+            self.dirty = true;
+        }
+    }
+
+    /// The dab of the panel's settings at `at`, combing along `moved`.
+    fn dab_at(&self, at: Vec3, moved: Vec3) -> Dab {
+        let c = &self.controls;
+        Dab {
+            center: at,
+            radius: c.radius,
+            strength: c.strength,
+            direction: moved * c.strength,
+            falloff: c.falloff,
+            mirror_x: c.mirror_x,
+        }
+    }
+
     /// Starts a stroke.
     pub fn begin_stroke(&mut self) {
         self.stroke = Some(Stroke {
@@ -181,9 +219,15 @@ impl GroomingSession {
     }
 
     /// Ends the stroke: its dabs become one undo step.
-    pub fn end_stroke(&mut self) {
-        if let Some(stroke) = self.stroke.take() {
-            self.groom.join_last_steps(stroke.edits);
+    /// Ends the stroke: its dabs' edits become one undo step. Returns how
+    /// many dabs changed the groom.
+    pub fn end_stroke(&mut self) -> usize {
+        match self.stroke.take() {
+            Some(stroke) => {
+                self.groom.join_last_steps(stroke.edits);
+                stroke.edits
+            }
+            None => 0,
         }
     }
 
@@ -219,15 +263,7 @@ impl GroomingSession {
 
     /// One dab of `brush` at `at`, combing along `moved`.
     pub fn dab(&mut self, brush: &Brush, at: Vec3, moved: Vec3) -> anyhow::Result<()> {
-        let c = &self.controls;
-        let dab = Dab {
-            center: at,
-            radius: c.radius,
-            strength: c.strength,
-            direction: moved * c.strength,
-            falloff: c.falloff,
-            mirror_x: c.mirror_x,
-        };
+        let dab = self.dab_at(at, moved);
         let started = Instant::now();
         match self.groom.brush(brush, &dab) {
             Ok(Some(r)) => {
@@ -243,6 +279,18 @@ impl GroomingSession {
                     r.hairs
                 );
                 self.dirty = true;
+            }
+            // A guide brush that reached no guide says so, and how far the
+            // nearest was: a dab that changes nothing is otherwise silent.
+            Ok(None) if brush.shapes_guides() => {
+                self.status = match pelage::groom::brush::nearest_guide_distance(&self.groom, at) {
+                    Some(d) => format!(
+                        "{}: no guide within the radius {:.4} (the nearest is {d:.4} away)",
+                        brush.name(),
+                        dab.radius
+                    ),
+                    None => format!("{}: the groom has no guides", brush.name()),
+                };
             }
             Ok(None) => {}
             // The window shows a refusal in its status line; a script
@@ -342,10 +390,15 @@ impl GroomingSession {
         }
         if c.guides {
             let guides = self.groom.guides().curves();
-            let widths = vec![3.0 * mean_width.max(1e-5); guides.points().len()];
+            let width = 3.0 * mean_width.max(1e-5);
+            let mut widths = vec![width; guides.points().len()];
+            let mut colors = vec![GUIDE_COLOR; guides.points().len()];
+            for &g in self.reached.iter().filter(|&&g| g < guides.curve_count()) {
+                widths[guides.range(g)].fill(2.0 * width);
+                colors[guides.range(g)].fill(REACHED_COLOR);
+            }
             let wide = Curves::new(guides.points().to_vec(), widths, guides.offsets().to_vec())?;
-            let n = wide.points().len();
-            parts.push(wide.with_colors(vec![GUIDE_COLOR; n])?);
+            parts.push(wide.with_colors(colors)?);
         }
         let curves = pelage::curves::join(parts.iter())?;
         let scene = PreviewScene {

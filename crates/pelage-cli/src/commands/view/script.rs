@@ -23,6 +23,8 @@
 //!
 //! # `pelage view fur.toml --groom`:
 //! [[step]]
+//! pointer = [500, 300]               # the guides the panel's brush would move there, highlighted
+//! [[step]]
 //! brush = { name = "comb", from = [500, 300], to = [560, 330], radius = 0.1, strength = 0.8 }
 //! [[step]]
 //! undo = 1                           # and redo = 1
@@ -71,6 +73,9 @@ pub enum Step {
     Time(f32),
     /// What a groom view draws: the panel's toggles.
     Show(ShowStep),
+    /// Move the pointer to this pixel, no button held: in the groom mode
+    /// the guides the panel's brush would move there are highlighted.
+    Pointer([f32; 2]),
     /// A brush stroke in the groom mode (`--groom`), dabs along the
     /// pixels from `from` to `to`.
     Brush(BrushStep),
@@ -251,6 +256,11 @@ impl Script {
             }
         }
         for step in &steps {
+            if let Step::Brush(b) = step {
+                check_brush_values(source, b)?;
+            }
+        }
+        for step in &steps {
             if let Step::Brush(b) = step
                 && b.dabs > MAX_STROKE_DABS
             {
@@ -276,6 +286,44 @@ impl Script {
             steps: vec![Step::Wait(frames), Step::Screenshot(screenshot)],
         }
     }
+}
+
+/// A brush step's radius, strength and layer, refused when the read
+/// script is: a dab with them would be refused at its stroke, after the
+/// steps before it had run.
+fn check_brush_values(source: &SettingsSource, b: &BrushStep) -> Result<(), GroomError> {
+    use pelage::groom::GroomErrorKind;
+    let refuse = |key: &str, kind: GroomErrorKind| {
+        Err(GroomError::new(
+            source.path.clone(),
+            None,
+            Some(format!("step.brush.{key}")),
+            kind,
+        ))
+    };
+    if let Some(r) = b.radius
+        && !(r.is_finite() && r > 0.0)
+    {
+        return refuse(
+            "radius",
+            GroomErrorKind::OutOfRange(format!("radius {r}: use a positive distance")),
+        );
+    }
+    let most = pelage::groom::brush::MAX_BRUSH_STRENGTH;
+    if let Some(s) = b.strength
+        && !(s.is_finite() && s.abs() <= most)
+    {
+        return refuse(
+            "strength",
+            GroomErrorKind::OutOfRange(format!("strength {s}: use -{most} to {most}")),
+        );
+    }
+    if let Some(layer) = &b.layer
+        && let Err(e) = pelage::groom::brush::check_layer_name(layer)
+    {
+        return refuse("layer", GroomErrorKind::Brush(e));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -349,6 +397,27 @@ quit = true
             .unwrap_err()
             .to_string();
         assert!(err.contains("shots/act.toml:2:"), "{err}");
+    }
+
+    #[test]
+    fn a_brush_step_with_a_bad_radius_strength_or_layer_is_refused_at_its_key() {
+        for (value, key) in [
+            ("radius = -0.1", "radius"),
+            ("radius = nan", "radius"),
+            ("strength = 1e30", "strength"),
+            ("layer = \"my layer\"", "layer"),
+            ("layer = \"\"", "layer"),
+        ] {
+            let text =
+                format!("[[step]]\nbrush = {{ name = \"paint\", from = [1, 2], {value} }}\n");
+            let err = parse(&text).unwrap_err();
+            assert_eq!(
+                err.at.key.as_deref(),
+                Some(&*format!("step.brush.{key}")),
+                "{value}: {err}"
+            );
+        }
+        assert!(parse("[[step]]\nbrush = { name = \"paint\", from = [1, 2], radius = 0.1, layer = \"belly_2\" }\n").is_ok());
     }
 
     #[test]
