@@ -1021,3 +1021,57 @@ fn look_grooms_write_shading_primvars_and_a_materialx_hair_material() {
     let (ok, out) = usdcheck(&[&bad_path]).unwrap();
     assert!(!ok && out.contains("reads primvar hair_redness"), "{out}");
 }
+
+#[test]
+fn grooms_without_a_look_are_bound_to_the_hair_material_shaded_by_their_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = |finish: &str| {
+        format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 200\n\
+             [guides]\ngenerate = {{ count = 20, length = 0.05 }}\n[finish]\npoints = 4\n{finish}"
+        )
+    };
+    // Red-orange hairs, a fox's: melanin fitted to the colour at each root,
+    // mostly pheomelanin. No pigment mix is as saturated as this orange:
+    // the colour it gives back is the nearest one, orange, red first.
+    let orange = "color = { root = [0.6, 0.2, 0.05], tip = [0.6, 0.2, 0.05] }\n";
+    let mut files = Vec::new();
+    for (name, finish) in [("plain", ""), ("orange", orange)] {
+        let groom = pelage::groom::Groom::from_text("fur.toml", text(finish)).unwrap();
+        let generator = groom.generator(None).unwrap();
+        let part = generator.part(0).unwrap();
+        let path = dir.path().join(format!("{name}.usda"));
+        write_curves(
+            &path,
+            [("part_0".to_string(), &part)],
+            &groom.export_for(&generator, None),
+        )
+        .unwrap();
+        let written = std::fs::read_to_string(&path).unwrap();
+        assert!(written.contains("rel material:binding"), "{name}: bound");
+        match part.shading() {
+            None => {
+                assert_eq!(name, "plain");
+                // The material's defaults, once for the prim.
+                assert!(
+                    written.contains("float[] primvars:hair_melanin = [0.8]"),
+                    "{written}"
+                );
+            }
+            Some(shading) => {
+                assert_eq!(name, "orange");
+                for (&m, &r) in shading.melanin.iter().zip(&shading.melanin_redness) {
+                    let back = pelage::groom::color_of_melanin(m, r, 0.3);
+                    let apart = (back.to_array().map(f32::ln)[0] - 0.6f32.ln()).abs();
+                    assert!(back.x > back.y && back.y > back.z && apart < 1.0, "{back}");
+                    assert!(r > 0.8, "mostly pheomelanin: {r}");
+                }
+            }
+        }
+        files.push(path);
+    }
+    // usdcheck: every primvar the material reads is on the curves.
+    if let Some((ok, out)) = usdcheck(&files) {
+        assert!(ok, "{out}");
+    }
+}

@@ -57,6 +57,13 @@ impl HairShading {
     /// The tint's attribute name.
     pub const TINT: &'static str = Self::NAMES[5];
 
+    /// The values of hairs nothing shades (no `[look]`, no colours), in
+    /// the order of [`Self::FLOAT_NAMES`], with a white tint: Cycles'
+    /// Principled Hair defaults (melanin 0.8, redness 1, roughness and
+    /// radial roughness 0.3) and a `hair_random` of 0.5. The hair
+    /// material reads these where a primvar is missing.
+    pub const DEFAULTS: [f32; 5] = [0.8, 1.0, 0.3, 0.3, 0.5];
+
     /// The values a reader found under [`Self::FLOAT_NAMES`] (in that
     /// order) and [`Self::TINT`]: `None` unless all six are there, as
     /// pelage writes them. The inverse of [`Self::floats`].

@@ -284,12 +284,29 @@ fn clip_layer(
         format!("./{}", name.unwrap_or_default())
     };
     let mut prims = 0;
+    let mut material_stitched = false;
     for run in runs {
         let Some((first_file, info)) = run.first() else {
             continue;
         };
+        // A reference keeps only targets inside the prim it references:
+        // the parts' binding to the file's hair material is authored here
+        // again, to the material the layer references too.
+        let material = crate::io::HAIR_MATERIAL_NAME;
+        let bound = info.children.iter().any(|c| c == material);
         for prim in &info.children {
+            // Every run's files hold the same material: it is stitched
+            // once, from the first run's.
+            if prim == material && material_stitched {
+                continue;
+            }
+            material_stitched |= prim == material;
             prims += 1;
+            let binding = if bound && prim.starts_with("part_") {
+                format!("        rel material:binding = </{root}/{material}>\n")
+            } else {
+                String::new()
+            };
             let assets: Vec<String> = run
                 .iter()
                 .map(|(f, _)| asset_path(&relative(&f.path)))
@@ -304,7 +321,7 @@ fn clip_layer(
                 .collect();
             let _ = write!(
                 text,
-                "    over \"{prim}\" (\n        clips = {{\n            dictionary default = {{\n                double2[] active = [{}]\n                asset[] assetPaths = [{}]\n                string primPath = \"/{root}/{prim}\"\n            }}\n        }}\n        prepend references = {}</{root}/{prim}>\n    )\n    {{\n    }}\n",
+                "    over \"{prim}\" (\n        clips = {{\n            dictionary default = {{\n                double2[] active = [{}]\n                asset[] assetPaths = [{}]\n                string primPath = \"/{root}/{prim}\"\n            }}\n        }}\n        prepend references = {}</{root}/{prim}>\n    )\n    {{\n{binding}    }}\n",
                 active.join(", "),
                 assets.join(", "),
                 asset_path(&relative(&first_file.path)),

@@ -8,6 +8,7 @@
 use super::blue_noise;
 use super::error::{GroomError, GroomErrorKind};
 use super::generator::{Generator, PartRoots};
+use super::hair_look::HairLook;
 use super::ops::{Hair, HairBatch, Operator, RootContext, Scratch};
 use super::spec::RootDistribution;
 use crate::curves::frames::{
@@ -437,14 +438,25 @@ impl Generator {
     }
 
     /// Adds what each hair's root and id alone decide: its values for a
-    /// hair shader when the groom has a `[look]`, its region when it has
-    /// `[regions]`.
+    /// hair shader (the groom's `[look]`, or without one, melanin fitted
+    /// to each root's colour when the hairs have colours), its region
+    /// when it has `[regions]`.
     pub(crate) fn with_root_values(&self, mut curves: Curves) -> Curves {
         let roots = curves.roots().expect("grown curves carry their roots");
         let regions = self.regions_at(roots);
-        if let Some(look) = &self.look {
-            let ids = curves.ids().expect("grown curves carry their ids");
-            let shading = look.shade(&self.mesh, roots, ids);
+        let ids = curves.ids().expect("grown curves carry their ids");
+        let shading = match (&self.look, curves.colors()) {
+            (Some(look), _) => Some(look.shade(&self.mesh, roots, ids)),
+            (None, Some(colors)) => {
+                let at_roots: Vec<Vec3> = curves.offsets()[..curves.curve_count()]
+                    .iter()
+                    .map(|&o| colors[o as usize])
+                    .collect();
+                Some(HairLook::fitted_to_colors(&at_roots, ids))
+            }
+            (None, None) => None,
+        };
+        if let Some(shading) = shading {
             curves = curves
                 .with_shading(shading)
                 .expect("one value a hair, each within 0 to 1 or a finite tint");

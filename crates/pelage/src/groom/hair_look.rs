@@ -9,6 +9,12 @@
 //! Values are found after a part is grown, from each hair's root and id
 //! alone, so a hair has the same values in every part, thread, preview
 //! fraction and animated frame.
+//!
+//! A groom with colours and no `[look]` is shaded by its colours
+//! ([`HairLook::fitted_to_colors`]): each hair's melanin and redness are
+//! the pigments whose absorption gives its root colour, by Chiang et al.
+//! 2016's colour-to-absorption mapping (§4.2, eq. 9) inverted over
+//! Cycles' eumelanin and pheomelanin absorptions.
 
 use crate::curves::HairShading;
 use crate::map::{Map, MapSite};
@@ -129,6 +135,92 @@ impl HairLook {
     }
 }
 
+/// Cycles' absorption coefficients of a unit concentration of eumelanin
+/// and of pheomelanin (as the hair material's network uses them).
+const EUMELANIN_SIGMA: Vec3 = Vec3::new(0.506, 0.841, 1.653);
+const PHEOMELANIN_SIGMA: Vec3 = Vec3::new(0.343, 0.733, 1.924);
+
+/// Chiang et al. 2016, eq. 9's denominator: how the absorption that
+/// gives a colour scales with the azimuthal roughness `beta`
+/// (`σ_a = (ln c / D(β))²`).
+fn color_scale(beta: f32) -> f32 {
+    5.969 - 0.215 * beta + 2.532 * beta.powi(2) - 10.73 * beta.powi(3)
+        + 5.574 * beta.powi(4)
+        + 0.245 * beta.powi(5)
+}
+
+/// The colour (linear RGB) a hair of `melanin` and `redness` (Cycles'
+/// 0–1 scales) reads as at azimuthal roughness `beta`: the inverse of
+/// [`melanin_of_color`].
+pub fn color_of_melanin(melanin: f32, redness: f32, beta: f32) -> Vec3 {
+    let concentration = -(1.0 - melanin).max(1e-4).ln();
+    let sigma = concentration * ((1.0 - redness) * EUMELANIN_SIGMA + redness * PHEOMELANIN_SIGMA);
+    let scale = color_scale(beta);
+    Vec3::from(sigma.to_array().map(|s| (-s.max(0.0).sqrt() * scale).exp()))
+}
+
+/// The melanin and redness (Cycles' 0–1 scales) whose colour at
+/// azimuthal roughness `beta` is nearest the linear colour `color`, in
+/// log colour (`ln c`, each channel within 10⁻⁶ to 1): a mix of the two
+/// pigments gives `ln c = −√(concentration · σ(redness)) · D(β)`, linear in
+/// `√concentration`, so for each redness the best concentration is a
+/// least-squares line fit; the redness is searched on a grid of 100
+/// steps, then of 0.001 around the best. Exact where a mix gives the
+/// colour; a colour none gives (a blue, an orange more saturated than
+/// pheomelanin) gets the nearest.
+pub fn melanin_of_color(color: Vec3, beta: f32) -> (f32, f32) {
+    let scale = color_scale(beta);
+    let logs = color.to_array().map(|c| c.clamp(1e-6, 1.0).ln());
+    // For redness r: the best √concentration and its squared error.
+    let fit = |r: f32| {
+        let sigma = (1.0 - r) * EUMELANIN_SIGMA + r * PHEOMELANIN_SIGMA;
+        let a = sigma.to_array().map(|s| s.sqrt() * scale);
+        let aa: f32 = a.iter().map(|x| x * x).sum();
+        let la: f32 = logs.iter().zip(&a).map(|(l, x)| l * x).sum();
+        let t = (-la / aa).max(0.0);
+        let error: f32 = logs.iter().zip(&a).map(|(l, x)| (l + t * x).powi(2)).sum();
+        (error, t)
+    };
+    let best = |steps: std::ops::RangeInclusive<i32>, step: f32, from: f32| {
+        steps
+            .map(|k| (from + k as f32 * step).clamp(0.0, 1.0))
+            .map(|r| (fit(r), r))
+            .min_by(|((x, _), _), ((y, _), _)| x.total_cmp(y))
+            .expect("a step")
+    };
+    let (_, coarse) = best(0..=100, 0.01, 0.0);
+    let ((_, t), redness) = best(-10..=10, 0.001, coarse);
+    let concentration = t * t;
+    if concentration <= 0.0 {
+        return (0.0, 0.0);
+    }
+    (unit(1.0 - (-concentration).exp()), unit(redness))
+}
+
+impl HairLook {
+    /// The values of hairs shaded by their colours, for a groom with
+    /// colours and no `[look]`: melanin and redness fitted to each root's
+    /// colour ([`melanin_of_color`]), the other values the defaults'
+    /// (a white tint, roughness and radial roughness 0.3), and
+    /// `hair_random` from each id.
+    pub fn fitted_to_colors(root_colors: &[Vec3], ids: &[u64]) -> HairShading {
+        let look = Self::default();
+        let beta = 0.3;
+        let mut out = HairShading::with_capacity(root_colors.len());
+        for (&color, &id) in root_colors.iter().zip(ids) {
+            let (melanin, redness) = melanin_of_color(color, beta);
+            out.melanin.push(melanin);
+            out.melanin_redness.push(redness);
+            out.roughness.push(0.3);
+            out.radial_roughness.push(beta);
+            out.tint.push(Vec3::ONE);
+            out.random
+                .push(SampleRng::new(look.seed ^ salts::LOOK_RANDOM, id).uniform_f32());
+        }
+        out
+    }
+}
+
 /// `v` kept within 0 to 1 (NaN reads 0).
 fn unit(v: f32) -> f32 {
     if v > 0.0 { v.min(1.0) } else { 0.0 }
@@ -137,6 +229,31 @@ fn unit(v: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn melanin_fitted_to_a_colour_gives_that_colour_back() {
+        // Every mix of the two pigments, read as a colour and fitted
+        // again: the same colour (the fit is exact where a mix exists).
+        for melanin in [0.05, 0.2, 0.5, 0.8, 0.95] {
+            for redness in [0.0, 0.3, 0.7, 1.0] {
+                let color = color_of_melanin(melanin, redness, 0.3);
+                let (m, r) = melanin_of_color(color, 0.3);
+                let back = color_of_melanin(m, r, 0.3);
+                assert!(
+                    (back - color).abs().max_element() < 2e-3,
+                    "{melanin} {redness}: {color} fitted as {m} {r}, giving {back}"
+                );
+            }
+        }
+        // A red fox's orange is mostly pheomelanin, white little of
+        // either, black a lot of eumelanin.
+        let (m, r) = melanin_of_color(Vec3::new(0.6, 0.2, 0.05), 0.3);
+        assert!(r > 0.8 && m > 0.05 && m < 0.5, "{m} {r}");
+        let (m, _) = melanin_of_color(Vec3::splat(0.9), 0.3);
+        assert!(m < 0.1, "{m}");
+        let (m, r) = melanin_of_color(Vec3::splat(0.01), 0.3);
+        assert!(m > 0.3 && r < 0.2, "{m} {r}");
+    }
 
     #[test]
     fn constants_come_through_and_jitter_stays_within_its_band() {

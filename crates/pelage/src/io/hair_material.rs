@@ -16,10 +16,11 @@
 //! The tint colours the transmitted lobes (`tint_TT`, `tint_TRT`), where
 //! Cycles adds it to the absorption: close, not equal.
 
+use crate::curves::HairShading;
 use glam::Vec3;
 
 /// The material prim's name, under the file's default prim.
-pub(crate) const MATERIAL_NAME: &str = "hair_material";
+pub const MATERIAL_NAME: &str = "hair_material";
 
 /// A prim of the network: its name, type, attributes and children.
 pub(crate) struct NetworkPrim {
@@ -148,7 +149,7 @@ fn melanin_concentration() -> Vec<NetworkPrim> {
     let float = "float";
     let out = &[("outputs:out", "float")][..];
     vec![
-        reader("melanin", "hair_melanin", 0.8),
+        reader("melanin", "hair_melanin", HairShading::DEFAULTS[0]),
         shader(
             "melanin_remaining",
             "ND_subtract_float",
@@ -190,7 +191,11 @@ fn melanin_concentration() -> Vec<NetworkPrim> {
 fn absorption() -> Vec<NetworkPrim> {
     let float = "float";
     vec![
-        reader("melanin_redness", "hair_melanin_redness", 1.0),
+        reader(
+            "melanin_redness",
+            "hair_melanin_redness",
+            HairShading::DEFAULTS[1],
+        ),
         shader(
             "absorption",
             "ND_deon_hair_absorption_from_melanin",
@@ -237,8 +242,16 @@ fn tint_and_roughness() -> Vec<NetworkPrim> {
             ],
             &[("outputs:out", "color3f")],
         ),
-        reader("longitudinal_roughness", "hair_roughness", 0.3),
-        reader("azimuthal_roughness", "hair_radial_roughness", 0.3),
+        reader(
+            "longitudinal_roughness",
+            "hair_roughness",
+            HairShading::DEFAULTS[2],
+        ),
+        reader(
+            "azimuthal_roughness",
+            "hair_radial_roughness",
+            HairShading::DEFAULTS[3],
+        ),
         shader(
             "roughness",
             "ND_chiang_hair_roughness",

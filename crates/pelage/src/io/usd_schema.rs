@@ -13,6 +13,7 @@
 
 use super::usd_options::{CurveBasis, PrimWriteError, UsdOptions, UsdWrap};
 use crate::Curves;
+use crate::curves::HairShading;
 use crate::mesh::{Mesh, Uvs};
 use glam::{Vec2, Vec3};
 use std::borrow::Cow;
@@ -264,6 +265,19 @@ pub(crate) fn basis_curves_attributes<'a>(
         attributes.push(
             UsdAttribute::new("primvars:hair_tint", "color3f[]", tint).interpolated("uniform"),
         );
+    } else if binds_hair_material(options) {
+        // Bound to the material all the same: one value for the whole
+        // prim (constant primvars), the material's defaults, so that
+        // every primvar it reads is there.
+        static DEFAULTS: [f32; 5] = HairShading::DEFAULTS;
+        for (value, name) in DEFAULTS.iter().zip(SHADING_PRIMVARS) {
+            let one = UsdValues::Floats(std::slice::from_ref(value));
+            attributes.push(UsdAttribute::new(name, "float[]", one).interpolated("constant"));
+        }
+        let tint = UsdValues::Vec3s(Cow::Owned(vec![Vec3::ONE]));
+        attributes.push(
+            UsdAttribute::new("primvars:hair_tint", "color3f[]", tint).interpolated("constant"),
+        );
     }
     if let Some(uvs) = curves.root_uvs() {
         let values = UsdValues::Vec2s(uvs);
@@ -301,7 +315,12 @@ pub(crate) fn guide_curves_attributes<'a>(
     guides: &'a Curves,
     options: &UsdOptions,
 ) -> Result<Vec<UsdAttribute<'a>>, PrimWriteError> {
-    let mut attributes = basis_curves_attributes(name, guides, options)?;
+    // Guides are not bound to the hair material: no default primvars.
+    let unbound = UsdOptions {
+        hair_material: false,
+        ..options.clone()
+    };
+    let mut attributes = basis_curves_attributes(name, guides, &unbound)?;
     attributes.push(UsdAttribute::uniform_token("purpose", "guide"));
     Ok(attributes)
 }
@@ -316,10 +335,12 @@ const SHADING_PRIMVARS: [&str; 5] = [
     "primvars:hair_random",
 ];
 
-/// Whether a part's prim is bound to the hair material: its curves carry
-/// hair-shading values and the options ask for the material.
-pub(crate) fn binds_hair_material(curves: &Curves, options: &UsdOptions) -> bool {
-    options.hair_material && curves.shading().is_some()
+/// Whether a part's prim is bound to the hair material: whenever the
+/// options ask for it. Curves without hair-shading values are shaded by
+/// the network's defaults (Cycles' Principled Hair's: a brown of melanin
+/// 0.8), not left to a renderer's grey.
+pub(crate) fn binds_hair_material(options: &UsdOptions) -> bool {
+    options.hair_material
 }
 
 /// The attributes of the skin's `Mesh` prim: triangles, vertex normals,

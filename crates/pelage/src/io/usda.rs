@@ -50,10 +50,13 @@ impl<W: Write> UsdaWriter<W> {
         };
         write!(
             out,
-            "#usda 1.0\n(\n    defaultPrim = \"{root}\"\n    doc = \"Written by pelage {version}\"\n    \
+            "#usda 1.0\n(\n    defaultPrim = \"{root}\"\n    doc = \"{doc}\"\n    \
              metersPerUnit = {mpu}\n    upAxis = \"{up}\"\n)\n\ndef Xform \"{root}\"\n{{\n",
             root = options.root,
-            version = env!("CARGO_PKG_VERSION"),
+            doc = options
+                .documentation
+                .clone()
+                .unwrap_or_else(|| format!("Written by pelage {}", env!("CARGO_PKG_VERSION"))),
             mpu = ryu::Buffer::new().format(options.meters_per_unit),
         )?;
         Ok(Self {
@@ -75,7 +78,7 @@ impl<W: Write> UsdaWriter<W> {
     /// Writes one part as a `BasisCurves` prim named `name`.
     pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         let attributes = basis_curves_attributes(name, curves, &self.options)?;
-        let bound = binds_hair_material(curves, &self.options);
+        let bound = binds_hair_material(&self.options);
         if bound && !self.material_written {
             self.claim(MATERIAL_NAME)?;
             let path = format!("/{}/{MATERIAL_NAME}", self.options.root);

@@ -94,7 +94,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
             names: HashSet::new(),
             animated: BTreeMap::new(),
             material: None,
-            documentation: None,
+            documentation: options.documentation.clone(),
         })
     }
 
@@ -108,7 +108,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
     /// Writes one part as a `BasisCurves` prim named `name`.
     pub fn write_part(&mut self, name: &str, curves: &Curves) -> Result<(), PrimWriteError> {
         let attributes = basis_curves_attributes(name, curves, &self.options)?;
-        let material = self.material_for(curves)?;
+        let material = self.material()?;
         self.write_prim_bound("BasisCurves", name, &attributes, false, material)?;
         Ok(())
     }
@@ -162,7 +162,7 @@ impl<W: Write + Seek> UsdcWriter<W> {
                 (guide_curves_attributes(name, curves, &self.options)?, None)
             } else {
                 let attributes = basis_curves_attributes(name, curves, &self.options)?;
-                (attributes, self.material_for(curves)?)
+                (attributes, self.material()?)
             };
             let specs = self.write_prim_bound("BasisCurves", name, &attributes, true, material)?;
             self.track(name, specs, curves.offsets().to_vec());
@@ -285,10 +285,10 @@ impl<W: Write + Seek> UsdcWriter<W> {
         Ok(())
     }
 
-    /// The hair material's path where `curves` are bound to it, the
-    /// material written first if it is not yet.
-    fn material_for(&mut self, curves: &Curves) -> Result<Option<u32>, PrimWriteError> {
-        if !binds_hair_material(curves, &self.options) {
+    /// The hair material's path when parts are bound to it, the material
+    /// written first if it is not yet.
+    fn material(&mut self) -> Result<Option<u32>, PrimWriteError> {
+        if !binds_hair_material(&self.options) {
             return Ok(None);
         }
         if self.material.is_none() {
