@@ -82,6 +82,14 @@ impl ConvertArgs {
 
 pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
     let curves = read_curves(&args.input).context("cannot read the curves")?;
+    // An animated file converts at its first sample: said, not silent.
+    let samples = pelage::io::curves_sample_count(&args.input).unwrap_or(1);
+    if samples > 1 {
+        eprintln!(
+            "note: {} is animated ({samples} time samples): convert writes its first; its skin, if it has one, is not converted (`--with-mesh` writes a still mesh); `pelage render --frames` and Python's read_curves(path, time=) read the others",
+            args.input.display()
+        );
+    }
     let mesh = match args.with_mesh.as_deref() {
         None => None,
         Some("spot") => Some(load_mesh(None)?),

@@ -7,7 +7,7 @@
 
 use super::animate::{AnimatedGroom, FrameOutput};
 use super::clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
-use super::farm::{FarmError, FarmRun, find_part_files};
+use super::farm::{FarmError, FarmRun, check_part_keys, find_part_files, part_documentation};
 use super::generator::Generator;
 use super::load::Groom;
 use super::output::{write_alembic_assembly, write_assembly};
@@ -28,6 +28,22 @@ impl Groom {
             hair_material: self.writes_hair_material(),
             ..UsdOptions::default()
         }
+    }
+
+    /// A key of everything a farm run's hairs come from: pelage's
+    /// version, the groom file's text, the share grown, the mesh and the
+    /// bound guides (FNV-1a over their bits). Each run writes it into its
+    /// part file; the assembly refuses a part whose key is not the
+    /// groom's (a run left from an earlier version of it).
+    pub fn farm_key(&self) -> u64 {
+        let mut key = super::simulate::Fnv1a::default();
+        key.bytes(env!("CARGO_PKG_VERSION").as_bytes());
+        key.bytes(self.source().text.as_bytes());
+        key.bytes(&self.fraction().to_le_bytes());
+        key.bytes(bytemuck::cast_slice(self.mesh().positions()));
+        key.bytes(bytemuck::cast_slice(self.mesh().triangles()));
+        key.bytes(bytemuck::cast_slice(self.guides().curves().points()));
+        key.0
     }
 
     /// What a still groom writes beside its curves: the USD options and,
@@ -51,8 +67,12 @@ impl Groom {
     /// guides`) the guide curves with their regions in the first run only,
     /// so an assembly holds one of each.
     pub fn export_for(&self, generator: &Generator, run: Option<FarmRun>) -> CurvesExport<'_> {
+        let mut usd = self.usd_options();
+        // A farm run's part file says which groom grew it, so the assembly
+        // can refuse a part left from an earlier version of the groom.
+        usd.documentation = run.map(|run| part_documentation(self.farm_key(), run));
         CurvesExport {
-            usd: self.usd_options(),
+            usd,
             mesh: self.writes_skin_in(run).then(|| self.mesh()),
             guides: self.writes_guides_in(run).then(|| generator.guide_curves()),
         }
@@ -207,6 +227,7 @@ impl Groom {
             }
             None => {
                 let files = find_part_files(output)?;
+                check_part_keys(&files, Some(self.farm_key()))?;
                 let extent = if alembic {
                     let skin = self.writes_skin().then(|| self.mesh());
                     write_alembic_assembly(output, &files, &self.usd_options(), skin)?

@@ -131,6 +131,76 @@ pub enum FarmError {
         /// Its run.
         run: FarmRun,
     },
+    /// A run's file was grown from another version of the groom than
+    /// the others, or than the groom assembling them.
+    #[error(
+        "{path} was grown from another version of the groom (groom key {found:016x}, {than} {want:016x}): grow run {run} again (`pelage groom FILE --part {run}`)"
+    )]
+    Stale {
+        /// The part file.
+        path: PathBuf,
+        /// Its run.
+        run: FarmRun,
+        /// Its key.
+        found: u64,
+        /// The key it should have.
+        want: u64,
+        /// Whose key that is: the groom's, or the first part's.
+        than: &'static str,
+    },
+}
+
+/// What a farm run's part file says of the groom that grew it (the USD
+/// layer's `documentation`, the Alembic archive's description).
+pub fn part_documentation(key: u64, run: FarmRun) -> String {
+    format!(
+        "pelage {} part {} of {}, groom key {key:016x}",
+        env!("CARGO_PKG_VERSION"),
+        run.k,
+        run.n
+    )
+}
+
+/// The groom key a part file carries, if it carries one: a file another
+/// tool or an older pelage wrote carries none, and one that cannot be
+/// read is left to the assembly, which reads it whole and says what is
+/// wrong with it.
+fn part_key(path: &Path) -> Option<u64> {
+    let text = if crate::io::CurvesFormat::from_path(path) == Some(crate::io::CurvesFormat::Abc) {
+        crate::io::read_abc_description(path).ok()?
+    } else {
+        crate::io::read_usd_layer_info(path).ok()?.documentation
+    };
+    let text = text?;
+    let (_, hex) = text.split_once("groom key ")?;
+    u64::from_str_radix(hex.trim(), 16).ok()
+}
+
+/// Refuses part files (in run order) grown from different versions of a
+/// groom: every key must be `groom`'s when it is known, else the first
+/// part's. Parts without a key are let through.
+pub fn check_part_keys(files: &[PathBuf], groom: Option<u64>) -> Result<(), FarmError> {
+    let n = files.len();
+    let mut want = groom.map(|k| (k, "the groom's is"));
+    for (k, path) in files.iter().enumerate() {
+        let Some(found) = part_key(path) else {
+            continue;
+        };
+        match want {
+            None => want = Some((found, "the first part's is")),
+            Some((want, than)) if want != found => {
+                return Err(FarmError::Stale {
+                    path: path.clone(),
+                    run: FarmRun { k: k + 1, n },
+                    found,
+                    want,
+                    than,
+                });
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(())
 }
 
 /// The part files of one farm run of `output` (`NAME.part-K-of-N.EXT`

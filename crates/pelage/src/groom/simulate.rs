@@ -197,7 +197,7 @@ pub fn simulation_key(
 
 /// FNV-1a, 64 bits: small, stable across platforms and versions of Rust
 /// (unlike `std`'s hasher), which a key written to a file needs.
-struct Fnv1a(u64);
+pub(crate) struct Fnv1a(pub(crate) u64);
 
 impl Default for Fnv1a {
     fn default() -> Self {
@@ -206,7 +206,7 @@ impl Default for Fnv1a {
 }
 
 impl Fnv1a {
-    fn bytes(&mut self, bytes: &[u8]) {
+    pub(crate) fn bytes(&mut self, bytes: &[u8]) {
         for &b in bytes {
             self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
         }

@@ -118,6 +118,20 @@ pub fn read_curves(path: &Path) -> Result<Curves, CurvesReadError> {
     }
 }
 
+/// How many times a curves file samples its curves: 1 for a still file
+/// (PLY, .hair, a USD or Alembic file without time samples), the count
+/// for an animated USD or Alembic file, of which [`read_curves`] reads
+/// the first.
+pub fn curves_sample_count(path: &Path) -> Result<usize, CurvesReadError> {
+    Ok(match CurvesFormat::from_path(path) {
+        Some(CurvesFormat::Usda | CurvesFormat::Usdc) => {
+            super::UsdCurvesSequence::open(path)?.times().len().max(1)
+        }
+        Some(CurvesFormat::Abc) => super::read_abc_sample_count(path)?.max(1),
+        _ => 1,
+    })
+}
+
 /// How [`write_curves`] writes.
 #[derive(Debug, Clone, Default)]
 pub struct CurvesExport<'a> {

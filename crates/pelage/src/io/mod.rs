@@ -25,6 +25,7 @@ mod curves_file;
 mod curves_ply;
 mod hair;
 mod hair_material;
+pub use hair_material::MATERIAL_NAME as HAIR_MATERIAL_NAME;
 mod mesh_file;
 mod points_ply;
 mod read_error;
@@ -38,13 +39,15 @@ mod usdc;
 
 pub use abc::{
     AbcCurvesObject, AbcWriter, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at,
-    read_abc_objects,
+    read_abc_description, read_abc_objects, read_abc_sample_count,
 };
 pub use atomic::{
     AtomicFile, check_free_space, check_input, check_output, check_writable, note_input,
     protect_inputs, remove_temporary_files, write_atomically, write_atomically_with,
 };
-pub use curves_file::{CurvesExport, CurvesFormat, read_curves, write_curves, write_streamed};
+pub use curves_file::{
+    CurvesExport, CurvesFormat, curves_sample_count, read_curves, write_curves, write_streamed,
+};
 pub use curves_ply::{read_curves_ply, write_curves_ply};
 pub use hair::{HairFile, HairWriteError};
 pub(crate) use mesh_file::usd_mesh_error;

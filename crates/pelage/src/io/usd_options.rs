@@ -90,6 +90,11 @@ pub struct UsdOptions {
     /// Bind curves that carry hair-shading values to a MaterialX hair
     /// material written beside them (`hair_material`).
     pub hair_material: bool,
+    /// The layer's `documentation` (USD) or the archive's description
+    /// (Alembic), in place of "Written by pelage VERSION": what a farm
+    /// run's part file says of the groom that grew it. Plain text, no
+    /// `;`, `=` or `"`.
+    pub documentation: Option<String>,
 }
 
 impl Default for UsdOptions {
@@ -102,6 +107,7 @@ impl Default for UsdOptions {
             root: "groom".into(),
             time_codes_per_second: 24.0,
             hair_material: true,
+            documentation: None,
         }
     }
 }

@@ -4,8 +4,11 @@
 //!
 //! Text layers are parsed by the `openusd` crate (pure Rust), binary ones
 //! by pelage's checked crate reader (`usdc::read`) into openusd's layer
-//! type. Only the file's own layer is read: references, payloads and
-//! sublayers are not followed. Animated attributes are read at their first
+//! type. Only the file's own layer is read, except a layer with no curves
+//! of its own whose prims reference files (pelage's farm assembly): those
+//! files' curves are read, in path order. Payloads, sublayers, references
+//! of a layer with curves, and transforms above a reference are not
+//! followed. Animated attributes are read at their first
 //! time sample (the first frame). Widths are read as
 //! `vertex` (or `varying` on linear curves), `uniform` or `constant`;
 //! curves without widths get [`DEFAULT_WIDTH`].
@@ -30,8 +33,70 @@ pub fn read_usd_curves(path: &Path) -> Result<Curves, CurvesReadError> {
 /// first and after the last, as USD does); `None` reads the first sample.
 /// Everything else is read as [`read_usd_curves`] reads it.
 pub fn read_usd_curves_at(path: &Path, time: Option<f64>) -> Result<Curves, CurvesReadError> {
+    read_usd_curves_within(path, time, 0)
+}
+
+/// How many layers deep references are followed (a farm assembly is one;
+/// a loop of references stops here).
+const MOST_REFERENCE_DEPTH: usize = 4;
+
+/// [`read_usd_curves_at`] of a layer `depth` references below the file
+/// asked for.
+fn read_usd_curves_within(
+    path: &Path,
+    time: Option<f64>,
+    depth: usize,
+) -> Result<Curves, CurvesReadError> {
     let data = open_layer_with(path, time.is_some())?;
-    curves_from_layer(path, data.as_ref(), time)
+    let data = data.as_ref();
+    if !curve_prims(data).is_empty() {
+        return curves_from_layer(path, data, time);
+    }
+    let files = referenced_files(path, data);
+    if files.is_empty() || depth >= MOST_REFERENCE_DEPTH {
+        return curves_from_layer(path, data, time);
+    }
+    let mut parts = Vec::with_capacity(files.len());
+    for file in &files {
+        if !file.exists() {
+            return Err(CurvesReadError::whole(
+                path,
+                Kind::Inconsistent(format!(
+                    "it references {}, which is not there",
+                    file.display()
+                )),
+            ));
+        }
+        parts.push(read_usd_curves_within(file, time, depth + 1)?);
+    }
+    crate::curves::join(parts.iter())
+        .map_err(|e| CurvesReadError::whole(path, Kind::Inconsistent(e.to_string())))
+}
+
+/// The files `data`'s prims reference (`references` with an asset path),
+/// in prim path order, relative to `path`'s folder: a farm assembly's part
+/// files.
+fn referenced_files(path: &Path, data: &dyn AbstractData) -> Vec<std::path::PathBuf> {
+    let folder = crate::io::folder_of(path);
+    let mut prims: Vec<sdf::Path> = data
+        .spec_paths()
+        .into_iter()
+        .filter(|p| data.spec_type(p) == Some(SpecType::Prim))
+        .collect();
+    prims.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+    let mut files = Vec::new();
+    for prim in &prims {
+        if let Ok(Some(value)) = data.try_field(prim, "references")
+            && let Value::ReferenceListOp(list) = value.as_ref()
+        {
+            files.extend(
+                list.iter()
+                    .filter(|r| !r.asset_path.is_empty())
+                    .map(|r| folder.join(&r.asset_path)),
+            );
+        }
+    }
+    files
 }
 
 /// [`read_usd_curves`] of a usda or usdc file's bytes held in memory (a

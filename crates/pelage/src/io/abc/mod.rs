@@ -23,7 +23,8 @@ mod ogawa;
 mod read;
 
 pub use read::{
-    AbcCurvesObject, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at, read_abc_objects,
+    AbcCurvesObject, abc_curves_from_bytes, read_abc_curves, read_abc_curves_at,
+    read_abc_description, read_abc_objects, read_abc_sample_count,
 };
 
 use super::usd_options::check_name;
@@ -766,8 +767,13 @@ impl<W: Write + Seek> AbcWriter<W> {
             }
         }
         let metadata = format!(
-            "_ai_AlembicVersion=Alembic 1.8.0 (written by pelage {v});_ai_Application=pelage {v};_ai_Description=hair curves",
-            v = env!("CARGO_PKG_VERSION")
+            "_ai_AlembicVersion=Alembic 1.8.0 (written by pelage {v});_ai_Application=pelage {v};_ai_Description={d}",
+            v = env!("CARGO_PKG_VERSION"),
+            d = self
+                .options
+                .documentation
+                .as_deref()
+                .unwrap_or("hair curves"),
         );
         let root = [
             self.ogawa.data(&[&OGAWA_FILE_VERSION.to_le_bytes()])?,

@@ -143,6 +143,20 @@ impl<'a> Ogawa<'a> {
     }
 
     /// A group's children.
+    /// The file and its archive's six top parts (objects, metadata, time
+    /// samplings, indexed metadata, …), checked to be six.
+    fn archive(bytes: &'a [u8], path: &'a Path) -> Result<(Self, Vec<Child>), CurvesReadError> {
+        let (file, root) = Self::open(bytes, path)?;
+        let top = file.group(root, "the archive")?;
+        if top.len() < 6 {
+            return Err(file.fail(
+                root,
+                format!("the archive has {} parts; Alembic has 6", top.len()),
+            ));
+        }
+        Ok((file, top))
+    }
+
     fn group(&self, child: Child, what: &str) -> Result<Vec<Child>, CurvesReadError> {
         if child & EMPTY_DATA != 0 {
             return Err(self.fail(
@@ -499,19 +513,40 @@ fn abc_parts_from_bytes(
         .collect())
 }
 
+/// The most time samples any property of the archive has (1, or 0, for a
+/// still archive): whether reading it at one time leaves others out.
+pub fn read_abc_sample_count(path: &Path) -> Result<usize, CurvesReadError> {
+    let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
+    let (file, top) = Ogawa::archive(&bytes, path)?;
+    let samplings = time_samplings(file.data(top[4], "the time samplings")?).ok_or_else(|| {
+        file.fail(
+            top[4] & !EMPTY_DATA,
+            "the time samplings are cut short".into(),
+        )
+    })?;
+    Ok(samplings
+        .iter()
+        .map(|s| s.max_sample as usize)
+        .max()
+        .unwrap_or(0))
+}
+
+/// The archive's description (`_ai_Description` of its metadata), when
+/// it has one: what a farm run's part file says of the groom that grew
+/// it.
+pub fn read_abc_description(path: &Path) -> Result<Option<String>, CurvesReadError> {
+    let bytes = std::fs::read(path).map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
+    let (file, top) = Ogawa::archive(&bytes, path)?;
+    let metadata = String::from_utf8_lossy(file.data(top[3], "the archive's metadata")?);
+    Ok(metadata_value(&metadata, "_ai_Description").map(str::to_string))
+}
+
 fn abc_objects_from_bytes(
     bytes: &[u8],
     path: &Path,
     seconds: Option<f64>,
 ) -> Result<Vec<AbcCurvesObject>, CurvesReadError> {
-    let (file, root) = Ogawa::open(bytes, path)?;
-    let top = file.group(root, "the archive")?;
-    if top.len() < 6 {
-        return Err(file.fail(
-            root,
-            format!("the archive has {} parts; Alembic has 6", top.len()),
-        ));
-    }
+    let (file, top) = Ogawa::archive(bytes, path)?;
     let mut indexed = vec![String::new()];
     let block = file.data(top[5], "the indexed metadata")?;
     let mut f = Fields {
@@ -710,6 +745,8 @@ fn read_xform(
 /// (seconds). Acyclic samplings list every time.
 #[derive(Debug, Clone)]
 struct TimeSampling {
+    /// The most samples a property of this sampling has.
+    max_sample: u32,
     per_cycle: f64,
     times: Vec<f64>,
 }
@@ -770,7 +807,7 @@ fn time_samplings(block: &[u8]) -> Option<Vec<TimeSampling>> {
         Some(bytes)
     };
     while at < block.len() {
-        take(&mut at, 4)?; // max sample
+        let max_sample = u32::from_le_bytes(take(&mut at, 4)?.try_into().ok()?);
         let per_cycle = f64::from_le_bytes(take(&mut at, 8)?.try_into().ok()?);
         let n = u32::from_le_bytes(take(&mut at, 4)?.try_into().ok()?) as usize;
         if n > (block.len() - at) / 8 {
@@ -779,7 +816,11 @@ fn time_samplings(block: &[u8]) -> Option<Vec<TimeSampling>> {
         let times = (0..n)
             .map(|_| Some(f64::from_le_bytes(take(&mut at, 8)?.try_into().ok()?)))
             .collect::<Option<Vec<f64>>>()?;
-        out.push(TimeSampling { per_cycle, times });
+        out.push(TimeSampling {
+            max_sample,
+            per_cycle,
+            times,
+        });
     }
     Some(out)
 }
