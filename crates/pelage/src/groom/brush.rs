@@ -676,9 +676,17 @@ pub fn height_above_skin(mesh: &Mesh, bvh: &TriangleBvh, p: Vec3) -> f32 {
 }
 
 /// Lifts every point laid below the skin to it, keeping segment lengths:
-/// the segment is turned toward the lifted point and laid again.
+/// the segment is turned toward the lifted point and laid again, and
+/// every point after it follows at its length (follow-the-leader), so the
+/// segment after a lifted point keeps its length too. Points before the
+/// first lift keep every bit.
 fn keep_above(guide: &mut [Vec3], mesh: &Mesh, bvh: &TriangleBvh, lengths: &[f32]) {
+    let mut moved = false;
     for k in 1..guide.len() {
+        if moved {
+            let direction = (guide[k] - guide[k - 1]).normalize_or(Vec3::Y);
+            guide[k] = guide[k - 1] + direction * lengths[k - 1];
+        }
         for _ in 0..4 {
             let p = guide[k];
             let Some(hit) = bvh.closest(p) else {
@@ -694,6 +702,7 @@ fn keep_above(guide: &mut [Vec3], mesh: &Mesh, bvh: &TriangleBvh, lengths: &[f32
             let target = p + normal * (lift - height);
             let direction = (target - guide[k - 1]).normalize_or(normal);
             guide[k] = guide[k - 1] + direction * lengths[k - 1];
+            moved = true;
         }
     }
 }

@@ -18,6 +18,7 @@
 mod image;
 mod noise;
 mod spec;
+pub use spec::image_path_in_spec;
 mod udim;
 mod vertex;
 

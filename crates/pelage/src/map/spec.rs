@@ -15,6 +15,36 @@ use super::{
 };
 use std::path::Path;
 
+/// The image file a map spec names and the suffixes after it
+/// (`("fur.png", ":r:clamp")`), for a spec of an image or of UDIM tiles;
+/// `None` for a number, noise or a vertex map.
+pub fn image_path_in_spec(spec: &str) -> Option<(&str, &str)> {
+    let spec = spec.trim();
+    if spec.is_empty()
+        || spec.parse::<f32>().is_ok()
+        || spec.starts_with("vertex:")
+        || spec == "noise"
+        || spec.starts_with("noise:")
+    {
+        return None;
+    }
+    let mut path = spec;
+    let (mut channel, mut wrap, mut filter) = (false, false, false);
+    while let Some((head, suffix)) = path.rsplit_once(':') {
+        if !channel && Channel::parse(suffix).is_some() {
+            channel = true;
+        } else if !wrap && Wrap::parse(suffix).is_some() {
+            wrap = true;
+        } else if !filter && Filter::parse(suffix).is_some() {
+            filter = true;
+        } else {
+            break;
+        }
+        path = head;
+    }
+    Some((path, &spec[path.len()..]))
+}
+
 impl Map {
     /// Parses a map spec; image paths are relative to the working folder.
     pub fn parse(spec: &str) -> Result<Map, MapError> {

@@ -63,8 +63,9 @@ impl EditableGroom {
     /// from: every setting is kept from it except the guides, the layers,
     /// and the density and regions maps when they are paint layers. A
     /// relative mesh path is rewritten when the file moves to another
-    /// folder; other relative paths in it (image maps) are kept as
-    /// written. Without `original`, a groom file of the session's own
+    /// folder, and so are relative image maps (in `[roots]`, the
+    /// operators, `[finish]`, `[look]` and `[regions]`) whose file is
+    /// there. Without `original`, a groom file of the session's own
     /// settings that groom files can hold is written (mesh, roots,
     /// guides, interpolation by name, regions).
     pub fn save(
@@ -155,6 +156,14 @@ impl EditableGroom {
             Some(p) => mesh.insert("layers".into(), name_of(p).into()),
             None => mesh.remove("layers"),
         };
+        // Image maps: their files, named from the new folder.
+        if let Some(source) = original.filter(|_| moved) {
+            for name in ["roots", "ops", "finish", "look", "regions"] {
+                if let Some(value) = table.get_mut(name) {
+                    rebase_image_maps(value, source.folder());
+                }
+            }
+        }
         table.insert("mesh".into(), mesh.into());
         // [guides]: the file just written.
         let mut guides = toml::Table::new();
@@ -197,6 +206,37 @@ impl EditableGroom {
             layers: layers_path,
             mesh: mesh_path,
         })
+    }
+}
+
+/// Every image map in `value` (a string, or strings in its tables and
+/// arrays) whose relative path names a file in `from` made absolute, so
+/// a groom file saved elsewhere still finds it.
+fn rebase_image_maps(value: &mut toml::Value, from: &Path) {
+    match value {
+        toml::Value::String(spec) => {
+            if let Some((path, suffixes)) = crate::map::image_path_in_spec(spec)
+                && Path::new(path).is_relative()
+            {
+                let file = from.join(path);
+                let tiles = path.contains(crate::map::UDIM_TOKEN);
+                if tiles || file.is_file() {
+                    let folder = file
+                        .parent()
+                        .map(|f| f.canonicalize().unwrap_or(f.to_path_buf()));
+                    let absolute = match (folder, file.file_name()) {
+                        (Some(folder), Some(name)) => folder.join(name),
+                        _ => file.clone(),
+                    };
+                    *spec = format!("{}{suffixes}", absolute.to_string_lossy());
+                }
+            }
+        }
+        toml::Value::Array(items) => items.iter_mut().for_each(|v| rebase_image_maps(v, from)),
+        toml::Value::Table(table) => table
+            .iter_mut()
+            .for_each(|(_, v)| rebase_image_maps(v, from)),
+        _ => {}
     }
 }
 
