@@ -948,3 +948,41 @@ fn guides_of_one_point_each_are_said_to_be_too_short_not_too_far() {
     assert!(e.to_string().contains("fewer than two points"), "{e}");
     assert!(!e.to_string().contains("tolerance"), "{e}");
 }
+
+#[test]
+fn a_gltf_skins_base_colour_texture_colours_the_fur_by_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let fox = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/fox/Fox.gltf");
+    std::fs::write(dir.path().join("fox.png"), pelage::assets::FOX_TEXTURE_PNG).unwrap();
+    let text = |mesh: &str, finish: &str| {
+        format!(
+            "[mesh]\npath = {fox:?}\n{mesh}[roots]\ncount = 500\n\
+             [guides]\ngenerate = {{ count = 30, length = 5.0 }}\n[finish]\npoints = 4\n{finish}"
+        )
+    };
+    let grow = |text: String| {
+        let groom = pelage::groom::Groom::from_text(dir.path().join("fox.toml"), text).unwrap();
+        groom.generator(None).unwrap().part(0).unwrap()
+    };
+    // No colour given: the glTF material's baseColorTexture at each root,
+    // as the same texture named by hand colours it.
+    let by_default = grow(text("", ""));
+    let named = grow(text(
+        "",
+        "color = { root = [\"fox.png:r\", \"fox.png:g\", \"fox.png:b\"], tip = [\"fox.png:r\", \"fox.png:g\", \"fox.png:b\"] }\n",
+    ));
+    let (a, b) = (by_default.colors().unwrap(), named.colors().unwrap());
+    assert_eq!(a.len(), b.len());
+    assert!(
+        a.iter()
+            .zip(b)
+            .all(|(x, y)| (*x - *y).abs().max_element() < 1e-6)
+    );
+    // The fox is orange and white: not one grey.
+    let spread =
+        a.iter().fold(Vec3::ZERO, |m, c| m.max(*c)) - a.iter().fold(Vec3::ONE, |m, c| m.min(*c));
+    assert!(spread.max_element() > 0.3, "{spread}");
+    // Turned off, the hairs have no colour of their own.
+    let plain = grow(text("base_color = false\n", ""));
+    assert!(plain.colors().is_none());
+}

@@ -937,3 +937,46 @@ fn the_first_paint_dab_reports_no_more_regrown_hairs_than_the_groom_has() {
         r.hairs
     );
 }
+
+#[test]
+fn a_painted_animated_groom_saves_a_file_that_grows_and_simulates_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let fox = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/fox/Fox.gltf");
+    for mode in ["deform", "simulate"] {
+        let groom_file = dir.path().join(format!("{mode}.toml"));
+        std::fs::write(
+            &groom_file,
+            format!(
+                "[mesh]\npath = {fox:?}\n[roots]\ncount = 400\n\
+                 [guides]\ngenerate = {{ count = 30, length = 5.0 }}\n\
+                 [animation]\nframes = \"1-3\"\nclip = \"Run\"\nmode = \"{mode}\"\n"
+            ),
+        )
+        .unwrap();
+        let loaded = pelage::groom::Groom::load(&groom_file).unwrap();
+        let mut groom = EditableGroom::new(loaded.spec().unwrap(), 1.0).unwrap();
+        groom
+            .brush(
+                &Brush::Paint {
+                    layer: "density".into(),
+                    value: 0.0,
+                },
+                &dab(root(&groom, 3), 8.0),
+            )
+            .unwrap()
+            .unwrap();
+        let saved = groom
+            .save(
+                &dir.path().join(format!("{mode}_groomed.toml")),
+                Some(loaded.source()),
+            )
+            .unwrap();
+        let again = pelage::groom::Groom::load(&saved.groom).unwrap();
+        let animated = again.animated(None).unwrap().expect("still animated");
+        let frame = animated.part(0, 2.0).unwrap();
+        assert!(frame.curve_count() > 0, "{mode}");
+        if mode == "simulate" {
+            again.simulated_guides().unwrap();
+        }
+    }
+}

@@ -393,6 +393,10 @@ pub struct MeshSection {
     /// properties become the mesh's paint layers (`vertex:NAME` maps),
     /// after subdivision; it must have the same vertex count.
     pub layers: Option<Spanned<String>>,
+    /// Fur takes the mesh's base colour texture (a glTF material's
+    /// `baseColorTexture`) at its root when `[finish]` gives no colour.
+    #[serde(default = "default_true")]
+    pub base_color: bool,
 }
 
 impl MeshSection {

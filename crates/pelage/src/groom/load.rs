@@ -19,6 +19,7 @@ use crate::anim::{AnimatedSkin, FrameRange, SkinOptions};
 use crate::dynamics::{GuideStrandParams, Wind};
 use crate::guides::{BindReport, CombMap, GuideGrowth, Guides};
 use crate::interp::{InterpolationMethod, StyleMeshOptions};
+use crate::map::Map;
 use crate::mesh::{Mesh, MeshError, MeshErrorKind};
 use crate::sample::SampleError;
 use crate::settings::SettingsSource;
@@ -34,6 +35,9 @@ pub struct Groom {
     source: SettingsSource,
     file: GroomFile,
     mesh: Arc<Mesh>,
+    /// The mesh file's base colour texture, as red, green and blue maps:
+    /// the hairs' colour when `[finish]` gives none.
+    skin_colors: Option<[Map; 3]>,
     guides: Arc<Guides>,
     bind_report: Option<BindReport>,
     animation: Option<LoadedAnimation>,
@@ -247,10 +251,15 @@ impl Groom {
             }
             _ => None,
         };
+        let skin_colors = match &file.mesh {
+            Some(section) if !mesh_is_value && section.base_color => skin_colors(&source, section)?,
+            _ => None,
+        };
         Ok(Self {
             source,
             file,
             mesh,
+            skin_colors,
             guides: Arc::new(guides),
             bind_report,
             animation,
@@ -638,17 +647,17 @@ impl Groom {
             &file.finish.width,
             &mut SpecReader::new(source, &self.mesh, lines, "finish.width".into()),
         )?;
-        let color = file
-            .finish
-            .color
-            .as_ref()
-            .map(|c| {
-                Color::read(
-                    c,
-                    &mut SpecReader::new(source, &self.mesh, lines, "finish.color".into()),
-                )
-            })
-            .transpose()?;
+        let color = match &file.finish.color {
+            Some(c) => Some(Color::read(
+                c,
+                &mut SpecReader::new(source, &self.mesh, lines, "finish.color".into()),
+            )?),
+            // The skin's own colours, root to tip.
+            None => self
+                .skin_colors
+                .clone()
+                .map(|maps| Color::new(maps.clone(), maps)),
+        };
         let opacity = file
             .finish
             .opacity
@@ -781,6 +790,37 @@ impl Groom {
         }
         Generator::new(spec)
     }
+}
+
+/// The red, green and blue of the base colour texture of the mesh file a
+/// `[mesh]` section names (a glTF's), when it has one; a texture that
+/// cannot be read is an error at `mesh.path`.
+fn skin_colors(
+    source: &SettingsSource,
+    section: &MeshSection,
+) -> Result<Option<[Map; 3]>, GroomError> {
+    if section.path.get_ref() == "spot" {
+        return Ok(None);
+    }
+    let path = source.folder().join(section.path.get_ref());
+    let at_path = |kind| source.error_at(section.path.span(), kind);
+    let Some(image) =
+        crate::mesh::base_color_texture(&path).map_err(|e| at_path(GroomErrorKind::Mesh(e)))?
+    else {
+        return Ok(None);
+    };
+    let name = format!("{}'s base colour texture", path.display());
+    let channel = |c| {
+        crate::map::ImageMap::from_image(&name, &image, c, crate::map::Wrap::Repeat)
+            .map(Map::Image)
+            .map_err(|e| at_path(GroomErrorKind::Map(e)))
+    };
+    use crate::map::Channel;
+    Ok(Some([
+        channel(Channel::R)?,
+        channel(Channel::G)?,
+        channel(Channel::B)?,
+    ]))
 }
 
 /// The mesh a `[mesh]` section names, subdivided as asked, with its paint

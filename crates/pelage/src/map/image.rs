@@ -310,7 +310,7 @@ impl ImageMap {
         Self::from_image(name, &decoded, channel, wrap)
     }
 
-    fn from_image(
+    pub(crate) fn from_image(
         name: &str,
         decoded: &image::DynamicImage,
         channel: Channel,

@@ -22,6 +22,49 @@ pub(crate) fn parse(name: &str, bytes: &[u8], base: Option<&Path>) -> Result<Mes
     parse_with_sources(name, bytes, base).map(|parsed| parsed.mesh)
 }
 
+/// The base colour texture of the first material a triangle primitive of
+/// the glTF uses that has one (`pbrMetallicRoughness.baseColorTexture`),
+/// decoded; `None` when no material has one. `base` is the folder
+/// external buffers and images are resolved against.
+pub(crate) fn base_color_image(
+    name: &str,
+    bytes: &[u8],
+    base: &Path,
+) -> Result<Option<image::DynamicImage>, MeshError> {
+    let whole = |msg: String| MeshError::whole(name, MeshErrorKind::Syntax(msg));
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| whole(format!("not a readable glTF file: {e}")))?;
+    validate(&gltf.document).map_err(whole)?;
+    let Some(texture) = gltf
+        .document
+        .meshes()
+        .flat_map(|m| m.primitives().collect::<Vec<_>>())
+        .filter_map(|p| p.material().pbr_metallic_roughness().base_color_texture())
+        .map(|info| info.texture())
+        .next()
+    else {
+        return Ok(None);
+    };
+    let buffers = gltf::import_buffers(&gltf.document, Some(base), gltf.blob.clone())
+        .map_err(|e| whole(format!("cannot load the glTF's buffers: {e}")))?;
+    let data = gltf::image::Data::from_source(texture.source().source(), Some(base), &buffers)
+        .map_err(|e| whole(format!("cannot read its base colour texture: {e}")))?;
+    let (w, h) = (data.width, data.height);
+    let image = match data.format {
+        gltf::image::Format::R8G8B8A8 => {
+            image::RgbaImage::from_raw(w, h, data.pixels).map(image::DynamicImage::ImageRgba8)
+        }
+        gltf::image::Format::R8G8B8 => {
+            image::RgbImage::from_raw(w, h, data.pixels).map(image::DynamicImage::ImageRgb8)
+        }
+        gltf::image::Format::R8 => {
+            image::GrayImage::from_raw(w, h, data.pixels).map(image::DynamicImage::ImageLuma8)
+        }
+        _ => None,
+    };
+    Ok(image)
+}
+
 /// A glTF read as one mesh, with what skinning it again needs: the
 /// document, its buffers, and where each welded vertex came from.
 pub(crate) struct ParsedGltf {

@@ -20,6 +20,28 @@
 mod closest;
 mod error;
 pub(crate) mod gltf;
+
+/// The base colour texture of a glTF or GLB file's first textured
+/// material, decoded (`None` for other formats, or a glTF without one):
+/// what fur takes its colour from when a groom gives none.
+pub fn base_color_texture(
+    path: &std::path::Path,
+) -> Result<Option<image::DynamicImage>, MeshError> {
+    let name = path.display().to_string();
+    let is_gltf = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+    if !is_gltf {
+        return Ok(None);
+    }
+    let bytes = std::fs::read(path).map_err(|e| MeshError::whole(&name, MeshErrorKind::Io(e)))?;
+    gltf::base_color_image(
+        &name,
+        &bytes,
+        path.parent().unwrap_or(std::path::Path::new(".")),
+    )
+}
 mod graph;
 pub(crate) mod obj;
 pub(crate) mod ply;
