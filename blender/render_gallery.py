@@ -20,7 +20,8 @@ density painted as a vertex group (none on the face), and face sets,
 one a side, as the parting. With ``--fox`` the surface is the Khronos Fox
 imported with Blender's glTF importer, posed at frame 9 of its Walk, with
 the Short preset grown on it at that frame: the fur is grown on the rest
-pose and carried to the pose by Deform Curves on Surface
+pose and carried to the pose by Deform Curves on Surface, and takes its
+colour (and pigment) from the fox's own texture, Colour from Skin
 (docs/gallery/blender-fox-posed.png).
 """
 
@@ -61,7 +62,6 @@ if posed_fox:
     bpy.context.view_layer.objects.active = fox
     fox.pelage_fur.preset = "SHORT"
     fox.pelage_fur.count = 150_000
-    fox.pelage_fur.melanin, fox.pelage_fur.melanin_redness = 0.45, 0.95
     assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
     fur = [o for o in bpy.data.objects if o.type == "CURVES" and o.parent == fox][0]
     # Framed from the side on the posed fox's bounds, in its world.

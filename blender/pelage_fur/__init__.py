@@ -222,6 +222,10 @@ class PelageFurSettings(bpy.types.PropertyGroup):
     roughness: FloatProperty(update=_setting_changed, name="Roughness", description="Longitudinal roughness: how far highlights spread along hairs", default=0.3, min=0.0, max=1.0)
     radial_roughness: FloatProperty(update=_setting_changed, name="Radial Roughness", description="Azimuthal roughness: how far light spreads around hairs", default=0.3, min=0.0, max=1.0)
     look_jitter: FloatProperty(update=_setting_changed, name="Variation", description="Per-hair variation of pigment and roughness, a fraction", default=0.1, min=0.0, max=1.0)
+    skin_color: BoolProperty(update=_setting_changed, name="Colour from Skin",
+                             description="When the mesh's material takes its Base Color from an image, the fur takes "
+                                         "its colour there at each root, and its pigment from that colour (the look's "
+                                         "melanin and redness are not used)", default=True)
 
 
 def surface_of(context):
@@ -692,8 +696,14 @@ class PELAGE_PT_fur(bpy.types.Panel):
         look = layout.column(align=True)
         look.enabled = not settings.groom_file
         look.label(text="Look (Principled Hair BSDF)")
+        skin_image = fur.skin_color_image(surface_of(context))
+        if skin_image is not None:
+            look.prop(settings, "skin_color", text=f"Colour from Skin ({skin_image})")
+        from_skin = skin_image is not None and settings.skin_color
         for name in ("melanin", "melanin_redness", "roughness", "radial_roughness", "look_jitter"):
-            look.prop(settings, name)
+            row = look.row()
+            row.enabled = not from_skin
+            row.prop(settings, name)
         if not surface_of(context).data.uv_layers:
             # Pelage grows without UVs (object-space noise, vertex maps);
             # Blender's deformer is what needs them.

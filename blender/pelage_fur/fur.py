@@ -199,15 +199,16 @@ def png16(path, rows):
                 + chunk(b"IEND", b""))
 
 
-def blender_image_map(value, folder=None, relative=False):
+def blender_image_map(value, folder=None, relative=False, linear=False):
     """A map as pelage reads it: ``image:NAME[:SUFFIX...]`` names a Blender
     image (saved, packed, or painted and never saved), written from its
     pixels as a 16-bit PNG into ``folder`` (default ``image_folder()``)
     and named by its path (its file name when ``relative``) with the same
     suffixes; lists are resolved item by item; any other value as it
-    is."""
+    is. With ``linear``, an sRGB image's colour is decoded to linear
+    first (a colour, not data), into a file of its own."""
     if isinstance(value, list):
-        return [blender_image_map(v, folder, relative) for v in value]
+        return [blender_image_map(v, folder, relative, linear) for v in value]
     if not isinstance(value, str) or not value.startswith(IMAGE_PREFIX):
         return value
     import os
@@ -230,7 +231,13 @@ def blender_image_map(value, folder=None, relative=False):
     image.pixels.foreach_get(pixels)
     # Blender's first row of pixels is the image's bottom.
     rows = pixels.reshape(height, width, 4)[::-1]
-    file_name = "".join(c if c.isalnum() or c in "-_." else "_" for c in name) + ".png"
+    decode = linear and image.colorspace_settings.name == "sRGB"
+    if decode:
+        rgb = np.clip(rows[:, :, :3], 0.0, 1.0)
+        rows = rows.copy()
+        rows[:, :, :3] = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+    stem = "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
+    file_name = stem + ("-linear" if decode else "") + ".png"
     folder = folder or image_folder()
     png16(os.path.join(folder, file_name), rows)
     target = file_name if relative else os.path.join(folder, file_name)
@@ -321,8 +328,28 @@ def slider_ops(settings):
     return ops
 
 
+def skin_color_image(obj):
+    """The name of the Blender image the first material of ``obj`` takes
+    its Base Color from (a Principled BSDF's Base Color linked from an
+    Image Texture node), or None."""
+    for slot in getattr(obj, "material_slots", ()):
+        material = slot.material
+        if material is None or material.node_tree is None:
+            continue
+        for node in material.node_tree.nodes:
+            if node.type != "BSDF_PRINCIPLED":
+                continue
+            base = node.inputs.get("Base Color")
+            if base is None or not base.is_linked:
+                continue
+            source = base.links[0].from_node
+            if source.type == "TEX_IMAGE" and source.image is not None:
+                return source.image.name
+    return None
+
+
 def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animation=None,
-                        simulation=None, images=None, relative=False):
+                        simulation=None, images=None, relative=False, skin_image=None):
     """A ``pelage.Groom`` on ``mesh`` from the panel's settings: the groom
     file when one is set (its ``[mesh]`` replaced by ``mesh``), else
     roots, the operator stack (or the Clump, Curl and Noise sliders when
@@ -333,7 +360,10 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
     vertices}``, ``mesh`` at the first frame) and ``animation`` (the
     ``[animation]`` table): animated, simulated with ``simulation``.
     Maps naming Blender images (``image:NAME:r``) are written into
-    ``images`` (``blender_image_map``), by file name when ``relative``."""
+    ``images`` (``blender_image_map``), by file name when ``relative``.
+    With ``skin_image`` (``skin_color_image``'s) and Colour from Skin on,
+    the hairs take that image's colour at their roots and no look: pelage
+    fits each hair's melanin to its colour."""
     import pelage
 
     if settings.groom_file:
@@ -365,6 +395,16 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
                "ATTRIBUTE": {"faces": "groups"}}
     interpolation = ({"method": "style-mesh"} if settings.interpolation == "STYLE_MESH"
                      else {"method": "shepard", "k": settings.interpolation_k})
+    finish = {"points": settings.points, "outside_skin": settings.outside_skin,
+              "width": {"root": settings.width, "tip": settings.width * 0.1}}
+    look = {"melanin": settings.melanin, "melanin_redness": settings.melanin_redness,
+            "roughness": settings.roughness, "radial_roughness": settings.radial_roughness,
+            "jitter": settings.look_jitter, "seed": settings.seed}
+    if skin_image is not None and settings.skin_color:
+        rgb = blender_image_map([f"{IMAGE_PREFIX}{skin_image}:{c}" for c in "rgb"], images, relative,
+                                linear=True)
+        finish["color"] = {"root": rgb, "tip": rgb}
+        look = None
     return pelage.Groom(
         mesh=mesh,
         interpolation=interpolation,
@@ -376,11 +416,8 @@ def groom_from_settings(mesh, settings, guides=None, size=1.0, skin=None, animat
         regions=parting.get(settings.parting),
         roots=roots,
         ops=ops,
-        finish={"points": settings.points, "outside_skin": settings.outside_skin,
-                "width": {"root": settings.width, "tip": settings.width * 0.1}},
-        look={"melanin": settings.melanin, "melanin_redness": settings.melanin_redness,
-              "roughness": settings.roughness, "radial_roughness": settings.radial_roughness,
-              "jitter": settings.look_jitter, "seed": settings.seed},
+        finish=finish,
+        look=look,
     )
 
 
@@ -506,7 +543,7 @@ def groom_for(surface, settings, mesh, depsgraph, images=None, relative=False, r
     if settings.guides_object is not None and not settings.groom_file:
         guides = guides_from_curves_object(settings.guides_object, depsgraph, rest=rest)
     return groom_from_settings(mesh, settings, guides, max(surface.dimensions) or 1.0,
-                               images=images, relative=relative)
+                               images=images, relative=relative, skin_image=skin_color_image(surface))
 
 
 def evaluated_positions(obj, depsgraph):
@@ -588,7 +625,8 @@ def animated_groom_for(context, surface, settings, progress=None, frames=None, r
             "preroll": settings.sim_preroll,
         }
     return groom_from_settings(mesh, settings, guides, max(surface.dimensions) or 1.0,
-                               skin=skin, animation=animation, simulation=simulation)
+                               skin=skin, animation=animation, simulation=simulation,
+                               skin_image=skin_color_image(surface))
 
 
 def export_groom_for(context, surface, settings):

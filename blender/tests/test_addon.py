@@ -808,6 +808,18 @@ panel.count, panel.guides_object = 20_000, fox_guides
 assert bpy.ops.pelage.grow_fur() == {"FINISHED"}
 worst = shown_off_skin()
 assert worst < 1e-3, f"fur grown at a posed frame lies {worst:.1%} of the fox's size off its skin"
+# The fur takes the fox's own texture (its material's Base Color image,
+# as the glTF importer set it up), and its pigment from that colour: an
+# orange and white fox, mostly red pigment, not the panel's one brown.
+assert addon_fur.skin_color_image(fox) is not None
+fox_fur = addon_fur.fur_object_of(fox).data
+assert addon_fur.COLOR in fox_fur.attributes
+fox_melanin = np.empty(len(fox_fur.curves), np.float32)
+fox_fur.attributes["hair_melanin"].data.foreach_get("value", fox_melanin)
+fox_redness = np.empty(len(fox_fur.curves), np.float32)
+fox_fur.attributes["hair_melanin_redness"].data.foreach_get("value", fox_redness)
+assert fox_melanin.max() - fox_melanin.min() > 0.1, (fox_melanin.min(), fox_melanin.max())
+assert np.median(fox_redness) > 0.5, np.median(fox_redness)
 # 3. Live, ticked after the grow; a guide combed sideways regrows the
 #    hairs near it, and they stay on the posed skin.
 panel.live = True

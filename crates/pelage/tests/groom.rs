@@ -965,7 +965,8 @@ fn a_gltf_skins_base_colour_texture_colours_the_fur_by_default() {
         groom.generator(None).unwrap().part(0).unwrap()
     };
     // No colour given: the glTF material's baseColorTexture at each root,
-    // as the same texture named by hand colours it.
+    // as the same texture named by hand colours it, made linear (the
+    // texture is sRGB-encoded).
     let by_default = grow(text("", ""));
     let named = grow(text(
         "",
@@ -973,10 +974,19 @@ fn a_gltf_skins_base_colour_texture_colours_the_fur_by_default() {
     ));
     let (a, b) = (by_default.colors().unwrap(), named.colors().unwrap());
     assert_eq!(a.len(), b.len());
+    // (Filtered between texels after, not before, the decoding: close,
+    // not equal, where neighbouring texels differ.)
+    let linear = |c: Vec3| Vec3::from(c.to_array().map(pelage::groom::srgb_to_linear));
+    let apart: Vec<f32> = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (*x - linear(*y)).abs().max_element())
+        .collect();
+    let close = apart.iter().filter(|d| **d < 0.02).count() as f64 / apart.len() as f64;
     assert!(
-        a.iter()
-            .zip(b)
-            .all(|(x, y)| (*x - *y).abs().max_element() < 1e-6)
+        close > 0.97,
+        "{:.1} % of the points within 0.02",
+        close * 100.0
     );
     // The fox is orange and white: not one grey.
     let spread =

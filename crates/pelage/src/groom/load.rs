@@ -792,8 +792,18 @@ impl Groom {
     }
 }
 
+/// An sRGB-encoded value (0–1) made linear: the sRGB transfer function's
+/// inverse (IEC 61966-2-1).
+pub fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// The red, green and blue of the base colour texture of the mesh file a
-/// `[mesh]` section names (a glTF's), when it has one; a texture that
+/// `[mesh]` section names (a glTF's, made linear), when it has one; a texture that
 /// cannot be read is an error at `mesh.path`.
 fn skin_colors(
     source: &SettingsSource,
@@ -810,6 +820,14 @@ fn skin_colors(
         return Ok(None);
     };
     let name = format!("{}'s base colour texture", path.display());
+    // glTF's base colour texture is sRGB-encoded; hair colours are linear.
+    let mut linear = image.to_rgba32f();
+    for texel in linear.pixels_mut() {
+        for c in &mut texel.0[..3] {
+            *c = srgb_to_linear(*c);
+        }
+    }
+    let image = image::DynamicImage::ImageRgba32F(linear);
     let channel = |c| {
         crate::map::ImageMap::from_image(&name, &image, c, crate::map::Wrap::Repeat)
             .map(Map::Image)
