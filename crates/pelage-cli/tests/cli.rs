@@ -1600,6 +1600,39 @@ fn an_assembly_refuses_a_part_grown_from_an_earlier_version_of_the_groom() {
 }
 
 #[test]
+fn an_animated_farms_assembly_refuses_frame_files_of_an_earlier_groom() {
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("fur.toml");
+    let g = groom.to_str().unwrap();
+    let text = |count: u32| {
+        format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = {count}\nparts = 2\n\
+             [guides]\ngenerate = {{ count = 10, length = 0.05 }}\n[animation]\nframes = \"1-2\"\n"
+        )
+    };
+    let farm = dir.path().join("farm.usda");
+    let farm = farm.to_str().unwrap();
+    let grow = |count: u32, part: &str| {
+        std::fs::write(&groom, text(count)).unwrap();
+        let out = pelage(&["groom", g, "--quiet", "-o", farm, "--part", part]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    };
+    grow(200, "1/2");
+    grow(200, "2/2");
+    grow(300, "1/2");
+    let out = pelage(&["groom", g, "--assemble", "-o", farm]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let said = stderr(&out);
+    assert!(
+        said.contains("farm.part-2-of-2") && said.contains("another version of the groom"),
+        "{said}"
+    );
+    grow(300, "2/2");
+    let out = pelage(&["groom", g, "--assemble", "-o", farm]);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
 fn converting_an_animated_file_says_it_writes_the_first_sample() {
     let dir = tempfile::tempdir().unwrap();
     let groom = dir.path().join("fur.toml");

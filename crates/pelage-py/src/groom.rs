@@ -577,7 +577,7 @@ impl PyGroom {
                 })?;
             let path = plan.outputs[0].path.clone();
             create_folder(&path)?;
-            let options = self.groom.usd_options();
+            let options = self.groom.run_usd_options(run);
             let with_skin = self.groom.writes_skin_in(run);
             let summary = py.detach(|| {
                 animated.write_files_until(

@@ -286,7 +286,7 @@ fn run_animated(
         );
         bar
     };
-    let options = groom.usd_options();
+    let options = groom.run_usd_options(args.part);
     plan.remove_stale_stitching()?;
     let growing = Instant::now();
     // In a farm, the first run writes the skin.

@@ -7,7 +7,9 @@
 
 use super::animate::{AnimatedGroom, FrameOutput};
 use super::clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
-use super::farm::{FarmError, FarmRun, check_part_keys, find_part_files, part_documentation};
+use super::farm::{
+    FarmError, FarmRun, check_part_keys, check_run_keys, find_part_files, part_documentation,
+};
 use super::generator::Generator;
 use super::load::Groom;
 use super::output::{write_alembic_assembly, write_assembly};
@@ -28,6 +30,15 @@ impl Groom {
             hair_material: self.writes_hair_material(),
             ..UsdOptions::default()
         }
+    }
+
+    /// [`Self::usd_options`] for `run` of a farm: its files say which
+    /// groom grew them ([`Self::farm_key`]), so the assembly can refuse a
+    /// file left from an earlier version of the groom.
+    pub fn run_usd_options(&self, run: Option<FarmRun>) -> UsdOptions {
+        let mut usd = self.usd_options();
+        usd.documentation = run.map(|run| part_documentation(self.farm_key(), run));
+        usd
     }
 
     /// A key of everything a farm run's hairs come from: pelage's
@@ -67,12 +78,8 @@ impl Groom {
     /// guides`) the guide curves with their regions in the first run only,
     /// so an assembly holds one of each.
     pub fn export_for(&self, generator: &Generator, run: Option<FarmRun>) -> CurvesExport<'_> {
-        let mut usd = self.usd_options();
-        // A farm run's part file says which groom grew it, so the assembly
-        // can refuse a part left from an earlier version of the groom.
-        usd.documentation = run.map(|run| part_documentation(self.farm_key(), run));
         CurvesExport {
-            usd,
+            usd: self.run_usd_options(run),
             mesh: self.writes_skin_in(run).then(|| self.mesh()),
             guides: self.writes_guides_in(run).then(|| generator.guide_curves()),
         }
@@ -218,6 +225,19 @@ impl Groom {
                 })?;
                 if found.is_empty() {
                     return Err(AssembleError::NoFrames(output.to_path_buf()));
+                }
+                let key = self.farm_key();
+                for (k, n) in found
+                    .iter()
+                    .map(|f| f.run)
+                    .collect::<std::collections::BTreeSet<_>>()
+                {
+                    let files: Vec<PathBuf> = found
+                        .iter()
+                        .filter(|f| f.run == (k, n))
+                        .map(|f| f.path.clone())
+                        .collect();
+                    check_run_keys(&files, FarmRun { k, n }, key)?;
                 }
                 Ok(Assembly::Frames(write_clip_assembly(
                     output,

@@ -176,6 +176,25 @@ fn part_key(path: &Path) -> Option<u64> {
     u64::from_str_radix(hex.trim(), 16).ok()
 }
 
+/// Refuses frame files of `run` grown from another version of the groom
+/// than the one with key `groom` (files without a key are let through).
+pub fn check_run_keys(files: &[PathBuf], run: FarmRun, groom: u64) -> Result<(), FarmError> {
+    for path in files {
+        if let Some(found) = part_key(path)
+            && found != groom
+        {
+            return Err(FarmError::Stale {
+                path: path.clone(),
+                run,
+                found,
+                want: groom,
+                than: "the groom's is",
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Refuses part files (in run order) grown from different versions of a
 /// groom: every key must be `groom`'s when it is known, else the first
 /// part's. Parts without a key are let through.
