@@ -49,6 +49,41 @@ for obj in list(bpy.data.objects):
     bpy.data.objects.remove(obj)
 scene = bpy.context.scene
 
+
+def aimed(obj, location, target):
+    """``obj`` at ``location``, looking at ``target``."""
+    obj.location = location
+    obj.rotation_euler = (target - obj.location).to_track_quat("-Z", "Y").to_euler()
+
+
+def render(camera_at, target, lens, lights, lit, what):
+    """A camera at ``camera_at`` looking at ``target``, area ``lights``
+    ((name, energy, size, location)) aimed at ``lit``, a dark world, and
+    Cycles on the CPU at 800×600 and 32 samples into OUT."""
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    aimed(camera, camera_at, target)
+    camera.data.lens = lens
+    for name, energy, size, location in lights:
+        light = bpy.data.objects.new(name, bpy.data.lights.new(name, "AREA"))
+        light.data.energy, light.data.size = energy, size
+        aimed(light, location, lit)
+        scene.collection.objects.link(light)
+    world = bpy.data.worlds.new("world")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.05, 0.06, 0.08, 1)
+    scene.world = world
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = 32
+    scene.cycles.use_denoising = False
+    scene.render.resolution_x, scene.render.resolution_y = 800, 600
+    scene.render.filepath = out
+    bpy.ops.render.render(write_still=True)
+    print(f"rendered {out}: {what}")
+
+
 if posed_fox:
     here = os.path.dirname(os.path.abspath(__file__))
     bpy.ops.import_scene.gltf(filepath=os.path.join(here, "..", "crates", "pelage", "assets", "fox", "Fox.gltf"))
@@ -69,30 +104,10 @@ if posed_fox:
     low = mathutils.Vector([min(c[i] for c in corners) for i in range(3)])
     high = mathutils.Vector([max(c[i] for c in corners) for i in range(3)])
     centre, size = (low + high) / 2, max(high - low)
-    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
-    scene.collection.objects.link(camera)
-    scene.camera = camera
-    camera.location = centre + size * mathutils.Vector((1.5, -1.0, 0.45))
-    camera.rotation_euler = (centre - camera.location).to_track_quat("-Z", "Y").to_euler()
-    camera.data.lens = 55
-    for name, energy, offset in (("key", 1500, (-1.2, -1.5, 1.8)), ("rim", 1000, (1.0, 1.8, 1.2))):
-        light = bpy.data.objects.new(name, bpy.data.lights.new(name, "AREA"))
-        light.data.energy, light.data.size = energy * size * size, size
-        light.location = centre + size * mathutils.Vector(offset)
-        light.rotation_euler = (centre - light.location).to_track_quat("-Z", "Y").to_euler()
-        scene.collection.objects.link(light)
-    world = bpy.data.worlds.new("world")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.05, 0.06, 0.08, 1)
-    scene.world = world
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = 32
-    scene.cycles.use_denoising = False
-    scene.render.resolution_x, scene.render.resolution_y = 800, 600
-    scene.render.filepath = out
-    bpy.ops.render.render(write_still=True)
-    print(f"rendered {out}: {len(fur.data.curves):,} curves on the Fox at Walk frame 9")
+    lights = [(name, energy * size * size, size, centre + size * mathutils.Vector(offset))
+              for name, energy, offset in (("key", 1500, (-1.2, -1.5, 1.8)), ("rim", 1000, (1.0, 1.8, 1.2)))]
+    render(centre + size * mathutils.Vector((1.5, -1.0, 0.45)), centre, 55, lights, centre,
+           f"{len(fur.data.curves):,} curves on the Fox at Walk frame 9")
     sys.exit(0)
 
 bpy.ops.mesh.primitive_monkey_add(size=1.6)
@@ -196,33 +211,7 @@ if bare:
     # half of the gallery pair.
     fur.data.materials.clear()
 
-camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
-scene.collection.objects.link(camera)
-scene.camera = camera
-camera.location = (1.6, -4.4, 1.1) if not workflow else (1.0, -3.4, 3.4)
-target = mathutils.Vector((0.0, 0.0, 0.05 if not workflow else 0.2))
-camera.rotation_euler = (target - camera.location).to_track_quat("-Z", "Y").to_euler()
-camera.data.lens = 60
-key = bpy.data.objects.new("key", bpy.data.lights.new("key", "AREA"))
-key.data.energy, key.data.size = 900, 3
-key.location = (-3, -3, 4)
-key.rotation_euler = (mathutils.Vector((0, 0, 0)) - key.location).to_track_quat("-Z", "Y").to_euler()
-rim = bpy.data.objects.new("rim", bpy.data.lights.new("rim", "AREA"))
-rim.data.energy, rim.data.size = 700, 2
-rim.location = (2.5, 3, 2.5)
-rim.rotation_euler = (mathutils.Vector((0, 0, 0)) - rim.location).to_track_quat("-Z", "Y").to_euler()
-for light in (key, rim):
-    scene.collection.objects.link(light)
-world = bpy.data.worlds.new("world")
-world.use_nodes = True
-world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.05, 0.06, 0.08, 1)
-scene.world = world
-
-scene.render.engine = "CYCLES"
-scene.cycles.device = "CPU"
-scene.cycles.samples = 32
-scene.cycles.use_denoising = False
-scene.render.resolution_x, scene.render.resolution_y = 800, 600
-scene.render.filepath = out
-bpy.ops.render.render(write_still=True)
-print(f"rendered {out}: {len(fur.data.curves):,} curves grown by the add-on")
+render(mathutils.Vector((1.6, -4.4, 1.1) if not workflow else (1.0, -3.4, 3.4)),
+       mathutils.Vector((0.0, 0.0, 0.05 if not workflow else 0.2)), 60,
+       [("key", 900, 3, mathutils.Vector((-3, -3, 4))), ("rim", 700, 2, mathutils.Vector((2.5, 3, 2.5)))],
+       mathutils.Vector((0, 0, 0)), f"{len(fur.data.curves):,} curves grown by the add-on")

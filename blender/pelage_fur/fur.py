@@ -563,8 +563,12 @@ def grows_at_rest(surface):
     """Whether fur on ``surface`` is grown on its rest pose: when it has a
     UV map, so that Deform Curves on Surface carries the fur to the pose
     on screen (without one the fur stays where it was grown, and is grown
-    on the mesh as it is)."""
-    return surface.data.uv_layers.active is not None
+    on the mesh as it is). When it is, Blender is asked to keep the rest
+    pose (``use_rest_positions``) before the mesh is next evaluated."""
+    rest = surface.data.uv_layers.active is not None
+    if rest:
+        use_rest_positions(surface)
+    return rest
 
 
 def animated_groom_for(context, surface, settings, progress=None, frames=None, rest_frame=None,
@@ -641,8 +645,6 @@ def export_groom_for(context, surface, settings):
     grown_at = fur.get("pelage_frame", current) if fur is not None else current
     if grown_at == current:
         rest = grows_at_rest(surface)
-        if rest:
-            use_rest_positions(surface)
         depsgraph = context.evaluated_depsgraph_get()
         mesh, _ = mesh_to_pelage(surface, depsgraph, rest=rest)
         if not rest or np.array_equal(mesh.positions, evaluated_positions(surface, depsgraph)):
@@ -665,8 +667,6 @@ def save_groom_file(context, surface, settings, path):
     import pelage
 
     rest = grows_at_rest(surface)
-    if rest:
-        use_rest_positions(surface)
     depsgraph = context.evaluated_depsgraph_get()
     mesh, _ = mesh_to_pelage(surface, depsgraph, rest=rest)
     # Blender images the maps name go beside the file, by name; a folder
@@ -747,8 +747,6 @@ class PreparedGrow:
         # On the rest pose whatever frame is on screen: Deform Curves on
         # Surface carries the fur from there to the pose.
         rest = grows_at_rest(surface)
-        if rest:
-            use_rest_positions(surface)
         depsgraph = context.evaluated_depsgraph_get()
         mesh, self.uv_map = mesh_to_pelage(surface, depsgraph, rest=rest)
         self.groom = groom_for(surface, settings, mesh, depsgraph, rest=rest)

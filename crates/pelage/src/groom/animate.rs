@@ -325,21 +325,10 @@ impl AnimatedGroom {
             SkinPose::new(mesh.positions().to_vec(), mesh.triangles()),
         );
         let generator = Generator::new(spec.clone())?;
-        let keep_out = spec.finish.outside_skin.map(|gap| {
-            // A hair's segment: the longest guide over the hair's
-            // segments (the band a pushed hair crosses).
-            let guides = &spec.guides;
-            let longest = (0..guides.len())
-                .map(|g| {
-                    guides
-                        .guide(g)
-                        .windows(2)
-                        .map(|w| (w[1] - w[0]).length())
-                        .sum::<f32>()
-                })
-                .fold(0.0f32, f32::max);
-            (gap, longest / (spec.finish.points.max(2) - 1) as f32)
-        });
+        let keep_out = spec
+            .finish
+            .outside_skin
+            .map(|gap| (gap, OutsideSkin::segment(&spec.guides, spec.finish.points)));
         Ok(Self {
             spec,
             generator,
@@ -614,28 +603,13 @@ impl AnimatedGroom {
     /// pose, skin and generator when `time` is one of its times, else its
     /// own.
     fn regrown_part(&self, p: usize, time: f64, window: &Window<'_>) -> Result<Curves, GroomError> {
+        let Some(k) = window.times.iter().position(|&t| t == time) else {
+            return self.part(p, time);
+        };
         let mut out = Curves::default();
-        match window.times.iter().position(|&t| t == time) {
-            Some(k) => {
-                let generator = window.generators[k].as_ref().unwrap_or(&self.generator);
-                let at = (&window.poses[k], window.outsides[k].as_ref());
-                self.part_at(p, time, at, generator, &mut None, &mut out)?;
-            }
-            None => {
-                let pose = self.pose(time)?;
-                let outside = self.outside_skin(&pose);
-                let regrown = self.frame_generator(time, &pose)?;
-                let generator = regrown.as_ref().unwrap_or(&self.generator);
-                self.part_at(
-                    p,
-                    time,
-                    (&pose, outside.as_ref()),
-                    generator,
-                    &mut None,
-                    &mut out,
-                )?;
-            }
-        }
+        let generator = window.generators[k].as_ref().unwrap_or(&self.generator);
+        let at = (&window.poses[k], window.outsides[k].as_ref());
+        self.part_at(p, time, at, generator, &mut None, &mut out)?;
         Ok(out)
     }
 

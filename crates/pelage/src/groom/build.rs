@@ -479,19 +479,11 @@ fn outside_skin_for(
         .and_then(|g| g.outside_skin.clone())
         .filter(|o| o.gap() == gap)
         .unwrap_or_else(|| {
-            // A hair's segment: the longest guide's length over
-            // the hair's segments.
-            let longest = (0..guides.len())
-                .map(|g| {
-                    guides
-                        .guide(g)
-                        .windows(2)
-                        .map(|w| (w[1] - w[0]).length())
-                        .sum::<f32>()
-                })
-                .fold(0.0f32, f32::max);
-            let segment = longest / (points.max(2) - 1) as f32;
-            Arc::new(OutsideSkin::new(mesh, gap, segment))
+            Arc::new(OutsideSkin::new(
+                mesh,
+                gap,
+                OutsideSkin::segment(guides, points),
+            ))
         })
 }
 

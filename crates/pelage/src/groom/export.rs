@@ -7,9 +7,7 @@
 
 use super::animate::{AnimatedGroom, FrameOutput};
 use super::clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
-use super::farm::{
-    FarmError, FarmRun, check_part_keys, check_run_keys, find_part_files, part_documentation,
-};
+use super::farm::{FarmError, FarmRun, check_part_keys, find_part_files, part_documentation};
 use super::generator::Generator;
 use super::load::Groom;
 use super::output::{write_alembic_assembly, write_assembly};
@@ -226,19 +224,19 @@ impl Groom {
                 if found.is_empty() {
                     return Err(AssembleError::NoFrames(output.to_path_buf()));
                 }
-                let key = self.farm_key();
-                for (k, n) in found
+                let runs: Vec<(PathBuf, FarmRun)> = found
                     .iter()
-                    .map(|f| f.run)
-                    .collect::<std::collections::BTreeSet<_>>()
-                {
-                    let files: Vec<PathBuf> = found
-                        .iter()
-                        .filter(|f| f.run == (k, n))
-                        .map(|f| f.path.clone())
-                        .collect();
-                    check_run_keys(&files, FarmRun { k, n }, key)?;
-                }
+                    .map(|f| {
+                        (
+                            f.path.clone(),
+                            FarmRun {
+                                k: f.run.0,
+                                n: f.run.1,
+                            },
+                        )
+                    })
+                    .collect();
+                check_part_keys(&runs, Some(self.farm_key()))?;
                 Ok(Assembly::Frames(write_clip_assembly(
                     output,
                     &found,
@@ -247,7 +245,12 @@ impl Groom {
             }
             None => {
                 let files = find_part_files(output)?;
-                check_part_keys(&files, Some(self.farm_key()))?;
+                let n = files.len();
+                let runs: Vec<(PathBuf, FarmRun)> = (1..=n)
+                    .zip(&files)
+                    .map(|(k, f)| (f.clone(), FarmRun { k, n }))
+                    .collect();
+                check_part_keys(&runs, Some(self.farm_key()))?;
                 let extent = if alembic {
                     let skin = self.writes_skin().then(|| self.mesh());
                     write_alembic_assembly(output, &files, &self.usd_options(), skin)?

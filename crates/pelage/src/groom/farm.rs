@@ -176,32 +176,13 @@ fn part_key(path: &Path) -> Option<u64> {
     u64::from_str_radix(hex.trim(), 16).ok()
 }
 
-/// Refuses frame files of `run` grown from another version of the groom
-/// than the one with key `groom` (files without a key are let through).
-pub fn check_run_keys(files: &[PathBuf], run: FarmRun, groom: u64) -> Result<(), FarmError> {
-    for path in files {
-        if let Some(found) = part_key(path)
-            && found != groom
-        {
-            return Err(FarmError::Stale {
-                path: path.clone(),
-                run,
-                found,
-                want: groom,
-                than: "the groom's is",
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Refuses part files (in run order) grown from different versions of a
-/// groom: every key must be `groom`'s when it is known, else the first
-/// part's. Parts without a key are let through.
-pub fn check_part_keys(files: &[PathBuf], groom: Option<u64>) -> Result<(), FarmError> {
-    let n = files.len();
+/// Refuses files of a farm's runs (each with the run that wrote it)
+/// grown from different versions of a groom: every key must be `groom`'s
+/// when it is known, else the first file's. Files without a key are let
+/// through.
+pub fn check_part_keys(files: &[(PathBuf, FarmRun)], groom: Option<u64>) -> Result<(), FarmError> {
     let mut want = groom.map(|k| (k, "the groom's is"));
-    for (k, path) in files.iter().enumerate() {
+    for (path, run) in files {
         let Some(found) = part_key(path) else {
             continue;
         };
@@ -210,7 +191,7 @@ pub fn check_part_keys(files: &[PathBuf], groom: Option<u64>) -> Result<(), Farm
             Some((want, than)) if want != found => {
                 return Err(FarmError::Stale {
                     path: path.clone(),
-                    run: FarmRun { k: k + 1, n },
+                    run: *run,
                     found,
                     want,
                     than,

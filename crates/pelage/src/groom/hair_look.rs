@@ -202,9 +202,8 @@ impl HairLook {
     /// colours and no `[look]`: melanin and redness fitted to each root's
     /// colour ([`melanin_of_color`]), the other values the defaults'
     /// (a white tint, roughness and radial roughness 0.3), and
-    /// `hair_random` from each id.
+    /// `hair_random` from each id, as the default look's seed (0) draws it.
     pub fn fitted_to_colors(root_colors: &[Vec3], ids: &[u64]) -> HairShading {
-        let look = Self::default();
         let beta = 0.3;
         let mut out = HairShading::with_capacity(root_colors.len());
         for (&color, &id) in root_colors.iter().zip(ids) {
@@ -215,7 +214,7 @@ impl HairLook {
             out.radial_roughness.push(beta);
             out.tint.push(Vec3::ONE);
             out.random
-                .push(SampleRng::new(look.seed ^ salts::LOOK_RANDOM, id).uniform_f32());
+                .push(SampleRng::new(salts::LOOK_RANDOM, id).uniform_f32());
         }
         out
     }

@@ -90,6 +90,22 @@ impl OutsideSkin {
         Self { skin, gap }
     }
 
+    /// A hair's segment, for hairs of `points` points shaped by `guides`:
+    /// the longest guide's length over the hair's segments (the depth of
+    /// band a pushed hair crosses).
+    pub fn segment(guides: &crate::guides::Guides, points: usize) -> f32 {
+        let longest = (0..guides.len())
+            .map(|g| {
+                guides
+                    .guide(g)
+                    .windows(2)
+                    .map(|w| (w[1] - w[0]).length())
+                    .sum::<f32>()
+            })
+            .fold(0.0f32, f32::max);
+        longest / (points.max(2) - 1) as f32
+    }
+
     /// The gap kept between hairs and the skin.
     pub fn gap(&self) -> f32 {
         self.gap
