@@ -62,13 +62,7 @@ fn grown_parts(groom: &pelage::groom::Groom) -> Vec<Curves> {
 /// The hairs of `parts` and the farthest any of their points is from the
 /// same point of the hair of the same id in `session`.
 fn farthest_by_id(parts: &[Curves], session: &Curves) -> (usize, f32) {
-    let by_id: std::collections::HashMap<u64, usize> = session
-        .ids()
-        .unwrap()
-        .iter()
-        .enumerate()
-        .map(|(i, id)| (*id, i))
-        .collect();
+    let by_id = index_by_id(session);
     let (mut hairs, mut worst) = (0, 0.0f32);
     for part in parts {
         for i in 0..part.curve_count() {
@@ -83,6 +77,12 @@ fn farthest_by_id(parts: &[Curves], session: &Curves) -> (usize, f32) {
         }
     }
     (hairs, worst)
+}
+
+/// Each hair's index in `curves`, by id.
+fn index_by_id(curves: &Curves) -> std::collections::HashMap<u64, usize> {
+    let ids = curves.ids().unwrap().iter();
+    ids.enumerate().map(|(i, id)| (*id, i)).collect()
 }
 
 fn lengths(points: &[Vec3]) -> Vec<f32> {
@@ -649,7 +649,7 @@ seed = 3
 
 [guides]
 points = 8
-generate = { count = 50, length = 0.06, comb = [0, -0.5, -1.0], seed = 2 }
+generate = { count = 50, length = 0.06, comb = [0, -0.5, -1.0], gravity = 0.4, seed = 2 }
 
 [[ops]]
 clump = { count = 30, rate = 0.5 }
@@ -674,6 +674,13 @@ path = "fur.usdc"
     let mut d = dab(guide[0], 0.2);
     d.direction = -0.06 * (guide[1] - guide[0]).normalize();
     groom.brush(&Brush::Comb, &d).unwrap().unwrap();
+    // Added guides take the shape the guides interpolate at their roots,
+    // laid out evenly by arc length as a bound guide is (uneven ones were
+    // resampled when bound again, and their hairs moved by 0.1 %).
+    groom
+        .brush(&Brush::Add { count: 12 }, &dab(root(&groom, 30), 0.3))
+        .unwrap()
+        .unwrap();
     groom
         .brush(
             &Brush::Paint {
@@ -915,10 +922,18 @@ fn spec_on_spot() -> GroomSpec {
 }
 
 #[test]
-fn the_first_paint_dab_reports_no_more_regrown_hairs_than_the_groom_has() {
-    // Its layer is added and painted as one step; the two regrowths were
-    // summed (101,774 regrown of 100,000).
-    let mut groom = EditableGroom::new(spec(2_000), 1.0).unwrap();
+fn the_first_density_dab_moves_only_the_hairs_under_it() {
+    // Painting density adds a layer that scales the groom's density map,
+    // starting at 1: the noise density stays, and only the cells under
+    // the dab (and a few at the margin) are sampled again. Painting the
+    // map read at the vertices instead moved every root. (The layer is
+    // added and painted as one step, whose regrowth is counted once:
+    // 101,774 of 100,000 were reported when the two were summed.)
+    let noise = Map::parse("noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4").unwrap();
+    let mut s = spec(20_000);
+    s.roots = s.roots.clone().with_density(noise);
+    let mut groom = EditableGroom::new(s, 1.0).unwrap();
+    let before = groom.curves();
     let at = root(&groom, 3);
     let r = groom
         .brush(
@@ -926,13 +941,53 @@ fn the_first_paint_dab_reports_no_more_regrown_hairs_than_the_groom_has() {
                 layer: "density".into(),
                 value: 0.0,
             },
-            &dab(at, 0.3),
+            &dab(at, 0.15),
         )
         .unwrap()
         .expect("the dab paints");
     assert!(
-        r.regrown_roots <= r.hairs,
-        "{} of {}",
+        r.regrown_roots * 10 < r.hairs,
+        "{} of {} regrown",
+        r.regrown_roots,
+        r.hairs
+    );
+    // Hairs rooted away from the dab kept their ids and every bit.
+    let after = groom.curves();
+    let kept = index_by_id(&after);
+    let (mut far, mut moved) = (0, 0);
+    for (i, id) in before.ids().unwrap().iter().enumerate() {
+        let points = &before.points()[before.range(i)];
+        if points[0].distance(at) < 0.4 {
+            continue;
+        }
+        far += 1;
+        match kept.get(id) {
+            Some(&j) if after.points()[after.range(j)] == *points => {}
+            _ => moved += 1,
+        }
+    }
+    assert!(
+        far > 5_000 && moved * 100 < far,
+        "{moved} of {far} far hairs moved"
+    );
+    // And it is what the painted groom grows from nothing.
+    assert_eq!(
+        bits(&groom.regrown_from_scratch().unwrap().curves()),
+        bits(&after)
+    );
+    let scale = &groom.spec().roots.density_scale;
+    assert!(
+        matches!(scale, Map::Vertex(v) if v.name == "density"),
+        "{scale:?}"
+    );
+    // The first part dab likewise regrows the hairs its parting reaches.
+    let r = groom
+        .brush(&Brush::Part { region: 1 }, &dab(root(&groom, 50), 0.15))
+        .unwrap()
+        .expect("the dab parts");
+    assert!(
+        r.regrown_roots * 4 < r.hairs,
+        "{} of {} regrown",
         r.regrown_roots,
         r.hairs
     );

@@ -164,9 +164,8 @@ pub enum Brush {
     /// Deletes the guides rooted under the dab.
     Delete,
     /// Blends a paint layer toward `value` under the dab (a new layer
-    /// starts at 0; `density`, when the groom's density is not a layer
-    /// yet, starts as the density map read at each vertex and becomes the
-    /// groom's density).
+    /// starts at 0; `density` starts at 1 and becomes the groom's
+    /// `density_scale`, which multiplies its density map).
     Paint {
         /// The layer's name.
         layer: String,
@@ -336,7 +335,7 @@ impl EditableGroom {
             },
             // The layer first, then the dab on it, as one step.
             Some(setup) => self
-                .apply_then(Edit::ReplaceSpec(Box::new(setup)), edit_on)
+                .apply_then(Edit::NewLayer(Box::new(setup)), edit_on)
                 .map(Some),
         }
     }
@@ -350,18 +349,20 @@ impl EditableGroom {
         let mut spec = self.spec().clone();
         let mesh = self.mesh();
         let values = if layer == "density" {
-            // The density as the groom has it, read at each vertex: the
-            // first dab paints over what the groom already grows.
-            let density = spec
+            // A scale on the density, starting as the scale the groom has
+            // (1 unless its file sets one): the density map itself stays,
+            // so the first dab moves only the roots under it. (Painting
+            // the density map read at the vertices would move every root.)
+            let scale = spec
                 .roots
-                .density
+                .density_scale
                 .on_mesh(mesh)
                 .map_err(GroomErrorKind::Map)?;
             let values = vertex_points(mesh)
                 .into_iter()
-                .map(|p| p.map_or(0.0, |p| density.eval(p)))
+                .map(|p| p.map_or(1.0, |p| scale.eval(p)))
                 .collect();
-            spec.roots.density = Map::Vertex(VertexMap::new(layer));
+            spec.roots.density_scale = Map::Vertex(VertexMap::new(layer));
             values
         } else {
             vec![0.0; mesh.vertex_count()]
@@ -746,6 +747,10 @@ fn add_guides(groom: &EditableGroom, count: u32, dabs: &[Dab]) -> Option<Edit> {
             let root = SurfacePoint::new(hit.triangle, [hit.weights[1], hit.weights[2]]);
             let mut shape = vec![Vec3::ZERO; n];
             interpolator.hair(mesh, root, &mut scratch, &mut shape);
+            // Blended guides space their points unevenly; a guide is bound
+            // evenly spaced by arc length, so the added one is laid out so
+            // now, and the saved file binds it again to the same shape.
+            let mut shape = resample_by_arc_length(&shape, n);
             let lengths = segment_lengths(&shape);
             keep_above(&mut shape, mesh, bvh, &lengths);
             // Widths of the guide weighted most.

@@ -396,7 +396,7 @@ fn check_numbers(spec: &GroomSpec) -> Result<(), GroomError> {
 /// `spec`.
 fn root_sampling(spec: &GroomSpec) -> Result<RootSampling, GroomError> {
     let mesh = &spec.mesh;
-    let sampler = DensitySampler::new(mesh, &spec.roots.density, Default::default())
+    let sampler = DensitySampler::new(mesh, &spec.roots.sampled_density(), Default::default())
         .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
     // A fraction grows the first arrivals: a subset of the groom.
     let grown = spec.roots.grown_count();
@@ -540,6 +540,7 @@ fn bind_maps(spec: &mut GroomSpec) -> Result<(), GroomError> {
             }
         };
         bind("roots.density".into(), &mut spec.roots.density);
+        bind("roots.density_scale".into(), &mut spec.roots.density_scale);
         let finish = &mut spec.finish;
         for (key, map) in finish.width.maps_mut() {
             bind(format!("finish.width.{key}"), map);

@@ -78,6 +78,11 @@ const GROOM_RULES: &[Rule] = &[
     ),
     Rule::new("interpolation.radius", Bound::more_than(0.0), "a distance"),
     Rule::new("roots.density", Bound::at_least(0.0), "a density"),
+    Rule::new(
+        "roots.density_scale",
+        Bound::at_least(0.0),
+        "a density scale",
+    ),
     Rule::new("finish.skin_gap", Bound::at_least(0.0), "a distance"),
     Rule::new(
         "simulation.substeps",
@@ -471,6 +476,10 @@ pub struct RootsSection {
     /// Root density map.
     #[serde(default = "one")]
     pub density: MapValue,
+    /// A map the density is multiplied by (a grooming session's painted
+    /// density layer).
+    #[serde(default = "one")]
+    pub density_scale: MapValue,
     /// Seed of every random number in the groom.
     #[serde(default = "seed_one")]
     pub seed: u64,

@@ -575,6 +575,7 @@ impl Groom {
         for (key, span) in [
             ("roots.count", file.roots.count.span()),
             ("roots.density", file.roots.density.span()),
+            ("roots.density_scale", file.roots.density_scale.span()),
             ("finish.points", file.finish.points.span()),
             ("finish.width", file.finish.width.root.span()),
         ] {
@@ -589,6 +590,7 @@ impl Groom {
         let roots = RootsSpec {
             count: *file.roots.count.get_ref(),
             density: map_on_mesh(source, &self.mesh, &file.roots.density)?,
+            density_scale: map_on_mesh(source, &self.mesh, &file.roots.density_scale)?,
             seed: file.roots.seed,
             parts: file.roots.parts.as_ref().map(|p| *p.get_ref()),
             ids: file.roots.ids,

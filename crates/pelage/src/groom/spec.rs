@@ -176,6 +176,10 @@ pub struct RootsSpec {
     pub count: u64,
     /// Root density over the surface.
     pub density: Map,
+    /// A map the density is multiplied by (the constant 1: none). A
+    /// grooming session paints its density here, on a layer that starts
+    /// at 1, so the first dab changes the roots under it alone.
+    pub density_scale: Map,
     /// Seed of every random number in the groom.
     pub seed: u64,
     /// Number of parts (`None`: one per 100,000 hairs).
@@ -266,6 +270,7 @@ impl RootsSpec {
         Self {
             count,
             density: Map::Constant(1.0),
+            density_scale: Map::Constant(1.0),
             seed: 1,
             parts: None,
             ids: HairIds::default(),
@@ -304,6 +309,15 @@ impl RootsSpec {
     pub fn with_density(mut self, density: Map) -> Self {
         self.density = density;
         self
+    }
+
+    /// The density the roots are drawn from: `density` times
+    /// `density_scale`.
+    pub fn sampled_density(&self) -> std::borrow::Cow<'_, Map> {
+        match &self.density_scale {
+            Map::Constant(c) if *c == 1.0 => std::borrow::Cow::Borrowed(&self.density),
+            scale => std::borrow::Cow::Owned(Map::product(self.density.clone(), scale.clone())),
+        }
     }
 
     /// Sets the seed.

@@ -1,8 +1,9 @@
 //! [`Map`]: a scalar field over the surface that any parameter can read: a
 //! constant, an image (PNG 8/16-bit, EXR float; bilinear; wrap or clamp;
 //! one channel; UDIM tiles), procedural Perlin/fBm noise (over UV, or
-//! over the rest position on meshes without UVs), or a per-vertex scalar
-//! of the mesh.
+//! over the rest position on meshes without UVs), a per-vertex scalar of
+//! the mesh, or the product of two maps (a painted layer scaling a
+//! groom's density).
 //!
 //! Every groom parameter is a map, as in Stubble (Sik, section 4: "every
 //! user parameter … is also specified by a texture"). A map is read at a
@@ -43,6 +44,8 @@ pub enum Map {
     Udim(UdimMap),
     /// A per-vertex scalar of the mesh, interpolated barycentrically.
     Vertex(VertexMap),
+    /// One map times another, point by point.
+    Product(Box<[Map; 2]>),
 }
 
 /// Where a map is read: what every kind of map needs of a surface point.
@@ -187,12 +190,23 @@ impl Map {
             },
             Map::Udim(udim) => udim.eval(site.uv.unwrap_or(Vec2::ZERO)),
             Map::Vertex(vertex) => vertex.eval(site.corners, site.weights),
+            Map::Product(maps) => maps[0].at(site) * maps[1].at(site),
+        }
+    }
+
+    /// `a` times `b` (either alone when the other is the constant 1).
+    pub fn product(a: Map, b: Map) -> Map {
+        match (a, b) {
+            (a, Map::Constant(c)) | (Map::Constant(c), a) if c == 1.0 => a,
+            (a, b) => Map::Product(Box::new([a, b])),
         }
     }
 
     /// A value no evaluation exceeds: the constant, the largest texel or
     /// vertex value, or `offset + |scale|` for noise (fBm is normalised to
-    /// [−1, 1]).
+    /// [−1, 1]). A product's bound is its factors' bounds multiplied,
+    /// which holds for maps that are never negative (densities, where it
+    /// is read).
     pub fn upper_bound(&self) -> f32 {
         match self {
             Map::Constant(c) => *c,
@@ -200,6 +214,7 @@ impl Map {
             Map::Noise(noise) => noise.offset + noise.scale.abs(),
             Map::Udim(udim) => udim.max_texel(),
             Map::Vertex(vertex) => vertex.max_value(),
+            Map::Product(maps) => maps[0].upper_bound().max(0.0) * maps[1].upper_bound().max(0.0),
         }
     }
 
@@ -208,11 +223,19 @@ impl Map {
     /// the mesh has none, or names a vertex attribute it does not have.
     pub fn bind(&mut self, mesh: &Mesh) -> Result<(), MapError> {
         self.check_on(mesh)?;
-        if let Map::Vertex(vertex) = self {
-            let attribute = mesh
-                .vertex_attribute(&vertex.name)
-                .expect("on_mesh checked the attribute");
-            vertex.values = Some(attribute.values.clone());
+        match self {
+            Map::Vertex(vertex) => {
+                let attribute = mesh
+                    .vertex_attribute(&vertex.name)
+                    .expect("on_mesh checked the attribute");
+                vertex.values = Some(attribute.values.clone());
+            }
+            Map::Product(maps) => {
+                for map in maps.iter_mut() {
+                    map.bind(mesh)?;
+                }
+            }
+            _ => {}
         }
         Ok(())
     }
@@ -220,16 +243,23 @@ impl Map {
     /// The map bound to `mesh` ([`Self::bind`]) when it needs binding, as
     /// a copy; otherwise itself.
     pub fn bound(&self, mesh: &Mesh) -> Result<std::borrow::Cow<'_, Map>, MapError> {
+        if self.is_bound_to(mesh) {
+            self.check_on(mesh)?;
+            Ok(std::borrow::Cow::Borrowed(self))
+        } else {
+            let mut map = self.clone();
+            map.bind(mesh)?;
+            Ok(std::borrow::Cow::Owned(map))
+        }
+    }
+
+    /// Whether every per-vertex map in it holds values for `mesh`'s
+    /// vertices.
+    fn is_bound_to(&self, mesh: &Mesh) -> bool {
         match self {
-            Map::Vertex(v) if v.values.as_ref().map(|x| x.len()) != Some(mesh.vertex_count()) => {
-                let mut map = self.clone();
-                map.bind(mesh)?;
-                Ok(std::borrow::Cow::Owned(map))
-            }
-            _ => {
-                self.check_on(mesh)?;
-                Ok(std::borrow::Cow::Borrowed(self))
-            }
+            Map::Vertex(v) => v.values.as_ref().map(|x| x.len()) == Some(mesh.vertex_count()),
+            Map::Product(maps) => maps.iter().all(|m| m.is_bound_to(mesh)),
+            _ => true,
         }
     }
 
@@ -250,6 +280,11 @@ impl Map {
                 let n = noise_samples(noise);
                 Some((n, n))
             }
+            // The finer grid of the two along each axis.
+            Map::Product(maps) => match (maps[0].resolution(), maps[1].resolution()) {
+                (Some((w0, h0)), Some((w1, h1))) => Some((w0.max(w1), h0.max(h1))),
+                (a, b) => a.or(b),
+            },
         }
     }
 
@@ -264,6 +299,13 @@ impl Map {
             {
                 Some(noise_samples(noise) as f32)
             }
+            Map::Product(maps) => {
+                let [a, b] = [0, 1].map(|i| maps[i].object_resolution(mesh_has_uvs));
+                match (a, b) {
+                    (Some(a), Some(b)) => Some(a.max(b)),
+                    (a, b) => a.or(b),
+                }
+            }
             _ => None,
         }
     }
@@ -271,7 +313,11 @@ impl Map {
     /// Whether the map varies inside a triangle without a texel grid
     /// (per-vertex maps: linearly from corner to corner).
     pub fn varies_within_triangles(&self) -> bool {
-        matches!(self, Map::Vertex(_))
+        match self {
+            Map::Vertex(_) => true,
+            Map::Product(maps) => maps.iter().any(Map::varies_within_triangles),
+            _ => false,
+        }
     }
 
     /// Whether evaluating the map needs texture coordinates: images, UDIM
@@ -281,6 +327,7 @@ impl Map {
             Map::Image(_) | Map::Udim(_) => true,
             Map::Noise(noise) => noise.space == NoiseSpace::Uv,
             Map::Constant(_) | Map::Vertex(_) => false,
+            Map::Product(maps) => maps.iter().any(Map::needs_uvs),
         }
     }
 
@@ -297,6 +344,9 @@ impl Map {
 
     /// Fails, naming the mesh, if the map cannot be read on it.
     fn check_on(&self, mesh: &Mesh) -> Result<(), MapError> {
+        if let Map::Product(maps) = self {
+            return maps.iter().try_for_each(|m| m.check_on(mesh));
+        }
         let attributes = |intro: &str| {
             let names: Vec<&str> = mesh
                 .vertex_attributes()
@@ -396,6 +446,44 @@ mod tests {
             .on_mesh(&mesh)
             .unwrap_err();
         assert!(err.to_string().contains("\"vertex:NAME\""), "{err}");
+    }
+
+    #[test]
+    fn a_product_multiplies_point_by_point_and_binds_both_factors() {
+        let mesh = unit_square()
+            .with_vertex_attribute("scale", vec![0.0, 1.0, 2.0, 3.0])
+            .unwrap();
+        let noise = Map::parse("noise:frequency=3,offset=1,scale=0.5").unwrap();
+        let scale = Map::parse("vertex:scale").unwrap();
+        // Times the constant 1 is the map itself.
+        assert_eq!(Map::product(noise.clone(), Map::Constant(1.0)), noise);
+        assert_eq!(Map::product(Map::Constant(1.0), scale.clone()), scale);
+        let product = Map::product(noise.clone(), scale.clone());
+        let bound = product.on_mesh(&mesh).unwrap();
+        let (noise, scale) = (noise.on_mesh(&mesh).unwrap(), scale.on_mesh(&mesh).unwrap());
+        for bary in [[0.1, 0.2], [0.6, 0.3], [0.0, 1.0]] {
+            let p = SurfacePoint::new(0, bary);
+            assert_eq!(bound.eval(p), noise.eval(p) * scale.eval(p));
+        }
+        // The sampler subdivides for the finer factor, and follows the
+        // layer's gradient inside triangles.
+        assert_eq!(
+            product.resolution(),
+            Map::parse("noise:frequency=3").unwrap().resolution()
+        );
+        assert!(product.varies_within_triangles());
+        let mut bound_product = product.clone();
+        bound_product.bind(&mesh).unwrap();
+        assert_eq!(bound_product.upper_bound(), 1.5 * 3.0);
+        // A factor the mesh cannot serve is named.
+        let missing = Map::product(Map::Constant(2.0), Map::parse("vertex:red").unwrap());
+        assert!(
+            missing
+                .on_mesh(&mesh)
+                .unwrap_err()
+                .to_string()
+                .contains("'red'")
+        );
     }
 
     #[test]

@@ -64,9 +64,15 @@ pub enum Edit {
         /// Their new values.
         values: Vec<f32>,
     },
-    /// Other settings (count, operators, finish, regions, a new layer):
-    /// regrows everything.
+    /// Other settings (count, operators, finish, regions): regrows
+    /// everything.
     ReplaceSpec(Box<GroomSpec>),
+    /// A paint layer added (or, undone, taken away) that leaves every
+    /// hair as it was: a density scale of ones, a region layer of zeros.
+    /// The roots and recipes are found again and compared, so only the
+    /// hairs whose recipe differs (none, or a few at float rounding) are
+    /// regrown.
+    NewLayer(Box<GroomSpec>),
     /// Several edits undone and redone as one.
     Group(Vec<Edit>),
 }
@@ -80,7 +86,7 @@ impl Edit {
             Edit::Paint {
                 vertices, values, ..
             } => vertices.len() * 4 + values.len() * 4,
-            Edit::ReplaceSpec(spec) => {
+            Edit::ReplaceSpec(spec) | Edit::NewLayer(spec) => {
                 spec.mesh.vertex_count() * 4 * (spec.mesh.vertex_attributes().len() + 1) + 1024
             }
             Edit::Group(edits) => edits.iter().map(Edit::bytes).sum(),
@@ -518,6 +524,22 @@ impl EditableGroom {
                 ));
                 Ok((Edit::ReplaceSpec(old), regrowth))
             }
+            Edit::NewLayer(spec) => {
+                let old = Box::new(self.spec.clone());
+                let keep = Keep {
+                    roots: false,
+                    regions: false,
+                    weights: false,
+                    only_guides_moved: false,
+                };
+                let change = Change {
+                    roots: true,
+                    recipes: true,
+                    ..Default::default()
+                };
+                let regrowth = self.transition(*spec, Some(keep), change)?;
+                Ok((Edit::NewLayer(old), regrowth))
+            }
         }
     }
 
@@ -636,7 +658,7 @@ impl EditableGroom {
         let mut spec = self.spec.clone();
         spec.mesh = Arc::new(new_mesh);
         let reads = |map: &Map| matches!(map, Map::Vertex(v) if v.name == layer);
-        let density = reads(&spec.roots.density);
+        let density = reads(&spec.roots.density) || reads(&spec.roots.density_scale);
         let regions = spec
             .regions
             .as_mut()

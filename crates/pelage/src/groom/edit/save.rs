@@ -174,13 +174,16 @@ impl EditableGroom {
         );
         table.insert("guides".into(), guides.into());
         // [roots]: count and seed as the session has them; the density
-        // when it is a paint layer.
+        // and its scale when they are paint layers.
         let spec = self.spec();
         let mut roots = section(&mut table, "roots");
         roots.insert("count".into(), (spec.roots.count as i64).into());
         roots.insert("seed".into(), (spec.roots.seed as i64).into());
         if let Map::Vertex(v) = &spec.roots.density {
             roots.insert("density".into(), format!("vertex:{}", v.name).into());
+        }
+        if let Map::Vertex(v) = &spec.roots.density_scale {
+            roots.insert("density_scale".into(), format!("vertex:{}", v.name).into());
         }
         table.insert("roots".into(), roots.into());
         // [regions]: a paint layer's.
