@@ -178,8 +178,13 @@ impl SkinBinding {
         let roots = rest.roots().expect("carried curves have roots");
         let offsets = rest.offsets();
         let points = rest.points();
-        out.clear();
-        out.resize(points.len(), Vec3::ZERO);
+        // Every value is written below (the curves cover every point), so
+        // a buffer of the right length from the last frame is reused as it
+        // is, not cleared.
+        if out.len() != points.len() {
+            out.clear();
+            out.resize(points.len(), Vec3::ZERO);
+        }
         let chunks: Vec<(std::ops::Range<usize>, &mut [Vec3])> = {
             let mut jobs = Vec::new();
             let mut left = &mut out[..];

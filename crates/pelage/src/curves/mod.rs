@@ -555,6 +555,19 @@ impl Curves {
         self.velocities.as_deref()
     }
 
+    /// The velocities, taken out (a buffer to fill for the next frame).
+    pub(crate) fn take_velocities(&mut self) -> Option<Vec<Vec3>> {
+        self.velocities.take()
+    }
+
+    /// Sets velocities its caller found finite, one a point, without
+    /// reading them again.
+    pub(crate) fn set_finite_velocities(&mut self, velocities: Vec<Vec3>) {
+        debug_assert_eq!(velocities.len(), self.points.len());
+        debug_assert!(velocities.iter().all(|v| v.is_finite()));
+        self.velocities = Some(velocities);
+    }
+
     /// Sets (or, with `None`, removes) the per-point velocities. Fails
     /// unless there is one finite velocity a point.
     pub fn set_velocities(&mut self, velocities: Option<Vec<Vec3>>) -> Result<(), CurvesError> {

@@ -504,15 +504,15 @@ impl AnimatedGroom {
     }
 
     /// Per-point velocities (units a second) of a deform part grown at
-    /// rest, between the skin just before and just after the time; `None`
-    /// when one is not finite.
+    /// rest, between the skin just before and just after the time, in
+    /// `out` (the last frame's, reused); `None` when one is not finite.
     fn velocities(
         &self,
         (rest, frames): (&Curves, &RestFrames),
         poses: (&SkinPose, &SkinPose),
         per_second: f32,
+        mut out: Vec<Vec3>,
     ) -> Option<Vec<Vec3>> {
-        let mut out = Vec::new();
         self.binding
             .velocities(rest, frames, poses, per_second, &mut out)
             .then_some(out)
@@ -585,7 +585,7 @@ impl AnimatedGroom {
         let (minus, plus, per_second) = self.velocity_poses(time, &pose, fps);
         let (curves, frames) = rest.as_ref().expect("deform grows at rest");
         let velocities = self
-            .velocities((curves, frames), (&minus, &plus), per_second)
+            .velocities((curves, frames), (&minus, &plus), per_second, Vec::new())
             .ok_or_else(|| {
                 self.spec.error(
                     "animation",
@@ -811,6 +811,8 @@ impl AnimatedGroom {
                 for &time in &output.times {
                     let k = index(time);
                     let generator = generators[k].as_ref().unwrap_or(&self.generator);
+                    // The last frame's velocities are this one's buffer.
+                    let buffer = out.take_velocities().unwrap_or_default();
                     let velocities = if regrow_velocities {
                         let window = Window {
                             times: &times,
@@ -823,10 +825,14 @@ impl AnimatedGroom {
                     } else {
                         let at = (&poses[k], outsides[k].as_ref());
                         self.part_at(p, time, at, generator, &mut rest, &mut out)?;
-                        self.deform_velocities(p, time, velocity_poses.get(k), &rest)?
+                        let poses = velocity_poses.get(k);
+                        self.deform_velocities(p, time, poses, &rest, buffer)?
                     };
-                    if velocities.is_some() {
-                        out.set_velocities(velocities).map_err(|e| {
+                    match velocities {
+                        // Carried velocities were found finite as they
+                        // were computed: not read a second time.
+                        Some(v) if !regrow_velocities => out.set_finite_velocities(v),
+                        Some(v) => out.set_velocities(Some(v)).map_err(|e| {
                             GroomWriteError::Groom(self.spec.error(
                                 "animation",
                                 GroomErrorKind::Velocities {
@@ -835,7 +841,8 @@ impl AnimatedGroom {
                                     error: e,
                                 },
                             ))
-                        })?;
+                        })?,
+                        None => {}
                     }
                     if !counted {
                         summary.hairs += out.curve_count() as u64;
@@ -993,10 +1000,11 @@ impl AnimatedGroom {
         time: f64,
         poses: Option<&(SkinPose, SkinPose, f32)>,
         rest: &Option<(Curves, RestFrames)>,
+        buffer: Vec<Vec3>,
     ) -> Result<Option<Vec<Vec3>>, GroomWriteError> {
         Ok(match (poses, rest) {
             (Some((minus, plus, per_second)), Some((curves, frames))) => Some(
-                self.velocities((curves, frames), (minus, plus), *per_second)
+                self.velocities((curves, frames), (minus, plus), *per_second, buffer)
                     .ok_or_else(|| {
                         GroomWriteError::Groom(self.spec.error(
                             "animation",
