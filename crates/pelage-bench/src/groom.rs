@@ -160,6 +160,16 @@ width = {{ root = 0.0015, tip = 0.0002 }}
     )
 }
 
+/// The Stubble figure with blue-noise roots (each part thinned on its
+/// own).
+fn blue_noise_text(hairs: u64) -> String {
+    groom_text(hairs, "shepard").replacen(
+        "[roots]\n",
+        "[roots]\ndistribution = \"blue-noise\"\n",
+        1,
+    )
+}
+
 /// The Stubble figure with hair ids numbered part by part, as before
 /// stable ids (the baseline of their cost).
 fn sequential_ids_text(hairs: u64) -> String {
@@ -288,6 +298,9 @@ struct GroomFigures {
     look_s: f64,
     /// With `[finish] outside_skin`: points pushed out of the skin.
     outside_s: f64,
+    /// With `[roots] distribution = "blue-noise"`: each part's roots
+    /// drawn four times over and thinned.
+    blue_noise_s: f64,
     stable_ratio: f64,
     parted_ratio: f64,
     style_prep_s: f64,
@@ -363,6 +376,9 @@ fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
     let outside = Groom::from_text("<bench>", groom_text(hairs, "shepard") + OUTSIDE_SKIN)?;
     let (outside_s, outside_counted) = median_seconds(runs, false, || grow_all(&outside));
     outside_counted?;
+    let blue_noise = Groom::from_text("<bench>", blue_noise_text(hairs))?;
+    let (blue_noise_s, blue_noise_counted) = median_seconds(runs, false, || grow_all(&blue_noise));
+    blue_noise_counted?;
     let stable_ratio = shepard_s / sequential_s;
     let parted_ratio = parted_s / sequential_s;
     let (style_prep_s, _) = median_seconds(1, false, || style.generator(None).map(|_| ()));
@@ -412,6 +428,7 @@ fn measure(args: &GroomBenchArgs) -> anyhow::Result<GroomFigures> {
         fraction_s,
         look_s,
         outside_s,
+        blue_noise_s,
         stable_ratio,
         parted_ratio,
         style_prep_s,
@@ -446,6 +463,7 @@ impl GroomFigures {
             fraction_s,
             look_s,
             outside_s,
+            blue_noise_s,
             stable_ratio,
             parted_ratio,
             style_prep_s,
@@ -492,6 +510,8 @@ impl GroomFigures {
             "look_ratio": look_s / shepard_s,
             "outside_skin_seconds": outside_s,
             "outside_skin_ratio": outside_s / shepard_s,
+            "blue_noise_groom_seconds": blue_noise_s,
+            "blue_noise_groom_ratio": blue_noise_s / shepard_s,
             "rss_hairs": rss_hairs,
             "peak_rss_bytes": rss,
             "rss_usd_bytes": usd_bytes,
@@ -520,6 +540,7 @@ impl GroomFigures {
             fraction_s,
             look_s,
             outside_s,
+            blue_noise_s,
             stable_ratio,
             parted_ratio,
             style_s,
@@ -572,27 +593,29 @@ impl GroomFigures {
             hair_count as f64 / parted_s / 1e6,
             format!("{parted_ratio:.2}× old")
         );
-        println!(
-            "{:<40} {:>10.3} {:>12.2} {:>14}",
+        // The same groom with one thing changed, against all of it.
+        let variant = |label: &str, seconds: f64, hairs: f64, target: &str| {
+            println!(
+                "{label:<40} {seconds:>10.3} {:>12.2} {:>14}",
+                hairs / seconds / 1e6,
+                format!("{:.3}× all{target}", seconds / shepard_s)
+            );
+        };
+        let hairs = hair_count as f64;
+        variant(
             "  a tenth (--fraction 0.1), wider hairs",
             fraction_s,
-            hair_count as f64 / 10.0 / fraction_s / 1e6,
-            format!("{:.3}× all", fraction_s / shepard_s)
+            hairs / 10.0,
+            "",
         );
-        println!(
-            "{:<40} {:>10.3} {:>12.2} {:>14}",
-            "  with a [look] (melanin map, jitter)",
-            look_s,
-            hair_count as f64 / look_s / 1e6,
-            format!("{:.3}× all", look_s / shepard_s)
-        );
-        println!(
-            "{:<40} {:>10.3} {:>12.2} {:>14}",
+        variant("  with a [look] (melanin map, jitter)", look_s, hairs, "");
+        variant(
             "  hairs out of the skin (outside_skin)",
             outside_s,
-            hair_count as f64 / outside_s / 1e6,
-            format!("{:.3}× all, target ≤ 1.25×", outside_s / shepard_s)
+            hairs,
+            ", target ≤ 1.25×",
         );
+        variant("  blue-noise roots", blue_noise_s, hairs, ", target ≤ 1.5×");
         println!(
             "{:<40} {:>10.3} {:>12.2} {:>14}",
             "style mesh, all of it",
