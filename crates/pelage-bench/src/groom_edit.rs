@@ -112,7 +112,7 @@ fn comb(groom: &mut EditableGroom, dabs: &[Dab]) -> anyhow::Result<(f64, usize, 
 
 fn measure(args: &GroomBenchArgs) -> anyhow::Result<EditFigures> {
     let (hairs, peer_hairs, runs, dab_count) = args.scale().pick(
-        (1_600_000u64, 1_000_000u64, 3, 9),
+        (1_600_000u64, 1_000_000u64, 3, 25),
         (200_000, 200_000, 3, 7),
         (5_000, 5_000, 1, 3),
     );

@@ -448,8 +448,8 @@ impl GrownHairs {
             by_cell[c].push((k, first..first + n));
             first += n;
         }
-        let grown = grown.as_ref();
         let flags = (self.normals, self.colors, self.opacities, self.root_uvs);
+        let grown_ref = grown.as_ref();
         self.cells
             .par_iter_mut()
             .zip(by_cell)
@@ -459,10 +459,16 @@ impl GrownHairs {
                     return;
                 }
                 replaced.sort_unstable_by_key(|(k, _)| *k);
-                if !(complete && replace_in_place(cell, &replaced, grown, flags)) {
-                    splice(cell, &replaced, grown, flags);
+                if !(complete && replace_in_place(cell, &replaced, grown_ref, flags)) {
+                    splice(cell, &replaced, grown_ref, flags);
                 }
             });
+        // The next edit's generator shares this one's spare arrays (a
+        // guide edit keeps the roots): it grows into them instead of into
+        // fresh pages the kernel must zero.
+        if let Some(grown) = grown {
+            generator.recycle(grown);
+        }
         Ok(())
     }
 
