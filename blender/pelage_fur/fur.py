@@ -525,6 +525,37 @@ def deform_on_surface_modifier(obj):
     return modifier
 
 
+def surface_deforms(surface):
+    """Whether anything moves the vertices of ``surface`` under its fur:
+    shape keys or a modifier (an armature's, a lattice's, a
+    displacement…). Without them the mesh Blender shows is its rest pose,
+    Deform Curves on Surface would move nothing, and the object's own
+    motion carries the fur by the parenting alone."""
+    return surface.data.shape_keys is not None or len(surface.modifiers) > 0
+
+
+def deform_modifier_of(obj):
+    """The fur object's Deform Curves on Surface modifier, or None."""
+    return next((m for m in obj.modifiers if m.type == "NODES" and m.node_group is not None
+                 and m.node_group.name == DEFORM_GROUP), None)
+
+
+def follow_surface(obj, surface):
+    """Gives the fur ``obj`` Deform Curves on Surface when ``surface``
+    deforms and has a UV map, and takes it away when it no longer does:
+    the node recomputes every point on every update of the fur (180 ms at
+    1.2 M points, most of a live comb's time), for nothing on a mesh that
+    nothing deforms. A user's own modifiers stay."""
+    modifier = deform_modifier_of(obj)
+    needed = surface.data.uv_layers.active is not None and surface_deforms(surface)
+    if needed and modifier is None:
+        # The node compares the deformed surface with its rest positions.
+        use_rest_positions(surface)
+        deform_on_surface_modifier(obj)
+    elif not needed and modifier is not None:
+        obj.modifiers.remove(modifier)
+
+
 def guide_warnings(report):
     """The guides a groom leaves out, with why, from its report (the
     library's: ``Groom.report()`` or ``Groom.write()["report"]``)."""
@@ -698,10 +729,7 @@ def save_groom_file(context, surface, settings, path):
 def fur_object_of(surface):
     """The fur a grow made on ``surface`` before (a Curves object parented
     to it that carries pelage's settings), or None."""
-    import bpy
-
-    return next((o for o in bpy.data.objects
-                 if o.type == "CURVES" and o.parent == surface and "pelage_settings" in o), None)
+    return next((o for o in surface.children if o.type == "CURVES" and "pelage_settings" in o), None)
 
 
 #: What Length and Width start at on an object, fractions of its largest
@@ -816,12 +844,7 @@ def finish_grow(surface, settings, prepared, grown, session):
         obj.matrix_parent_inverse.identity()
     else:
         replace_data(obj, data)
-    if uv_map is not None:
-        # The node compares the deformed surface with its rest positions.
-        use_rest_positions(surface)
-        if not any(m.type == "NODES" and m.node_group is not None
-                   and m.node_group.name == DEFORM_GROUP for m in obj.modifiers):
-            deform_on_surface_modifier(obj)
+    follow_surface(obj, surface)
     obj["pelage_settings"] = groom.settings
     # Where the object was when grown (the rest pose is moved by the
     # object's own transform): exports at other frames start from there.
@@ -1014,6 +1037,13 @@ def on_depsgraph_update(scene, depsgraph):
     import bpy
 
     touched = {update.id.original for update in depsgraph.updates}
+    # A surface rigged, shape-keyed or given a modifier after its fur
+    # was grown: the fur follows it from now on.
+    for surface in touched:
+        if isinstance(surface, bpy.types.Object) and surface.type == "MESH":
+            fur = fur_object_of(surface)
+            if fur is not None:
+                follow_surface(fur, surface)
     for name in list(LIVE):
         surface = bpy.data.objects.get(name)
         if surface is None:

@@ -7,8 +7,12 @@ CASE_DIR holds case.json (the add-on's folder, hairs, guides a side,
 edits). On a grid with guides in a hair Curves object it times (1) Grow
 pelage fur with Live on (the session's start and the transfer), (2) each
 guide edit followed by the add-on's `live_update` (pelage's incremental
-regrowth, the points into the Curves object), median of the edits, and
-(3) the peer: Blender's Distribute Points on Faces + Interpolate Curves
+regrowth, the points into the Curves object), median of the edits,
+(2b) the same end to end: the edit, the add-on's handler as Blender runs
+it after a depsgraph update, and Blender's own evaluation of the fur
+object after it (its modifiers, what a redraw waits for), on the grid as
+it is and again with a shape key (the fur then has Deform Curves on
+Surface), and (3) the peer: Blender's Distribute Points on Faces + Interpolate Curves
 (geometry nodes) re-evaluated after the same edits, median. Prints one
 JSON line.
 """
@@ -79,6 +83,47 @@ for edit in edits:
     pelage_times.append(time.perf_counter() - start)
     assert done is not None
 
+
+def evaluated_fur_points():
+    """The fur's points as Blender evaluates them for display."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    depsgraph.update()
+    evaluated = fur_object.evaluated_get(depsgraph).data
+    return len(evaluated.points)
+
+
+# End to end: the comb as the user makes it. The edit, the depsgraph
+# update that reports it (the add-on's handler schedules the regrow),
+# the scheduled regrow, and Blender's evaluation of the moved fur.
+def combs(points):
+    """Each edit combed end to end; the seconds of each, and the guides'
+    points after."""
+    evaluated_fur_points()
+    fur.PENDING.clear()
+    times = []
+    for edit in edits:
+        points = apply(points, edit)
+        start = time.perf_counter()
+        bpy.context.evaluated_depsgraph_get().update()
+        assert fur.PENDING.get(grid.name) is not None, "the handler saw the comb"
+        fur.PENDING.pop(grid.name, None)
+        assert fur.live_update(grid) is not None
+        evaluated_fur_points()
+        times.append(time.perf_counter() - start)
+    return times, points
+
+
+# Nothing deforms the grid: the fur has no Deform Curves on Surface.
+assert fur.deform_modifier_of(fur_object) is None
+comb_times, points = combs(points)
+# A shape key on the grid: now the fur has the modifier, whose node
+# recomputes every point of the fur after each comb.
+grid.shape_key_add(name="Basis")
+grid.shape_key_add(name="lifted").value = 0.5
+bpy.context.view_layer.update()
+assert fur.deform_modifier_of(fur_object) is not None
+deforming_times, points = combs(points)
+
 # The peer, on the same grid and guides (the live fur object removed).
 bpy.data.objects.remove(fur_object)
 fur.LIVE.clear()
@@ -116,6 +161,8 @@ print(json.dumps({
     "edit_update_s": statistics.median(pelage_times),
     "edit_update_min_s": min(pelage_times),
     "edit_update_max_s": max(pelage_times),
+    "live_comb_s": statistics.median(comb_times),
+    "live_comb_deforming_s": statistics.median(deforming_times),
     "blender_interpolate_s": statistics.median(blender_times),
     "blender_hairs": blender_hairs,
     "edits": len(edits),
