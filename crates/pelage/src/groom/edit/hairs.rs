@@ -196,6 +196,21 @@ impl HairIndex {
     }
 }
 
+/// Drops each root that repeats the one before it, with its id (ids are
+/// unique to a root, so equal ids mean the same root).
+fn dedup_pairs(roots: &mut Vec<SurfacePoint>, ids: &mut Vec<u64>) {
+    let mut kept = 0;
+    for i in 0..ids.len() {
+        if kept == 0 || ids[i] != ids[kept - 1] {
+            roots[kept] = roots[i];
+            ids[kept] = ids[i];
+            kept += 1;
+        }
+    }
+    roots.truncate(kept);
+    ids.truncate(kept);
+}
+
 fn pack(cell: usize, k: usize) -> u64 {
     ((cell as u64) << 32) | k as u64
 }
@@ -268,7 +283,11 @@ impl GrownHairs {
         };
         let recipes = everything || change.recipes || change.roots || centres_moved;
         let affected: Vec<u64> = if !recipes && change.touched_triangles.is_empty() {
-            // Guides moved, nothing else: the indices answer.
+            // Guides moved, nothing else: the indices answer. A hair
+            // weighted by several moved guides is listed once for each;
+            // `regrow` drops the repeats after its sort by triangle, which
+            // puts them side by side (a sort of the packed list first cost
+            // a twentieth of a comb dab).
             let mut hairs: Vec<u64> = Vec::new();
             for &g in &change.moved_guides {
                 hairs.extend_from_slice(self.by_guide.of(g));
@@ -278,8 +297,6 @@ impl GrownHairs {
                     hairs.extend_from_slice(self.by_centre[level].of(centre as u32));
                 }
             }
-            hairs.par_sort_unstable();
-            hairs.dedup();
             hairs
         } else {
             self.compare_all(
@@ -293,12 +310,12 @@ impl GrownHairs {
             )
         };
         self.levels = new_levels.len();
-        self.regrow(new, cells.len(), &affected)?;
+        let regrown = self.regrow(new, cells.len(), &affected)?;
         if recipes {
             self.rebuild_indices(new.guides().len(), &new_levels);
         }
         Ok(Regrowth {
-            regrown_roots: affected.len(),
+            regrown_roots: regrown,
             hairs: self.cells.iter().map(CellHairs::hair_count).sum(),
         })
     }
@@ -400,14 +417,15 @@ impl GrownHairs {
         per_cell.concat()
     }
 
-    /// Grows the roots `affected` (packed cell and root) with `generator`
-    /// and splices their hairs into their cells.
+    /// Grows the roots `affected` (packed cell and root, repeats allowed)
+    /// with `generator` and splices their hairs into their cells; returns
+    /// how many roots it grew.
     fn regrow(
         &mut self,
         generator: &Generator,
         cell_count: usize,
         affected: &[u64],
-    ) -> Result<(), GroomError> {
+    ) -> Result<usize, GroomError> {
         self.normals = generator.normals;
         self.colors = generator.colors;
         self.opacities = generator.opacities;
@@ -429,7 +447,10 @@ impl GrownHairs {
             .collect();
         // Grown in the order a part grows them (by triangle), which keeps
         // the guide searches' candidate lists warm.
-        let (roots, ids) = sorted_by_triangle_with_ids(roots, ids);
+        let (mut roots, mut ids) = sorted_by_triangle_with_ids(roots, ids);
+        // A root listed twice is now next to itself (same root, same id).
+        dedup_pairs(&mut roots, &mut ids);
+        let regrown = roots.len();
         let (grown, per_root) = if roots.is_empty() {
             (None, None)
         } else {
@@ -469,7 +490,7 @@ impl GrownHairs {
         if let Some(grown) = grown {
             generator.recycle(grown);
         }
-        Ok(())
+        Ok(regrown)
     }
 
     fn rebuild_indices(&mut self, guides: usize, levels: &[&ClumpCentres]) {
