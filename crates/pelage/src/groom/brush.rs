@@ -22,7 +22,7 @@ use super::edit::{EditableGroom, Regrowth};
 use super::error::{GroomError, GroomErrorKind};
 use super::regions::{RegionSource, RegionsSpec};
 use super::spec::GroomSpec;
-use crate::groom::edit::Edit;
+use crate::groom::edit::{Edit, LayerSetup};
 use crate::guides::{Guides, resample_by_arc_length};
 use crate::interp::HairScratch;
 use crate::map::{Map, VertexMap};
@@ -335,7 +335,7 @@ impl EditableGroom {
             },
             // The layer first, then the dab on it, as one step.
             Some(setup) => self
-                .apply_then(Edit::NewLayer(Box::new(setup)), edit_on)
+                .apply_then(Edit::NewLayer(LayerSetup(Box::new(setup))), edit_on)
                 .map(Some),
         }
     }

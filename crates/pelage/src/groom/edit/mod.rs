@@ -71,8 +71,8 @@ pub enum Edit {
     /// hair as it was: a density scale of ones, a region layer of zeros.
     /// The roots and recipes are found again and compared, so only the
     /// hairs whose recipe differs (none, or a few at float rounding) are
-    /// regrown.
-    NewLayer(Box<GroomSpec>),
+    /// regrown. Made by the paint and part brushes only.
+    NewLayer(LayerSetup),
     /// Several edits undone and redone as one.
     Group(Vec<Edit>),
 }
@@ -86,13 +86,19 @@ impl Edit {
             Edit::Paint {
                 vertices, values, ..
             } => vertices.len() * 4 + values.len() * 4,
-            Edit::ReplaceSpec(spec) | Edit::NewLayer(spec) => {
+            Edit::ReplaceSpec(spec) | Edit::NewLayer(LayerSetup(spec)) => {
                 spec.mesh.vertex_count() * 4 * (spec.mesh.vertex_attributes().len() + 1) + 1024
             }
             Edit::Group(edits) => edits.iter().map(Edit::bytes).sum(),
         }
     }
 }
+
+/// A groom that differs from the one it follows by paint layers, the
+/// density scale and the regions alone. Only the brushes make one: its
+/// regrowth compares roots and recipes, and would miss any other change.
+#[derive(Debug, Clone)]
+pub struct LayerSetup(pub(crate) Box<GroomSpec>);
 
 /// An edit and its inverse, as the undo and redo stacks keep them.
 #[derive(Debug, Clone)]
@@ -524,8 +530,8 @@ impl EditableGroom {
                 ));
                 Ok((Edit::ReplaceSpec(old), regrowth))
             }
-            Edit::NewLayer(spec) => {
-                let old = Box::new(self.spec.clone());
+            Edit::NewLayer(LayerSetup(spec)) => {
+                let old = LayerSetup(Box::new(self.spec.clone()));
                 let keep = Keep {
                     roots: false,
                     regions: false,
