@@ -397,7 +397,20 @@ fn check_numbers(spec: &GroomSpec) -> Result<(), GroomError> {
 fn root_sampling(spec: &GroomSpec) -> Result<RootSampling, GroomError> {
     let mesh = &spec.mesh;
     let sampler = DensitySampler::new(mesh, &spec.roots.sampled_density(), Default::default())
-        .map_err(|e| spec.error("roots.density", GroomErrorKind::Sample(e)))?;
+        .map_err(|e| {
+            // A scaled density that fails where the density alone does
+            // not: the scale is what to fix (only on this error path is
+            // the density sampled alone).
+            let scaled = !matches!(spec.roots.density_scale, Map::Constant(c) if c == 1.0);
+            let key = if scaled
+                && DensitySampler::new(mesh, &spec.roots.density, Default::default()).is_ok()
+            {
+                "roots.density_scale"
+            } else {
+                "roots.density"
+            };
+            spec.error(key, GroomErrorKind::Sample(e))
+        })?;
     // A fraction grows the first arrivals: a subset of the groom.
     let grown = spec.roots.grown_count();
     let parts = part_count(mesh, grown, spec.roots.parts, spec.roots.ids);
