@@ -1660,6 +1660,14 @@ fn converting_an_animated_file_says_it_writes_the_first_sample() {
             "{ext}: {}",
             stderr(&out)
         );
+        // The first sample, as the ordinary reader reads it (convert
+        // parses a USD file once for both the curves and the count).
+        let first = pelage::io::read_curves(&animated).unwrap();
+        let written = pelage::io::read_curves(&ply).unwrap();
+        assert_eq!(written.points(), first.points(), "{ext}");
+        assert_eq!(written.offsets(), first.offsets(), "{ext}");
+        let (read, samples) = pelage::io::read_curves_and_sample_count(&animated).unwrap();
+        assert_eq!((read.points(), samples), (first.points(), 3), "{ext}");
     }
     // A still file converts without a word.
     let still_groom = dir.path().join("still.toml");

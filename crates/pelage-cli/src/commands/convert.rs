@@ -7,7 +7,8 @@ use anyhow::Context;
 use clap::builder::TypedValueParser;
 use clap::{Args, ValueEnum};
 use pelage::io::{
-    CurveBasis, CurvesExport, UpAxis, UsdOptions, UsdWrap, read_curves, write_curves,
+    CurveBasis, CurvesExport, UpAxis, UsdOptions, UsdWrap, read_curves_and_sample_count,
+    write_curves,
 };
 use std::path::PathBuf;
 
@@ -81,9 +82,9 @@ impl ConvertArgs {
 }
 
 pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
-    let curves = read_curves(&args.input).context("cannot read the curves")?;
     // An animated file converts at its first sample: said, not silent.
-    let samples = pelage::io::curves_sample_count(&args.input).unwrap_or(1);
+    let (curves, samples) =
+        read_curves_and_sample_count(&args.input).context("cannot read the curves")?;
     if samples > 1 {
         eprintln!(
             "note: {} is animated ({samples} time samples): convert writes its first; its skin, if it has one, is not converted (`--with-mesh` writes a still mesh); `pelage render --frames` and Python's read_curves(path, time=) read the others",

@@ -118,6 +118,25 @@ pub fn read_curves(path: &Path) -> Result<Curves, CurvesReadError> {
     }
 }
 
+/// [`read_curves`] and [`curves_sample_count`] at once, reading a USD
+/// file once instead of twice (`pelage convert` of a large file).
+pub fn read_curves_and_sample_count(path: &Path) -> Result<(Curves, usize), CurvesReadError> {
+    if let Some(CurvesFormat::Usda | CurvesFormat::Usdc) = CurvesFormat::from_path(path)
+        && path.is_file()
+    {
+        let sequence = super::UsdCurvesSequence::open(path)?;
+        let samples = sequence.times().len().max(1);
+        return match sequence.first() {
+            Some(curves) => Ok((curves?, samples)),
+            // An assembly: its references read by the ordinary reader.
+            None => Ok((read_curves(path)?, samples)),
+        };
+    }
+    // Alembic and the rest: the count read apart (a file whose count
+    // cannot be read converts as still, as its curves read).
+    Ok((read_curves(path)?, curves_sample_count(path).unwrap_or(1)))
+}
+
 /// How many times a curves file samples its curves: 1 for a still file
 /// (PLY, .hair, a USD or Alembic file without time samples), the count
 /// for an animated USD or Alembic file, of which [`read_curves`] reads

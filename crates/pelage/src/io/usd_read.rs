@@ -127,6 +127,14 @@ impl UsdCurvesSequence {
         curves_from_layer(&self.path, self.layer.as_ref(), Some(time))
     }
 
+    /// The curves at their first sample, as [`read_usd_curves`] reads
+    /// them; `None` for a layer that holds no curves itself (a farm
+    /// assembly, whose references [`read_usd_curves`] follows).
+    pub fn first(&self) -> Option<Result<Curves, CurvesReadError>> {
+        let data = self.layer.as_ref();
+        (!curve_prims(data).is_empty()).then(|| curves_from_layer(&self.path, data, None))
+    }
+
     /// The time codes at which any curves' points are sampled, ascending
     /// (empty for still curves).
     pub fn times(&self) -> Vec<f64> {
