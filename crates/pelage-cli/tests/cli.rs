@@ -1692,4 +1692,8 @@ fn converting_an_animated_file_says_it_writes_the_first_sample() {
         "{}",
         stderr(&out)
     );
+    let written = pelage::io::read_curves(&dir.path().join("still.ply")).unwrap();
+    let read = pelage::io::read_curves(&still).unwrap();
+    assert_eq!(written.points(), read.points());
+    assert_eq!(written.widths(), read.widths());
 }
