@@ -116,6 +116,9 @@ pub struct UsdCurvesSequence {
 impl UsdCurvesSequence {
     /// Parses the file at `path`.
     pub fn open(path: &Path) -> Result<Self, CurvesReadError> {
+        // An input of this run: no writer may replace it.
+        crate::io::check_input(path, "a USD file (.usd, .usda, .usdc)")
+            .map_err(|e| CurvesReadError::whole(path, Kind::Io(e)))?;
         Ok(Self {
             path: path.to_path_buf(),
             layer: open_layer_with(path, true)?,
