@@ -224,27 +224,21 @@ fn a_groom_built_in_code_equals_the_same_groom_file() {
 fn a_negative_density_scale_is_blamed_on_the_scale_at_its_line() {
     // The roots are drawn from the density times its scale: where only
     // the product goes negative, the scale is named, not the density.
-    let text = |density: &str, scale: &str| {
-        format!(
+    let message = |density: &str, scale: &str| {
+        let text = format!(
             "[mesh]\npath = \"spot\"\n[roots]\ncount = 10\ndensity = \"{density}\"\ndensity_scale = \"{scale}\"\n[guides]\ngenerate = {{ count = 5, length = 0.1 }}\n"
-        )
+        );
+        groom(&text).generator(None).unwrap_err().to_string()
     };
-    let err = groom(&text("noise:frequency=3", "noise:offset=-2"))
-        .generator(None)
-        .unwrap_err();
-    let message = err.to_string();
+    let scale = message("noise:frequency=3", "noise:offset=-2");
     assert!(
-        message.starts_with("test.toml:6:17: roots.density_scale: ")
-            && message.contains("negative"),
-        "{message}"
+        scale.starts_with("test.toml:6:17: roots.density_scale: ") && scale.contains("negative"),
+        "{scale}"
     );
-    let err = groom(&text("noise:offset=-2", "noise:frequency=3"))
-        .generator(None)
-        .unwrap_err();
-    let message = err.to_string();
+    let density = message("noise:offset=-2", "noise:frequency=3");
     assert!(
-        message.starts_with("test.toml:5:11: roots.density: "),
-        "{message}"
+        density.starts_with("test.toml:5:11: roots.density: "),
+        "{density}"
     );
 }
 

@@ -811,8 +811,6 @@ impl AnimatedGroom {
                 for &time in &output.times {
                     let k = index(time);
                     let generator = generators[k].as_ref().unwrap_or(&self.generator);
-                    // The last frame's velocities are this one's buffer.
-                    let buffer = out.take_velocities().unwrap_or_default();
                     let velocities = if regrow_velocities {
                         let window = Window {
                             times: &times,
@@ -825,6 +823,8 @@ impl AnimatedGroom {
                     } else {
                         let at = (&poses[k], outsides[k].as_ref());
                         self.part_at(p, time, at, generator, &mut rest, &mut out)?;
+                        // The last frame's velocities are this one's buffer.
+                        let buffer = out.take_velocities().unwrap_or_default();
                         let poses = velocity_poses.get(k);
                         self.deform_velocities(p, time, poses, &rest, buffer)?
                     };

@@ -118,8 +118,10 @@ pub fn read_curves(path: &Path) -> Result<Curves, CurvesReadError> {
     }
 }
 
-/// [`read_curves`] and [`curves_sample_count`] at once, reading a USD
-/// file once instead of twice (`pelage convert` of a large file).
+/// [`read_curves`] and how many times the file samples its curves: 1 for
+/// a still file (PLY, .hair, a USD or Alembic file without time samples),
+/// the count for an animated USD or Alembic file, of which the curves are
+/// the first. A USD file is parsed once for both.
 pub fn read_curves_and_sample_count(path: &Path) -> Result<(Curves, usize), CurvesReadError> {
     if let Some(CurvesFormat::Usda | CurvesFormat::Usdc) = CurvesFormat::from_path(path)
         && path.is_file()
@@ -132,23 +134,14 @@ pub fn read_curves_and_sample_count(path: &Path) -> Result<(Curves, usize), Curv
             None => Ok((read_curves(path)?, samples)),
         };
     }
-    // Alembic and the rest: the count read apart (a file whose count
-    // cannot be read converts as still, as its curves read).
-    Ok((read_curves(path)?, curves_sample_count(path).unwrap_or(1)))
-}
-
-/// How many times a curves file samples its curves: 1 for a still file
-/// (PLY, .hair, a USD or Alembic file without time samples), the count
-/// for an animated USD or Alembic file, of which [`read_curves`] reads
-/// the first.
-pub fn curves_sample_count(path: &Path) -> Result<usize, CurvesReadError> {
-    Ok(match CurvesFormat::from_path(path) {
-        Some(CurvesFormat::Usda | CurvesFormat::Usdc) => {
-            super::UsdCurvesSequence::open(path)?.times().len().max(1)
-        }
-        Some(CurvesFormat::Abc) => super::read_abc_sample_count(path)?.max(1),
+    let curves = read_curves(path)?;
+    // Alembic's count is read apart (a file whose count cannot be read
+    // counts as still, as its curves read).
+    let samples = match CurvesFormat::from_path(path) {
+        Some(CurvesFormat::Abc) => super::read_abc_sample_count(path).map_or(1, |n| n.max(1)),
         _ => 1,
-    })
+    };
+    Ok((curves, samples))
 }
 
 /// How [`write_curves`] writes.

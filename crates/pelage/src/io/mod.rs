@@ -46,8 +46,8 @@ pub use atomic::{
     protect_inputs, remove_temporary_files, write_atomically, write_atomically_with,
 };
 pub use curves_file::{
-    CurvesExport, CurvesFormat, curves_sample_count, read_curves, read_curves_and_sample_count,
-    write_curves, write_streamed,
+    CurvesExport, CurvesFormat, read_curves, read_curves_and_sample_count, write_curves,
+    write_streamed,
 };
 pub use curves_ply::{read_curves_ply, write_curves_ply};
 pub use hair::{HairFile, HairWriteError};

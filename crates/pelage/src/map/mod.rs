@@ -222,20 +222,16 @@ impl Map {
     /// mesh's values. Fails, naming the mesh, when the map reads UVs and
     /// the mesh has none, or names a vertex attribute it does not have.
     pub fn bind(&mut self, mesh: &Mesh) -> Result<(), MapError> {
+        if let Map::Product(maps) = self {
+            // Each factor checks itself.
+            return maps.iter_mut().try_for_each(|map| map.bind(mesh));
+        }
         self.check_on(mesh)?;
-        match self {
-            Map::Vertex(vertex) => {
-                let attribute = mesh
-                    .vertex_attribute(&vertex.name)
-                    .expect("on_mesh checked the attribute");
-                vertex.values = Some(attribute.values.clone());
-            }
-            Map::Product(maps) => {
-                for map in maps.iter_mut() {
-                    map.bind(mesh)?;
-                }
-            }
-            _ => {}
+        if let Map::Vertex(vertex) = self {
+            let attribute = mesh
+                .vertex_attribute(&vertex.name)
+                .expect("on_mesh checked the attribute");
+            vertex.values = Some(attribute.values.clone());
         }
         Ok(())
     }

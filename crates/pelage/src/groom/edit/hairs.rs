@@ -196,21 +196,6 @@ impl HairIndex {
     }
 }
 
-/// Drops each root that repeats the one before it, with its id (ids are
-/// unique to a root, so equal ids mean the same root).
-fn dedup_pairs(roots: &mut Vec<SurfacePoint>, ids: &mut Vec<u64>) {
-    let mut kept = 0;
-    for i in 0..ids.len() {
-        if kept == 0 || ids[i] != ids[kept - 1] {
-            roots[kept] = roots[i];
-            ids[kept] = ids[i];
-            kept += 1;
-        }
-    }
-    roots.truncate(kept);
-    ids.truncate(kept);
-}
-
 fn pack(cell: usize, k: usize) -> u64 {
     ((cell as u64) << 32) | k as u64
 }
@@ -447,9 +432,14 @@ impl GrownHairs {
             .collect();
         // Grown in the order a part grows them (by triangle), which keeps
         // the guide searches' candidate lists warm.
-        let (mut roots, mut ids) = sorted_by_triangle_with_ids(roots, ids);
-        // A root listed twice is now next to itself (same root, same id).
-        dedup_pairs(&mut roots, &mut ids);
+        let (roots, ids) = sorted_by_triangle_with_ids(roots, ids);
+        // A root listed twice is now next to itself (same root, same id;
+        // ids are unique to a root).
+        let (roots, ids): (Vec<SurfacePoint>, Vec<u64>) = {
+            let mut pairs: Vec<_> = roots.into_iter().zip(ids).collect();
+            pairs.dedup_by_key(|(_, id)| *id);
+            pairs.into_iter().unzip()
+        };
         let regrown = roots.len();
         let (grown, per_root) = if roots.is_empty() {
             (None, None)
