@@ -160,8 +160,8 @@ width = {{ root = 0.0015, tip = 0.0002 }}
     )
 }
 
-/// The Stubble figure with blue-noise roots (each part thinned on its
-/// own).
+/// The Stubble figure with blue-noise roots (thinned all parts
+/// together).
 fn blue_noise_text(hairs: u64) -> String {
     groom_text(hairs, "shepard").replacen(
         "[roots]\n",
@@ -298,8 +298,8 @@ struct GroomFigures {
     look_s: f64,
     /// With `[finish] outside_skin`: points pushed out of the skin.
     outside_s: f64,
-    /// With `[roots] distribution = "blue-noise"`: each part's roots
-    /// drawn four times over and thinned.
+    /// With `[roots] distribution = "blue-noise"`: the roots drawn twice
+    /// over and thinned, all parts together.
     blue_noise_s: f64,
     stable_ratio: f64,
     parted_ratio: f64,

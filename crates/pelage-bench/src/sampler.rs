@@ -39,6 +39,12 @@ pub struct SamplerBenchArgs {
     /// tests/data/meshes).
     #[arg(long)]
     pub meshes: Option<PathBuf>,
+    /// Measure a peer in the same run: `blender` times Blender's Poisson
+    /// Disk distribution for the blue noise's count and spacing, with
+    /// Blender as a Python module (bpy, set up in a cached venv by
+    /// tools/bpy-python).
+    #[arg(long, value_enum)]
+    pub peer: Option<crate::groom::Peer>,
 }
 
 impl SamplerBenchArgs {
@@ -166,6 +172,7 @@ pub fn run(args: &SamplerBenchArgs) -> anyhow::Result<()> {
     let (sampler, rate_all) = run.headline()?;
     run.stable_ids(&sampler, rate_all);
     run.blue_noise(&sampler);
+    run.blue_noise_against_blender(args.peer.is_some());
     run.selectors(&sampler);
     drop(sampler);
     run.table1()?;
@@ -350,8 +357,8 @@ impl SamplerRun {
         Ok((sampler, rate_all))
     }
 
-    /// Blue-noise samples (weighted sample elimination over the whole
-    /// mesh) against random samples of the same count, mesh and density,
+    /// Blue-noise samples (dart throwing over the whole mesh's
+    /// candidates) against random samples of the same count, mesh and density,
     /// on every thread, with where the blue noise's time goes.
     fn blue_noise(&mut self, sampler: &DensitySampler) {
         let n = self.plan.blue_noise;
@@ -382,7 +389,7 @@ impl SamplerRun {
                 },
                 Row {
                     cells: vec![
-                        "blue noise (4× candidates, eliminated)".into(),
+                        "blue noise (2× candidates, dart throwing)".into(),
                         format!("{:.1} ms", blue_s * 1e3),
                         format!("{ratio:.1}"),
                         "≤ 3".into(),
@@ -398,7 +405,7 @@ impl SamplerRun {
                 },
                 Row {
                     cells: vec![
-                        "  kd-tree and neighbours within 2r".into(),
+                        "  grid of cells (sort by cell)".into(),
                         format!("{:.1} ms", phases.neighbours * 1e3),
                         share(phases.neighbours),
                         "".into(),
@@ -406,7 +413,7 @@ impl SamplerRun {
                 },
                 Row {
                     cells: vec![
-                        "  elimination (one at a time)".into(),
+                        "  dart throwing and the count".into(),
                         format!("{:.1} ms", phases.elimination * 1e3),
                         share(phases.elimination),
                         "".into(),
@@ -426,6 +433,81 @@ impl SamplerRun {
             .insert("blue_noise_neighbours_s".into(), phases.neighbours.into());
         self.json
             .insert("blue_noise_elimination_s".into(), phases.elimination.into());
+    }
+
+    /// Blue noise against Blender's own, same run: Distribute Points on
+    /// Faces in Poisson Disk mode (`blender_poisson.py`) on the same mesh,
+    /// uniform density, for the count of pelage's blue noise and its
+    /// minimum distance (`2 · SPACING · r`, which no two of pelage's
+    /// points come closer than once the count needed only removals).
+    fn blue_noise_against_blender(&mut self, measure: bool) {
+        use pelage::sample::blue_noise::{SPACING, blue_noise_samples, radius};
+        let n = self.plan.blue_noise;
+        let uniform = DensitySampler::new(
+            &self.blub,
+            &Map::Constant(1.0),
+            DensitySamplerOptions::default(),
+        )
+        .expect("a constant density samples");
+        let (pelage_s, points) = median_seconds(self.plan.runs, true, || {
+            blue_noise_samples(&uniform, &self.blub, 1, n)
+        });
+        let area = self.blub.surface_area();
+        let distance = 2.0 * SPACING * radius(n as f64 / area);
+        let closest = closest_pair(&self.blub, &points);
+        let peer = if measure {
+            measure_blender_poisson(&self.blub, n, distance, self.plan.runs)
+                .map_err(|e| format!("{e:#}"))
+        } else {
+            Err("run with --peer blender".to_string())
+        };
+        let title = format!(
+            "Blue noise against Blender: {} points on blub ×1, uniform, at least {distance:.5} apart",
+            thousands(n)
+        );
+        let mut rows = vec![Row {
+            cells: vec![
+                "pelage (dart throwing)".into(),
+                format!("{:.1} ms", pelage_s * 1e3),
+                thousands(points.len() as u64),
+                format!("{closest:.5}"),
+                "".into(),
+            ],
+        }];
+        match &peer {
+            Ok(b) => {
+                let speedup = b.seconds / pelage_s;
+                rows.push(Row {
+                    cells: vec![
+                        format!("Blender {} Poisson Disk", b.version),
+                        format!("{:.1} ms", b.seconds * 1e3),
+                        thousands(b.points),
+                        format!("{distance:.5}"),
+                        format!("pelage {speedup:.2}× faster (target ≥ 1)"),
+                    ],
+                });
+                self.json
+                    .insert("blender_poisson_s".into(), b.seconds.into());
+                self.json
+                    .insert("blender_poisson_points".into(), b.points.into());
+                self.json
+                    .insert("blue_noise_speedup_over_blender".into(), speedup.into());
+            }
+            Err(why) => rows.push(Row {
+                cells: vec![
+                    "Blender Poisson Disk".into(),
+                    "not measured".into(),
+                    "".into(),
+                    "".into(),
+                    why.clone(),
+                ],
+            }),
+        }
+        self.report += &table(&title, &["", "time", "points", "closest pair", ""], &rows);
+        self.json
+            .insert("blue_noise_uniform_s".into(), pelage_s.into());
+        self.json
+            .insert("blue_noise_min_distance".into(), f64::from(distance).into());
     }
 
     /// Stable hair ids: root cells against the whole-mesh alias sampler.
@@ -819,4 +901,56 @@ impl SamplerRun {
         );
         Ok(())
     }
+}
+
+/// Blender's Poisson Disk distribution measured by Blender itself.
+struct BlenderPoisson {
+    seconds: f64,
+    points: u64,
+    version: String,
+}
+
+/// Runs `blender_poisson.py` on `mesh` for `count` points at least
+/// `distance` apart. An error says why it was not measured.
+fn measure_blender_poisson(
+    mesh: &Mesh,
+    count: u64,
+    distance: f32,
+    runs: usize,
+) -> anyhow::Result<BlenderPoisson> {
+    let report = super::run_bpy_case(
+        "blender_poisson.py",
+        include_str!("blender_poisson.py"),
+        |dir| {
+            super::write_mesh_case(dir, mesh)?;
+            let case = serde_json::json!({
+                "count": count,
+                "distance": distance,
+                "area": mesh.surface_area(),
+                "runs": runs,
+            });
+            std::fs::write(dir.join("case.json"), case.to_string())?;
+            Ok(())
+        },
+    )?;
+    let number = |key: &str| report[key].as_f64().context("a number in Blender's report");
+    Ok(BlenderPoisson {
+        seconds: number("seconds")?,
+        points: number("points")? as u64,
+        version: report["blender"].as_str().unwrap_or("?").to_string(),
+    })
+}
+
+/// The smallest distance between two of `points`.
+fn closest_pair(mesh: &Mesh, points: &[SurfacePoint]) -> f32 {
+    let positions: Vec<glam::Vec3> = points.iter().map(|p| p.position(mesh)).collect();
+    let tree = pelage::nearest::NearestPoints::new(positions.clone());
+    positions
+        .par_iter()
+        .map_init(Vec::new, |out, p| {
+            tree.nearest(*p, 2, out);
+            out.get(1)
+                .map_or(f32::INFINITY, |n| n.distance_squared.sqrt())
+        })
+        .reduce(|| f32::INFINITY, f32::min)
 }

@@ -49,7 +49,7 @@ impl PySamples {
 /// `"noise:frequency=8"`), or a 2-D numpy array read like an image over
 /// the mesh's UVs (row 0 at the top, v = 1). Sample i depends only on (`seed`, `first` + i),
 /// so batches with `first=` add up to one big sample and any thread count
-/// gives the same roots. `distribution="blue-noise"` thins four times as
+/// gives the same roots. `distribution="blue-noise"` thins twice as
 /// many to roots that keep their distance (the whole set at once: no
 /// `first=`, at most 20,000,000).
 #[pyfunction]

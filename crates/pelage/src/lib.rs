@@ -11,8 +11,7 @@
 //! - [`sample`]: hair roots: points distributed by a density map (Sik §3),
 //!   deterministic by `(seed, index)`.
 //! - [`nearest`]: the k nearest of a fixed point set (kd-tree plus exact
-//!   candidate lists for coherent queries): guide roots, clump centres,
-//!   blue-noise spacing.
+//!   candidate lists for coherent queries): guide roots, clump centres.
 //! - [`curves`]: [`Curves`], hair curves as structure of arrays with an
 //!   offsets array (Blender's `CurvesGeometry`, USD `BasisCurves`).
 //! - [`guides`]: [`guides::Guides`], artist guide curves bound to the mesh

@@ -68,8 +68,8 @@ pub enum Method {
 pub enum Distribution {
     /// Independent samples of the density.
     Random,
-    /// Samples of the density that keep their distance (Yuksel's weighted
-    /// sample elimination over the whole mesh).
+    /// Samples of the density that keep their distance (twice as many
+    /// thinned by dart throwing over the whole mesh).
     BlueNoise,
 }
 

@@ -1,52 +1,138 @@
-//! Blue-noise roots: a part's roots drawn four times over and thinned back
-//! by weighted sample elimination (`sample/blue_noise.rs` says how).
+//! Blue-noise roots: the groom's roots drawn twice over and thinned
+//! back by dart throwing (`sample/blue_noise.rs` says how), all parts
+//! together, so that roots either side of a part border are thinned
+//! against each other (no seams).
 //!
-//! The candidates are the part's own roots and three times as many more
-//! from its own stream; hairs keep the part's ids (a survivor that was a
-//! root keeps its id, the others take the ids of the roots removed, in
-//! order), so ids stay unique and the same on every run. The elimination
-//! runs inside one part, so neighbours across a part border are not
-//! thinned against each other.
+//! The candidates are each root cell's first twice its count of the
+//! cell's own stream (the first of them its regular roots) with stable
+//! ids, or each part's regular roots and as many more from the part's own
+//! stream. Each part keeps exactly its hairs, and hairs keep
+//! their part's ids: a survivor that was a regular root keeps its id, the
+//! others take the ids of the regular roots removed, in order. Ids stay
+//! unique and the same on every run. (A cell's count may change: blue
+//! noise is not a subset of a larger groom, which is why fractions and
+//! brushes ask for random roots.)
+//!
+//! The thinning needs every part's candidates, so the first part asked
+//! for thins the whole groom's roots at once, and the other parts read
+//! theirs from it (a farm task that grows one part places every root).
 
-use super::generator::Generator;
+use super::generator::{Generator, PartRoots};
 use super::parts::sorted_by_triangle_with_ids;
 use crate::mesh::SurfacePoint;
-use crate::sample::blue_noise::{OVERSAMPLING, eliminate, positions_and_radii};
+use crate::sample::blue_noise::{OVERSAMPLING, Unit, arrival, positions_and_radii, thin};
 use crate::sample::{mix64, salts, sample_range};
+use rayon::prelude::*;
 
-/// Part `p`'s roots thinned to blue noise, ordered by triangle, with ids.
-pub(super) fn part_roots(generator: &Generator, p: usize) -> (Vec<SurfacePoint>, Vec<u64>) {
-    let part = &generator.layout.parts()[p];
-    let (roots, ids) = generator.regular_part_roots(p);
-    let n = roots.len() as u64;
-    if n < 2 {
-        return (roots, ids);
+/// A part's candidates (each stream's in its order of arrival), each
+/// one's place of arrival in its stream, and the ids of its regular roots
+/// in candidate order.
+#[derive(Default)]
+struct PartCandidates {
+    candidates: Vec<SurfacePoint>,
+    arrivals: Vec<u32>,
+    ids: Vec<u64>,
+    /// Whether each candidate is a regular root.
+    regular: Vec<bool>,
+}
+
+impl PartCandidates {
+    /// Appends a stream's candidates, of which the first `regular` are
+    /// regular roots with ids `ids`.
+    fn push_stream(&mut self, candidates: Vec<SurfacePoint>, ids: impl Iterator<Item = u64>) {
+        let before = self.ids.len();
+        self.ids.extend(ids);
+        let regular = self.ids.len() - before;
+        let len = candidates.len();
+        self.arrivals.extend((0..len).map(|k| arrival(k, len)));
+        self.regular.extend((0..len).map(|k| k < regular));
+        self.candidates.extend(candidates);
     }
-    let Some(sampler) = generator.sampler.restricted(&part.triangles) else {
-        return (roots, ids);
-    };
-    let mesh = generator.mesh();
-    let stream = mix64(generator.seed() ^ mix64(salts::BLUE_NOISE + p as u64));
-    let mut candidates = roots.clone();
-    candidates.extend(sample_range(&sampler, stream, 0..(OVERSAMPLING - 1) * n));
-    let (positions, radii) = positions_and_radii(&sampler, mesh, &candidates, n);
-    let kept = eliminate(&positions, &radii, n as usize);
-    // Survivors that were roots keep their ids; the others take the ids
-    // of the roots removed, in order.
-    let mut is_kept = vec![false; candidates.len()];
-    for &i in &kept {
-        is_kept[i] = true;
-    }
-    let mut free = (0..roots.len()).filter(|&i| !is_kept[i]).map(|i| ids[i]);
-    let mut out_roots = Vec::with_capacity(kept.len());
-    let mut out_ids = Vec::with_capacity(kept.len());
-    for i in kept {
-        out_roots.push(candidates[i]);
-        out_ids.push(if i < roots.len() {
-            ids[i]
-        } else {
-            free.next().expect("as many free ids as new survivors")
+}
+
+/// Every part's roots thinned to blue noise, ordered by triangle, with
+/// ids.
+pub(super) fn all_part_roots(generator: &Generator) -> Vec<PartRoots> {
+    let parts = candidates(generator);
+    let mut all = Vec::with_capacity(parts.iter().map(|p| p.candidates.len()).sum());
+    let mut arrivals = Vec::with_capacity(all.capacity());
+    let mut units = Vec::with_capacity(parts.len());
+    for part in &parts {
+        units.push(Unit {
+            candidates: all.len()..all.len() + part.candidates.len(),
+            keep: part.ids.len(),
         });
+        all.extend_from_slice(&part.candidates);
+        arrivals.extend_from_slice(&part.arrivals);
     }
-    sorted_by_triangle_with_ids(out_roots, out_ids)
+    let hairs = generator.layout.parts().iter().map(|p| p.hair_count).sum();
+    let (positions, radii) =
+        positions_and_radii(&*generator.sampler, generator.mesh(), &all, hairs);
+    drop(all);
+    let kept = thin(&positions, &radii, &arrivals, &units);
+    parts
+        .into_par_iter()
+        .zip(units)
+        .map(|(part, unit)| survivors(part, &kept[unit.candidates]))
+        .collect()
+}
+
+/// A part's survivors, ordered by triangle, with ids.
+fn survivors(part: PartCandidates, kept: &[bool]) -> PartRoots {
+    let mut regular_ids = part.ids.iter().copied();
+    let id_of: Vec<Option<u64>> = part
+        .regular
+        .iter()
+        .map(|&r| r.then(|| regular_ids.next().expect("an id a regular root")))
+        .collect();
+    let mut free = (0..kept.len())
+        .filter(|&k| !kept[k])
+        .filter_map(|k| id_of[k]);
+    let mut roots = Vec::with_capacity(part.ids.len());
+    let mut ids = Vec::with_capacity(part.ids.len());
+    for (k, candidate) in part.candidates.into_iter().enumerate() {
+        if kept[k] {
+            roots.push(candidate);
+            ids.push(id_of[k].unwrap_or_else(|| free.next().expect("a free id a new survivor")));
+        }
+    }
+    sorted_by_triangle_with_ids(roots, ids)
+}
+
+/// Every part's candidates: its root cells' streams (stable ids) or its
+/// own.
+fn candidates(generator: &Generator) -> Vec<PartCandidates> {
+    let seed = generator.seed();
+    let sampler = &generator.sampler;
+    generator
+        .layout
+        .parts()
+        .par_iter()
+        .enumerate()
+        .map(|(p, part)| {
+            let mut out = PartCandidates::default();
+            match &generator.cells {
+                Some(cells) => {
+                    for &(c, n) in &part.cells {
+                        let c = c as usize;
+                        let candidates = cells.roots(sampler, seed, c, OVERSAMPLING * n);
+                        let regular = (n as usize).min(candidates.len()) as u64;
+                        out.push_stream(candidates, (0..regular).map(|k| cells.id(c, k)));
+                    }
+                }
+                None => {
+                    let Some(sampler) = sampler.restricted(&part.triangles) else {
+                        return out;
+                    };
+                    let n = part.hair_count;
+                    let stream = mix64(seed ^ mix64(salts::PART_ROOTS + p as u64));
+                    let mut candidates = sample_range(&sampler, stream, 0..n);
+                    let stream = mix64(seed ^ mix64(salts::BLUE_NOISE + p as u64));
+                    candidates.extend(sample_range(&sampler, stream, 0..(OVERSAMPLING - 1) * n));
+                    out.push_stream(candidates, part.first_hair..part.first_hair + n);
+                }
+            }
+            out
+        })
+        .collect()
 }

@@ -25,7 +25,7 @@ use crate::sample::{DensitySampler, RootCells};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::atomic::AtomicUsize;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 impl GroomSpec {
     /// Prepares generation: the root sampler and part layout, the
@@ -160,6 +160,7 @@ impl Generator {
             spare: shared_roots.map_or_else(Default::default, |g| g.spare.clone()),
             last_part: AtomicUsize::new(usize::MAX),
             prefetched: Mutex::new(None),
+            blue_noise_roots: OnceLock::new(),
         };
         generator.prepare_chain(ops, shared_weights.map(|g| (g, moved.as_deref())))?;
         Ok(generator)

@@ -1,7 +1,7 @@
 //! The generator: a [`GroomSpec`] prepared for growing (the root sampler
 //! and part layout, the interpolator, the operator chain with its clump
 //! centres), what it holds and answers, and each part's roots before any
-//! thinning. Its layers above: `blue_noise.rs` thins a part's roots,
+//! thinning. Its layers above: `blue_noise.rs` thins the roots of all parts,
 //! `grow.rs` grows a part's hairs (and traces a hair that overflows to its
 //! operator), `build.rs` builds a generator from a spec. See the module
 //! docs of [`crate::groom`] for the path of one hair.
@@ -22,7 +22,7 @@ use crate::sample::{DensitySampler, RootCells, mix64, salts, sample_range};
 use rayon::prelude::*;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicUsize;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// What a generated part holds, for progress and summaries.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -80,6 +80,9 @@ pub struct Generator {
     /// the one after it, sampled ahead.
     pub(super) last_part: AtomicUsize,
     pub(super) prefetched: Mutex<Option<(usize, PartRoots)>>,
+    /// Blue-noise roots: every part's, thinned together when the first
+    /// part asks.
+    pub(super) blue_noise_roots: OnceLock<Vec<PartRoots>>,
 }
 
 /// What [`Generator::rebuilt`] takes from an earlier generator instead of

@@ -52,10 +52,14 @@ impl Generator {
     /// part's root cells samples its own hairs from its own stream;
     /// otherwise the part samples its hairs in its triangles with its own
     /// stream, numbered from the part's first hair id. Blue-noise roots
-    /// are then thinned from four times as many (`blue_noise.rs`).
+    /// are then thinned, all parts together, from four times as many
+    /// (`blue_noise.rs`).
     pub fn part_roots(&self, p: usize) -> (Vec<SurfacePoint>, Vec<u64>) {
         if self.distribution == RootDistribution::BlueNoise {
-            return blue_noise::part_roots(self, p);
+            return self
+                .blue_noise_roots
+                .get_or_init(|| blue_noise::all_part_roots(self))[p]
+                .clone();
         }
         self.regular_part_roots(p)
     }

@@ -245,10 +245,10 @@ pub enum RootDistribution {
     /// Independent random roots following the density (Sik §3).
     #[default]
     Random,
-    /// Blue-noise-like roots: drawn four times over and thinned by
-    /// weighted sample elimination (Yuksel 2015) with radii that follow
-    /// the density, so neighbours keep their distance and the density
-    /// still matches the map.
+    /// Blue-noise roots: drawn twice over and thinned by dart throwing
+    /// with spacings that follow the density, all parts together, so
+    /// neighbours keep their distance (no seams at part borders) and the
+    /// density still matches the map.
     BlueNoise,
 }
 

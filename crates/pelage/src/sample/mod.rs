@@ -6,7 +6,7 @@
 //!   uniform grid or by an alias table.
 //! - [`RejectionSampler`]: the paper's baseline (§3.4.1).
 //! - [`blue_noise_samples`]: samples of a [`DensitySampler`] thinned to
-//!   blue noise (Yuksel's weighted sample elimination).
+//!   blue noise (dart throwing over candidates, in parallel).
 //!
 //! Both implement [`SurfaceSampler`]: sample `i` is a pure function of
 //! `(seed, i)` ([`PairDraws`], [`SampleRng`]), and each sampler gives its probability
