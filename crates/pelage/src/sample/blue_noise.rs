@@ -682,6 +682,49 @@ mod tests {
         assert!(min_distance(&thinned) > 3.0 * min_distance(random));
     }
 
+    /// Counts far from what dart throwing keeps by itself still come out
+    /// exact: a unit asking for nearly every candidate (rejected ones come
+    /// back, the least crowded first), one asking for a few, an empty one
+    /// and one that keeps nothing.
+    #[test]
+    fn every_unit_gets_its_count_however_far_from_the_spacing() {
+        let points: Vec<Vec3> = (0..3000u64)
+            .map(|i| {
+                let h = mix64(i);
+                Vec3::new(
+                    (h >> 40) as f32 / 16_777_216.0,
+                    (h & 0xFF_FFFF) as f32 / 16_777_216.0,
+                    0.0,
+                )
+            })
+            .collect();
+        let radii = vec![radius(500.0); points.len()];
+        let arrivals: Vec<u32> = (0..3000).map(|k| arrival(k, 3000)).collect();
+        let units = [
+            Unit {
+                candidates: 0..1000,
+                keep: 950,
+            },
+            Unit {
+                candidates: 1000..2000,
+                keep: 7,
+            },
+            Unit {
+                candidates: 2000..2000,
+                keep: 0,
+            },
+            Unit {
+                candidates: 2000..3000,
+                keep: 0,
+            },
+        ];
+        let kept = thin(&points, &radii, &arrivals, &units);
+        for unit in &units {
+            let count = kept[unit.candidates.clone()].iter().filter(|&&k| k).count();
+            assert_eq!(count, unit.keep, "{unit:?}");
+        }
+    }
+
     /// A whole mesh's blue noise: the count asked for, spread further than
     /// random points, and the same on one thread and on two.
     #[test]
