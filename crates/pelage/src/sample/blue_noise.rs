@@ -274,25 +274,13 @@ impl Grid {
             .max(extent / (MAX_CELLS - 1) as f32)
             .max(f32::MIN_POSITIVE);
         let axis_bits = (32 - ((extent / width) as u32).min(MAX_CELLS - 1).leading_zeros()).max(1);
-        let mut keyed: Vec<(u64, u32)> = positions
-            .par_iter()
-            .enumerate()
-            .map(|(i, &p)| (morton(cell_of(p, corner, width).0), i as u32))
-            .collect();
-        radix_sort(&mut keyed, 3 * axis_bits);
-        let mut starts = Vec::new();
-        let mut keys = Vec::new();
-        for (s, &(key, _)) in keyed.iter().enumerate() {
-            if s == 0 || key != keyed[s - 1].0 {
-                starts.push(s as u32);
-                keys.push(key);
-            }
-        }
-        starts.push(m as u32);
+        let (mut index, starts, keys) = sorted_by_cell(m, 3 * axis_bits, |i| {
+            morton(cell_of(positions[i], corner, width).0)
+        });
         // Each cell's candidates in order of arrival (the sort kept the
         // caller's order).
-        let mut pieces: Vec<&mut [(u64, u32)]> = Vec::with_capacity(keys.len());
-        let mut rest = &mut keyed[..];
+        let mut pieces: Vec<&mut [u32]> = Vec::with_capacity(keys.len());
+        let mut rest = &mut index[..];
         for w in starts.windows(2) {
             let (head, tail) = rest.split_at_mut((w[1] - w[0]) as usize);
             pieces.push(head);
@@ -301,7 +289,7 @@ impl Grid {
         pieces
             .par_iter_mut()
             .with_min_len(256)
-            .for_each(|cell| cell.sort_unstable_by_key(|&(_, i)| (arrivals[i as usize], i)));
+            .for_each(|cell| cell.sort_unstable_by_key(|&i| (arrivals[i as usize], i)));
         let mut phases: [Vec<u32>; 8] = Default::default();
         let (mut blocks, mut tables, mut block_of) = (Vec::new(), Vec::new(), Vec::new());
         for (c, &key) in keys.iter().enumerate() {
@@ -314,14 +302,14 @@ impl Grid {
             block_of.push(blocks.len() as u32 - 1);
         }
         Some(Self {
-            sphere: keyed
+            sphere: index
                 .par_iter()
-                .map(|&(_, i)| {
+                .map(|&i| {
                     let p = positions[i as usize];
                     [p.x, p.y, p.z, radii[i as usize].min(cap)]
                 })
                 .collect(),
-            index: keyed.into_iter().map(|(_, i)| i).collect(),
+            index,
             corner,
             width,
             keys,
@@ -518,27 +506,79 @@ fn search_from(keys: &[u64], from: usize, key: u64) -> Option<usize> {
     keys[lo..hi].binary_search(&key).ok().map(|k| lo + k)
 }
 
-/// Sorts pairs by the low `bits` bits of their keys, stably: split by the
+/// The candidates `0..m` sorted by their cells (`cell(i)`, a key of
+/// `key_bits` bits), stably: the sorted indices, the first place of each
+/// cell (and the end), and each cell's key. The index rides in the key's
+/// low bits when both fit in 64 (half the bytes to move), beside it
+/// otherwise.
+fn sorted_by_cell(
+    m: usize,
+    key_bits: u32,
+    cell: impl Fn(usize) -> u64 + Sync,
+) -> (Vec<u32>, Vec<u32>, Vec<u64>) {
+    let index_bits = (usize::BITS - m.leading_zeros()).max(1);
+    if key_bits + index_bits <= 64 {
+        let mask = (1u64 << index_bits) - 1;
+        let mut packed: Vec<u64> = (0..m)
+            .into_par_iter()
+            .map(|i| cell(i) << index_bits | i as u64)
+            .collect();
+        radix_sort(&mut packed, |&v| v >> index_bits, key_bits);
+        runs(&packed, |&v| v >> index_bits, |&v| (v & mask) as u32)
+    } else {
+        let mut pairs: Vec<(u64, u32)> = (0..m)
+            .into_par_iter()
+            .map(|i| (cell(i), i as u32))
+            .collect();
+        radix_sort(&mut pairs, |&(k, _)| k, key_bits);
+        runs(&pairs, |&(k, _)| k, |&(_, i)| i)
+    }
+}
+
+/// The indices of sorted items, the first place of each run of equal keys
+/// (and the end), and each run's key.
+fn runs<T: Sync>(
+    sorted: &[T],
+    key: impl Fn(&T) -> u64,
+    index: impl Fn(&T) -> u32 + Sync + Send,
+) -> (Vec<u32>, Vec<u32>, Vec<u64>) {
+    let mut starts = Vec::new();
+    let mut keys = Vec::new();
+    for (s, item) in sorted.iter().enumerate() {
+        let k = key(item);
+        if keys.last() != Some(&k) {
+            starts.push(s as u32);
+            keys.push(k);
+        }
+    }
+    starts.push(sorted.len() as u32);
+    (sorted.par_iter().map(index).collect(), starts, keys)
+}
+
+/// Sorts items by the low `bits` bits of their keys, stably: split by the
 /// top byte first, then each part least significant byte first, the
 /// parts in parallel.
-fn radix_sort(pairs: &mut Vec<(u64, u32)>, bits: u32) {
+fn radix_sort<T: Copy + Default + Send + Sync>(
+    items: &mut Vec<T>,
+    key: impl Fn(&T) -> u64 + Sync,
+    bits: u32,
+) {
     let top = bits.saturating_sub(8);
-    let digit = |k: u64| ((k >> top) & 0xff) as usize;
     let mut counts = [0usize; 257];
-    for &(k, _) in pairs.iter() {
-        counts[digit(k) + 1] += 1;
+    for item in items.iter() {
+        counts[((key(item) >> top) & 0xff) as usize + 1] += 1;
     }
     for b in 0..256 {
         counts[b + 1] += counts[b];
     }
-    let mut split = vec![(0u64, 0u32); pairs.len()];
+    let mut split = vec![T::default(); items.len()];
     let mut fill = counts;
-    for &pair in pairs.iter() {
-        let slot = &mut fill[digit(pair.0)];
-        split[*slot] = pair;
+    for &item in items.iter() {
+        let slot = &mut fill[((key(&item) >> top) & 0xff) as usize];
+        split[*slot] = item;
         *slot += 1;
     }
-    let mut parts: Vec<&mut [(u64, u32)]> = Vec::with_capacity(256);
+    let mut parts: Vec<&mut [T]> = Vec::with_capacity(256);
     let mut rest = &mut split[..];
     for b in 0..256 {
         let (head, tail) = rest.split_at_mut(counts[b + 1] - counts[b]);
@@ -546,13 +586,13 @@ fn radix_sort(pairs: &mut Vec<(u64, u32)>, bits: u32) {
         rest = tail;
     }
     parts.into_par_iter().for_each(|part| {
-        let mut other = vec![(0u64, 0u32); part.len()];
+        let mut other = vec![T::default(); part.len()];
         let mut in_part = true;
         for shift in (0..top).step_by(8) {
             if in_part {
-                scatter_by_byte(part, &mut other, shift);
+                scatter_by_byte(part, &mut other, &key, shift);
             } else {
-                scatter_by_byte(&other, part, shift);
+                scatter_by_byte(&other, part, &key, shift);
             }
             in_part = !in_part;
         }
@@ -560,23 +600,23 @@ fn radix_sort(pairs: &mut Vec<(u64, u32)>, bits: u32) {
             part.copy_from_slice(&other);
         }
     });
-    *pairs = split;
+    *items = split;
 }
 
 /// One stable pass of a radix sort: `src` into `dst` by the byte of the
 /// keys at `shift`.
-fn scatter_by_byte(src: &[(u64, u32)], dst: &mut [(u64, u32)], shift: u32) {
-    let digit = |k: u64| ((k >> shift) & 0xff) as usize;
+fn scatter_by_byte<T: Copy>(src: &[T], dst: &mut [T], key: impl Fn(&T) -> u64, shift: u32) {
+    let digit = |item: &T| ((key(item) >> shift) & 0xff) as usize;
     let mut counts = [0usize; 257];
-    for &(k, _) in src {
-        counts[digit(k) + 1] += 1;
+    for item in src {
+        counts[digit(item) + 1] += 1;
     }
     for b in 0..256 {
         counts[b + 1] += counts[b];
     }
-    for &pair in src {
-        let slot = &mut counts[digit(pair.0)];
-        dst[*slot] = pair;
+    for item in src {
+        let slot = &mut counts[digit(item)];
+        dst[*slot] = *item;
         *slot += 1;
     }
 }
