@@ -298,8 +298,8 @@ struct GroomFigures {
     look_s: f64,
     /// With `[finish] outside_skin`: points pushed out of the skin.
     outside_s: f64,
-    /// With `[roots] distribution = "blue-noise"`: the roots drawn one and a
-    /// half times over and thinned, all parts together.
+    /// With `[roots] distribution = "blue-noise"`: the roots drawn twice
+    /// over and thinned, all parts together.
     blue_noise_s: f64,
     stable_ratio: f64,
     parted_ratio: f64,

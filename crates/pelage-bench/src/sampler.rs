@@ -389,7 +389,7 @@ impl SamplerRun {
                 },
                 Row {
                     cells: vec![
-                        "blue noise (1.5× candidates, dart throwing)".into(),
+                        "blue noise (2× candidates, dart throwing)".into(),
                         format!("{:.1} ms", blue_s * 1e3),
                         format!("{ratio:.1}"),
                         "≤ 3".into(),

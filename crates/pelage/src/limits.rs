@@ -42,9 +42,9 @@ pub const MAX_SAMPLE_POINTS: u64 = 200_000_000;
 
 /// Points `pelage sample --distribution blue-noise` (and Python's
 /// `sample(distribution="blue-noise")`) thins to at once: the whole set is
-/// thinned together, one and a half candidates a point, each with its
-/// position, radius, cell and order: about 150 bytes a point kept (3 GB
-/// at the ceiling).
+/// thinned together, two candidates a point, each with its position,
+/// radius, cell and order: about 200 bytes a point kept (4 GB at the
+/// ceiling).
 pub const MAX_BLUE_NOISE_POINTS: u64 = 20_000_000;
 
 /// Triangles of a mesh after `subdivide` (each step makes four of one). A

@@ -68,7 +68,7 @@ pub enum Method {
 pub enum Distribution {
     /// Independent samples of the density.
     Random,
-    /// Samples of the density that keep their distance (one and a half times as many
+    /// Samples of the density that keep their distance (twice as many
     /// thinned by dart throwing over the whole mesh).
     BlueNoise,
 }

@@ -1,13 +1,12 @@
-//! Blue-noise roots: the groom's roots drawn one and a half times over
-//! and thinned
+//! Blue-noise roots: the groom's roots drawn twice over and thinned
 //! back by dart throwing (`sample/blue_noise.rs` says how), all parts
 //! together, so that roots either side of a part border are thinned
 //! against each other (no seams).
 //!
-//! The candidates are each root cell's first one and a half times its
-//! count of the cell's own stream (the first of them its regular roots)
-//! with stable ids, or each part's regular roots and half as many more
-//! from the part's own stream. Each part keeps exactly its hairs, and hairs keep
+//! The candidates are each root cell's first twice its count of the
+//! cell's own stream (the first of them its regular roots) with stable
+//! ids, or each part's regular roots and as many more from the part's own
+//! stream. Each part keeps exactly its hairs, and hairs keep
 //! their part's ids: a survivor that was a regular root keeps its id, the
 //! others take the ids of the regular roots removed, in order. Ids stay
 //! unique and the same on every run. (A cell's count may change: blue
@@ -21,7 +20,7 @@
 use super::generator::{Generator, PartRoots};
 use super::parts::sorted_by_triangle_with_ids;
 use crate::mesh::SurfacePoint;
-use crate::sample::blue_noise::{Unit, arrival, candidates_for, positions_and_radii, thin};
+use crate::sample::blue_noise::{OVERSAMPLING, Unit, arrival, positions_and_radii, thin};
 use crate::sample::{mix64, salts, sample_range};
 use rayon::prelude::*;
 
@@ -116,7 +115,7 @@ fn candidates(generator: &Generator) -> Vec<PartCandidates> {
                 Some(cells) => {
                     for &(c, n) in &part.cells {
                         let c = c as usize;
-                        let candidates = cells.roots(sampler, seed, c, candidates_for(n));
+                        let candidates = cells.roots(sampler, seed, c, OVERSAMPLING * n);
                         let regular = (n as usize).min(candidates.len()) as u64;
                         out.push_stream(candidates, (0..regular).map(|k| cells.id(c, k)));
                     }
@@ -129,7 +128,7 @@ fn candidates(generator: &Generator) -> Vec<PartCandidates> {
                     let stream = mix64(seed ^ mix64(salts::PART_ROOTS + p as u64));
                     let mut candidates = sample_range(&sampler, stream, 0..n);
                     let stream = mix64(seed ^ mix64(salts::BLUE_NOISE + p as u64));
-                    candidates.extend(sample_range(&sampler, stream, 0..candidates_for(n) - n));
+                    candidates.extend(sample_range(&sampler, stream, 0..(OVERSAMPLING - 1) * n));
                     out.push_stream(candidates, part.first_hair..part.first_hair + n);
                 }
             }

@@ -245,8 +245,7 @@ pub enum RootDistribution {
     /// Independent random roots following the density (Sik §3).
     #[default]
     Random,
-    /// Blue-noise roots: drawn one and a half times over and thinned by
-    /// dart throwing
+    /// Blue-noise roots: drawn twice over and thinned by dart throwing
     /// with spacings that follow the density, all parts together, so
     /// neighbours keep their distance (no seams at part borders) and the
     /// density still matches the map.
