@@ -684,4 +684,19 @@ fn blue_noise_roots_keep_twice_the_distance_and_still_follow_the_density() {
     // The density still matches the map.
     let (counts, p) = spatial_bins(&mesh, &blue, |t| sampler.triangle_probability(t));
     assert_fits("blue-noise roots", &counts, &p);
+    // Thinned all at once, so a count past the ceiling is refused at once,
+    // naming the setting, before anything is placed.
+    let too_many = pelage::limits::MAX_BLUE_NOISE_POINTS + 1;
+    let err = GroomSpec::new(
+        mesh.clone(),
+        guides.clone(),
+        RootsSpec::new(too_many).with_distribution(RootDistribution::BlueNoise),
+    )
+    .generator()
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("roots.count") && err.contains("20,000,000") && err.contains("random"),
+        "{err}"
+    );
 }

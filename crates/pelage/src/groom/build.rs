@@ -369,6 +369,17 @@ fn check_numbers(spec: &GroomSpec) -> Result<(), GroomError> {
             .map_err(|e| spec.error(key, GroomErrorKind::Count(e)))
     };
     ceiling("roots.count", count, limits::MAX_HAIRS, "hairs")?;
+    if spec.roots.distribution == RootDistribution::BlueNoise
+        && count > limits::MAX_BLUE_NOISE_POINTS
+    {
+        return Err(spec.error(
+            "roots.count",
+            GroomErrorKind::OutOfRange(format!(
+                "blue-noise roots are thinned all at once, at most {} hairs (about 200 bytes a hair while they are placed); grow more with `distribution = \"random\"`",
+                limits::grouped(limits::MAX_BLUE_NOISE_POINTS as f64)
+            )),
+        ));
+    }
     ceiling(
         "finish.points",
         points as u64,
