@@ -25,27 +25,26 @@ use crate::sample::{mix64, salts, sample_range};
 use rayon::prelude::*;
 
 /// A part's candidates (each stream's in its order of arrival), each
-/// one's place of arrival in its stream, and the ids of its regular roots
-/// in candidate order.
+/// one's place of arrival in its stream and, for a regular root, its
+/// hair's id.
 #[derive(Default)]
 struct PartCandidates {
     candidates: Vec<SurfacePoint>,
     arrivals: Vec<u32>,
-    ids: Vec<u64>,
-    /// Whether each candidate is a regular root.
-    regular: Vec<bool>,
+    ids: Vec<Option<u64>>,
+    /// The hairs it keeps: as many as its regular roots.
+    keep: usize,
 }
 
 impl PartCandidates {
-    /// Appends a stream's candidates, of which the first `regular` are
-    /// regular roots with ids `ids`.
+    /// Appends a stream's candidates, of which the first are regular roots
+    /// with ids `ids`.
     fn push_stream(&mut self, candidates: Vec<SurfacePoint>, ids: impl Iterator<Item = u64>) {
-        let before = self.ids.len();
-        self.ids.extend(ids);
-        let regular = self.ids.len() - before;
-        let len = candidates.len();
+        let (before, len) = (self.ids.len(), candidates.len());
+        self.ids.extend(ids.map(Some));
+        self.keep += self.ids.len() - before;
+        self.ids.resize(before + len, None);
         self.arrivals.extend((0..len).map(|k| arrival(k, len)));
-        self.regular.extend((0..len).map(|k| k < regular));
         self.candidates.extend(candidates);
     }
 }
@@ -60,7 +59,7 @@ pub(super) fn all_part_roots(generator: &Generator) -> Vec<PartRoots> {
     for part in &parts {
         units.push(Unit {
             candidates: all.len()..all.len() + part.candidates.len(),
-            keep: part.ids.len(),
+            keep: part.keep,
         });
         all.extend_from_slice(&part.candidates);
         arrivals.extend_from_slice(&part.arrivals);
@@ -79,21 +78,15 @@ pub(super) fn all_part_roots(generator: &Generator) -> Vec<PartRoots> {
 
 /// A part's survivors, ordered by triangle, with ids.
 fn survivors(part: PartCandidates, kept: &[bool]) -> PartRoots {
-    let mut regular_ids = part.ids.iter().copied();
-    let id_of: Vec<Option<u64>> = part
-        .regular
-        .iter()
-        .map(|&r| r.then(|| regular_ids.next().expect("an id a regular root")))
-        .collect();
     let mut free = (0..kept.len())
         .filter(|&k| !kept[k])
-        .filter_map(|k| id_of[k]);
-    let mut roots = Vec::with_capacity(part.ids.len());
-    let mut ids = Vec::with_capacity(part.ids.len());
+        .filter_map(|k| part.ids[k]);
+    let mut roots = Vec::with_capacity(part.keep);
+    let mut ids = Vec::with_capacity(part.keep);
     for (k, candidate) in part.candidates.into_iter().enumerate() {
         if kept[k] {
             roots.push(candidate);
-            ids.push(id_of[k].unwrap_or_else(|| free.next().expect("a free id a new survivor")));
+            ids.push(part.ids[k].unwrap_or_else(|| free.next().expect("a free id a new survivor")));
         }
     }
     sorted_by_triangle_with_ids(roots, ids)

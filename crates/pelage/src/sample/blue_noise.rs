@@ -210,6 +210,13 @@ pub(crate) fn thin_timed(
 /// `(dx + 1) + 3 (dy + 1) + 9 (dz + 1)`.
 const SELF: usize = 13;
 
+/// The coordinates whose parity a step to neighbour `slot` flips, as
+/// colour bits.
+fn parity_flips(slot: usize) -> u64 {
+    let [x, y, z] = offset(slot).map(|d| (d != 0) as u64);
+    x | y << 1 | z << 2
+}
+
 /// A neighbour's offset from its number.
 fn offset(slot: usize) -> [i64; 3] {
     [slot % 3, slot / 3 % 3, slot / 9].map(|d| d as i64 - 1)
@@ -325,7 +332,8 @@ impl Grid {
         self.starts[c] as usize..self.starts[c + 1] as usize
     }
 
-    /// Cell `c`'s neighbour at offset `slot`, if it holds candidates.
+    /// Cell `c`'s neighbour at offset `slot`, if it holds candidates
+    /// (found from `c`'s block: a neighbour's is mostly the same one).
     fn neighbour(&self, c: usize, slot: usize) -> Option<usize> {
         let [x, y, z] = unmorton(self.keys[c]).map(|v| v as i64);
         let d = offset(slot);
@@ -364,19 +372,14 @@ impl Grid {
         let DartScratch { around, slots, own } = scratch;
         around.clear();
         own.clear();
-        let [x, y, z] = unmorton(self.keys[c]);
         for (slot, range) in slots.iter_mut().enumerate() {
             let start = around.len() as u32;
-            // Only the neighbours decided before (a neighbour's colour is
-            // never the cell's own) are looked up.
-            let d = offset(slot);
-            let parity = |v: u32, d: i64| ((v as i64 + d) & 1) as u64;
-            let earlier =
-                (parity(x, d[0]) | parity(y, d[1]) << 1 | parity(z, d[2]) << 2) < own_colour;
-            if let Some(n) = (slot != SELF && earlier)
-                .then(|| self.neighbour(c, slot))
-                .flatten()
-            {
+            // Only the neighbours decided before are looked up: a step
+            // along an axis flips that coordinate's parity, so a
+            // neighbour's colour is the cell's with those bits flipped
+            // (never the cell's own).
+            let earlier = slot != SELF && own_colour ^ parity_flips(slot) < own_colour;
+            if let Some(n) = earlier.then(|| self.neighbour(c, slot)).flatten() {
                 around.extend(
                     self.range(n)
                         .filter(|&j| kept[j].load(Ordering::Relaxed))
@@ -564,24 +567,12 @@ fn radix_sort<T: Copy + Default + Send + Sync>(
     bits: u32,
 ) {
     let top = bits.saturating_sub(8);
-    let mut counts = [0usize; 257];
-    for item in items.iter() {
-        counts[((key(item) >> top) & 0xff) as usize + 1] += 1;
-    }
-    for b in 0..256 {
-        counts[b + 1] += counts[b];
-    }
     let mut split = vec![T::default(); items.len()];
-    let mut fill = counts;
-    for &item in items.iter() {
-        let slot = &mut fill[((key(&item) >> top) & 0xff) as usize];
-        split[*slot] = item;
-        *slot += 1;
-    }
+    let starts = scatter_by_byte(items, &mut split, &key, top);
     let mut parts: Vec<&mut [T]> = Vec::with_capacity(256);
     let mut rest = &mut split[..];
     for b in 0..256 {
-        let (head, tail) = rest.split_at_mut(counts[b + 1] - counts[b]);
+        let (head, tail) = rest.split_at_mut(starts[b + 1] - starts[b]);
         parts.push(head);
         rest = tail;
     }
@@ -604,21 +595,29 @@ fn radix_sort<T: Copy + Default + Send + Sync>(
 }
 
 /// One stable pass of a radix sort: `src` into `dst` by the byte of the
-/// keys at `shift`.
-fn scatter_by_byte<T: Copy>(src: &[T], dst: &mut [T], key: impl Fn(&T) -> u64, shift: u32) {
+/// keys at `shift`. Returns where each byte's items start in `dst` (and
+/// the end).
+fn scatter_by_byte<T: Copy>(
+    src: &[T],
+    dst: &mut [T],
+    key: impl Fn(&T) -> u64,
+    shift: u32,
+) -> [usize; 257] {
     let digit = |item: &T| ((key(item) >> shift) & 0xff) as usize;
-    let mut counts = [0usize; 257];
+    let mut starts = [0usize; 257];
     for item in src {
-        counts[digit(item) + 1] += 1;
+        starts[digit(item) + 1] += 1;
     }
     for b in 0..256 {
-        counts[b + 1] += counts[b];
+        starts[b + 1] += starts[b];
     }
+    let mut fill = starts;
     for item in src {
-        let slot = &mut counts[digit(item)];
+        let slot = &mut fill[digit(item)];
         dst[*slot] = *item;
         *slot += 1;
     }
+    starts
 }
 
 /// No cell there.
@@ -670,11 +669,9 @@ mod tests {
     use super::*;
     use crate::nearest::NearestPoints;
 
-    #[test]
-    fn thinning_keeps_each_units_count_and_spreads_the_points() {
-        // 4,000 random points on the unit square, thinned to 1,000: the
-        // left half's candidates (a unit) to 600, the right half's to 400.
-        let points: Vec<Vec3> = (0..4000u64)
+    /// `n` random points on the unit square (z = 0).
+    fn points_on_square(n: u64) -> Vec<Vec3> {
+        (0..n)
             .map(|i| {
                 let h = mix64(i);
                 Vec3::new(
@@ -683,8 +680,14 @@ mod tests {
                     0.0,
                 )
             })
-            .collect();
-        let mut points = points;
+            .collect()
+    }
+
+    #[test]
+    fn thinning_keeps_each_units_count_and_spreads_the_points() {
+        // 4,000 random points on the unit square, thinned to 1,000: the
+        // left half's candidates (a unit) to 600, the right half's to 400.
+        let mut points = points_on_square(4000);
         points.sort_by(|a, b| a.x.total_cmp(&b.x));
         let units = [
             Unit {
@@ -728,16 +731,7 @@ mod tests {
     /// and one that keeps nothing.
     #[test]
     fn every_unit_gets_its_count_however_far_from_the_spacing() {
-        let points: Vec<Vec3> = (0..3000u64)
-            .map(|i| {
-                let h = mix64(i);
-                Vec3::new(
-                    (h >> 40) as f32 / 16_777_216.0,
-                    (h & 0xFF_FFFF) as f32 / 16_777_216.0,
-                    0.0,
-                )
-            })
-            .collect();
+        let points = points_on_square(3000);
         let radii = vec![radius(500.0); points.len()];
         let arrivals: Vec<u32> = (0..3000).map(|k| arrival(k, 3000)).collect();
         let units = [

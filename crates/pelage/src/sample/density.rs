@@ -555,12 +555,6 @@ impl SurfaceSampler for DensitySampler {
         let area = f64::from(self.areas[t]);
         let b = Vec2::from(point.bary);
         let range = self.first_record[t] as usize..self.first_record[t + 1] as usize;
-        if range.len() == 1 {
-            // One record covers the whole triangle.
-            let r = self.records[range.start];
-            let sub = self.positions.get(r.position);
-            return f64::from(r.probability) / self.total / (area * f64::from(sub.area_fraction()));
-        }
         self.records[range]
             .iter()
             .map(|r| (r, self.positions.get(r.position)))
