@@ -335,6 +335,7 @@ pub(crate) mod entry {
 #[cfg(test)]
 mod tests {
     use crate::dynamics::StepUniform;
+    use crate::groom::GroomPassUniform;
     use crate::renderer::FrameUniforms;
     use crate::shells::ShellUniforms;
     use crate::strands::{GridHeader, StrandStepUniform};
@@ -387,6 +388,8 @@ mod tests {
         );
         let grid = std::mem::size_of::<GridHeader>();
         check("strands.wgsl", "Grid", grid, GridHeader::FIELDS);
+        let groom = std::mem::size_of::<GroomPassUniform>();
+        check("groom.wgsl", "GroomPass", groom, GroomPassUniform::FIELDS);
     }
 
     /// A vertex input: name, location and type (`f32x3`).

@@ -14,6 +14,7 @@
 mod camera;
 mod context;
 mod dynamics;
+mod groom;
 mod layout;
 mod motion;
 mod player;
@@ -25,6 +26,7 @@ mod strands;
 pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
 pub use dynamics::GpuMassSpring;
+pub use groom::{GpuGroom, MAX_GPU_HAIR_POINTS};
 pub use motion::{FurMotion, SkinMotion};
 pub use pelage::Curves;
 pub use player::ShellScenePlayer;
@@ -129,6 +131,14 @@ pub const SHADERS: &[(&str, &str)] = &[
         "strands.wgsl",
         concat!(
             include_str!("shaders/strands.wgsl"),
+            include_str!("shaders/noise.wgsl")
+        ),
+    ),
+    // A groom's hairs grown from the frame's guides and skin (compute).
+    (
+        "groom.wgsl",
+        concat!(
+            include_str!("shaders/groom.wgsl"),
             include_str!("shaders/noise.wgsl")
         ),
     ),

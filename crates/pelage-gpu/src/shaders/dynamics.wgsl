@@ -49,6 +49,11 @@ struct Step {
 @group(0) @binding(5) var<storage, read> spring_ends: array<vec2<u32>>;
 // The turbulence's doubled permutation table.
 @group(0) @binding(6) var<storage, read> permutation: array<u32>;
+
+// noise.wgsl's table lookup: this shader's one field.
+fn perm_at(i: u32) -> u32 {
+    return permutation[i & 511u];
+}
 @group(0) @binding(7) var<storage, read> tips_in: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read> velocities_in: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read_write> tips_out: array<vec4<f32>>;

@@ -1,10 +1,8 @@
 // pelage::map::NoiseMap::perlin3_vector, for the compute shaders that
-// blow wind through fur. Appended to a shader that declares
-// `permutation`: the noise's doubled permutation table.
-
-fn perm_at(i: u32) -> u32 {
-    return permutation[i & 511u];
-}
+// blow wind through fur and grow grooms. Appended to a shader that
+// declares `perm_at(i)`: entry `i & 511` of the noise's doubled
+// permutation table (a shader with one field reads it directly; the groom
+// shader picks the current operator's table).
 
 // pelage::map::noise::gradient3: Perlin's reference `grad`, selects and sign
 // flips picking one of his sixteen gradient rows: no array indexed at run

@@ -59,6 +59,11 @@ struct Grid {
 // Two a substep: the wind's gusting mean and the turbulence's drift.
 @group(0) @binding(5) var<storage, read> winds: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read> permutation: array<u32>;
+
+// noise.wgsl's table lookup: this shader's one field.
+fn perm_at(i: u32) -> u32 {
+    return permutation[i & 511u];
+}
 @group(0) @binding(7) var<storage, read> grids: array<Grid>;
 @group(0) @binding(8) var<storage, read> distances: array<f32>;
 @group(0) @binding(9) var<storage, read> nearest: array<u32>;

@@ -206,8 +206,7 @@ impl Generator {
         reshaping: Option<(&Generator, Option<&[bool]>)>,
     ) -> ClumpCentres {
         let grow_one = |i: usize, ws: &mut Workspace, out: &mut Vec<Vec3>| {
-            let id = (1u64 << 63) | ((k as u64) << 40) | i as u64;
-            self.grow(roots[i], id, &self.ops[..k], ws);
+            self.grow(roots[i], centre_hair_id(k, i), &self.ops[..k], ws);
             match ws.batch.hairs().first() {
                 Some(hair) => out.extend_from_slice(&hair.points),
                 // Cut away entirely: the centre is its interpolated shape.
@@ -548,6 +547,13 @@ impl ChainSoFar for ChainBuild<'_> {
     fn clump_centres(&self, k: usize, roots: &[SurfacePoint]) -> ClumpCentres {
         self.generator.clump_centres(k, roots, self.reshaping)
     }
+}
+
+/// The id of centre `i` of the clump at chain position `k`: apart from
+/// every render hair's (the top bit), so no centre shares a hair's random
+/// numbers.
+pub(crate) fn centre_hair_id(k: usize, i: usize) -> u64 {
+    (1u64 << 63) | ((k as u64) << 40) | i as u64
 }
 
 /// Binds every map of the groom to its mesh (per-vertex maps take their

@@ -21,7 +21,9 @@
 //!    holds), `blue_noise.rs` (a part's roots thinned), `grow.rs`
 //!    ([`Generator::part`]: a part's hairs grown; a hair that overflows
 //!    traced to its operator), `build.rs` (a spec made a generator; a
-//!    clump's centres grown through the operators before it).
+//!    clump's centres grown through the operators before it),
+//!    [`GroomRecipe`] (`recipe.rs`: the groom flattened for an evaluator
+//!    that grows every hair again each frame, the GPU's).
 //! 5. **Write**: `output.rs` ([`Generator::write`] streams parts to a file,
 //!    [`write_assembly`]), [`FarmRun`] (`farm.rs`, `K/N`, with
 //!    [`find_part_files`]), `clips.rs` (frame files stitched with USD value
@@ -63,6 +65,7 @@ mod output;
 mod outside_skin;
 pub mod parts;
 mod ramp;
+mod recipe;
 pub mod regions;
 mod report;
 mod simulate;
@@ -89,6 +92,7 @@ pub use output::{GroomWriteError, StreamError, part_file, part_name, part_slice,
 pub use outside_skin::OutsideSkin;
 pub use parts::{HAIRS_PER_PART, Part, PartLayout};
 pub use ramp::Ramp;
+pub use recipe::{GroomRecipe, LeftOut, MAX_RECIPE_WEIGHTS, RecipePass, RecipeStep, StepKind};
 pub use report::{
     GroomReport, GuideNote, GuidesReport, LostGuideNote, PartReport, RegionReport, ReportBuilder,
     Timings,

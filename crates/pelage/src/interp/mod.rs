@@ -222,6 +222,17 @@ impl Interpolator {
         Self::with_shared_weights(mesh, guides.into(), self.weights.clone())
     }
 
+    /// Each guide's offsets from its root, guide after guide (what
+    /// [`Self::shape`] turns and weights).
+    pub fn guide_offsets(&self) -> &[Vec3] {
+        &self.offsets
+    }
+
+    /// Each guide's skin normal at its root.
+    pub fn guide_normals(&self) -> impl ExactSizeIterator<Item = Vec3> + '_ {
+        self.normals.iter().map(|&n| Vec3::from(n))
+    }
+
     /// The guides.
     pub fn guides(&self) -> &Guides {
         &self.guides

@@ -75,22 +75,16 @@ impl Clump {
     }
 
     /// Pulls one hair toward its centre.
-    pub(super) fn pull(
-        &self,
-        hair: &mut Hair,
-        root: &RootContext,
-        near: &mut NeighbourCache,
-        ramps: &mut RampTables,
-    ) {
-        let Some((centre, distance)) = self.centres.nearest_near(
+    /// The centre a hair rooted at `root` follows, and how strongly (the
+    /// rate, faded by the distance when the clump has a size).
+    pub(crate) fn target(&self, root: &RootContext, near: &mut NeighbourCache) -> Option<(usize, f32)> {
+        let (centre, distance) = self.centres.nearest_near(
             root.position,
             Some(root.normal),
             root.region,
             near,
             root.skin_triangle,
-        ) else {
-            return;
-        };
+        )?;
         let mut w = self.rate.at(&root.site);
         if let Some(size) = &self.size {
             let size = size.at(&root.site);
@@ -100,6 +94,24 @@ impl Clump {
                 0.0
             };
         }
+        Some((centre, w))
+    }
+
+    /// The pull's profile root to tip.
+    pub(crate) fn ramp(&self) -> &Ramp {
+        &self.ramp
+    }
+
+    pub(super) fn pull(
+        &self,
+        hair: &mut Hair,
+        root: &RootContext,
+        near: &mut NeighbourCache,
+        ramps: &mut RampTables,
+    ) {
+        let Some((centre, w)) = self.target(root, near) else {
+            return;
+        };
         let shape = self.centres.shape(centre);
         if w == 0.0 || shape.len() != hair.points.len() {
             return;

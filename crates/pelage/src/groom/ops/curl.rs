@@ -59,6 +59,24 @@ impl Curl {
     }
 }
 
+impl Curl {
+    /// Hair `id`'s helix at `root`: radius, turns and phase (radians).
+    pub(crate) fn helix(&self, id: u64, root: &RootContext) -> [f32; 3] {
+        let radius = self.radius.at(&root.site);
+        if radius == 0.0 {
+            return [0.0; 3];
+        }
+        let turns = self.turns.at(&root.site);
+        let phase = TAU * SampleRng::new(self.seed ^ PHASE_SALT, id).uniform_f32();
+        [radius, turns, phase]
+    }
+
+    /// The radius's profile root to tip.
+    pub(crate) fn ramp(&self) -> &Ramp {
+        &self.ramp
+    }
+}
+
 impl OperatorKind for Curl {
     const NAME: &'static str = "curl";
     const SUMMARY: &'static str =
@@ -71,12 +89,10 @@ impl OperatorKind for Curl {
     }
 
     fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
-        let radius = self.radius.at(&root.site);
+        let [radius, turns, phase] = self.helix(hair.id, root);
         if radius == 0.0 {
             return;
         }
-        let turns = self.turns.at(&root.site);
-        let phase = TAU * SampleRng::new(self.seed ^ PHASE_SALT, hair.id).uniform_f32();
         let n = hair.points.len();
         scratch.frame_along(&hair.points, root.normal);
         let ramp = scratch.ramps.along(&self.ramp, n);

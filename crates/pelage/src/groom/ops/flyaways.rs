@@ -63,6 +63,53 @@ impl Flyaways {
     }
 }
 
+/// How one stray hair flies away.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Stray {
+    /// Its length's factor.
+    pub(crate) length: f32,
+    /// How far it is pushed at the tip.
+    pub(crate) spread: f32,
+    /// The wander's cycles along the hair.
+    pub(crate) frequency: f32,
+    /// Its place in the noise field.
+    pub(crate) phase: Vec3,
+    /// The push's direction.
+    pub(crate) across: Vec3,
+}
+
+impl Flyaways {
+    /// How hair `id` flies away, when it is among the strays.
+    pub(crate) fn strayed(&self, id: u64, root: &RootContext) -> Option<Stray> {
+        let p = &self.params;
+        let mut rng = self.stray(id, p.fraction.at(&root.site))?;
+        // The push: a direction of the hair's own, across the skin
+        // normal's side of the hair (strays stand off the coat, never into
+        // the skin), wandering by the noise along the hair.
+        let [a, b] = rng.uniform_f32_pair();
+        let phase = Vec3::new(a, b, rng.uniform_f32()) * 256.0;
+        let angle = std::f32::consts::TAU * rng.uniform_f32();
+        let side = root.normal.any_orthonormal_pair();
+        Some(Stray {
+            length: p.length.at(&root.site).max(0.0),
+            spread: p.spread.at(&root.site),
+            frequency: p.frequency.at(&root.site),
+            phase,
+            across: (angle.cos() * side.0 + angle.sin() * side.1 + root.normal).normalize(),
+        })
+    }
+
+    /// The wander's permutation table.
+    pub(crate) fn permutation(&self) -> &[u8; 512] {
+        self.field.permutation()
+    }
+
+    /// The push's profile root to tip.
+    pub(crate) fn ramp(&self) -> &Ramp {
+        &self.params.ramp
+    }
+}
+
 impl OperatorKind for Flyaways {
     const NAME: &'static str = "flyaways";
     const SUMMARY: &'static str = "A `fraction` of the hairs lengthened and pushed `spread` off their clump, each its own way.";
@@ -79,23 +126,19 @@ impl OperatorKind for Flyaways {
 
     fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
         let p = &self.params;
-        let Some(mut rng) = self.stray(hair.id, p.fraction.at(&root.site)) else {
-            return;
-        };
         let Some(&origin) = hair.points.first() else {
             return;
         };
-        let length = p.length.at(&root.site).max(0.0);
-        let spread = p.spread.at(&root.site);
-        let frequency = p.frequency.at(&root.site);
-        // The push: a direction of the hair's own, across the skin
-        // normal's side of the hair (strays stand off the coat, never into
-        // the skin), wandering by the noise along the hair.
-        let [a, b] = rng.uniform_f32_pair();
-        let phase = Vec3::new(a, b, rng.uniform_f32()) * 256.0;
-        let angle = std::f32::consts::TAU * rng.uniform_f32();
-        let side = root.normal.any_orthonormal_pair();
-        let across = (angle.cos() * side.0 + angle.sin() * side.1 + root.normal).normalize();
+        let Some(Stray {
+            length,
+            spread,
+            frequency,
+            phase,
+            across,
+        }) = self.strayed(hair.id, root)
+        else {
+            return;
+        };
         let n = hair.points.len();
         let ramp = scratch.ramps.along(&p.ramp, n);
         for (j, (point, profile)) in hair.points.iter_mut().zip(ramp).enumerate() {

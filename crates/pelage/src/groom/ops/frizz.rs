@@ -68,6 +68,31 @@ impl Frizz {
     }
 }
 
+impl Frizz {
+    /// Hair `id`'s amplitude, frequency and place in the noise field
+    /// when it is among the frizzed `fraction`.
+    pub(crate) fn frizzed(&self, id: u64, root: &RootContext) -> Option<(f32, f32, Vec3)> {
+        let mut rng = SampleRng::new(self.seed ^ HAIR_SALT, id);
+        if rng.uniform_f32() >= self.fraction.at(&root.site) {
+            return None;
+        }
+        let amplitude = self.amplitude.at(&root.site);
+        let frequency = self.frequency.at(&root.site);
+        let [a, b] = rng.uniform_f32_pair();
+        Some((amplitude, frequency, Vec3::new(a, b, rng.uniform_f32()) * 256.0))
+    }
+
+    /// The noise field's permutation table.
+    pub(crate) fn permutation(&self) -> &[u8; 512] {
+        self.field.permutation()
+    }
+
+    /// The displacement's profile root to tip.
+    pub(crate) fn ramp(&self) -> &Ramp {
+        &self.ramp
+    }
+}
+
 impl OperatorKind for Frizz {
     const NAME: &'static str = "frizz";
     const SUMMARY: &'static str =
@@ -86,14 +111,9 @@ impl OperatorKind for Frizz {
     }
 
     fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
-        let mut rng = SampleRng::new(self.seed ^ HAIR_SALT, hair.id);
-        if rng.uniform_f32() >= self.fraction.at(&root.site) {
+        let Some((amplitude, frequency, phase)) = self.frizzed(hair.id, root) else {
             return;
-        }
-        let amplitude = self.amplitude.at(&root.site);
-        let frequency = self.frequency.at(&root.site);
-        let [a, b] = rng.uniform_f32_pair();
-        let phase = Vec3::new(a, b, rng.uniform_f32()) * 256.0;
+        };
         let n = hair.points.len();
         let ramp = scratch.ramps.along(&self.ramp, n);
         for (j, (p, profile)) in hair.points.iter_mut().zip(ramp).enumerate() {

@@ -50,10 +50,14 @@ impl Length {
     }
 
     /// Scales one hair about its root.
+    /// Hair `id`'s factor at `root`: the scale map's value, jittered.
+    pub(crate) fn factor(&self, id: u64, root: &RootContext) -> f32 {
+        let mut rng = SampleRng::new(self.seed ^ JITTER_SALT, id);
+        (self.scale.at(&root.site) * jittered(self.jitter.at(&root.site), &mut rng)).max(0.0)
+    }
+
     pub(super) fn lengthen(&self, hair: &mut Hair, root: &RootContext) {
-        let mut rng = SampleRng::new(self.seed ^ JITTER_SALT, hair.id);
-        let factor =
-            (self.scale.at(&root.site) * jittered(self.jitter.at(&root.site), &mut rng)).max(0.0);
+        let factor = self.factor(hair.id, root);
         let Some(&origin) = hair.points.first() else {
             return;
         };

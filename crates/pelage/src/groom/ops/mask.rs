@@ -49,8 +49,9 @@ impl Masked {
     }
 
     /// The mask's value at the root, clamped to 0–1 (NaN reads 0).
+    /// The mask's weight at `root`, 0 to 1.
     #[inline]
-    fn weight(&self, root: &RootContext) -> f32 {
+    pub(crate) fn weight(&self, root: &RootContext) -> f32 {
         let m = self.mask.at(&root.site);
         if m > 0.0 { m.min(1.0) } else { 0.0 }
     }

@@ -79,7 +79,12 @@ impl VectorNoise {
         self.0.perlin3_vector(p + Self::OFF_LATTICE)
     }
 
-    const OFF_LATTICE: Vec3 = Vec3::new(0.371, 0.713, 0.137);
+    pub(crate) const OFF_LATTICE: Vec3 = Vec3::new(0.371, 0.713, 0.137);
+
+    /// The field's permutation table.
+    pub(crate) fn permutation(&self) -> &[u8; 512] {
+        self.0.permutation_table()
+    }
 
     /// Where [`at`](Self::at) reads the noise for `p`.
     #[inline]
@@ -212,7 +217,29 @@ impl Noise {
     }
 
     /// How many noise vectors a hair of `n` points samples.
-    fn vectors_along(&self, n: usize) -> usize {
+    /// The amplitude and frequency at `root`.
+    pub(crate) fn strength(&self, root: &RootContext) -> (f32, f32) {
+        (self.amplitude.at(&root.site), self.frequency.at(&root.site))
+    }
+
+    /// The field's permutation table.
+    pub(crate) fn permutation(&self) -> &[u8; 512] {
+        self.field.permutation()
+    }
+
+    /// The displacement's profile root to tip.
+    pub(crate) fn ramp(&self) -> &Ramp {
+        &self.ramp
+    }
+
+    /// Noise vectors along an `n`-point hair, and the resamplings from
+    /// its points to them and back (empty when there is a vector a point).
+    pub(crate) fn vector_spacing(&self, n: usize) -> (usize, Resampling, Resampling) {
+        let m = self.vectors_along(n);
+        (m, Resampling::new(n, m), Resampling::new(m, n))
+    }
+
+    pub(crate) fn vectors_along(&self, n: usize) -> usize {
         if self.vectors == 0 || self.vectors >= n {
             n
         } else {

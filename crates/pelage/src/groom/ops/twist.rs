@@ -41,6 +41,23 @@ operator_settings! {
 #[derive(Debug, Clone)]
 pub struct Twist(TwistParams);
 
+impl Twist {
+    /// Hair `id`'s turn at the tip, in radians (0: none).
+    pub(crate) fn angle(&self, id: u64, root: &RootContext) -> f32 {
+        let p = &self.0;
+        let degrees = p.angle.at(&root.site);
+        if degrees == 0.0 {
+            return 0.0;
+        }
+        degrees.to_radians() * varied(p.jitter.at(&root.site), p.seed ^ JITTER_SALT, id)
+    }
+
+    /// The turn's profile root to tip.
+    pub(crate) fn ramp(&self) -> &Ramp {
+        &self.0.ramp
+    }
+}
+
 impl OperatorKind for Twist {
     const NAME: &'static str = "twist";
     const SUMMARY: &'static str =
@@ -55,16 +72,14 @@ impl OperatorKind for Twist {
 
     fn apply_to_hair(&self, hair: &mut Hair, root: &RootContext, scratch: &mut Scratch) {
         let p = &self.0;
-        let degrees = p.angle.at(&root.site);
         let (Some(&origin), Some(&tip)) = (hair.points.first(), hair.points.last()) else {
             return;
         };
         let axis = (tip - origin).normalize_or_zero();
-        if degrees == 0.0 || axis == Vec3::ZERO {
+        let angle = self.angle(hair.id, root);
+        if angle == 0.0 || axis == Vec3::ZERO {
             return;
         }
-        let factor = varied(p.jitter.at(&root.site), p.seed ^ JITTER_SALT, hair.id);
-        let angle = degrees.to_radians() * factor;
         let n = hair.points.len();
         let ramp = scratch.ramps.along(&p.ramp, n);
         for (point, profile) in hair.points.iter_mut().zip(ramp).skip(1) {

@@ -1,0 +1,384 @@
+//! A groom grown on the GPU every frame: a [`GroomRecipe`] uploaded once,
+//! then, each frame, the frame's guides (in rest space) and posed skin in,
+//! every hair's points out, by one compute dispatch a recipe pass
+//! (`shaders/groom.wgsl`, one invocation a hair, its points in registers).
+//! The CPU groom of the same frame (`Generator::part`, or
+//! `AnimatedGroom::part` for a posed frame) is the reference:
+//! `tests/groom.rs` grows both and compares hair by hair.
+//!
+//! The output buffer holds each point as `xyz` and its width in `w`,
+//! point-major (point `j` of hair `h` at `j · hairs + h`, clump centres
+//! first, the render hairs last), ready for a strand renderer to read.
+
+use crate::layout::{UniformRing, compute_pipeline, entry, gpu_struct, group};
+use crate::{GpuContext, GpuError, workgroups};
+use glam::{Mat3, Vec3};
+use pelage::Curves;
+use pelage::anim::{SkinBinding, SkinPose};
+use pelage::groom::GroomRecipe;
+use wgpu::util::DeviceExt;
+
+/// The most points a hair has on the GPU (the shader's `MAX_POINTS`: a
+/// hair's points live in registers).
+pub const MAX_GPU_HAIR_POINTS: usize = 32;
+
+gpu_struct! {
+    /// The shader's `GroomPass` block: one recipe pass.
+    pub(crate) struct GroomPassUniform {
+        first: u32,
+        count: u32,
+        steps: u32,
+        points: u32,
+        guide_points: u32,
+        hairs: u32,
+        values_per_hair: u32,
+        posed: u32,
+        resample_at: u32,
+        render_first: u32,
+        width_scale: f32,
+        pad0: u32,
+    }
+}
+
+/// A [`GroomRecipe`] on the GPU, grown again each [`Self::grow`].
+#[derive(Debug)]
+pub struct GpuGroom {
+    pipeline: wgpu::ComputePipeline,
+    passes: Vec<GroomPassUniform>,
+    ring: UniformRing<GroomPassUniform>,
+    bind_group: wgpu::BindGroup,
+    guide_offsets: wgpu::Buffer,
+    skin: wgpu::Buffer,
+    points: wgpu::Buffer,
+    hairs: u32,
+    n: u32,
+    guide_values: usize,
+    skin_vertices: usize,
+    render: std::ops::Range<u32>,
+    /// The render hairs' ids, colours and opacities, for read-back.
+    ids: Vec<u64>,
+    colors: Option<Vec<Vec3>>,
+    opacities: Option<Vec<f32>>,
+}
+
+/// `v` as a `vec4` with `w`.
+fn v4(v: Vec3, w: f32) -> [f32; 4] {
+    [v.x, v.y, v.z, w]
+}
+
+impl GpuGroom {
+    /// Uploads `recipe`. `binding` is the skin the hairs are carried on
+    /// when [`Self::grow`] is given a pose (its rest pose is the one the
+    /// groom was grown on).
+    ///
+    /// # Errors
+    /// When hairs or guides have more than [`MAX_GPU_HAIR_POINTS`] points,
+    /// or a buffer is larger than the adapter binds.
+    pub fn new(
+        ctx: &GpuContext,
+        recipe: &GroomRecipe,
+        binding: Option<&SkinBinding>,
+    ) -> Result<Self, GpuError> {
+        let (n, gp) = (recipe.points as usize, recipe.guide_points as usize);
+        if n > MAX_GPU_HAIR_POINTS || gp > MAX_GPU_HAIR_POINTS {
+            return Err(GpuError::Mismatch(format!(
+                "hairs of {n} points from guides of {gp}: the GPU groom takes at most {MAX_GPU_HAIR_POINTS}; lower [finish] points or resample the guides"
+            )));
+        }
+        let hairs = recipe.hair_count();
+        let hairs32 = u32::try_from(hairs)
+            .map_err(|_| GpuError::Mismatch(format!("{hairs} hairs: too many for a GPU index")))?;
+        let limit = ctx.device.limits().max_storage_buffer_binding_size;
+        let largest = (hairs * n * 16) as u64;
+        if largest > limit {
+            return Err(GpuError::Mismatch(format!(
+                "{hairs} hairs of {n} points need {largest} bytes a buffer; the adapter binds at most {limit}: grow fewer hairs (a fraction) or fewer points"
+            )));
+        }
+        let render = recipe.render_hairs();
+        let rest_frame = |i: usize| match binding {
+            Some(b) if render.contains(&(i as u32)) => b.rest().frame_at(b.triangles(), recipe.roots[i]),
+            _ => (recipe.root_positions[i], Mat3::IDENTITY),
+        };
+        let roots: Vec<[f32; 4]> = (0..hairs)
+            .flat_map(|i| {
+                let root = recipe.roots[i];
+                let (origin, frame) = rest_frame(i);
+                [
+                    v4(recipe.root_positions[i], f32::from_bits(root.tri)),
+                    v4(recipe.root_normals[i], root.bary[0]),
+                    v4(origin, root.bary[1]),
+                    v4(frame.x_axis, 0.0),
+                    v4(frame.y_axis, 0.0),
+                    v4(frame.z_axis, 0.0),
+                ]
+            })
+            .collect();
+        let weights: Vec<[f32; 2]> = recipe
+            .weights
+            .iter()
+            .map(|w| [f32::from_bits(w.guide), w.weight])
+            .collect();
+        let guide_normals: Vec<[f32; 4]> =
+            recipe.guide_normals.iter().map(|&v| v4(v, 0.0)).collect();
+        let steps: Vec<[u32; 8]> = recipe
+            .steps
+            .iter()
+            .map(|s| {
+                [
+                    s.kind as u32,
+                    s.values,
+                    u32::from(s.masked),
+                    s.table,
+                    s.permutation,
+                    s.vectors,
+                    s.centres,
+                    0,
+                ]
+            })
+            .collect();
+        let mut tables = recipe.tables.clone();
+        let resample_at = if recipe.resampling.is_empty() {
+            u32::MAX
+        } else {
+            let at = tables.len() as u32;
+            tables.extend(recipe.resampling.iter().flat_map(|&(j, f)| [j as f32, f]));
+            at
+        };
+        let (skin_vertices, triangles): (usize, Vec<u32>) = match binding {
+            Some(b) => (
+                b.rest().positions().len(),
+                b.triangles().iter().flatten().copied().collect(),
+            ),
+            None => (1, vec![0; 3]),
+        };
+        let device = &ctx.device;
+        let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
+            // An empty array still binds a whole element (a step is 32 bytes).
+            let zeros = [0u8; 32];
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: if bytes.is_empty() { &zeros } else { bytes },
+                usage: wgpu::BufferUsages::STORAGE | extra,
+            })
+        };
+        let none = wgpu::BufferUsages::empty();
+        let dst = wgpu::BufferUsages::COPY_DST;
+        let bytes = bytemuck::cast_slice::<[f32; 4], u8>;
+        let buffers = [
+            storage("groom roots", bytes(&roots), none),
+            storage("groom weights", bytemuck::cast_slice(&weights), none),
+            storage("groom guide normals", bytes(&guide_normals), none),
+            storage(
+                "groom guide offsets",
+                &vec![0u8; recipe.guides as usize * gp * 16],
+                dst,
+            ),
+            storage("groom values", bytemuck::cast_slice(&recipe.values), none),
+            storage("groom steps", bytemuck::cast_slice(&steps), none),
+            storage("groom tables", bytemuck::cast_slice(&tables), none),
+            storage(
+                "groom noise permutations",
+                bytemuck::cast_slice(&recipe.permutations),
+                none,
+            ),
+            storage("groom skin", &vec![0u8; skin_vertices * 32], dst),
+            storage("groom skin triangles", bytemuck::cast_slice(&triangles), none),
+            storage("groom widths", bytemuck::cast_slice(&recipe.widths), none),
+            storage(
+                "groom points",
+                &vec![0u8; hairs * n * 16],
+                wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::VERTEX,
+            ),
+        ];
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let mut entries: Vec<_> = (0..11).map(|b| entry::storage(b, compute, true)).collect();
+        entries.push(entry::storage(11, compute, false));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("groom"),
+            entries: &entries,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("groom"),
+            layout: &layout,
+            entries: &group::buffers(buffers.each_ref()),
+        });
+        let ring_layout = UniformRing::<GroomPassUniform>::layout(device, "groom pass", compute);
+        let ring = UniformRing::new(device, "groom pass", &ring_layout);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("groom.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(crate::shader_source("groom.wgsl").into()),
+        });
+        let pipeline = compute_pipeline(
+            device,
+            "groom",
+            &module,
+            "grow_hairs",
+            &[&layout, &ring_layout],
+        );
+        let passes = recipe
+            .passes
+            .iter()
+            .map(|p| GroomPassUniform {
+                first: p.hairs.start,
+                count: p.hairs.len() as u32,
+                steps: p.steps,
+                points: n as u32,
+                guide_points: gp as u32,
+                hairs: hairs32,
+                values_per_hair: recipe.values_per_hair,
+                posed: 0,
+                resample_at,
+                render_first: render.start,
+                width_scale: 1.0,
+                pad0: 0,
+            })
+            .collect();
+        let [_, _, _, guide_offsets, _, _, _, _, skin, _, _, points] = buffers;
+        Ok(Self {
+            pipeline,
+            passes,
+            ring,
+            bind_group,
+            guide_offsets,
+            skin,
+            points,
+            hairs: hairs32,
+            n: n as u32,
+            guide_values: recipe.guides as usize * gp,
+            skin_vertices,
+            render: render.clone(),
+            ids: recipe.ids[render.start as usize..render.end as usize].to_vec(),
+            colors: recipe.colors.clone(),
+            opacities: recipe.opacities.clone(),
+        })
+    }
+
+    /// Queues a frame: every hair grown from `guide_offsets` (the frame's
+    /// guides in rest space, [`GroomRecipe::guide_offsets`]) and, with a
+    /// `pose`, carried from the rest skin to it (the binding's skin, as
+    /// `SkinBinding::carry_in_place` carries the CPU's hairs).
+    ///
+    /// # Errors
+    /// When the guides or the pose do not match what was uploaded.
+    pub fn grow(
+        &self,
+        ctx: &GpuContext,
+        guide_offsets: &[Vec3],
+        pose: Option<&SkinPose>,
+    ) -> Result<(), GpuError> {
+        if guide_offsets.len() != self.guide_values {
+            return Err(GpuError::Mismatch(format!(
+                "{} guide points for a groom of {}",
+                guide_offsets.len(),
+                self.guide_values
+            )));
+        }
+        let offsets: Vec<[f32; 4]> = guide_offsets.iter().map(|&v| v4(v, 0.0)).collect();
+        ctx.queue
+            .write_buffer(&self.guide_offsets, 0, bytemuck::cast_slice(&offsets));
+        if let Some(pose) = pose {
+            if pose.positions().len() != self.skin_vertices {
+                return Err(GpuError::Mismatch(format!(
+                    "a pose of {} vertices for a skin of {}",
+                    pose.positions().len(),
+                    self.skin_vertices
+                )));
+            }
+            let skin: Vec<[f32; 4]> = pose
+                .positions()
+                .iter()
+                .zip(pose.normals())
+                .flat_map(|(&p, &n)| [v4(p, 0.0), v4(n, 0.0)])
+                .collect();
+            ctx.queue
+                .write_buffer(&self.skin, 0, bytemuck::cast_slice(&skin));
+        }
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("groom"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            let last = self.passes.len().saturating_sub(1);
+            for (i, p) in self.passes.iter().enumerate() {
+                if p.count == 0 {
+                    continue;
+                }
+                let uniform = GroomPassUniform {
+                    posed: u32::from(pose.is_some() && i == last),
+                    ..*p
+                };
+                let offset = self.ring.write(&ctx.queue, &uniform);
+                pass.set_bind_group(1, self.ring.group(), &[offset]);
+                let (x, y) = workgroups(p.count);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+        }
+        ctx.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// Every hair's points, `xyz` and width, point-major (module docs).
+    pub fn points(&self) -> &wgpu::Buffer {
+        &self.points
+    }
+
+    /// The render hairs: which hairs of [`Self::points`] to draw.
+    pub fn render_hairs(&self) -> std::ops::Range<u32> {
+        self.render.clone()
+    }
+
+    /// Hairs in [`Self::points`] (its rows' stride) and points a hair.
+    pub fn layout(&self) -> (u32, u32) {
+        (self.hairs, self.n)
+    }
+
+    /// The render hairs as last grown, read back: points, widths and ids
+    /// (with the recipe's colours and opacities).
+    ///
+    /// # Errors
+    /// When the read-back fails or a value is not finite.
+    pub fn read_curves(&self, ctx: &GpuContext) -> Result<Curves, GpuError> {
+        let size = self.points.size();
+        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("groom readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.points, 0, &readback, 0, size);
+        ctx.queue.submit([encoder.finish()]);
+        let (hairs, n) = (self.hairs as usize, self.n as usize);
+        let render = self.render.start as usize..self.render.end as usize;
+        let (points, widths) = crate::readback::map_read(ctx, &readback, |mapped| {
+            let values: &[[f32; 4]] = bytemuck::cast_slice(mapped);
+            let mut points = Vec::with_capacity(render.len() * n);
+            let mut widths = Vec::with_capacity(render.len() * n);
+            for h in render.clone() {
+                for j in 0..n {
+                    let v = values[j * hairs + h];
+                    points.push(Vec3::new(v[0], v[1], v[2]));
+                    widths.push(v[3]);
+                }
+            }
+            (points, widths)
+        })?;
+        let offsets = (0..=render.len() as u32).map(|i| i * n as u32).collect();
+        let bad = |e: pelage::curves::CurvesError| GpuError::Mismatch(format!("grown hairs: {e}"));
+        let mut curves = Curves::new(points, widths, offsets)
+            .map_err(bad)?
+            .with_ids(self.ids.clone())
+            .map_err(bad)?;
+        if let Some(colors) = &self.colors {
+            curves = curves.with_colors(colors.clone()).map_err(bad)?;
+        }
+        if let Some(opacities) = &self.opacities {
+            curves = curves.with_opacities(opacities.clone()).map_err(bad)?;
+        }
+        Ok(curves)
+    }
+}

@@ -1,0 +1,462 @@
+// A groom's hairs grown again from this frame's guides and skin, one
+// invocation a hair (pelage::groom::GroomRecipe has what each hair keeps;
+// its module docs say why the split). Every function mirrors the Rust one
+// named in its comment; keep them in step (tests/groom.rs grows both and
+// compares hair by hair). Points are written point-major (point j of hair
+// h at j * hairs + h) so neighbouring invocations write neighbouring
+// memory.
+
+const MAX_POINTS: u32 = 32u;
+const MAX_WEIGHTS: u32 = 8u;
+const TAU: f32 = 6.283185307179586;
+// pelage::groom::ops::noise::VectorNoise::OFF_LATTICE.
+const OFF_LATTICE: vec3<f32> = vec3<f32>(0.371, 0.713, 0.137);
+
+// Mirrors GroomPassUniform in groom.rs (a test checks names and offsets).
+struct GroomPass {
+    // The pass's first hair and how many.
+    first: u32,
+    count: u32,
+    // Steps the pass's hairs go through.
+    steps: u32,
+    // Points a hair and a guide.
+    points: u32,
+    guide_points: u32,
+    // Hairs in all: the stride of a point's row.
+    hairs: u32,
+    values_per_hair: u32,
+    // 1: carry the hairs from the rest skin to the posed one.
+    posed: u32,
+    // Where the guide-to-hair resampling starts in `tables` (u32::MAX: none).
+    resample_at: u32,
+    // The render hairs' first (widths are theirs alone).
+    render_first: u32,
+    // Every width's factor (level of detail).
+    width_scale: f32,
+    pad0: u32,
+};
+
+// pelage::groom::RecipeStep.
+struct Step {
+    kind: u32,
+    values: u32,
+    masked: u32,
+    table: u32,
+    permutation: u32,
+    vectors: u32,
+    centres: u32,
+    pad0: u32,
+};
+
+// A hair's root: where it is and how it is carried.
+struct HairRoot {
+    // Rest position; w: the skin triangle (u32 bits).
+    position: vec4<f32>,
+    // Rest skin normal; w: the first barycentric.
+    normal: vec4<f32>,
+    // The rest skin frame's origin; w: the second barycentric.
+    origin: vec4<f32>,
+    // The rest skin frame's columns (tangent, bitangent, normal).
+    x_axis: vec4<f32>,
+    y_axis: vec4<f32>,
+    z_axis: vec4<f32>,
+};
+
+@group(0) @binding(0) var<storage, read> hair_roots: array<HairRoot>;
+// MAX_WEIGHTS a hair: (guide as u32 bits, weight).
+@group(0) @binding(1) var<storage, read> weights: array<vec2<f32>>;
+@group(0) @binding(2) var<storage, read> guide_normals: array<vec4<f32>>;
+// This frame's guides: each point's offset from its guide's root, in rest space.
+@group(0) @binding(3) var<storage, read> guide_offsets: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> values: array<f32>;
+@group(0) @binding(5) var<storage, read> steps: array<Step>;
+@group(0) @binding(6) var<storage, read> tables: array<f32>;
+@group(0) @binding(7) var<storage, read> permutation: array<u32>;
+// This frame's skin: a vertex's posed position, then its normal.
+@group(0) @binding(8) var<storage, read> skin: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read> triangles: array<u32>;
+@group(0) @binding(10) var<storage, read> widths: array<f32>;
+// xyz: the point; w: its width.
+@group(0) @binding(11) var<storage, read_write> points: array<vec4<f32>>;
+@group(1) @binding(0) var<uniform> pass_: GroomPass;
+
+var<private> pts: array<vec3<f32>, MAX_POINTS>;
+var<private> before: array<vec3<f32>, MAX_POINTS>;
+var<private> tangents: array<vec3<f32>, MAX_POINTS>;
+var<private> frame: array<vec3<f32>, MAX_POINTS>;
+var<private> samples: array<vec3<f32>, MAX_POINTS>;
+// The noise field the current step reads (noise.wgsl's perm_at).
+var<private> perm_base: u32;
+
+fn perm_at(i: u32) -> u32 {
+    return permutation[perm_base + (i & 511u)];
+}
+
+// pelage::groom::ops::param.
+fn param(j: u32, n: u32) -> f32 {
+    if n > 1u {
+        return f32(j) / f32(n - 1u);
+    }
+    return 0.0;
+}
+
+// glam's Vec3::any_orthonormal_vector (Duff et al. 2017); signum(0) = 1.
+fn any_orthonormal(v: vec3<f32>) -> vec3<f32> {
+    let s = select(-1.0, 1.0, v.z >= 0.0);
+    let a = -1.0 / (s + v.z);
+    let b = v.x * v.y * a;
+    return vec3<f32>(b, s + v.y * v.y * a, -v.y);
+}
+
+// glam's normalize_or_zero.
+fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
+    let len = length(v);
+    if len > 0.0 && len < 3.0e38 {
+        return v / len;
+    }
+    return vec3<f32>(0.0);
+}
+
+// pelage::interp::rotation_between (from `a_dir` to `b_dir`): Rodrigues
+// without trigonometry; a half turn about a perpendicular where the
+// normals nearly oppose.
+fn rotation_between(a_dir: vec3<f32>, b_dir: vec3<f32>) -> mat3x3<f32> {
+    let v = cross(a_dir, b_dir);
+    let c = dot(a_dir, b_dir);
+    let one_plus_c = 1.0 + c;
+    if one_plus_c < 1e-4 {
+        let a = any_orthonormal(a_dir);
+        return mat3x3<f32>(2.0 * a.x * a, 2.0 * a.y * a, 2.0 * a.z * a)
+            - mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+    }
+    let h = 1.0 / one_plus_c;
+    let hx = h * v.x;
+    let hy = h * v.y;
+    let hz = h * v.z;
+    let xy = hx * v.y;
+    let xz = hx * v.z;
+    let yz = hy * v.z;
+    return mat3x3<f32>(
+        vec3<f32>(1.0 - hy * v.y - hz * v.z, xy + v.z, xz - v.y),
+        vec3<f32>(xy - v.z, 1.0 - hx * v.x - hz * v.z, yz + v.x),
+        vec3<f32>(xz + v.y, yz - v.x, 1.0 - hx * v.x - hy * v.y),
+    );
+}
+
+// pelage::interp::Interpolator::shape, then Resampling::apply: the
+// guides' offsets turned into the hair's frame, weighted, at the hair's
+// point count.
+fn interpolate(h: u32, position: vec3<f32>, normal: vec3<f32>) {
+    let gp = pass_.guide_points;
+    for (var j = 0u; j < gp; j++) {
+        samples[j] = position;
+    }
+    for (var w = 0u; w < MAX_WEIGHTS; w++) {
+        let gw = weights[h * MAX_WEIGHTS + w];
+        if gw.y == 0.0 {
+            continue;
+        }
+        let g = bitcast<u32>(gw.x);
+        let turn = gw.y * rotation_between(guide_normals[g].xyz, normal);
+        for (var j = 0u; j < gp; j++) {
+            samples[j] += turn * guide_offsets[g * gp + j].xyz;
+        }
+    }
+    let n = pass_.points;
+    if pass_.resample_at == 0xffffffffu {
+        for (var j = 0u; j < n; j++) {
+            pts[j] = samples[j];
+        }
+    } else {
+        for (var k = 0u; k < n; k++) {
+            let at = pass_.resample_at + 2u * k;
+            let j = u32(tables[at]);
+            pts[k] = mix(samples[j], samples[j + 1u], tables[at + 1u]);
+        }
+    }
+}
+
+// pelage::curves::frames::catmull_rom_tangents and
+// rotation_minimizing_normals from the skin normal's any_orthonormal_vector
+// (Scratch::frame_along).
+fn frame_along(n: u32, skin_normal: vec3<f32>) {
+    if n < 2u {
+        for (var i = 0u; i < n; i++) {
+            tangents[i] = vec3<f32>(0.0, 0.0, 1.0);
+        }
+    } else {
+        for (var i = 0u; i < n; i++) {
+            let a = pts[select(i - 1u, 0u, i == 0u)];
+            let b = pts[min(i + 1u, n - 1u)];
+            tangents[i] = normalize_or_zero(b - a);
+        }
+        for (var i = 1u; i < n; i++) {
+            if all(tangents[i] == vec3<f32>(0.0)) {
+                tangents[i] = tangents[i - 1u];
+            }
+        }
+        for (var k = 1u; k < n; k++) {
+            let i = n - 1u - k;
+            if all(tangents[i] == vec3<f32>(0.0)) {
+                tangents[i] = tangents[i + 1u];
+            }
+        }
+    }
+    if n == 0u {
+        return;
+    }
+    let first = any_orthonormal(skin_normal);
+    let t0 = tangents[0];
+    var r = normalize_or_zero(first - t0 * dot(t0, first));
+    if all(r == vec3<f32>(0.0)) {
+        r = any_orthonormal(t0);
+    }
+    frame[0] = r;
+    for (var i = 0u; i + 1u < n; i++) {
+        let v1 = pts[i + 1u] - pts[i];
+        let c1 = dot(v1, v1);
+        let k1 = select(0.0, 2.0 / c1, c1 > 1e-20);
+        let t_l = tangents[i] - k1 * dot(v1, tangents[i]) * v1;
+        let v2 = tangents[i + 1u] - t_l;
+        let c2 = dot(v2, v2);
+        let k2 = select(0.0, 2.0 / c2, c2 > 1e-20);
+        let r_l = r - k1 * dot(v1, r) * v1;
+        let reflected = r_l - k2 * dot(v2, r_l) * v2;
+        let t = tangents[i + 1u];
+        let projected = reflected - t * dot(t, reflected);
+        if dot(projected, projected) > 1e-12 {
+            r = reflected;
+        } else {
+            r = any_orthonormal(t);
+        }
+        frame[i + 1u] = r;
+    }
+}
+
+// pelage::groom::ops::Length::lengthen.
+fn lengthen(n: u32, factor: f32) {
+    let origin = pts[0];
+    for (var j = 1u; j < n; j++) {
+        pts[j] = origin + (pts[j] - origin) * factor;
+    }
+}
+
+// pelage::groom::ops::Curl::apply_to_hair.
+fn curl(n: u32, v: u32, table: u32, skin_normal: vec3<f32>) {
+    let radius = values[v];
+    if radius == 0.0 {
+        return;
+    }
+    let turns = values[v + 1u];
+    let phase = values[v + 2u];
+    frame_along(n, skin_normal);
+    for (var j = 0u; j < n; j++) {
+        let t = param(j, n);
+        let alpha = radius * tables[table + j];
+        let angle = TAU * turns * t + phase;
+        let r = frame[j];
+        let b = cross(tangents[j], r);
+        pts[j] += alpha * (cos(angle) * r + sin(angle) * b);
+    }
+}
+
+// pelage::groom::ops::Twist::apply_to_hair: each point turned about the
+// root–tip axis (Rodrigues' rotation for glam's quaternion).
+fn twist(n: u32, v: u32, table: u32) {
+    let angle = values[v];
+    let origin = pts[0];
+    let axis = normalize_or_zero(pts[n - 1u] - origin);
+    if angle == 0.0 || all(axis == vec3<f32>(0.0)) {
+        return;
+    }
+    for (var j = 1u; j < n; j++) {
+        let theta = angle * tables[table + j];
+        let d = pts[j] - origin;
+        let c = cos(theta);
+        let s = sin(theta);
+        pts[j] = origin + d * c + cross(axis, d) * s + axis * dot(axis, d) * (1.0 - c);
+    }
+}
+
+// pelage::groom::ops::Noise::displace_each: the field at the hair's
+// points (or at `vectors` points along it, spread back to every point).
+fn noise(n: u32, v: u32, step: Step) {
+    let amplitude = values[v];
+    if amplitude == 0.0 || n == 0u {
+        return;
+    }
+    let frequency = values[v + 1u];
+    let m = step.vectors;
+    if m == n {
+        for (var j = 0u; j < n; j++) {
+            let s = perlin3_vector(pts[j] * frequency + OFF_LATTICE);
+            let a = amplitude * tables[step.table + j];
+            if a != 0.0 {
+                pts[j] += a * s;
+            }
+        }
+        return;
+    }
+    let to_vectors = step.table + n;
+    for (var k = 0u; k < m; k++) {
+        let j = u32(tables[to_vectors + 2u * k]);
+        let f = tables[to_vectors + 2u * k + 1u];
+        samples[k] = perlin3_vector(mix(pts[j], pts[j + 1u], f) * frequency + OFF_LATTICE);
+    }
+    let to_points = to_vectors + 2u * m;
+    for (var j = 0u; j < n; j++) {
+        let a = amplitude * tables[step.table + j];
+        if a != 0.0 {
+            let k = u32(tables[to_points + 2u * j]);
+            let f = tables[to_points + 2u * j + 1u];
+            pts[j] += a * mix(samples[k], samples[k + 1u], f);
+        }
+    }
+}
+
+// pelage::groom::ops::Frizz::apply_to_hair.
+fn frizz(n: u32, v: u32, table: u32) {
+    let amplitude = values[v];
+    if amplitude == 0.0 {
+        return;
+    }
+    let frequency = values[v + 1u];
+    let phase = vec3<f32>(values[v + 2u], values[v + 3u], values[v + 4u]);
+    for (var j = 0u; j < n; j++) {
+        let t = param(j, n);
+        let at = phase + vec3<f32>(frequency * t, 0.0, 0.0);
+        pts[j] += amplitude * tables[table + j] * perlin3_vector(at + OFF_LATTICE);
+    }
+}
+
+// pelage::groom::ops::Flyaways::apply_to_hair.
+fn flyaways(n: u32, v: u32, table: u32) {
+    if values[v] == 0.0 {
+        return;
+    }
+    let len = values[v + 1u];
+    let spread = values[v + 2u];
+    let frequency = values[v + 3u];
+    let phase = vec3<f32>(values[v + 4u], values[v + 5u], values[v + 6u]);
+    let across = vec3<f32>(values[v + 7u], values[v + 8u], values[v + 9u]);
+    let origin = pts[0];
+    for (var j = 0u; j < n; j++) {
+        let t = param(j, n);
+        let at = phase + vec3<f32>(frequency * t, 0.0, 0.0);
+        let wander = perlin3_vector(at + OFF_LATTICE);
+        pts[j] = origin + (pts[j] - origin) * len + spread * tables[table + j] * (across + 0.5 * wander);
+    }
+}
+
+// pelage::groom::ops::Clump::pull: toward the centre hair's points, grown
+// by an earlier pass.
+fn clump(n: u32, v: u32, step: Step) {
+    let w = values[v + 1u];
+    if w == 0.0 {
+        return;
+    }
+    let centre = step.centres + bitcast<u32>(values[v]);
+    for (var j = 0u; j < n; j++) {
+        let c = points[j * pass_.hairs + centre].xyz;
+        pts[j] += w * tables[step.table + j] * (c - pts[j]);
+    }
+}
+
+// pelage::anim::SkinPose::frame_at on this frame's skin: the root's
+// position and frame (tangent along the longest edge, normal from the
+// vertex normals).
+fn posed_frame(tri: u32, b1: f32, b2: f32) -> mat4x3<f32> {
+    let a = triangles[3u * tri];
+    let b = triangles[3u * tri + 1u];
+    let c = triangles[3u * tri + 2u];
+    let p0 = skin[2u * a].xyz;
+    let p1 = skin[2u * b].xyz;
+    let p2 = skin[2u * c].xyz;
+    let position = p0 + b1 * (p1 - p0) + b2 * (p2 - p0);
+    let w0 = 1.0 - b1 - b2;
+    var normal = normalize_or_zero(w0 * skin[2u * a + 1u].xyz + b1 * skin[2u * b + 1u].xyz + b2 * skin[2u * c + 1u].xyz);
+    if all(normal == vec3<f32>(0.0)) {
+        normal = normalize_or_zero(cross(p1 - p0, p2 - p0));
+        if all(normal == vec3<f32>(0.0)) {
+            normal = vec3<f32>(0.0, 0.0, 1.0);
+        }
+    }
+    // Rust's max_by keeps the last of equal lengths.
+    var edge = p1 - p0;
+    let e1 = p2 - p1;
+    let e2 = p0 - p2;
+    if dot(e1, e1) >= dot(edge, edge) {
+        edge = e1;
+    }
+    if dot(e2, e2) >= dot(edge, edge) {
+        edge = e2;
+    }
+    var tangent = normalize_or_zero(edge - normal * dot(normal, edge));
+    if all(tangent == vec3<f32>(0.0)) {
+        tangent = any_orthonormal(normal);
+    }
+    return mat4x3<f32>(tangent, cross(normal, tangent), normal, position);
+}
+
+@compute @workgroup_size(64)
+fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let i = id.x + id.y * groups.x * 64u;
+    if i >= pass_.count {
+        return;
+    }
+    let h = pass_.first + i;
+    let n = pass_.points;
+    let root = hair_roots[h];
+    let skin_normal = root.normal.xyz;
+    interpolate(h, root.position.xyz, skin_normal);
+    for (var s = 0u; s < pass_.steps; s++) {
+        let step = steps[s];
+        var v = h * pass_.values_per_hair + step.values;
+        var m = 1.0;
+        if step.masked != 0u {
+            m = values[v];
+            v += 1u;
+            if m == 0.0 {
+                continue;
+            }
+            for (var j = 0u; j < n; j++) {
+                before[j] = pts[j];
+            }
+        }
+        perm_base = step.permutation;
+        switch step.kind {
+            case 0u: { lengthen(n, values[v]); }
+            case 1u: { curl(n, v, step.table, skin_normal); }
+            case 2u: { twist(n, v, step.table); }
+            case 3u: { noise(n, v, step); }
+            case 4u: { frizz(n, v, step.table); }
+            case 5u: { flyaways(n, v, step.table); }
+            case 6u: { clump(n, v, step); }
+            default: {}
+        }
+        if m != 1.0 {
+            for (var j = 0u; j < n; j++) {
+                pts[j] = before[j] + m * (pts[j] - before[j]);
+            }
+        }
+    }
+    if pass_.posed != 0u {
+        let rest = mat3x3<f32>(root.x_axis.xyz, root.y_axis.xyz, root.z_axis.xyz);
+        let posed = posed_frame(bitcast<u32>(root.position.w), root.normal.w, root.origin.w);
+        let turn = mat3x3<f32>(posed[0], posed[1], posed[2]) * transpose(rest);
+        for (var j = 0u; j < n; j++) {
+            pts[j] = posed[3] + turn * (pts[j] - root.origin.xyz);
+        }
+    }
+    var width_at = 0xffffffffu;
+    if h >= pass_.render_first {
+        width_at = (h - pass_.render_first) * n;
+    }
+    for (var j = 0u; j < n; j++) {
+        var w = 0.0;
+        if width_at != 0xffffffffu {
+            w = widths[width_at + j] * pass_.width_scale;
+        }
+        points[j * pass_.hairs + h] = vec4<f32>(pts[j], w);
+    }
+}

@@ -1,0 +1,200 @@
+//! The groom grown on the GPU (`GpuGroom`, from a `GroomRecipe`) against
+//! the CPU groom of the same frame (`Generator::part`,
+//! `AnimatedGroom::part`): every operator alone, and a groom with all of
+//! them (masks, maps, regions' worth of clumps at two levels); at rest, on
+//! a posed Fox (hairs carried by the skin) and on a Fox whose guides were
+//! simulated. Every point of every hair, matched by hair id, must lie
+//! within 1e-4 of the groom's size of the CPU's; widths and colours are the
+//! CPU operators' own.
+//! Needs an adapter (lavapipe serves); `PELAGE_REQUIRE_GPU=1` (CI) makes
+//! a missing one a failure.
+
+use pelage::Curves;
+use pelage::groom::{Generator, Groom, GroomRecipe};
+use pelage_gpu::{GpuContext, GpuGroom};
+use std::collections::HashMap;
+mod common;
+
+use common::gpu;
+
+const FOX: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../pelage/assets/fox/Fox.gltf");
+
+/// A groom on the embedded Spot: `ops` are its `[[ops]]` tables.
+fn spot_groom(ops: &[&str]) -> Groom {
+    let mut text = String::from(
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 3000\nseed = 3\n\
+         [guides]\npoints = 6\ngenerate = { count = 60, length = 0.08, comb = [0, -0.5, -1.0], gravity = 0.3, seed = 5 }\n\
+         [finish]\npoints = 9\nwidth = { root = 0.002, tip = 0.0005, jitter = 0.2 }\n",
+    );
+    for op in ops {
+        text.push_str(&format!("[[ops]]\n{op}\n"));
+    }
+    Groom::from_text("spot.toml", &text).unwrap_or_else(|e| panic!("{ops:?}: {e}"))
+}
+
+/// Every part's roots and ids, in part order.
+fn all_roots(generator: &Generator) -> (Vec<pelage::mesh::SurfacePoint>, Vec<u64>) {
+    let (mut roots, mut ids) = (Vec::new(), Vec::new());
+    for p in 0..generator.parts().len() {
+        let (r, i) = generator.part_roots(p);
+        roots.extend(r);
+        ids.extend(i);
+    }
+    (roots, ids)
+}
+
+/// The largest distance, over every point of every hair matched by id,
+/// between `cpu` and `gpu`, and the largest width difference.
+fn farthest(cpu: &[Curves], gpu: &Curves) -> (f32, f32) {
+    let index: HashMap<u64, usize> = gpu
+        .ids()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .map(|(i, &id)| (id, i))
+        .collect();
+    let (mut far, mut wide, mut hairs) = (0f32, 0f32, 0);
+    for part in cpu {
+        let ids = part.ids().unwrap();
+        for (c, id) in ids.iter().enumerate() {
+            let g = *index
+                .get(id)
+                .unwrap_or_else(|| panic!("hair {id} is missing on the GPU"));
+            let (a, b) = (part.range(c), gpu.range(g));
+            assert_eq!(a.len(), b.len(), "hair {id}: point counts");
+            for (p, q) in part.points()[a.clone()].iter().zip(&gpu.points()[b.clone()]) {
+                far = far.max(p.distance(*q));
+            }
+            for (w, v) in part.widths()[a].iter().zip(&gpu.widths()[b]) {
+                wide = wide.max((w - v).abs());
+            }
+            hairs += 1;
+        }
+    }
+    assert_eq!(hairs, gpu.curve_count(), "as many hairs on both");
+    (far, wide)
+}
+
+/// The groom's size: its skin's bounding box's largest side.
+fn size_of(generator: &Generator) -> f32 {
+    let (lo, hi) = generator.mesh().bounds();
+    (hi - lo).max_element()
+}
+
+/// Grows `groom` at rest on the GPU and the CPU and compares them.
+fn compare_at_rest(ctx: &GpuContext, groom: &Groom, what: &str) {
+    let generator = groom.generator(None).unwrap();
+    let (roots, ids) = all_roots(&generator);
+    let recipe = GroomRecipe::new(&generator, &roots, &ids).unwrap();
+    assert!(recipe.left_out.is_empty(), "{what}: {:?}", recipe.left_out);
+    let on_gpu = GpuGroom::new(ctx, &recipe, None).unwrap();
+    let offsets = GroomRecipe::guide_offsets(generator.guides());
+    on_gpu.grow(ctx, &offsets, None).unwrap();
+    let gpu_curves = on_gpu.read_curves(ctx).unwrap();
+    let cpu: Vec<Curves> = (0..generator.parts().len())
+        .map(|p| generator.part(p).unwrap())
+        .collect();
+    let (far, wide) = farthest(&cpu, &gpu_curves);
+    let size = size_of(&generator);
+    assert!(
+        far <= 1e-4 * size,
+        "{what}: a point {far} from the CPU's (size {size})"
+    );
+    assert!(wide <= 1e-7, "{what}: a width {wide} from the CPU's");
+    if let Some(colors) = cpu[0].colors() {
+        let gpu_colors = gpu_curves.colors().expect("colours on the GPU too");
+        assert_eq!(&gpu_colors[..colors.len().min(9)], &colors[..colors.len().min(9)]);
+    }
+}
+
+#[test]
+fn every_operator_alone_grows_as_on_the_cpu() {
+    let Some(ctx) = gpu() else { return };
+    let ops = [
+        "length = { scale = 1.4, jitter = 0.3 }",
+        "curl = { radius = 0.004, turns = 2.5 }",
+        "twist = { angle = 120, jitter = 0.5, ramp = \"smooth\" }",
+        "noise = { amplitude = 0.01, frequency = 20 }",
+        "noise = { amplitude = 0.01, frequency = 20, vectors = 4 }",
+        "frizz = { amplitude = 0.006, frequency = 5, fraction = 0.5 }",
+        "flyaways = { spread = 0.02, fraction = 0.3 }",
+        "clump = { count = 80, rate = 0.8, ramp = 1.5 }",
+        "clump = { count = 80, rate = 0.8, size = 0.05 }",
+        "width = { root = 0.003, tip = 0.001, jitter = 0.3 }",
+        "color = { root = [0.5, 0.3, 0.1], tip = [0.9, 0.8, 0.6], jitter = 0.2 }",
+        "opacity = { root = 1.0, tip = 0.3 }",
+    ];
+    for op in ops {
+        compare_at_rest(ctx, &spot_groom(&[op]), op);
+    }
+}
+
+#[test]
+fn a_groom_with_every_operator_masked_mapped_and_clumped_twice_grows_as_on_the_cpu() {
+    let Some(ctx) = gpu() else { return };
+    let mask = "mask = \"noise:frequency=4,seed=9\"";
+    let ops = [
+        "clump = { count = 40, rate = 0.7 }".to_string(),
+        "noise = { amplitude = \"noise:frequency=3,scale=0.02\", frequency = 15 }".into(),
+        format!("clump = {{ count = 200, rate = 0.5, {mask} }}"),
+        format!("curl = {{ radius = 0.003, turns = \"noise:frequency=2,offset=2\", {mask} }}"),
+        "twist = { angle = 60 }".into(),
+        format!("length = {{ scale = 1.2, jitter = 0.2, {mask} }}"),
+        "frizz = { amplitude = 0.004, fraction = 0.3 }".into(),
+        "flyaways = { spread = 0.01, fraction = 0.05 }".into(),
+        "color = { root = [0.4, 0.3, 0.2], tip = [0.8, 0.7, 0.5] }".into(),
+        format!("opacity = {{ root = 1.0, tip = 0.5, {mask} }}"),
+    ];
+    let ops: Vec<&str> = ops.iter().map(String::as_str).collect();
+    compare_at_rest(ctx, &spot_groom(&ops), "every operator");
+}
+
+/// The Fox running, with a groom in `mode`.
+fn fox_groom(mode: &str, extra: &str) -> Groom {
+    let text = format!(
+        "[mesh]\npath = {FOX:?}\n[roots]\ncount = 2000\n\
+         [guides]\npoints = 8\ngenerate = {{ count = 120, length = 12.0, comb = [0, -0.2, -0.8] }}\n\
+         [[ops]]\nclump = {{ count = 150, rate = 0.5 }}\n\
+         [[ops]]\ncurl = {{ radius = 0.6, turns = 2 }}\n\
+         [[ops]]\nnoise = {{ amplitude = 0.8, frequency = 0.15 }}\n\
+         [finish]\npoints = 10\noutside_skin = false\n\
+         [animation]\nframes = \"1-4\"\nclip = \"Run\"\nmode = \"{mode}\"\n{extra}"
+    );
+    Groom::from_text("fox.toml", &text).unwrap()
+}
+
+/// Frame `time` of `groom` on the GPU against the CPU's.
+fn compare_posed(ctx: &GpuContext, groom: &Groom, time: f64, what: &str) {
+    let animated = groom.animated(None).unwrap().expect("an animated groom");
+    let rest = animated.generator();
+    let (roots, ids) = all_roots(rest);
+    let recipe = GroomRecipe::new(rest, &roots, &ids).unwrap();
+    assert!(recipe.left_out.is_empty(), "{what}: {:?}", recipe.left_out);
+    let on_gpu = GpuGroom::new(ctx, &recipe, Some(animated.binding())).unwrap();
+    let pose = animated.pose(time).unwrap();
+    let guides = match animated.animation().mode.regrows() {
+        true => animated.regrown_generator(time, &pose).unwrap().guides().clone(),
+        false => rest.guides().clone(),
+    };
+    on_gpu
+        .grow(ctx, &GroomRecipe::guide_offsets(&guides), Some(&pose))
+        .unwrap();
+    let gpu_curves = on_gpu.read_curves(ctx).unwrap();
+    let cpu: Vec<Curves> = (0..rest.parts().len())
+        .map(|p| animated.part(p, time).unwrap())
+        .collect();
+    let (far, _) = farthest(&cpu, &gpu_curves);
+    let size = size_of(rest);
+    assert!(
+        far <= 1e-4 * size,
+        "{what}: a point {far} from the CPU's (size {size})"
+    );
+}
+
+#[test]
+fn a_posed_and_a_simulated_fox_grow_as_on_the_cpu() {
+    let Some(ctx) = gpu() else { return };
+    compare_posed(ctx, &fox_groom("deform", ""), 3.0, "deformed");
+    let simulation = "[simulation]\ngravity = [0, -500, 0]\nfollow = 0\npreroll = 2\n";
+    compare_posed(ctx, &fox_groom("simulate", simulation), 3.0, "simulated");
+}
