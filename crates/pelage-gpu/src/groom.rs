@@ -49,7 +49,14 @@ pub struct GpuGroom {
     bind_group: wgpu::BindGroup,
     guide_offsets: wgpu::Buffer,
     skin: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+    triangle_count: u32,
+    /// The rest pose as the skin buffer holds it, written back when a
+    /// frame at rest follows a posed one.
+    rest_skin: Vec<[f32; 4]>,
+    posed: std::sync::atomic::AtomicBool,
     points: wgpu::Buffer,
+    colors_buffer: wgpu::Buffer,
     hairs: u32,
     n: u32,
     guide_values: usize,
@@ -61,15 +68,25 @@ pub struct GpuGroom {
     opacities: Option<Vec<f32>>,
 }
 
+/// A pose's vertices as the shaders read them: position, then normal.
+fn skin_vertices_of(pose: &SkinPose) -> Vec<[f32; 4]> {
+    pose.positions()
+        .iter()
+        .zip(pose.normals())
+        .flat_map(|(&p, &n)| [v4(p, 0.0), v4(n, 0.0)])
+        .collect()
+}
+
 /// `v` as a `vec4` with `w`.
 fn v4(v: Vec3, w: f32) -> [f32; 4] {
     [v.x, v.y, v.z, w]
 }
 
 impl GpuGroom {
-    /// Uploads `recipe`. `binding` is the skin the hairs are carried on
-    /// when [`Self::grow`] is given a pose (its rest pose is the one the
-    /// groom was grown on).
+    /// Uploads `recipe`. `skin` is the skin the hairs grow on: its rest
+    /// pose is the one the groom was grown on, [`Self::grow`] carries the
+    /// hairs to its other poses, and a strand renderer's shadows fall
+    /// from it ([`Self::skin_at_rest`] makes one of a still mesh).
     ///
     /// # Errors
     /// When hairs or guides have more than [`MAX_GPU_HAIR_POINTS`] points,
@@ -77,8 +94,9 @@ impl GpuGroom {
     pub fn new(
         ctx: &GpuContext,
         recipe: &GroomRecipe,
-        binding: Option<&SkinBinding>,
+        skin: &SkinBinding,
     ) -> Result<Self, GpuError> {
+        let binding = Some(skin);
         let (n, gp) = (recipe.points as usize, recipe.guide_points as usize);
         if n > MAX_GPU_HAIR_POINTS || gp > MAX_GPU_HAIR_POINTS {
             return Err(GpuError::Mismatch(format!(
@@ -97,7 +115,9 @@ impl GpuGroom {
         }
         let render = recipe.render_hairs();
         let rest_frame = |i: usize| match binding {
-            Some(b) if render.contains(&(i as u32)) => b.rest().frame_at(b.triangles(), recipe.roots[i]),
+            Some(b) if render.contains(&(i as u32)) => {
+                b.rest().frame_at(b.triangles(), recipe.roots[i])
+            }
             _ => (recipe.root_positions[i], Mat3::IDENTITY),
         };
         let roots: Vec<[f32; 4]> = (0..hairs)
@@ -145,13 +165,8 @@ impl GpuGroom {
             tables.extend(recipe.resampling.iter().flat_map(|&(j, f)| [j as f32, f]));
             at
         };
-        let (skin_vertices, triangles): (usize, Vec<u32>) = match binding {
-            Some(b) => (
-                b.rest().positions().len(),
-                b.triangles().iter().flatten().copied().collect(),
-            ),
-            None => (1, vec![0; 3]),
-        };
+        let skin_vertices = skin.rest().positions().len();
+        let triangles: Vec<u32> = skin.triangles().iter().flatten().copied().collect();
         let device = &ctx.device;
         let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
             // An empty array still binds a whole element (a step is 32 bytes).
@@ -182,8 +197,12 @@ impl GpuGroom {
                 bytemuck::cast_slice(&recipe.permutations),
                 none,
             ),
-            storage("groom skin", &vec![0u8; skin_vertices * 32], dst),
-            storage("groom skin triangles", bytemuck::cast_slice(&triangles), none),
+            storage("groom skin", bytes(&skin_vertices_of(skin.rest())), dst),
+            storage(
+                "groom skin triangles",
+                bytemuck::cast_slice(&triangles),
+                none,
+            ),
             storage("groom widths", bytemuck::cast_slice(&recipe.widths), none),
             storage(
                 "groom points",
@@ -234,15 +253,42 @@ impl GpuGroom {
                 pad0: 0,
             })
             .collect();
-        let [_, _, _, guide_offsets, _, _, _, _, skin, _, _, points] = buffers;
+        let [
+            _,
+            _,
+            _,
+            guide_offsets,
+            _,
+            _,
+            _,
+            _,
+            skin_buffer,
+            triangles_buffer,
+            _,
+            points,
+        ] = buffers;
+        // A render point's colour (negative: the hairs have none) and
+        // opacity, for a strand renderer.
+        let shade: Vec<[f32; 4]> = (0..render.len() * n)
+            .map(|k| {
+                let c = recipe.colors.as_ref().map_or(Vec3::splat(-1.0), |c| c[k]);
+                v4(c, recipe.opacities.as_ref().map_or(1.0, |o| o[k]))
+            })
+            .collect();
+        let colors_buffer = storage("groom colours", bytes(&shade), none);
         Ok(Self {
             pipeline,
             passes,
             ring,
             bind_group,
             guide_offsets,
-            skin,
+            skin: skin_buffer,
+            triangles: triangles_buffer,
+            triangle_count: skin.triangles().len() as u32,
+            rest_skin: skin_vertices_of(skin.rest()),
+            posed: std::sync::atomic::AtomicBool::new(false),
             points,
+            colors_buffer,
             hairs: hairs32,
             n: n as u32,
             guide_values: recipe.guides as usize * gp,
@@ -277,22 +323,27 @@ impl GpuGroom {
         let offsets: Vec<[f32; 4]> = guide_offsets.iter().map(|&v| v4(v, 0.0)).collect();
         ctx.queue
             .write_buffer(&self.guide_offsets, 0, bytemuck::cast_slice(&offsets));
-        if let Some(pose) = pose {
-            if pose.positions().len() != self.skin_vertices {
-                return Err(GpuError::Mismatch(format!(
-                    "a pose of {} vertices for a skin of {}",
-                    pose.positions().len(),
-                    self.skin_vertices
-                )));
+        use std::sync::atomic::Ordering;
+        match pose {
+            Some(pose) => {
+                if pose.positions().len() != self.skin_vertices {
+                    return Err(GpuError::Mismatch(format!(
+                        "a pose of {} vertices for a skin of {}",
+                        pose.positions().len(),
+                        self.skin_vertices
+                    )));
+                }
+                let skin = skin_vertices_of(pose);
+                ctx.queue
+                    .write_buffer(&self.skin, 0, bytemuck::cast_slice(&skin));
+                self.posed.store(true, Ordering::Relaxed);
             }
-            let skin: Vec<[f32; 4]> = pose
-                .positions()
-                .iter()
-                .zip(pose.normals())
-                .flat_map(|(&p, &n)| [v4(p, 0.0), v4(n, 0.0)])
-                .collect();
-            ctx.queue
-                .write_buffer(&self.skin, 0, bytemuck::cast_slice(&skin));
+            None => {
+                if self.posed.swap(false, Ordering::Relaxed) {
+                    ctx.queue
+                        .write_buffer(&self.skin, 0, bytemuck::cast_slice(&self.rest_skin));
+                }
+            }
         }
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         {
@@ -324,6 +375,26 @@ impl GpuGroom {
     /// Every hair's points, `xyz` and width, point-major (module docs).
     pub fn points(&self) -> &wgpu::Buffer {
         &self.points
+    }
+
+    /// A still mesh as the skin hairs grow on, for [`Self::new`]: its
+    /// rest pose is the mesh.
+    pub fn skin_at_rest(mesh: &pelage::Mesh) -> SkinBinding {
+        let triangles = mesh.triangles().to_vec();
+        let rest = SkinPose::new(mesh.positions().to_vec(), &triangles);
+        SkinBinding::new(triangles, rest)
+    }
+
+    /// The skin as last grown on (a vertex's position, then its normal)
+    /// and its triangles (three indices each), and how many triangles.
+    pub fn skin(&self) -> (&wgpu::Buffer, &wgpu::Buffer, u32) {
+        (&self.skin, &self.triangles, self.triangle_count)
+    }
+
+    /// Each render hair's points' colours (`rgb`, negative where the
+    /// groom has none) and opacities (`w`), hair after hair.
+    pub fn colors(&self) -> &wgpu::Buffer {
+        &self.colors_buffer
     }
 
     /// The render hairs: which hairs of [`Self::points`] to draw.

@@ -336,6 +336,7 @@ pub(crate) mod entry {
 mod tests {
     use crate::dynamics::StepUniform;
     use crate::groom::GroomPassUniform;
+    use crate::hair_render::StrandUniforms;
     use crate::renderer::FrameUniforms;
     use crate::shells::ShellUniforms;
     use crate::strands::{GridHeader, StrandStepUniform};
@@ -390,6 +391,8 @@ mod tests {
         check("strands.wgsl", "Grid", grid, GridHeader::FIELDS);
         let groom = std::mem::size_of::<GroomPassUniform>();
         check("groom.wgsl", "GroomPass", groom, GroomPassUniform::FIELDS);
+        let strands = std::mem::size_of::<StrandUniforms>();
+        check("hair.wgsl", "Strands", strands, StrandUniforms::FIELDS);
     }
 
     /// A vertex input: name, location and type (`f32x3`).

@@ -15,6 +15,7 @@ mod camera;
 mod context;
 mod dynamics;
 mod groom;
+mod hair_render;
 mod layout;
 mod motion;
 mod player;
@@ -27,6 +28,7 @@ pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
 pub use dynamics::GpuMassSpring;
 pub use groom::{GpuGroom, MAX_GPU_HAIR_POINTS};
+pub use hair_render::{StrandBinding, StrandFrame, StrandLook, StrandParams, StrandRenderer};
 pub use motion::{FurMotion, SkinMotion};
 pub use pelage::Curves;
 pub use player::ShellScenePlayer;
@@ -142,6 +144,8 @@ pub const SHADERS: &[(&str, &str)] = &[
             include_str!("shaders/noise.wgsl")
         ),
     ),
+    // Real-time strands: the GPU groom's hairs drawn, and their shadows.
+    ("hair.wgsl", include_str!("shaders/hair.wgsl")),
     // Linear-blend skinning of shell models (compute).
     ("skin.wgsl", include_str!("shaders/skin.wgsl")),
 ];

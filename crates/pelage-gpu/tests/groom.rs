@@ -9,9 +9,15 @@
 //! Needs an adapter (lavapipe serves); `PELAGE_REQUIRE_GPU=1` (CI) makes
 //! a missing one a failure.
 
+use glam::Vec3;
+use image::RgbaImage;
 use pelage::Curves;
 use pelage::groom::{Generator, Groom, GroomRecipe};
-use pelage_gpu::{GpuContext, GpuGroom};
+use pelage::shell::{ShellTextureParams, ShellTextures};
+use pelage_gpu::{
+    Camera, GpuContext, GpuGroom, ShellFeatures, ShellParams, ShellRenderer, ShellTarget,
+    ShellView, StrandLook, StrandParams, StrandRenderer,
+};
 use std::collections::HashMap;
 mod common;
 
@@ -62,7 +68,10 @@ fn farthest(cpu: &[Curves], gpu: &Curves) -> (f32, f32) {
                 .unwrap_or_else(|| panic!("hair {id} is missing on the GPU"));
             let (a, b) = (part.range(c), gpu.range(g));
             assert_eq!(a.len(), b.len(), "hair {id}: point counts");
-            for (p, q) in part.points()[a.clone()].iter().zip(&gpu.points()[b.clone()]) {
+            for (p, q) in part.points()[a.clone()]
+                .iter()
+                .zip(&gpu.points()[b.clone()])
+            {
                 far = far.max(p.distance(*q));
             }
             for (w, v) in part.widths()[a].iter().zip(&gpu.widths()[b]) {
@@ -87,7 +96,7 @@ fn compare_at_rest(ctx: &GpuContext, groom: &Groom, what: &str) {
     let (roots, ids) = all_roots(&generator);
     let recipe = GroomRecipe::new(&generator, &roots, &ids).unwrap();
     assert!(recipe.left_out.is_empty(), "{what}: {:?}", recipe.left_out);
-    let on_gpu = GpuGroom::new(ctx, &recipe, None).unwrap();
+    let on_gpu = GpuGroom::new(ctx, &recipe, &GpuGroom::skin_at_rest(generator.mesh())).unwrap();
     let offsets = GroomRecipe::guide_offsets(generator.guides());
     on_gpu.grow(ctx, &offsets, None).unwrap();
     let gpu_curves = on_gpu.read_curves(ctx).unwrap();
@@ -103,7 +112,10 @@ fn compare_at_rest(ctx: &GpuContext, groom: &Groom, what: &str) {
     assert!(wide <= 1e-7, "{what}: a width {wide} from the CPU's");
     if let Some(colors) = cpu[0].colors() {
         let gpu_colors = gpu_curves.colors().expect("colours on the GPU too");
-        assert_eq!(&gpu_colors[..colors.len().min(9)], &colors[..colors.len().min(9)]);
+        assert_eq!(
+            &gpu_colors[..colors.len().min(9)],
+            &colors[..colors.len().min(9)]
+        );
     }
 }
 
@@ -170,10 +182,14 @@ fn compare_posed(ctx: &GpuContext, groom: &Groom, time: f64, what: &str) {
     let (roots, ids) = all_roots(rest);
     let recipe = GroomRecipe::new(rest, &roots, &ids).unwrap();
     assert!(recipe.left_out.is_empty(), "{what}: {:?}", recipe.left_out);
-    let on_gpu = GpuGroom::new(ctx, &recipe, Some(animated.binding())).unwrap();
+    let on_gpu = GpuGroom::new(ctx, &recipe, animated.binding()).unwrap();
     let pose = animated.pose(time).unwrap();
     let guides = match animated.animation().mode.regrows() {
-        true => animated.regrown_generator(time, &pose).unwrap().guides().clone(),
+        true => animated
+            .regrown_generator(time, &pose)
+            .unwrap()
+            .guides()
+            .clone(),
         false => rest.guides().clone(),
     };
     on_gpu
@@ -197,4 +213,155 @@ fn a_posed_and_a_simulated_fox_grow_as_on_the_cpu() {
     compare_posed(ctx, &fox_groom("deform", ""), 3.0, "deformed");
     let simulation = "[simulation]\ngravity = [0, -500, 0]\nfollow = 0\npreroll = 2\n";
     compare_posed(ctx, &fox_groom("simulate", simulation), 3.0, "simulated");
+}
+
+/// Spot's groom drawn by the strand renderer over its skin, `size`²
+/// pixels on pure blue, lit from `light` (toward the light) as the camera
+/// at `eye` sees it; `shadows` turns the shadow map on.
+fn draw_spot(ctx: &GpuContext, light: Vec3, eye: Vec3, shadows: bool) -> RgbaImage {
+    const SIZE: u32 = 256;
+    let groom = spot_groom(&["clump = { count = 300, rate = 0.3 }"]);
+    // Thick enough to cover their pixels at this distance.
+    let text = groom
+        .source()
+        .text
+        .replace("count = 3000", "count = 20000")
+        .replace("root = 0.002, tip = 0.0005", "root = 0.008, tip = 0.003");
+    let groom = Groom::from_text("spot.toml", &text).unwrap();
+    let generator = groom.generator(None).unwrap();
+    let (roots, ids) = all_roots(&generator);
+    let recipe = GroomRecipe::new(&generator, &roots, &ids).unwrap();
+    let on_gpu = GpuGroom::new(ctx, &recipe, &GpuGroom::skin_at_rest(generator.mesh())).unwrap();
+    let offsets = GroomRecipe::guide_offsets(generator.guides());
+    on_gpu.grow(ctx, &offsets, None).unwrap();
+    let shells = ShellRenderer::new(ctx, ShellFeatures::default());
+    let strands = StrandRenderer::new(ctx, shells.target_formats());
+    let mesh = generator.mesh();
+    let textures = ShellTextures::generate(&ShellTextureParams {
+        resolution: 16,
+        layers: 1,
+        ..Default::default()
+    });
+    let grey = RgbaImage::from_pixel(4, 4, image::Rgba([90, 80, 70, 255]));
+    let model = shells.upload(ctx, mesh, &grey, &textures, 16).unwrap();
+    let skin = ShellParams {
+        background: [0.0, 0.0, 1.0],
+        ..ShellParams::plain(0, 0.08)
+    };
+    let (lo, hi) = mesh.bounds();
+    let camera = Camera {
+        eye,
+        target: 0.5 * (lo + hi),
+        fov_y_degrees: 30.0,
+    };
+    let view = ShellView::new(Some(camera), (lo, hi), 0.1, 1.0, Some(light));
+    let target = ShellTarget::new(ctx, &shells, SIZE, SIZE).unwrap();
+    // Blond: light hair lets light through (TT), as blond fur glows
+    // against the sun.
+    let params = StrandParams {
+        shadow_layer: shadows.then_some(0.02),
+        look: StrandLook::from_melanin(0.15, 0.2, 0.3),
+        ..StrandParams::for_length(0.08)
+    };
+    let grown = (lo - Vec3::splat(0.1), hi + Vec3::splat(0.1));
+    let binding = strands.bind(ctx, &on_gpu);
+    strands
+        .render(
+            ctx,
+            &binding,
+            &params,
+            &view,
+            grown,
+            Some((&shells, &model, &skin)),
+            &target,
+        )
+        .unwrap()
+}
+
+/// Whether pixel `p` is the background (pure blue).
+fn background(p: &image::Rgba<u8>) -> bool {
+    p.0[0] < 3 && p.0[1] < 3 && p.0[2] > 250
+}
+
+/// The mean red + green of the picture's fur pixels within `reach`
+/// pixels of the background (the rim), and of all the others.
+fn rim_and_inside(image: &RgbaImage, reach: i64) -> (f64, f64) {
+    let (w, h) = (image.width() as i64, image.height() as i64);
+    let (mut rim, mut rims, mut inside, mut insides) = (0.0, 0, 0.0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let p = image.get_pixel(x as u32, y as u32);
+            if background(p) {
+                continue;
+            }
+            let near_background = (-reach..=reach).any(|dy| {
+                (-reach..=reach).any(|dx| {
+                    let (u, v) = (x + dx, y + dy);
+                    (0..w).contains(&u)
+                        && (0..h).contains(&v)
+                        && background(image.get_pixel(u as u32, v as u32))
+                })
+            });
+            let value = f64::from(p.0[0]) + f64::from(p.0[1]);
+            if near_background {
+                rim += value;
+                rims += 1;
+            } else {
+                inside += value;
+                insides += 1;
+            }
+        }
+    }
+    assert!(
+        rims > 100 && insides > 100,
+        "{rims} rim and {insides} inner pixels"
+    );
+    (rim / rims as f64, inside / insides as f64)
+}
+
+#[test]
+fn strands_lit_from_behind_glow_at_the_rim_and_shadows_darken_the_hairs_below() {
+    let Some(ctx) = gpu() else { return };
+    let toward_eye = Vec3::new(1.0, 0.2, 0.15).normalize();
+    let eye = 3.6 * toward_eye;
+    let front = draw_spot(ctx, toward_eye, eye, true);
+    let behind = draw_spot(ctx, -toward_eye, eye, true);
+    let above = (Vec3::Y + 0.3 * toward_eye).normalize();
+    let lit = draw_spot(ctx, above, eye, false);
+    let shadowed = draw_spot(ctx, above, eye, true);
+    if std::env::var_os("PELAGE_KEEP_PICTURES").is_some() {
+        let pictures = [
+            ("front", &front),
+            ("behind", &behind),
+            ("lit", &lit),
+            ("shadowed", &shadowed),
+        ];
+        for (name, image) in pictures {
+            image.save(format!("/tmp/strands-{name}.png")).unwrap();
+        }
+    }
+    let (front_rim, _) = rim_and_inside(&front, 2);
+    let (behind_rim, behind_inside) = rim_and_inside(&behind, 2);
+    // The light through the hairs (TT) makes the back-lit rim the
+    // brightest fur of either picture.
+    assert!(
+        behind_rim > 1.05 * front_rim && behind_rim > 2.0 * behind_inside,
+        "rim lit from behind {behind_rim:.1}, from the front {front_rim:.1}; inside lit from behind {behind_inside:.1}"
+    );
+    // Light from above: the coat's top hairs keep their light, the ones
+    // below them lose some.
+    let fur = |image: &RgbaImage| {
+        let mut values: Vec<f64> = image
+            .pixels()
+            .filter(|p| !background(p))
+            .map(|p| f64::from(p.0[0]) + f64::from(p.0[1]))
+            .collect();
+        values.sort_by(f64::total_cmp);
+        (values[values.len() / 2], values[values.len() * 19 / 20])
+    };
+    let ((lit_median, lit_top), (shadowed_median, shadowed_top)) = (fur(&lit), fur(&shadowed));
+    assert!(
+        shadowed_median < 0.85 * lit_median && shadowed_top > 0.8 * lit_top,
+        "median {lit_median} → {shadowed_median}, brightest 5 % {lit_top} → {shadowed_top}"
+    );
 }

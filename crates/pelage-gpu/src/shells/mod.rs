@@ -359,6 +359,37 @@ gpu_struct! {
 }
 
 impl ShellParams {
+    /// Plain fur: `layers` shells `length` long, Kajiya-Kay shaded as a
+    /// scene file without a `[shading]` table is, without curl, clumps,
+    /// fins or a level of detail (`layers = 0`: the skin alone, as a host
+    /// drawing strands over it wants).
+    pub fn plain(layers: u32, length: f32) -> Self {
+        Self {
+            layers,
+            length,
+            tiles: 1.0,
+            curl: CurlParams {
+                radius: 0.0,
+                frequency: 0.0,
+            },
+            clump: ClumpParams {
+                w: 0.0,
+                strength: 0.0,
+            },
+            coupling: Coupling::Bezier,
+            offset: Vec3::ZERO,
+            mode: ShadingMode::KajiyaKay,
+            kajiya_kay: KajiyaKay {
+                specular: Vec3::new(0.12, 0.11, 0.1),
+                exponent: 30.0,
+                k_shadow: 2.0,
+            },
+            background: [0.62, 0.66, 0.72],
+            fins: None,
+            lod: None,
+        }
+    }
+
     /// The parameters a scene file sets, on the grey-blue background of
     /// the groom previews (white fur on white would vanish).
     pub fn from_scene(scene: &ShellScene) -> Self {

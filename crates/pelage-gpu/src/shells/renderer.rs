@@ -529,10 +529,10 @@ fn shell_pipeline(
 /// Colour, depth and resolve targets of one size, reused frame to frame.
 #[derive(Debug)]
 pub struct ShellTarget {
-    pub(super) color: wgpu::TextureView,
-    pub(super) depth: wgpu::TextureView,
-    pub(super) resolved: wgpu::Texture,
-    pub(super) size: (u32, u32),
+    pub(crate) color: wgpu::TextureView,
+    pub(crate) depth: wgpu::TextureView,
+    pub(crate) resolved: wgpu::Texture,
+    pub(crate) size: (u32, u32),
 }
 
 impl ShellTarget {

@@ -323,7 +323,8 @@ impl GroomRecipe {
             };
             if let Some(table) = permutation {
                 step.permutation = self.permutations.len() as u32;
-                self.permutations.extend(table.iter().map(|&p| u32::from(p)));
+                self.permutations
+                    .extend(table.iter().map(|&p| u32::from(p)));
             }
             offset += kind.values() + u32::from(masked);
             self.steps.push(step);

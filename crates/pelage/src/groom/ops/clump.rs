@@ -77,7 +77,11 @@ impl Clump {
     /// Pulls one hair toward its centre.
     /// The centre a hair rooted at `root` follows, and how strongly (the
     /// rate, faded by the distance when the clump has a size).
-    pub(crate) fn target(&self, root: &RootContext, near: &mut NeighbourCache) -> Option<(usize, f32)> {
+    pub(crate) fn target(
+        &self,
+        root: &RootContext,
+        near: &mut NeighbourCache,
+    ) -> Option<(usize, f32)> {
         let (centre, distance) = self.centres.nearest_near(
             root.position,
             Some(root.normal),

@@ -79,7 +79,11 @@ impl Frizz {
         let amplitude = self.amplitude.at(&root.site);
         let frequency = self.frequency.at(&root.site);
         let [a, b] = rng.uniform_f32_pair();
-        Some((amplitude, frequency, Vec3::new(a, b, rng.uniform_f32()) * 256.0))
+        Some((
+            amplitude,
+            frequency,
+            Vec3::new(a, b, rng.uniform_f32()) * 256.0,
+        ))
     }
 
     /// The noise field's permutation table.
