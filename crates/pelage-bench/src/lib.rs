@@ -17,6 +17,7 @@ mod groom_edit;
 pub mod interp;
 pub mod io;
 pub mod python;
+pub mod realtime;
 pub mod render;
 pub mod sampler;
 pub mod shells;
@@ -59,6 +60,9 @@ pub enum BenchWhat {
     /// Grooming in Blender: a guide edit with the add-on's Live mode
     /// against Blender's Interpolate Curves.
     Blender(blender::BlenderBenchArgs),
+    /// The groom in the game: the running Fox's guides simulated, its
+    /// hairs grown and drawn on the GPU every frame, beside the CPU groom.
+    Realtime(realtime::RealtimeBenchArgs),
 }
 
 /// The demo groom file (`pelage demo`), which the I/O benchmark grows.
@@ -139,6 +143,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Animation(a) => animation::run(a),
         BenchWhat::Python(a) => python::run(a),
         BenchWhat::Blender(a) => blender::run(a),
+        BenchWhat::Realtime(a) => realtime::run(a),
     }
 }
 

@@ -1697,3 +1697,99 @@ fn converting_an_animated_file_says_it_writes_the_first_sample() {
     assert_eq!(written.points(), read.points());
     assert_eq!(written.widths(), read.widths());
 }
+
+#[test]
+fn groom_on_the_gpu_writes_what_the_cpu_writes() {
+    // Needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_none() {
+        eprintln!("SKIPPED: set PELAGE_REQUIRE_GPU=1 to grow on the GPU through the CLI");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("fur.toml");
+    // Two parts, clumps at two levels, masks, a map, colours and normals:
+    // what a file carries beside the points.
+    std::fs::write(
+        &groom,
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 6000\nparts = 2\n\
+         [guides]\npoints = 6\ngenerate = { count = 80, length = 0.06, comb = [0, -0.5, -1] }\n\
+         [[ops]]\nclump = { count = 30, rate = 0.6 }\n\
+         [[ops]]\nclump = { count = 200, rate = 0.4, mask = \"noise:frequency=3\" }\n\
+         [[ops]]\ncurl = { radius = 0.002, turns = 2 }\n\
+         [[ops]]\nnoise = { amplitude = \"noise:frequency=2,scale=0.01\", frequency = 20 }\n\
+         [finish]\npoints = 9\nnormals = true\n\
+         color = { root = [0.3, 0.2, 0.1], tip = [0.8, 0.7, 0.5], jitter = 0.1 }\n",
+    )
+    .unwrap();
+    let cpu = dir.path().join("cpu.usdc");
+    let gpu = dir.path().join("gpu.usdc");
+    for (out, extra) in [(&cpu, None), (&gpu, Some("--gpu"))] {
+        let mut args = vec![
+            "groom",
+            groom.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ];
+        args.extend(extra);
+        let o = pelage(&args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    }
+    let (a, b) = (
+        pelage::io::read_curves(&cpu).unwrap(),
+        pelage::io::read_curves(&gpu).unwrap(),
+    );
+    assert_eq!(a.curve_count(), 6000);
+    assert_eq!(a.offsets(), b.offsets());
+    assert_eq!(a.ids(), b.ids(), "the same hairs in the same order");
+    assert_eq!(a.roots(), b.roots());
+    assert_eq!(a.colors(), b.colors());
+    let near = |x: &[glam::Vec3], y: &[glam::Vec3], tolerance: f32| {
+        x.iter()
+            .zip(y)
+            .map(|(p, q)| p.distance(*q))
+            .fold(0.0f32, f32::max)
+            <= tolerance
+    };
+    // Spot is about a unit across: 1e-4 of the groom's size.
+    assert!(near(a.points(), b.points(), 1e-4));
+    assert!(near(a.normals().unwrap(), b.normals().unwrap(), 1e-2));
+    let widths = a
+        .widths()
+        .iter()
+        .zip(b.widths())
+        .all(|(x, y)| (x - y).abs() <= 1e-7);
+    assert!(widths, "widths are the CPU operators' own");
+}
+
+#[test]
+fn groom_on_the_gpu_refuses_what_its_evaluator_leaves_out() {
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_none() {
+        eprintln!("SKIPPED: set PELAGE_REQUIRE_GPU=1 to grow on the GPU through the CLI");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let groom = dir.path().join("cut.toml");
+    std::fs::write(
+        &groom,
+        "[mesh]\npath = \"spot\"\n[roots]\ncount = 100\n\
+         [guides]\ngenerate = { count = 20, length = 0.05 }\n\
+         [[ops]]\ncut = { at = 0.5 }\n",
+    )
+    .unwrap();
+    let out = dir.path().join("cut.usdc");
+    let o = pelage(&[
+        "groom",
+        groom.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--gpu",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(
+        err.contains("cut.toml:7") && err.contains("ops[0].cut") && err.contains("without --gpu"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written");
+}

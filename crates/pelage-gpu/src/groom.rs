@@ -15,7 +15,7 @@ use crate::{GpuContext, GpuError, workgroups};
 use glam::{Mat3, Vec3};
 use pelage::Curves;
 use pelage::anim::{SkinBinding, SkinPose};
-use pelage::groom::GroomRecipe;
+use pelage::groom::{Generator, GroomError, GroomErrorKind, GroomRecipe};
 use wgpu::util::DeviceExt;
 
 /// The most points a hair has on the GPU (the shader's `MAX_POINTS`: a
@@ -313,6 +313,25 @@ impl GpuGroom {
         guide_offsets: &[Vec3],
         pose: Option<&SkinPose>,
     ) -> Result<(), GpuError> {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.record(&ctx.queue, &mut encoder, guide_offsets, pose)?;
+        ctx.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// [`Self::grow`] recorded into a caller's encoder (a host's frame):
+    /// the guides and pose are written through `queue`, the compute pass
+    /// is recorded; submit after it.
+    ///
+    /// # Errors
+    /// When the guides or the pose do not match what was uploaded.
+    pub fn record(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        guide_offsets: &[Vec3],
+        pose: Option<&SkinPose>,
+    ) -> Result<(), GpuError> {
         if guide_offsets.len() != self.guide_values {
             return Err(GpuError::Mismatch(format!(
                 "{} guide points for a groom of {}",
@@ -321,8 +340,7 @@ impl GpuGroom {
             )));
         }
         let offsets: Vec<[f32; 4]> = guide_offsets.iter().map(|&v| v4(v, 0.0)).collect();
-        ctx.queue
-            .write_buffer(&self.guide_offsets, 0, bytemuck::cast_slice(&offsets));
+        queue.write_buffer(&self.guide_offsets, 0, bytemuck::cast_slice(&offsets));
         use std::sync::atomic::Ordering;
         match pose {
             Some(pose) => {
@@ -334,41 +352,35 @@ impl GpuGroom {
                     )));
                 }
                 let skin = skin_vertices_of(pose);
-                ctx.queue
-                    .write_buffer(&self.skin, 0, bytemuck::cast_slice(&skin));
+                queue.write_buffer(&self.skin, 0, bytemuck::cast_slice(&skin));
                 self.posed.store(true, Ordering::Relaxed);
             }
             None => {
                 if self.posed.swap(false, Ordering::Relaxed) {
-                    ctx.queue
-                        .write_buffer(&self.skin, 0, bytemuck::cast_slice(&self.rest_skin));
+                    queue.write_buffer(&self.skin, 0, bytemuck::cast_slice(&self.rest_skin));
                 }
             }
         }
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("groom"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &self.bind_group, &[]);
-            let last = self.passes.len().saturating_sub(1);
-            for (i, p) in self.passes.iter().enumerate() {
-                if p.count == 0 {
-                    continue;
-                }
-                let uniform = GroomPassUniform {
-                    posed: u32::from(pose.is_some() && i == last),
-                    ..*p
-                };
-                let offset = self.ring.write(&ctx.queue, &uniform);
-                pass.set_bind_group(1, self.ring.group(), &[offset]);
-                let (x, y) = workgroups(p.count);
-                pass.dispatch_workgroups(x, y, 1);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("groom"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        let last = self.passes.len().saturating_sub(1);
+        for (i, p) in self.passes.iter().enumerate() {
+            if p.count == 0 {
+                continue;
             }
+            let uniform = GroomPassUniform {
+                posed: u32::from(pose.is_some() && i == last),
+                ..*p
+            };
+            let offset = self.ring.write(queue, &uniform);
+            pass.set_bind_group(1, self.ring.group(), &[offset]);
+            let (x, y) = workgroups(p.count);
+            pass.dispatch_workgroups(x, y, 1);
         }
-        ctx.queue.submit([encoder.finish()]);
         Ok(())
     }
 
@@ -413,32 +425,9 @@ impl GpuGroom {
     /// # Errors
     /// When the read-back fails or a value is not finite.
     pub fn read_curves(&self, ctx: &GpuContext) -> Result<Curves, GpuError> {
-        let size = self.points.size();
-        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("groom readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&self.points, 0, &readback, 0, size);
-        ctx.queue.submit([encoder.finish()]);
-        let (hairs, n) = (self.hairs as usize, self.n as usize);
-        let render = self.render.start as usize..self.render.end as usize;
-        let (points, widths) = crate::readback::map_read(ctx, &readback, |mapped| {
-            let values: &[[f32; 4]] = bytemuck::cast_slice(mapped);
-            let mut points = Vec::with_capacity(render.len() * n);
-            let mut widths = Vec::with_capacity(render.len() * n);
-            for h in render.clone() {
-                for j in 0..n {
-                    let v = values[j * hairs + h];
-                    points.push(Vec3::new(v[0], v[1], v[2]));
-                    widths.push(v[3]);
-                }
-            }
-            (points, widths)
-        })?;
-        let offsets = (0..=render.len() as u32).map(|i| i * n as u32).collect();
+        let (points, widths) = self.read_points(ctx)?;
+        let n = self.n;
+        let offsets = (0..=self.ids.len() as u32).map(|i| i * n).collect();
         let bad = |e: pelage::curves::CurvesError| GpuError::Mismatch(format!("grown hairs: {e}"));
         let mut curves = Curves::new(points, widths, offsets)
             .map_err(bad)?
@@ -451,5 +440,95 @@ impl GpuGroom {
             curves = curves.with_opacities(opacities.clone()).map_err(bad)?;
         }
         Ok(curves)
+    }
+
+    /// The render hairs' points and widths as last grown, read back, hair
+    /// after hair.
+    ///
+    /// # Errors
+    /// When the read-back fails.
+    pub fn read_points(&self, ctx: &GpuContext) -> Result<(Vec<Vec3>, Vec<f32>), GpuError> {
+        let size = self.points.size();
+        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("groom readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.points, 0, &readback, 0, size);
+        ctx.queue.submit([encoder.finish()]);
+        let (hairs, n) = (self.hairs as usize, self.n as usize);
+        let render = self.render.start as usize..self.render.end as usize;
+        crate::readback::map_read(ctx, &readback, |mapped| {
+            let values: &[[f32; 4]] = bytemuck::cast_slice(mapped);
+            let mut points = Vec::with_capacity(render.len() * n);
+            let mut widths = Vec::with_capacity(render.len() * n);
+            for h in render.clone() {
+                for j in 0..n {
+                    let v = values[j * hairs + h];
+                    points.push(Vec3::new(v[0], v[1], v[2]));
+                    widths.push(v[3]);
+                }
+            }
+            (points, widths)
+        })
+    }
+}
+
+/// A still groom's parts grown on the GPU, for
+/// [`Generator::write_grown_until`]: each part's recipe uploaded and grown,
+/// its hairs read back and finished by [`Generator::part_from_grown`]
+/// (normals, root UVs, the look), so the files are the CPU's within
+/// rounding (`pelage groom --gpu`).
+#[derive(Debug)]
+pub struct GpuPartGrower<'a> {
+    ctx: &'a GpuContext,
+    generator: &'a Generator,
+    skin: SkinBinding,
+}
+
+impl<'a> GpuPartGrower<'a> {
+    /// The grower of `generator`'s parts on `ctx`.
+    ///
+    /// # Errors
+    /// When the groom has what the GPU evaluator leaves out
+    /// ([`GroomRecipe::left_out`]): growing it there would write a
+    /// different groom.
+    pub fn new(ctx: &'a GpuContext, generator: &'a Generator) -> Result<Self, GroomError> {
+        let probe = GroomRecipe::new(generator, &[], &[])?;
+        if let Some(first) = probe.left_out.first() {
+            let all: Vec<String> = probe.left_out.iter().map(|l| l.key.clone()).collect();
+            return Err(generator.error(
+                &first.key,
+                GroomErrorKind::Conflict(format!(
+                    "the GPU evaluator leaves out {} ({}): grow this groom without --gpu",
+                    all.join(", "),
+                    first.why
+                )),
+            ));
+        }
+        Ok(Self {
+            ctx,
+            generator,
+            skin: GpuGroom::skin_at_rest(generator.mesh()),
+        })
+    }
+
+    /// Part `p`, grown on the GPU.
+    ///
+    /// # Errors
+    /// When the GPU fails, or a hair grew a value that is not finite.
+    pub fn part(&self, p: usize) -> Result<Curves, GroomError> {
+        let generator = self.generator;
+        let (roots, ids) = generator.part_roots(p);
+        let recipe = GroomRecipe::new(generator, &roots, &ids)?;
+        let evaluator =
+            |e: GpuError| generator.error("finish", GroomErrorKind::Evaluator(Box::new(e)));
+        let gpu = GpuGroom::new(self.ctx, &recipe, &self.skin).map_err(evaluator)?;
+        let offsets = GroomRecipe::guide_offsets(generator.guides());
+        gpu.grow(self.ctx, &offsets, None).map_err(evaluator)?;
+        let (points, widths) = gpu.read_points(self.ctx).map_err(evaluator)?;
+        generator.part_from_grown(roots, ids, points, widths, recipe.colors, recipe.opacities)
     }
 }

@@ -575,9 +575,111 @@ impl StrandRenderer {
         pass.draw(0..frame.vertices, 0..1);
     }
 
-    /// A picture: `skin` (a shell renderer drawing the skin, and its
-    /// shells when their layers are not 0) and the strands in one pass of
-    /// pelage's own `target`, read back.
+    /// Records a frame into pelage's own `target`: the key light's maps,
+    /// then one pass cleared to the background with `skin` (a shell
+    /// renderer drawing the skin, and its shells when their layers are
+    /// not 0) and the strands, resolved into the target.
+    ///
+    /// # Errors
+    /// When the skin cannot be drawn.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        binding: &StrandBinding,
+        params: &StrandParams,
+        view: &ShellView,
+        bounds: (Vec3, Vec3),
+        skin: Option<(&ShellRenderer, &ShellModel, &ShellParams)>,
+        target: &ShellTarget,
+    ) -> Result<(), GpuError> {
+        let frame = self.prepare(
+            &ctx.queue,
+            encoder,
+            binding,
+            params,
+            view,
+            (bounds, target.size),
+        );
+        let background = skin
+            .map_or([0.0; 3], |(_, _, p)| p.background)
+            .map(f64::from);
+        let resolve = target.resolved.create_view(&Default::default());
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("strands"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &target.color,
+                depth_slice: None,
+                resolve_target: Some(&resolve),
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: background[0],
+                        g: background[1],
+                        b: background[2],
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Discard,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &target.depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if let Some((shells, model, shell_params)) = skin {
+            shells.record(
+                &ctx.queue,
+                &mut pass,
+                model,
+                shell_params,
+                view,
+                target.size.1 as f32,
+            )?;
+        }
+        self.record(&mut pass, binding, &frame);
+        Ok(())
+    }
+
+    /// [`Self::encode`] submitted, waiting for the GPU to finish (a
+    /// frame's cost, for benchmarks).
+    ///
+    /// # Errors
+    /// When the GPU fails.
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw(
+        &self,
+        ctx: &GpuContext,
+        binding: &StrandBinding,
+        params: &StrandParams,
+        view: &ShellView,
+        bounds: (Vec3, Vec3),
+        skin: Option<(&ShellRenderer, &ShellModel, &ShellParams)>,
+        target: &ShellTarget,
+    ) -> Result<(), GpuError> {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.encode(
+            ctx,
+            &mut encoder,
+            binding,
+            params,
+            view,
+            bounds,
+            skin,
+            target,
+        )?;
+        ctx.queue.submit([encoder.finish()]);
+        ctx.wait()
+    }
+
+    /// [`Self::encode`], read back: a picture.
     ///
     /// # Errors
     /// When the GPU fails or the read-back does.
@@ -594,59 +696,16 @@ impl StrandRenderer {
     ) -> Result<image::RgbaImage, GpuError> {
         check_size(ctx, target.size.0, target.size.1)?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let frame = self.prepare(
-            &ctx.queue,
+        self.encode(
+            ctx,
             &mut encoder,
             binding,
             params,
             view,
-            (bounds, target.size),
-        );
-        let background = skin
-            .map_or([0.0; 3], |(_, _, p)| p.background)
-            .map(f64::from);
-        let resolve = target.resolved.create_view(&Default::default());
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("strands"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target.color,
-                    depth_slice: None,
-                    resolve_target: Some(&resolve),
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: background[0],
-                            g: background[1],
-                            b: background[2],
-                            a: 1.0,
-                        }),
-                        store: wgpu::StoreOp::Discard,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &target.depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if let Some((shells, model, shell_params)) = skin {
-                shells.record(
-                    &ctx.queue,
-                    &mut pass,
-                    model,
-                    shell_params,
-                    view,
-                    target.size.1 as f32,
-                )?;
-            }
-            self.record(&mut pass, binding, &frame);
-        }
+            bounds,
+            skin,
+            target,
+        )?;
         crate::readback::read_texture(ctx, encoder, &target.resolved)
     }
 }

@@ -27,7 +27,7 @@ mod strands;
 pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
 pub use dynamics::GpuMassSpring;
-pub use groom::{GpuGroom, MAX_GPU_HAIR_POINTS};
+pub use groom::{GpuGroom, GpuPartGrower, MAX_GPU_HAIR_POINTS};
 pub use hair_render::{StrandBinding, StrandFrame, StrandLook, StrandParams, StrandRenderer};
 pub use motion::{FurMotion, SkinMotion};
 pub use pelage::Curves;

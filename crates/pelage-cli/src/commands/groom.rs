@@ -56,6 +56,12 @@ pub struct GroomArgs {
     /// stitches them with USD value clips.
     #[arg(long, conflicts_with_all = ["part", "assemble"])]
     pub frame_files: bool,
+    /// Grow the hairs on the GPU, with the evaluator real-time strands
+    /// use (docs/realtime.md): the same file, every point within 1e-4 of
+    /// the groom's size of the CPU's. Still grooms; without a GPU adapter
+    /// it says so and exits 2.
+    #[arg(long)]
+    pub gpu: bool,
     /// Also draw the hairs on the skin into this PNG (headless GPU; at
     /// most 300,000 hairs, evenly chosen).
     #[arg(long, value_name = "PNG")]
@@ -97,6 +103,11 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         }
     }
     if let Some(animated) = groom.animated(args.seed)? {
+        if args.gpu {
+            bail!(
+                "--gpu grows still grooms for now; grow this animated one without --gpu (or without --frames and [animation])"
+            );
+        }
         if args.report.is_some() {
             bail!(
                 "--report describes still grooms; grow this one without --frames (or without [animation]) to get its report"
@@ -159,17 +170,45 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     let stride = planned.div_ceil(PREVIEW_HAIRS).max(1) as usize;
     let mut shown = Vec::new();
     let mut report = args.report.as_ref().map(|_| ReportBuilder::new(&generator));
-    let summary = generator.write(&path, range.clone(), &export, |p, curves| {
-        if args.preview.is_some() {
-            shown.push(curves.every_nth(stride));
+    // On the GPU: an adapter first (none: exit 2 with why), then each
+    // part grown there and finished as the CPU finishes it.
+    let gpu = match args.gpu {
+        true => Some(
+            pelage_gpu::GpuContext::headless()
+                .context("--gpu: no GPU to grow on; grow without --gpu")?,
+        ),
+        false => None,
+    };
+    let grower = match &gpu {
+        Some(ctx) => {
+            println!("growing on {}", ctx.adapter_name());
+            Some(pelage_gpu::GpuPartGrower::new(ctx, &generator)?)
         }
-        if let Some(report) = &mut report {
-            report.add_part(&generator, p, curves);
-        }
-        done += curves.curve_count() as u64;
-        bar.set_message(format!("{} hairs", thousands(done)));
-        bar.inc(1);
-    })?;
+        None => None,
+    };
+    let grow = |p: usize| match &grower {
+        Some(g) => g.part(p),
+        None => generator.part(p),
+    };
+    let never = std::sync::atomic::AtomicBool::new(false);
+    let summary = generator.write_grown_until(
+        &path,
+        range.clone(),
+        &export,
+        &never,
+        &grow,
+        |p, curves| {
+            if args.preview.is_some() {
+                shown.push(curves.every_nth(stride));
+            }
+            if let Some(report) = &mut report {
+                report.add_part(&generator, p, curves);
+            }
+            done += curves.curve_count() as u64;
+            bar.set_message(format!("{} hairs", thousands(done)));
+            bar.inc(1);
+        },
+    )?;
     bar.finish_and_clear();
     let seconds = growing.elapsed().as_secs_f64();
     println!(

@@ -94,6 +94,10 @@ pub enum GroomErrorKind {
     /// A brush cannot make its edit.
     #[error("{0}")]
     Brush(BrushRefusal),
+    /// Another evaluator of the groom (the GPU's) could not grow it; its
+    /// error, kept typed inside.
+    #[error("the GPU evaluator: {0}")]
+    Evaluator(Box<dyn std::error::Error + Send + Sync>),
     /// Stopped by its caller (a Ctrl-C) before the work was done.
     #[error("stopped {0}")]
     Stopped(String),

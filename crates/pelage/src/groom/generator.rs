@@ -127,9 +127,9 @@ impl std::fmt::Debug for Generator {
 }
 
 impl Generator {
-    /// An error about the setting `key`, at its line when the groom came
-    /// from a file.
-    pub(super) fn error(&self, key: &str, kind: GroomErrorKind) -> GroomError {
+    /// An error about the setting `key` (`ops[2].clump`,
+    /// `finish.outside_skin`), at its line when the groom came from a file.
+    pub fn error(&self, key: &str, kind: GroomErrorKind) -> GroomError {
         setting_error(&self.name, self.origin.as_deref(), key, kind)
     }
 

@@ -374,6 +374,81 @@ impl Generator {
         }))
     }
 
+    /// A part assembled from hairs another evaluator grew (the GPU's,
+    /// from a [`super::GroomRecipe`] of this groom): hair `i` rooted at
+    /// `roots[i]` with id `ids[i]`, its points and widths the `n` values
+    /// from `i · n`, colours and opacities as the groom has them. Normals,
+    /// root UVs, the look's values and regions are added as
+    /// [`Self::part`] adds them, so both write the same files.
+    ///
+    /// # Errors
+    /// When a point, width or normal is not a finite number (named as
+    /// [`Self::part`] names it); when the arrays do not hold one hair a
+    /// root of the groom's point count.
+    pub fn part_from_grown(
+        &self,
+        roots: Vec<SurfacePoint>,
+        ids: Vec<u64>,
+        points: Vec<Vec3>,
+        widths: Vec<f32>,
+        colors: Option<Vec<Vec3>>,
+        opacities: Option<Vec<f32>>,
+    ) -> Result<Curves, GroomError> {
+        let n = self.points;
+        let total = roots.len() * n;
+        let colors = colors.filter(|_| self.colors).unwrap_or_default();
+        let opacities = opacities.filter(|_| self.opacities).unwrap_or_default();
+        let sized = |len: usize, on: bool| len == if on { total } else { 0 };
+        if ids.len() != roots.len()
+            || points.len() != total
+            || widths.len() != total
+            || !sized(colors.len(), self.colors)
+            || !sized(opacities.len(), self.opacities)
+        {
+            return Err(self.error(
+                "finish.points",
+                GroomErrorKind::Mismatch(format!(
+                    "{} grown points for {} roots of {n} points each",
+                    points.len(),
+                    roots.len()
+                )),
+            ));
+        }
+        let mut normals = vec![Vec3::ZERO; if self.normals { total } else { 0 }];
+        if self.normals && n > 0 {
+            let mesh = &self.mesh;
+            normals
+                .par_chunks_mut(CHUNK * n)
+                .zip(points.par_chunks(CHUNK * n))
+                .zip(roots.par_chunks(CHUNK))
+                .for_each_init(FrameScratch::default, |frames, ((out, p), r)| {
+                    let first: Vec<Vec3> = r.iter().map(|r| r.normal(mesh)).collect();
+                    hair_normals(p, n, &first, out, frames);
+                });
+        }
+        let bad = (0..roots.len()).find(|&i| {
+            let range = i * n..(i + 1) * n;
+            !vectors_finite(&points[range.clone()])
+                || !widths[range.clone()].iter().all(|w| w.is_finite())
+                || (self.normals && !vectors_finite(&normals[range]))
+        });
+        if let Some(i) = bad {
+            return Err(self.non_finite_error(roots[i], ids[i]));
+        }
+        let offsets = (0..=roots.len() as u32).map(|i| i * n as u32).collect();
+        Ok(self.assemble(CurveArrays {
+            points,
+            widths,
+            normals,
+            colors,
+            opacities,
+            offsets,
+            ids,
+            roots,
+            root_uvs: Vec::new(),
+        }))
+    }
+
     /// Adds each hair's root UV (USD's uniform `st`, which renderers use to
     /// read skin textures along the hair) when the mesh has UVs.
     fn with_root_uvs(&self, curves: Curves) -> Curves {

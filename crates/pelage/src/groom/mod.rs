@@ -88,7 +88,9 @@ pub use generator::{Generator, GroomSummary};
 pub use hair_look::{HairLook, color_of_melanin, melanin_of_color};
 pub use load::srgb_to_linear;
 pub use load::{Groom, GroomInputs};
-pub use output::{GroomWriteError, StreamError, part_file, part_name, part_slice, write_assembly};
+pub use output::{
+    GroomWriteError, PartGrower, StreamError, part_file, part_name, part_slice, write_assembly,
+};
 pub use outside_skin::OutsideSkin;
 pub use parts::{HAIRS_PER_PART, Part, PartLayout};
 pub use ramp::Ramp;

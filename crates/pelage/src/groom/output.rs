@@ -75,6 +75,21 @@ impl Generator {
         parts: Range<usize>,
         export: &CurvesExport,
         cancel: &AtomicBool,
+        on_part: impl FnMut(usize, &Curves) + Send,
+    ) -> Result<GroomSummary, GroomWriteError> {
+        self.write_grown_until(path, parts, export, cancel, &|p| self.part(p), on_part)
+    }
+
+    /// [`Self::write_until`] with each part grown by `grow` instead of
+    /// [`Self::part`]: another evaluator of this groom (the GPU's, which
+    /// hands its hairs to [`Self::part_from_grown`]).
+    pub fn write_grown_until(
+        &self,
+        path: &Path,
+        parts: Range<usize>,
+        export: &CurvesExport,
+        cancel: &AtomicBool,
+        grow: PartGrower<'_>,
         mut on_part: impl FnMut(usize, &Curves) + Send,
     ) -> Result<GroomSummary, GroomWriteError> {
         let mut summary = GroomSummary::default();
@@ -87,7 +102,7 @@ impl Generator {
         if !streamed {
             let mut grown = Vec::new();
             for p in parts {
-                let curves = self.part(p)?;
+                let curves = grow(p)?;
                 on_part(p, &curves);
                 if cancel.load(Ordering::Relaxed) {
                     return Err(GroomWriteError::Cancelled);
@@ -107,7 +122,7 @@ impl Generator {
             };
             let format = format.expect("a streamed format");
             write_streamed(out, format, &export.usd, |layer| {
-                self.stream_parts(layer, parts, export, cancel, on_part)
+                self.stream_parts(layer, parts, export, (cancel, grow), on_part)
             })
         })
         .map_err(|e| e.at(path))?;
@@ -144,19 +159,27 @@ impl Generator {
         on_part: impl FnMut(usize, &Curves) + Send,
     ) -> Result<(), StreamError> {
         let mut usd = UsdaWriter::new(out, &export.usd)?;
-        self.stream_parts(&mut usd, parts, export, &AtomicBool::new(false), on_part)?;
+        let never = AtomicBool::new(false);
+        self.stream_parts(
+            &mut usd,
+            parts,
+            export,
+            (&never, &|p| self.part(p)),
+            on_part,
+        )?;
         usd.finish()?;
         Ok(())
     }
 
-    /// Writes the skin (if exported), then grows `parts` on a second
-    /// thread and writes each as it arrives.
+    /// Writes the skin (if exported), then grows `parts` with `grow` on a
+    /// second thread and writes each as it arrives, stopping once `cancel`
+    /// is set.
     fn stream_parts(
         &self,
         usd: &mut dyn PrimWriter,
         parts: Range<usize>,
         export: &CurvesExport,
-        cancel: &AtomicBool,
+        (cancel, grow): (&AtomicBool, PartGrower<'_>),
         mut on_part: impl FnMut(usize, &Curves) + Send,
     ) -> Result<(), StreamError> {
         if let Some(mesh) = export.mesh {
@@ -170,7 +193,7 @@ impl Generator {
             let (send, receive) = std::sync::mpsc::sync_channel::<Grown>(1);
             let grower = scope.spawn(move || {
                 for p in parts {
-                    let part = self.part(p);
+                    let part = grow(p);
                     let failed = part.is_err();
                     if send.send((p, part)).is_err() || failed {
                         break; // the writer failed and hung up, or we did
@@ -196,6 +219,10 @@ impl Generator {
         })
     }
 }
+
+/// Grows part `p` of a groom: [`Generator::part`], or another evaluator
+/// of the same groom (the GPU's).
+pub type PartGrower<'a> = &'a (dyn Fn(usize) -> Result<Curves, GroomError> + Sync);
 
 /// A groom could not be streamed into a layer: a part did not grow, the
 /// writer refused a prim, or the file itself failed.

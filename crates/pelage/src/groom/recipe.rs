@@ -111,7 +111,7 @@ pub struct RecipePass {
 /// Something of the groom a recipe does not grow.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LeftOut {
-    /// Where it is in the groom file (`ops[3] cut`, `finish.outside_skin`).
+    /// Its setting in the groom file (`ops[3].cut`, `finish.outside_skin`).
     pub key: String,
     /// Why.
     pub why: &'static str,
@@ -285,7 +285,7 @@ impl GroomRecipe {
                 Operator::Width(_) | Operator::Color(_) | Operator::Opacity(_) => continue,
                 Operator::Cut(_) | Operator::Strands(_) | Operator::Masked(_) => {
                     self.left_out.push(LeftOut {
-                        key: format!("ops[{k}] {}", op.name()),
+                        key: format!("ops[{k}].{}", op.name()),
                         why: "it changes how many hairs or points a root grows; no evaluator step yet",
                     });
                     continue;
