@@ -102,6 +102,7 @@ fn grass() -> Grass {
         background: [0.62, 0.66, 0.72],
         fins: None,
         lod: None,
+        opacity: 1.0,
     };
     Grass {
         mesh,

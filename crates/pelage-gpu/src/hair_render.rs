@@ -51,7 +51,7 @@ gpu_struct! {
         shadowed: u32,
         shadow_size: f32,
         hair_opacity: f32,
-        pad0: u32,
+        opacity: f32,
         pad1: u32,
         pad2: u32,
     }
@@ -111,6 +111,9 @@ pub struct StrandParams {
     pub hairs: Option<u32>,
     /// Every width's factor.
     pub width_scale: f32,
+    /// The strands' opacity, 0 to 1 (less where they hand over to shell
+    /// fur; through alpha-to-coverage with MSAA).
+    pub opacity: f32,
     /// Self-shadowing: world units below the first hair or skin the key
     /// light sees that the deep opacity map's first layer spans (the next
     /// end at 2×, 4× and 8× of it; `None`: no self-shadowing).
@@ -125,6 +128,7 @@ impl StrandParams {
             look: StrandLook::default(),
             hairs: None,
             width_scale: 1.0,
+            opacity: 1.0,
             shadow_layer: Some(length / 4.0),
         }
     }
@@ -477,7 +481,7 @@ impl StrandRenderer {
             shadowed: u32::from(params.shadow_layer.is_some()),
             shadow_size: SHADOW_SIZE as f32,
             hair_opacity: look.opacity,
-            pad0: 0,
+            opacity: params.opacity.clamp(0.0, 1.0),
             pad1: 0,
             pad2: 0,
         };

@@ -15,8 +15,8 @@ use pelage::Curves;
 use pelage::groom::{Generator, Groom, GroomRecipe};
 use pelage::shell::{ShellTextureParams, ShellTextures};
 use pelage_gpu::{
-    Camera, GpuContext, GpuGroom, ShellFeatures, ShellParams, ShellRenderer, ShellTarget,
-    ShellView, StrandLook, StrandParams, StrandRenderer,
+    Camera, FurLevel, FurLod, GpuContext, GpuGroom, ShellFeatures, ShellParams, ShellRenderer,
+    ShellStandIn, ShellTarget, ShellView, StrandLook, StrandParams, StrandRenderer,
 };
 use std::collections::HashMap;
 mod common;
@@ -363,5 +363,163 @@ fn strands_lit_from_behind_glow_at_the_rim_and_shadows_darken_the_hairs_below() 
     assert!(
         shadowed_median < 0.85 * lit_median && shadowed_top > 0.8 * lit_top,
         "median {lit_median} → {shadowed_median}, brightest 5 % {lit_top} → {shadowed_top}"
+    );
+}
+
+/// sRGB bytes of a linear colour.
+fn srgb(c: Vec3) -> image::Rgba<u8> {
+    let encode = |x: f32| {
+        let x = x.clamp(0.0, 1.0);
+        let s = if x <= 0.003_130_8 {
+            12.92 * x
+        } else {
+            1.055 * x.powf(1.0 / 2.4) - 0.055
+        };
+        (255.0 * s).round() as u8
+    };
+    image::Rgba([encode(c.x), encode(c.y), encode(c.z), 255])
+}
+
+/// The share of `a`'s and `b`'s fur or skin pixels (not background in
+/// either) that differ by more than 40/255 in a channel, and how many such
+/// pixels there are.
+fn changed(a: &RgbaImage, b: &RgbaImage) -> (f64, usize) {
+    let (mut changed, mut object) = (0usize, 0usize);
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        if background(p) && background(q) {
+            continue;
+        }
+        object += 1;
+        changed += usize::from((0..3).any(|c| p.0[c].abs_diff(q.0[c]) > 40));
+    }
+    (changed as f64 / object.max(1) as f64, object)
+}
+
+#[test]
+fn the_level_of_detail_hands_over_from_strands_to_shells_without_a_pop() {
+    let Some(ctx) = gpu() else { return };
+    const SIZE: u32 = 192;
+    let groom = spot_groom(&["clump = { count = 300, rate = 0.3 }"]);
+    let text = groom
+        .source()
+        .text
+        .replace("count = 3000", "count = 30000")
+        .replace("root = 0.002, tip = 0.0005", "root = 0.004, tip = 0.0015");
+    let groom = Groom::from_text("spot.toml", &text).unwrap();
+    let generator = groom.generator(None).unwrap();
+    let (roots, ids) = pelage::groom::roots_by_arrival(&generator);
+    let recipe = GroomRecipe::new(&generator, &roots, &ids).unwrap();
+    let on_gpu = GpuGroom::new(ctx, &recipe, &GpuGroom::skin_at_rest(generator.mesh())).unwrap();
+    on_gpu
+        .grow(ctx, &GroomRecipe::guide_offsets(generator.guides()), None)
+        .unwrap();
+    let shells = ShellRenderer::new(ctx, ShellFeatures::default());
+    let strands = StrandRenderer::new(ctx, shells.target_formats());
+    let binding = strands.bind(ctx, &on_gpu);
+    let look = StrandLook::default();
+    let stand_in = ShellStandIn::of(&generator, 16);
+    let mesh = generator.mesh();
+    let model = shells
+        .upload(
+            ctx,
+            mesh,
+            &RgbaImage::from_pixel(2, 2, srgb(stand_in.color(look.color))),
+            &ShellTextures::generate(&stand_in.texture),
+            16,
+        )
+        .unwrap();
+    let base_shells = stand_in.params(ShellParams {
+        background: [0.0, 0.0, 1.0],
+        ..ShellParams::plain(0, 0.08)
+    });
+    let base_strands = StrandParams {
+        shadow_layer: None,
+        ..StrandParams::for_length(0.08)
+    };
+    let (lo, hi) = mesh.bounds();
+    let centre = 0.5 * (lo + hi);
+    let height = (hi - lo).y;
+    let lod = FurLod {
+        full_px: 140.0,
+        ..FurLod::default()
+    };
+    let target = ShellTarget::new(ctx, &shells, SIZE, SIZE).unwrap();
+    let grown = (lo - Vec3::splat(0.1), hi + Vec3::splat(0.1));
+    let hairs = recipe.render_hairs().len() as u32;
+    let draw = |view: &ShellView, level: Option<&FurLevel>| {
+        let (strand_params, shell_params) = match level {
+            Some(level) => (
+                level.strands(base_strands, hairs).unwrap_or(StrandParams {
+                    hairs: Some(0),
+                    ..base_strands
+                }),
+                level.shells(base_shells),
+            ),
+            // The skin alone.
+            None => (
+                StrandParams {
+                    hairs: Some(0),
+                    ..base_strands
+                },
+                ShellParams {
+                    layers: 0,
+                    ..base_shells
+                },
+            ),
+        };
+        strands
+            .render(
+                ctx,
+                &binding,
+                &strand_params,
+                view,
+                grown,
+                Some((&shells, &model, &shell_params)),
+                &target,
+            )
+            .unwrap()
+    };
+    let toward_eye = Vec3::new(1.0, 0.25, 0.3).normalize();
+    let (mut worst_pop, mut least_fur) = (0.0f64, 1.0f64);
+    let mut kinds = std::collections::BTreeSet::new();
+    for rung in 0..17 {
+        let eye = centre + 2.4 * 1.18f32.powi(rung) * toward_eye;
+        let camera = Camera {
+            eye,
+            target: centre,
+            fov_y_degrees: 30.0,
+        };
+        let view = ShellView::new(Some(camera), (lo, hi), 0.1, 1.0, None);
+        let px = view.projected_length(centre, height, SIZE as f32);
+        let here = lod.level(px);
+        let next = lod.level(px / 1.18);
+        kinds.insert((here.strand_opacity > 0.0, here.shell_opacity > 0.0));
+        let now = draw(&view, Some(&here));
+        let after = draw(&view, Some(&next));
+        let bare = draw(&view, None);
+        let (pop, _) = changed(&now, &after);
+        let (fur, object) = changed(&now, &bare);
+        assert!(
+            object > 30,
+            "rung {rung}: Spot is on screen ({object} pixels)"
+        );
+        worst_pop = worst_pop.max(pop);
+        least_fur = least_fur.min(fur);
+        if std::env::var_os("PELAGE_KEEP_PICTURES").is_some() {
+            now.save(format!("/tmp/lod-{rung}.png")).unwrap();
+        }
+        assert!(
+            pop <= 0.12 && fur >= 0.15,
+            "rung {rung} ({px:.0} px, {here:?} → {next:?}): {:.0} % of the pixels change, fur on {:.0} %",
+            100.0 * pop,
+            100.0 * fur
+        );
+    }
+    // The ladder went through strands alone, both, and shells alone.
+    assert_eq!(kinds.len(), 3, "{kinds:?}");
+    eprintln!(
+        "worst hand-over {:.1} %, least fur {:.1} %",
+        100.0 * worst_pop,
+        100.0 * least_fur
     );
 }

@@ -257,6 +257,7 @@ fn params(layers: u32) -> ShellParams {
         background: [0.0, 0.0, 1.0],
         fins: None,
         lod: None,
+        opacity: 1.0,
     }
 }
 

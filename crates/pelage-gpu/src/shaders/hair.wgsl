@@ -72,7 +72,8 @@ struct Strands {
     // The share of the key light a hair stops (the rest goes through,
     // forward).
     hair_opacity: f32,
-    pad0: u32,
+    // The strands' opacity (a cross-fade with shell fur).
+    opacity: f32,
     pad1: u32,
     pad2: u32,
 };
@@ -281,5 +282,5 @@ fn fs_main(v: VertexOut) -> @location(0) vec4<f32> {
     let diffuse = sqrt(max(0.0, 1.0 - sin_i * sin_i)) * clamp(0.5 + 0.5 * cos_across, 0.0, 1.0);
     let color = base * (u.ambient + 0.6 * diffuse * lit)
         + (vec3<f32>(r) + base * (trt + tt)) * lit;
-    return vec4<f32>(color, v.coverage * v.color.a);
+    return vec4<f32>(color, v.coverage * v.color.a * u.opacity);
 }

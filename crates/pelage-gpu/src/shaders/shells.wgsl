@@ -47,7 +47,9 @@ struct Shell {
     // Fins: opacity edge-on, and the |n·e| where they have faded out.
     fin_opacity: f32,
     fin_width: f32,
-    pad0: vec2<f32>,
+    // The layers' and fins' opacity (a cross-fade with real-time strands).
+    fur_opacity: f32,
+    pad0: f32,
 };
 
 @group(0) @binding(0) var<uniform> shell: Shell;
@@ -356,7 +358,7 @@ fn fs_layer(v: LayerOut) -> @location(0) vec4<f32> {
     if v.coverage != 1.0 {
         alpha = 1.0 - pow(1.0 - alpha, v.coverage);
     }
-    alpha *= v.fade;
+    alpha *= v.fade * shell.fur_opacity;
     let color = textureSampleLevel(color_texture, color_sampler, uv_color, 0.0).rgb;
     // The strand tangent, leaning with the texel's own hair: its direction
     // in the texture plane (x along dP/du, y down the image, i.e. −v).
@@ -482,7 +484,7 @@ fn fs_fin(v: FinOut) -> @location(0) vec4<f32> {
     if far.a > near.a {
         fur = far;
     }
-    let alpha = (1.0 - clear) * v.opacity;
+    let alpha = (1.0 - clear) * v.opacity * shell.fur_opacity;
     if alpha <= 0.0 {
         discard;
     }

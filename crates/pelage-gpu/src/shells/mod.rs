@@ -105,6 +105,9 @@ pub struct ShellParams {
     pub fins: Option<FinParams>,
     /// Level of detail by projected size, if on (else every layer, mip 0).
     pub lod: Option<ShellLod>,
+    /// The layers' and fins' opacity, 0 to 1 (1: as the shader makes
+    /// them; less where real-time strands hand over to the shells).
+    pub opacity: f32,
 }
 
 /// Fins: quads standing on the mesh's edges, textured with a vertical
@@ -354,7 +357,9 @@ gpu_struct! {
         fin_opacity: f32,
         /// Fins: how far from edge-on (|n·e|) a fin fades out.
         fin_width: f32,
-        pad0: [f32; 2],
+        /// The layers' and fins' opacity.
+        fur_opacity: f32,
+        pad0: f32,
     }
 }
 
@@ -387,6 +392,7 @@ impl ShellParams {
             background: [0.62, 0.66, 0.72],
             fins: None,
             lod: None,
+            opacity: 1.0,
         }
     }
 
@@ -415,6 +421,7 @@ impl ShellParams {
                 max_gap_px: l.max_gap_px,
                 min_layers: l.min_layers,
             }),
+            opacity: 1.0,
         }
     }
 }

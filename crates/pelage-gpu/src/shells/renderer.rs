@@ -375,7 +375,8 @@ impl ShellRenderer {
             fur_mip: level.mip,
             fin_opacity: fins.map_or(0.0, |f| f.opacity),
             fin_width: fins.map_or(1.0, |f| f.width.max(1e-3)),
-            pad0: [0.0; 2],
+            fur_opacity: params.opacity.clamp(0.0, 1.0),
+            pad0: 0.0,
         };
         let uniform_offset = self.uniforms.write(queue, &uniforms);
         pass.set_bind_group(0, self.uniforms.group(), &[uniform_offset]);

@@ -166,6 +166,50 @@ pub struct GroomRecipe {
     pub left_out: Vec<LeftOut>,
 }
 
+/// Every root of `generator`'s groom with its hair's id, ordered so that
+/// the first `k` are the hairs a preview fraction of `k` hairs grows:
+/// with stable ids, by the time each arrives in its root cell (a groom of
+/// `N` hairs is the `N` earliest; `--fraction`); otherwise by a hash of
+/// the id (an even share, stable by id). A level of detail draws a prefix.
+pub fn roots_by_arrival(generator: &Generator) -> (Vec<SurfacePoint>, Vec<u64>) {
+    let (mut roots, mut ids) = (Vec::new(), Vec::new());
+    for p in 0..generator.parts().len() {
+        let (r, i) = generator.part_roots(p);
+        roots.extend(r);
+        ids.extend(i);
+    }
+    let keys: Vec<f64> = match generator.root_cells() {
+        Some(cells) => {
+            let mut most = vec![0u64; cells.len()];
+            for &id in &ids {
+                let (c, k) = cells.cell_of(id);
+                most[c] = most[c].max(k + 1);
+            }
+            let seed = generator.seed();
+            let times: Vec<Vec<f64>> = (0..cells.len())
+                .into_par_iter()
+                .map(|c| cells.arrivals(seed, c, most[c]))
+                .collect();
+            ids.iter()
+                .map(|&id| {
+                    let (c, k) = cells.cell_of(id);
+                    times[c].get(k as usize).copied().unwrap_or(f64::INFINITY)
+                })
+                .collect()
+        }
+        None => ids
+            .iter()
+            .map(|&id| crate::sample::mix64(id) as f64)
+            .collect(),
+    };
+    let mut order: Vec<usize> = (0..ids.len()).collect();
+    order.sort_by(|&a, &b| keys[a].total_cmp(&keys[b]).then(ids[a].cmp(&ids[b])));
+    (
+        order.iter().map(|&i| roots[i]).collect(),
+        order.iter().map(|&i| ids[i]).collect(),
+    )
+}
+
 impl GroomRecipe {
     /// The recipe of the hairs `ids` rooted at `roots` (from
     /// [`Generator::part_roots`]) of `generator`'s groom.
@@ -530,5 +574,43 @@ fn step_values(
             None => out.extend([0.0, 0.0]),
         },
         _ => unreachable!("only operators with a step have values"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::groom::{GroomSpec, RootsSpec};
+    use crate::guides::{GuideGrowth, Guides};
+    use std::collections::HashSet;
+    use std::sync::Arc;
+
+    fn spot_groom(roots: RootsSpec) -> Generator {
+        let mesh = Arc::new(crate::assets::spot());
+        let guides = Guides::grow(
+            &mesh,
+            &GuideGrowth {
+                count: 30,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        GroomSpec::new(mesh, guides, roots).generator().unwrap()
+    }
+
+    #[test]
+    fn the_first_hairs_by_arrival_are_the_hairs_a_preview_fraction_grows() {
+        let full = spot_groom(RootsSpec::new(20_000));
+        let (_, ordered) = roots_by_arrival(&full);
+        assert_eq!(ordered.len(), 20_000);
+        for fraction in [0.05, 0.3, 0.77] {
+            let preview = spot_groom(RootsSpec::new(20_000).with_fraction(fraction));
+            let (_, ids) = roots_by_arrival(&preview);
+            let grown: HashSet<u64> = ids.iter().copied().collect();
+            let first: HashSet<u64> = ordered[..ids.len()].iter().copied().collect();
+            assert_eq!(grown, first, "fraction {fraction}");
+            // And in the same order: a prefix of a prefix.
+            assert_eq!(ids, ordered[..ids.len()]);
+        }
     }
 }

@@ -163,6 +163,35 @@ impl RootCells {
         states.into_iter().map(|s| s.count).collect()
     }
 
+    /// When each of the first `count` hairs of cell `c` arrives, for the
+    /// groom's `seed`: `T_{c,k}`, summed as [`Self::counts`] sums it, so a
+    /// groom of `N` hairs is exactly the `N` earliest (a preview fraction
+    /// is the hairs before a time). Empty in a cell of rate 0.
+    pub fn arrivals(&self, seed: u64, c: usize, count: u64) -> Vec<f64> {
+        let rate = self.rates[c];
+        if rate <= 0.0 || count == 0 {
+            return Vec::new();
+        }
+        let stream = self.stream(seed, c);
+        let mean_gap = 1.0 / rate;
+        let mut s = Arrivals {
+            count: 0,
+            next: exponential(stream, 0) * mean_gap,
+        };
+        let mut out = Vec::with_capacity(count as usize);
+        while (out.len() as u64) < count {
+            out.push(s.next);
+            s.advance(stream, mean_gap);
+        }
+        out
+    }
+
+    /// The cell and place in it of hair `id` ([`Self::id`]'s inverse).
+    pub fn cell_of(&self, id: u64) -> (usize, u64) {
+        let cells = self.cells.len() as u64;
+        ((id % cells) as usize, id / cells)
+    }
+
     /// The first `count` roots of cell `c` (hair `k` is sample `k` of the
     /// cell's stream), or none when the density is zero there.
     pub fn roots(
