@@ -20,12 +20,10 @@ use clap::Args;
 use glam::Vec3;
 use pelage::Curves;
 use pelage::anim::SkinPose;
-use pelage::dynamics::{GuideSimulation, GuideStrandParams};
-use pelage::groom::{AnimatedGroom, Groom, GroomRecipe, GroomSpec};
+use pelage::groom::{AnimatedGroom, Groom, GroomSpec};
 use pelage::guides::Guides;
 use pelage_gpu::{
-    Camera, GpuContext, GpuGroom, GpuStrands, ShellFeatures, ShellParams, ShellRenderer,
-    ShellTarget, ShellUpload, ShellView, StrandParams, StrandRenderer,
+    Camera, FurLod, GpuContext, RealtimeFur, ShellTarget, ShellTargetFormats, ShellView,
 };
 use std::sync::Arc;
 use std::time::Instant;
@@ -56,12 +54,24 @@ struct Figures {
     draw_ms: f64,
     cpu_eval_ms: f64,
     cpu_frames: usize,
+    lod: Vec<LodRow>,
     adapter: String,
     software: bool,
 }
 
+/// The fur at one distance: the character's height on screen, what the
+/// level of detail drew and its cost, beside shells alone at that size.
+struct LodRow {
+    screen_share: f32,
+    hairs: u32,
+    shell_opacity: f32,
+    ms: f64,
+    shells_ms: f64,
+}
+
 /// The Fox's groom: `hairs` hairs of `points` points from `guides`
-/// guides, clumped, curled and waved, coloured by its texture.
+/// guides, clumped, curled and waved, coloured by its texture, the
+/// guides simulated.
 fn fox_groom(hairs: usize, guides: usize, points: usize) -> anyhow::Result<Groom> {
     let fox =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../pelage/assets/fox/Fox.gltf");
@@ -73,37 +83,27 @@ fn fox_groom(hairs: usize, guides: usize, points: usize) -> anyhow::Result<Groom
          [[ops]]\ncurl = {{ radius = 0.3, turns = 2 }}\n\
          [[ops]]\nnoise = {{ amplitude = 0.4, frequency = 0.15 }}\n\
          [finish]\npoints = {points}\noutside_skin = false\nwidth = {{ root = 0.9, tip = 0.25 }}\n\
-         [animation]\nframes = \"1-28\"\nfps = 24\nclip = \"Run\"\nmode = \"deform\"\n"
+         [animation]\nframes = \"1-48\"\nfps = 24\nclip = \"Run\"\nmode = \"simulate\"\n\
+         [simulation]\ngravity = [0, -1200, 0]\ndamping = 2\nbend = 0.3\nfollow = 0.05\n"
     );
     Ok(Groom::from_text("fox.toml", &text)?)
 }
 
-/// The guide simulation's settings on a skin `size` long.
-fn sim_params(size: f32) -> GuideStrandParams {
-    GuideStrandParams {
-        substeps: 4,
-        gravity: Vec3::new(0.0, -9.81 * size / 1.4, 0.0),
-        thickness: 0.004 * size,
-        bend: 0.3,
-        follow: 0.05,
-        ..Default::default()
-    }
-}
-
-/// Simulated guides (strand after strand, posed) brought back to the
-/// rest pose through their roots' frames: the frame's guides as the
-/// groom reads them.
-fn guides_at_rest(animated: &AnimatedGroom, posed: &[Vec3], pose: &SkinPose) -> Guides {
-    let rest = animated.generator().guides();
-    let n = rest.points_per_guide();
-    let mut points = vec![Vec3::ZERO; posed.len()];
-    for (i, (&root, out)) in rest.roots().iter().zip(points.chunks_mut(n)).enumerate() {
-        animated
-            .binding()
-            .to_rest(&posed[i * n..(i + 1) * n], root, pose, out);
-    }
-    rest.with_points(points)
-        .expect("simulated guides keep their layout")
+/// A camera on the Fox from `distance` units away.
+fn view_from(fur: &RealtimeFur, distance: f32, size: (u32, u32)) -> ShellView {
+    let (lo, hi) = fur.bounds();
+    let centre = 0.5 * (lo + hi);
+    ShellView::new(
+        Some(Camera {
+            eye: centre + distance * Vec3::new(1.0, 0.35, 0.75).normalize(),
+            target: centre,
+            fov_y_degrees: 30.0,
+        }),
+        (lo, hi),
+        0.0,
+        size.0 as f32 / size.1 as f32,
+        None,
+    )
 }
 
 fn measure(scale: Scale) -> anyhow::Result<Figures> {
@@ -114,130 +114,70 @@ fn measure(scale: Scale) -> anyhow::Result<Figures> {
     let cpu_frames = scale.pick(3, 2, 1);
     let groom = fox_groom(hairs, guides, points)?;
     let spec = groom.spec()?;
-    let animated = groom.animated(None)?.expect("the groom is animated");
-    let rest = animated.generator();
-    let (mut roots, mut ids) = (Vec::new(), Vec::new());
-    for p in 0..rest.parts().len() {
-        let (r, i) = rest.part_roots(p);
-        roots.extend(r);
-        ids.extend(i);
-    }
     let ctx = GpuContext::headless()?;
-    let recipe = GroomRecipe::new(rest, &roots, &ids)?;
-    let gpu_groom = GpuGroom::new(&ctx, &recipe, animated.binding())?;
-    // The skin: drawn by the shell renderer, skinned on the GPU by the
-    // glTF's rig (the groom's skin, the same vertices).
-    let skin = animated.skin();
-    let rig = skin
-        .rig()
-        .ok_or_else(|| anyhow::anyhow!("the Fox has no rig"))?;
-    let rest_mesh = skin.mesh_at(1.0)?;
-    let shells = ShellRenderer::new(&ctx, ShellFeatures::default());
-    let textures = pelage::shell::ShellTextures::generate(&pelage::shell::ShellTextureParams {
-        resolution: 16,
-        layers: 1,
-        ..Default::default()
-    });
-    let color = image::load_from_memory(pelage::assets::FOX_TEXTURE_PNG)?.to_rgba8();
-    let model = shells.upload_with(
-        &ctx,
-        &rest_mesh,
-        &color,
-        &textures,
-        16,
-        ShellUpload {
-            rig: Some(rig),
-            per_corner: false,
-        },
-    )?;
-    let strands = StrandRenderer::new(&ctx, shells.target_formats());
-    let binding = strands.bind(&ctx, &gpu_groom);
-    let target = ShellTarget::new(&ctx, &shells, size.0, size.1)?;
-    let (lo, hi) = rest_mesh.bounds();
-    let length = 9.0;
-    let view = ShellView::new(
-        Some(Camera {
-            eye: Vec3::new(190.0, 85.0, 140.0),
-            target: Vec3::new(0.0, 40.0, -10.0),
-            fov_y_degrees: 32.0,
-        }),
-        (lo, hi),
-        length,
-        size.0 as f32 / size.1 as f32,
-        None,
-    );
-    let skin_params = ShellParams::plain(0, length);
-    let params = StrandParams::for_length(length);
-    let triangles = animated.binding().triangles().to_vec();
-    let pose_at = |frame: usize| animated.pose(frame as f64);
-    let fox_size = (hi - lo).max_element();
-    let sim_settings = sim_params(fox_size);
-    let first = pose_at(1)?;
-    let mut sim = GuideSimulation::new(
-        rest.guides(),
-        &triangles,
-        &first,
-        sim_settings.clone(),
-        true,
-    )?;
-    let mut gpu_strands = GpuStrands::new(&ctx, sim.strands())?;
-    let dt = 1.0 / 24.0;
+    let mut fur = RealtimeFur::new(&ctx, groom, ShellTargetFormats::own())?;
+    let target = ShellTarget::new(&ctx, fur.shell_renderer(), size.0, size.1)?;
+    // Every strand, whatever the size on screen, for the frame rows.
+    let lod = fur.lod;
+    fur.lod = FurLod {
+        full_px: 1.0,
+        ..lod
+    };
+    let near = view_from(&fur, 260.0, size);
     let (mut sim_t, mut eval_t, mut draw_t, mut cpu_t) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let grown = (
-        lo - Vec3::splat(2.0 * length),
-        hi + Vec3::splat(2.0 * length),
-    );
-    for frame in 2..frames + 2 {
-        let pose = pose_at(frame)?;
-        let start = Instant::now();
-        let root_frames = sim.root_frames(&pose);
-        let grids = sim.substep_grids(&pose);
-        gpu_strands.step(
-            &ctx,
-            &sim_settings,
-            dt,
-            frame as f32 * dt,
-            &root_frames,
-            &grids,
-        )?;
-        let posed = gpu_strands.read_positions(&ctx)?;
-        sim.note_pose(&pose);
-        let frame_guides = guides_at_rest(&animated, &posed, &pose);
-        let offsets = GroomRecipe::guide_offsets(&frame_guides);
-        sim_t.push(start.elapsed().as_secs_f64());
-
-        let start = Instant::now();
-        gpu_groom.grow(&ctx, &offsets, Some(&pose))?;
-        ctx.wait()?;
-        eval_t.push(start.elapsed().as_secs_f64());
-
-        let start = Instant::now();
-        let seconds = (frame as f64 - 1.0) / 24.0;
-        let palette = skin
-            .palette_at_seconds(seconds)
-            .ok_or_else(|| anyhow::anyhow!("the Fox has no clip"))?;
-        shells.pose_now(&ctx, &model, &palette)?;
-        strands.draw(
-            &ctx,
-            &binding,
-            &params,
-            &view,
-            grown,
-            Some((&shells, &model, &skin_params)),
-            &target,
-        )?;
-        draw_t.push(start.elapsed().as_secs_f64());
-
-        if cpu_t.len() < cpu_frames {
-            cpu_t.push(cpu_groom(&animated, &spec, frame_guides, &pose)?.0);
+    for frame in 1..=frames {
+        fur.advance_to(&ctx, frame as f64)?;
+        fur.draw(&ctx, &near, &target)?;
+        let stats = fur.stats();
+        sim_t.push(stats.sim_ms);
+        eval_t.push(stats.eval_ms);
+        draw_t.push(stats.draw_ms);
+        if cpu_t.len() < cpu_frames
+            && let (Some(animated), Some(guides)) = (fur.animated(), fur.frame_guides())
+        {
+            let pose = animated.pose(frame as f64)?;
+            cpu_t.push(1e3 * cpu_groom(animated, &spec, guides.clone(), &pose)?.0);
         }
     }
-    let ms = |t: &[f64]| 1e3 * median(t);
+    // The level of detail: the Fox at shares of the screen's height, each
+    // drawn as the level of detail draws it and as shells alone.
+    let mut rows = Vec::new();
+    for share in [0.75f32, 0.25, 0.1] {
+        let (lo, hi) = fur.bounds();
+        let extent = (hi - lo).max_element();
+        let fov = 30f32.to_radians();
+        let distance = extent / (share * 2.0 * (0.5 * fov).tan());
+        let view = view_from(&fur, distance, size);
+        let draws = scale.pick(5, 3, 1);
+        let mut timed = |lod: FurLod| -> anyhow::Result<(f64, pelage_gpu::RealtimeStats)> {
+            fur.lod = lod;
+            let mut t = Vec::new();
+            for _ in 0..draws {
+                fur.draw(&ctx, &view, &target)?;
+                t.push(fur.stats().draw_ms);
+            }
+            Ok((median(&t), fur.stats()))
+        };
+        let (ms, stats) = timed(lod)?;
+        // Shells alone: a hand-over height past any screen.
+        let (shells_ms, _) = timed(FurLod {
+            full_px: 1e9,
+            ..lod
+        })?;
+        rows.push(LodRow {
+            screen_share: share,
+            hairs: stats.drawn,
+            shell_opacity: stats.level.shell_opacity,
+            ms,
+            shells_ms,
+        });
+    }
+    let ms = |t: &[f64]| median(t);
     Ok(Figures {
-        hairs: recipe.render_hairs().len(),
+        hairs: fur.stats().hairs as usize,
         points_per_hair: points,
-        guides: rest.guides().len(),
+        guides: fur.guide_count(),
         size,
         frames,
         sim_ms: ms(&sim_t),
@@ -245,6 +185,7 @@ fn measure(scale: Scale) -> anyhow::Result<Figures> {
         draw_ms: ms(&draw_t),
         cpu_eval_ms: ms(&cpu_t),
         cpu_frames: cpu_t.len(),
+        lod: rows,
         adapter: ctx.adapter_name(),
         software: ctx.is_software(),
     })
@@ -295,6 +236,14 @@ pub fn run(args: &RealtimeBenchArgs) -> anyhow::Result<()> {
             "cpu_frames": f.cpu_frames,
             "eval_speedup": speedup,
             "threads": rayon::current_num_threads(),
+            "lod": f.lod.iter().map(|r| serde_json::json!({
+                "screen_share": r.screen_share,
+                "hairs": r.hairs,
+                "shell_opacity": r.shell_opacity,
+                "ms": r.ms,
+                "shells_ms": r.shells_ms,
+                "over_shells": r.ms / r.shells_ms,
+            })).collect::<Vec<_>>(),
             "adapter": f.adapter,
             "software": f.software,
         });
@@ -343,5 +292,27 @@ pub fn run(args: &RealtimeBenchArgs) -> anyhow::Result<()> {
         "{:>28}  {:>10.1}×   target ≥ 50×",
         "GPU evaluation speedup", speedup
     );
+    println!();
+    println!("level of detail: the Fox at a share of the screen's height, drawn (median ms)");
+    println!(
+        "{:>10}  {:>10}  {:>8}  {:>10}  {:>12}  {:>10}",
+        "height", "strands", "shells", "fur", "shells alone", "ratio"
+    );
+    for r in &f.lod {
+        println!(
+            "{:>9.0} %  {:>10}  {:>6.0} %  {:>10.2}  {:>12.2}  {:>9.2}×{}",
+            100.0 * r.screen_share,
+            thousands(u64::from(r.hairs)),
+            100.0 * r.shell_opacity,
+            r.ms,
+            r.shells_ms,
+            r.ms / r.shells_ms,
+            if (r.screen_share - 0.1).abs() < 1e-3 {
+                "   target ≤ 1.2×"
+            } else {
+                ""
+            }
+        );
+    }
     Ok(())
 }

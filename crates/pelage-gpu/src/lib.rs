@@ -21,6 +21,7 @@ mod layout;
 mod motion;
 mod player;
 mod readback;
+mod realtime;
 mod renderer;
 mod shells;
 mod strands;
@@ -35,6 +36,7 @@ pub use motion::{FurMotion, SkinMotion};
 pub use pelage::Curves;
 pub use player::ShellScenePlayer;
 pub use readback::read_texture;
+pub use realtime::{RealtimeError, RealtimeFur, RealtimeStats};
 pub use renderer::{GpuScene, PreviewScene, PreviewStyle, Renderer};
 pub use shells::{
     FinParams, ShellFeatures, ShellLevel, ShellLod, ShellModel, ShellParams, ShellRenderer,

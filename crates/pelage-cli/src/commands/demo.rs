@@ -32,6 +32,11 @@ pub struct DemoArgs {
     /// simulated (gravity, inertia, collisions with the body).
     #[arg(long)]
     pub simulate: bool,
+    /// With `fox`: the groom in real time, on the GPU: guides simulated,
+    /// hairs grown and drawn every frame, strands near and shell fur far
+    /// as the camera pulls back; writes a GIF and each stage's time.
+    #[arg(long, conflicts_with = "simulate")]
+    pub realtime: bool,
 }
 
 /// The demos.
@@ -48,6 +53,9 @@ pub const FOX_GROOM: &str = include_str!("../demo_fox.toml");
 
 /// `demo fox --simulate`'s groom file.
 pub const FOX_SIMULATE_GROOM: &str = include_str!("../demo_fox_simulate.toml");
+
+/// `demo fox --realtime`'s groom file.
+pub const FOX_REALTIME_GROOM: &str = include_str!("../demo_fox_realtime.toml");
 
 /// The demo's groom file, as written for the user.
 pub const DEMO_GROOM: &str = include_str!("../demo.toml");
@@ -80,6 +88,14 @@ fn render_preview(
 }
 
 pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
+    if args.which == DemoName::Fox && args.realtime {
+        let out = args.out.clone();
+        return run_fox_realtime(&out.unwrap_or_else(|| PathBuf::from("pelage-fox-realtime")));
+    }
+    anyhow::ensure!(
+        !args.realtime,
+        "--realtime goes with the fox demo: pelage demo fox --realtime"
+    );
     if args.which == DemoName::Fox {
         let folder = if args.simulate {
             "pelage-fox-simulate"
@@ -172,6 +188,113 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Writes the fox demo's files (`groom` as `fox.toml`, the Fox, its
+/// texture and licence) into `out`.
+fn write_fox_files(out: &std::path::Path, groom: &str) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create the folder {}", out.display()))?;
+    for (name, bytes) in [
+        ("fox.toml", groom.as_bytes()),
+        ("Fox.gltf", pelage::assets::FOX_GLTF),
+        ("fox.png", pelage::assets::FOX_TEXTURE_PNG),
+        ("LICENSE-fox.md", pelage::assets::FOX_LICENSE.as_bytes()),
+    ] {
+        write_atomically(&out.join(name), |w| w.write_all(bytes))?;
+    }
+    Ok(())
+}
+
+/// `pelage demo fox --realtime`: the Fox running, played by the
+/// real-time player (GPU guides, GPU hairs, strands near and shells far)
+/// while the camera pulls back from near to far; a GIF and a still.
+fn run_fox_realtime(out: &std::path::Path) -> anyhow::Result<()> {
+    use pelage_gpu::{Camera, GpuContext, RealtimeFur, ShellTarget, ShellView};
+    let start = Instant::now();
+    println!(
+        "pelage {} demo — the running Khronos Fox in real time (GPU)\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    write_fox_files(out, FOX_REALTIME_GROOM)?;
+    let groom = Groom::load(&out.join("fox.toml"))?;
+    let ctx = GpuContext::headless().context("--realtime draws on the GPU")?;
+    let (w, h) = (480, 300);
+    let mut fur = RealtimeFur::new(&ctx, groom, pelage_gpu::ShellTargetFormats::own())?;
+    for left_out in fur.left_out() {
+        eprintln!(
+            "warning: not on the GPU: {} ({})",
+            left_out.key, left_out.why
+        );
+    }
+    let target = ShellTarget::new(&ctx, fur.shell_renderer(), w, h)?;
+    let frames = fur.frames().map_or(vec![1], |f| f.frames().to_vec());
+    println!(
+        "{} hairs from {} guides, {} frames, {}×{} on {}",
+        thousands(u64::from(fur.stats().hairs)),
+        thousands(fur.guide_count() as u64),
+        frames.len(),
+        w,
+        h,
+        ctx.adapter_name()
+    );
+    let (lo, hi) = fur.bounds();
+    let target_point = 0.5 * (lo + hi);
+    let mut images = Vec::with_capacity(frames.len());
+    let mut stats = Vec::with_capacity(frames.len());
+    for (i, &frame) in frames.iter().enumerate() {
+        fur.advance_to(&ctx, f64::from(frame))?;
+        // From beside the Fox to far away: strands, fewer strands, shells.
+        let t = i as f32 / (frames.len().max(2) - 1) as f32;
+        let eye =
+            target_point + glam::Vec3::new(1.0, 0.35, 0.75).normalize() * (220.0 * 6f32.powf(t));
+        let camera = Camera {
+            eye,
+            target: target_point,
+            fov_y_degrees: 30.0,
+        };
+        let view = ShellView::new(Some(camera), (lo, hi), 0.0, w as f32 / h as f32, None);
+        images.push(fur.render(&ctx, &view, &target)?);
+        stats.push(fur.stats());
+    }
+    let gif = out.join("fox-realtime.gif");
+    super::shells::write_gif(&gif, &images, 24.0)?;
+    // A still: near (strands), the hand-over (both), far (shells).
+    let handover = stats
+        .iter()
+        .position(|s| s.level.shell_opacity > 0.3)
+        .unwrap_or(images.len() / 2);
+    let mut strip = image::RgbaImage::new(3 * w, h);
+    for (k, &i) in [0, handover, images.len() - 1].iter().enumerate() {
+        image::GenericImage::copy_from(&mut strip, &images[i], k as u32 * w, 0)?;
+    }
+    strip.save(out.join("fox-realtime.png"))?;
+    let median = |f: fn(&pelage_gpu::RealtimeStats) -> f64| {
+        let mut v: Vec<f64> = stats.iter().map(f).collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    println!(
+        "a frame (median): guides {:.1} ms, hairs {:.1} ms, drawing {:.1} ms",
+        median(|s| s.sim_ms),
+        median(|s| s.eval_ms),
+        median(|s| s.draw_ms)
+    );
+    let first = stats.first().expect("a frame");
+    let last = stats.last().expect("a frame");
+    println!(
+        "near: {} strands; far: {} strands, shells at {:.0} %",
+        thousands(u64::from(first.drawn)),
+        thousands(u64::from(last.drawn)),
+        100.0 * last.level.shell_opacity
+    );
+    println!(
+        "→ {} and {}",
+        gif.display(),
+        out.join("fox-realtime.png").display()
+    );
+    println!("done in {:.2} s", start.elapsed().as_secs_f64());
+    Ok(())
+}
+
 /// `pelage demo fox`: the fox groom grown over the walk cycle into one
 /// time-sampled usdc (with the walking skin), rendered to a PNG a frame
 /// and a GIF.
@@ -186,16 +309,7 @@ fn run_fox(out: &std::path::Path, simulate: bool) -> anyhow::Result<()> {
         ("fur on the walking Khronos Fox", FOX_GROOM)
     };
     println!("pelage {} demo — {what}\n", env!("CARGO_PKG_VERSION"));
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create the folder {}", out.display()))?;
-    for (name, bytes) in [
-        ("fox.toml", groom_text.as_bytes()),
-        ("Fox.gltf", pelage::assets::FOX_GLTF),
-        ("fox.png", pelage::assets::FOX_TEXTURE_PNG),
-        ("LICENSE-fox.md", pelage::assets::FOX_LICENSE.as_bytes()),
-    ] {
-        write_atomically(&out.join(name), |w| w.write_all(bytes))?;
-    }
+    write_fox_files(out, groom_text)?;
     let groom_path = out.join("fox.toml");
     let groom = Groom::load(&groom_path)?;
     let simulating = Instant::now();

@@ -30,6 +30,12 @@ pub struct ShellTargetFormats {
 }
 
 impl ShellTargetFormats {
+    /// pelage's own targets ([`ShellTarget`]): sRGB RGBA8, 32-bit float
+    /// depth, 4× multisampling.
+    pub fn own() -> Self {
+        Self::pelage(COLOR_FORMAT)
+    }
+
     /// pelage's own: `format`, 32-bit float depth, 4× multisampling.
     pub fn pelage(color: wgpu::TextureFormat) -> Self {
         Self {

@@ -261,6 +261,17 @@ impl AnimatedSkin {
         }
     }
 
+    /// The palette of [`Self::rig`] at `frame` (frame 1 is the clip's
+    /// start, as [`Self::positions_at`] counts).
+    pub fn palette_at_frame(&self, frame: f64) -> Option<Vec<Mat4>> {
+        self.palette_at_seconds((frame - 1.0) / self.fps)
+    }
+
+    /// Frames per second of a glTF clip's time.
+    pub fn fps(&self) -> f64 {
+        self.fps
+    }
+
     /// The palette of [`Self::rig`] at `seconds` into the clip (clips
     /// loop, as frames do).
     pub fn palette_at_seconds(&self, seconds: f64) -> Option<Vec<Mat4>> {

@@ -538,6 +538,52 @@ impl Groom {
         &self.guides
     }
 
+    /// The `[mesh]` file's base colour texture (a glTF's), sRGB as stored,
+    /// when it has one: what a renderer colours the skin with.
+    ///
+    /// # Errors
+    /// When the texture cannot be read.
+    pub fn base_color_texture(&self) -> Result<Option<image::DynamicImage>, GroomError> {
+        let Some(section) = &self.file.mesh else {
+            return Ok(None);
+        };
+        if section.path.get_ref() == "spot" {
+            return Ok(None);
+        }
+        let path = self.source.folder().join(section.path.get_ref());
+        crate::mesh::base_color_texture(&path).map_err(|e| {
+            self.source
+                .error_at(section.path.span(), GroomErrorKind::Mesh(e))
+        })
+    }
+
+    /// `[simulation]` as the guide solver takes it, when the groom is
+    /// animated with `mode = "simulate"`: what a real-time player
+    /// simulates its guides with, frame by frame.
+    ///
+    /// # Errors
+    /// When a `[simulation]` value is out of its range.
+    pub fn simulation_settings_for_playing(
+        &self,
+    ) -> Result<Option<SimulationSettings>, GroomError> {
+        match &self.animation {
+            Some(a) if a.spec.mode == AnimationMode::Simulate => {
+                self.simulation_settings(a).map(Some)
+            }
+            _ => Ok(None),
+        }
+    }
+
+    /// Makes an animated groom's frames `mode`'s (a real-time player
+    /// carries the hairs and simulates the guides itself: it asks for
+    /// [`AnimationMode::Deform`] so that [`Self::animated`] does not
+    /// simulate the whole range first). No effect on a still groom.
+    pub fn set_animation_mode(&mut self, mode: AnimationMode) {
+        if let Some(a) = &mut self.animation {
+            a.spec.mode = mode;
+        }
+    }
+
     /// When the guides came from a file: what binding them kept and left
     /// out.
     pub fn bind_report(&self) -> Option<&BindReport> {
