@@ -543,3 +543,73 @@ fn the_guides_under_the_brush_are_highlighted_where_the_pointer_is() {
         "{before} green pixels before, {after} after"
     );
 }
+
+#[test]
+fn a_groom_plays_in_real_time_and_its_fur_runs_with_the_fox() {
+    if !has_display() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let fox = Path::new(env!("CARGO_MANIFEST_DIR")).join("../pelage/assets/fox/Fox.gltf");
+    let groom = dir.path().join("fox.toml");
+    std::fs::write(
+        &groom,
+        format!(
+            "[mesh]\npath = {fox:?}\n[roots]\ncount = 4000\n\
+             [guides]\npoints = 8\ngenerate = {{ count = 100, length = 10 }}\n\
+             [[ops]]\nclump = {{ count = 300, rate = 0.4 }}\n\
+             [finish]\npoints = 8\noutside_skin = false\nwidth = {{ root = 1.2, tip = 0.4 }}\n\
+             [animation]\nframes = \"1-12\"\nclip = \"Run\"\nmode = \"simulate\"\n\
+             [simulation]\ngravity = [0, -1000, 0]\n"
+        ),
+    )
+    .unwrap();
+    let script = dir.path().join("script.toml");
+    std::fs::write(
+        &script,
+        "ui = false\n\
+         [[step]]\ntime = 0.1\n\
+         [[step]]\nwait = 2\n\
+         [[step]]\nscreenshot = \"early.png\"\n\
+         [[step]]\ntime = 0.4\n\
+         [[step]]\nwait = 2\n\
+         [[step]]\nscreenshot = \"late.png\"\n",
+    )
+    .unwrap();
+    let size = format!("{}x{}", SIZE.0, SIZE.1);
+    let out = pelage(&[
+        "view",
+        groom.to_str().unwrap(),
+        "--realtime",
+        "--script",
+        script.to_str().unwrap(),
+        "--size",
+        &size,
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("4000 hairs from 100 guides, in real time"),
+        "{stdout}"
+    );
+    assert!(!stderr.contains("not on the GPU"), "{stderr}");
+    let read = |name: &str| image::open(dir.path().join(name)).unwrap().to_rgb8();
+    let (early, late) = (read("early.png"), read("late.png"));
+    // Orange-brown fur over a good part of the picture, and elsewhere
+    // 0.3 s later.
+    let furred = |image: &image::RgbImage| {
+        image
+            .pixels()
+            .filter(|p| u16::from(p.0[0]) > u16::from(p.0[2]) + 40 && p.0[0] > 80)
+            .count()
+    };
+    let total = (SIZE.0 * SIZE.1) as usize;
+    let (a, b) = (furred(&early), furred(&late));
+    assert!(
+        a > total / 20 && b > total / 20,
+        "fox pixels {a} {b} of {total}"
+    );
+    let (near, far) = changed_near_and_far(&early, &late, (0.0, 0.0), 0.0);
+    assert!(near + far > total / 50, "{} pixels changed", near + far);
+}

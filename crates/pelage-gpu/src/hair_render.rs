@@ -598,6 +598,28 @@ impl StrandRenderer {
         skin: Option<(&ShellRenderer, &ShellModel, &ShellParams)>,
         target: &ShellTarget,
     ) -> Result<(), GpuError> {
+        let resolve = target.resolved.create_view(&Default::default());
+        let skin_and_target = (skin, target, &resolve);
+        self.encode_to(ctx, encoder, binding, params, view, bounds, skin_and_target)
+    }
+
+    /// [`Self::encode`] resolved into `resolve` (a view of `target`'s
+    /// size: its own resolve texture, or a window's surface texture).
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_to(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        binding: &StrandBinding,
+        params: &StrandParams,
+        view: &ShellView,
+        bounds: (Vec3, Vec3),
+        (skin, target, resolve): (
+            Option<(&ShellRenderer, &ShellModel, &ShellParams)>,
+            &ShellTarget,
+            &wgpu::TextureView,
+        ),
+    ) -> Result<(), GpuError> {
         let frame = self.prepare(
             &ctx.queue,
             encoder,
@@ -609,13 +631,12 @@ impl StrandRenderer {
         let background = skin
             .map_or([0.0; 3], |(_, _, p)| p.background)
             .map(f64::from);
-        let resolve = target.resolved.create_view(&Default::default());
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("strands"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: &target.color,
                 depth_slice: None,
-                resolve_target: Some(&resolve),
+                resolve_target: Some(resolve),
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(wgpu::Color {
                         r: background[0],

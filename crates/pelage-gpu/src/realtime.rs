@@ -359,6 +359,25 @@ impl RealtimeFur {
         view: &ShellView,
         target: &ShellTarget,
     ) -> Result<(), RealtimeError> {
+        let resolve = target.resolved().create_view(&Default::default());
+        self.encode_to(ctx, encoder, view, target, &resolve)
+    }
+
+    /// Records the frame into `encoder`: drawn in `target` (of this
+    /// player's formats), resolved into `resolve` (a view of its size: a
+    /// window's surface texture). The key light's maps are a pass of their
+    /// own before it.
+    ///
+    /// # Errors
+    /// When the skin cannot be drawn.
+    pub fn encode_to(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &ShellView,
+        target: &ShellTarget,
+        resolve: &wgpu::TextureView,
+    ) -> Result<(), RealtimeError> {
         let (_, height) = target.size();
         let level = self.level(view, height as f32);
         let strands = level
@@ -374,15 +393,14 @@ impl RealtimeFur {
         self.stats.level = level;
         self.stats.drawn = strands.hairs.unwrap_or(self.hairs);
         let skin = (&self.shells, &self.model, &shells);
-        self.strands.encode(
+        self.strands.encode_to(
             ctx,
             encoder,
             &self.binding,
             &strands,
             view,
             self.bounds(),
-            Some(skin),
-            target,
+            (Some(skin), target, resolve),
         )?;
         Ok(())
     }

@@ -8,6 +8,7 @@
 
 use super::curves::{CurvesSession, CurvesSource};
 use super::grooming::{GroomingSession, PALETTE};
+use super::realtime::RealtimeSession;
 use super::script::{Script, Step};
 use super::shells::{ShellSession, Tool};
 use anyhow::Context as _;
@@ -60,6 +61,8 @@ pub enum Content {
     Curves(CurvesSource),
     /// A groom file, groomed by hand.
     Groom(PathBuf),
+    /// A groom file, played in real time on the GPU.
+    Realtime(PathBuf),
 }
 
 /// A session in the window: shell fur, a groom to look at, or a groom to
@@ -68,6 +71,7 @@ enum Session {
     Shells(Box<ShellSession>),
     Curves(Box<CurvesSession>),
     Groom(Box<GroomingSession>),
+    Realtime(Box<RealtimeSession>),
 }
 
 impl Session {
@@ -76,13 +80,14 @@ impl Session {
             Session::Shells(s) => s.initial_orbit(aspect),
             Session::Curves(c) => c.initial_orbit(aspect),
             Session::Groom(g) => g.initial_orbit(aspect),
+            Session::Realtime(r) => r.initial_orbit(aspect),
         }
     }
 
     fn fps(&self) -> f32 {
         match self {
             Session::Shells(s) => s.scene().fps.max(1.0),
-            Session::Curves(_) | Session::Groom(_) => 24.0,
+            Session::Curves(_) | Session::Groom(_) | Session::Realtime(_) => 24.0,
         }
     }
 
@@ -112,6 +117,10 @@ impl Session {
                 Ok(0.0)
             }
             Session::Groom(_) => Ok(0.0),
+            Session::Realtime(r) => {
+                r.advance(ctx)?;
+                Ok(r.last_simulation_ms)
+            }
         }
     }
 
@@ -120,6 +129,7 @@ impl Session {
         match self {
             Session::Shells(s) => s.panel(ui),
             Session::Curves(c) => c.panel(ui),
+            Session::Realtime(r) => r.panel(ui),
             Session::Groom(g) => return Some(g.panel(ui)),
         }
         None
@@ -139,6 +149,7 @@ impl Session {
             Session::Shells(s) => Ok(s.encode(ctx, encoder, orbit, view, width, height)?),
             Session::Curves(c) => c.encode(ctx, encoder, orbit, view, width, height),
             Session::Groom(g) => g.encode(ctx, encoder, orbit, view, width, height),
+            Session::Realtime(r) => r.encode(ctx, encoder, orbit, view, width, height),
         }
     }
 }
@@ -352,6 +363,9 @@ impl WindowState {
             }
             Content::Groom(path) => {
                 Session::Groom(Box::new(GroomingSession::new(&ctx, &path, format)?))
+            }
+            Content::Realtime(path) => {
+                Session::Realtime(Box::new(RealtimeSession::new(&ctx, &path, format)?))
             }
         };
         let show_ui = options.script.as_ref().is_none_or(|s| s.ui);
@@ -590,7 +604,7 @@ impl WindowState {
         let position = p.position;
         let tool = match &self.session {
             Session::Shells(s) => s.controls.tool,
-            Session::Curves(_) | Session::Groom(_) => return,
+            Session::Curves(_) | Session::Groom(_) | Session::Realtime(_) => return,
         };
         p.button = None;
         p.pressed_at = None;
@@ -709,6 +723,7 @@ impl WindowState {
                                 );
                             }
                         }
+                        Session::Realtime(r) => r.hold_at(seconds),
                         Session::Groom(_) => {
                             eprintln!(
                                 "warning: `time` is for skinned scenes and animated curves files; ignored"
@@ -734,7 +749,7 @@ impl WindowState {
                             t.guides = show.guides.unwrap_or(t.guides);
                             t.show_layer = show.layer.unwrap_or(t.show_layer);
                         }
-                        Session::Shells(_) => {
+                        Session::Shells(_) | Session::Realtime(_) => {
                             eprintln!("warning: `show` is for groom and curves views; ignored");
                         }
                     },

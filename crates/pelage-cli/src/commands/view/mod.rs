@@ -14,6 +14,8 @@ mod curves;
 #[cfg(feature = "viewer")]
 mod grooming;
 #[cfg(feature = "viewer")]
+mod realtime;
+#[cfg(feature = "viewer")]
 pub mod script;
 #[cfg(feature = "viewer")]
 mod shells;
@@ -44,6 +46,11 @@ pub struct ViewArgs {
     /// layers, undo, redo, save (docs/grooming.md).
     #[arg(long)]
     pub groom: bool,
+    /// Play the groom file in real time on the GPU: the skin running, its
+    /// guides simulated when the groom says so, every hair grown each
+    /// frame, strands near and shells far (docs/realtime.md).
+    #[arg(long, conflicts_with = "groom")]
+    pub realtime: bool,
     /// Window size, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x800", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -70,6 +77,18 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         .as_deref()
         .map_or("embedded spot".into(), |p| p.display().to_string());
     let content = match &args.input {
+        Some(path) if args.realtime => {
+            if !is_groom_file(path)? {
+                anyhow::bail!(
+                    "{}: `--realtime` plays a groom file (TOML with [roots], [guides], …; docs/realtime.md)",
+                    path.display()
+                );
+            }
+            app::Content::Realtime(path.clone())
+        }
+        None if args.realtime => anyhow::bail!(
+            "`--realtime` needs a groom file: `pelage view fox.toml --realtime` (`pelage demo fox --realtime` writes one)"
+        ),
         Some(path) if args.groom => {
             if !is_groom_file(path)? {
                 anyhow::bail!(
