@@ -10,13 +10,18 @@
 //! ```
 //!
 //! Three foxes run side by side (one skinned model drawn three times, each
-//! placed by its offset), with fins and the level of detail.
+//! placed by its offset): two in shell fur with fins and the level of
+//! detail, the middle one in real-time strands (a groom grown on the GPU
+//! every frame and carried by the pose, recorded into the same pass;
+//! docs/realtime.md).
 
 use glam::{Mat4, Vec3};
+use pelage::groom::{AnimatedGroom, Groom, GroomRecipe};
 use pelage::shell::{ShellAnimation, ShellScene, ShellTextureParams, ShellTextures};
 use pelage_gpu::{
-    FinParams, GpuContext, ShellFeatures, ShellLod, ShellModel, ShellParams, ShellRenderer,
-    ShellTargetFormats, ShellUpload, ShellView,
+    FinParams, GpuContext, GpuGroom, ShellFeatures, ShellLod, ShellModel, ShellParams,
+    ShellRenderer, ShellTargetFormats, ShellUpload, ShellView, StrandBinding, StrandParams,
+    StrandRenderer,
 };
 use std::sync::Arc;
 use std::time::Instant;
@@ -33,6 +38,12 @@ struct Furry {
     fox: ShellAnimation,
     fox_model: ShellModel,
     fox_params: ShellParams,
+    /// The middle fox's groom: carried by its pose, grown on the GPU.
+    groom: AnimatedGroom,
+    hairs: GpuGroom,
+    rest_guides: Vec<Vec3>,
+    strands: StrandRenderer,
+    strand_binding: StrandBinding,
 }
 
 struct Running {
@@ -115,7 +126,36 @@ impl Furry {
         )?;
         let (lo, hi) = fox.bounds();
         fox_model.set_bounds(lo, hi);
+        // A groom on the same Fox, grown on the GPU every frame.
+        let text = format!(
+            "[mesh]\npath = {:?}\n[roots]\ncount = 30000\n\
+             [guides]\npoints = 8\ngenerate = {{ count = 300, length = 8, comb = [0, -0.2, -0.8] }}\n\
+             [[ops]]\nclump = {{ count = 1500, rate = 0.35 }}\n\
+             [finish]\npoints = 8\noutside_skin = false\nwidth = {{ root = 1.0, tip = 0.3 }}\n\
+             [animation]\nframes = \"1-28\"\nclip = \"Run\"\n",
+            assets.join("Fox.gltf")
+        );
+        let groom = Groom::from_text("fox.toml", &text)?
+            .animated(None)?
+            .expect("the groom is animated");
+        let (roots, ids) = pelage::groom::roots_by_arrival(groom.generator());
+        let recipe = GroomRecipe::new(groom.generator(), &roots, &ids)?;
+        let hairs = GpuGroom::new(&ctx, &recipe, groom.binding())?;
+        let strands = StrandRenderer::new(
+            &ctx,
+            ShellTargetFormats {
+                color,
+                depth: DEPTH,
+                samples: 1,
+            },
+        );
+        let strand_binding = strands.bind(&ctx, &hairs);
         Ok(Self {
+            rest_guides: GroomRecipe::guide_offsets(groom.generator().guides()),
+            groom,
+            hairs,
+            strands,
+            strand_binding,
             renderer,
             fox_params: ShellParams {
                 layers: 24,
@@ -165,6 +205,23 @@ impl Running {
             &furry.fox_model,
             &furry.fox.palette_at(seconds),
         )?;
+        // pelage grows the middle fox's hairs on its pose (frame 1 is the
+        // clip's start, 24 frames a second), then draws the key light's
+        // shadow maps: passes of their own, before the app's.
+        let pose = furry.groom.pose(1.0 + 24.0 * f64::from(seconds))?;
+        furry
+            .hairs
+            .record(&self.queue, &mut encoder, &furry.rest_guides, Some(&pose))?;
+        let (lo, hi) = furry.fox.bounds();
+        let grown = (lo - Vec3::splat(16.0), hi + Vec3::splat(16.0));
+        let strand_frame = furry.strands.prepare(
+            &self.queue,
+            &mut encoder,
+            &furry.strand_binding,
+            &StrandParams::for_length(8.0),
+            &camera,
+            (grown, (self.config.width, self.config.height)),
+        );
         {
             // 2. The app's own pass: its clear colour, its depth buffer.
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -195,10 +252,13 @@ impl Running {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            // 3. pelage records fur into it: three foxes.
+            // 3. pelage records fur into it: three foxes, the middle one's
+            // skin bare under its strands.
             for x in [-90.0, 0.0, 90.0] {
                 let params = ShellParams {
                     offset: Vec3::new(x, 0.0, -x),
+                    layers: if x == 0.0 { 0 } else { furry.fox_params.layers },
+                    fins: furry.fox_params.fins.filter(|_| x != 0.0),
                     ..furry.fox_params
                 };
                 furry.renderer.record(
@@ -210,6 +270,9 @@ impl Running {
                     height,
                 )?;
             }
+            furry
+                .strands
+                .record(&mut pass, &furry.strand_binding, &strand_frame);
         }
         match screenshot {
             Some(path) => {
@@ -275,7 +338,7 @@ impl ApplicationHandler for App {
             surface.configure(&device, &config);
             let furry = Furry::new(&adapter, &device, &queue, format)?;
             println!(
-                "{}: pelage's shells in the app's pass",
+                "{}: pelage's shells and strands in the app's pass",
                 adapter.get_info().name
             );
             Ok(Running {

@@ -36,6 +36,13 @@ gpu_struct! {
         resample_at: u32,
         render_first: u32,
         width_scale: f32,
+        weights_at: u32,
+        normals_at: u32,
+        values_at: u32,
+        steps_at: u32,
+        tables_at: u32,
+        permutation_at: u32,
+        widths_at: u32,
         pad0: u32,
     }
 }
@@ -134,37 +141,47 @@ impl GpuGroom {
                 ]
             })
             .collect();
-        let weights: Vec<[f32; 2]> = recipe
-            .weights
-            .iter()
-            .map(|w| [f32::from_bits(w.guide), w.weight])
-            .collect();
-        let guide_normals: Vec<[f32; 4]> =
-            recipe.guide_normals.iter().map(|&v| v4(v, 0.0)).collect();
-        let steps: Vec<[u32; 8]> = recipe
-            .steps
-            .iter()
-            .map(|s| {
-                [
-                    s.kind as u32,
-                    s.values,
-                    u32::from(s.masked),
-                    s.table,
-                    s.permutation,
-                    s.vectors,
-                    s.centres,
-                    0,
-                ]
-            })
-            .collect();
-        let mut tables = recipe.tables.clone();
+        // Everything read-only but the roots, one array of words: the
+        // shader's `data`, each section's start in the pass uniform.
+        let mut data: Vec<f32> = Vec::new();
+        let mut section = |words: &mut dyn Iterator<Item = f32>| {
+            let at = data.len() as u32;
+            data.extend(words);
+            at
+        };
+        let bits = f32::from_bits;
+        let weights_at = section(
+            &mut recipe
+                .weights
+                .iter()
+                .flat_map(|w| [bits(w.guide), w.weight]),
+        );
+        let normals_at = section(&mut recipe.guide_normals.iter().flat_map(|v| v.to_array()));
+        let values_at = section(&mut recipe.values.iter().copied());
+        let steps_at = section(&mut recipe.steps.iter().flat_map(|s| {
+            [
+                s.kind as u32,
+                s.values,
+                u32::from(s.masked),
+                s.table,
+                s.permutation,
+                s.vectors,
+                s.centres,
+                0,
+            ]
+            .map(bits)
+        }));
+        let tables_at = section(&mut recipe.tables.iter().copied());
+        // The guide-to-hair resampling after the steps' tables, as pairs.
         let resample_at = if recipe.resampling.is_empty() {
             u32::MAX
         } else {
-            let at = tables.len() as u32;
-            tables.extend(recipe.resampling.iter().flat_map(|&(j, f)| [j as f32, f]));
+            let at = recipe.tables.len() as u32;
+            section(&mut recipe.resampling.iter().flat_map(|&(j, f)| [j as f32, f]));
             at
         };
+        let permutation_at = section(&mut recipe.permutations.iter().map(|&p| bits(p)));
+        let widths_at = section(&mut recipe.widths.iter().copied());
         let skin_vertices = skin.rest().positions().len();
         let triangles: Vec<u32> = skin.triangles().iter().flatten().copied().collect();
         let device = &ctx.device;
@@ -182,20 +199,11 @@ impl GpuGroom {
         let bytes = bytemuck::cast_slice::<[f32; 4], u8>;
         let buffers = [
             storage("groom roots", bytes(&roots), none),
-            storage("groom weights", bytemuck::cast_slice(&weights), none),
-            storage("groom guide normals", bytes(&guide_normals), none),
+            storage("groom data", bytemuck::cast_slice(&data), none),
             storage(
                 "groom guide offsets",
                 &vec![0u8; recipe.guides as usize * gp * 16],
                 dst,
-            ),
-            storage("groom values", bytemuck::cast_slice(&recipe.values), none),
-            storage("groom steps", bytemuck::cast_slice(&steps), none),
-            storage("groom tables", bytemuck::cast_slice(&tables), none),
-            storage(
-                "groom noise permutations",
-                bytemuck::cast_slice(&recipe.permutations),
-                none,
             ),
             storage("groom skin", bytes(&skin_vertices_of(skin.rest())), dst),
             storage(
@@ -203,7 +211,6 @@ impl GpuGroom {
                 bytemuck::cast_slice(&triangles),
                 none,
             ),
-            storage("groom widths", bytemuck::cast_slice(&recipe.widths), none),
             storage(
                 "groom points",
                 &vec![0u8; hairs * n * 16],
@@ -211,8 +218,8 @@ impl GpuGroom {
             ),
         ];
         let compute = wgpu::ShaderStages::COMPUTE;
-        let mut entries: Vec<_> = (0..11).map(|b| entry::storage(b, compute, true)).collect();
-        entries.push(entry::storage(11, compute, false));
+        let mut entries: Vec<_> = (0..5).map(|b| entry::storage(b, compute, true)).collect();
+        entries.push(entry::storage(5, compute, false));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("groom"),
             entries: &entries,
@@ -250,23 +257,17 @@ impl GpuGroom {
                 resample_at,
                 render_first: render.start,
                 width_scale: 1.0,
+                weights_at,
+                normals_at,
+                values_at,
+                steps_at,
+                tables_at,
+                permutation_at,
+                widths_at,
                 pad0: 0,
             })
             .collect();
-        let [
-            _,
-            _,
-            _,
-            guide_offsets,
-            _,
-            _,
-            _,
-            _,
-            skin_buffer,
-            triangles_buffer,
-            _,
-            points,
-        ] = buffers;
+        let [_, _, guide_offsets, skin_buffer, triangles_buffer, points] = buffers;
         // A render point's colour (negative: the hairs have none) and
         // opacity, for a strand renderer.
         let shade: Vec<[f32; 4]> = (0..render.len() * n)

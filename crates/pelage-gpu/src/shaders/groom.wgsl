@@ -33,6 +33,14 @@ struct GroomPass {
     render_first: u32,
     // Every width's factor (level of detail).
     width_scale: f32,
+    // Where each section of `data` starts.
+    weights_at: u32,
+    normals_at: u32,
+    values_at: u32,
+    steps_at: u32,
+    tables_at: u32,
+    permutation_at: u32,
+    widths_at: u32,
     pad0: u32,
 };
 
@@ -63,22 +71,55 @@ struct HairRoot {
 };
 
 @group(0) @binding(0) var<storage, read> hair_roots: array<HairRoot>;
-// MAX_WEIGHTS a hair: (guide as u32 bits, weight).
-@group(0) @binding(1) var<storage, read> weights: array<vec2<f32>>;
-@group(0) @binding(2) var<storage, read> guide_normals: array<vec4<f32>>;
+// Everything else that does not change, one array of 32-bit words (u32s
+// stored by their bits): each hair's guide weights, the guides' normals,
+// each hair's values, the steps, their tables, the noise permutations and
+// the render hairs' widths, where the pass says each starts. One binding
+// keeps the shader within the storage buffers a default device allows.
+@group(0) @binding(1) var<storage, read> data: array<f32>;
 // This frame's guides: each point's offset from its guide's root, in rest space.
-@group(0) @binding(3) var<storage, read> guide_offsets: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read> values: array<f32>;
-@group(0) @binding(5) var<storage, read> steps: array<Step>;
-@group(0) @binding(6) var<storage, read> tables: array<f32>;
-@group(0) @binding(7) var<storage, read> permutation: array<u32>;
+@group(0) @binding(2) var<storage, read> guide_offsets: array<vec4<f32>>;
 // This frame's skin: a vertex's posed position, then its normal.
-@group(0) @binding(8) var<storage, read> skin: array<vec4<f32>>;
-@group(0) @binding(9) var<storage, read> triangles: array<u32>;
-@group(0) @binding(10) var<storage, read> widths: array<f32>;
+@group(0) @binding(3) var<storage, read> skin: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> triangles: array<u32>;
 // xyz: the point; w: its width.
-@group(0) @binding(11) var<storage, read_write> points: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> points: array<vec4<f32>>;
 @group(1) @binding(0) var<uniform> pass_: GroomPass;
+
+// A hair's guide `i` of MAX_WEIGHTS: (guide as u32 bits, weight).
+fn weight_at(i: u32) -> vec2<f32> {
+    let k = pass_.weights_at + 2u * i;
+    return vec2<f32>(data[k], data[k + 1u]);
+}
+
+fn guide_normal(g: u32) -> vec3<f32> {
+    let k = pass_.normals_at + 3u * g;
+    return vec3<f32>(data[k], data[k + 1u], data[k + 2u]);
+}
+
+// Word `i` of the hairs' values (a hair's block, then its steps').
+fn value_word(i: u32) -> f32 {
+    return data[pass_.values_at + i];
+}
+
+// Word `i` of the steps' tables (profiles, resamplings).
+fn table_word(i: u32) -> f32 {
+    return data[pass_.tables_at + i];
+}
+
+fn hair_width(i: u32) -> f32 {
+    return data[pass_.widths_at + i];
+}
+
+// pelage::groom::RecipeStep `s`, eight words.
+fn step_at(s: u32) -> Step {
+    let k = pass_.steps_at + 8u * s;
+    var w: array<u32, 8>;
+    for (var i = 0u; i < 8u; i++) {
+        w[i] = bitcast<u32>(data[k + i]);
+    }
+    return Step(w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]);
+}
 
 var<private> pts: array<vec3<f32>, MAX_POINTS>;
 var<private> before: array<vec3<f32>, MAX_POINTS>;
@@ -89,7 +130,7 @@ var<private> samples: array<vec3<f32>, MAX_POINTS>;
 var<private> perm_base: u32;
 
 fn perm_at(i: u32) -> u32 {
-    return permutation[perm_base + (i & 511u)];
+    return bitcast<u32>(data[pass_.permutation_at + perm_base + (i & 511u)]);
 }
 
 // pelage::groom::ops::param.
@@ -152,12 +193,12 @@ fn interpolate(h: u32, position: vec3<f32>, normal: vec3<f32>) {
         samples[j] = position;
     }
     for (var w = 0u; w < MAX_WEIGHTS; w++) {
-        let gw = weights[h * MAX_WEIGHTS + w];
+        let gw = weight_at(h * MAX_WEIGHTS + w);
         if gw.y == 0.0 {
             continue;
         }
         let g = bitcast<u32>(gw.x);
-        let turn = gw.y * rotation_between(guide_normals[g].xyz, normal);
+        let turn = gw.y * rotation_between(guide_normal(g), normal);
         for (var j = 0u; j < gp; j++) {
             samples[j] += turn * guide_offsets[g * gp + j].xyz;
         }
@@ -170,8 +211,8 @@ fn interpolate(h: u32, position: vec3<f32>, normal: vec3<f32>) {
     } else {
         for (var k = 0u; k < n; k++) {
             let at = pass_.resample_at + 2u * k;
-            let j = u32(tables[at]);
-            pts[k] = mix(samples[j], samples[j + 1u], tables[at + 1u]);
+            let j = u32(table_word(at));
+            pts[k] = mix(samples[j], samples[j + 1u], table_word(at + 1u));
         }
     }
 }
@@ -243,16 +284,16 @@ fn lengthen(n: u32, factor: f32) {
 
 // pelage::groom::ops::Curl::apply_to_hair.
 fn curl(n: u32, v: u32, table: u32, skin_normal: vec3<f32>) {
-    let radius = values[v];
+    let radius = value_word(v);
     if radius == 0.0 {
         return;
     }
-    let turns = values[v + 1u];
-    let phase = values[v + 2u];
+    let turns = value_word(v + 1u);
+    let phase = value_word(v + 2u);
     frame_along(n, skin_normal);
     for (var j = 0u; j < n; j++) {
         let t = param(j, n);
-        let alpha = radius * tables[table + j];
+        let alpha = radius * table_word(table + j);
         let angle = TAU * turns * t + phase;
         let r = frame[j];
         let b = cross(tangents[j], r);
@@ -263,14 +304,14 @@ fn curl(n: u32, v: u32, table: u32, skin_normal: vec3<f32>) {
 // pelage::groom::ops::Twist::apply_to_hair: each point turned about the
 // root–tip axis (Rodrigues' rotation for glam's quaternion).
 fn twist(n: u32, v: u32, table: u32) {
-    let angle = values[v];
+    let angle = value_word(v);
     let origin = pts[0];
     let axis = normalize_or_zero(pts[n - 1u] - origin);
     if angle == 0.0 || all(axis == vec3<f32>(0.0)) {
         return;
     }
     for (var j = 1u; j < n; j++) {
-        let theta = angle * tables[table + j];
+        let theta = angle * table_word(table + j);
         let d = pts[j] - origin;
         let c = cos(theta);
         let s = sin(theta);
@@ -281,16 +322,16 @@ fn twist(n: u32, v: u32, table: u32) {
 // pelage::groom::ops::Noise::displace_each: the field at the hair's
 // points (or at `vectors` points along it, spread back to every point).
 fn noise(n: u32, v: u32, step: Step) {
-    let amplitude = values[v];
+    let amplitude = value_word(v);
     if amplitude == 0.0 || n == 0u {
         return;
     }
-    let frequency = values[v + 1u];
+    let frequency = value_word(v + 1u);
     let m = step.vectors;
     if m == n {
         for (var j = 0u; j < n; j++) {
             let s = perlin3_vector(pts[j] * frequency + OFF_LATTICE);
-            let a = amplitude * tables[step.table + j];
+            let a = amplitude * table_word(step.table + j);
             if a != 0.0 {
                 pts[j] += a * s;
             }
@@ -299,16 +340,16 @@ fn noise(n: u32, v: u32, step: Step) {
     }
     let to_vectors = step.table + n;
     for (var k = 0u; k < m; k++) {
-        let j = u32(tables[to_vectors + 2u * k]);
-        let f = tables[to_vectors + 2u * k + 1u];
+        let j = u32(table_word(to_vectors + 2u * k));
+        let f = table_word(to_vectors + 2u * k + 1u);
         samples[k] = perlin3_vector(mix(pts[j], pts[j + 1u], f) * frequency + OFF_LATTICE);
     }
     let to_points = to_vectors + 2u * m;
     for (var j = 0u; j < n; j++) {
-        let a = amplitude * tables[step.table + j];
+        let a = amplitude * table_word(step.table + j);
         if a != 0.0 {
-            let k = u32(tables[to_points + 2u * j]);
-            let f = tables[to_points + 2u * j + 1u];
+            let k = u32(table_word(to_points + 2u * j));
+            let f = table_word(to_points + 2u * j + 1u);
             pts[j] += a * mix(samples[k], samples[k + 1u], f);
         }
     }
@@ -316,49 +357,49 @@ fn noise(n: u32, v: u32, step: Step) {
 
 // pelage::groom::ops::Frizz::apply_to_hair.
 fn frizz(n: u32, v: u32, table: u32) {
-    let amplitude = values[v];
+    let amplitude = value_word(v);
     if amplitude == 0.0 {
         return;
     }
-    let frequency = values[v + 1u];
-    let phase = vec3<f32>(values[v + 2u], values[v + 3u], values[v + 4u]);
+    let frequency = value_word(v + 1u);
+    let phase = vec3<f32>(value_word(v + 2u), value_word(v + 3u), value_word(v + 4u));
     for (var j = 0u; j < n; j++) {
         let t = param(j, n);
         let at = phase + vec3<f32>(frequency * t, 0.0, 0.0);
-        pts[j] += amplitude * tables[table + j] * perlin3_vector(at + OFF_LATTICE);
+        pts[j] += amplitude * table_word(table + j) * perlin3_vector(at + OFF_LATTICE);
     }
 }
 
 // pelage::groom::ops::Flyaways::apply_to_hair.
 fn flyaways(n: u32, v: u32, table: u32) {
-    if values[v] == 0.0 {
+    if value_word(v) == 0.0 {
         return;
     }
-    let len = values[v + 1u];
-    let spread = values[v + 2u];
-    let frequency = values[v + 3u];
-    let phase = vec3<f32>(values[v + 4u], values[v + 5u], values[v + 6u]);
-    let across = vec3<f32>(values[v + 7u], values[v + 8u], values[v + 9u]);
+    let len = value_word(v + 1u);
+    let spread = value_word(v + 2u);
+    let frequency = value_word(v + 3u);
+    let phase = vec3<f32>(value_word(v + 4u), value_word(v + 5u), value_word(v + 6u));
+    let across = vec3<f32>(value_word(v + 7u), value_word(v + 8u), value_word(v + 9u));
     let origin = pts[0];
     for (var j = 0u; j < n; j++) {
         let t = param(j, n);
         let at = phase + vec3<f32>(frequency * t, 0.0, 0.0);
         let wander = perlin3_vector(at + OFF_LATTICE);
-        pts[j] = origin + (pts[j] - origin) * len + spread * tables[table + j] * (across + 0.5 * wander);
+        pts[j] = origin + (pts[j] - origin) * len + spread * table_word(table + j) * (across + 0.5 * wander);
     }
 }
 
 // pelage::groom::ops::Clump::pull: toward the centre hair's points, grown
 // by an earlier pass.
 fn clump(n: u32, v: u32, step: Step) {
-    let w = values[v + 1u];
+    let w = value_word(v + 1u);
     if w == 0.0 {
         return;
     }
-    let centre = step.centres + bitcast<u32>(values[v]);
+    let centre = step.centres + bitcast<u32>(value_word(v));
     for (var j = 0u; j < n; j++) {
         let c = points[j * pass_.hairs + centre].xyz;
-        pts[j] += w * tables[step.table + j] * (c - pts[j]);
+        pts[j] += w * table_word(step.table + j) * (c - pts[j]);
     }
 }
 
@@ -410,11 +451,11 @@ fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     let skin_normal = root.normal.xyz;
     interpolate(h, root.position.xyz, skin_normal);
     for (var s = 0u; s < pass_.steps; s++) {
-        let step = steps[s];
+        let step = step_at(s);
         var v = h * pass_.values_per_hair + step.values;
         var m = 1.0;
         if step.masked != 0u {
-            m = values[v];
+            m = value_word(v);
             v += 1u;
             if m == 0.0 {
                 continue;
@@ -425,7 +466,7 @@ fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
         }
         perm_base = step.permutation;
         switch step.kind {
-            case 0u: { lengthen(n, values[v]); }
+            case 0u: { lengthen(n, value_word(v)); }
             case 1u: { curl(n, v, step.table, skin_normal); }
             case 2u: { twist(n, v, step.table); }
             case 3u: { noise(n, v, step); }
@@ -455,7 +496,7 @@ fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     for (var j = 0u; j < n; j++) {
         var w = 0.0;
         if width_at != 0xffffffffu {
-            w = widths[width_at + j] * pass_.width_scale;
+            w = hair_width(width_at + j) * pass_.width_scale;
         }
         points[j * pass_.hairs + h] = vec4<f32>(pts[j], w);
     }
