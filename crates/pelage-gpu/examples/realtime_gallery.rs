@@ -3,10 +3,14 @@
 //! - `realtime-fox.png`: the Fox mid-run, its groom grown on the GPU from
 //!   the frame's pose and drawn as shaded strands with self-shadowing;
 //! - `realtime-lobes.png`: the same coat lit from the front and from
-//!   behind (the back-lit rim is the light through the hairs, TT).
+//!   behind (the back-lit rim is the light through the hairs, TT);
+//! - `target/realtime-reference/fox8.usdc`: the same groom at the same
+//!   frame, grown on the CPU and written with its skin, for Cycles to
+//!   render beside the still (`realtime-vs-cycles.png`):
 //!
 //! ```sh
 //! cargo run --release -p pelage-gpu --example realtime_gallery
+//! tools/bpy-python blender/render_realtime_reference.py target/realtime-reference/fox8.usdc docs/gallery/realtime-fox.png docs/gallery/realtime-vs-cycles.png
 //! ```
 
 use glam::Vec3;
@@ -21,7 +25,7 @@ use std::path::Path;
 
 /// The Fox's groom: long fur, clumped and waved, coloured by its skin's
 /// texture (a glTF's base colour, the default of `[finish] color`).
-fn fox_groom(assets: &Path, hairs: u32) -> Result<Groom, Box<dyn std::error::Error>> {
+fn fox_groom(assets: &Path, hairs: u32, frames: &str) -> Result<Groom, Box<dyn std::error::Error>> {
     let fox = assets.join("Fox.gltf");
     let text = format!(
         "[mesh]\npath = {fox:?}\n\
@@ -31,7 +35,7 @@ fn fox_groom(assets: &Path, hairs: u32) -> Result<Groom, Box<dyn std::error::Err
          [[ops]]\nnoise = {{ amplitude = 0.4, frequency = 0.15 }}\n\
          [finish]\npoints = 12\noutside_skin = false\n\
          width = {{ root = 0.9, tip = 0.25 }}\n\
-         [animation]\nframes = \"1-28\"\nfps = 24\nclip = \"Run\"\nmode = \"deform\"\n"
+         [animation]\nframes = \"{frames}\"\nrest_frame = 1\nfps = 24\nclip = \"Run\"\nmode = \"deform\"\n"
     );
     Ok(Groom::from_text("fox.toml", &text)?)
 }
@@ -85,7 +89,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let gallery = root.join("docs/gallery");
     let assets = root.join("crates/pelage/assets/fox");
-    let groom = fox_groom(&assets, 100_000)?;
+    let groom = fox_groom(&assets, 100_000, "1-28")?;
     let animated = groom.animated(None)?.expect("an animated groom");
     let rest = animated.generator();
     let (mut roots, mut ids) = (Vec::new(), Vec::new());
@@ -151,5 +155,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     pair.save(gallery.join("realtime-lobes.png"))?;
     println!("wrote realtime-lobes.png");
+
+    // The still's groom and frame for Cycles: grown at rest on the CPU,
+    // carried to frame 8, written with the posed skin.
+    let reference = root.join("target/realtime-reference");
+    std::fs::create_dir_all(&reference)?;
+    let one_frame = fox_groom(&assets, 100_000, "8")?;
+    let animated = one_frame.animated(None)?.expect("an animated groom");
+    let parts = 0..animated.generator().parts().len();
+    let usd = reference.join("fox8.usdc");
+    animated.write(&usd, parts, &one_frame.usd_options(), true, |_| {})?;
+    println!("wrote {}", usd.display());
     Ok(())
 }
