@@ -75,6 +75,130 @@ pub struct GpuGroom {
     opacities: Option<Vec<f32>>,
 }
 
+/// Where each section of the shader's `data` starts (its words), and the
+/// guide-to-hair resampling's start within the tables (`u32::MAX`: none).
+struct Sections {
+    weights: u32,
+    normals: u32,
+    values: u32,
+    steps: u32,
+    tables: u32,
+    resample: u32,
+    permutation: u32,
+    widths: u32,
+}
+
+/// Everything of `recipe` that does not change but the roots, as one
+/// array of 32-bit words (u32s by their bits): the shader's `data`.
+fn packed(recipe: &GroomRecipe) -> (Vec<f32>, Sections) {
+    let mut data: Vec<f32> = Vec::new();
+    let mut section = |words: &mut dyn Iterator<Item = f32>| {
+        let at = data.len() as u32;
+        data.extend(words);
+        at
+    };
+    let bits = f32::from_bits;
+    let weights = section(
+        &mut recipe
+            .weights
+            .iter()
+            .flat_map(|w| [bits(w.guide), w.weight]),
+    );
+    let normals = section(&mut recipe.guide_normals.iter().flat_map(|v| v.to_array()));
+    let values = section(&mut recipe.values.iter().copied());
+    let steps = section(&mut recipe.steps.iter().flat_map(|s| {
+        [
+            s.kind as u32,
+            s.values,
+            u32::from(s.masked),
+            s.table,
+            s.permutation,
+            s.vectors,
+            s.centres,
+            0,
+        ]
+        .map(bits)
+    }));
+    let tables = section(&mut recipe.tables.iter().copied());
+    // The guide-to-hair resampling after the steps' tables, as pairs.
+    let resample = if recipe.resampling.is_empty() {
+        u32::MAX
+    } else {
+        let at = recipe.tables.len() as u32;
+        section(&mut recipe.resampling.iter().flat_map(|&(j, f)| [j as f32, f]));
+        at
+    };
+    let permutation = section(&mut recipe.permutations.iter().map(|&p| bits(p)));
+    let widths = section(&mut recipe.widths.iter().copied());
+    let sections = Sections {
+        weights,
+        normals,
+        values,
+        steps,
+        tables,
+        resample,
+        permutation,
+        widths,
+    };
+    (data, sections)
+}
+
+/// Each hair's root record (the shader's `HairRoot`, six `vec4`s): its
+/// rest position and triangle, rest normal and barycentrics, and — for
+/// render hairs — the rest skin frame it is carried from.
+fn root_records(recipe: &GroomRecipe, skin: &SkinBinding) -> Vec<[f32; 4]> {
+    let render = recipe.render_hairs();
+    (0..recipe.hair_count())
+        .flat_map(|i| {
+            let root = recipe.roots[i];
+            let (origin, frame) = if render.contains(&(i as u32)) {
+                skin.rest().frame_at(skin.triangles(), root)
+            } else {
+                (recipe.root_positions[i], Mat3::IDENTITY)
+            };
+            [
+                v4(recipe.root_positions[i], f32::from_bits(root.tri)),
+                v4(recipe.root_normals[i], root.bary[0]),
+                v4(origin, root.bary[1]),
+                v4(frame.x_axis, 0.0),
+                v4(frame.y_axis, 0.0),
+                v4(frame.z_axis, 0.0),
+            ]
+        })
+        .collect()
+}
+
+/// The groom shader's bind group layouts (its buffers; the pass ring) and
+/// pipeline.
+fn groom_pipeline(
+    device: &wgpu::Device,
+) -> (
+    wgpu::BindGroupLayout,
+    wgpu::BindGroupLayout,
+    wgpu::ComputePipeline,
+) {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let mut entries: Vec<_> = (0..5).map(|b| entry::storage(b, compute, true)).collect();
+    entries.push(entry::storage(5, compute, false));
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("groom"),
+        entries: &entries,
+    });
+    let ring_layout = UniformRing::<GroomPassUniform>::layout(device, "groom pass", compute);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("groom.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(crate::shader_source("groom.wgsl").into()),
+    });
+    let pipeline = compute_pipeline(
+        device,
+        "groom",
+        &module,
+        "grow_hairs",
+        &[&layout, &ring_layout],
+    );
+    (layout, ring_layout, pipeline)
+}
+
 /// A pose's vertices as the shaders read them: position, then normal.
 fn skin_vertices_of(pose: &SkinPose) -> Vec<[f32; 4]> {
     pose.positions()
@@ -103,7 +227,6 @@ impl GpuGroom {
         recipe: &GroomRecipe,
         skin: &SkinBinding,
     ) -> Result<Self, GpuError> {
-        let binding = Some(skin);
         let (n, gp) = (recipe.points as usize, recipe.guide_points as usize);
         if n > MAX_GPU_HAIR_POINTS || gp > MAX_GPU_HAIR_POINTS {
             return Err(GpuError::Mismatch(format!(
@@ -121,67 +244,8 @@ impl GpuGroom {
             )));
         }
         let render = recipe.render_hairs();
-        let rest_frame = |i: usize| match binding {
-            Some(b) if render.contains(&(i as u32)) => {
-                b.rest().frame_at(b.triangles(), recipe.roots[i])
-            }
-            _ => (recipe.root_positions[i], Mat3::IDENTITY),
-        };
-        let roots: Vec<[f32; 4]> = (0..hairs)
-            .flat_map(|i| {
-                let root = recipe.roots[i];
-                let (origin, frame) = rest_frame(i);
-                [
-                    v4(recipe.root_positions[i], f32::from_bits(root.tri)),
-                    v4(recipe.root_normals[i], root.bary[0]),
-                    v4(origin, root.bary[1]),
-                    v4(frame.x_axis, 0.0),
-                    v4(frame.y_axis, 0.0),
-                    v4(frame.z_axis, 0.0),
-                ]
-            })
-            .collect();
-        // Everything read-only but the roots, one array of words: the
-        // shader's `data`, each section's start in the pass uniform.
-        let mut data: Vec<f32> = Vec::new();
-        let mut section = |words: &mut dyn Iterator<Item = f32>| {
-            let at = data.len() as u32;
-            data.extend(words);
-            at
-        };
-        let bits = f32::from_bits;
-        let weights_at = section(
-            &mut recipe
-                .weights
-                .iter()
-                .flat_map(|w| [bits(w.guide), w.weight]),
-        );
-        let normals_at = section(&mut recipe.guide_normals.iter().flat_map(|v| v.to_array()));
-        let values_at = section(&mut recipe.values.iter().copied());
-        let steps_at = section(&mut recipe.steps.iter().flat_map(|s| {
-            [
-                s.kind as u32,
-                s.values,
-                u32::from(s.masked),
-                s.table,
-                s.permutation,
-                s.vectors,
-                s.centres,
-                0,
-            ]
-            .map(bits)
-        }));
-        let tables_at = section(&mut recipe.tables.iter().copied());
-        // The guide-to-hair resampling after the steps' tables, as pairs.
-        let resample_at = if recipe.resampling.is_empty() {
-            u32::MAX
-        } else {
-            let at = recipe.tables.len() as u32;
-            section(&mut recipe.resampling.iter().flat_map(|&(j, f)| [j as f32, f]));
-            at
-        };
-        let permutation_at = section(&mut recipe.permutations.iter().map(|&p| bits(p)));
-        let widths_at = section(&mut recipe.widths.iter().copied());
+        let roots = root_records(recipe, skin);
+        let (data, sections) = packed(recipe);
         let skin_vertices = skin.rest().positions().len();
         let triangles: Vec<u32> = skin.triangles().iter().flatten().copied().collect();
         let device = &ctx.device;
@@ -217,31 +281,13 @@ impl GpuGroom {
                 wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::VERTEX,
             ),
         ];
-        let compute = wgpu::ShaderStages::COMPUTE;
-        let mut entries: Vec<_> = (0..5).map(|b| entry::storage(b, compute, true)).collect();
-        entries.push(entry::storage(5, compute, false));
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("groom"),
-            entries: &entries,
-        });
+        let (layout, ring_layout, pipeline) = groom_pipeline(device);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("groom"),
             layout: &layout,
             entries: &group::buffers(buffers.each_ref()),
         });
-        let ring_layout = UniformRing::<GroomPassUniform>::layout(device, "groom pass", compute);
         let ring = UniformRing::new(device, "groom pass", &ring_layout);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("groom.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(crate::shader_source("groom.wgsl").into()),
-        });
-        let pipeline = compute_pipeline(
-            device,
-            "groom",
-            &module,
-            "grow_hairs",
-            &[&layout, &ring_layout],
-        );
         let passes = recipe
             .passes
             .iter()
@@ -254,16 +300,16 @@ impl GpuGroom {
                 hairs: hairs32,
                 values_per_hair: recipe.values_per_hair,
                 posed: 0,
-                resample_at,
+                resample_at: sections.resample,
                 render_first: render.start,
                 width_scale: 1.0,
-                weights_at,
-                normals_at,
-                values_at,
-                steps_at,
-                tables_at,
-                permutation_at,
-                widths_at,
+                weights_at: sections.weights,
+                normals_at: sections.normals,
+                values_at: sections.values,
+                steps_at: sections.steps,
+                tables_at: sections.tables,
+                permutation_at: sections.permutation,
+                widths_at: sections.widths,
                 pad0: 0,
             })
             .collect();

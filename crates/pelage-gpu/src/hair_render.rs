@@ -161,35 +161,22 @@ struct ShadowPipelines {
     hair_opacity: wgpu::RenderPipeline,
 }
 
-/// Draws real-time strands. Build once, draw many frames.
-#[derive(Debug)]
-pub struct StrandRenderer {
-    formats: ShellTargetFormats,
-    uniforms: UniformRing<StrandUniforms>,
-    points_layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
-    shadow_pipelines: ShadowPipelines,
+/// The key light's three maps (the hairs' first depth, the skin's depth,
+/// the opacity layers) and how the passes bind them.
+struct ShadowMaps {
     shadow_view: wgpu::TextureView,
     skin_shadow_view: wgpu::TextureView,
     opacity_view: wgpu::TextureView,
+    /// The opacity pass reads the first depth…
+    first_depth_layout: wgpu::BindGroupLayout,
     first_depth_group: wgpu::BindGroup,
+    /// … the frame reads all three.
+    shadow_layout: wgpu::BindGroupLayout,
     shadow_group: wgpu::BindGroup,
 }
 
-impl StrandRenderer {
-    /// The pipelines, drawing into targets of `formats`.
-    pub fn new(ctx: &GpuContext, formats: ShellTargetFormats) -> Self {
-        let device = &ctx.device;
-        let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-        let uniform_layout = UniformRing::<StrandUniforms>::layout(device, "strands", both);
-        let uniforms = UniformRing::new(device, "strands", &uniform_layout);
-        let vertex = wgpu::ShaderStages::VERTEX;
-        let points_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("strand points"),
-            entries: &(0..4)
-                .map(|b| entry::storage(b, vertex, true))
-                .collect::<Vec<_>>(),
-        });
+impl ShadowMaps {
+    fn new(device: &wgpu::Device) -> Self {
         let fragment = wgpu::ShaderStages::FRAGMENT;
         let depth_entry = wgpu::BindGroupLayoutEntry {
             binding: 0,
@@ -253,6 +240,151 @@ impl StrandRenderer {
                 wgpu::BindingResource::TextureView(&skin_shadow_view),
             ]),
         });
+        Self {
+            shadow_view,
+            skin_shadow_view,
+            opacity_view,
+            first_depth_layout,
+            first_depth_group,
+            shadow_layout,
+            shadow_group,
+        }
+    }
+}
+
+/// Ribbons are triangle lists, both sides drawn.
+const PRIMITIVE: wgpu::PrimitiveState = wgpu::PrimitiveState {
+    topology: wgpu::PrimitiveTopology::TriangleList,
+    strip_index_format: None,
+    front_face: wgpu::FrontFace::Ccw,
+    cull_mode: None,
+    unclipped_depth: false,
+    polygon_mode: wgpu::PolygonMode::Fill,
+    conservative: false,
+};
+
+/// Depth tested and written.
+fn depth_state(format: wgpu::TextureFormat) -> Option<wgpu::DepthStencilState> {
+    Some(wgpu::DepthStencilState {
+        format,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias: Default::default(),
+    })
+}
+
+impl ShadowPipelines {
+    /// The key light's pipelines over `[uniforms, points, first depth]`.
+    fn new(
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        [uniform_layout, points_layout, first_depth_layout]: [&wgpu::BindGroupLayout; 3],
+    ) -> Self {
+        let layout = |groups: &[Option<&wgpu::BindGroupLayout>]| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("strand shadows"),
+                bind_group_layouts: groups,
+                immediate_size: 0,
+            })
+        };
+        let shadow_pipeline_layout = layout(&[Some(uniform_layout), Some(points_layout)]);
+        let depth_only = |label, entry_point| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&shadow_pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some(entry_point),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: PRIMITIVE,
+                depth_stencil: depth_state(DEPTH_FORMAT),
+                multisample: Default::default(),
+                fragment: None,
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let opacity_layout = layout(&[
+            Some(uniform_layout),
+            Some(points_layout),
+            Some(first_depth_layout),
+        ]);
+        let adding = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let opacity = |label, entry_point| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&opacity_layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some(entry_point),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: PRIMITIVE,
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_opacity"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: OPACITY_FORMAT,
+                        blend: Some(wgpu::BlendState {
+                            color: adding,
+                            alpha: adding,
+                        }),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        Self {
+            hair_depth: depth_only("strand shadow depth", "vs_shadow"),
+            skin_depth: depth_only("skin shadow depth", "vs_occluder"),
+            hair_opacity: opacity("strand opacity", "vs_shadow"),
+        }
+    }
+}
+
+/// Draws real-time strands. Build once, draw many frames.
+#[derive(Debug)]
+pub struct StrandRenderer {
+    formats: ShellTargetFormats,
+    uniforms: UniformRing<StrandUniforms>,
+    points_layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+    shadow_pipelines: ShadowPipelines,
+    shadow_view: wgpu::TextureView,
+    skin_shadow_view: wgpu::TextureView,
+    opacity_view: wgpu::TextureView,
+    first_depth_group: wgpu::BindGroup,
+    shadow_group: wgpu::BindGroup,
+}
+
+impl StrandRenderer {
+    /// The pipelines, drawing into targets of `formats`.
+    pub fn new(ctx: &GpuContext, formats: ShellTargetFormats) -> Self {
+        let device = &ctx.device;
+        let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let uniform_layout = UniformRing::<StrandUniforms>::layout(device, "strands", both);
+        let uniforms = UniformRing::new(device, "strands", &uniform_layout);
+        let vertex = wgpu::ShaderStages::VERTEX;
+        let points_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("strand points"),
+            entries: &(0..4)
+                .map(|b| entry::storage(b, vertex, true))
+                .collect::<Vec<_>>(),
+        });
+        let maps = ShadowMaps::new(device);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("hair.wgsl"),
             source: wgpu::ShaderSource::Wgsl(crate::shader_source("hair.wgsl").into()),
@@ -267,22 +399,8 @@ impl StrandRenderer {
         let main_layout = layout(&[
             Some(&uniform_layout),
             Some(&points_layout),
-            Some(&shadow_layout),
+            Some(&maps.shadow_layout),
         ]);
-        let depth = |format| {
-            Some(wgpu::DepthStencilState {
-                format,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            })
-        };
-        let primitive = wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
-            ..Default::default()
-        };
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("strands"),
             layout: Some(&main_layout),
@@ -292,8 +410,8 @@ impl StrandRenderer {
                 compilation_options: Default::default(),
                 buffers: &[],
             },
-            primitive,
-            depth_stencil: depth(formats.depth),
+            primitive: PRIMITIVE,
+            depth_stencil: depth_state(formats.depth),
             multisample: wgpu::MultisampleState {
                 count: formats.samples,
                 mask: !0,
@@ -313,81 +431,22 @@ impl StrandRenderer {
             multiview_mask: None,
             cache: None,
         });
-        let shadow_pipeline_layout = layout(&[Some(&uniform_layout), Some(&points_layout)]);
-        let depth_only = |label, entry_point| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&shadow_pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(entry_point),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive,
-                depth_stencil: depth(DEPTH_FORMAT),
-                multisample: Default::default(),
-                fragment: None,
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let opacity_layout = layout(&[
-            Some(&uniform_layout),
-            Some(&points_layout),
-            Some(&first_depth_layout),
-        ]);
-        let adding = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let opacity = |label, entry_point| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&opacity_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(entry_point),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive,
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_opacity"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: OPACITY_FORMAT,
-                        blend: Some(wgpu::BlendState {
-                            color: adding,
-                            alpha: adding,
-                        }),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let shadow_pipelines = ShadowPipelines {
-            hair_depth: depth_only("strand shadow depth", "vs_shadow"),
-            skin_depth: depth_only("skin shadow depth", "vs_occluder"),
-            hair_opacity: opacity("strand opacity", "vs_shadow"),
-        };
+        let shadow_pipelines = ShadowPipelines::new(
+            device,
+            &module,
+            [&uniform_layout, &points_layout, &maps.first_depth_layout],
+        );
         Self {
             formats,
             uniforms,
             points_layout,
             pipeline,
             shadow_pipelines,
-            shadow_view,
-            skin_shadow_view,
-            opacity_view,
-            first_depth_group,
-            shadow_group,
+            shadow_view: maps.shadow_view,
+            skin_shadow_view: maps.skin_shadow_view,
+            opacity_view: maps.opacity_view,
+            first_depth_group: maps.first_depth_group,
+            shadow_group: maps.shadow_group,
         }
     }
 
