@@ -82,7 +82,7 @@ fn fox_groom(hairs: usize, guides: usize, points: usize) -> anyhow::Result<Groom
          [[ops]]\nclump = {{ count = 3000, rate = 0.35 }}\n\
          [[ops]]\ncurl = {{ radius = 0.3, turns = 2 }}\n\
          [[ops]]\nnoise = {{ amplitude = 0.4, frequency = 0.15 }}\n\
-         [finish]\npoints = {points}\noutside_skin = false\nwidth = {{ root = 0.9, tip = 0.25 }}\n\
+         [finish]\npoints = {points}\nwidth = {{ root = 0.9, tip = 0.25 }}\n\
          [animation]\nframes = \"1-48\"\nfps = 24\nclip = \"Run\"\nmode = \"simulate\"\n\
          [simulation]\ngravity = [0, -1200, 0]\ndamping = 2\nbend = 0.3\nfollow = 0.05\n"
     );
@@ -192,8 +192,9 @@ fn measure(scale: Scale) -> anyhow::Result<Figures> {
 }
 
 /// The CPU groom of the same frame (all threads): a generator reshaped to
-/// the frame's guides, every part grown and carried to the pose, as
-/// `AnimatedGroom` regrows a frame. Returns its seconds and hairs.
+/// the frame's guides, every part grown, carried to the pose and kept out
+/// of the posed skin, as `AnimatedGroom` regrows a frame. Returns its
+/// seconds and hairs.
 fn cpu_groom(
     animated: &AnimatedGroom,
     spec: &GroomSpec,
@@ -204,10 +205,15 @@ fn cpu_groom(
     let mut spec = spec.clone();
     spec.guides = Arc::new(guides);
     let generator = animated.generator().reshaped(spec)?;
+    let outside = animated.outside_skin(pose);
+    let triangles = animated.binding().triangles();
     let mut hairs = 0;
     for p in 0..generator.parts().len() {
         let mut part: Curves = generator.part(p)?;
         animated.binding().carry_in_place(&mut part, pose);
+        if let Some(outside) = &outside {
+            outside.apply_all(&mut part, |root| pose.frame_at(triangles, root).1.z_axis);
+        }
         hairs += part.curve_count();
     }
     Ok((start.elapsed().as_secs_f64(), hairs))

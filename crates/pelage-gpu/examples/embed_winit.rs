@@ -209,9 +209,10 @@ impl Running {
         // clip's start, 24 frames a second), then draws the key light's
         // shadow maps: passes of their own, before the app's.
         let pose = furry.groom.pose(1.0 + 24.0 * f64::from(seconds))?;
+        let ctx = GpuContext::wrap(&self.adapter, &self.device, &self.queue);
         furry
             .hairs
-            .record(&self.queue, &mut encoder, &furry.rest_guides, Some(&pose))?;
+            .record(&ctx, &mut encoder, &furry.rest_guides, Some(&pose))?;
         let (lo, hi) = furry.fox.bounds();
         let grown = (lo - Vec3::splat(16.0), hi + Vec3::splat(16.0));
         let strand_frame = furry.strands.prepare(

@@ -43,7 +43,7 @@ fn fox_groom(assets: &Path, hairs: u32, frames: &str) -> Result<Groom, Box<dyn s
 /// Draws the Fox at `time` with its strands, seen by `view`.
 struct FoxFrame<'a> {
     animated: &'a AnimatedGroom,
-    gpu_groom: &'a GpuGroom,
+    gpu_groom: &'a mut GpuGroom,
     shells: &'a ShellRenderer,
     strands: &'a StrandRenderer,
     skin_color: RgbaImage,
@@ -52,7 +52,7 @@ struct FoxFrame<'a> {
 
 impl FoxFrame<'_> {
     fn draw(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         time: f64,
         view: &ShellView,
@@ -99,12 +99,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ids.extend(i);
     }
     let recipe = GroomRecipe::new(rest, &roots, &ids)?;
-    let gpu_groom = GpuGroom::new(&ctx, &recipe, animated.binding())?;
+    let mut gpu_groom = GpuGroom::new(&ctx, &recipe, animated.binding())?;
     let shells = ShellRenderer::new(&ctx, ShellFeatures::default());
     let strands = StrandRenderer::new(&ctx, shells.target_formats());
-    let frame = FoxFrame {
+    let mut frame = FoxFrame {
         animated: &animated,
-        gpu_groom: &gpu_groom,
+        gpu_groom: &mut gpu_groom,
         shells: &shells,
         strands: &strands,
         skin_color: image::load_from_memory(pelage::assets::FOX_TEXTURE_PNG)?.to_rgba8(),

@@ -43,7 +43,11 @@ gpu_struct! {
         tables_at: u32,
         permutation_at: u32,
         widths_at: u32,
+        outside: u32,
+        gap: f32,
         pad0: u32,
+        pad1: u32,
+        pad2: u32,
     }
 }
 
@@ -54,6 +58,15 @@ pub struct GpuGroom {
     passes: Vec<GroomPassUniform>,
     ring: UniformRing<GroomPassUniform>,
     bind_group: wgpu::BindGroup,
+    layout: wgpu::BindGroupLayout,
+    /// The roots, the packed data and the rest skin's grid (bindings 0,
+    /// 1 and 6), kept to bind again when the posed grid's buffer grows.
+    static_buffers: [wgpu::Buffer; 3],
+    posed_sdf: wgpu::Buffer,
+    /// `[finish] outside_skin`: the gap, and the hairs' segment for a
+    /// posed skin's grid.
+    keep_out: Option<(f32, f32)>,
+    triangle_list: Vec<[u32; 3]>,
     guide_offsets: wgpu::Buffer,
     skin: wgpu::Buffer,
     triangles: wgpu::Buffer,
@@ -75,6 +88,79 @@ pub struct GpuGroom {
     opacities: Option<Vec<f32>>,
 }
 
+/// No usage beyond storage.
+const NONE: wgpu::BufferUsages = wgpu::BufferUsages::empty();
+
+/// A storage buffer holding `bytes` (an empty array still binds a whole
+/// element: a step is 32 bytes), with `extra` usages.
+fn storage(
+    device: &wgpu::Device,
+    label: &str,
+    bytes: &[u8],
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let zeros = [0u8; 32];
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: if bytes.is_empty() { &zeros } else { bytes },
+        usage: wgpu::BufferUsages::STORAGE | extra,
+    })
+}
+
+/// The groom shader's buffers, bindings 0 to 7: the roots, the packed
+/// data, this frame's guides, the skin and its triangles, the points, the
+/// skin's grids at rest and posed.
+fn groom_buffers(
+    device: &wgpu::Device,
+    recipe: &GroomRecipe,
+    skin: &SkinBinding,
+    (roots, data): (&[[f32; 4]], &[u32]),
+) -> [wgpu::Buffer; 8] {
+    let dst = wgpu::BufferUsages::COPY_DST;
+    let bytes = bytemuck::cast_slice::<[f32; 4], u8>;
+    let (n, gp) = (recipe.points as usize, recipe.guide_points as usize);
+    let triangles: Vec<u32> = skin.triangles().iter().flatten().copied().collect();
+    let rest_grid = recipe
+        .outside_skin
+        .as_ref()
+        .map_or_else(Vec::new, |(o, _)| packed_sdf(o.sdf(), 0));
+    [
+        storage(device, "groom roots", bytes(roots), NONE),
+        storage(device, "groom data", bytemuck::cast_slice(data), NONE),
+        storage(
+            device,
+            "groom guide offsets",
+            &vec![0u8; recipe.guides as usize * gp * 16],
+            dst,
+        ),
+        storage(
+            device,
+            "groom skin",
+            bytes(&skin_vertices_of(skin.rest())),
+            dst,
+        ),
+        storage(
+            device,
+            "groom skin triangles",
+            bytemuck::cast_slice(&triangles),
+            NONE,
+        ),
+        storage(
+            device,
+            "groom points",
+            &vec![0u8; recipe.hair_count() * n * 16],
+            wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::VERTEX,
+        ),
+        storage(
+            device,
+            "groom rest skin grid",
+            bytemuck::cast_slice(&rest_grid),
+            NONE,
+        ),
+        storage(device, "groom posed skin grid", &[0u8; 64], dst),
+    ]
+}
+
 /// Where each section of the shader's `data` starts (its words), and the
 /// guide-to-hair resampling's start within the tables (`u32::MAX`: none).
 struct Sections {
@@ -89,12 +175,12 @@ struct Sections {
 }
 
 /// Everything of `recipe` that does not change but the roots, as one
-/// array of 32-bit words (u32s by their bits): the shader's `data`.
-fn packed(recipe: &GroomRecipe) -> (Vec<f32>, Sections) {
-    let mut data: Vec<f32> = Vec::new();
+/// array of 32-bit words (floats by their bits): the shader's `data`.
+fn packed(recipe: &GroomRecipe) -> (Vec<u32>, Sections) {
+    let mut data: Vec<u32> = Vec::new();
     let mut section = |words: &mut dyn Iterator<Item = f32>| {
         let at = data.len() as u32;
-        data.extend(words);
+        data.extend(words.map(f32::to_bits));
         at
     };
     let bits = f32::from_bits;
@@ -178,8 +264,7 @@ fn groom_pipeline(
     wgpu::ComputePipeline,
 ) {
     let compute = wgpu::ShaderStages::COMPUTE;
-    let mut entries: Vec<_> = (0..5).map(|b| entry::storage(b, compute, true)).collect();
-    entries.push(entry::storage(5, compute, false));
+    let entries: Vec<_> = (0..8).map(|b| entry::storage(b, compute, b != 5)).collect();
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("groom"),
         entries: &entries,
@@ -197,6 +282,39 @@ fn groom_pipeline(
         &[&layout, &ring_layout],
     );
     (layout, ring_layout, pipeline)
+}
+
+/// A skin's distance grid as the groom shader reads it (skin_sdf.wgsl's
+/// `Grid` header, then the nodes' distances, their nearest triangles and
+/// the triangles' corners and corner normals, all as words); `which`: 0 at
+/// rest, 1 posed (the header's pad0).
+fn packed_sdf(sdf: &pelage::dynamics::SkinSdf, which: u32) -> Vec<u32> {
+    const HEADER: u32 = 12;
+    let (origin, cell, dims) = sdf.layout();
+    let nodes = sdf.distances().len() as u32;
+    let mut out = vec![
+        origin.x.to_bits(),
+        origin.y.to_bits(),
+        origin.z.to_bits(),
+        cell.to_bits(),
+        dims[0] as u32,
+        dims[1] as u32,
+        dims[2] as u32,
+        sdf.band_depth().to_bits(),
+        HEADER,
+        0,
+        which,
+        HEADER + nodes,
+    ];
+    out.extend(sdf.distances().iter().map(|d| d.to_bits()));
+    out.extend_from_slice(sdf.nearest_triangles());
+    let (corners, normals) = sdf.triangles();
+    for (c, n) in corners.iter().zip(normals) {
+        for v in c.iter().chain(n) {
+            out.extend([v.x, v.y, v.z, 0.0].map(f32::to_bits));
+        }
+    }
+    out
 }
 
 /// A pose's vertices as the shaders read them: position, then normal.
@@ -247,40 +365,8 @@ impl GpuGroom {
         let roots = root_records(recipe, skin);
         let (data, sections) = packed(recipe);
         let skin_vertices = skin.rest().positions().len();
-        let triangles: Vec<u32> = skin.triangles().iter().flatten().copied().collect();
         let device = &ctx.device;
-        let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
-            // An empty array still binds a whole element (a step is 32 bytes).
-            let zeros = [0u8; 32];
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: if bytes.is_empty() { &zeros } else { bytes },
-                usage: wgpu::BufferUsages::STORAGE | extra,
-            })
-        };
-        let none = wgpu::BufferUsages::empty();
-        let dst = wgpu::BufferUsages::COPY_DST;
-        let bytes = bytemuck::cast_slice::<[f32; 4], u8>;
-        let buffers = [
-            storage("groom roots", bytes(&roots), none),
-            storage("groom data", bytemuck::cast_slice(&data), none),
-            storage(
-                "groom guide offsets",
-                &vec![0u8; recipe.guides as usize * gp * 16],
-                dst,
-            ),
-            storage("groom skin", bytes(&skin_vertices_of(skin.rest())), dst),
-            storage(
-                "groom skin triangles",
-                bytemuck::cast_slice(&triangles),
-                none,
-            ),
-            storage(
-                "groom points",
-                &vec![0u8; hairs * n * 16],
-                wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::VERTEX,
-            ),
-        ];
+        let buffers = groom_buffers(device, recipe, skin, (&roots, &data));
         let (layout, ring_layout, pipeline) = groom_pipeline(device);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("groom"),
@@ -310,10 +396,23 @@ impl GpuGroom {
                 tables_at: sections.tables,
                 permutation_at: sections.permutation,
                 widths_at: sections.widths,
+                outside: u32::from(recipe.outside_skin.is_some()),
+                gap: recipe.outside_skin.as_ref().map_or(0.0, |(o, _)| o.gap()),
                 pad0: 0,
+                pad1: 0,
+                pad2: 0,
             })
             .collect();
-        let [_, _, guide_offsets, skin_buffer, triangles_buffer, points] = buffers;
+        let [
+            roots_buffer,
+            data_buffer,
+            guide_offsets,
+            skin_buffer,
+            triangles_buffer,
+            points,
+            rest_sdf,
+            posed_sdf,
+        ] = buffers;
         // A render point's colour (negative: the hairs have none) and
         // opacity, for a strand renderer.
         let shade: Vec<[f32; 4]> = (0..render.len() * n)
@@ -322,12 +421,20 @@ impl GpuGroom {
                 v4(c, recipe.opacities.as_ref().map_or(1.0, |o| o[k]))
             })
             .collect();
-        let colors_buffer = storage("groom colours", bytes(&shade), none);
+        let colors_buffer = storage(device, "groom colours", bytemuck::cast_slice(&shade), NONE);
         Ok(Self {
             pipeline,
             passes,
             ring,
             bind_group,
+            layout,
+            static_buffers: [roots_buffer, data_buffer, rest_sdf],
+            posed_sdf,
+            keep_out: recipe
+                .outside_skin
+                .as_ref()
+                .map(|(o, segment)| (o.gap(), *segment)),
+            triangle_list: skin.triangles().to_vec(),
             guide_offsets,
             skin: skin_buffer,
             triangles: triangles_buffer,
@@ -355,26 +462,29 @@ impl GpuGroom {
     /// # Errors
     /// When the guides or the pose do not match what was uploaded.
     pub fn grow(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         guide_offsets: &[Vec3],
         pose: Option<&SkinPose>,
     ) -> Result<(), GpuError> {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        self.record(&ctx.queue, &mut encoder, guide_offsets, pose)?;
+        self.record(ctx, &mut encoder, guide_offsets, pose)?;
         ctx.queue.submit([encoder.finish()]);
         Ok(())
     }
 
     /// [`Self::grow`] recorded into a caller's encoder (a host's frame):
-    /// the guides and pose are written through `queue`, the compute pass
-    /// is recorded; submit after it.
+    /// the guides and pose are written through the context's queue, the
+    /// compute pass is recorded; submit after it. With `[finish]
+    /// outside_skin`, a pose's distance grid is built here on the CPU (a
+    /// few milliseconds for a character) and the carried hairs are kept
+    /// out of it, as an animated groom's frames are.
     ///
     /// # Errors
     /// When the guides or the pose do not match what was uploaded.
     pub fn record(
-        &self,
-        queue: &wgpu::Queue,
+        &mut self,
+        ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         guide_offsets: &[Vec3],
         pose: Option<&SkinPose>,
@@ -386,8 +496,10 @@ impl GpuGroom {
                 self.guide_values
             )));
         }
+        let queue = &ctx.queue;
         let offsets: Vec<[f32; 4]> = guide_offsets.iter().map(|&v| v4(v, 0.0)).collect();
         queue.write_buffer(&self.guide_offsets, 0, bytemuck::cast_slice(&offsets));
+        let posed_grid = self.posed_grid(ctx, pose);
         use std::sync::atomic::Ordering;
         match pose {
             Some(pose) => {
@@ -419,8 +531,10 @@ impl GpuGroom {
             if p.count == 0 {
                 continue;
             }
+            let last_pass = i == last;
             let uniform = GroomPassUniform {
-                posed: u32::from(pose.is_some() && i == last),
+                posed: u32::from(pose.is_some() && last_pass),
+                outside: p.outside | if posed_grid && last_pass { 2 } else { 0 },
                 ..*p
             };
             let offset = self.ring.write(queue, &uniform);
@@ -429,6 +543,55 @@ impl GpuGroom {
             pass.dispatch_workgroups(x, y, 1);
         }
         Ok(())
+    }
+
+    /// With `[finish] outside_skin` and a pose other than the rest pose:
+    /// the pose's distance grid written for the shader (its buffer grown,
+    /// and bound again, when it does not fit). Whether there is one.
+    fn posed_grid(&mut self, ctx: &GpuContext, pose: Option<&SkinPose>) -> bool {
+        let (Some((gap, segment)), Some(pose)) = (self.keep_out, pose) else {
+            return false;
+        };
+        let rest = &self.rest_skin;
+        let at_rest = pose.positions().len() * 2 == rest.len()
+            && pose
+                .positions()
+                .iter()
+                .zip(rest.iter().step_by(2))
+                .all(|(p, r)| p.to_array() == [r[0], r[1], r[2]]);
+        if at_rest {
+            return false;
+        }
+        let skin = (pose.positions(), pose.normals(), &self.triangle_list[..]);
+        let posed = pelage::groom::OutsideSkin::posed(skin, gap, segment);
+        let words = packed_sdf(posed.sdf(), 1);
+        let bytes: &[u8] = bytemuck::cast_slice(&words);
+        if bytes.len() as u64 > self.posed_sdf.size() {
+            self.posed_sdf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("groom posed skin grid"),
+                size: (bytes.len() as u64).next_power_of_two(),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let [roots, data, rest_sdf] = &self.static_buffers;
+            let entries = group::buffers([
+                roots,
+                data,
+                &self.guide_offsets,
+                &self.skin,
+                &self.triangles,
+                &self.points,
+                rest_sdf,
+                &self.posed_sdf,
+            ]);
+            self.bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("groom"),
+                layout: &self.layout,
+                entries: &entries,
+            });
+        }
+        ctx.queue.write_buffer(&self.posed_sdf, 0, bytes);
+        true
     }
 
     /// Every hair's points, `xyz` and width, point-major (module docs).
@@ -572,7 +735,7 @@ impl<'a> GpuPartGrower<'a> {
         let recipe = GroomRecipe::new(generator, &roots, &ids)?;
         let evaluator =
             |e: GpuError| generator.error("finish", GroomErrorKind::Evaluator(Box::new(e)));
-        let gpu = GpuGroom::new(self.ctx, &recipe, &self.skin).map_err(evaluator)?;
+        let mut gpu = GpuGroom::new(self.ctx, &recipe, &self.skin).map_err(evaluator)?;
         let offsets = GroomRecipe::guide_offsets(generator.guides());
         gpu.grow(self.ctx, &offsets, None).map_err(evaluator)?;
         let (points, widths) = gpu.read_points(self.ctx).map_err(evaluator)?;

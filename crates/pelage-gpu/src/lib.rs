@@ -137,6 +137,7 @@ pub const SHADERS: &[(&str, &str)] = &[
         "strands.wgsl",
         concat!(
             include_str!("shaders/strands.wgsl"),
+            include_str!("shaders/skin_sdf.wgsl"),
             include_str!("shaders/noise.wgsl")
         ),
     ),
@@ -145,6 +146,7 @@ pub const SHADERS: &[(&str, &str)] = &[
         "groom.wgsl",
         concat!(
             include_str!("shaders/groom.wgsl"),
+            include_str!("shaders/skin_sdf.wgsl"),
             include_str!("shaders/noise.wgsl")
         ),
     ),

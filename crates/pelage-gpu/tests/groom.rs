@@ -2,8 +2,8 @@
 //! the CPU groom of the same frame (`Generator::part`,
 //! `AnimatedGroom::part`): every operator alone, and a groom with all of
 //! them (masks, maps, regions' worth of clumps at two levels); at rest, on
-//! a posed Fox (hairs carried by the skin) and on a Fox whose guides were
-//! simulated. Every point of every hair, matched by hair id, must lie
+//! a posed Fox (hairs carried by the skin), on a Fox whose guides were
+//! simulated, and with the hairs kept out of the skin at rest and posed. Every point of every hair, matched by hair id, must lie
 //! within 1e-4 of the groom's size of the CPU's; widths and colours are the
 //! CPU operators' own.
 //! Needs an adapter (lavapipe serves); `PELAGE_REQUIRE_GPU=1` (CI) makes
@@ -96,7 +96,8 @@ fn compare_at_rest(ctx: &GpuContext, groom: &Groom, what: &str) {
     let (roots, ids) = all_roots(&generator);
     let recipe = GroomRecipe::new(&generator, &roots, &ids).unwrap();
     assert!(recipe.left_out.is_empty(), "{what}: {:?}", recipe.left_out);
-    let on_gpu = GpuGroom::new(ctx, &recipe, &GpuGroom::skin_at_rest(generator.mesh())).unwrap();
+    let mut on_gpu =
+        GpuGroom::new(ctx, &recipe, &GpuGroom::skin_at_rest(generator.mesh())).unwrap();
     let offsets = GroomRecipe::guide_offsets(generator.guides());
     on_gpu.grow(ctx, &offsets, None).unwrap();
     let gpu_curves = on_gpu.read_curves(ctx).unwrap();
@@ -161,15 +162,21 @@ fn a_groom_with_every_operator_masked_mapped_and_clumped_twice_grows_as_on_the_c
     compare_at_rest(ctx, &spot_groom(&ops), "every operator");
 }
 
-/// The Fox running, with a groom in `mode`.
+/// The Fox running, with a groom in `mode` (`extra`: more sections).
 fn fox_groom(mode: &str, extra: &str) -> Groom {
+    fox_groom_kept_out(mode, extra, false)
+}
+
+/// [`fox_groom`], its hairs kept out of the skin or not (`outside_skin`,
+/// an animated groom's default).
+fn fox_groom_kept_out(mode: &str, extra: &str, outside: bool) -> Groom {
     let text = format!(
         "[mesh]\npath = {FOX:?}\n[roots]\ncount = 2000\n\
          [guides]\npoints = 8\ngenerate = {{ count = 120, length = 12.0, comb = [0, -0.2, -0.8] }}\n\
          [[ops]]\nclump = {{ count = 150, rate = 0.5 }}\n\
          [[ops]]\ncurl = {{ radius = 0.6, turns = 2 }}\n\
          [[ops]]\nnoise = {{ amplitude = 0.8, frequency = 0.15 }}\n\
-         [finish]\npoints = 10\noutside_skin = false\n\
+         [finish]\npoints = 10\noutside_skin = {outside}\n\
          [animation]\nframes = \"1-4\"\nclip = \"Run\"\nmode = \"{mode}\"\n{extra}"
     );
     Groom::from_text("fox.toml", &text).unwrap()
@@ -182,7 +189,7 @@ fn compare_posed(ctx: &GpuContext, groom: &Groom, time: f64, what: &str) {
     let (roots, ids) = all_roots(rest);
     let recipe = GroomRecipe::new(rest, &roots, &ids).unwrap();
     assert!(recipe.left_out.is_empty(), "{what}: {:?}", recipe.left_out);
-    let on_gpu = GpuGroom::new(ctx, &recipe, animated.binding()).unwrap();
+    let mut on_gpu = GpuGroom::new(ctx, &recipe, animated.binding()).unwrap();
     let pose = animated.pose(time).unwrap();
     let guides = match animated.animation().mode.regrows() {
         true => animated
@@ -213,6 +220,11 @@ fn a_posed_and_a_simulated_fox_grow_as_on_the_cpu() {
     compare_posed(ctx, &fox_groom("deform", ""), 3.0, "deformed");
     let simulation = "[simulation]\ngravity = [0, -500, 0]\nfollow = 0\npreroll = 2\n";
     compare_posed(ctx, &fox_groom("simulate", simulation), 3.0, "simulated");
+    // Kept out of the skin at rest and on the pose (an animated groom's
+    // default `outside_skin`): the same grids' queries, the same pushes.
+    let kept_out = fox_groom_kept_out("simulate", simulation, true);
+    compare_posed(ctx, &kept_out, 1.0, "kept out, at rest");
+    compare_posed(ctx, &kept_out, 3.0, "kept out, simulated");
 }
 
 /// Spot's groom drawn by the strand renderer over its skin, `size`²
@@ -231,7 +243,8 @@ fn draw_spot(ctx: &GpuContext, light: Vec3, eye: Vec3, shadows: bool) -> RgbaIma
     let generator = groom.generator(None).unwrap();
     let (roots, ids) = all_roots(&generator);
     let recipe = GroomRecipe::new(&generator, &roots, &ids).unwrap();
-    let on_gpu = GpuGroom::new(ctx, &recipe, &GpuGroom::skin_at_rest(generator.mesh())).unwrap();
+    let mut on_gpu =
+        GpuGroom::new(ctx, &recipe, &GpuGroom::skin_at_rest(generator.mesh())).unwrap();
     let offsets = GroomRecipe::guide_offsets(generator.guides());
     on_gpu.grow(ctx, &offsets, None).unwrap();
     let shells = ShellRenderer::new(ctx, ShellFeatures::default());
@@ -409,7 +422,8 @@ fn the_level_of_detail_hands_over_from_strands_to_shells_without_a_pop() {
     let generator = groom.generator(None).unwrap();
     let (roots, ids) = pelage::groom::roots_by_arrival(&generator);
     let recipe = GroomRecipe::new(&generator, &roots, &ids).unwrap();
-    let on_gpu = GpuGroom::new(ctx, &recipe, &GpuGroom::skin_at_rest(generator.mesh())).unwrap();
+    let mut on_gpu =
+        GpuGroom::new(ctx, &recipe, &GpuGroom::skin_at_rest(generator.mesh())).unwrap();
     on_gpu
         .grow(ctx, &GroomRecipe::guide_offsets(generator.guides()), None)
         .unwrap();

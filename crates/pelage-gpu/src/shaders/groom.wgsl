@@ -41,7 +41,14 @@ struct GroomPass {
     tables_at: u32,
     permutation_at: u32,
     widths_at: u32,
+    // Bit 0: keep hairs out of the skin at rest after the operators;
+    // bit 1: and out of this frame's posed skin after the carry.
+    outside: u32,
+    // The gap kept above the skin.
+    gap: f32,
     pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
 
 // pelage::groom::RecipeStep.
@@ -71,12 +78,13 @@ struct HairRoot {
 };
 
 @group(0) @binding(0) var<storage, read> hair_roots: array<HairRoot>;
-// Everything else that does not change, one array of 32-bit words (u32s
-// stored by their bits): each hair's guide weights, the guides' normals,
+// Everything else that does not change, one array of 32-bit words (floats
+// by their bits: read as u32s, so no denormal is flushed on the way): each
+// hair's guide weights, the guides' normals,
 // each hair's values, the steps, their tables, the noise permutations and
 // the render hairs' widths, where the pass says each starts. One binding
 // keeps the shader within the storage buffers a default device allows.
-@group(0) @binding(1) var<storage, read> data: array<f32>;
+@group(0) @binding(1) var<storage, read> data: array<u32>;
 // This frame's guides: each point's offset from its guide's root, in rest space.
 @group(0) @binding(2) var<storage, read> guide_offsets: array<vec4<f32>>;
 // This frame's skin: a vertex's posed position, then its normal.
@@ -84,31 +92,119 @@ struct HairRoot {
 @group(0) @binding(4) var<storage, read> triangles: array<u32>;
 // xyz: the point; w: its width.
 @group(0) @binding(5) var<storage, read_write> points: array<vec4<f32>>;
+// The skin hairs are kept out of, at rest and in this frame's pose: each
+// a grid as skin_sdf.wgsl reads it, in words (floats by their bits): a
+// 12-word header, its nodes' distances, their nearest triangles (from the
+// header's pad1), its triangles (six vec4s each, after the nodes).
+@group(0) @binding(6) var<storage, read> rest_skin_sdf: array<u32>;
+@group(0) @binding(7) var<storage, read> posed_skin_sdf: array<u32>;
+
+// Word `i` of grid `g`'s buffer (its pad0: 0 at rest, 1 posed).
+fn sdf_word(g: Grid, i: u32) -> u32 {
+    if g.pad0 == 0u {
+        return rest_skin_sdf[i];
+    }
+    return posed_skin_sdf[i];
+}
+
+// skin_sdf.wgsl's reads.
+fn sdf_distance(g: Grid, i: u32) -> f32 {
+    return bitcast<f32>(sdf_word(g, i));
+}
+
+fn sdf_nearest(g: Grid, i: u32) -> u32 {
+    return sdf_word(g, g.pad1 + i - g.node_offset);
+}
+
+fn sdf_triangle(g: Grid, i: u32) -> vec3<f32> {
+    let k = g.pad1 + g.nx * g.ny * g.nz + 4u * i;
+    return bitcast<vec3<f32>>(vec3<u32>(sdf_word(g, k), sdf_word(g, k + 1u), sdf_word(g, k + 2u)));
+}
+
+// Grid `which`'s header (0: at rest, 1: posed).
+fn grid_of(which: u32) -> Grid {
+    var w: array<u32, 12>;
+    for (var i = 0u; i < 12u; i++) {
+        if which == 0u {
+            w[i] = rest_skin_sdf[i];
+        } else {
+            w[i] = posed_skin_sdf[i];
+        }
+    }
+    return Grid(
+        bitcast<vec3<f32>>(vec3<u32>(w[0], w[1], w[2])), bitcast<f32>(w[3]),
+        w[4], w[5], w[6], bitcast<f32>(w[7]),
+        w[8], w[9], w[10], w[11],
+    );
+}
+
+// pelage::dynamics::strands::follow_outside with a still groom's contact
+// (OutsideSkin::apply): the point at `len` from `leader` toward `goal`,
+// pushed out to `thickness` above the skin up to 8 times, keeping its
+// length unless that takes it back in.
+fn follow_outside(g: Grid, leader: vec3<f32>, goal: vec3<f32>, len: f32, fallback: vec3<f32>, thickness: f32) -> vec3<f32> {
+    var q = leader + len * normalize_or(goal - leader, fallback);
+    for (var k = 0u; k < 8u; k++) {
+        let s = sample(g, q);
+        if all(s.out == vec3<f32>(0.0)) || s.d >= thickness {
+            break;
+        }
+        let pushed = q + (thickness - s.d) * s.out;
+        q = leader + len * normalize_or(pushed - leader, s.out);
+        if sample(g, q).d < 0.0 {
+            q = pushed;
+        }
+    }
+    return q;
+}
+
+// pelage::groom::OutsideSkin::apply: from the first point after the root
+// that is not clear of the skin and nearer it than the gap, each point
+// follows the one before at its length, out of the skin.
+fn keep_out(g: Grid, n: u32, normal: vec3<f32>) {
+    var first = 0u;
+    for (var i = 1u; i < n; i++) {
+        if !clear_of(g, pts[i], pass_.gap) && sample(g, pts[i]).d < pass_.gap {
+            first = i;
+            break;
+        }
+    }
+    if first == 0u {
+        return;
+    }
+    var before = pts[first - 1u];
+    for (var i = first; i < n; i++) {
+        let goal = pts[i];
+        let len = length(goal - before);
+        pts[i] = follow_outside(g, pts[i - 1u], goal, len, normal, pass_.gap);
+        before = goal;
+    }
+}
 @group(1) @binding(0) var<uniform> pass_: GroomPass;
 
 // A hair's guide `i` of MAX_WEIGHTS: (guide as u32 bits, weight).
 fn weight_at(i: u32) -> vec2<f32> {
     let k = pass_.weights_at + 2u * i;
-    return vec2<f32>(data[k], data[k + 1u]);
+    return vec2<f32>(bitcast<f32>(data[k]), bitcast<f32>(data[k + 1u]));
 }
 
 fn guide_normal(g: u32) -> vec3<f32> {
     let k = pass_.normals_at + 3u * g;
-    return vec3<f32>(data[k], data[k + 1u], data[k + 2u]);
+    return bitcast<vec3<f32>>(vec3<u32>(data[k], data[k + 1u], data[k + 2u]));
 }
 
 // Word `i` of the hairs' values (a hair's block, then its steps').
 fn value_word(i: u32) -> f32 {
-    return data[pass_.values_at + i];
+    return bitcast<f32>(data[pass_.values_at + i]);
 }
 
 // Word `i` of the steps' tables (profiles, resamplings).
 fn table_word(i: u32) -> f32 {
-    return data[pass_.tables_at + i];
+    return bitcast<f32>(data[pass_.tables_at + i]);
 }
 
 fn hair_width(i: u32) -> f32 {
-    return data[pass_.widths_at + i];
+    return bitcast<f32>(data[pass_.widths_at + i]);
 }
 
 // pelage::groom::RecipeStep `s`, eight words.
@@ -116,7 +212,7 @@ fn step_at(s: u32) -> Step {
     let k = pass_.steps_at + 8u * s;
     var w: array<u32, 8>;
     for (var i = 0u; i < 8u; i++) {
-        w[i] = bitcast<u32>(data[k + i]);
+        w[i] = data[k + i];
     }
     return Step(w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]);
 }
@@ -130,7 +226,7 @@ var<private> samples: array<vec3<f32>, MAX_POINTS>;
 var<private> perm_base: u32;
 
 fn perm_at(i: u32) -> u32 {
-    return bitcast<u32>(data[pass_.permutation_at + perm_base + (i & 511u)]);
+    return data[pass_.permutation_at + perm_base + (i & 511u)];
 }
 
 // pelage::groom::ops::param.
@@ -481,12 +577,18 @@ fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
             }
         }
     }
+    if (pass_.outside & 1u) != 0u {
+        keep_out(grid_of(0u), n, skin_normal);
+    }
     if pass_.posed != 0u {
         let rest = mat3x3<f32>(root.x_axis.xyz, root.y_axis.xyz, root.z_axis.xyz);
         let posed = posed_frame(bitcast<u32>(root.position.w), root.normal.w, root.origin.w);
         let turn = mat3x3<f32>(posed[0], posed[1], posed[2]) * transpose(rest);
         for (var j = 0u; j < n; j++) {
             pts[j] = posed[3] + turn * (pts[j] - root.origin.xyz);
+        }
+        if (pass_.outside & 2u) != 0u {
+            keep_out(grid_of(1u), n, posed[2]);
         }
     }
     var width_at = 0xffffffffu;

@@ -106,6 +106,11 @@ impl OutsideSkin {
         longest / (points.max(2) - 1) as f32
     }
 
+    /// The skin as a distance grid (for a GPU port of [`Self::apply`]).
+    pub fn sdf(&self) -> &SkinSdf {
+        &self.skin
+    }
+
     /// The gap kept between hairs and the skin.
     pub fn gap(&self) -> f32 {
         self.gap

@@ -14,10 +14,11 @@
 //!
 //! Widths, colours and opacities never read a hair's points, so they are
 //! made once here by the CPU operators themselves and the evaluator only
-//! copies them. Operators that change how many hairs a root grows or how
-//! many points a hair has (`strands`, `cut`) and the finish's
-//! `outside_skin` have no step yet: [`GroomRecipe::left_out`] names them,
-//! and a front end says so rather than draw a different groom silently.
+//! copies them. `[finish] outside_skin` comes as the skin at rest it keeps
+//! hairs out of ([`GroomRecipe::outside_skin`]). Operators that change how
+//! many hairs a root grows or how many points a hair has (`strands`,
+//! `cut`) have no step yet: [`GroomRecipe::left_out`] names them, and a
+//! front end says so rather than draw a different groom silently.
 //!
 //! Clump centres are hairs of the recipe too: each clump level's centres
 //! are grown in a pass of their own through the steps before the clump,
@@ -28,6 +29,7 @@ use super::build::centre_hair_id;
 use super::error::{GroomError, GroomErrorKind};
 use super::generator::Generator;
 use super::ops::{HairBatch, Operator, RootContext, Scratch, param};
+use super::outside_skin::OutsideSkin;
 use crate::interp::{GuideWeight, HairRoot, HairScratch, NeighbourCache};
 use crate::mesh::SurfacePoint;
 use glam::Vec3;
@@ -162,6 +164,11 @@ pub struct GroomRecipe {
     pub colors: Option<Vec<Vec3>>,
     /// Each render hair's opacities, when the groom has them.
     pub opacities: Option<Vec<f32>>,
+    /// `[finish] outside_skin`: the skin at rest the hairs are kept out
+    /// of after the operators (centres too), and the hairs' segment
+    /// length, with which an evaluator keeps carried hairs out of a posed
+    /// skin (`OutsideSkin::posed`), as an animated groom does.
+    pub outside_skin: Option<(OutsideSkin, f32)>,
     /// What the recipe does not grow.
     pub left_out: Vec<LeftOut>,
 }
@@ -244,6 +251,7 @@ impl GroomRecipe {
             widths: Vec::new(),
             colors: None,
             opacities: None,
+            outside_skin: None,
             left_out: Vec::new(),
         };
         recipe.add_steps(generator);
@@ -374,12 +382,10 @@ impl GroomRecipe {
             self.steps.push(step);
         }
         self.values_per_hair = offset;
-        if generator.outside_skin.is_some() {
-            self.left_out.push(LeftOut {
-                key: "finish.outside_skin".into(),
-                why: "no evaluator step yet: hairs may enter the skin",
-            });
-        }
+        self.outside_skin = generator.outside_skin.as_ref().map(|skin| {
+            let segment = OutsideSkin::segment(&generator.guides, generator.points);
+            ((**skin).clone(), segment)
+        });
     }
 
     /// Appends the hairs `ids` at `roots`: their roots, weights and
