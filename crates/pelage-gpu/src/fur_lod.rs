@@ -120,16 +120,8 @@ impl ShellStandIn {
     /// The stand-in for `generator`'s groom, with `layers` shells.
     pub fn of(generator: &Generator, layers: u32) -> Self {
         let guides = generator.guides();
-        let length = (0..guides.len())
-            .map(|g| {
-                guides
-                    .guide(g)
-                    .windows(2)
-                    .map(|w| (w[1] - w[0]).length())
-                    .sum::<f32>()
-            })
-            .sum::<f32>()
-            / guides.len().max(1) as f32;
+        let length =
+            (0..guides.len()).map(|g| guides.length(g)).sum::<f32>() / guides.len().max(1) as f32;
         let hairs: u64 = generator.parts().iter().map(|p| p.hair_count).sum();
         let mesh = generator.mesh();
         // The UV square's share the skin covers: its triangles' UV area.

@@ -441,18 +441,10 @@ fn step_guides(
 
 /// sRGB bytes of a linear colour.
 fn srgb(c: Vec3) -> image::Rgba<u8> {
-    let [r, g, b] = c.to_array().map(encode);
+    let [r, g, b] = c
+        .to_array()
+        .map(|x| (255.0 * pelage::groom::linear_to_srgb(x)).round() as u8);
     image::Rgba([r, g, b, 255])
-}
-
-fn encode(x: f32) -> u8 {
-    let x = x.clamp(0.0, 1.0);
-    let s = if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    };
-    (255.0 * s).round() as u8
 }
 
 /// A skin texture (sRGB) brightened as the stand-in's shells need.

@@ -381,16 +381,10 @@ fn strands_lit_from_behind_glow_at_the_rim_and_shadows_darken_the_hairs_below() 
 
 /// sRGB bytes of a linear colour.
 fn srgb(c: Vec3) -> image::Rgba<u8> {
-    let encode = |x: f32| {
-        let x = x.clamp(0.0, 1.0);
-        let s = if x <= 0.003_130_8 {
-            12.92 * x
-        } else {
-            1.055 * x.powf(1.0 / 2.4) - 0.055
-        };
-        (255.0 * s).round() as u8
-    };
-    image::Rgba([encode(c.x), encode(c.y), encode(c.z), 255])
+    let [r, g, b] = c
+        .to_array()
+        .map(|x| (255.0 * pelage::groom::linear_to_srgb(x)).round() as u8);
+    image::Rgba([r, g, b, 255])
 }
 
 /// The share of `a`'s and `b`'s fur or skin pixels (not background in

@@ -850,6 +850,17 @@ pub fn srgb_to_linear(v: f32) -> f32 {
     }
 }
 
+/// A linear value (0–1) sRGB-encoded: the sRGB transfer function
+/// (IEC 61966-2-1), [`srgb_to_linear`]'s inverse.
+pub fn linear_to_srgb(v: f32) -> f32 {
+    let v = v.clamp(0.0, 1.0);
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
 /// The red, green and blue of the base colour texture of the mesh file a
 /// `[mesh]` section names (a glTF's, made linear), when it has one; a texture that
 /// cannot be read is an error at `mesh.path`.

@@ -86,8 +86,8 @@ pub use export::{
 pub use farm::{FarmError, FarmRun, find_part_files};
 pub use generator::{Generator, GroomSummary};
 pub use hair_look::{HairLook, color_of_melanin, melanin_of_color};
-pub use load::srgb_to_linear;
 pub use load::{Groom, GroomInputs};
+pub use load::{linear_to_srgb, srgb_to_linear};
 pub use output::{
     GroomWriteError, PartGrower, StreamError, part_file, part_name, part_slice, write_assembly,
 };

@@ -95,13 +95,7 @@ impl OutsideSkin {
     /// band a pushed hair crosses).
     pub fn segment(guides: &crate::guides::Guides, points: usize) -> f32 {
         let longest = (0..guides.len())
-            .map(|g| {
-                guides
-                    .guide(g)
-                    .windows(2)
-                    .map(|w| (w[1] - w[0]).length())
-                    .sum::<f32>()
-            })
+            .map(|g| guides.length(g))
             .fold(0.0f32, f32::max);
         longest / (points.max(2) - 1) as f32
     }

@@ -260,6 +260,14 @@ impl Guides {
         })
     }
 
+    /// Guide `i`'s length along its points.
+    pub fn length(&self, i: usize) -> f32 {
+        self.guide(i)
+            .windows(2)
+            .map(|w| (w[1] - w[0]).length())
+            .sum()
+    }
+
     /// The same guides (roots, widths) in other shapes: `points` holds
     /// every guide's points, `points_per_guide` each, in order.
     pub fn with_points(&self, points: Vec<Vec3>) -> Result<Self, CurvesError> {
