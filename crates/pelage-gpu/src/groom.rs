@@ -230,8 +230,9 @@ fn packed(recipe: &GroomRecipe) -> (Vec<u32>, Sections) {
 }
 
 /// Each hair's root record (the shader's `HairRoot`, six `vec4`s): its
-/// rest position and triangle, rest normal and barycentrics, and — for
-/// render hairs — the rest skin frame it is carried from.
+/// rest position and triangle, rest normal and barycentrics, whether it
+/// grows bare, and — for render hairs — the rest skin frame it is carried
+/// from.
 fn root_records(recipe: &GroomRecipe, skin: &SkinBinding) -> Vec<[f32; 4]> {
     let render = recipe.render_hairs();
     (0..recipe.hair_count())
@@ -246,7 +247,7 @@ fn root_records(recipe: &GroomRecipe, skin: &SkinBinding) -> Vec<[f32; 4]> {
                 v4(recipe.root_positions[i], f32::from_bits(root.tri)),
                 v4(recipe.root_normals[i], root.bary[0]),
                 v4(origin, root.bary[1]),
-                v4(frame.x_axis, 0.0),
+                v4(frame.x_axis, if recipe.bare[i] { 1.0 } else { 0.0 }),
                 v4(frame.y_axis, 0.0),
                 v4(frame.z_axis, 0.0),
             ]
@@ -739,6 +740,13 @@ impl<'a> GpuPartGrower<'a> {
         let offsets = GroomRecipe::guide_offsets(generator.guides());
         gpu.grow(self.ctx, &offsets, None).map_err(evaluator)?;
         let (points, widths) = gpu.read_points(self.ctx).map_err(evaluator)?;
+        // The hairs the recipe kept (a cut can take some away whole).
+        let render = recipe.render_hairs();
+        let kept = render.start as usize..render.end as usize;
+        let (roots, ids) = (
+            recipe.roots[kept.clone()].to_vec(),
+            recipe.ids[kept].to_vec(),
+        );
         generator.part_from_grown(roots, ids, points, widths, recipe.colors, recipe.opacities)
     }
 }

@@ -90,8 +90,9 @@ fn size_of(generator: &Generator) -> f32 {
     (hi - lo).max_element()
 }
 
-/// Grows `groom` at rest on the GPU and the CPU and compares them.
-fn compare_at_rest(ctx: &GpuContext, groom: &Groom, what: &str) {
+/// Grows `groom` at rest on the GPU and the CPU and compares them;
+/// returns how many hairs grew.
+fn compare_at_rest(ctx: &GpuContext, groom: &Groom, what: &str) -> usize {
     let generator = groom.generator(None).unwrap();
     let (roots, ids) = all_roots(&generator);
     let recipe = GroomRecipe::new(&generator, &roots, &ids).unwrap();
@@ -118,6 +119,7 @@ fn compare_at_rest(ctx: &GpuContext, groom: &Groom, what: &str) {
             &colors[..colors.len().min(9)]
         );
     }
+    gpu_curves.curve_count()
 }
 
 #[test]
@@ -136,10 +138,15 @@ fn every_operator_alone_grows_as_on_the_cpu() {
         "width = { root = 0.003, tip = 0.001, jitter = 0.3 }",
         "color = { root = [0.5, 0.3, 0.1], tip = [0.9, 0.8, 0.6], jitter = 0.2 }",
         "opacity = { root = 1.0, tip = 0.3 }",
+        "cut = { at = 0.6 }",
     ];
     for op in ops {
         compare_at_rest(ctx, &spot_groom(&[op]), op);
     }
+    // Some hairs cut away whole (the map below 0 there): gone on both.
+    let cut_away = "cut = { at = \"noise:frequency=3,offset=0.1,scale=1.0\" }";
+    let hairs = compare_at_rest(ctx, &spot_groom(&[cut_away]), cut_away);
+    assert!(hairs > 0 && hairs < 3000, "{hairs} hairs left");
 }
 
 #[test]
@@ -147,6 +154,9 @@ fn a_groom_with_every_operator_masked_mapped_and_clumped_twice_grows_as_on_the_c
     let Some(ctx) = gpu() else { return };
     let mask = "mask = \"noise:frequency=4,seed=9\"";
     let ops = [
+        // Before the first clump: some of its centres are cut away whole
+        // and grow bare, as the CPU grows them.
+        format!("cut = {{ at = \"noise:frequency=5,offset=0.1,scale=1.2\", {mask} }}"),
         "clump = { count = 40, rate = 0.7 }".to_string(),
         "noise = { amplitude = \"noise:frequency=3,scale=0.02\", frequency = 15 }".into(),
         format!("clump = {{ count = 200, rate = 0.5, {mask} }}"),

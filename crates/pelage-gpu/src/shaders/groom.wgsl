@@ -71,7 +71,9 @@ struct HairRoot {
     normal: vec4<f32>,
     // The rest skin frame's origin; w: the second barycentric.
     origin: vec4<f32>,
-    // The rest skin frame's columns (tangent, bitangent, normal).
+    // The rest skin frame's columns (tangent, bitangent, normal); x_axis.w:
+    // 1 where the hair grows bare (a clump centre cut away: its
+    // interpolated shape).
     x_axis: vec4<f32>,
     y_axis: vec4<f32>,
     z_axis: vec4<f32>,
@@ -485,6 +487,24 @@ fn flyaways(n: u32, v: u32, table: u32) {
     }
 }
 
+// pelage::groom::ops::Cut::cut_at: the hair ends at curve parameter `at`
+// and keeps its point count (point k at parameter at · t_k of the old one).
+fn cut(n: u32, v: u32) {
+    let at = value_word(v);
+    if at >= 1.0 || n < 2u {
+        return;
+    }
+    for (var j = 0u; j < n; j++) {
+        before[j] = pts[j];
+    }
+    for (var k = 0u; k < n; k++) {
+        let x = at * param(k, n) * f32(n - 1u);
+        let j = min(u32(x), n - 2u);
+        let f = x - f32(j);
+        pts[k] = before[j] + (before[j + 1u] - before[j]) * f;
+    }
+}
+
 // pelage::groom::ops::Clump::pull: toward the centre hair's points, grown
 // by an earlier pass.
 fn clump(n: u32, v: u32, step: Step) {
@@ -546,7 +566,12 @@ fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
     let root = hair_roots[h];
     let skin_normal = root.normal.xyz;
     interpolate(h, root.position.xyz, skin_normal);
-    for (var s = 0u; s < pass_.steps; s++) {
+    let bare = root.x_axis.w != 0.0;
+    var steps = pass_.steps;
+    if bare {
+        steps = 0u;
+    }
+    for (var s = 0u; s < steps; s++) {
         let step = step_at(s);
         var v = h * pass_.values_per_hair + step.values;
         var m = 1.0;
@@ -569,6 +594,7 @@ fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
             case 4u: { frizz(n, v, step.table); }
             case 5u: { flyaways(n, v, step.table); }
             case 6u: { clump(n, v, step); }
+            case 7u: { cut(n, v); }
             default: {}
         }
         if m != 1.0 {
@@ -577,7 +603,7 @@ fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
             }
         }
     }
-    if (pass_.outside & 1u) != 0u {
+    if (pass_.outside & 1u) != 0u && !bare {
         keep_out(grid_of(0u), n, skin_normal);
     }
     if pass_.posed != 0u {

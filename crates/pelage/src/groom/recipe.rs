@@ -15,9 +15,10 @@
 //! Widths, colours and opacities never read a hair's points, so they are
 //! made once here by the CPU operators themselves and the evaluator only
 //! copies them. `[finish] outside_skin` comes as the skin at rest it keeps
-//! hairs out of ([`GroomRecipe::outside_skin`]). Operators that change how
-//! many hairs a root grows or how many points a hair has (`strands`,
-//! `cut`) have no step yet: [`GroomRecipe::left_out`] names them, and a
+//! hairs out of ([`GroomRecipe::outside_skin`]). A `cut` is a step (its
+//! parameter per hair); the hairs it takes away whole are not in the
+//! recipe, as the CPU drops them. `strands`, which grows several hairs
+//! from a root, has no step yet: [`GroomRecipe::left_out`] names it, and a
 //! front end says so rather than draw a different groom silently.
 //!
 //! Clump centres are hairs of the recipe too: each clump level's centres
@@ -60,13 +61,17 @@ pub enum StepKind {
     Flyaways = 5,
     /// `clump`: values `[centre (u32 bits), weight]`.
     Clump = 6,
+    /// `cut`: values `[at]`, a mask folded in (`1 − m (1 − at)`, as a
+    /// masked cut fades its parameter); at 1 or more, no cut. A hair cut
+    /// at 0 or less is not in the recipe (a clump centre grows bare).
+    Cut = 7,
 }
 
 impl StepKind {
     /// Values a hair holds for a step of this kind (without its mask).
     pub fn values(self) -> u32 {
         match self {
-            Self::Length | Self::Twist => 1,
+            Self::Length | Self::Twist | Self::Cut => 1,
             Self::Noise | Self::Clump => 2,
             Self::Curl => 3,
             Self::Frizz => 5,
@@ -132,6 +137,9 @@ pub struct GroomRecipe {
     pub guides: u32,
     /// Each hair's id.
     pub ids: Vec<u64>,
+    /// Whether a hair grows bare: a clump centre cut away entirely is its
+    /// interpolated shape, no step applied.
+    pub bare: Vec<bool>,
     /// Each hair's root on the skin.
     pub roots: Vec<SurfacePoint>,
     /// Each root's position at rest.
@@ -236,6 +244,7 @@ impl GroomRecipe {
             guide_points: generator.guides.points_per_guide() as u32,
             guides: generator.guides.len() as u32,
             ids: Vec::new(),
+            bare: Vec::new(),
             roots: Vec::new(),
             root_positions: Vec::new(),
             root_normals: Vec::new(),
@@ -272,16 +281,20 @@ impl GroomRecipe {
             let before = recipe.steps.iter().filter(|s| s.chain_index < k).count();
             hairs.push((centre_roots, centre_ids, before as u32));
         }
+        let centre_passes = hairs.len();
         hairs.push((roots.to_vec(), ids.to_vec(), recipe.steps.len() as u32));
         let mut first = 0u32;
-        for (roots, ids, steps) in hairs {
-            let count = roots.len() as u32;
+        let mut render = (Vec::new(), Vec::new());
+        for (pass, (roots, ids, steps)) in hairs.into_iter().enumerate() {
+            let centres = pass < centre_passes;
+            let kept = recipe.add_hairs(generator, (&roots, &ids), (steps as usize, centres))?;
+            let count = kept.0.len() as u32;
             recipe.passes.push(RecipePass {
                 hairs: first..first + count,
                 steps,
             });
-            recipe.add_hairs(generator, &roots, &ids)?;
             first += count;
+            render = kept;
         }
         let centres: Vec<u32> = recipe.passes.iter().map(|p| p.hairs.start).collect();
         for (step, start) in recipe
@@ -292,7 +305,7 @@ impl GroomRecipe {
         {
             step.centres = start;
         }
-        recipe.add_attributes(generator, roots, ids);
+        recipe.add_attributes(generator, &render.0, &render.1);
         Ok(recipe)
     }
 
@@ -324,7 +337,9 @@ impl GroomRecipe {
         let n = generator.points;
         let mut offset = 0u32;
         for (k, op) in generator.ops.iter().enumerate() {
-            let masked = matches!(op, Operator::Masked(_));
+            // A masked cut fades its parameter, not its result.
+            let masked =
+                matches!(op, Operator::Masked(_)) && !matches!(op.unmasked(), Operator::Cut(_));
             let (kind, ramp) = match op.unmasked() {
                 Operator::Length(_) => (StepKind::Length, None),
                 Operator::Curl(c) => (StepKind::Curl, Some(c.ramp())),
@@ -335,10 +350,11 @@ impl GroomRecipe {
                 Operator::Clump(c) => (StepKind::Clump, Some(c.ramp())),
                 // Widths, colours and opacities: made once (module docs).
                 Operator::Width(_) | Operator::Color(_) | Operator::Opacity(_) => continue,
-                Operator::Cut(_) | Operator::Strands(_) | Operator::Masked(_) => {
+                Operator::Cut(_) => (StepKind::Cut, None),
+                Operator::Strands(_) | Operator::Masked(_) => {
                     self.left_out.push(LeftOut {
                         key: format!("ops[{k}].{}", op.name()),
-                        why: "it changes how many hairs or points a root grows; no evaluator step yet",
+                        why: "it grows several hairs from a root; no evaluator step yet",
                     });
                     continue;
                 }
@@ -390,16 +406,33 @@ impl GroomRecipe {
 
     /// Appends the hairs `ids` at `roots`: their roots, weights and
     /// values.
+    /// Returns the roots and ids kept: render hairs cut away entirely
+    /// (a `cut` at 0 or less among the pass's `steps`) are left out, as
+    /// the CPU removes them; a clump centre cut away grows bare (its
+    /// interpolated shape, no step), as the CPU grows it.
     fn add_hairs(
         &mut self,
         generator: &Generator,
-        roots: &[SurfacePoint],
-        ids: &[u64],
-    ) -> Result<(), GroomError> {
+        (roots, ids): (&[SurfacePoint], &[u64]),
+        (steps_run, centres): (usize, bool),
+    ) -> Result<(Vec<SurfacePoint>, Vec<u64>), GroomError> {
         const CHUNK: usize = 1024;
         let per_hair = self.values_per_hair as usize;
         let steps = &self.steps;
-        type Chunk = (Vec<Vec3>, Vec<Vec3>, Vec<GuideWeight>, Vec<f32>, usize);
+        // Whether a hair's values cut it away within the pass's steps.
+        let cut_away = |values: &[f32]| {
+            steps[..steps_run]
+                .iter()
+                .any(|s| s.kind == StepKind::Cut && values[s.values as usize] <= 0.0)
+        };
+        type Chunk = (
+            Vec<Vec3>,
+            Vec<Vec3>,
+            Vec<GuideWeight>,
+            Vec<f32>,
+            usize,
+            Vec<(SurfacePoint, u64, bool)>,
+        );
         let chunks: Vec<Chunk> = roots
             .par_chunks(CHUNK)
             .zip(ids.par_chunks(CHUNK))
@@ -412,7 +445,9 @@ impl GroomRecipe {
                         Vec::with_capacity(roots.len() * MAX_RECIPE_WEIGHTS),
                         Vec::with_capacity(roots.len() * per_hair),
                         0,
+                        Vec::with_capacity(roots.len()),
                     );
+                    let mut hair_values = Vec::with_capacity(per_hair);
                     for (&root, &id) in roots.iter().zip(ids) {
                         let context = generator.root_context(root);
                         let hair_root = HairRoot {
@@ -425,6 +460,16 @@ impl GroomRecipe {
                             &mut interp.near,
                             &mut interp.weights,
                         );
+                        hair_values.clear();
+                        for step in steps {
+                            step_values(generator, step, id, &context, near, &mut hair_values);
+                        }
+                        let bare = cut_away(&hair_values);
+                        if bare && !centres {
+                            continue;
+                        }
+                        out.5.push((root, id, bare));
+                        out.3.extend_from_slice(&hair_values);
                         out.4 = out.4.max(interp.weights.len());
                         let padding = GuideWeight {
                             guide: 0,
@@ -440,15 +485,13 @@ impl GroomRecipe {
                         );
                         out.0.push(context.position);
                         out.1.push(context.normal);
-                        for step in steps {
-                            step_values(generator, step, id, &context, near, &mut out.3);
-                        }
                     }
                     out
                 },
             )
             .collect();
-        for (positions, normals, weights, values, most) in chunks {
+        let (mut kept_roots, mut kept_ids) = (Vec::new(), Vec::new());
+        for (positions, normals, weights, values, most, kept) in chunks {
             if most > MAX_RECIPE_WEIGHTS {
                 return Err(generator.error(
                     "interpolation",
@@ -461,10 +504,15 @@ impl GroomRecipe {
             self.root_normals.extend(normals);
             self.weights.extend(weights);
             self.values.extend(values);
+            for (root, id, bare) in kept {
+                kept_roots.push(root);
+                kept_ids.push(id);
+                self.bare.push(bare);
+            }
         }
-        self.roots.extend_from_slice(roots);
-        self.ids.extend_from_slice(ids);
-        Ok(())
+        self.roots.extend_from_slice(&kept_roots);
+        self.ids.extend_from_slice(&kept_ids);
+        Ok((kept_roots, kept_ids))
     }
 
     /// The render hairs' widths, colours and opacities, made by the CPU
@@ -475,10 +523,14 @@ impl GroomRecipe {
             .base
             .iter()
             .chain(&generator.ops)
+            // A cut resamples the attributes there are when it cuts.
             .filter(|op| {
                 matches!(
                     op.unmasked(),
-                    Operator::Width(_) | Operator::Color(_) | Operator::Opacity(_)
+                    Operator::Width(_)
+                        | Operator::Color(_)
+                        | Operator::Opacity(_)
+                        | Operator::Cut(_)
                 )
             })
             .collect();
@@ -538,15 +590,16 @@ fn step_values(
     out: &mut Vec<f32>,
 ) {
     let mut op = &generator.ops[step.chain_index];
+    let mut m = 1.0;
+    while let Operator::Masked(masked) = op {
+        m *= masked.weight(context);
+        op = masked.operator();
+    }
     if step.masked {
-        let mut m = 1.0;
-        while let Operator::Masked(masked) = op {
-            m *= masked.weight(context);
-            op = masked.operator();
-        }
         out.push(m);
     }
     match op {
+        Operator::Cut(c) => out.push(1.0 - m * (1.0 - c.at().at(&context.site))),
         Operator::Length(l) => out.push(l.factor(id, context)),
         Operator::Curl(c) => out.extend(c.helix(id, context)),
         Operator::Twist(t) => out.push(t.angle(id, context)),
