@@ -1708,8 +1708,8 @@ fn groom_on_the_gpu_writes_what_the_cpu_writes() {
     let dir = tempfile::tempdir().unwrap();
     let groom = dir.path().join("fur.toml");
     // Two parts, clumps at two levels, masks, a map, colours and normals,
-    // a cut that takes some hairs away whole: what a file carries beside
-    // the points.
+    // a cut that takes some hairs away whole, strands: what a file carries
+    // beside the points.
     std::fs::write(
         &groom,
         "[mesh]\npath = \"spot\"\n[roots]\ncount = 6000\nparts = 2\n\
@@ -1719,6 +1719,7 @@ fn groom_on_the_gpu_writes_what_the_cpu_writes() {
          [[ops]]\ncurl = { radius = 0.002, turns = 2 }\n\
          [[ops]]\nnoise = { amplitude = \"noise:frequency=2,scale=0.01\", frequency = 20 }\n\
          [[ops]]\ncut = { at = \"noise:frequency=4,offset=0.1,scale=1.0\" }\n\
+         [[ops]]\nstrands = { count = 2, tip_spread = 0.003 }\n\
          [finish]\npoints = 9\nnormals = true\n\
          color = { root = [0.3, 0.2, 0.1], tip = [0.8, 0.7, 0.5], jitter = 0.1 }\n",
     )
@@ -1741,7 +1742,8 @@ fn groom_on_the_gpu_writes_what_the_cpu_writes() {
         pelage::io::read_curves(&cpu).unwrap(),
         pelage::io::read_curves(&gpu).unwrap(),
     );
-    assert!(a.curve_count() < 6000, "the cut takes some hairs away");
+    assert!(a.curve_count() < 12000, "the cut takes some hairs away");
+    assert_eq!(a.curve_count() % 2, 0, "two hairs a strand");
     assert_eq!(a.offsets(), b.offsets());
     assert_eq!(a.ids(), b.ids(), "the same hairs in the same order");
     assert_eq!(a.roots(), b.roots());
@@ -1776,7 +1778,8 @@ fn groom_on_the_gpu_refuses_what_its_evaluator_leaves_out() {
         &groom,
         "[mesh]\npath = \"spot\"\n[roots]\ncount = 100\n\
          [guides]\ngenerate = { count = 20, length = 0.05 }\n\
-         [[ops]]\nstrands = { count = 3, tip_spread = 0.002 }\n",
+         [[ops]]\nstrands = { count = 3, tip_spread = 0.002 }\n\
+         [[ops]]\nstrands = { count = 2, tip_spread = 0.001 }\n",
     )
     .unwrap();
     let out = dir.path().join("strands.usdc");
@@ -1790,8 +1793,8 @@ fn groom_on_the_gpu_refuses_what_its_evaluator_leaves_out() {
     assert_eq!(o.status.code(), Some(2));
     let err = stderr(&o);
     assert!(
-        err.contains("strands.toml:7")
-            && err.contains("ops[0].strands")
+        err.contains("strands.toml:9")
+            && err.contains("ops[1].strands")
             && err.contains("without --gpu"),
         "{err}"
     );

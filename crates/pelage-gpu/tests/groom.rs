@@ -139,10 +139,17 @@ fn every_operator_alone_grows_as_on_the_cpu() {
         "color = { root = [0.5, 0.3, 0.1], tip = [0.9, 0.8, 0.6], jitter = 0.2 }",
         "opacity = { root = 1.0, tip = 0.3 }",
         "cut = { at = 0.6 }",
+        "strands = { count = 4, root_spread = 0.001, tip_spread = 0.006, twist = 0.5 }",
     ];
     for op in ops {
         compare_at_rest(ctx, &spot_groom(&[op]), op);
     }
+    // Strands before a clump: its centres are their strands' first hairs.
+    let split_then_clump = [
+        "strands = { count = 3, tip_spread = 0.005 }",
+        "clump = { count = 60, rate = 0.6 }",
+    ];
+    compare_at_rest(ctx, &spot_groom(&split_then_clump), "strands, then clump");
     // Some hairs cut away whole (the map below 0 there): gone on both.
     let cut_away = "cut = { at = \"noise:frequency=3,offset=0.1,scale=1.0\" }";
     let hairs = compare_at_rest(ctx, &spot_groom(&[cut_away]), cut_away);
@@ -167,6 +174,10 @@ fn a_groom_with_every_operator_masked_mapped_and_clumped_twice_grows_as_on_the_c
         "flyaways = { spread = 0.01, fraction = 0.05 }".into(),
         "color = { root = [0.4, 0.3, 0.2], tip = [0.8, 0.7, 0.5] }".into(),
         format!("opacity = {{ root = 1.0, tip = 0.5, {mask} }}"),
+        // After the clumps (their centres are strands' first hairs), and
+        // masked: where the mask is 0 a root keeps one whole hair.
+        format!("strands = {{ count = 3, tip_spread = 0.004, {mask} }}"),
+        "width = { root = 0.003, tip = 0.001, jitter = 0.4 }".into(),
     ];
     let ops: Vec<&str> = ops.iter().map(String::as_str).collect();
     compare_at_rest(ctx, &spot_groom(&ops), "every operator");

@@ -505,6 +505,25 @@ fn cut(n: u32, v: u32) {
     }
 }
 
+// pelage::groom::ops::Strands::split, for the one strand hair this is:
+// offset around its base hair in the base's rotation-minimizing frame,
+// spread from the root's to the tip's, turning by the twist.
+fn strand(n: u32, v: u32, skin_normal: vec3<f32>) {
+    let s0 = value_word(v);
+    let s1 = value_word(v + 1u);
+    let twist = value_word(v + 2u);
+    let rho = value_word(v + 3u);
+    let turn = value_word(v + 4u);
+    frame_along(n, skin_normal);
+    for (var j = 0u; j < n; j++) {
+        let t = param(j, n);
+        let angle = TAU * (turn + twist * t);
+        let r = frame[j];
+        let side = cross(tangents[j], r);
+        pts[j] += (s0 + t * (s1 - s0)) * rho * (cos(angle) * r + sin(angle) * side);
+    }
+}
+
 // pelage::groom::ops::Clump::pull: toward the centre hair's points, grown
 // by an earlier pass.
 fn clump(n: u32, v: u32, step: Step) {
@@ -595,6 +614,7 @@ fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
             case 5u: { flyaways(n, v, step.table); }
             case 6u: { clump(n, v, step); }
             case 7u: { cut(n, v); }
+            case 8u: { strand(n, v, skin_normal); }
             default: {}
         }
         if m != 1.0 {

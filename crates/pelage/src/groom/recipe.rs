@@ -17,9 +17,11 @@
 //! copies them. `[finish] outside_skin` comes as the skin at rest it keeps
 //! hairs out of ([`GroomRecipe::outside_skin`]). A `cut` is a step (its
 //! parameter per hair); the hairs it takes away whole are not in the
-//! recipe, as the CPU drops them. `strands`, which grows several hairs
-//! from a root, has no step yet: [`GroomRecipe::left_out`] names it, and a
-//! front end says so rather than draw a different groom silently.
+//! recipe, as the CPU drops them. `strands` is a step too: the recipe
+//! holds each strand hair, whose steps before the split read its base
+//! hair's numbers. A second `strands` has no step:
+//! [`GroomRecipe::left_out`] names it, and a front end says so rather than
+//! draw a different groom silently.
 //!
 //! Clump centres are hairs of the recipe too: each clump level's centres
 //! are grown in a pass of their own through the steps before the clump,
@@ -65,6 +67,11 @@ pub enum StepKind {
     /// masked cut fades its parameter); at 1 or more, no cut. A hair cut
     /// at 0 or less is not in the recipe (a clump centre grows bare).
     Cut = 7,
+    /// `strands`: values `[root spread, tip spread, twist, ρ, turn]`: the
+    /// hair is one of its base hair's strand, offset around it. The
+    /// recipe holds every strand hair; the steps before this one read the
+    /// base hair's numbers, the ones after the strand hair's.
+    Strands = 8,
 }
 
 impl StepKind {
@@ -74,7 +81,7 @@ impl StepKind {
             Self::Length | Self::Twist | Self::Cut => 1,
             Self::Noise | Self::Clump => 2,
             Self::Curl => 3,
-            Self::Frizz => 5,
+            Self::Frizz | Self::Strands => 5,
             Self::Flyaways => 10,
         }
     }
@@ -179,6 +186,9 @@ pub struct GroomRecipe {
     pub outside_skin: Option<(OutsideSkin, f32)>,
     /// What the recipe does not grow.
     pub left_out: Vec<LeftOut>,
+    /// The chain position of the `strands` operator the recipe splits
+    /// hairs at, if any.
+    strands: Option<usize>,
 }
 
 /// Every root of `generator`'s groom with its hair's id, ordered so that
@@ -262,6 +272,7 @@ impl GroomRecipe {
             opacities: None,
             outside_skin: None,
             left_out: Vec::new(),
+            strands: None,
         };
         recipe.add_steps(generator);
         // Each clump level's centres, then the render hairs.
@@ -284,17 +295,16 @@ impl GroomRecipe {
         let centre_passes = hairs.len();
         hairs.push((roots.to_vec(), ids.to_vec(), recipe.steps.len() as u32));
         let mut first = 0u32;
-        let mut render = (Vec::new(), Vec::new());
         for (pass, (roots, ids, steps)) in hairs.into_iter().enumerate() {
             let centres = pass < centre_passes;
-            let kept = recipe.add_hairs(generator, (&roots, &ids), (steps as usize, centres))?;
-            let count = kept.0.len() as u32;
+            let (kept, _) =
+                recipe.add_hairs(generator, (&roots, &ids), (steps as usize, centres))?;
+            let count = kept.len() as u32;
             recipe.passes.push(RecipePass {
                 hairs: first..first + count,
                 steps,
             });
             first += count;
-            render = kept;
         }
         let centres: Vec<u32> = recipe.passes.iter().map(|p| p.hairs.start).collect();
         for (step, start) in recipe
@@ -305,7 +315,8 @@ impl GroomRecipe {
         {
             step.centres = start;
         }
-        recipe.add_attributes(generator, &render.0, &render.1);
+        // By root: the operators split and drop hairs as they grow them.
+        recipe.add_attributes(generator, roots, ids);
         Ok(recipe)
     }
 
@@ -351,10 +362,14 @@ impl GroomRecipe {
                 // Widths, colours and opacities: made once (module docs).
                 Operator::Width(_) | Operator::Color(_) | Operator::Opacity(_) => continue,
                 Operator::Cut(_) => (StepKind::Cut, None),
+                Operator::Strands(_) if self.strands.is_none() => {
+                    self.strands = Some(k);
+                    (StepKind::Strands, None)
+                }
                 Operator::Strands(_) | Operator::Masked(_) => {
                     self.left_out.push(LeftOut {
                         key: format!("ops[{k}].{}", op.name()),
-                        why: "it grows several hairs from a root; no evaluator step yet",
+                        why: "a second `strands` (strands of strands); the evaluator splits a hair once",
                     });
                     continue;
                 }
@@ -420,6 +435,16 @@ impl GroomRecipe {
         let per_hair = self.values_per_hair as usize;
         let steps = &self.steps;
         // Whether a hair's values cut it away within the pass's steps.
+        // The strands operator the pass splits hairs at, and how many.
+        let strands_at = self
+            .strands
+            .filter(|&k| steps[..steps_run].iter().any(|s| s.chain_index == k));
+        let split = strands_at.map(|k| {
+            let Operator::Strands(s) = generator.ops[k].unmasked() else {
+                unreachable!("a strands step is a strands operator");
+            };
+            (s, s.count())
+        });
         let cut_away = |values: &[f32]| {
             steps[..steps_run]
                 .iter()
@@ -448,7 +473,7 @@ impl GroomRecipe {
                         Vec::with_capacity(roots.len()),
                     );
                     let mut hair_values = Vec::with_capacity(per_hair);
-                    for (&root, &id) in roots.iter().zip(ids) {
+                    for (&root, &base_id) in roots.iter().zip(ids) {
                         let context = generator.root_context(root);
                         let hair_root = HairRoot {
                             position: context.position,
@@ -460,31 +485,60 @@ impl GroomRecipe {
                             &mut interp.near,
                             &mut interp.weights,
                         );
-                        hair_values.clear();
-                        for step in steps {
-                            step_values(generator, step, id, &context, near, &mut hair_values);
-                        }
-                        let bare = cut_away(&hair_values);
-                        if bare && !centres {
-                            continue;
-                        }
-                        out.5.push((root, id, bare));
-                        out.3.extend_from_slice(&hair_values);
                         out.4 = out.4.max(interp.weights.len());
                         let padding = GuideWeight {
                             guide: 0,
                             weight: 0.0,
                         };
-                        out.2.extend(
-                            interp
-                                .weights
-                                .iter()
-                                .copied()
-                                .chain(std::iter::repeat(padding))
-                                .take(MAX_RECIPE_WEIGHTS),
-                        );
-                        out.0.push(context.position);
-                        out.1.push(context.normal);
+                        // The strand hairs a root grows in this pass (a
+                        // centre is the first of its strand, as the CPU
+                        // takes it).
+                        // A mask of 0 there leaves the hair whole, as the
+                        // CPU's masked strands do.
+                        let split = split.filter(|_| {
+                            strands_at
+                                .is_some_and(|k| mask_weight(&generator.ops[k], &context) > 0.0)
+                        });
+                        let copies = match split {
+                            Some((_, count)) if !centres => count,
+                            _ => 1,
+                        };
+                        for k in 0..u64::from(copies) {
+                            let strand = split.map(|(s, _)| s.strand_id(base_id, k));
+                            hair_values.clear();
+                            for step in steps {
+                                let id = match (strand, split) {
+                                    (Some(id), Some((_, _)))
+                                        if step.chain_index >= strands_at.unwrap_or(usize::MAX) =>
+                                    {
+                                        id
+                                    }
+                                    _ => base_id,
+                                };
+                                step_values(generator, step, id, &context, near, &mut hair_values);
+                            }
+                            let bare = cut_away(&hair_values);
+                            if bare && !centres {
+                                continue;
+                            }
+                            let id = if centres {
+                                base_id
+                            } else {
+                                strand.unwrap_or(base_id)
+                            };
+                            out.5.push((root, id, bare));
+                            out.3.extend_from_slice(&hair_values);
+                            out.2.extend(
+                                interp
+                                    .weights
+                                    .iter()
+                                    .copied()
+                                    .chain(std::iter::repeat(padding))
+                                    .take(MAX_RECIPE_WEIGHTS),
+                            );
+                            out.0.push(context.position);
+                            out.1.push(context.normal);
+                        }
                     }
                     out
                 },
@@ -531,6 +585,7 @@ impl GroomRecipe {
                         | Operator::Color(_)
                         | Operator::Opacity(_)
                         | Operator::Cut(_)
+                        | Operator::Strands(_)
                 )
             })
             .collect();
@@ -555,13 +610,16 @@ impl GroomRecipe {
                         for op in &attribute_ops {
                             op.apply(batch, &context, scratch);
                         }
-                        let hair = &batch.hairs()[0];
-                        out.0.extend(hair.widths.iter().map(|w| w * scale));
-                        if generator.colors {
-                            out.1.extend_from_slice(&hair.colors);
-                        }
-                        if generator.opacities {
-                            out.2.extend_from_slice(&hair.opacities);
+                        // Every hair the root grew: its strand's, none
+                        // when a cut took them away.
+                        for hair in batch.hairs() {
+                            out.0.extend(hair.widths.iter().map(|w| w * scale));
+                            if generator.colors {
+                                out.1.extend_from_slice(&hair.colors);
+                            }
+                            if generator.opacities {
+                                out.2.extend_from_slice(&hair.opacities);
+                            }
                         }
                     }
                     out
@@ -579,6 +637,16 @@ impl GroomRecipe {
     }
 }
 
+/// The weight of every mask over `op` at `context` (1: none).
+fn mask_weight(mut op: &Operator, context: &RootContext) -> f32 {
+    let mut m = 1.0;
+    while let Operator::Masked(masked) = op {
+        m *= masked.weight(context);
+        op = masked.operator();
+    }
+    m
+}
+
 /// Appends hair `id`'s values for `step` at `context`, by the operator's
 /// own functions.
 fn step_values(
@@ -589,17 +657,18 @@ fn step_values(
     near: &mut NeighbourCache,
     out: &mut Vec<f32>,
 ) {
-    let mut op = &generator.ops[step.chain_index];
-    let mut m = 1.0;
-    while let Operator::Masked(masked) = op {
-        m *= masked.weight(context);
-        op = masked.operator();
-    }
+    let m = mask_weight(&generator.ops[step.chain_index], context);
+    let op = generator.ops[step.chain_index].unmasked();
     if step.masked {
         out.push(m);
     }
     match op {
         Operator::Cut(c) => out.push(1.0 - m * (1.0 - c.at().at(&context.site))),
+        Operator::Strands(s) => {
+            let (rho, turn) = s.place(id);
+            out.extend(s.spreads(context));
+            out.extend([rho, turn]);
+        }
         Operator::Length(l) => out.push(l.factor(id, context)),
         Operator::Curl(c) => out.extend(c.helix(id, context)),
         Operator::Twist(t) => out.push(t.angle(id, context)),

@@ -70,6 +70,32 @@ impl Strands {
     }
 
     /// Replaces every hair of `batch` by its strand.
+    /// Hairs a strand.
+    pub(crate) fn count(&self) -> u32 {
+        self.count
+    }
+
+    /// The id of hair `k` of the strand around the hair `base_id`.
+    pub(crate) fn strand_id(&self, base_id: u64, k: u64) -> u64 {
+        base_id.wrapping_mul(u64::from(self.count)).wrapping_add(k)
+    }
+
+    /// Where strand hair `id` sits around its base hair: its share of the
+    /// spread (`√ξ`, even over the disc) and its angle (turns).
+    pub(crate) fn place(&self, id: u64) -> (f32, f32) {
+        let [a, b] = SampleRng::new(self.seed ^ SPREAD_SALT, id).uniform_f32_pair();
+        (a.sqrt(), b)
+    }
+
+    /// The spreads at the root and the tip, and the twist, at `root`.
+    pub(crate) fn spreads(&self, root: &RootContext) -> [f32; 3] {
+        [
+            self.root_spread.at(&root.site),
+            self.tip_spread.at(&root.site),
+            self.twist.at(&root.site),
+        ]
+    }
+
     pub(super) fn split(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
         // Taken out of the scratch (and put back) so the frame buffers can
         // be borrowed beside it.
@@ -78,19 +104,14 @@ impl Strands {
         for hair in batch.hairs() {
             bases.push().copy_from(hair);
         }
-        let (s0, s1) = (
-            self.root_spread.at(&root.site),
-            self.tip_spread.at(&root.site),
-        );
-        let twist = self.twist.at(&root.site);
+        let [s0, s1, twist] = self.spreads(root);
         batch.len = 0;
         for base in bases.hairs() {
             let n = base.points.len();
             scratch.frame_along(&base.points, root.normal);
             for k in 0..u64::from(self.count) {
-                let id = base.id.wrapping_mul(u64::from(self.count)).wrapping_add(k);
-                let [a, b] = SampleRng::new(self.seed ^ SPREAD_SALT, id).uniform_f32_pair();
-                let rho = a.sqrt();
+                let id = self.strand_id(base.id, k);
+                let (rho, b) = self.place(id);
                 let hair = batch.push();
                 hair.copy_from(base);
                 hair.id = id;
