@@ -379,24 +379,38 @@ impl PyGroom {
     /// Grows hair curves: one part (`part=k`), or all of them joined
     /// (`part=None`). `seed` replaces the groom's. `progress(done, total)`
     /// is called after each part. The interpreter is released while
-    /// hairs grow.
-    #[pyo3(signature = (part = None, *, seed = None, progress = None))]
+    /// hairs grow. `gpu=True` grows them on the GPU with the real-time
+    /// evaluator (docs/realtime.md): the same hairs within 1e-4 of the
+    /// groom's size; a `RuntimeError` without a GPU adapter.
+    #[pyo3(signature = (part = None, *, seed = None, progress = None, gpu = false))]
     fn grow(
         &self,
         py: Python<'_>,
         part: Option<usize>,
         seed: Option<u64>,
         progress: Option<Py<PyAny>>,
+        gpu: bool,
     ) -> PyResult<PyCurves> {
         let generator = self.generator(py, seed)?;
         let parts = generator.parts().len();
+        let context = gpu.then(gpu_context).transpose()?;
+        let grower = match &context {
+            Some(ctx) => {
+                Some(pelage_gpu::GpuPartGrower::new(ctx, &generator).map_err(|e| self.error(e))?)
+            }
+            None => None,
+        };
+        let grow_part = |p: usize| match &grower {
+            Some(g) => g.part(p),
+            None => generator.part(p),
+        };
         if let Some(p) = part {
             check_part(p, parts)?;
             let hairs = generator.parts()[p]
                 .hair_count
                 .saturating_mul(generator.most_hairs_per_root());
             check_memory(hairs, generator.points_per_hair(), "this part")?;
-            let curves = py.detach(|| generator.part(p)).map_err(|e| self.error(e))?;
+            let curves = py.detach(|| grow_part(p)).map_err(|e| self.error(e))?;
             return Ok(PyCurves::grown_by(curves, generator));
         }
         // Counted after `strands`, which multiplies the hairs of a root.
@@ -405,7 +419,7 @@ impl PyGroom {
         check_memory(hairs, generator.points_per_hair(), "the whole groom")?;
         let mut grown = Vec::with_capacity(parts);
         for p in 0..parts {
-            grown.push(py.detach(|| generator.part(p)).map_err(|e| self.error(e))?);
+            grown.push(py.detach(|| grow_part(p)).map_err(|e| self.error(e))?);
             if let Some(progress) = &progress {
                 progress.call1(py, (p + 1, parts))?;
             }
@@ -514,7 +528,8 @@ impl PyGroom {
     /// written. Returns `{"path", "hairs", "points", "report"}`:
     /// `report` (a still groom's) is what `pelage groom --report` writes —
     /// hairs per part and region, the guides left out and why, timings.
-    #[pyo3(signature = (path = None, *, part = None, seed = None, progress = None))]
+    /// `gpu=True` grows a still groom on the GPU, as `grow(gpu=True)`.
+    #[pyo3(signature = (path = None, *, part = None, seed = None, progress = None, gpu = false))]
     fn write<'py>(
         &self,
         py: Python<'py>,
@@ -522,6 +537,7 @@ impl PyGroom {
         part: Option<(usize, usize)>,
         seed: Option<u64>,
         progress: Option<Py<PyAny>>,
+        gpu: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let output = self.output(path, "write")?;
         // The farm's errors, said of the argument as the user wrote it.
@@ -565,6 +581,11 @@ impl PyGroom {
                 animated.map_err(|e| self.error(e))?.map(Arc::new)
             }
         };
+        if gpu && animated.is_some() {
+            return Err(PyValueError::new_err(
+                "gpu=True grows still grooms for now; write this animated one without it",
+            ));
+        }
         let (summary, written, grown) = if let Some(animated) = animated {
             // The library's plan: a farm run's file is named by its frames,
             // as the CLI names it and `assemble` finds it.
@@ -604,12 +625,30 @@ impl PyGroom {
             let mut done = 0;
             let mut gathered = ReportBuilder::new(&generator);
             let setup = started.elapsed().as_secs_f64();
+            let context = gpu.then(gpu_context).transpose()?;
+            let grower = match &context {
+                Some(ctx) => Some(
+                    pelage_gpu::GpuPartGrower::new(ctx, &generator).map_err(|e| self.error(e))?,
+                ),
+                None => None,
+            };
+            let grow_part = |p: usize| match &grower {
+                Some(g) => g.part(p),
+                None => generator.part(p),
+            };
             let summary = py.detach(|| {
-                generator.write_until(&path, range, &export, &cancel, |p, curves| {
-                    gathered.add_part(&generator, p, curves);
-                    done += 1;
-                    report(done, total);
-                })
+                generator.write_grown_until(
+                    &path,
+                    range,
+                    &export,
+                    &cancel,
+                    &grow_part,
+                    |p, curves| {
+                        gathered.add_part(&generator, p, curves);
+                        done += 1;
+                        report(done, total);
+                    },
+                )
             });
             let timings = Timings {
                 setup,
@@ -1007,4 +1046,14 @@ impl Interrupt {
             None => Ok(()),
         }
     }
+}
+
+/// A headless GPU for `gpu=True`, or a `RuntimeError` saying why there is
+/// none.
+fn gpu_context() -> PyResult<pelage_gpu::GpuContext> {
+    pelage_gpu::GpuContext::headless().map_err(|e| {
+        pyo3::exceptions::PyRuntimeError::new_err(format!(
+            "gpu=True: no GPU to grow on ({e}); grow without gpu=True"
+        ))
+    })
 }

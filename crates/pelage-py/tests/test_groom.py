@@ -624,3 +624,27 @@ def test_a_skin_given_as_frames_moves_the_groom(spot):
             mesh=spot, skin=many, guides={"generate": {"count": 3, "length": 0.05}},
             roots=10, animation={"frames": "1-2"},
         )
+
+
+def test_the_gpu_grows_the_cpus_hairs(groom, tmp_path):
+    # The real-time evaluator, headless (lavapipe serves); without an
+    # adapter it says so, unless CI requires one.
+    import os
+
+    try:
+        on_gpu = groom.grow(gpu=True)
+    except RuntimeError as e:
+        if os.environ.get("PELAGE_REQUIRE_GPU"):
+            raise
+        assert "no GPU" in str(e)
+        pytest.skip(f"no GPU adapter: {e}")
+    on_cpu = groom.grow()
+    assert on_gpu.curve_count == on_cpu.curve_count == 5_000
+    assert np.array_equal(on_gpu.ids, on_cpu.ids)
+    # Spot is about a unit across: within 1e-4 of the groom's size.
+    assert np.abs(on_gpu.points - on_cpu.points).max() < 1e-4
+    assert np.abs(on_gpu.widths - on_cpu.widths).max() < 1e-7
+    written = groom.write(tmp_path / "gpu.usdc", gpu=True)
+    assert written["hairs"] == 5_000
+    back = pelage.read_curves(tmp_path / "gpu.usdc")
+    assert np.abs(back.points - on_cpu.points).max() < 1e-4
