@@ -134,10 +134,10 @@ fn measure(scale: Scale) -> anyhow::Result<Figures> {
         eval_t.push(stats.eval_ms);
         draw_t.push(stats.draw_ms);
         if cpu_t.len() < cpu_frames
-            && let (Some(animated), Some(guides)) = (fur.animated(), fur.frame_guides())
+            && let (Some(animated), Some(guides)) = (fur.animated(), fur.frame_guides(&ctx)?)
         {
             let pose = animated.pose(frame as f64)?;
-            cpu_t.push(1e3 * cpu_groom(animated, &spec, guides.clone(), &pose)?.0);
+            cpu_t.push(1e3 * cpu_groom(animated, &spec, guides, &pose)?.0);
         }
     }
     // The level of detail: the Fox at shares of the screen's height, each

@@ -63,6 +63,14 @@ pub struct GpuGroom {
     /// 1 and 6), kept to bind again when the posed grid's buffer grows.
     static_buffers: [wgpu::Buffer; 3],
     posed_sdf: wgpu::Buffer,
+    /// Turning GPU strands into the frame's guides: the pipeline, its
+    /// group 0 (guides, skin, triangles), group 2's layout and the guides'
+    /// roots.
+    rest_pipeline: wgpu::ComputePipeline,
+    rest_frame_group: wgpu::BindGroup,
+    rest_strands_layout: wgpu::BindGroupLayout,
+    guide_roots: wgpu::Buffer,
+    guide_count: u32,
     /// `[finish] outside_skin`: the gap, and the hairs' segment for a
     /// posed skin's grid.
     keep_out: Option<(f32, f32)>,
@@ -265,7 +273,10 @@ fn groom_pipeline(
     wgpu::ComputePipeline,
 ) {
     let compute = wgpu::ShaderStages::COMPUTE;
-    let entries: Vec<_> = (0..8).map(|b| entry::storage(b, compute, b != 5)).collect();
+    // The guides (2) and the points (5) are written.
+    let entries: Vec<_> = (0..8)
+        .map(|b| entry::storage(b, compute, b != 2 && b != 5))
+        .collect();
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("groom"),
         entries: &entries,
@@ -316,6 +327,66 @@ fn packed_sdf(sdf: &pelage::dynamics::SkinSdf, which: u32) -> Vec<u32> {
         }
     }
     out
+}
+
+/// The pipeline turning GPU strands into the frame's guide offsets
+/// (`guides_to_rest`): its layouts for group 0 (the guides, written; the
+/// skin and its triangles) and group 2 (the strands' points, the guides'
+/// roots), the pass ring's as group 1.
+fn rest_pipeline(
+    device: &wgpu::Device,
+    ring_layout: &wgpu::BindGroupLayout,
+) -> (
+    wgpu::BindGroupLayout,
+    wgpu::BindGroupLayout,
+    wgpu::ComputePipeline,
+) {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("groom guides to rest"),
+        entries: &[
+            entry::storage(2, compute, false),
+            entry::storage(3, compute, true),
+            entry::storage(4, compute, true),
+        ],
+    });
+    let strands = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("groom strands"),
+        entries: &[
+            entry::storage(0, compute, true),
+            entry::storage(1, compute, true),
+        ],
+    });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("groom.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(crate::shader_source("groom.wgsl").into()),
+    });
+    let pipeline = compute_pipeline(
+        device,
+        "groom guides to rest",
+        &module,
+        "guides_to_rest",
+        &[&frame, ring_layout, &strands],
+    );
+    (frame, strands, pipeline)
+}
+
+/// Each guide's root as `guides_to_rest` reads it: (triangle bits, b1,
+/// b2, 0), then its rest frame's columns.
+fn guide_root_records(recipe: &GroomRecipe, skin: &SkinBinding) -> Vec<[f32; 4]> {
+    recipe
+        .guide_roots
+        .iter()
+        .flat_map(|&root| {
+            let (_, frame) = skin.rest().frame_at(skin.triangles(), root);
+            [
+                [f32::from_bits(root.tri), root.bary[0], root.bary[1], 0.0],
+                v4(frame.x_axis, 0.0),
+                v4(frame.y_axis, 0.0),
+                v4(frame.z_axis, 0.0),
+            ]
+        })
+        .collect()
 }
 
 /// A pose's vertices as the shaders read them: position, then normal.
@@ -375,6 +446,14 @@ impl GpuGroom {
             entries: &group::buffers(buffers.each_ref()),
         });
         let ring = UniformRing::new(device, "groom pass", &ring_layout);
+        let (rest_frame_layout, rest_strands_layout, rest_pipeline) =
+            rest_pipeline(device, &ring_layout);
+        let guide_roots = storage(
+            device,
+            "groom guide roots",
+            bytemuck::cast_slice(&guide_root_records(recipe, skin)),
+            NONE,
+        );
         let passes = recipe
             .passes
             .iter()
@@ -429,6 +508,19 @@ impl GpuGroom {
             ring,
             bind_group,
             layout,
+            rest_frame_group: device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("groom guides to rest"),
+                layout: &rest_frame_layout,
+                entries: &group::buffers_at([
+                    (2, &guide_offsets),
+                    (3, &skin_buffer),
+                    (4, &triangles_buffer),
+                ]),
+            }),
+            rest_strands_layout,
+            rest_pipeline,
+            guide_roots,
+            guide_count: recipe.guides,
             static_buffers: [roots_buffer, data_buffer, rest_sdf],
             posed_sdf,
             keep_out: recipe
@@ -497,9 +589,46 @@ impl GpuGroom {
                 self.guide_values
             )));
         }
-        let queue = &ctx.queue;
         let offsets: Vec<[f32; 4]> = guide_offsets.iter().map(|&v| v4(v, 0.0)).collect();
-        queue.write_buffer(&self.guide_offsets, 0, bytemuck::cast_slice(&offsets));
+        ctx.queue
+            .write_buffer(&self.guide_offsets, 0, bytemuck::cast_slice(&offsets));
+        self.record_frame(ctx, encoder, pose, None)
+    }
+
+    /// [`Self::record`] with the frame's guides read from `strands` on the
+    /// GPU (stepped on `pose`, the same guides in the same order) and
+    /// turned to rest space there: no read-back, nothing waits.
+    ///
+    /// # Errors
+    /// When the strands are not this groom's guides, or the pose does not
+    /// match the skin.
+    pub fn record_from_strands(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        strands: &crate::GpuStrands,
+        pose: &SkinPose,
+    ) -> Result<(), GpuError> {
+        let (_, count, points) = strands.positions_buffer();
+        if count != self.guide_count || count as usize * points as usize != self.guide_values {
+            return Err(GpuError::Mismatch(format!(
+                "{count} strands of {points} points for a groom of {} guide points in {} guides",
+                self.guide_values, self.guide_count
+            )));
+        }
+        self.record_frame(ctx, encoder, Some(pose), Some(strands))
+    }
+
+    /// A frame's passes: the pose and its grid written, the guides turned
+    /// to rest from `strands` when given, then every pass of hairs.
+    fn record_frame(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        pose: Option<&SkinPose>,
+        strands: Option<&crate::GpuStrands>,
+    ) -> Result<(), GpuError> {
+        let queue = &ctx.queue;
         let posed_grid = self.posed_grid(ctx, pose);
         use std::sync::atomic::Ordering;
         match pose {
@@ -525,6 +654,27 @@ impl GpuGroom {
             label: Some("groom"),
             timestamp_writes: None,
         });
+        if let Some(strands) = strands {
+            let (points, count, _) = strands.positions_buffer();
+            let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("groom strands"),
+                layout: &self.rest_strands_layout,
+                entries: &group::buffers([points, &self.guide_roots]),
+            });
+            let uniform = GroomPassUniform {
+                first: 0,
+                count: self.guide_count,
+                hairs: count,
+                ..self.passes[0]
+            };
+            let offset = self.ring.write(queue, &uniform);
+            pass.set_pipeline(&self.rest_pipeline);
+            pass.set_bind_group(0, &self.rest_frame_group, &[]);
+            pass.set_bind_group(1, self.ring.group(), &[offset]);
+            pass.set_bind_group(2, &group, &[]);
+            let (x, y) = workgroups(self.guide_count);
+            pass.dispatch_workgroups(x, y, 1);
+        }
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);
         let last = self.passes.len().saturating_sub(1);

@@ -81,8 +81,6 @@ pub struct RealtimeFur {
     model: ShellModel,
     stand_in: ShellStandIn,
     simulated: Option<Simulated>,
-    /// The last frame's guides in rest space, when they moved.
-    frame_guides: Option<Guides>,
     left_out: Vec<LeftOut>,
     guides: usize,
     bounds: (Vec3, Vec3),
@@ -204,7 +202,6 @@ impl RealtimeFur {
             shells,
             model,
             simulated,
-            frame_guides: None,
             left_out: recipe.left_out.clone(),
             guides: generator.guides().len(),
             bounds,
@@ -258,9 +255,29 @@ impl RealtimeFur {
         self.animated.as_ref()
     }
 
-    /// The last frame's guides in rest space, when they were simulated.
-    pub fn frame_guides(&self) -> Option<&Guides> {
-        self.frame_guides.as_ref()
+    /// The last frame's guides in rest space, when they were simulated:
+    /// read back from the GPU and turned to rest on the CPU (a reference
+    /// for comparisons; a frame itself reads nothing back).
+    ///
+    /// # Errors
+    /// When the read-back fails.
+    pub fn frame_guides(&self, ctx: &GpuContext) -> Result<Option<Guides>, RealtimeError> {
+        let (Some(s), Some(a)) = (&self.simulated, &self.animated) else {
+            return Ok(None);
+        };
+        let pose = a.pose(self.frame)?;
+        let posed = s.gpu.read_positions(ctx)?;
+        let rest = a.generator().guides();
+        let n = rest.points_per_guide();
+        let mut points = vec![Vec3::ZERO; posed.len()];
+        for (i, (&root, out)) in rest.roots().iter().zip(points.chunks_mut(n)).enumerate() {
+            a.binding()
+                .to_rest(&posed[i * n..(i + 1) * n], root, &pose, out);
+        }
+        let guides = rest.with_points(points).map_err(|e| {
+            RealtimeError::Unsupported(format!("simulated guides at frame {}: {e}", self.frame))
+        })?;
+        Ok(Some(guides))
     }
 
     /// The last frame's figures.
@@ -276,26 +293,34 @@ impl RealtimeFur {
     /// When the skin cannot be posed or the GPU fails.
     pub fn advance_to(&mut self, ctx: &GpuContext, frame: f64) -> Result<(), RealtimeError> {
         let start = Instant::now();
-        let (offsets, pose) = match &self.animated {
-            None => (None, None),
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let pose = match &self.animated {
+            None => None,
             Some(a) => {
                 let pose = a.pose(frame)?;
-                let guides = match &mut self.simulated {
-                    Some(s) => Some(step_guides(ctx, a, s, &pose, frame)?),
-                    None => None,
-                };
+                if let Some(s) = &mut self.simulated {
+                    step_guides(ctx, s, &pose, frame)?;
+                }
                 if let Some(palette) = a.skin().palette_at_frame(frame) {
                     self.shells.pose_now(ctx, &self.model, &palette)?;
                 }
-                let offsets = guides.as_ref().map(GroomRecipe::guide_offsets);
-                self.frame_guides = guides;
-                (offsets, Some(pose))
+                Some(pose)
             }
         };
         let sim_ms = 1e3 * start.elapsed().as_secs_f64();
         let start = Instant::now();
-        let offsets = offsets.as_deref().unwrap_or(&self.rest_offsets);
-        self.groom.grow(ctx, offsets, pose.as_ref())?;
+        match (&self.simulated, &pose) {
+            // The guides straight from the GPU strands: no read-back.
+            (Some(s), Some(pose)) => {
+                self.groom
+                    .record_from_strands(ctx, &mut encoder, &s.gpu, pose)?;
+            }
+            _ => {
+                self.groom
+                    .record(ctx, &mut encoder, &self.rest_offsets, pose.as_ref())?;
+            }
+        }
+        ctx.queue.submit([encoder.finish()]);
         ctx.wait()?;
         self.stats.sim_ms = sim_ms;
         self.stats.eval_ms = 1e3 * start.elapsed().as_secs_f64();
@@ -411,32 +436,21 @@ impl RealtimeFur {
     }
 }
 
-/// One step of the simulated guides to `frame`, read back and brought to
-/// rest space through their roots' frames on `pose`.
+/// One step of the simulated guides to `frame` on the GPU, the skin's
+/// roots and grids made on the CPU.
 fn step_guides(
     ctx: &GpuContext,
-    animated: &AnimatedGroom,
     s: &mut Simulated,
     pose: &SkinPose,
     frame: f64,
-) -> Result<Guides, RealtimeError> {
+) -> Result<(), RealtimeError> {
     let roots = s.sim.root_frames(pose);
     let grids = s.sim.substep_grids(pose);
     let dt = (1.0 / s.fps) as f32;
     s.gpu
         .step(ctx, &s.params, dt, (frame / s.fps) as f32, &roots, &grids)?;
-    let posed = s.gpu.read_positions(ctx)?;
     s.sim.note_pose(pose);
-    let rest = animated.generator().guides();
-    let n = rest.points_per_guide();
-    let mut points = vec![Vec3::ZERO; posed.len()];
-    for (i, (&root, out)) in rest.roots().iter().zip(points.chunks_mut(n)).enumerate() {
-        animated
-            .binding()
-            .to_rest(&posed[i * n..(i + 1) * n], root, pose, out);
-    }
-    rest.with_points(points)
-        .map_err(|e| RealtimeError::Unsupported(format!("simulated guides at frame {frame}: {e}")))
+    Ok(())
 }
 
 /// sRGB bytes of a linear colour.

@@ -422,6 +422,14 @@ impl GpuStrands {
         })
     }
 
+    /// Every point now, point-major (point `i` of strand `s` at
+    /// `i · strands + s`, `xyz`), and the strands and points a strand: what
+    /// a [`crate::GpuGroom`] reads its frame's guides from without a
+    /// read-back.
+    pub fn positions_buffer(&self) -> (&wgpu::Buffer, u32, u32) {
+        (&self.positions.buffer, self.strands, self.points)
+    }
+
     /// Waits for every queued frame to finish.
     pub fn wait(&self, ctx: &GpuContext) -> Result<(), GpuError> {
         ctx.wait()

@@ -552,3 +552,85 @@ fn the_level_of_detail_hands_over_from_strands_to_shells_without_a_pop() {
         100.0 * least_fur
     );
 }
+
+#[test]
+fn guides_simulated_on_the_gpu_feed_the_hairs_without_a_read_back() {
+    let Some(ctx) = gpu() else { return };
+    use pelage::dynamics::{GuideSimulation, GuideStrandParams};
+    let groom = fox_groom("deform", "");
+    let animated = groom.animated(None).unwrap().unwrap();
+    let rest = animated.generator();
+    let (roots, ids) = all_roots(rest);
+    let recipe = GroomRecipe::new(rest, &roots, &ids).unwrap();
+    let triangles = animated.binding().triangles().to_vec();
+    let size = size_of(rest);
+    let params = GuideStrandParams {
+        substeps: 2,
+        gravity: Vec3::new(0.0, -9.81 * size / 1.4, 0.0),
+        thickness: 0.004 * size,
+        ..Default::default()
+    };
+    let first = animated.pose(1.0).unwrap();
+    let mut sim =
+        GuideSimulation::new(rest.guides(), &triangles, &first, params.clone(), true).unwrap();
+    let mut strands = pelage_gpu::GpuStrands::new(ctx, sim.strands()).unwrap();
+    let pose = animated.pose(3.0).unwrap();
+    let (frames, grids) = (sim.root_frames(&pose), sim.substep_grids(&pose));
+    strands
+        .step(ctx, &params, 1.0 / 24.0, 0.1, &frames, &grids)
+        .unwrap();
+    sim.note_pose(&pose);
+    // Read back and turned to rest on the CPU…
+    let posed = strands.read_positions(ctx).unwrap();
+    let n = rest.guides().points_per_guide();
+    let mut points = vec![Vec3::ZERO; posed.len()];
+    for (i, (&root, out)) in rest
+        .guides()
+        .roots()
+        .iter()
+        .zip(points.chunks_mut(n))
+        .enumerate()
+    {
+        animated
+            .binding()
+            .to_rest(&posed[i * n..(i + 1) * n], root, &pose, out);
+    }
+    let frame_guides = rest.guides().with_points(points).unwrap();
+    let mut read_back = GpuGroom::new(ctx, &recipe, animated.binding()).unwrap();
+    read_back
+        .grow(ctx, &GroomRecipe::guide_offsets(&frame_guides), Some(&pose))
+        .unwrap();
+    let a = read_back.read_curves(ctx).unwrap();
+    // …and on the GPU, straight from the strands.
+    let mut direct = GpuGroom::new(ctx, &recipe, animated.binding()).unwrap();
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    direct
+        .record_from_strands(ctx, &mut encoder, &strands, &pose)
+        .unwrap();
+    ctx.queue.submit([encoder.finish()]);
+    let b = direct.read_curves(ctx).unwrap();
+    let far = a
+        .points()
+        .iter()
+        .zip(b.points())
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0f32, f32::max);
+    assert_eq!(a.ids(), b.ids());
+    assert!(far <= 1e-4 * size, "a point {far} apart (size {size})");
+    // The guides did move: the frame is not the rest groom.
+    let mut at_rest = GpuGroom::new(ctx, &recipe, animated.binding()).unwrap();
+    at_rest
+        .grow(ctx, &GroomRecipe::guide_offsets(rest.guides()), Some(&pose))
+        .unwrap();
+    let c = at_rest.read_curves(ctx).unwrap();
+    let moved = c
+        .points()
+        .iter()
+        .zip(b.points())
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0f32, f32::max);
+    assert!(
+        moved > 1e-3 * size,
+        "the simulated guides moved the hairs ({moved})"
+    );
+}

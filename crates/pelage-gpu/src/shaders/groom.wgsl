@@ -88,7 +88,8 @@ struct HairRoot {
 // keeps the shader within the storage buffers a default device allows.
 @group(0) @binding(1) var<storage, read> data: array<u32>;
 // This frame's guides: each point's offset from its guide's root, in rest space.
-@group(0) @binding(2) var<storage, read> guide_offsets: array<vec4<f32>>;
+// (Written by `guides_to_rest` when the guides come from GPU strands.)
+@group(0) @binding(2) var<storage, read_write> guide_offsets: array<vec4<f32>>;
 // This frame's skin: a vertex's posed position, then its normal.
 @group(0) @binding(3) var<storage, read> skin: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> triangles: array<u32>;
@@ -647,5 +648,35 @@ fn grow_hairs(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgro
             w = hair_width(width_at + j) * pass_.width_scale;
         }
         points[j * pass_.hairs + h] = vec4<f32>(pts[j], w);
+    }
+}
+
+// ---- the frame's guides from the GPU strands, without a read-back ----
+
+// The strands as stepped (point i of strand s at i * strands + s).
+@group(2) @binding(0) var<storage, read> strand_points: array<vec4<f32>>;
+// Each guide's root: (triangle bits, b1, b2, 0), then its rest frame's
+// columns (tangent, bitangent, normal): four vec4 a guide.
+@group(2) @binding(1) var<storage, read> guide_roots: array<vec4<f32>>;
+
+// pelage::anim::SkinBinding::to_rest for a whole guide, as offsets from
+// its root: each point turned by the root's change of frame from this
+// pose back to rest (`pass_.count` guides, `pass_.hairs` strands).
+@compute @workgroup_size(64)
+fn guides_to_rest(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let g = id.x + id.y * groups.x * 64u;
+    if g >= pass_.count {
+        return;
+    }
+    let root = guide_roots[4u * g];
+    let posed = posed_frame(bitcast<u32>(root.x), root.y, root.z);
+    let rest = mat3x3<f32>(guide_roots[4u * g + 1u].xyz, guide_roots[4u * g + 2u].xyz, guide_roots[4u * g + 3u].xyz);
+    let turn = rest * transpose(mat3x3<f32>(posed[0], posed[1], posed[2]));
+    let gp = pass_.guide_points;
+    let strands = pass_.hairs;
+    let first = strand_points[g].xyz;
+    for (var i = 0u; i < gp; i++) {
+        let p = strand_points[i * strands + g].xyz;
+        guide_offsets[g * gp + i] = vec4<f32>(turn * (p - first), 0.0);
     }
 }

@@ -158,6 +158,9 @@ pub struct GroomRecipe {
     pub weights: Vec<GuideWeight>,
     /// Each guide's skin normal at its root.
     pub guide_normals: Vec<Vec3>,
+    /// Each guide's root on the skin (where an evaluator turns posed
+    /// guides back to rest space).
+    pub guide_roots: Vec<SurfacePoint>,
     /// From a guide's points to a hair's: `(segment, fraction)` a hair
     /// point; empty when both have as many points.
     pub resampling: Vec<(u32, f32)>,
@@ -260,6 +263,7 @@ impl GroomRecipe {
             root_normals: Vec::new(),
             weights: Vec::new(),
             guide_normals: generator.interpolator.guide_normals().collect(),
+            guide_roots: generator.guides.roots().to_vec(),
             resampling: generator.resampling.between().to_vec(),
             steps: Vec::new(),
             passes: Vec::new(),
