@@ -82,7 +82,7 @@ pub struct GpuGroom {
     /// The rest pose as the skin buffer holds it, written back when a
     /// frame at rest follows a posed one.
     rest_skin: Vec<[f32; 4]>,
-    posed: std::sync::atomic::AtomicBool,
+    posed: bool,
     points: wgpu::Buffer,
     colors_buffer: wgpu::Buffer,
     hairs: u32,
@@ -533,7 +533,7 @@ impl GpuGroom {
             triangles: triangles_buffer,
             triangle_count: skin.triangles().len() as u32,
             rest_skin: skin_vertices_of(skin.rest()),
-            posed: std::sync::atomic::AtomicBool::new(false),
+            posed: false,
             points,
             colors_buffer,
             hairs: hairs32,
@@ -630,7 +630,6 @@ impl GpuGroom {
     ) -> Result<(), GpuError> {
         let queue = &ctx.queue;
         let posed_grid = self.posed_grid(ctx, pose);
-        use std::sync::atomic::Ordering;
         match pose {
             Some(pose) => {
                 if pose.positions().len() != self.skin_vertices {
@@ -642,10 +641,10 @@ impl GpuGroom {
                 }
                 let skin = skin_vertices_of(pose);
                 queue.write_buffer(&self.skin, 0, bytemuck::cast_slice(&skin));
-                self.posed.store(true, Ordering::Relaxed);
+                self.posed = true;
             }
             None => {
-                if self.posed.swap(false, Ordering::Relaxed) {
+                if std::mem::take(&mut self.posed) {
                     queue.write_buffer(&self.skin, 0, bytemuck::cast_slice(&self.rest_skin));
                 }
             }

@@ -274,6 +274,34 @@ fn depth_state(format: wgpu::TextureFormat) -> Option<wgpu::DepthStencilState> {
     })
 }
 
+/// A pipeline drawing the ribbons (or the skin) pulled by vertex index:
+/// no vertex buffers, both sides, `entry_point` and `fragment` of `module`.
+fn pulled_pipeline(
+    device: &wgpu::Device,
+    (label, layout): (&str, &wgpu::PipelineLayout),
+    (module, entry_point): (&wgpu::ShaderModule, &str),
+    depth_stencil: Option<wgpu::DepthStencilState>,
+    multisample: wgpu::MultisampleState,
+    fragment: Option<wgpu::FragmentState<'_>>,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(entry_point),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: PRIMITIVE,
+        depth_stencil,
+        multisample,
+        fragment,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 impl ShadowPipelines {
     /// The key light's pipelines over `[uniforms, points, first depth]`.
     fn new(
@@ -288,24 +316,16 @@ impl ShadowPipelines {
                 immediate_size: 0,
             })
         };
-        let shadow_pipeline_layout = layout(&[Some(uniform_layout), Some(points_layout)]);
+        let shadow_layout = layout(&[Some(uniform_layout), Some(points_layout)]);
         let depth_only = |label, entry_point| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&shadow_pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module,
-                    entry_point: Some(entry_point),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: PRIMITIVE,
-                depth_stencil: depth_state(DEPTH_FORMAT),
-                multisample: Default::default(),
-                fragment: None,
-                multiview_mask: None,
-                cache: None,
-            })
+            pulled_pipeline(
+                device,
+                (label, &shadow_layout),
+                (module, entry_point),
+                depth_state(DEPTH_FORMAT),
+                Default::default(),
+                None,
+            )
         };
         let opacity_layout = layout(&[
             Some(uniform_layout),
@@ -317,40 +337,31 @@ impl ShadowPipelines {
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
-        let opacity = |label, entry_point| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&opacity_layout),
-                vertex: wgpu::VertexState {
-                    module,
-                    entry_point: Some(entry_point),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: PRIMITIVE,
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module,
-                    entry_point: Some("fs_opacity"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: OPACITY_FORMAT,
-                        blend: Some(wgpu::BlendState {
-                            color: adding,
-                            alpha: adding,
-                        }),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
+        let targets = [Some(wgpu::ColorTargetState {
+            format: OPACITY_FORMAT,
+            blend: Some(wgpu::BlendState {
+                color: adding,
+                alpha: adding,
+            }),
+            write_mask: wgpu::ColorWrites::ALL,
+        })];
+        let hair_opacity = pulled_pipeline(
+            device,
+            ("strand opacity", &opacity_layout),
+            (module, "vs_shadow"),
+            None,
+            Default::default(),
+            Some(wgpu::FragmentState {
+                module,
+                entry_point: Some("fs_opacity"),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+        );
         Self {
             hair_depth: depth_only("strand shadow depth", "vs_shadow"),
             skin_depth: depth_only("skin shadow depth", "vs_occluder"),
-            hair_opacity: opacity("strand opacity", "vs_shadow"),
+            hair_opacity,
         }
     }
 }
@@ -401,36 +412,29 @@ impl StrandRenderer {
             Some(&points_layout),
             Some(&maps.shadow_layout),
         ]);
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("strands"),
-            layout: Some(&main_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: PRIMITIVE,
-            depth_stencil: depth_state(formats.depth),
-            multisample: wgpu::MultisampleState {
+        let targets = [Some(wgpu::ColorTargetState {
+            format: formats.color,
+            // Without MSAA, coverage blends.
+            blend: (formats.samples == 1).then_some(wgpu::BlendState::ALPHA_BLENDING),
+            write_mask: wgpu::ColorWrites::ALL,
+        })];
+        let pipeline = pulled_pipeline(
+            device,
+            ("strands", &main_layout),
+            (&module, "vs_main"),
+            depth_state(formats.depth),
+            wgpu::MultisampleState {
                 count: formats.samples,
                 mask: !0,
                 alpha_to_coverage_enabled: formats.samples > 1,
             },
-            fragment: Some(wgpu::FragmentState {
+            Some(wgpu::FragmentState {
                 module: &module,
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: formats.color,
-                    // Without MSAA, coverage blends.
-                    blend: (formats.samples == 1).then_some(wgpu::BlendState::ALPHA_BLENDING),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
+                targets: &targets,
             }),
-            multiview_mask: None,
-            cache: None,
-        });
+        );
         let shadow_pipelines = ShadowPipelines::new(
             device,
             &module,
@@ -687,37 +691,8 @@ impl StrandRenderer {
             view,
             (bounds, target.size),
         );
-        let background = skin
-            .map_or([0.0; 3], |(_, _, p)| p.background)
-            .map(f64::from);
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("strands"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.color,
-                depth_slice: None,
-                resolve_target: Some(resolve),
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: background[0],
-                        g: background[1],
-                        b: background[2],
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Discard,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &target.depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let background = skin.map_or([0.0; 3], |(_, _, p)| p.background);
+        let mut pass = target.begin_pass(encoder, "strands", resolve, background);
         if let Some((shells, model, shell_params)) = skin {
             shells.record(
                 &ctx.queue,

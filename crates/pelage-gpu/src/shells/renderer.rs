@@ -265,34 +265,8 @@ impl ShellRenderer {
         target: &ShellTarget,
         resolve: &wgpu::TextureView,
     ) -> Result<Vec<ShellLevel>, GpuError> {
-        let background = objects
-            .first()
-            .map_or([0.0; 3], |(_, p)| p.background)
-            .map(f64::from);
-        let [r, g, b] = background;
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("shells"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.color,
-                depth_slice: None,
-                resolve_target: Some(resolve),
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
-                    store: wgpu::StoreOp::Discard,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &target.depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let background = objects.first().map_or([0.0; 3], |(_, p)| p.background);
+        let mut pass = target.begin_pass(encoder, "shells", resolve, background);
         let height = target.size.1 as f32;
         objects
             .iter()
@@ -543,6 +517,42 @@ pub struct ShellTarget {
 }
 
 impl ShellTarget {
+    /// A pass into this target, cleared to `background` (linear RGB) and
+    /// the far depth, resolved into `resolve` (a view of its size: its own
+    /// resolve texture, or a window's surface texture).
+    pub(crate) fn begin_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        label: &str,
+        resolve: &wgpu::TextureView,
+        background: [f32; 3],
+    ) -> wgpu::RenderPass<'e> {
+        let [r, g, b] = background.map(f64::from);
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.color,
+                depth_slice: None,
+                resolve_target: Some(resolve),
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
+                    store: wgpu::StoreOp::Discard,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+
     /// Targets for `width × height` images.
     pub fn new(
         ctx: &GpuContext,

@@ -511,12 +511,9 @@ impl GroomRecipe {
                             let strand = split.map(|(s, _)| s.strand_id(base_id, k));
                             hair_values.clear();
                             for step in steps {
-                                let id = match (strand, split) {
-                                    (Some(id), Some((_, _)))
-                                        if step.chain_index >= strands_at.unwrap_or(usize::MAX) =>
-                                    {
-                                        id
-                                    }
+                                // From the split on, the strand hair's own.
+                                let id = match (strand, strands_at) {
+                                    (Some(id), Some(k)) if step.chain_index >= k => id,
                                     _ => base_id,
                                 };
                                 step_values(generator, step, id, &context, near, &mut hair_values);
