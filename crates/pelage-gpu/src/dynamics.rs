@@ -142,7 +142,7 @@ impl GpuMassSpring {
         let bind_groups = [0usize, 1].map(|k| buffers.step_group(device, &layout, k));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("dynamics.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(crate::shader_source("dynamics.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shader_source("dynamics.wgsl")),
         });
         let explicit = compute_pipeline(
             device,

@@ -284,7 +284,7 @@ fn groom_pipeline(
     let ring_layout = UniformRing::<GroomPassUniform>::layout(device, "groom pass", compute);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("groom.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(crate::shader_source("groom.wgsl").into()),
+        source: wgpu::ShaderSource::Wgsl(crate::shader_source("groom.wgsl")),
     });
     let pipeline = compute_pipeline(
         device,
@@ -359,7 +359,7 @@ fn rest_pipeline(
     });
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("groom.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(crate::shader_source("groom.wgsl").into()),
+        source: wgpu::ShaderSource::Wgsl(crate::shader_source("groom.wgsl")),
     });
     let pipeline = compute_pipeline(
         device,

@@ -398,7 +398,7 @@ impl StrandRenderer {
         let maps = ShadowMaps::new(device);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("hair.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(crate::shader_source("hair.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shader_source("hair.wgsl")),
         });
         let layout = |groups: &[Option<&wgpu::BindGroupLayout>]| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

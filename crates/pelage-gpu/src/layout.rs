@@ -361,7 +361,7 @@ mod tests {
     }
 
     fn check(shader: &str, wgsl_name: &str, size: usize, fields: &[(&str, usize)]) {
-        let (wgsl_size, wgsl_fields) = reflect(crate::shader_source(shader), wgsl_name);
+        let (wgsl_size, wgsl_fields) = reflect(&crate::shader_source(shader), wgsl_name);
         let rust: Vec<(String, usize)> = fields.iter().map(|(n, o)| (n.to_string(), *o)).collect();
         assert_eq!(
             rust, wgsl_fields,
@@ -477,7 +477,7 @@ mod tests {
             ),
         ];
         for (shader, name, rust) in cases {
-            let wgsl = reflect_inputs(crate::shader_source(shader), name);
+            let wgsl = reflect_inputs(&crate::shader_source(shader), name);
             assert_eq!(
                 rust, wgsl,
                 "{shader}: {name}: Rust (left) and WGSL (right) differ"

@@ -99,7 +99,9 @@ pub enum GpuError {
 }
 
 /// The WGSL of each pipeline: the shared `Frame` uniform block
-/// (`frame.wgsl`) followed by the pipeline's own shader.
+/// (`frame.wgsl`) followed by the pipeline's own shader. Shell fur's
+/// functions come from the layer both GPU hosts share
+/// ([`pelage_shaders::shell::MATH_WGSL`]), put first when the shader is made.
 pub const SHADERS: &[(&str, &str)] = &[
     (
         "mesh.wgsl",
@@ -122,7 +124,7 @@ pub const SHADERS: &[(&str, &str)] = &[
             include_str!("shaders/curves.wgsl")
         ),
     ),
-    // Shell fur has its own uniform block.
+    // Shell fur has its own uniform block; its math is shared (see above).
     ("shells.wgsl", include_str!("shaders/shells.wgsl")),
     // The explicit mass-spring substep (compute).
     (
@@ -168,13 +170,19 @@ pub(crate) fn workgroups(n: u32) -> (u32, u32) {
     (x, groups.div_ceil(x))
 }
 
-/// The WGSL source of the named shader (with its prelude).
-pub(crate) fn shader_source(name: &str) -> &'static str {
-    SHADERS
+/// The WGSL source of the named shader (with its prelude, and for shell
+/// fur the shared math before it).
+pub(crate) fn shader_source(name: &str) -> std::borrow::Cow<'static, str> {
+    let own = SHADERS
         .iter()
         .find(|(n, _)| *n == name)
         .map(|(_, s)| *s)
-        .expect("the shader exists")
+        .expect("the shader exists");
+    if name == "shells.wgsl" {
+        format!("{}\n{own}", pelage_shaders::shell::MATH_WGSL).into()
+    } else {
+        own.into()
+    }
 }
 
 #[cfg(test)]
@@ -182,7 +190,8 @@ mod tests {
     /// Every shader parses and validates with naga, with no GPU needed.
     #[test]
     fn shaders_validate_with_naga() {
-        for (name, source) in super::SHADERS {
+        for (name, _) in super::SHADERS {
+            let source = &*super::shader_source(name);
             let module = naga::front::wgsl::parse_str(source)
                 .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
             naga::valid::Validator::new(

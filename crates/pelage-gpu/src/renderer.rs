@@ -214,9 +214,9 @@ impl Renderer {
                 source: wgpu::ShaderSource::Wgsl(source.into()),
             })
         };
-        let mesh_shader = shader("mesh.wgsl", crate::shader_source("mesh.wgsl"));
-        let points_shader = shader("points.wgsl", crate::shader_source("points.wgsl"));
-        let curves_shader = shader("curves.wgsl", crate::shader_source("curves.wgsl"));
+        let mesh_shader = shader("mesh.wgsl", &crate::shader_source("mesh.wgsl"));
+        let points_shader = shader("points.wgsl", &crate::shader_source("points.wgsl"));
+        let curves_shader = shader("curves.wgsl", &crate::shader_source("curves.wgsl"));
         let pipeline = |module: &wgpu::ShaderModule,
                         buffers: &[Option<wgpu::VertexBufferLayout>],
                         alpha_to_coverage: bool| {

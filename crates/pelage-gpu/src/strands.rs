@@ -211,7 +211,7 @@ impl GpuStrands {
             .device
             .create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("strands.wgsl"),
-                source: wgpu::ShaderSource::Wgsl(crate::shader_source("strands.wgsl").into()),
+                source: wgpu::ShaderSource::Wgsl(crate::shader_source("strands.wgsl")),
             });
         let pipeline = compute_pipeline(
             &ctx.device,

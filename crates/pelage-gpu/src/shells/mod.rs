@@ -17,8 +17,9 @@
 //! The parts, lowest first (each uses only those above it in this list):
 //!
 //! - `prepare.rs`: a mesh prepared on the CPU, without wgpu: welded
-//!   corners, pose and surface vertices with tangents ([`vertex_tangents`]),
-//!   skin influences, the shell texture's mips;
+//!   corners, pose and surface vertices with tangents ([`vertex_tangents`],
+//!   from `pelage_shaders::shell`, which also makes the texture's mips),
+//!   skin influences;
 //! - `fins.rs`: the fin records of a mesh's edges;
 //! - `model.rs`: [`ShellModel`] (a furry mesh on the GPU: welded vertices,
 //!   pose, textures with mips, rig);
@@ -38,7 +39,7 @@ mod renderer;
 mod upload;
 
 pub use model::{ShellModel, ShellUpload};
-pub use prepare::vertex_tangents;
+pub use pelage_shaders::shell::vertex_tangents;
 pub use renderer::{ShellRenderer, ShellTarget, ShellTargetFormats};
 
 use crate::Camera;

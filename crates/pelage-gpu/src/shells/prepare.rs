@@ -1,46 +1,14 @@
 //! A mesh prepared for the shell renderer, on the CPU and without wgpu:
-//! triangle corners welded into indexed vertices ([`WeldedCorners`]),
-//! per-vertex tangents ([`vertex_tangents`]) and the shell texture's mip
-//! chain. The uploads of `upload.rs` and the fins of `fins.rs` read these.
+//! triangle corners welded into indexed vertices ([`WeldedCorners`]) with
+//! their pose, surface and skin vertices. Per-vertex tangents and the
+//! shell texture's mip chain come from the layer the GPU hosts share
+//! (`pelage_shaders::shell`). The uploads of `upload.rs` and the fins of
+//! `fins.rs` read these.
 
 use super::{PoseVertex, SurfaceVertex};
-use glam::Vec3;
 use pelage::Mesh;
 use pelage::anim::SkinRig;
-use pelage::shell::ShellTextures;
-
-/// Per-vertex `dP/du` (the texture's x direction on the surface), averaged
-/// over the triangles around each vertex and made perpendicular to its
-/// normal, so neighbouring triangles curl the same way and layers do not
-/// tear. Vertices where UVs give no direction get any tangent.
-pub fn vertex_tangents(mesh: &Mesh) -> Vec<Vec3> {
-    let mut sum = vec![Vec3::ZERO; mesh.vertex_count()];
-    for t in 0..mesh.triangle_count() {
-        let Some([t0, t1, t2]) = mesh.triangle_uvs(t) else {
-            break;
-        };
-        let [p0, p1, p2] = mesh.triangle_positions(t);
-        let (e1, e2) = (p1 - p0, p2 - p0);
-        let (d1, d2) = (t1 - t0, t2 - t0);
-        let det = d1.x * d2.y - d2.x * d1.y;
-        if det.abs() <= f32::EPSILON {
-            continue;
-        }
-        // Area-weighted: the cross product's length is twice the area.
-        let dp_du = ((e1 * d2.y - e2 * d1.y) / det).normalize_or_zero() * e1.cross(e2).length();
-        for &v in &mesh.triangles()[t] {
-            sum[v as usize] += dp_du;
-        }
-    }
-    sum.iter()
-        .zip(mesh.normals())
-        .map(|(&s, &n)| {
-            (s - n * n.dot(s))
-                .try_normalize()
-                .unwrap_or_else(|| n.any_orthonormal_vector())
-        })
-        .collect()
-}
+use pelage_shaders::shell::vertex_tangents;
 
 /// A mesh's triangle corners welded into indexed vertices.
 #[derive(Debug)]
@@ -146,59 +114,10 @@ impl WeldedCorners {
     }
 }
 
-/// The shell texture's layers with a mip chain, layer by layer, each
-/// layer's levels in turn (wgpu's layer-major order): each
-/// level a box filter of the one above, colour weighted by alpha (a
-/// transparent texel's direction must not leak into its neighbours).
-pub(super) fn fur_mip_chain(textures: &ShellTextures) -> (Vec<u8>, u32) {
-    let r = textures.resolution() as usize;
-    let texels: &[u8] = bytemuck::cast_slice(textures.texels());
-    // Halving to one texel: a texture that is not a power of two gets
-    // wgpu's sizes, max(1, r >> level).
-    let levels = usize::BITS - r.leading_zeros();
-    let mut data = Vec::with_capacity(texels.len() * 4 / 3 + 4 * textures.layers() as usize);
-    for layer in texels.chunks_exact(r * r * 4) {
-        data.extend_from_slice(layer);
-        let mut above = layer.to_vec();
-        let mut size = r;
-        while size > 1 {
-            let half = size / 2;
-            let mut next = vec![0u8; half * half * 4];
-            for y in 0..half {
-                for x in 0..half {
-                    let mut rgb = [0.0f32; 3];
-                    let mut alpha = 0.0f32;
-                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                        let i = ((2 * y + dy) * size + 2 * x + dx) * 4;
-                        let a = f32::from(above[i + 3]);
-                        for c in 0..3 {
-                            rgb[c] += a * f32::from(above[i + c]);
-                        }
-                        alpha += a;
-                    }
-                    let o = (y * half + x) * 4;
-                    for c in 0..3 {
-                        next[o + c] = if alpha > 0.0 {
-                            (rgb[c] / alpha).round() as u8
-                        } else {
-                            128
-                        };
-                    }
-                    next[o + 3] = (alpha / 4.0).round() as u8;
-                }
-            }
-            data.extend_from_slice(&next);
-            above = next;
-            size = half;
-        }
-    }
-    (data, levels)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec2;
+    use glam::{Vec2, Vec3};
     use pelage::mesh::Uvs;
 
     /// Two triangles over a square sharing the diagonal 0–2; vertex 2's
@@ -246,27 +165,5 @@ mod tests {
             let (t, k) = (c as usize / 3, c as usize % 3);
             assert_eq!(square(true).triangles()[t][k], seam.mesh_vertices[i]);
         }
-    }
-
-    #[test]
-    fn the_mip_chain_halves_to_one_texel_and_keeps_coverage() {
-        let textures = ShellTextures::generate(&pelage::shell::ShellTextureParams {
-            resolution: 16,
-            layers: 2,
-            ..Default::default()
-        });
-        let (data, levels) = fur_mip_chain(&textures);
-        assert_eq!(levels, 5, "16, 8, 4, 2, 1");
-        let per_layer: usize = [16, 8, 4, 2, 1].iter().map(|s| s * s * 4).sum();
-        assert_eq!(data.len(), 2 * per_layer);
-        // The last level of layer 0 is the mean alpha of its 256 texels.
-        let texels: &[u8] = bytemuck::cast_slice(textures.texels());
-        let mean: f32 = texels[..16 * 16 * 4]
-            .chunks(4)
-            .map(|t| f32::from(t[3]))
-            .sum::<f32>()
-            / 256.0;
-        let last = data[per_layer - 1];
-        assert!((f32::from(last) - mean).abs() <= 2.0, "{last} vs {mean}");
     }
 }

@@ -147,7 +147,7 @@ impl ShellRenderer {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shells.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(crate::shader_source("shells.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shader_source("shells.wgsl")),
         });
         let pass_pipeline = |kind| {
             let layout = match kind {
@@ -158,7 +158,7 @@ impl ShellRenderer {
         };
         let skin_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("skin.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(crate::shader_source("skin.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(crate::shader_source("skin.wgsl")),
         });
         let skinning = compute_pipeline(
             device,

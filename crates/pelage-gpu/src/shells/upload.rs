@@ -7,7 +7,7 @@
 
 use super::fins::fin_records;
 use super::model::{GpuSkin, ShellModel, ShellUpload};
-use super::prepare::{WeldedCorners, fur_mip_chain};
+use super::prepare::WeldedCorners;
 use super::renderer::ShellRenderer;
 use super::{PoseVertex, TipOffset};
 use crate::layout::group;
@@ -16,6 +16,7 @@ use glam::Vec3;
 use pelage::Mesh;
 use pelage::anim::SkinRig;
 use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
+use pelage_shaders::shell::fur_mip_chain;
 use wgpu::util::DeviceExt;
 
 impl ShellRenderer {

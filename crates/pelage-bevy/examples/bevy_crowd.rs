@@ -1,0 +1,133 @@
+//! A hundred furred foxes running in a field: one shells file, one fur
+//! mesh a level of detail shared by all, each fox's fur skinned by its own
+//! joints and its layers chosen per camera by distance (fewer layers far
+//! away). Prints frames per second every two seconds.
+//!
+//! ```text
+//! cargo run --release -p pelage-bevy --example bevy_crowd
+//! cargo run --release -p pelage-bevy --example bevy_crowd -- --frames 90 --screenshot crowd.png
+//! ```
+
+mod common;
+
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::prelude::*;
+use bevy::world_serialization::WorldInstanceReady;
+use common::Args;
+use pelage_bevy::ShellFur;
+
+/// Foxes a side of the square.
+const SIDE: i32 = 10;
+/// Between neighbours (the fox is about 100 units long).
+const SPACING: f32 = 140.0;
+
+fn main() {
+    let args = Args::parse((1280, 720));
+    common::app(&args, "pelage in Bevy: a crowd of foxes")
+        .add_systems(Startup, setup)
+        .add_systems(Update, (fly_over, report_fps))
+        .run();
+}
+
+/// The clip to play and where in it to start, until the scene is ready.
+#[derive(Component)]
+struct Running {
+    graph: Handle<AnimationGraph>,
+    index: AnimationNodeIndex,
+    phase: f32,
+}
+
+fn setup(
+    mut commands: Commands,
+    args: Res<Args>,
+    target: Res<common::Target>,
+    assets: Res<AssetServer>,
+    mut graphs: ResMut<Assets<AnimationGraph>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let (graph, index) = AnimationGraph::from_clip(
+        assets.load(GltfAssetLabel::Animation(2).from_asset("fox/Fox.gltf")),
+    );
+    let graph = graphs.add(graph);
+    let scene = assets.load(GltfAssetLabel::Scene(0).from_asset("fox/Fox.gltf"));
+    let fur = assets.load("fox/fox.shells.toml");
+    for i in 0..SIDE * SIDE {
+        let (x, z) = ((i % SIDE) as f32, (i / SIDE) as f32);
+        let offset = (SIDE as f32 - 1.0) / 2.0;
+        let mut fox = commands.spawn((
+            WorldAssetRoot(scene.clone()),
+            Transform::from_xyz((x - offset) * SPACING, 0.0, (z - offset) * SPACING)
+                .with_rotation(Quat::from_rotation_y(0.3 * (i as f32 * 1.7).sin())),
+            Running {
+                graph: graph.clone(),
+                index,
+                phase: (i as f32 * 0.37) % 1.0,
+            },
+        ));
+        if !args.no_fur {
+            fox.insert(ShellFur(fur.clone()));
+        }
+        fox.observe(start_running);
+    }
+    commands.spawn((
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(4000.0, 4000.0))),
+        MeshMaterial3d(materials.add(Color::srgb(0.32, 0.42, 0.28))),
+    ));
+    commands.spawn((
+        DirectionalLight {
+            illuminance: 8000.0,
+            ..default()
+        },
+        Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    // Bevy's default tonemapping (TonyMcMapface) needs its LUT feature,
+    // which these examples leave out to build faster.
+    let mut camera = commands.spawn((
+        Camera3d::default(),
+        Tonemapping::AcesFitted,
+        Transform::default(),
+    ));
+    if let Some(image) = target.camera() {
+        camera.insert(image);
+    }
+}
+
+fn start_running(
+    ready: On<WorldInstanceReady>,
+    mut commands: Commands,
+    children: Query<&Children>,
+    running: Query<&Running>,
+    mut players: Query<&mut AnimationPlayer>,
+) {
+    let Ok(run) = running.get(ready.entity) else {
+        return;
+    };
+    for child in children.iter_descendants(ready.entity) {
+        if let Ok(mut player) = players.get_mut(child) {
+            player.play(run.index).repeat().seek_to(run.phase * 0.7);
+            commands
+                .entity(child)
+                .insert(AnimationGraphHandle(run.graph.clone()));
+        }
+    }
+}
+
+/// The camera circles the field, near foxes close, far ones small.
+fn fly_over(time: Res<Time>, mut cameras: Query<&mut Transform, With<Camera3d>>) {
+    let a = 0.1 * time.elapsed_secs() + 0.5;
+    for mut t in &mut cameras {
+        let eye = Vec3::new(900.0 * a.sin(), 260.0, 900.0 * a.cos());
+        *t = Transform::from_translation(eye).looking_at(Vec3::new(0.0, 0.0, 0.0), Vec3::Y);
+    }
+}
+
+fn report_fps(time: Res<Time<Real>>, mut since: Local<f32>, mut frames: Local<u32>) {
+    *frames += 1;
+    *since += time.delta_secs();
+    if *since >= 2.0 {
+        println!("{:.1} frames/s", *frames as f32 / *since);
+        *since = 0.0;
+        *frames = 0;
+    }
+}

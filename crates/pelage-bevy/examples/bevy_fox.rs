@@ -1,0 +1,176 @@
+//! The Khronos Fox, loaded by Bevy's glTF loader and running, wearing
+//! pelage's shell fur (`fox/fox.shells.toml`): Bevy skins the fur with the
+//! fox's own joints, a ball passes in front and hides it, the sun lights
+//! both. Drag with the left mouse button to orbit, scroll to zoom.
+//!
+//! ```text
+//! cargo run --release -p pelage-bevy --example bevy_fox
+//! cargo run --release -p pelage-bevy --example bevy_fox -- --frames 60 --screenshot fox.png
+//! ```
+//!
+//! `--no-fur` draws the same scene without fur (the benchmark's baseline).
+
+mod common;
+
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll};
+use bevy::prelude::*;
+use bevy::world_serialization::WorldInstanceReady;
+use common::Args;
+use pelage_bevy::ShellFur;
+
+fn main() {
+    let args = Args::parse((1280, 720));
+    common::app(&args, "pelage in Bevy: the Fox")
+        .add_systems(Startup, setup)
+        .add_systems(Update, (orbit, pass_the_ball))
+        .run();
+}
+
+/// The clip to play, until the scene is ready for it.
+#[derive(Component)]
+struct Running {
+    graph: Handle<AnimationGraph>,
+    index: AnimationNodeIndex,
+}
+
+/// The camera's orbit about the fox.
+#[derive(Component)]
+struct Orbit {
+    yaw: f32,
+    pitch: f32,
+    distance: f32,
+}
+
+/// The ball that passes between the camera and the fox.
+#[derive(Component)]
+struct Ball;
+
+fn setup(
+    mut commands: Commands,
+    args: Res<Args>,
+    target: Res<common::Target>,
+    assets: Res<AssetServer>,
+    mut graphs: ResMut<Assets<AnimationGraph>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let (graph, index) = AnimationGraph::from_clip(
+        assets.load(GltfAssetLabel::Animation(2).from_asset("fox/Fox.gltf")),
+    );
+    let mut fox = commands.spawn((
+        WorldAssetRoot(assets.load(GltfAssetLabel::Scene(0).from_asset("fox/Fox.gltf"))),
+        Running {
+            graph: graphs.add(graph),
+            index,
+        },
+    ));
+    if !args.no_fur {
+        fox.insert(ShellFur(assets.load("fox/fox.shells.toml")));
+    }
+    fox.observe(start_running);
+
+    commands.spawn((
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(600.0, 600.0))),
+        MeshMaterial3d(materials.add(Color::srgb(0.32, 0.42, 0.28))),
+    ));
+    commands.spawn((
+        Ball,
+        Mesh3d(meshes.add(Sphere::new(14.0).mesh().uv(48, 24))),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::srgb(0.75, 0.2, 0.15),
+            perceptual_roughness: 0.35,
+            ..default()
+        })),
+        Transform::from_xyz(0.0, 30.0, 90.0),
+    ));
+    commands.spawn((
+        DirectionalLight {
+            illuminance: 8000.0,
+            shadow_maps_enabled: true,
+            ..default()
+        },
+        Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    let mut camera = commands.spawn((
+        Camera3d::default(),
+        // Bevy's default (TonyMcMapface) needs its LUT feature, which
+        // these examples leave out to build faster.
+        Tonemapping::AcesFitted,
+        Orbit {
+            yaw: 0.6,
+            pitch: 0.3,
+            distance: 190.0,
+        },
+        Transform::default(),
+    ));
+    if let Some(image) = target.camera() {
+        camera.insert(image);
+    }
+}
+
+fn start_running(
+    ready: On<WorldInstanceReady>,
+    mut commands: Commands,
+    children: Query<&Children>,
+    running: Query<&Running>,
+    mut players: Query<&mut AnimationPlayer>,
+) {
+    let Ok(run) = running.get(ready.entity) else {
+        return;
+    };
+    for child in children.iter_descendants(ready.entity) {
+        if let Ok(mut player) = players.get_mut(child) {
+            player.play(run.index).repeat();
+            commands
+                .entity(child)
+                .insert(AnimationGraphHandle(run.graph.clone()));
+        }
+    }
+}
+
+/// Drag to turn, scroll to zoom; left alone, the camera circles slowly.
+fn orbit(
+    time: Res<Time>,
+    buttons: Res<ButtonInput<MouseButton>>,
+    motion: Res<AccumulatedMouseMotion>,
+    scroll: Res<AccumulatedMouseScroll>,
+    mut cameras: Query<(&mut Orbit, &mut Transform)>,
+) {
+    for (mut orbit, mut transform) in &mut cameras {
+        if buttons.pressed(MouseButton::Left) {
+            orbit.yaw -= motion.delta.x * 0.005;
+            orbit.pitch = (orbit.pitch + motion.delta.y * 0.005).clamp(-0.2, 1.4);
+        } else {
+            orbit.yaw += 0.15 * time.delta_secs();
+        }
+        orbit.distance = (orbit.distance * (1.0 - 0.1 * scroll.delta.y)).clamp(40.0, 3000.0);
+        let target = Vec3::new(0.0, 35.0, 0.0);
+        let eye = target
+            + orbit.distance
+                * Vec3::new(
+                    orbit.yaw.sin() * orbit.pitch.cos(),
+                    orbit.pitch.sin(),
+                    orbit.yaw.cos() * orbit.pitch.cos(),
+                );
+        *transform = Transform::from_translation(eye).looking_at(target, Vec3::Y);
+    }
+}
+
+/// The ball swings across the line between the camera and the fox.
+fn pass_the_ball(
+    time: Res<Time>,
+    cameras: Query<&Transform, (With<Camera3d>, Without<Ball>)>,
+    mut balls: Query<&mut Transform, With<Ball>>,
+) {
+    let Ok(camera) = cameras.single() else {
+        return;
+    };
+    let target = Vec3::new(0.0, 30.0, 0.0);
+    let towards = (camera.translation - target).normalize_or_zero();
+    let across = towards.cross(Vec3::Y).normalize_or_zero();
+    let swing = (time.elapsed_secs() * 0.8).sin() * 70.0;
+    for mut ball in &mut balls {
+        ball.translation = target + 70.0 * towards + swing * across;
+    }
+}

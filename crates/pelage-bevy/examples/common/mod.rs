@@ -1,0 +1,258 @@
+//! What both examples share: their command line (`--frames N
+//! --screenshot PNG --no-fur --size WxH --headless --timing`), the app
+//! (Bevy's default plugins on pelage's asset folder, with the Fox, and
+//! [`PelagePlugin`]), a window or, headless, an image to draw into, and
+//! the screenshot taken after N frames, then exit.
+
+use bevy::app::ScheduleRunnerPlugin;
+use bevy::camera::RenderTarget;
+use bevy::prelude::*;
+use bevy::render::render_resource::{TextureFormat, TextureUsages};
+use bevy::render::renderer::RenderDevice;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy::render::{Render, RenderApp, RenderSystems};
+use bevy::time::TimeUpdateStrategy;
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+use pelage_bevy::PelagePlugin;
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// The examples' command line.
+#[derive(Resource, Debug, Clone)]
+pub struct Args {
+    /// Stop after this many frames (with `--screenshot`, after saving it).
+    pub frames: Option<u32>,
+    /// Save the last frame here.
+    pub screenshot: Option<PathBuf>,
+    /// Leave the fur off (the same app and scene, for comparison).
+    pub no_fur: bool,
+    /// Window size.
+    pub size: (u32, u32),
+    /// Print the median frame time at the end (the benchmark reads it);
+    /// each frame then waits for the GPU to finish it.
+    pub timing: bool,
+    /// No window: draw into an image (servers, the benchmark).
+    pub headless: bool,
+}
+
+impl Args {
+    /// Reads `std::env::args`, exiting with a message on a bad one.
+    pub fn parse(default_size: (u32, u32)) -> Self {
+        let mut args = Args {
+            frames: None,
+            screenshot: None,
+            no_fur: false,
+            size: default_size,
+            timing: false,
+            headless: false,
+        };
+        let mut it = std::env::args().skip(1);
+        while let Some(a) = it.next() {
+            let mut value = |name: &str| {
+                it.next().unwrap_or_else(|| {
+                    eprintln!("{name} needs a value");
+                    std::process::exit(2)
+                })
+            };
+            match a.as_str() {
+                "--frames" => {
+                    args.frames = Some(value("--frames").parse().unwrap_or_else(|_| {
+                        eprintln!("--frames takes a whole number");
+                        std::process::exit(2)
+                    }))
+                }
+                "--screenshot" => args.screenshot = Some(value("--screenshot").into()),
+                "--no-fur" => args.no_fur = true,
+                "--timing" => args.timing = true,
+                "--headless" => args.headless = true,
+                "--size" => {
+                    let v = value("--size");
+                    let parsed = v
+                        .split_once('x')
+                        .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
+                    args.size = parsed.unwrap_or_else(|| {
+                        eprintln!("--size takes WIDTHxHEIGHT, e.g. 1280x720");
+                        std::process::exit(2)
+                    });
+                }
+                "-h" | "--help" => {
+                    println!(
+                        "options: --frames N  --screenshot PNG  --no-fur  --size WxH  --headless  --timing"
+                    );
+                    std::process::exit(0)
+                }
+                other => {
+                    eprintln!("unknown option {other} (try --help)");
+                    std::process::exit(2)
+                }
+            }
+        }
+        args
+    }
+}
+
+/// pelage's asset folder, where the Fox and its shells file are.
+pub fn asset_folder() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../pelage/assets"))
+}
+
+/// Where a headless app draws (none: the window).
+#[derive(Resource, Clone, Default)]
+pub struct Target(pub Option<Handle<Image>>);
+
+impl Target {
+    /// The camera's target component, if not the window.
+    pub fn camera(&self) -> Option<RenderTarget> {
+        self.0.clone().map(|h| RenderTarget::Image(h.into()))
+    }
+}
+
+/// The app both examples run: Bevy's default plugins on pelage's assets,
+/// a window (or an image, `--headless`), pelage's plugin, and the frame
+/// counter.
+pub fn app(args: &Args, title: &str) -> App {
+    let folder = asset_folder();
+    let mut app = App::new();
+    let assets = AssetPlugin {
+        file_path: folder.display().to_string(),
+        ..default()
+    };
+    if args.headless {
+        app.add_plugins(
+            DefaultPlugins
+                .set(assets)
+                .set(WindowPlugin {
+                    primary_window: None,
+                    exit_condition: ExitCondition::DontExit,
+                    ..default()
+                })
+                .disable::<WinitPlugin>(),
+        )
+        .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::ZERO));
+    } else {
+        app.add_plugins(DefaultPlugins.set(assets).set(WindowPlugin {
+            primary_window: Some(Window {
+                title: title.into(),
+                resolution: args.size.into(),
+                ..default()
+            }),
+            ..default()
+        }));
+    }
+    app.insert_resource(args.clone())
+        .insert_resource(GlobalAmbientLight {
+            color: Color::WHITE,
+            brightness: 600.0,
+            ..default()
+        })
+        .add_plugins(PelagePlugin {
+            asset_folder: Some(folder),
+        })
+        .add_plugins(RunFor);
+    let target = args.headless.then(|| {
+        let (w, h) = args.size;
+        let mut image = Image::new_target_texture(w, h, TextureFormat::Rgba8UnormSrgb, None);
+        image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+        app.world_mut().resource_mut::<Assets<Image>>().add(image)
+    });
+    app.insert_resource(Target(target));
+    if args.timing
+        && let Some(render) = app.get_sub_app_mut(RenderApp)
+    {
+        render.add_systems(Render, wait_for_gpu.after(RenderSystems::Render));
+    }
+    app
+}
+
+/// With `--timing`, each frame ends when the GPU has drawn it, so the
+/// frame time counts the GPU's work, not only its submission.
+fn wait_for_gpu(device: Res<RenderDevice>) {
+    let _ = device.poll(bevy::render::render_resource::PollType::wait_indefinitely());
+}
+
+/// Counts frames; with `--frames`, steps time by exactly 1/30 s a frame
+/// (the same pictures on any machine), saves the screenshot and exits.
+pub struct RunFor;
+
+/// Frames drawn, and each frame's wall time.
+#[derive(Resource, Default)]
+struct FrameLog {
+    frames: u32,
+    last: Option<std::time::Instant>,
+    times: Vec<f64>,
+    asked: bool,
+}
+
+impl Plugin for RunFor {
+    fn build(&self, app: &mut App) {
+        let args = app.world().resource::<Args>().clone();
+        if args.frames.is_some() {
+            app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
+                1.0 / 30.0,
+            )));
+        }
+        app.init_resource::<FrameLog>()
+            .add_systems(Last, count_frames);
+    }
+}
+
+fn count_frames(
+    mut commands: Commands,
+    args: Res<Args>,
+    target: Res<Target>,
+    mut log: ResMut<FrameLog>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let now = std::time::Instant::now();
+    if let Some(last) = log.last {
+        log.times.push((now - last).as_secs_f64() * 1e3);
+    }
+    log.last = Some(now);
+    log.frames += 1;
+    let Some(frames) = args.frames else {
+        return;
+    };
+    if log.frames < frames || log.asked {
+        return;
+    }
+    log.asked = true;
+    if args.timing {
+        // The first quarter warms up (pipelines compile, assets arrive).
+        let mut t: Vec<f64> = log.times[log.times.len() / 4..].to_vec();
+        t.sort_by(f64::total_cmp);
+        let median = t.get(t.len() / 2).copied().unwrap_or(f64::NAN);
+        println!("frame_ms {median:.3} frames {}", t.len());
+    }
+    match args.screenshot.clone() {
+        Some(path) => {
+            let shot = match &target.0 {
+                Some(image) => Screenshot::image(image.clone()),
+                None => Screenshot::primary_window(),
+            };
+            commands.spawn(shot).observe(
+                move |captured: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
+                    let saved = captured
+                        .image
+                        .clone()
+                        .try_into_dynamic()
+                        .map_err(|e| e.to_string())
+                        .and_then(|i| i.to_rgb8().save(&path).map_err(|e| e.to_string()));
+                    match saved {
+                        Ok(()) => {
+                            println!("wrote {}", path.display());
+                            exit.write(AppExit::Success);
+                        }
+                        Err(e) => {
+                            eprintln!("could not save {}: {e}", path.display());
+                            exit.write(AppExit::error());
+                        }
+                    }
+                },
+            );
+        }
+        None => {
+            exit.write(AppExit::Success);
+        }
+    }
+}

@@ -1,0 +1,423 @@
+//! pelage-bevy in a real Bevy app, rendered headless into an image on
+//! whatever adapter wgpu finds (Mesa's lavapipe in CI). One test binary,
+//! so Bevy is linked once. The Khronos Fox comes from Bevy's own glTF
+//! loader; the fur from `fox/fox.shells.toml`.
+
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::log::LogPlugin;
+use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+use pelage_bevy::{FurLayers, PelagePlugin, ShellFur};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+const WIDTH: u32 = 320;
+const HEIGHT: u32 = 240;
+/// How far fur may reach past the skin on screen, in pixels: it is 2.5 %
+/// of the fox's 150-unit diagonal, 3.8 units, at up to 2 pixels a unit
+/// (the fox's face, 150 units from the camera; 45° over 240 pixels), with
+/// gravity's sag and a pixel for rasterisation.
+const FUR_PX: i32 = 10;
+/// The clear colour: anything else in a picture is the scene.
+const BACKGROUND: [u8; 3] = [0, 0, 0];
+
+/// Bevy apps are heavy; on a two-core machine they take turns.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// Whether an adapter exists (else the test says why and passes, unless
+/// PELAGE_REQUIRE_GPU is set, as in CI).
+fn gpu_available() -> bool {
+    match pelage_gpu::GpuContext::headless() {
+        Ok(_) => true,
+        Err(e) if std::env::var_os("PELAGE_REQUIRE_GPU").is_some() => {
+            panic!("PELAGE_REQUIRE_GPU is set but no adapter: {e}")
+        }
+        Err(e) => {
+            eprintln!("skipped: {e}");
+            false
+        }
+    }
+}
+
+fn pelage_assets() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../pelage/assets"))
+}
+
+/// A headless Bevy app drawing into an image, stepped frame by frame.
+struct Headless {
+    app: App,
+    target: Handle<Image>,
+}
+
+impl Headless {
+    fn new(folder: &Path) -> Self {
+        let mut app = App::new();
+        app.add_plugins(
+            DefaultPlugins
+                .set(AssetPlugin {
+                    file_path: folder.display().to_string(),
+                    watch_for_changes_override: Some(true),
+                    ..default()
+                })
+                .set(WindowPlugin {
+                    primary_window: None,
+                    exit_condition: ExitCondition::DontExit,
+                    ..default()
+                })
+                .disable::<WinitPlugin>()
+                .disable::<LogPlugin>(),
+        )
+        .add_plugins(PelagePlugin {
+            asset_folder: Some(folder.to_path_buf()),
+        })
+        .insert_resource(ClearColor(Color::srgb_u8(
+            BACKGROUND[0],
+            BACKGROUND[1],
+            BACKGROUND[2],
+        )));
+        app.finish();
+        app.cleanup();
+        let mut image =
+            Image::new_target_texture(WIDTH, HEIGHT, TextureFormat::Rgba8UnormSrgb, None);
+        image.texture_descriptor.usage |= bevy::render::render_resource::TextureUsages::COPY_SRC;
+        let target = app.world_mut().resource_mut::<Assets<Image>>().add(image);
+        let world = app.world_mut();
+        world.spawn((
+            Camera3d::default(),
+            RenderTarget::Image(target.clone().into()),
+            Tonemapping::None,
+            Msaa::Off,
+            Transform::from_xyz(0.0, 45.0, 190.0).looking_at(Vec3::new(0.0, 35.0, 0.0), Vec3::Y),
+        ));
+        world.spawn((
+            DirectionalLight {
+                illuminance: 6000.0,
+                ..default()
+            },
+            Transform::from_xyz(0.5, 1.0, 1.0).looking_at(Vec3::ZERO, Vec3::Y),
+        ));
+        Self { app, target }
+    }
+
+    fn frames(&mut self, n: u32) {
+        for _ in 0..n {
+            self.app.update();
+        }
+    }
+
+    /// Steps until `ready` holds (assets loaded, a scene spawned), at most
+    /// `limit` frames.
+    fn until(&mut self, limit: u32, mut ready: impl FnMut(&mut World) -> bool) {
+        for _ in 0..limit {
+            self.app.update();
+            if ready(self.app.world_mut()) {
+                return;
+            }
+        }
+        panic!("not ready after {limit} frames");
+    }
+
+    /// The next frame's picture, RGB.
+    fn picture(&mut self) -> image::RgbImage {
+        let shot: Arc<Mutex<Option<Image>>> = Arc::default();
+        let into = shot.clone();
+        self.app
+            .world_mut()
+            .spawn(Screenshot::image(self.target.clone()))
+            .observe(move |captured: On<ScreenshotCaptured>| {
+                *into.lock().unwrap() = Some(captured.image.clone());
+            });
+        // Bevy takes it when the target has been drawn (pipelines being
+        // compiled can hold a first frame back for a while).
+        for frame in 0..400 {
+            self.app.update();
+            if let Some(image) = shot.lock().unwrap().take() {
+                if frame > 20 {
+                    eprintln!("screenshot after {frame} frames");
+                }
+                return image.try_into_dynamic().expect("an RGBA image").to_rgb8();
+            }
+        }
+        panic!("no screenshot after 400 frames");
+    }
+
+    /// A few frames for pipelines to compile (Bevy compiles them in the
+    /// background and draws nothing with a pipeline not ready), then a
+    /// picture that no longer changes.
+    fn settled_picture(&mut self) -> image::RgbImage {
+        let mut last = self.picture();
+        for _ in 0..40 {
+            self.frames(3);
+            let next = self.picture();
+            if next == last {
+                return next;
+            }
+            last = next;
+        }
+        panic!("the picture never settled");
+    }
+}
+
+/// The Fox's scene root, once its meshes are spawned.
+fn spawn_fox(h: &mut Headless, folder_fur: Option<&str>) -> Entity {
+    let world = h.app.world_mut();
+    let assets = world.resource::<AssetServer>().clone();
+    let mut fox = world.spawn(WorldAssetRoot(
+        assets.load(GltfAssetLabel::Scene(0).from_asset("fox/Fox.gltf")),
+    ));
+    if let Some(path) = folder_fur {
+        fox.insert(ShellFur(assets.load(path.to_string())));
+    }
+    let fox = fox.id();
+    h.until(600, |world| {
+        let mut q = world.query::<&Mesh3d>();
+        q.iter(world).next().is_some()
+    });
+    fox
+}
+
+fn with_fur(h: &mut Headless, fox: Entity, on: bool) {
+    let world = h.app.world_mut();
+    if on {
+        let fur = world.resource::<AssetServer>().load("fox/fox.shells.toml");
+        world.entity_mut(fox).insert(ShellFur(fur));
+        h.until(600, |world| {
+            let mut q = world.query::<&FurLayers>();
+            q.iter(world).next().is_some()
+        });
+    } else {
+        world.entity_mut(fox).remove::<ShellFur>();
+        h.frames(2);
+    }
+}
+
+/// Pixels that are not the background.
+fn mask(picture: &image::RgbImage) -> Vec<bool> {
+    picture.pixels().map(|p| p.0 != BACKGROUND).collect()
+}
+
+/// Pixels that differ between two pictures.
+fn differ(a: &image::RgbImage, b: &image::RgbImage) -> Vec<bool> {
+    a.pixels().zip(b.pixels()).map(|(p, q)| p != q).collect()
+}
+
+/// `m` grown by `r` pixels.
+fn dilate(m: &[bool], r: i32) -> Vec<bool> {
+    let (w, h) = (WIDTH as i32, HEIGHT as i32);
+    let mut out = vec![false; m.len()];
+    for y in 0..h {
+        for x in 0..w {
+            if !m[(y * w + x) as usize] {
+                continue;
+            }
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let (u, v) = (x + dx, y + dy);
+                    if u >= 0 && v >= 0 && u < w && v < h {
+                        out[(v * w + u) as usize] = true;
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn count(m: &[bool]) -> usize {
+    m.iter().filter(|&&b| b).count()
+}
+
+/// Turns the fox's head and tail (its joints, as an animation would), so
+/// Bevy skins it into a new pose.
+fn pose(h: &mut Headless, angle: f32) {
+    let world = h.app.world_mut();
+    let mut q = world.query::<(&Name, &mut Transform)>();
+    for (name, mut t) in q.iter_mut(world) {
+        if ["b_Neck_04", "b_Tail01_012", "b_Spine02_03"].contains(&name.as_str()) {
+            t.rotate_local_z(angle);
+        }
+    }
+    h.frames(2);
+}
+
+fn save_for_inspection(name: &str, picture: &image::RgbImage) {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bevy");
+    std::fs::create_dir_all(&dir).unwrap();
+    picture.save(dir.join(name)).unwrap();
+}
+
+/// Fur shows on the fox and nowhere else; a cube in front hides it; and
+/// after a pose change it is where the posed skin is, not where it was.
+#[test]
+fn fur_sits_on_the_fox_is_hidden_by_what_is_in_front_and_follows_its_pose() {
+    if !gpu_available() {
+        return;
+    }
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let mut h = Headless::new(&pelage_assets());
+    let fox = spawn_fox(&mut h, None);
+
+    let bare = h.settled_picture();
+    with_fur(&mut h, fox, true);
+    let furred = h.settled_picture();
+    save_for_inspection("bare.png", &bare);
+    save_for_inspection("furred.png", &furred);
+    let skin = mask(&bare);
+    let fur = differ(&bare, &furred);
+    assert!(count(&skin) > 2000, "the fox fills {} pixels", count(&skin));
+    // The fur changes most of the fox's pixels...
+    let on_skin = fur.iter().zip(&skin).filter(|(f, s)| **f && **s).count();
+    assert!(
+        on_skin as f64 > 0.5 * count(&skin) as f64,
+        "fur on {on_skin} of {} fox pixels",
+        count(&skin)
+    );
+    // ...and nothing farther from it than the fur is long on screen.
+    let near = dilate(&skin, FUR_PX);
+    let astray = fur.iter().zip(&near).filter(|(f, n)| **f && !**n).count();
+    if astray > 0 {
+        let mut debug = furred.clone();
+        for (i, p) in debug.pixels_mut().enumerate() {
+            if fur[i] && !near[i] {
+                *p = image::Rgb([255, 0, 0]);
+            }
+        }
+        save_for_inspection("astray.png", &debug);
+    }
+    assert_eq!(astray, 0, "{astray} fur pixels away from the fox");
+    // It stands out past the bare silhouette.
+    let outside = fur.iter().zip(&skin).filter(|(f, s)| **f && !**s).count();
+    assert!(outside > 50, "fur beyond the silhouette: {outside} pixels");
+
+    // A cube between the camera and the fox's front half.
+    let cube = {
+        let world = h.app.world_mut();
+        let mesh = world
+            .resource_mut::<Assets<Mesh>>()
+            .add(Cuboid::new(24.0, 24.0, 2.0));
+        let material = world
+            .resource_mut::<Assets<StandardMaterial>>()
+            .add(Color::srgb(0.2, 0.4, 0.9));
+        world
+            .spawn((
+                Mesh3d(mesh),
+                MeshMaterial3d(material),
+                Transform::from_xyz(-12.0, 40.0, 70.0),
+            ))
+            .id()
+    };
+    let cube_furred = h.settled_picture();
+    with_fur(&mut h, fox, false);
+    let cube_bare = h.settled_picture();
+    save_for_inspection("cube-furred.png", &cube_furred);
+    let cube_pixels = differ(&bare, &cube_bare);
+    let hidden_fur = differ(&cube_bare, &cube_furred);
+    let inside = dilate(&cube_pixels.iter().map(|&c| !c).collect::<Vec<_>>(), 1);
+    let through = hidden_fur
+        .iter()
+        .zip(&cube_pixels)
+        .zip(&inside)
+        .filter(|((f, c), edge)| **f && **c && !**edge)
+        .count();
+    assert!(
+        count(&cube_pixels) > 1000,
+        "the cube covers {}",
+        count(&cube_pixels)
+    );
+    assert_eq!(through, 0, "{through} fur pixels drawn over the cube");
+    assert!(count(&hidden_fur) > 500, "fur still shows beside the cube");
+    h.app.world_mut().entity_mut(cube).despawn();
+
+    // A new pose, skinned by Bevy: the fur goes with it.
+    pose(&mut h, 0.5);
+    let posed_bare = h.settled_picture();
+    with_fur(&mut h, fox, true);
+    let posed_furred = h.settled_picture();
+    save_for_inspection("posed-furred.png", &posed_furred);
+    let posed_skin = mask(&posed_bare);
+    let posed_fur = differ(&posed_bare, &posed_furred);
+    let moved = differ(&bare, &posed_bare);
+    assert!(
+        count(&moved) > 300,
+        "the pose moved {} pixels",
+        count(&moved)
+    );
+    let near = dilate(&posed_skin, FUR_PX);
+    let astray = posed_fur
+        .iter()
+        .zip(&near)
+        .filter(|(f, n)| **f && !**n)
+        .count();
+    assert_eq!(
+        astray, 0,
+        "{astray} posed fur pixels away from the posed fox"
+    );
+    // Where the skin left, no fur stayed behind.
+    let left = skin
+        .iter()
+        .zip(&dilate(&posed_skin, FUR_PX))
+        .map(|(was, is)| *was && !*is)
+        .collect::<Vec<_>>();
+    let stayed = posed_fur
+        .iter()
+        .zip(&left)
+        .filter(|(f, l)| **f && **l)
+        .count();
+    assert!(
+        count(&left) > 50,
+        "the pose uncovered {} pixels",
+        count(&left)
+    );
+    assert_eq!(stayed, 0, "{stayed} fur pixels where the skin was");
+}
+
+/// Editing the shells file while the app runs regrows the fur: longer
+/// fur covers more of the picture.
+#[test]
+fn a_changed_shells_file_changes_the_picture() {
+    if !gpu_available() {
+        return;
+    }
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = tempfile::tempdir().unwrap();
+    let fox_dir = dir.path().join("fox");
+    std::fs::create_dir_all(&fox_dir).unwrap();
+    for f in ["Fox.gltf", "fox.png", "fox.shells.toml"] {
+        std::fs::copy(pelage_assets().join("fox").join(f), fox_dir.join(f)).unwrap();
+    }
+    let shells = fox_dir.join("fox.shells.toml");
+    let text = std::fs::read_to_string(&shells).unwrap();
+    std::fs::write(&shells, text.replace("[fur]\n", "[fur]\nlength = 2.0\n")).unwrap();
+
+    let mut h = Headless::new(dir.path());
+    spawn_fox(&mut h, Some("fox/fox.shells.toml"));
+    h.until(600, |world| {
+        let mut q = world.query::<&FurLayers>();
+        q.iter(world).next().is_some()
+    });
+    let short = h.settled_picture();
+
+    std::fs::write(&shells, text.replace("[fur]\n", "[fur]\nlength = 9.0\n")).unwrap();
+    // The file watcher reports the change; the fur regrows.
+    let mut long = short.clone();
+    for _ in 0..100 {
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        long = h.settled_picture();
+        if long != short {
+            break;
+        }
+    }
+    save_for_inspection("reload-short.png", &short);
+    save_for_inspection("reload-long.png", &long);
+    assert!(long != short, "the picture did not change after the edit");
+    assert!(
+        count(&mask(&long)) > count(&mask(&short)) + 200,
+        "longer fur covers {} pixels, shorter {}",
+        count(&mask(&long)),
+        count(&mask(&short))
+    );
+}

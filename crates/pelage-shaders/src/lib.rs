@@ -1,0 +1,12 @@
+//! pelage-shaders: what pelage's GPU hosts share, with no GPU API in it.
+//!
+//! Two hosts draw pelage's fur: `pelage-gpu` on its own wgpu device, and
+//! `pelage-bevy` through Bevy's renderer (a different wgpu version). Each
+//! builds its own pipelines; the WGSL they run and the data they upload
+//! come from here, so the fur is the same in both and moving either host
+//! to a new wgpu is a version bump, not a port.
+//!
+//! - [`shell`]: shell fur's math in WGSL, the strand frame's tangents and
+//!   the shell texture's mip chain.
+
+pub mod shell;
