@@ -9,6 +9,7 @@
 //! runs, and comparisons are ratios taken within one run.
 
 pub mod animation;
+pub mod bevy;
 pub mod blender;
 pub mod dynamics;
 pub mod format;
@@ -63,6 +64,9 @@ pub enum BenchWhat {
     /// The groom in the game: the running Fox's guides simulated, its
     /// hairs grown and drawn on the GPU every frame, beside the CPU groom.
     Realtime(realtime::RealtimeBenchArgs),
+    /// pelage's fur in a Bevy game: the plugin's Fox and crowd examples
+    /// with and without fur, headless, in the same run.
+    Bevy(bevy::BevyBenchArgs),
 }
 
 /// The demo groom file (`pelage demo`), which the I/O benchmark grows.
@@ -144,6 +148,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchWhat::Python(a) => python::run(a),
         BenchWhat::Blender(a) => blender::run(a),
         BenchWhat::Realtime(a) => realtime::run(a),
+        BenchWhat::Bevy(a) => bevy::run(a),
     }
 }
 

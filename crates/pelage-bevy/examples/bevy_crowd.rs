@@ -19,11 +19,12 @@ use pelage_bevy::ShellFur;
 /// Foxes a side of the square.
 const SIDE: i32 = 10;
 /// Between neighbours (the fox is about 100 units long).
-const SPACING: f32 = 140.0;
+const SPACING: f32 = 200.0;
 
 fn main() {
     let args = Args::parse((1280, 720));
     common::app(&args, "pelage in Bevy: a crowd of foxes")
+        .insert_resource(common::Characters((SIDE * SIDE) as usize))
         .add_systems(Startup, setup)
         .add_systems(Update, (fly_over, report_fps))
         .run();
@@ -117,7 +118,7 @@ fn start_running(
 fn fly_over(time: Res<Time>, mut cameras: Query<&mut Transform, With<Camera3d>>) {
     let a = 0.1 * time.elapsed_secs() + 0.5;
     for mut t in &mut cameras {
-        let eye = Vec3::new(900.0 * a.sin(), 260.0, 900.0 * a.cos());
+        let eye = Vec3::new(1500.0 * a.sin(), 520.0, 1500.0 * a.cos());
         *t = Transform::from_translation(eye).looking_at(Vec3::new(0.0, 0.0, 0.0), Vec3::Y);
     }
 }

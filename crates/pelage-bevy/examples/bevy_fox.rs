@@ -22,6 +22,7 @@ use pelage_bevy::ShellFur;
 fn main() {
     let args = Args::parse((1280, 720));
     common::app(&args, "pelage in Bevy: the Fox")
+        .insert_resource(common::Characters(1))
         .add_systems(Startup, setup)
         .add_systems(Update, (orbit, pass_the_ball))
         .run();
@@ -159,7 +160,7 @@ fn orbit(
 
 /// The ball swings across the line between the camera and the fox.
 fn pass_the_ball(
-    time: Res<Time>,
+    clock: Res<common::SceneClock>,
     cameras: Query<&Transform, (With<Camera3d>, Without<Ball>)>,
     mut balls: Query<&mut Transform, With<Ball>>,
 ) {
@@ -169,7 +170,9 @@ fn pass_the_ball(
     let target = Vec3::new(0.0, 30.0, 0.0);
     let towards = (camera.translation - target).normalize_or_zero();
     let across = towards.cross(Vec3::Y).normalize_or_zero();
-    let swing = (time.elapsed_secs() * 0.8).sin() * 70.0;
+    // Before the fox's face a second and a quarter after the scene is
+    // ready (the sixth frame a `--frames` run counts), then to either side.
+    let swing = (0.8 * (clock.0 - 1.2)).sin() * 70.0;
     for mut ball in &mut balls {
         ball.translation = target + 70.0 * towards + swing * across;
     }

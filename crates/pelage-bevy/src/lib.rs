@@ -1,7 +1,7 @@
 //! pelage in Bevy: shell fur on Bevy's own meshes and skinned characters.
 //!
 //! Add [`PelagePlugin`], then put a [`ShellFur`] on an entity with a
-//! [`Mesh3d`](bevy::prelude::Mesh3d) — or on a glTF scene's root, and
+//! [`Mesh3d`] — or on a glTF scene's root, and
 //! every mesh below it wears the fur once the scene has spawned:
 //!
 //! ```no_run
@@ -10,7 +10,7 @@
 //!
 //! fn setup(mut commands: Commands, assets: Res<AssetServer>) {
 //!     commands.spawn((
-//!         SceneRoot(assets.load(GltfAssetLabel::Scene(0).from_asset("fox/Fox.gltf"))),
+//!         WorldAssetRoot(assets.load(GltfAssetLabel::Scene(0).from_asset("fox/Fox.gltf"))),
 //!         ShellFur(assets.load("fox/fox.shells.toml")),
 //!     ));
 //! }
