@@ -14,7 +14,6 @@ use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy::world_serialization::WorldInstanceReady;
 use common::Args;
-use pelage_bevy::ShellFur;
 
 /// Foxes a side of the square.
 const SIDE: i32 = 10;
@@ -52,7 +51,6 @@ fn setup(
     );
     let graph = graphs.add(graph);
     let scene = assets.load(GltfAssetLabel::Scene(0).from_asset("fox/Fox.gltf"));
-    let fur = assets.load("fox/fox.shells.toml");
     for i in 0..SIDE * SIDE {
         let (x, z) = ((i % SIDE) as f32, (i / SIDE) as f32);
         let offset = (SIDE as f32 - 1.0) / 2.0;
@@ -66,9 +64,7 @@ fn setup(
                 phase: (i as f32 * 0.37) % 1.0,
             },
         ));
-        if !args.no_fur {
-            fox.insert(ShellFur(fur.clone()));
-        }
+        common::fox_fur(&args, &assets, &mut fox);
         fox.observe(start_running);
     }
     commands.spawn((

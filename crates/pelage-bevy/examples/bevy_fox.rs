@@ -8,7 +8,8 @@
 //! cargo run --release -p pelage-bevy --example bevy_fox -- --frames 60 --screenshot fox.png
 //! ```
 //!
-//! `--no-fur` draws the same scene without fur (the benchmark's baseline).
+//! `--no-fur` draws the same scene without fur (the benchmark's baseline);
+//! `--groom` furs it from `fox/fox.groom.toml` (`GroomFur`) instead.
 
 mod common;
 
@@ -17,7 +18,6 @@ use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll};
 use bevy::prelude::*;
 use bevy::world_serialization::WorldInstanceReady;
 use common::Args;
-use pelage_bevy::ShellFur;
 
 fn main() {
     let args = Args::parse((1280, 720));
@@ -66,9 +66,7 @@ fn setup(
             index,
         },
     ));
-    if !args.no_fur {
-        fox.insert(ShellFur(assets.load("fox/fox.shells.toml")));
-    }
+    common::fox_fur(&args, &assets, &mut fox);
     fox.observe(start_running);
 
     commands.spawn((

@@ -114,3 +114,110 @@ impl AssetLoader for ShellFurLoader {
         &["shells.toml", "toml"]
     }
 }
+
+/// Layers of the shell fur that stands in for a groom.
+const STAND_IN_LAYERS: u32 = 16;
+
+/// A groom file as Bevy fur: the shell fur that stands in for it (its
+/// density, length and colour; pelage-gpu's real-time strands hand over
+/// to the same stand-in far away), as a labelled [`ShellFurAsset`].
+#[derive(Asset, TypePath, Debug, Clone)]
+pub struct GroomFurAsset {
+    /// The stand-in, drawn as any shell fur is.
+    pub shells: Handle<ShellFurAsset>,
+    /// Hairs the groom grows.
+    pub hairs: u64,
+}
+
+/// Reads pelage groom files (`*.groom.toml`, or any `*.toml` loaded as a
+/// [`GroomFurAsset`]) from the folder Bevy's assets are in.
+#[derive(TypePath)]
+pub struct GroomFurLoader {
+    /// Bevy's asset folder on disk: a groom file names its mesh, guides
+    /// and maps relative to itself.
+    pub(crate) folder: PathBuf,
+}
+
+/// Why a groom file did not load: pelage's error, with the file and line.
+#[derive(Debug, thiserror::Error)]
+pub enum GroomFurLoadError {
+    /// The file could not be read.
+    #[error("reading {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// pelage refused it (syntax, a key, a range, its mesh, guides, maps).
+    #[error(transparent)]
+    Groom(#[from] pelage::groom::GroomError),
+}
+
+impl ShellFurAsset {
+    /// The shell fur standing in for `groom`: pelage's stand-in (the
+    /// groom's density of hairs on the skin, its guides' mean length, its
+    /// colour texture brightened to meet the strands'), Kajiya-Kay shaded
+    /// as a shells file without `[shading]`, with a level of detail.
+    pub fn stand_in_for(groom: &pelage::groom::Groom) -> Result<(Self, u64), GroomFurLoadError> {
+        let generator = groom.generator(None)?;
+        let hairs = generator.parts().iter().map(|p| p.hair_count).sum();
+        let stand_in = pelage_shaders::stand_in::ShellStandIn::of(&generator, STAND_IN_LAYERS);
+        // The strands' default look (melanin 0.5, redness 0.3), where the
+        // groom has no colour texture.
+        let hair = pelage::groom::color_of_melanin(0.5, 0.3, 0.3);
+        let color = stand_in.color_texture(groom, hair)?;
+        Ok((
+            Self {
+                layers: STAND_IN_LAYERS,
+                length: stand_in.length,
+                tiles: stand_in.tiles,
+                textures: Arc::new(ShellTextures::generate(&stand_in.texture)),
+                color: Arc::new(color),
+                shading: KajiyaKay {
+                    specular: glam::Vec3::new(0.12, 0.11, 0.1),
+                    exponent: 30.0,
+                    k_shadow: 2.0,
+                },
+                coupling: Coupling::Bezier,
+                dynamics: None,
+                lod: Some((0.75, 4)),
+            },
+            hairs,
+        ))
+    }
+}
+
+impl AssetLoader for GroomFurLoader {
+    type Asset = GroomFurAsset;
+    type Settings = ();
+    type Error = GroomFurLoadError;
+
+    async fn load(
+        &self,
+        reader: &mut dyn Reader,
+        _settings: &(),
+        load_context: &mut LoadContext<'_>,
+    ) -> Result<GroomFurAsset, GroomFurLoadError> {
+        let path = self.folder.join(load_context.path().path());
+        let mut bytes = Vec::new();
+        reader
+            .read_to_end(&mut bytes)
+            .await
+            .map_err(|source| GroomFurLoadError::Io {
+                path: path.clone(),
+                source,
+            })?;
+        let groom = pelage::groom::Groom::from_source(pelage::settings::SettingsSource {
+            path,
+            text: String::from_utf8_lossy(&bytes).into_owned(),
+        })?;
+        let (shells, hairs) = ShellFurAsset::stand_in_for(&groom)?;
+        let shells = load_context.add_labeled_asset("shells", shells);
+        Ok(GroomFurAsset { shells, hairs })
+    }
+
+    fn extensions(&self) -> &[&str] {
+        &["groom.toml", "toml"]
+    }
+}

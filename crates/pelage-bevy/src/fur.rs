@@ -5,7 +5,7 @@
 //! each level of detail is shown at the distances where its layers stand
 //! at most the file's pixel gap apart on the camera's screen.
 
-use crate::asset::ShellFurAsset;
+use crate::asset::{GroomFurAsset, ShellFurAsset};
 use crate::dynamics::{FurForces, FurMotion};
 use crate::material::{ShellFurMaterial, ShellFurUniform};
 use crate::mesh::fur_mesh;
@@ -22,6 +22,12 @@ use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 /// [`Mesh3d`] (a glTF scene's root), on every mesh below it.
 #[derive(Component, Debug, Clone)]
 pub struct ShellFur(pub Handle<ShellFurAsset>);
+
+/// A groom on this entity's mesh, or on every mesh below it: drawn as
+/// the shell fur that stands in for it (the plugin gives the entity that
+/// [`ShellFur`] once the groom has loaded, and takes it away with this).
+#[derive(Component, Debug, Clone)]
+pub struct GroomFur(pub Handle<GroomFurAsset>);
 
 /// A fur entity (a child of the mesh it grows on): its layers and level
 /// of detail.
@@ -176,6 +182,31 @@ pub(crate) fn attach_fur(
                 fur: spawned,
             });
             commands.entity(owner).insert_if_new(FurMotion::default());
+        }
+    }
+}
+
+/// Gives an entity with a loaded [`GroomFur`] its stand-in's
+/// [`ShellFur`]; a removed `GroomFur` takes it away.
+pub(crate) fn wear_grooms(
+    mut commands: Commands,
+    grooms: Query<(Entity, &GroomFur, Option<&ShellFur>)>,
+    mut removed: RemovedComponents<GroomFur>,
+    assets: Res<Assets<GroomFurAsset>>,
+) {
+    for (entity, groom, worn) in &grooms {
+        let Some(asset) = assets.get(&groom.0) else {
+            continue;
+        };
+        if worn.is_none_or(|w| w.0 != asset.shells) {
+            commands
+                .entity(entity)
+                .insert(ShellFur(asset.shells.clone()));
+        }
+    }
+    for entity in removed.read() {
+        if let Ok(mut e) = commands.get_entity(entity) {
+            e.remove::<ShellFur>();
         }
     }
 }

@@ -42,9 +42,12 @@ mod fur;
 mod material;
 mod mesh;
 
-pub use asset::{ShellFurAsset, ShellFurLoadError, ShellFurLoader};
+pub use asset::{
+    GroomFurAsset, GroomFurLoadError, GroomFurLoader, ShellFurAsset, ShellFurLoadError,
+    ShellFurLoader,
+};
 pub use dynamics::{FurForces, FurMotion};
-pub use fur::{FurLayers, ShellFur, lod_layers};
+pub use fur::{FurLayers, GroomFur, ShellFur, lod_layers};
 pub use material::{ATTRIBUTE_SHELL_LAYER, ShellFurMaterial, ShellFurUniform};
 pub use mesh::{FurMeshError, fur_mesh};
 
@@ -70,12 +73,22 @@ impl Plugin for PelagePlugin {
         material::register_shaders(app);
         app.add_plugins(MaterialPlugin::<ShellFurMaterial>::default())
             .init_asset::<ShellFurAsset>()
-            .register_asset_loader(ShellFurLoader { folder })
+            .init_asset::<GroomFurAsset>()
+            .register_asset_loader(ShellFurLoader {
+                folder: folder.clone(),
+            })
+            .register_asset_loader(GroomFurLoader { folder })
             .init_resource::<FurForces>()
             .init_resource::<fur::FurCache>()
             .add_systems(
                 Update,
-                (fur::detach_fur, fur::attach_fur, fur::step_dynamics).chain(),
+                (
+                    fur::wear_grooms,
+                    fur::detach_fur,
+                    fur::attach_fur,
+                    fur::step_dynamics,
+                )
+                    .chain(),
             )
             .add_systems(PostUpdate, fur::choose_levels);
     }

@@ -11,7 +11,7 @@ use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
-use pelage_bevy::{FurLayers, PelagePlugin, ShellFur};
+use pelage_bevy::{FurForces, FurLayers, GroomFur, PelagePlugin, ShellFur, ShellFurAsset};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
@@ -73,6 +73,11 @@ impl Headless {
         )
         .add_plugins(PelagePlugin {
             asset_folder: Some(folder.to_path_buf()),
+        })
+        // No gravity: the coat's spring stays at rest, so pictures settle.
+        .insert_resource(FurForces {
+            gravity: Some(Vec3::ZERO),
+            wind: Vec3::ZERO,
         })
         .insert_resource(ClearColor(Color::srgb_u8(
             BACKGROUND[0],
@@ -394,7 +399,7 @@ fn a_changed_shells_file_changes_the_picture() {
     std::fs::write(&shells, text.replace("[fur]\n", "[fur]\nlength = 2.0\n")).unwrap();
 
     let mut h = Headless::new(dir.path());
-    spawn_fox(&mut h, Some("fox/fox.shells.toml"));
+    let fox = spawn_fox(&mut h, Some("fox/fox.shells.toml"));
     h.until(600, |world| {
         let mut q = world.query::<&FurLayers>();
         q.iter(world).next().is_some()
@@ -402,15 +407,26 @@ fn a_changed_shells_file_changes_the_picture() {
     let short = h.settled_picture();
 
     std::fs::write(&shells, text.replace("[fur]\n", "[fur]\nlength = 9.0\n")).unwrap();
-    // The file watcher reports the change; the fur regrows.
-    let mut long = short.clone();
-    for _ in 0..100 {
-        std::thread::sleep(std::time::Duration::from_millis(100));
-        long = h.settled_picture();
-        if long != short {
+    // The file watcher reports the change and the asset is read again.
+    let reloaded = |world: &mut World| {
+        let handle = world.get::<ShellFur>(fox).unwrap().0.clone();
+        world
+            .resource::<Assets<ShellFurAsset>>()
+            .get(&handle)
+            .is_some_and(|a| a.length == 9.0)
+    };
+    for _ in 0..200 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.frames(1);
+        if reloaded(h.app.world_mut()) {
             break;
         }
     }
+    assert!(
+        reloaded(h.app.world_mut()),
+        "the edit was not reloaded in 10 s"
+    );
+    let long = h.settled_picture();
     save_for_inspection("reload-short.png", &short);
     save_for_inspection("reload-long.png", &long);
     assert!(long != short, "the picture did not change after the edit");
@@ -420,4 +436,44 @@ fn a_changed_shells_file_changes_the_picture() {
         count(&mask(&long)),
         count(&mask(&short))
     );
+}
+
+/// A groom file on the Fox is drawn as the shell fur that stands in for
+/// it, on the fox and only near it; taking the groom away takes the fur.
+#[test]
+fn a_groom_wears_its_shell_stand_in() {
+    if !gpu_available() {
+        return;
+    }
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let mut h = Headless::new(&pelage_assets());
+    let fox = spawn_fox(&mut h, None);
+    let bare = h.settled_picture();
+    let world = h.app.world_mut();
+    let groom = world.resource::<AssetServer>().load("fox/fox.groom.toml");
+    world.entity_mut(fox).insert(GroomFur(groom));
+    h.until(900, |world| {
+        let mut q = world.query::<&FurLayers>();
+        q.iter(world).next().is_some()
+    });
+    let furred = h.settled_picture();
+    save_for_inspection("groom-furred.png", &furred);
+    let skin = mask(&bare);
+    let fur = differ(&bare, &furred);
+    let on_skin = fur.iter().zip(&skin).filter(|(f, s)| **f && **s).count();
+    assert!(
+        on_skin as f64 > 0.5 * count(&skin) as f64,
+        "the stand-in on {on_skin} of {} fox pixels",
+        count(&skin)
+    );
+    // The guides are 6 units long: up to 12 pixels here, and the sag.
+    let near = dilate(&skin, 15);
+    let astray = fur.iter().zip(&near).filter(|(f, n)| **f && !**n).count();
+    assert_eq!(astray, 0, "{astray} stand-in pixels away from the fox");
+
+    h.app.world_mut().entity_mut(fox).remove::<GroomFur>();
+    h.frames(3);
+    let world = h.app.world_mut();
+    let mut q = world.query::<&FurLayers>();
+    assert_eq!(q.iter(world).count(), 0, "the fur went with the groom");
 }

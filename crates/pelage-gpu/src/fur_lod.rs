@@ -11,8 +11,7 @@
 //! stay about the same from near to far.
 
 use crate::{ShellParams, StrandParams};
-use pelage::groom::Generator;
-use pelage::shell::ShellTextureParams;
+pub use pelage_shaders::stand_in::ShellStandIn;
 
 /// When to draw what, by a character's height on screen.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,68 +99,15 @@ impl FurLevel {
     }
 }
 
-/// How much brighter a stand-in's shells are coloured than its hairs.
-const SHELL_GAIN: f32 = 1.8;
-
-/// Shell fur standing in for a groom far away: its texture's density of
-/// hairs per texel matched to the groom's on the skin, its length the
-/// guides' mean length, its clumping from the groom's first clump.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ShellStandIn {
-    /// The shell texture to generate.
-    pub texture: ShellTextureParams,
-    /// Texture repeats across the UV square.
-    pub tiles: f32,
-    /// The shells' length (world units).
-    pub length: f32,
-}
-
-impl ShellStandIn {
-    /// The stand-in for `generator`'s groom, with `layers` shells.
-    pub fn of(generator: &Generator, layers: u32) -> Self {
-        let guides = generator.guides();
-        let length =
-            (0..guides.len()).map(|g| guides.length(g)).sum::<f32>() / guides.len().max(1) as f32;
-        let hairs: u64 = generator.parts().iter().map(|p| p.hair_count).sum();
-        let mesh = generator.mesh();
-        // The UV square's share the skin covers: its triangles' UV area.
-        let uv_area: f32 = (0..mesh.triangle_count())
-            .filter_map(|t| mesh.triangle_uvs(t))
-            .map(|[a, b, c]| 0.5 * (b - a).perp_dot(c - a).abs())
-            .sum::<f32>()
-            .clamp(1e-3, 1.0);
-        let texture = ShellTextureParams {
-            layers,
-            resolution: 256,
-            ..Default::default()
-        };
-        // Guard hairs per texel as the texture's default, tiled as often
-        // as the groom's hairs need over the skin's share of the square.
-        let per_tile = texture.density * (texture.resolution as f32).powi(2);
-        let tiles = (hairs as f32 / (uv_area * per_tile)).sqrt().max(1.0);
-        Self {
-            texture,
-            tiles,
-            length,
-        }
-    }
-
-    /// The shells' colour for hairs of `color` (linear RGB): brighter, so
-    /// that the shells, which lose light to their depth's shadow factor
-    /// and have only a diffuse lobe and a faint highlight, are about as
-    /// bright as the strands they take over from (the gain measured on
-    /// Spot's level-of-detail ladder, `tests/groom.rs`).
-    pub fn color(&self, color: glam::Vec3) -> glam::Vec3 {
-        (SHELL_GAIN * color).min(glam::Vec3::ONE)
-    }
-
-    /// Shell parameters drawing this stand-in over `base`'s shading.
-    pub fn params(&self, base: ShellParams) -> ShellParams {
+impl ShellParams {
+    /// These parameters' shading, drawing `stand_in`'s layers, length and
+    /// tiles.
+    pub fn for_stand_in(self, stand_in: &ShellStandIn) -> Self {
         ShellParams {
-            layers: self.texture.layers,
-            length: self.length,
-            tiles: self.tiles,
-            ..base
+            layers: stand_in.texture.layers,
+            length: stand_in.length,
+            tiles: stand_in.tiles,
+            ..self
         }
     }
 }

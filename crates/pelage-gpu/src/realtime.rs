@@ -143,10 +143,7 @@ impl RealtimeFur {
         let binding = strands.bind(ctx, &hairs);
         let stand_in = ShellStandIn::of(generator, STAND_IN_LAYERS);
         let look = crate::StrandLook::default();
-        let texture = match groom.base_color_texture()? {
-            Some(image) => brightened(&image.to_rgba8(), &stand_in),
-            None => image::RgbaImage::from_pixel(2, 2, srgb(stand_in.color(look.color))),
-        };
+        let texture = stand_in.color_texture(&groom, look.color)?;
         let textures = ShellTextures::generate(&stand_in.texture);
         let (model, bounds) = match &animated {
             Some(a) => {
@@ -216,7 +213,7 @@ impl RealtimeFur {
             },
             lod: FurLod::default(),
             strand_params: StrandParams::for_length(stand_in.length),
-            shell_params: stand_in.params(ShellParams::plain(0, stand_in.length)),
+            shell_params: ShellParams::plain(0, stand_in.length).for_stand_in(&stand_in),
             stand_in,
             animated,
         })
@@ -451,27 +448,4 @@ fn step_guides(
         .step(ctx, &s.params, dt, (frame / s.fps) as f32, &roots, &grids)?;
     s.sim.note_pose(pose);
     Ok(())
-}
-
-/// sRGB bytes of a linear colour.
-fn srgb(c: Vec3) -> image::Rgba<u8> {
-    let [r, g, b] = c
-        .to_array()
-        .map(|x| (255.0 * pelage::groom::linear_to_srgb(x)).round() as u8);
-    image::Rgba([r, g, b, 255])
-}
-
-/// A skin texture (sRGB) brightened as the stand-in's shells need.
-fn brightened(image: &image::RgbaImage, stand_in: &ShellStandIn) -> image::RgbaImage {
-    let mut out = image.clone();
-    for p in out.pixels_mut() {
-        let linear = Vec3::new(
-            pelage::groom::srgb_to_linear(f32::from(p.0[0]) / 255.0),
-            pelage::groom::srgb_to_linear(f32::from(p.0[1]) / 255.0),
-            pelage::groom::srgb_to_linear(f32::from(p.0[2]) / 255.0),
-        );
-        let [r, g, b, _] = srgb(stand_in.color(linear)).0;
-        p.0[..3].copy_from_slice(&[r, g, b]);
-    }
-    out
 }

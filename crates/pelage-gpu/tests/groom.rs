@@ -457,10 +457,11 @@ fn the_level_of_detail_hands_over_from_strands_to_shells_without_a_pop() {
             16,
         )
         .unwrap();
-    let base_shells = stand_in.params(ShellParams {
+    let base_shells = ShellParams {
         background: [0.0, 0.0, 1.0],
         ..ShellParams::plain(0, 0.08)
-    });
+    }
+    .for_stand_in(&stand_in);
     let base_strands = StrandParams {
         shadow_layer: None,
         ..StrandParams::for_length(0.08)

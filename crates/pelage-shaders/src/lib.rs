@@ -7,6 +7,8 @@
 //! to a new wgpu is a version bump, not a port.
 //!
 //! - [`shell`]: shell fur's math in WGSL, the strand frame's tangents and
-//!   the shell texture's mip chain.
+//!   the shell texture's mip chain;
+//! - [`stand_in`]: the shell fur that stands in for a groom far away.
 
 pub mod shell;
+pub mod stand_in;

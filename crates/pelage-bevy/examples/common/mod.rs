@@ -34,6 +34,9 @@ pub struct Args {
     pub timing: bool,
     /// No window: draw into an image (servers, the benchmark).
     pub headless: bool,
+    /// Fur from a groom file (`GroomFur`: its shell stand-in) rather
+    /// than a shells file.
+    pub groom: bool,
 }
 
 impl Args {
@@ -46,6 +49,7 @@ impl Args {
             size: default_size,
             timing: false,
             headless: false,
+            groom: false,
         };
         let mut it = std::env::args().skip(1);
         while let Some(a) = it.next() {
@@ -66,6 +70,7 @@ impl Args {
                 "--no-fur" => args.no_fur = true,
                 "--timing" => args.timing = true,
                 "--headless" => args.headless = true,
+                "--groom" => args.groom = true,
                 "--size" => {
                     let v = value("--size");
                     let parsed = v
@@ -78,7 +83,7 @@ impl Args {
                 }
                 "-h" | "--help" => {
                     println!(
-                        "options: --frames N  --screenshot PNG  --no-fur  --size WxH  --headless  --timing"
+                        "options: --frames N  --screenshot PNG  --no-fur  --groom  --size WxH  --headless  --timing"
                     );
                     std::process::exit(0)
                 }
@@ -89,6 +94,19 @@ impl Args {
             }
         }
         args
+    }
+}
+
+/// The Fox's fur as the command line asks: its shells file, or its
+/// groom file's stand-in (`--groom`); none with `--no-fur`.
+pub fn fox_fur(args: &Args, assets: &AssetServer, entity: &mut EntityCommands) {
+    if args.no_fur {
+        return;
+    }
+    if args.groom {
+        entity.insert(pelage_bevy::GroomFur(assets.load("fox/fox.groom.toml")));
+    } else {
+        entity.insert(pelage_bevy::ShellFur(assets.load("fox/fox.shells.toml")));
     }
 }
 
