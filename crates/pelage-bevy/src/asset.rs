@@ -10,8 +10,8 @@ use bevy::asset::io::Reader;
 use bevy::asset::{AssetLoader, LoadContext};
 use bevy::prelude::*;
 use pelage::dynamics::DynamicsParams;
-use pelage::shell::math::{Coupling, KajiyaKay};
-use pelage::shell::{ShellScene, ShellTextures};
+use pelage::shell::math::{ClumpParams, Coupling, CurlParams, KajiyaKay};
+use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -32,11 +32,21 @@ pub struct ShellFurAsset {
     pub shading: KajiyaKay,
     /// How the tips bend the layers.
     pub coupling: Coupling,
+    /// Curl (Eq. 4): its radius in mesh units; 0: straight.
+    pub curl: CurlParams,
+    /// Clumping (Alg. 2), where the wetness mask is wet; `None`: off.
+    pub clump: Option<ClumpParams>,
+    /// The wetness mask: the file's droplets all fallen (the mask the
+    /// scene's timeline holds after its last droplet); `None`: dry.
+    pub wetness: Option<Arc<WetnessMask>>,
     /// The tips' spring, if the file has `[dynamics]`.
     pub dynamics: Option<DynamicsParams>,
     /// Level of detail: the most pixels between layers on screen, and the
     /// fewest layers; `None`: every layer at every distance.
     pub lod: Option<(f32, u32)>,
+    /// What the file asks for that Bevy does not draw (curl, clumps,
+    /// fins, droplets), named so the loader can say so.
+    pub left_out: Vec<&'static str>,
 }
 
 impl ShellFurAsset {
@@ -51,10 +61,34 @@ impl ShellFurAsset {
             color: Arc::new(scene.color.clone()),
             shading: scene.shading.kajiya_kay,
             coupling: dynamics.map_or(Coupling::Bezier, |d| d.coupling),
+            curl: scene.curl,
+            clump: scene.clump,
+            wetness: wetness_after_droplets(scene),
             dynamics: dynamics.map(|d| d.params.clone()),
             lod: scene.lod.map(|l| (l.max_gap_px, l.min_layers)),
+            left_out: left_out(scene),
         }
     }
+}
+
+/// The mask once every droplet of `scene` has fallen (drying between
+/// them as the timeline does); `None` for a dry scene.
+fn wetness_after_droplets(scene: &ShellScene) -> Option<Arc<WetnessMask>> {
+    let last = scene.droplets.last()?.time;
+    let mut timeline = scene.wetness_timeline();
+    Some(Arc::new(timeline.advance_to(last).clone()))
+}
+
+/// The settings of `scene` that the Bevy plugin does not draw.
+fn left_out(scene: &ShellScene) -> Vec<&'static str> {
+    let mut out = Vec::new();
+    if scene.fins.is_some() {
+        out.push("[fins]");
+    }
+    if scene.droplets.len() > 1 || scene.drying_rate > 0.0 {
+        out.push("droplets over time (Bevy draws the mask after the last one)");
+    }
+    out
 }
 
 /// Reads pelage shells files (`*.shells.toml`, or any `*.toml` loaded as
@@ -107,7 +141,15 @@ impl AssetLoader for ShellFurLoader {
             text: String::from_utf8_lossy(&bytes).into_owned(),
         };
         let scene = ShellScene::from_source(&source)?;
-        Ok(ShellFurAsset::from_scene(&scene))
+        let fur = ShellFurAsset::from_scene(&scene);
+        if !fur.left_out.is_empty() {
+            bevy::log::warn!(
+                "{}: {} not drawn in Bevy (pelage's own renderer draws them; docs/bevy.md, Limits)",
+                path.display(),
+                fur.left_out.join(", ")
+            );
+        }
+        Ok(fur)
     }
 
     fn extensions(&self) -> &[&str] {
@@ -180,8 +222,15 @@ impl ShellFurAsset {
                     k_shadow: 2.0,
                 },
                 coupling: Coupling::Bezier,
+                curl: CurlParams {
+                    radius: 0.0,
+                    frequency: 0.0,
+                },
+                clump: None,
+                wetness: None,
                 dynamics: None,
                 lod: Some((0.75, 4)),
+                left_out: Vec::new(),
             },
             hairs,
         ))
@@ -219,5 +268,35 @@ impl AssetLoader for GroomFurLoader {
 
     fn extensions(&self) -> &[&str] {
         &["groom.toml", "toml"]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fur_of(text: &str) -> ShellFurAsset {
+        let scene = ShellScene::from_source(&pelage::settings::SettingsSource {
+            path: "test.shells.toml".into(),
+            text: text.into(),
+        })
+        .unwrap();
+        ShellFurAsset::from_scene(&scene)
+    }
+
+    /// A file's settings reach the asset, and what Bevy does not draw is
+    /// named, never dropped silently.
+    #[test]
+    fn a_shells_file_becomes_fur_and_names_what_bevy_leaves_out() {
+        let plain = fur_of("[fur]\nlayers = 12\nlength = 0.5\ntiles = 4\n[lod]\nmax_gap = 1.5\n");
+        assert_eq!((plain.layers, plain.length, plain.tiles), (12, 0.5, 4.0));
+        assert_eq!(plain.lod, Some((1.5, 4)));
+        assert_eq!(plain.textures.layers(), 12);
+        assert!(plain.left_out.is_empty(), "{:?}", plain.left_out);
+        assert!(plain.dynamics.is_none());
+        let fancy = fur_of("[curl]\nradius = 0.3\n[fins]\n[dynamics]\nstiffness = 4.0\n");
+        assert_eq!(fancy.left_out, vec!["[fins]"]);
+        assert!(fancy.curl.radius > 0.0 && fancy.wetness.is_none());
+        assert_eq!(fancy.dynamics.as_ref().map(|d| d.stiffness), Some(4.0));
     }
 }

@@ -56,8 +56,16 @@ pub(crate) struct FurredSkin {
 /// character holds one copy).
 #[derive(Resource, Default)]
 pub(crate) struct FurCache {
-    images: HashMap<AssetId<ShellFurAsset>, (Handle<Image>, Handle<Image>)>,
+    images: HashMap<AssetId<ShellFurAsset>, FurImages>,
     meshes: HashMap<(AssetId<Mesh>, u32), Handle<Mesh>>,
+}
+
+/// One asset's images: shell texture, colour, wetness mask.
+#[derive(Clone)]
+struct FurImages {
+    layers: Handle<Image>,
+    color: Handle<Image>,
+    wetness: Handle<Image>,
 }
 
 /// The layer counts of the levels of detail: all, then halves down to
@@ -140,7 +148,7 @@ pub(crate) fn attach_fur(
                 let handle = meshes.add(m);
                 cache.meshes.insert((mesh3d.0.id(), layers), handle);
             }
-            let (layer_image, color_image) = cache
+            let textures = cache
                 .images
                 .entry(shell_fur.0.id())
                 .or_insert_with(|| fur_images(fur, &mut images))
@@ -152,8 +160,9 @@ pub(crate) fn attach_fur(
                 };
                 let material = materials.add(ShellFurMaterial {
                     fur: uniform(fur, layers),
-                    layers: layer_image.clone(),
-                    color: color_image.clone(),
+                    layers: textures.layers.clone(),
+                    color: textures.color.clone(),
+                    wetness: textures.wetness.clone(),
                 });
                 let mut e = commands.spawn((
                     Name::new(format!("pelage fur ({layers} layers)")),
@@ -353,13 +362,34 @@ fn uniform(fur: &ShellFurAsset, layers: u32) -> ShellFurUniform {
         k_shadow: fur.shading.k_shadow,
         opacity: 1.0,
         color_gain: 1.0,
-        pad: 0.0,
+        effects: effects(fur),
+        curl_radius: fur.curl.radius,
+        curl_frequency: fur.curl.frequency,
+        clump_w: fur.clump.map_or(0.0, |c| c.w),
+        clump_strength: fur.clump.map_or(0.0, |c| c.strength),
+        wetness_size: fur.wetness.as_ref().map_or(Vec2::ONE, |m| {
+            Vec2::new(m.width() as f32, m.height() as f32)
+        }),
     }
 }
 
-/// The shell texture (one slice a layer, pelage's mip chain, repeating)
-/// and the colour (sRGB) as Bevy images.
-fn fur_images(fur: &ShellFurAsset, images: &mut Assets<Image>) -> (Handle<Image>, Handle<Image>) {
+/// Which of curl and clumps `fur` draws: curl wherever it has a radius
+/// (dry fur curls most), clumps only where the mask is wet.
+fn effects(fur: &ShellFurAsset) -> u32 {
+    let mut bits = 0;
+    if fur.curl.radius > 0.0 {
+        bits |= ShellFurUniform::CURL;
+    }
+    if fur.wetness.is_some() && fur.clump.is_some_and(|c| c.strength > 0.0) {
+        bits |= ShellFurUniform::CLUMP;
+    }
+    bits
+}
+
+/// The shell texture (one slice a layer, pelage's mip chain, repeating),
+/// the colour (sRGB) and the wetness mask (a dry texel without one) as
+/// Bevy images.
+fn fur_images(fur: &ShellFurAsset, images: &mut Assets<Image>) -> FurImages {
     let t = &fur.textures;
     let (data, mips) = pelage_shaders::shell::fur_mip_chain(t);
     // Every level of every layer, layer by layer (Bevy's default
@@ -396,5 +426,28 @@ fn fur_images(fur: &ShellFurAsset, images: &mut Assets<Image>) -> (Handle<Image>
         TextureFormat::Rgba8UnormSrgb,
         RenderAssetUsages::RENDER_WORLD,
     );
-    (images.add(layers), images.add(color))
+    let (size, texels) = match &fur.wetness {
+        Some(m) => ((m.width(), m.height()), m.to_rgba()),
+        None => ((1, 1), vec![[0.0; 4]]),
+    };
+    let wetness = Image::new(
+        Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        texels
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect(),
+        TextureFormat::Rgba32Float,
+        RenderAssetUsages::RENDER_WORLD,
+    );
+    FurImages {
+        layers: images.add(layers),
+        color: images.add(color),
+        wetness: images.add(wetness),
+    }
 }

@@ -80,8 +80,25 @@ pub struct ShellFurUniform {
     pub opacity: f32,
     /// The colour texture's gain (1: as painted).
     pub color_gain: f32,
-    /// Keeps the block a multiple of 16 bytes.
-    pub pad: f32,
+    /// Bit 0: curl (Eq. 4); bit 1: clumps (Alg. 2).
+    pub effects: u32,
+    /// The curl's radius at the tip of dry fur `K_α` (mesh units).
+    pub curl_radius: f32,
+    /// The curl's turn from root to tip `ω` (radians).
+    pub curl_frequency: f32,
+    /// The clump profile's `w`.
+    pub clump_w: f32,
+    /// The clump's strength.
+    pub clump_strength: f32,
+    /// The wetness mask's size in texels.
+    pub wetness_size: Vec2,
+}
+
+impl ShellFurUniform {
+    /// `effects`' bit for curl.
+    pub const CURL: u32 = 1;
+    /// `effects`' bit for clumps.
+    pub const CLUMP: u32 = 2;
 }
 
 /// Shell fur as Bevy draws it: one per furred mesh and level of detail.
@@ -98,6 +115,10 @@ pub struct ShellFurMaterial {
     #[texture(3)]
     #[sampler(4)]
     pub color: Handle<Image>,
+    /// pelage's wetness mask (clump centre, radius, wetness; 32-bit
+    /// floats, read texel by texel).
+    #[texture(5, sample_type = "float", filterable = false)]
+    pub wetness: Handle<Image>,
 }
 
 impl Material for ShellFurMaterial {

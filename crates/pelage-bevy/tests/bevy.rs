@@ -436,6 +436,34 @@ fn a_changed_shells_file_changes_the_picture() {
         count(&mask(&long)),
         count(&mask(&short))
     );
+
+    // Curl, and droplets that wet the fur into clumps: the same fur,
+    // curled and clumped, draws differently.
+    let wet = text.replace("[fur]\n", "[fur]\nlength = 9.0\n")
+        + "\n[curl]\nradius = 0.5\nturns = 1.5\n\n[[droplets]]\ncount = 300\nradius = [0.03, 0.06]\nseed = 3\n";
+    std::fs::write(&shells, wet).unwrap();
+    let curled = |world: &mut World| {
+        let handle = world.get::<ShellFur>(fox).unwrap().0.clone();
+        world
+            .resource::<Assets<ShellFurAsset>>()
+            .get(&handle)
+            .is_some_and(|a| a.curl.radius > 0.0 && a.wetness.is_some())
+    };
+    for _ in 0..200 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.frames(1);
+        if curled(h.app.world_mut()) {
+            break;
+        }
+    }
+    assert!(
+        curled(h.app.world_mut()),
+        "the curl was not reloaded in 10 s"
+    );
+    let wet_picture = h.settled_picture();
+    save_for_inspection("reload-curled.png", &wet_picture);
+    let changed = count(&differ(&long, &wet_picture));
+    assert!(changed > 500, "curl and clumps changed {changed} pixels");
 }
 
 /// A groom file on the Fox is drawn as the shell fur that stands in for

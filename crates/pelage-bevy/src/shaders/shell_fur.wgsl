@@ -1,7 +1,8 @@
 // Shell fur in Bevy's main 3D pass (pelage-bevy's ShellFurMaterial): the
 // layers of a fur mesh (the skin's vertices once per layer, `layer` n)
 // skinned by Bevy's own joint matrices, pushed out along the strand
-// (Silva Eq. 1 with the file's coupling, Banisch Fig. 6), textured by
+// (Silva Eq. 1 with the file's coupling, Banisch Fig. 6), curled (Eq. 4)
+// and clumped (Alg. 2) by the wetness mask, textured by
 // pelage's shell texture and shaded with Kajiya-Kay (Silva Eq. 6) under
 // the scene's directional lights. The math is pelage's shared module
 // (pelage-shaders' shell_math.wgsl), the same pelage-gpu runs.
@@ -12,7 +13,10 @@
     mesh_view_bindings::{view, lights},
     view_transformations::position_world_to_clip,
 }
-#import pelage::shell_math::{coupled_offset, coupled_tangent, layer_height, kajiya_kay_lit, shadow_factor}
+#import pelage::shell_math::{
+    coupled_offset, coupled_tangent, layer_height, kajiya_kay_lit, shadow_factor,
+    curl_offset, curl_tangent, clump_profile, clump_displacement,
+}
 #ifdef TONEMAP_IN_SHADER
 #import bevy_core_pipeline::tonemapping::tone_mapping
 #endif
@@ -38,7 +42,16 @@ struct ShellFur {
     opacity: f32,
     // The colour texture's gain (1: as painted).
     color_gain: f32,
-    pad: f32,
+    // Bit 0: curl (Eq. 4); bit 1: clumps (Alg. 2).
+    effects: u32,
+    // K_α (mesh units) and ω of the curl.
+    curl_radius: f32,
+    curl_frequency: f32,
+    // w and the strength of the clump.
+    clump_w: f32,
+    clump_strength: f32,
+    // The wetness mask's size in texels.
+    wetness_size: vec2<f32>,
 };
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> fur: ShellFur;
@@ -46,6 +59,19 @@ struct ShellFur {
 @group(#{MATERIAL_BIND_GROUP}) @binding(2) var fur_sampler: sampler;
 @group(#{MATERIAL_BIND_GROUP}) @binding(3) var color_texture: texture_2d<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(4) var color_sampler: sampler;
+// pelage's WetnessMask (WetTexel: clump centre xy, radius z, wetness w),
+// read at mask coordinates: Bevy's glTF UVs are already those.
+@group(#{MATERIAL_BIND_GROUP}) @binding(5) var wetness: texture_2d<f32>;
+
+const CURL: u32 = 1u;
+const CLUMP: u32 = 2u;
+
+// WetnessMask::at: nearest texel, clamped.
+fn wetness_at(p: vec2<f32>) -> vec4<f32> {
+    let size = fur.wetness_size;
+    let texel = clamp(floor(p * size), vec2<f32>(0.0), size - 1.0);
+    return textureLoad(wetness, vec2<i32>(texel), 0);
+}
 
 // Locations as Bevy's mesh pipeline gives them (forward_io's Vertex), and
 // the layer at 8 (ATTRIBUTE_SHELL_LAYER).
@@ -87,20 +113,33 @@ fn vertex(v: Vertex) -> FurOut {
     let root = (world_from_local * vec4<f32>(v.position, 1.0)).xyz;
     let rest_tip = (world_from_local * vec4<f32>(v.position + fur.length * normalize(v.normal), 1.0)).xyz;
     let tip = rest_tip + fur.tip_offset;
-    let offset = coupled_offset(fur.coupling, fur.coupling_exponent, root, rest_tip, tip, h);
+    var offset = coupled_offset(fur.coupling, fur.coupling_exponent, root, rest_tip, tip, h);
     var t = coupled_tangent(fur.coupling, fur.coupling_exponent, root, rest_tip, tip, h);
     if dot(t, t) == 0.0 {
         t = rest_tip - root;
     }
     let n = normalize(rest_tip - root);
     let along = (world_from_local * vec4<f32>(v.tangent.xyz, 0.0)).xyz;
+    var u = along - n * dot(n, along);
+    if dot(u, u) == 0.0 {
+        u = vec3<f32>(1.0, 0.0, 0.0);
+    }
+    u = normalize(u);
+    if (fur.effects & CURL) != 0u {
+        // K_α is in mesh units; the skin's matrix scales it as the strand.
+        let scale = distance(rest_tip, root) / max(fur.length, 1e-12);
+        let wet = wetness_at(v.uv).w;
+        let k = fur.curl_radius * scale;
+        offset += curl_offset(h, wet, k, fur.curl_frequency, u, cross(n, u));
+        t += curl_tangent(h, wet, k, fur.curl_frequency, u, cross(n, u));
+    }
     var out: FurOut;
     out.world = root + offset;
     out.clip = position_world_to_clip(out.world);
     out.uv = v.uv;
     out.tangent = t;
     out.normal = n;
-    out.u_axis = along - n * dot(n, along);
+    out.u_axis = u;
     out.h = h;
     out.layer = v.layer;
     return out;
@@ -108,11 +147,34 @@ fn vertex(v: Vertex) -> FurOut {
 
 @fragment
 fn fragment(v: FurOut) -> @location(0) vec4<f32> {
-    let shell = textureSample(fur_layers, fur_sampler, v.uv * fur.tiles, v.layer);
+    var uv_color = v.uv;
+    var uv_geo = v.uv * fur.tiles;
+    // Derivatives taken before any branch (a clump may discard): the
+    // lookups below then need no uniform control flow.
+    let geo_dx = dpdx(uv_geo);
+    let geo_dy = dpdy(uv_geo);
+    let color_dx = dpdx(uv_color);
+    let color_dy = dpdy(uv_color);
+    // Alg. 2: a wet texel's hairs lean towards its clump's centre; what
+    // leaves the clump or lands on dry fur is not drawn.
+    if (fur.effects & CLUMP) != 0u {
+        let here = wetness_at(v.uv);
+        if here.w != 0.0 {
+            let profile = clump_profile(v.h, fur.clump_w, fur.layers);
+            let d = clump_displacement(profile, fur.clump_strength, here.w, v.uv, here.xy);
+            if distance(v.uv, here.xy) > here.z || wetness_at(v.uv + d).w == 0.0 {
+                discard;
+            }
+            uv_color += d;
+            uv_geo += d * fur.tiles;
+        }
+    }
+    let shell = textureSampleGrad(fur_layers, fur_sampler, uv_geo, v.layer, geo_dx, geo_dy);
     if shell.a <= 0.0 {
         discard;
     }
-    let color = fur.color_gain * textureSample(color_texture, color_sampler, v.uv).rgb;
+    let color = fur.color_gain
+        * textureSampleGrad(color_texture, color_sampler, uv_color, color_dx, color_dy).rgb;
     // The strand tangent, leaning with the texel's own hair (x along
     // dP/du, y down the image), as pelage-gpu's fs_layer does.
     let n = normalize(v.normal);
