@@ -122,27 +122,48 @@ pub(crate) fn attach_fur(
             if furred.is_some_and(|f| f.asset == shell_fur.0.id() && f.owner == owner) {
                 continue;
             }
+            // A mesh's own ShellFur wins over a scene root's above it; of
+            // two roots, the one that furred it first keeps it.
+            if let Some(f) = furred
+                && f.owner != owner
+                && owner != skin
+                && owners.contains(f.owner)
+            {
+                continue;
+            }
+            let Some(skin_mesh) = meshes.get(&mesh3d.0) else {
+                continue;
+            };
             if let Some(old) = furred {
                 for &e in &old.fur {
                     commands.entity(e).despawn();
                 }
             }
-            let Some(skin_mesh) = meshes.get(&mesh3d.0) else {
-                continue;
-            };
             // Each level's fur mesh: shared by every mesh of this shape.
             let levels = lod_layers(fur);
             let mut made = Vec::new();
+            let mut refused = false;
             for &layers in &levels {
                 if !cache.meshes.contains_key(&(mesh3d.0.id(), layers)) {
                     match fur_mesh(skin_mesh, layers) {
                         Ok(m) => made.push((layers, m)),
                         Err(e) => {
-                            bevy::log::warn!("pelage: no shell fur on {skin}: {e}");
+                            bevy::log::warn!("pelage: no shell fur on mesh entity {skin}: {e}");
+                            refused = true;
                             break;
                         }
                     }
                 }
+            }
+            if refused {
+                // Said once: the mesh is not tried again until the asset
+                // or the component changes.
+                commands.entity(skin).insert(FurredSkin {
+                    owner,
+                    asset: shell_fur.0.id(),
+                    fur: Vec::new(),
+                });
+                continue;
             }
             for (layers, m) in made {
                 let handle = meshes.add(m);
@@ -271,11 +292,12 @@ pub(crate) fn step_dynamics(
         let Ok((_, _, motion)) = owners.get(layers.owner) else {
             continue;
         };
-        // Only a moved spring touches the material (a touched material is
-        // uploaded again).
+        // Only a spring that moved visibly touches the material (a touched
+        // material is uploaded again); one settling by less than a
+        // thousandth of the fur's length leaves it.
         if materials
             .get(&material.0)
-            .is_some_and(|m| m.fur.tip_offset != motion.offset)
+            .is_some_and(|m| m.fur.tip_offset.distance(motion.offset) > 1e-3 * m.fur.length)
             && let Some(mut m) = materials.get_mut(&material.0)
         {
             m.fur.tip_offset = motion.offset;
