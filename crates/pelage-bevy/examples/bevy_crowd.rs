@@ -10,10 +10,8 @@
 
 mod common;
 
-use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
-use bevy::world_serialization::WorldInstanceReady;
-use common::Args;
+use common::{Args, Running};
 
 /// Foxes a side of the square.
 const SIDE: i32 = 10;
@@ -27,14 +25,6 @@ fn main() {
         .add_systems(Startup, setup)
         .add_systems(Update, (fly_over, report_fps))
         .run();
-}
-
-/// The clip to play and where in it to start, until the scene is ready.
-#[derive(Component)]
-struct Running {
-    graph: Handle<AnimationGraph>,
-    index: AnimationNodeIndex,
-    phase: f32,
 }
 
 fn setup(
@@ -61,11 +51,11 @@ fn setup(
             Running {
                 graph: graph.clone(),
                 index,
-                phase: (i as f32 * 0.37) % 1.0,
+                phase: 0.7 * ((i as f32 * 0.37) % 1.0),
             },
         ));
         common::fox_fur(&args, &assets, &mut fox);
-        fox.observe(start_running);
+        fox.observe(common::start_running);
     }
     commands.spawn((
         Mesh3d(meshes.add(Plane3d::default().mesh().size(4000.0, 4000.0))),
@@ -78,36 +68,7 @@ fn setup(
         },
         Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y),
     ));
-    // Bevy's default tonemapping (TonyMcMapface) needs its LUT feature,
-    // which these examples leave out to build faster.
-    let mut camera = commands.spawn((
-        Camera3d::default(),
-        Tonemapping::AcesFitted,
-        Transform::default(),
-    ));
-    if let Some(image) = target.camera() {
-        camera.insert(image);
-    }
-}
-
-fn start_running(
-    ready: On<WorldInstanceReady>,
-    mut commands: Commands,
-    children: Query<&Children>,
-    running: Query<&Running>,
-    mut players: Query<&mut AnimationPlayer>,
-) {
-    let Ok(run) = running.get(ready.entity) else {
-        return;
-    };
-    for child in children.iter_descendants(ready.entity) {
-        if let Ok(mut player) = players.get_mut(child) {
-            player.play(run.index).repeat().seek_to(run.phase * 0.7);
-            commands
-                .entity(child)
-                .insert(AnimationGraphHandle(run.graph.clone()));
-        }
-    }
+    target.spawn_camera(&mut commands);
 }
 
 /// The camera circles the field, near foxes close, far ones small.

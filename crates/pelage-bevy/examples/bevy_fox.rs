@@ -13,11 +13,9 @@
 
 mod common;
 
-use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll};
 use bevy::prelude::*;
-use bevy::world_serialization::WorldInstanceReady;
-use common::Args;
+use common::{Args, Running};
 
 fn main() {
     let args = Args::parse((1280, 720));
@@ -26,13 +24,6 @@ fn main() {
         .add_systems(Startup, setup)
         .add_systems(Update, (orbit, pass_the_ball))
         .run();
-}
-
-/// The clip to play, until the scene is ready for it.
-#[derive(Component)]
-struct Running {
-    graph: Handle<AnimationGraph>,
-    index: AnimationNodeIndex,
 }
 
 /// The camera's orbit about the fox.
@@ -64,10 +55,11 @@ fn setup(
         Running {
             graph: graphs.add(graph),
             index,
+            phase: 0.0,
         },
     ));
     common::fox_fur(&args, &assets, &mut fox);
-    fox.observe(start_running);
+    fox.observe(common::start_running);
 
     commands.spawn((
         Mesh3d(meshes.add(Plane3d::default().mesh().size(600.0, 600.0))),
@@ -91,41 +83,11 @@ fn setup(
         },
         Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y),
     ));
-    let mut camera = commands.spawn((
-        Camera3d::default(),
-        // Bevy's default (TonyMcMapface) needs its LUT feature, which
-        // these examples leave out to build faster.
-        Tonemapping::AcesFitted,
-        Orbit {
-            yaw: 0.6,
-            pitch: 0.3,
-            distance: 190.0,
-        },
-        Transform::default(),
-    ));
-    if let Some(image) = target.camera() {
-        camera.insert(image);
-    }
-}
-
-fn start_running(
-    ready: On<WorldInstanceReady>,
-    mut commands: Commands,
-    children: Query<&Children>,
-    running: Query<&Running>,
-    mut players: Query<&mut AnimationPlayer>,
-) {
-    let Ok(run) = running.get(ready.entity) else {
-        return;
-    };
-    for child in children.iter_descendants(ready.entity) {
-        if let Ok(mut player) = players.get_mut(child) {
-            player.play(run.index).repeat();
-            commands
-                .entity(child)
-                .insert(AnimationGraphHandle(run.graph.clone()));
-        }
-    }
+    target.spawn_camera(&mut commands).insert(Orbit {
+        yaw: 0.6,
+        pitch: 0.3,
+        distance: 190.0,
+    });
 }
 
 /// Drag to turn, scroll to zoom; left alone, the camera circles slowly.

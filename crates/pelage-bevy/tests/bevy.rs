@@ -380,6 +380,26 @@ fn fur_sits_on_the_fox_is_hidden_by_what_is_in_front_and_follows_its_pose() {
     assert_eq!(stayed, 0, "{stayed} fur pixels where the skin was");
 }
 
+/// Steps frames (in real time: the file watcher runs on its own thread)
+/// until the fox's shells asset satisfies `edited`, at most 10 s.
+fn wait_for_reload(h: &mut Headless, fox: Entity, edited: impl Fn(&ShellFurAsset) -> bool) {
+    let done = |world: &mut World| {
+        let handle = world.get::<ShellFur>(fox).unwrap().0.clone();
+        world
+            .resource::<Assets<ShellFurAsset>>()
+            .get(&handle)
+            .is_some_and(&edited)
+    };
+    for _ in 0..200 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.frames(1);
+        if done(h.app.world_mut()) {
+            return;
+        }
+    }
+    panic!("the edit was not reloaded in 10 s");
+}
+
 /// Editing the shells file while the app runs regrows the fur: longer
 /// fur covers more of the picture.
 #[test]
@@ -408,24 +428,7 @@ fn a_changed_shells_file_changes_the_picture() {
 
     std::fs::write(&shells, text.replace("[fur]\n", "[fur]\nlength = 9.0\n")).unwrap();
     // The file watcher reports the change and the asset is read again.
-    let reloaded = |world: &mut World| {
-        let handle = world.get::<ShellFur>(fox).unwrap().0.clone();
-        world
-            .resource::<Assets<ShellFurAsset>>()
-            .get(&handle)
-            .is_some_and(|a| a.length == 9.0)
-    };
-    for _ in 0..200 {
-        std::thread::sleep(std::time::Duration::from_millis(50));
-        h.frames(1);
-        if reloaded(h.app.world_mut()) {
-            break;
-        }
-    }
-    assert!(
-        reloaded(h.app.world_mut()),
-        "the edit was not reloaded in 10 s"
-    );
+    wait_for_reload(&mut h, fox, |a| a.length == 9.0);
     let long = h.settled_picture();
     save_for_inspection("reload-short.png", &short);
     save_for_inspection("reload-long.png", &long);
@@ -442,24 +445,7 @@ fn a_changed_shells_file_changes_the_picture() {
     let wet = text.replace("[fur]\n", "[fur]\nlength = 9.0\n")
         + "\n[curl]\nradius = 0.5\nturns = 1.5\n\n[[droplets]]\ncount = 300\nradius = [0.03, 0.06]\nseed = 3\n";
     std::fs::write(&shells, wet).unwrap();
-    let curled = |world: &mut World| {
-        let handle = world.get::<ShellFur>(fox).unwrap().0.clone();
-        world
-            .resource::<Assets<ShellFurAsset>>()
-            .get(&handle)
-            .is_some_and(|a| a.curl.radius > 0.0 && a.wetness.is_some())
-    };
-    for _ in 0..200 {
-        std::thread::sleep(std::time::Duration::from_millis(50));
-        h.frames(1);
-        if curled(h.app.world_mut()) {
-            break;
-        }
-    }
-    assert!(
-        curled(h.app.world_mut()),
-        "the curl was not reloaded in 10 s"
-    );
+    wait_for_reload(&mut h, fox, |a| a.curl.radius > 0.0 && a.wetness.is_some());
     let wet_picture = h.settled_picture();
     save_for_inspection("reload-curled.png", &wet_picture);
     let changed = count(&differ(&long, &wet_picture));

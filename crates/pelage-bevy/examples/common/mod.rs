@@ -110,6 +110,40 @@ pub fn fox_fur(args: &Args, assets: &AssetServer, entity: &mut EntityCommands) {
     }
 }
 
+/// A fox's clip, to play once its scene has spawned, from `phase`
+/// seconds in.
+#[derive(Component)]
+pub struct Running {
+    /// The graph holding the clip.
+    pub graph: Handle<AnimationGraph>,
+    /// The clip's node.
+    pub index: AnimationNodeIndex,
+    /// Where in the clip to start (s).
+    pub phase: f32,
+}
+
+/// Observer of a fox's scene: plays its [`Running`] clip on the scene's
+/// animation player.
+pub fn start_running(
+    ready: On<bevy::world_serialization::WorldInstanceReady>,
+    mut commands: Commands,
+    children: Query<&Children>,
+    running: Query<&Running>,
+    mut players: Query<&mut AnimationPlayer>,
+) {
+    let Ok(run) = running.get(ready.entity) else {
+        return;
+    };
+    for child in children.iter_descendants(ready.entity) {
+        if let Ok(mut player) = players.get_mut(child) {
+            player.play(run.index).repeat().seek_to(run.phase);
+            commands
+                .entity(child)
+                .insert(AnimationGraphHandle(run.graph.clone()));
+        }
+    }
+}
+
 /// pelage's asset folder, where the Fox and its shells file are.
 pub fn asset_folder() -> PathBuf {
     PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../pelage/assets"))
@@ -120,9 +154,19 @@ pub fn asset_folder() -> PathBuf {
 pub struct Target(pub Option<Handle<Image>>);
 
 impl Target {
-    /// The camera's target component, if not the window.
-    pub fn camera(&self) -> Option<RenderTarget> {
-        self.0.clone().map(|h| RenderTarget::Image(h.into()))
+    /// Spawns the examples' camera, drawing into the window or the image.
+    pub fn spawn_camera<'a>(&self, commands: &'a mut Commands) -> EntityCommands<'a> {
+        let mut camera = commands.spawn((
+            Camera3d::default(),
+            // Bevy's default (TonyMcMapface) needs its LUT feature, which
+            // these examples leave out to build faster.
+            bevy::core_pipeline::tonemapping::Tonemapping::AcesFitted,
+            Transform::default(),
+        ));
+        if let Some(h) = &self.0 {
+            camera.insert(RenderTarget::Image(h.clone().into()));
+        }
+        camera
     }
 }
 
