@@ -69,7 +69,10 @@ impl Headless {
                     ..default()
                 })
                 .disable::<WinitPlugin>()
-                .disable::<LogPlugin>(),
+                .disable::<LogPlugin>()
+                // The render world stays in the app between frames, so a
+                // test can ask its pipeline cache what is still compiling.
+                .disable::<bevy::render::pipelined_rendering::PipelinedRenderingPlugin>(),
         )
         .add_plugins(PelagePlugin {
             asset_folder: Some(folder.to_path_buf()),
@@ -150,15 +153,26 @@ impl Headless {
         panic!("no screenshot after 400 frames");
     }
 
+    /// Whether Bevy is still compiling a pipeline.
+    fn compiling(&self) -> bool {
+        let render = self.app.sub_app(bevy::render::RenderApp);
+        render
+            .world()
+            .resource::<bevy::render::render_resource::PipelineCache>()
+            .waiting_pipelines()
+            .next()
+            .is_some()
+    }
+
     /// A few frames for pipelines to compile (Bevy compiles them in the
     /// background and draws nothing with a pipeline not ready), then a
-    /// picture that no longer changes.
+    /// picture with something in it that no longer changes.
     fn settled_picture(&mut self) -> image::RgbImage {
         let mut last = self.picture();
-        for _ in 0..40 {
+        for _ in 0..60 {
             self.frames(3);
             let next = self.picture();
-            if next == last {
+            if next == last && count(&mask(&next)) > 0 && !self.compiling() {
                 return next;
             }
             last = next;
@@ -490,4 +504,63 @@ fn a_groom_wears_its_shell_stand_in() {
     let world = h.app.world_mut();
     let mut q = world.query::<&FurLayers>();
     assert_eq!(q.iter(world).count(), 0, "the fur went with the groom");
+}
+
+/// A mesh Bevy made itself, not skinned (a UV sphere), wears fur too:
+/// the layers follow its transform, and the fur stands past its outline.
+#[test]
+fn a_still_bevy_mesh_wears_fur_too() {
+    if !gpu_available() {
+        return;
+    }
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let mut h = Headless::new(&pelage_assets());
+    let world = h.app.world_mut();
+    let mesh = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Sphere::new(30.0).mesh().uv(48, 24));
+    let material = world
+        .resource_mut::<Assets<StandardMaterial>>()
+        .add(Color::srgb(0.5, 0.4, 0.3));
+    let ball = world
+        .spawn((
+            Mesh3d(mesh),
+            MeshMaterial3d(material),
+            Transform::from_xyz(0.0, 35.0, 0.0),
+        ))
+        .id();
+    let bare = h.settled_picture();
+    let fur = h
+        .app
+        .world_mut()
+        .resource::<AssetServer>()
+        .load("fox/fox.shells.toml");
+    h.app.world_mut().entity_mut(ball).insert(ShellFur(fur));
+    h.until(600, |world| {
+        let mut q = world.query::<&FurLayers>();
+        q.iter(world).next().is_some()
+    });
+    let furred = h.settled_picture();
+    save_for_inspection("sphere-furred.png", &furred);
+    let skin = mask(&bare);
+    let changed = differ(&bare, &furred);
+    let outside = changed
+        .iter()
+        .zip(&skin)
+        .filter(|(c, s)| **c && !**s)
+        .count();
+    let near = dilate(&skin, FUR_PX);
+    let astray = changed
+        .iter()
+        .zip(&near)
+        .filter(|(c, n)| **c && !**n)
+        .count();
+    assert!(
+        count(&changed) > count(&skin) / 2,
+        "fur on {} of {}",
+        count(&changed),
+        count(&skin)
+    );
+    assert!(outside > 100, "fur past the outline: {outside} pixels");
+    assert_eq!(astray, 0, "{astray} fur pixels away from the sphere");
 }
