@@ -306,7 +306,8 @@ pub(crate) fn step_dynamics(
 }
 
 /// Each level of detail drawn only at the distances where its layers
-/// stand at most the file's gap apart on screen, for the camera's
+/// stand at most the file's gap apart on screen (and no fur where all of
+/// it would be shorter than one gap), for the camera's
 /// projection (the first perspective camera); and the fur's bounds are
 /// its skin's, grown by the fur's length, so it is culled with it.
 pub(crate) fn choose_levels(
@@ -355,9 +356,11 @@ pub(crate) fn choose_levels(
         } else {
             d / layers.layers as f32
         };
+        // Past d the whole fur is shorter on screen than one gap: none is
+        // drawn there (the skin's own colour carries it).
         let end = match levels.get(layers.level + 1) {
             Some(&next) => d / next as f32,
-            None => f32::MAX,
+            None => d,
         };
         let wanted = VisibilityRange::abrupt(start, end);
         if range != Some(&wanted) {
