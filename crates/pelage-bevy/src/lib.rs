@@ -1,8 +1,9 @@
 //! pelage in Bevy: shell fur on Bevy's own meshes and skinned characters.
 //!
-//! Add [`PelagePlugin`], then put a [`ShellFur`] on an entity with a
-//! [`Mesh3d`] — or on a glTF scene's root, and
-//! every mesh below it wears the fur once the scene has spawned:
+//! Add [`PelagePlugin`], then put a [`ShellFur`] (a shells file) or a
+//! [`GroomFur`] (a groom file, drawn as its shell stand-in) on an entity
+//! with a [`Mesh3d`] — or on a glTF scene's root, and every mesh below it
+//! wears the fur once the scene has spawned:
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -25,15 +26,17 @@
 //! main 3D pass) with a [`ShellFurMaterial`]: Bevy skins its layers with
 //! the joint matrices it skins the character with, tests them against the
 //! depth of everything opaque, lights them with the scene's directional
-//! lights, culls them with the character and picks a level of detail per
-//! camera ([`VisibilityRange`](bevy::camera::visibility::VisibilityRange)).
-//! Its WGSL math and data (tangents, the shell texture's mips) are
-//! pelage's shared layer (`pelage-shaders`), the same pelage-gpu draws
-//! with. A shells file is an asset: edit it and the fur regrows.
+//! lights, curls and clumps them by the wetness mask, culls them with the
+//! character and picks a level of detail per camera
+//! ([`VisibilityRange`](bevy::camera::visibility::VisibilityRange)). Its
+//! WGSL math and data (tangents, the shell texture's mips, a groom's
+//! stand-in) are pelage's shared layer (`pelage-shaders`), the same
+//! pelage-gpu draws with. Shells and groom files are assets: edit one and
+//! the fur regrows. docs/bevy.md has the whole story and the limits.
 //!
 //! The parts, lowest first: `material.rs` (the material, its uniform
 //! block, the shaders), `mesh.rs` (a fur mesh from a Bevy mesh),
-//! `asset.rs` (a shells file as an asset), `dynamics.rs` (a coat's
+//! `asset.rs` (shells and groom files as assets), `dynamics.rs` (a coat's
 //! spring), `fur.rs` (the systems).
 
 mod asset;
@@ -59,9 +62,9 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, Default)]
 pub struct PelagePlugin {
     /// The folder Bevy reads assets from, as given to `AssetPlugin`
-    /// (`None`: Bevy's default, `assets/` beside the app). A shells file
-    /// names its mesh and colour relative to itself, and pelage reads
-    /// them from disk there.
+    /// (`None`: Bevy's default, `assets/` beside the app). A shells or
+    /// groom file names its mesh, colour and guides relative to itself,
+    /// and pelage reads them from disk there.
     pub asset_folder: Option<PathBuf>,
 }
 
