@@ -1,7 +1,9 @@
-//! The Khronos Fox, loaded by Bevy's glTF loader and running, wearing
-//! pelage's shell fur (`fox/fox.shells.toml`): Bevy skins the fur with the
-//! fox's own joints, a ball passes in front and hides it, the sun lights
-//! both. Drag with the left mouse button to orbit, scroll to zoom.
+//! The Khronos Fox, loaded by Bevy's glTF loader and running round a
+//! circle, wearing pelage's shell fur (`fox/fox.shells.toml`): Bevy skins
+//! the fur with the fox's own joints, the coat sways as the fox turns and
+//! hangs with gravity, a ball passes in front and hides it, the sun lights
+//! both. Drag with the left mouse button to orbit, scroll to zoom; hold W
+//! for wind (pelage's `FurForces`).
 //!
 //! ```text
 //! cargo run --release -p pelage-bevy --example bevy_fox
@@ -22,7 +24,7 @@ fn main() {
     common::app(&args, "pelage in Bevy: the Fox")
         .insert_resource(common::Characters(1))
         .add_systems(Startup, setup)
-        .add_systems(Update, (orbit, pass_the_ball))
+        .add_systems(Update, (run_round, orbit, pass_the_ball, blow))
         .run();
 }
 
@@ -38,6 +40,14 @@ struct Orbit {
 #[derive(Component)]
 struct Ball;
 
+/// The fox, running round the field's centre.
+#[derive(Component)]
+struct Fox;
+
+/// Radius of the fox's circle, and its speed (the Run clip's pace).
+const CIRCLE: f32 = 60.0;
+const SPEED: f32 = 110.0;
+
 fn setup(
     mut commands: Commands,
     args: Res<Args>,
@@ -51,6 +61,7 @@ fn setup(
         assets.load(GltfAssetLabel::Animation(2).from_asset("fox/Fox.gltf")),
     );
     let mut fox = commands.spawn((
+        Fox,
         WorldAssetRoot(assets.load(GltfAssetLabel::Scene(0).from_asset("fox/Fox.gltf"))),
         Running {
             graph: graphs.add(graph),
@@ -90,6 +101,27 @@ fn setup(
     });
 }
 
+/// The fox runs round the circle (its clip runs in place): the entity
+/// moves and turns, and its coat's spring feels it.
+fn run_round(clock: Res<common::SceneClock>, mut foxes: Query<&mut Transform, With<Fox>>) {
+    let angle = SPEED / CIRCLE * clock.0;
+    for mut t in &mut foxes {
+        t.translation = CIRCLE * Vec3::new(angle.cos(), 0.0, -angle.sin());
+        // The glTF fox faces +z; it runs along the circle's tangent.
+        let heading = Vec3::new(-angle.sin(), 0.0, -angle.cos());
+        t.rotation = Quat::from_rotation_arc(Vec3::Z, heading);
+    }
+}
+
+/// Hold W: wind across the field, pulling every coat (a resource).
+fn blow(keys: Res<ButtonInput<KeyCode>>, mut forces: ResMut<pelage_bevy::FurForces>) {
+    forces.wind = if keys.pressed(KeyCode::KeyW) {
+        Vec3::new(400.0, 0.0, 0.0)
+    } else {
+        Vec3::ZERO
+    };
+}
+
 /// Drag to turn, scroll to zoom; left alone, the camera circles slowly.
 fn orbit(
     time: Res<Time>,
@@ -118,16 +150,20 @@ fn orbit(
     }
 }
 
+/// The camera's transform, apart from the fox's and the ball's.
+type OnlyTheCamera = (With<Camera3d>, Without<Ball>, Without<Fox>);
+
 /// The ball swings across the line between the camera and the fox.
 fn pass_the_ball(
     clock: Res<common::SceneClock>,
-    cameras: Query<&Transform, (With<Camera3d>, Without<Ball>)>,
+    cameras: Query<&Transform, OnlyTheCamera>,
+    foxes: Query<&Transform, (With<Fox>, Without<Ball>)>,
     mut balls: Query<&mut Transform, With<Ball>>,
 ) {
-    let Ok(camera) = cameras.single() else {
+    let (Ok(camera), Ok(fox)) = (cameras.single(), foxes.single()) else {
         return;
     };
-    let target = Vec3::new(0.0, 30.0, 0.0);
+    let target = fox.translation + Vec3::new(0.0, 30.0, 0.0);
     let towards = (camera.translation - target).normalize_or_zero();
     let across = towards.cross(Vec3::Y).normalize_or_zero();
     // Before the fox's face a second and a quarter after the scene is
