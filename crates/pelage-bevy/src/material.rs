@@ -55,8 +55,10 @@ pub(crate) fn register_shaders(app: &mut App) {
         .expect("a fixed handle");
 }
 
-/// The fur's numbers as `shell_fur.wgsl` reads them (`struct ShellFur`).
-#[derive(Debug, Clone, Copy, ShaderType, PartialEq)]
+/// The fur's numbers as `shell_fur.wgsl` reads them (`struct ShellFur`;
+/// a test checks the two have the same fields in the same order and the
+/// same size).
+#[derive(Debug, Clone, Copy, ShaderType, PartialEq, Reflect)]
 pub struct ShellFurUniform {
     /// Where the dynamics pushed the strands' tips (world units).
     pub tip_offset: Vec3,
@@ -165,5 +167,62 @@ impl Material for ShellFurMaterial {
         // A closed skin's far side is behind its near side anyway.
         descriptor.primitive.cull_mode = Some(Face::Back);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bevy::reflect::structs::Struct;
+
+    /// `struct ShellFur` of the shader, as naga lays it out: its field
+    /// names in order, and its size.
+    fn wgsl_struct() -> (Vec<String>, u32) {
+        let source = include_str!("shaders/shell_fur.wgsl");
+        let start = source.find("struct ShellFur {").expect("the struct");
+        let end = start + source[start..].find("};").expect("its end") + 2;
+        let module = naga::front::wgsl::parse_str(&source[start..end]).expect("WGSL");
+        let ty = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some("ShellFur"))
+            .expect("ShellFur")
+            .1;
+        let naga::TypeInner::Struct { members, span } = &ty.inner else {
+            panic!("a struct");
+        };
+        let names = members.iter().map(|m| m.name.clone().unwrap()).collect();
+        (names, *span)
+    }
+
+    /// The Rust block and the WGSL struct agree field by field and in
+    /// size, so encase writes what the shader reads.
+    #[test]
+    fn the_uniform_block_matches_the_shader() {
+        let block = ShellFurUniform {
+            tip_offset: Vec3::ZERO,
+            length: 0.0,
+            specular: Vec3::ZERO,
+            exponent: 0.0,
+            layers: 0,
+            coupling: 0,
+            coupling_exponent: 0.0,
+            tiles: 0.0,
+            k_shadow: 0.0,
+            opacity: 0.0,
+            color_gain: 0.0,
+            effects: 0,
+            curl_radius: 0.0,
+            curl_frequency: 0.0,
+            clump_w: 0.0,
+            clump_strength: 0.0,
+            wetness_size: Vec2::ZERO,
+        };
+        let rust: Vec<String> = (0..block.field_len())
+            .map(|i| block.name_at(i).unwrap().to_string())
+            .collect();
+        let (wgsl, size) = wgsl_struct();
+        assert_eq!(rust, wgsl);
+        assert_eq!(ShellFurUniform::min_size().get(), u64::from(size));
     }
 }
