@@ -396,6 +396,37 @@ fn fur_sits_on_the_fox_is_hidden_by_what_is_in_front_and_follows_its_pose() {
         count(&left)
     );
     assert_eq!(stayed, 0, "{stayed} fur pixels where the skin was");
+
+    // Levels of detail by the camera's distance: the file asks for layers
+    // at most 0.75 pixels apart, so 24 layers near, 12 from about 120
+    // units (3.8-unit fur, 240 pixels over 45°), 6 from about 245, 3 from
+    // about 490, and none from about 1,470, where all the fur is shorter
+    // than 0.75 pixels.
+    for (distance, level) in [
+        (80.0, Some(0)),
+        (190.0, Some(1)),
+        (350.0, Some(2)),
+        (900.0, Some(3)),
+        (2000.0, None),
+    ] {
+        let world = h.app.world_mut();
+        let mut cameras = world.query_filtered::<&mut Transform, With<Camera3d>>();
+        for mut t in cameras.iter_mut(world) {
+            *t = Transform::from_xyz(0.0, 35.0, distance)
+                .looking_at(Vec3::new(0.0, 35.0, 0.0), Vec3::Y);
+        }
+        h.frames(3);
+        let world = h.app.world_mut();
+        let mut fur = world.query::<(&FurLayers, &ViewVisibility)>();
+        let mut drawn: Vec<usize> = fur
+            .iter(world)
+            .filter(|(_, v)| v.get())
+            .map(|(f, _)| f.level)
+            .collect();
+        drawn.sort();
+        drawn.dedup();
+        assert_eq!(drawn, Vec::from_iter(level), "at {distance} units");
+    }
 }
 
 /// Steps frames (in real time: the file watcher runs on its own thread)
