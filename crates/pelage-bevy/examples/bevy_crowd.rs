@@ -36,11 +36,7 @@ fn setup(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
-    let (graph, index) = AnimationGraph::from_clip(
-        assets.load(GltfAssetLabel::Animation(2).from_asset("fox/Fox.gltf")),
-    );
-    let graph = graphs.add(graph);
-    let scene = assets.load(GltfAssetLabel::Scene(0).from_asset("fox/Fox.gltf"));
+    let (scene, graph, index) = common::fox_scene_and_run(&assets, &mut graphs);
     for i in 0..SIDE * SIDE {
         let (x, z) = ((i % SIDE) as f32, (i / SIDE) as f32);
         let offset = (SIDE as f32 - 1.0) / 2.0;
@@ -57,17 +53,7 @@ fn setup(
         common::fox_fur(&args, &assets, &mut fox);
         fox.observe(common::start_running);
     }
-    commands.spawn((
-        Mesh3d(meshes.add(Plane3d::default().mesh().size(4000.0, 4000.0))),
-        MeshMaterial3d(materials.add(Color::srgb(0.32, 0.42, 0.28))),
-    ));
-    commands.spawn((
-        DirectionalLight {
-            illuminance: 8000.0,
-            ..default()
-        },
-        Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y),
-    ));
+    common::ground_and_sun(&mut commands, &mut meshes, &mut materials, 4000.0, false);
     target.spawn_camera(&mut commands);
 }
 

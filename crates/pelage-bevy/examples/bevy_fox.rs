@@ -57,14 +57,12 @@ fn setup(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
-    let (graph, index) = AnimationGraph::from_clip(
-        assets.load(GltfAssetLabel::Animation(2).from_asset("fox/Fox.gltf")),
-    );
+    let (scene, graph, index) = common::fox_scene_and_run(&assets, &mut graphs);
     let mut fox = commands.spawn((
         Fox,
-        WorldAssetRoot(assets.load(GltfAssetLabel::Scene(0).from_asset("fox/Fox.gltf"))),
+        WorldAssetRoot(scene),
         Running {
-            graph: graphs.add(graph),
+            graph,
             index,
             phase: 0.0,
         },
@@ -72,10 +70,7 @@ fn setup(
     common::fox_fur(&args, &assets, &mut fox);
     fox.observe(common::start_running);
 
-    commands.spawn((
-        Mesh3d(meshes.add(Plane3d::default().mesh().size(600.0, 600.0))),
-        MeshMaterial3d(materials.add(Color::srgb(0.32, 0.42, 0.28))),
-    ));
+    common::ground_and_sun(&mut commands, &mut meshes, &mut materials, 600.0, true);
     commands.spawn((
         Ball,
         Mesh3d(meshes.add(Sphere::new(14.0).mesh().uv(48, 24))),
@@ -85,14 +80,6 @@ fn setup(
             ..default()
         })),
         Transform::from_xyz(0.0, 30.0, 90.0),
-    ));
-    commands.spawn((
-        DirectionalLight {
-            illuminance: 8000.0,
-            shadow_maps_enabled: true,
-            ..default()
-        },
-        Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y),
     ));
     target.spawn_camera(&mut commands).insert(Orbit {
         yaw: 0.6,

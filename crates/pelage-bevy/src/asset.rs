@@ -91,6 +91,36 @@ fn left_out(scene: &ShellScene) -> Vec<&'static str> {
     out
 }
 
+/// A settings file Bevy could not read.
+#[derive(Debug, thiserror::Error)]
+#[error("reading {path}: {source}")]
+pub struct FileReadError {
+    /// The file.
+    pub path: PathBuf,
+    /// Why.
+    #[source]
+    pub source: std::io::Error,
+}
+
+/// The file `load_context` is loading, read whole, as pelage's settings
+/// parsers take it: named by its path on disk under `folder` (errors and
+/// relative paths in it need that).
+async fn read_settings(
+    folder: &std::path::Path,
+    reader: &mut dyn Reader,
+    load_context: &LoadContext<'_>,
+) -> Result<pelage::settings::SettingsSource, FileReadError> {
+    let path = folder.join(load_context.path().path());
+    let mut bytes = Vec::new();
+    match reader.read_to_end(&mut bytes).await {
+        Ok(_) => Ok(pelage::settings::SettingsSource {
+            path,
+            text: String::from_utf8_lossy(&bytes).into_owned(),
+        }),
+        Err(source) => Err(FileReadError { path, source }),
+    }
+}
+
 /// Reads pelage shells files (`*.shells.toml`, or any `*.toml` loaded as
 /// shell fur) from the folder Bevy's assets are in.
 #[derive(TypePath)]
@@ -104,13 +134,8 @@ pub struct ShellFurLoader {
 #[derive(Debug, thiserror::Error)]
 pub enum ShellFurLoadError {
     /// The file could not be read.
-    #[error("reading {path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] FileReadError),
     /// pelage refused it (syntax, a key, a range, its mesh or colour).
     #[error(transparent)]
     Scene(#[from] pelage::shell::SceneError),
@@ -127,25 +152,13 @@ impl AssetLoader for ShellFurLoader {
         _settings: &(),
         load_context: &mut LoadContext<'_>,
     ) -> Result<ShellFurAsset, ShellFurLoadError> {
-        let path = self.folder.join(load_context.path().path());
-        let mut bytes = Vec::new();
-        reader
-            .read_to_end(&mut bytes)
-            .await
-            .map_err(|source| ShellFurLoadError::Io {
-                path: path.clone(),
-                source,
-            })?;
-        let source = pelage::settings::SettingsSource {
-            path: path.clone(),
-            text: String::from_utf8_lossy(&bytes).into_owned(),
-        };
+        let source = read_settings(&self.folder, reader, load_context).await?;
         let scene = ShellScene::from_source(&source)?;
         let fur = ShellFurAsset::from_scene(&scene);
         if !fur.left_out.is_empty() {
             bevy::log::warn!(
                 "{}: {} not drawn in Bevy (pelage's own renderer draws them; docs/bevy.md, Limits)",
-                path.display(),
+                source.path.display(),
                 fur.left_out.join(", ")
             );
         }
@@ -184,13 +197,8 @@ pub struct GroomFurLoader {
 #[derive(Debug, thiserror::Error)]
 pub enum GroomFurLoadError {
     /// The file could not be read.
-    #[error("reading {path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] FileReadError),
     /// pelage refused it (syntax, a key, a range, its mesh, guides, maps).
     #[error(transparent)]
     Groom(#[from] pelage::groom::GroomError),
@@ -248,19 +256,8 @@ impl AssetLoader for GroomFurLoader {
         _settings: &(),
         load_context: &mut LoadContext<'_>,
     ) -> Result<GroomFurAsset, GroomFurLoadError> {
-        let path = self.folder.join(load_context.path().path());
-        let mut bytes = Vec::new();
-        reader
-            .read_to_end(&mut bytes)
-            .await
-            .map_err(|source| GroomFurLoadError::Io {
-                path: path.clone(),
-                source,
-            })?;
-        let groom = pelage::groom::Groom::from_source(pelage::settings::SettingsSource {
-            path,
-            text: String::from_utf8_lossy(&bytes).into_owned(),
-        })?;
+        let source = read_settings(&self.folder, reader, load_context).await?;
+        let groom = pelage::groom::Groom::from_source(source)?;
         let (shells, hairs) = ShellFurAsset::stand_in_for(&groom)?;
         let shells = load_context.add_labeled_asset("shells", shells);
         Ok(GroomFurAsset { shells, hairs })

@@ -46,8 +46,8 @@ mod material;
 mod mesh;
 
 pub use asset::{
-    GroomFurAsset, GroomFurLoadError, GroomFurLoader, ShellFurAsset, ShellFurLoadError,
-    ShellFurLoader,
+    FileReadError, GroomFurAsset, GroomFurLoadError, GroomFurLoader, ShellFurAsset,
+    ShellFurLoadError, ShellFurLoader,
 };
 pub use dynamics::{FurForces, FurMotion};
 pub use fur::{FurLayers, GroomFur, ShellFur, lod_layers};

@@ -13,7 +13,7 @@ use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
 use pelage_bevy::{FurForces, FurLayers, GroomFur, PelagePlugin, ShellFur, ShellFurAsset};
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
@@ -45,6 +45,16 @@ fn gpu_available() -> bool {
             false
         }
     }
+}
+
+/// A headless app on `folder`, with this test's turn at the GPU; `None`
+/// (the test passes, having said why) without an adapter.
+fn headless(folder: &Path) -> Option<(MutexGuard<'static, ()>, Headless)> {
+    if !gpu_available() {
+        return None;
+    }
+    let turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    Some((turn, Headless::new(folder)))
 }
 
 fn pelage_assets() -> PathBuf {
@@ -133,6 +143,15 @@ impl Headless {
         panic!("not ready after {limit} frames");
     }
 
+    /// Steps until some fur is grown (its asset loaded, a fur entity
+    /// spawned).
+    fn until_furred(&mut self) {
+        self.until(900, |world| {
+            let mut q = world.query::<&FurLayers>();
+            q.iter(world).next().is_some()
+        });
+    }
+
     /// The next frame's picture, RGB.
     fn picture(&mut self) -> image::RgbImage {
         let shot: Arc<Mutex<Option<Image>>> = Arc::default();
@@ -208,10 +227,7 @@ fn with_fur(h: &mut Headless, fox: Entity, on: bool) {
     if on {
         let fur = world.resource::<AssetServer>().load("fox/fox.shells.toml");
         world.entity_mut(fox).insert(ShellFur(fur));
-        h.until(600, |world| {
-            let mut q = world.query::<&FurLayers>();
-            q.iter(world).next().is_some()
-        });
+        h.until_furred();
     } else {
         world.entity_mut(fox).remove::<ShellFur>();
         h.frames(2);
@@ -277,11 +293,9 @@ fn save_for_inspection(name: &str, picture: &image::RgbImage) {
 /// after a pose change it is where the posed skin is, not where it was.
 #[test]
 fn fur_sits_on_the_fox_is_hidden_by_what_is_in_front_and_follows_its_pose() {
-    if !gpu_available() {
+    let Some((_turn, mut h)) = headless(&pelage_assets()) else {
         return;
-    }
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let mut h = Headless::new(&pelage_assets());
+    };
     let fox = spawn_fox(&mut h, None);
 
     let bare = h.settled_picture();
@@ -453,10 +467,6 @@ fn wait_for_reload(h: &mut Headless, fox: Entity, edited: impl Fn(&ShellFurAsset
 /// fur covers more of the picture.
 #[test]
 fn a_changed_shells_file_changes_the_picture() {
-    if !gpu_available() {
-        return;
-    }
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().unwrap();
     let fox_dir = dir.path().join("fox");
     std::fs::create_dir_all(&fox_dir).unwrap();
@@ -467,12 +477,11 @@ fn a_changed_shells_file_changes_the_picture() {
     let text = std::fs::read_to_string(&shells).unwrap();
     std::fs::write(&shells, text.replace("[fur]\n", "[fur]\nlength = 2.0\n")).unwrap();
 
-    let mut h = Headless::new(dir.path());
+    let Some((_turn, mut h)) = headless(dir.path()) else {
+        return;
+    };
     let fox = spawn_fox(&mut h, Some("fox/fox.shells.toml"));
-    h.until(600, |world| {
-        let mut q = world.query::<&FurLayers>();
-        q.iter(world).next().is_some()
-    });
+    h.until_furred();
     let short = h.settled_picture();
 
     std::fs::write(&shells, text.replace("[fur]\n", "[fur]\nlength = 9.0\n")).unwrap();
@@ -505,20 +514,15 @@ fn a_changed_shells_file_changes_the_picture() {
 /// it, on the fox and only near it; taking the groom away takes the fur.
 #[test]
 fn a_groom_wears_its_shell_stand_in() {
-    if !gpu_available() {
+    let Some((_turn, mut h)) = headless(&pelage_assets()) else {
         return;
-    }
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let mut h = Headless::new(&pelage_assets());
+    };
     let fox = spawn_fox(&mut h, None);
     let bare = h.settled_picture();
     let world = h.app.world_mut();
     let groom = world.resource::<AssetServer>().load("fox/fox.groom.toml");
     world.entity_mut(fox).insert(GroomFur(groom));
-    h.until(900, |world| {
-        let mut q = world.query::<&FurLayers>();
-        q.iter(world).next().is_some()
-    });
+    h.until_furred();
     let furred = h.settled_picture();
     save_for_inspection("groom-furred.png", &furred);
     let skin = mask(&bare);
@@ -545,11 +549,9 @@ fn a_groom_wears_its_shell_stand_in() {
 /// the layers follow its transform, and the fur stands past its outline.
 #[test]
 fn a_still_bevy_mesh_wears_fur_too() {
-    if !gpu_available() {
+    let Some((_turn, mut h)) = headless(&pelage_assets()) else {
         return;
-    }
-    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let mut h = Headless::new(&pelage_assets());
+    };
     let world = h.app.world_mut();
     let mesh = world
         .resource_mut::<Assets<Mesh>>()
@@ -571,10 +573,7 @@ fn a_still_bevy_mesh_wears_fur_too() {
         .resource::<AssetServer>()
         .load("fox/fox.shells.toml");
     h.app.world_mut().entity_mut(ball).insert(ShellFur(fur));
-    h.until(600, |world| {
-        let mut q = world.query::<&FurLayers>();
-        q.iter(world).next().is_some()
-    });
+    h.until_furred();
     let furred = h.settled_picture();
     save_for_inspection("sphere-furred.png", &furred);
     let skin = mask(&bare);

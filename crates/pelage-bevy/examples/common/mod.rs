@@ -110,6 +110,50 @@ pub fn fox_fur(args: &Args, assets: &AssetServer, entity: &mut EntityCommands) {
     }
 }
 
+/// The Khronos Fox in pelage's asset folder.
+const FOX: &str = "fox/Fox.gltf";
+
+/// The Fox's scene, and a graph playing its Run clip (the glTF's third).
+pub fn fox_scene_and_run(
+    assets: &AssetServer,
+    graphs: &mut Assets<AnimationGraph>,
+) -> (
+    Handle<WorldAsset>,
+    Handle<AnimationGraph>,
+    AnimationNodeIndex,
+) {
+    let (graph, index) =
+        AnimationGraph::from_clip(assets.load(GltfAssetLabel::Animation(2).from_asset(FOX)));
+    (
+        assets.load(GltfAssetLabel::Scene(0).from_asset(FOX)),
+        graphs.add(graph),
+        index,
+    )
+}
+
+/// A grass-green ground `size` units across and the sun (with shadow
+/// maps if `shadows`), as both examples light their foxes.
+pub fn ground_and_sun(
+    commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
+    materials: &mut Assets<StandardMaterial>,
+    size: f32,
+    shadows: bool,
+) {
+    commands.spawn((
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(size, size))),
+        MeshMaterial3d(materials.add(Color::srgb(0.32, 0.42, 0.28))),
+    ));
+    commands.spawn((
+        DirectionalLight {
+            illuminance: 8000.0,
+            shadow_maps_enabled: shadows,
+            ..default()
+        },
+        Transform::from_xyz(1.0, 2.0, 1.5).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+}
+
 /// A fox's clip, to play once its scene has spawned, from `phase`
 /// seconds in.
 #[derive(Component)]
