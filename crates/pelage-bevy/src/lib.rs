@@ -37,13 +37,15 @@
 //! The parts, lowest first: `material.rs` (the material, its uniform
 //! block, the shaders), `mesh.rs` (a fur mesh from a Bevy mesh),
 //! `asset.rs` (shells and groom files as assets), `dynamics.rs` (a coat's
-//! spring), `fur.rs` (the systems).
+//! spring), `fur.rs` (the systems), `probe.rs` (the fur's drawn vertices
+//! read back, for tests and tools).
 
 mod asset;
 mod dynamics;
 mod fur;
 mod material;
 mod mesh;
+mod probe;
 
 pub use asset::{
     FileReadError, GroomFurAsset, GroomFurLoadError, GroomFurLoader, ShellFurAsset,
@@ -53,6 +55,7 @@ pub use dynamics::{FurForces, FurMotion};
 pub use fur::{FurLayers, GroomFur, ShellFur, lod_layers};
 pub use material::{ATTRIBUTE_SHELL_LAYER, ShellFurMaterial, ShellFurUniform};
 pub use mesh::{FurMeshError, fur_mesh};
+pub use probe::{FurPositionProbe, FurPositionProbePlugin, ProbedShellFurMaterial};
 
 use bevy::prelude::*;
 use std::path::PathBuf;

@@ -6,12 +6,20 @@
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::log::LogPlugin;
+use bevy::mesh::VertexAttributeValues;
+use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
+use bevy::pbr::ExtendedMaterial;
 use bevy::prelude::*;
+use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::TextureFormat;
+use bevy::render::storage::ShaderBuffer;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
-use pelage_bevy::{FurForces, FurLayers, GroomFur, PelagePlugin, ShellFur, ShellFurAsset};
+use pelage_bevy::{
+    ATTRIBUTE_SHELL_LAYER, FurForces, FurLayers, FurPositionProbe, FurPositionProbePlugin,
+    GroomFur, PelagePlugin, ProbedShellFurMaterial, ShellFur, ShellFurAsset, ShellFurMaterial,
+};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -88,9 +96,12 @@ impl Headless {
                 // test can ask its pipeline cache what is still compiling.
                 .disable::<bevy::render::pipelined_rendering::PipelinedRenderingPlugin>(),
         )
-        .add_plugins(PelagePlugin {
-            asset_folder: Some(folder.to_path_buf()),
-        })
+        .add_plugins((
+            PelagePlugin {
+                asset_folder: Some(folder.to_path_buf()),
+            },
+            FurPositionProbePlugin,
+        ))
         // No gravity: the coat's spring stays at rest, so pictures settle.
         .insert_resource(FurForces {
             gravity: Some(Vec3::ZERO),
@@ -597,4 +608,219 @@ fn a_still_bevy_mesh_wears_fur_too() {
     );
     assert!(outside > 100, "fur past the outline: {outside} pixels");
     assert_eq!(astray, 0, "{astray} fur pixels away from the sphere");
+}
+
+/// A fur entity's shell material swapped for the probed one, and what it
+/// reads back.
+struct Probe {
+    fur: Entity,
+    /// The fur's mesh as the plugin made it (its own copy went to the
+    /// GPU): the skin's vertices once a layer.
+    mesh: Mesh,
+    material: ShellFurMaterial,
+    latest: Arc<Mutex<Option<Vec<u8>>>>,
+}
+
+impl Probe {
+    /// Probes the fur level the camera shows.
+    fn on_visible_level(h: &mut Headless) -> Self {
+        let world = h.app.world_mut();
+        let mut q = world.query::<(
+            Entity,
+            &FurLayers,
+            &ViewVisibility,
+            &MeshMaterial3d<ShellFurMaterial>,
+        )>();
+        let (fur, level, _, material) = q
+            .iter(world)
+            .find(|(_, _, seen, ..)| seen.get())
+            .expect("a fur level in view");
+        eprintln!("probing level {} ({} layers)", level.level, level.layers);
+        let (skin, layers, material) = (level.skin, level.layers, material.0.clone());
+        let skin = world.get::<Mesh3d>(skin).unwrap().0.clone();
+        let skin = world.resource::<Assets<Mesh>>().get(&skin).unwrap();
+        let mesh = pelage_bevy::fur_mesh(skin, layers).unwrap();
+        let vertices = mesh.count_vertices();
+        let material = world
+            .resource::<Assets<ShellFurMaterial>>()
+            .get(&material)
+            .unwrap()
+            .clone();
+        let buffer = world
+            .resource_mut::<Assets<ShaderBuffer>>()
+            .add(FurPositionProbe::buffer(vertices));
+        let probed = world
+            .resource_mut::<Assets<ProbedShellFurMaterial>>()
+            .add(ExtendedMaterial {
+                base: material.clone(),
+                extension: FurPositionProbe {
+                    positions: buffer.clone(),
+                },
+            });
+        world
+            .entity_mut(fur)
+            .remove::<MeshMaterial3d<ShellFurMaterial>>()
+            .insert(MeshMaterial3d(probed));
+        let latest: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
+        let into = latest.clone();
+        world
+            .spawn(Readback::buffer(buffer))
+            .observe(move |read: On<ReadbackComplete>| {
+                *into.lock().unwrap() = Some(read.data.clone());
+            });
+        Self {
+            fur,
+            mesh,
+            material,
+            latest,
+        }
+    }
+
+    /// The positions a frame drawn from now on stored (`None`: a vertex
+    /// never drawn).
+    fn read(&self, h: &mut Headless) -> Vec<Option<Vec3>> {
+        // Frames for the pipeline to compile and for readbacks already
+        // under way to land, then a fresh one.
+        h.frames(5);
+        while h.compiling() {
+            h.frames(1);
+        }
+        h.frames(3);
+        self.latest.lock().unwrap().take();
+        for _ in 0..100 {
+            h.frames(1);
+            if let Some(bytes) = self.latest.lock().unwrap().take() {
+                return FurPositionProbe::positions(&bytes);
+            }
+        }
+        panic!("no readback after 100 frames");
+    }
+
+    /// Where the fur's vertices belong by Bevy's skinning of the fox now
+    /// and pelage's strand model: each vertex's joint matrices (the
+    /// joints' world transforms times their inverse bind poses, as Bevy
+    /// skins with), weighted, carry its root and rest tip, and the layer
+    /// lies along pelage's coupled strand between them.
+    fn expected(&self, h: &mut Headless) -> Vec<Vec3> {
+        let world = h.app.world_mut();
+        let skin = world.get::<SkinnedMesh>(self.fur).unwrap().clone();
+        let joints: Vec<Mat4> = {
+            let bindposes = world.resource::<Assets<SkinnedMeshInverseBindposes>>();
+            let bindposes = bindposes.get(&skin.inverse_bindposes).unwrap();
+            skin.joints
+                .iter()
+                .zip(bindposes.iter())
+                .map(|(&j, ibp)| world.get::<GlobalTransform>(j).unwrap().affine() * *ibp)
+                .collect()
+        };
+        let mesh = &self.mesh;
+        let vec3s = |a| match mesh.attribute(a) {
+            Some(VertexAttributeValues::Float32x3(v)) => v.clone(),
+            other => panic!("{other:?}"),
+        };
+        let (positions, normals) = (
+            vec3s(Mesh::ATTRIBUTE_POSITION),
+            vec3s(Mesh::ATTRIBUTE_NORMAL),
+        );
+        let Some(VertexAttributeValues::Uint16x4(indices)) =
+            mesh.attribute(Mesh::ATTRIBUTE_JOINT_INDEX)
+        else {
+            panic!("joint indices");
+        };
+        let Some(VertexAttributeValues::Float32x4(weights)) =
+            mesh.attribute(Mesh::ATTRIBUTE_JOINT_WEIGHT)
+        else {
+            panic!("joint weights");
+        };
+        let Some(VertexAttributeValues::Uint32(layers)) = mesh.attribute(ATTRIBUTE_SHELL_LAYER)
+        else {
+            panic!("layers");
+        };
+        let u = &self.material.fur;
+        let coupling = match u.coupling {
+            0 => pelage::shell::Coupling::Bezier,
+            1 => pelage::shell::Coupling::Linear,
+            _ => pelage::shell::Coupling::Bent {
+                exponent: u.coupling_exponent,
+            },
+        };
+        let pelage_vec = |v: Vec3| glam::Vec3::from_array(v.to_array());
+        (0..positions.len())
+            .map(|i| {
+                let m: Mat4 = (0..4)
+                    .map(|k| joints[indices[i][k] as usize] * weights[i][k])
+                    .fold(Mat4::ZERO, |a, b| a + b);
+                let p = Vec3::from(positions[i]);
+                let n = Vec3::from(normals[i]).normalize();
+                let root = m.transform_point3(p);
+                let rest_tip = m.transform_point3(p + u.length * n);
+                let strand = pelage::shell::Strand {
+                    root: pelage_vec(root),
+                    rest_tip: pelage_vec(rest_tip),
+                    tip: pelage_vec(rest_tip + u.tip_offset),
+                };
+                let h = pelage::shell::math::layer_height(layers[i], u.layers);
+                root + Vec3::from_array(strand.coupled_offset(coupling, h).to_array())
+            })
+            .collect()
+    }
+}
+
+/// The largest distance between drawn and expected positions, over the
+/// fox's size; panics if a vertex was never drawn.
+fn worst(drawn: &[Option<Vec3>], expected: &[Vec3]) -> f32 {
+    assert_eq!(drawn.len(), expected.len());
+    let missing = drawn.iter().filter(|p| p.is_none()).count();
+    assert_eq!(
+        missing,
+        0,
+        "{missing} of {} fur vertices never drawn",
+        drawn.len()
+    );
+    let (lo, hi) = expected
+        .iter()
+        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    let size = (hi - lo).length();
+    drawn
+        .iter()
+        .zip(expected)
+        .map(|(d, e)| d.unwrap().distance(*e) / size)
+        .fold(0.0, f32::max)
+}
+
+/// Every fur vertex Bevy draws, read back from the GPU, lies within 1e-5
+/// of the fox's size of where Bevy's skinning and pelage's strand put it:
+/// at rest and after a pose change that moved the fur by far more.
+#[test]
+fn fur_vertices_are_where_bevy_skins_the_fox() {
+    let Some((_turn, mut h)) = headless(&pelage_assets()) else {
+        return;
+    };
+    // Back far enough that the posed fox's head stays in view.
+    let world = h.app.world_mut();
+    let mut cameras = world.query_filtered::<&mut Transform, With<Camera3d>>();
+    *cameras.single_mut(world).unwrap() =
+        Transform::from_xyz(0.0, 45.0, 300.0).looking_at(Vec3::new(0.0, 45.0, 0.0), Vec3::Y);
+    spawn_fox(&mut h, Some("fox/fox.shells.toml"));
+    h.until_furred();
+    h.frames(3);
+    let probe = Probe::on_visible_level(&mut h);
+    let still = probe.read(&mut h);
+    let still_expected = probe.expected(&mut h);
+    let still_error = worst(&still, &still_expected);
+    pose(&mut h, 0.5);
+    let posed = probe.read(&mut h);
+    let posed_expected = probe.expected(&mut h);
+    let posed_error = worst(&posed, &posed_expected);
+    let moved = worst(&posed, &still_expected);
+    eprintln!(
+        "{} fur vertices: drawn within {still_error:.1e} (still) and {posed_error:.1e} (posed) \
+         of the fox's size of Bevy's skinning; the pose moved them up to {moved:.3}",
+        still.len()
+    );
+    assert!(still_error < 1e-5, "still: {still_error:e}");
+    assert!(posed_error < 1e-5, "posed: {posed_error:e}");
+    assert!(moved > 0.05, "the pose moved the fur by only {moved}");
 }

@@ -6,11 +6,16 @@
 // pelage's shell texture and shaded with Kajiya-Kay (Silva Eq. 6) under
 // the scene's directional lights. The math is pelage's shared module
 // (pelage-shaders' shell_math.wgsl), the same pelage-gpu runs.
+//
+// With FUR_POSITION_PROBE (pelage-bevy's probe.rs) the same vertex stage
+// runs over points, and each point's fragment stores its vertex's world
+// position instead of shading.
 
 #import bevy_pbr::{
+    mesh_bindings::mesh,
     mesh_functions,
     skinning,
-    mesh_view_bindings::{view, lights},
+    mesh_view_bindings::{view, lights, globals},
     view_transformations::position_world_to_clip,
 }
 #import pelage::shell_math::{
@@ -63,6 +68,12 @@ struct ShellFur {
 // read at mask coordinates: Bevy's glTF UVs are already those.
 @group(#{MATERIAL_BIND_GROUP}) @binding(5) var wetness: texture_2d<f32>;
 
+#ifdef FUR_POSITION_PROBE
+// One world position a fur-mesh vertex, and in w the frame that stored
+// it (Bevy's frame count, plus 1), so stale ones can be told apart.
+@group(#{MATERIAL_BIND_GROUP}) @binding(100) var<storage, read_write> probed: array<vec4<f32>>;
+#endif
+
 const CURL: u32 = 1u;
 const CLUMP: u32 = 2u;
 
@@ -77,6 +88,7 @@ fn wetness_at(p: vec2<f32>) -> vec4<f32> {
 // the layer at 8 (ATTRIBUTE_SHELL_LAYER).
 struct Vertex {
     @builtin(instance_index) instance_index: u32,
+    @builtin(vertex_index) index: u32,
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
@@ -98,6 +110,12 @@ struct FurOut {
     @location(4) u_axis: vec3<f32>,
     @location(5) @interpolate(flat) h: f32,
     @location(6) @interpolate(flat) layer: u32,
+#ifdef FUR_POSITION_PROBE
+    @location(7) @interpolate(flat) probe_world: vec3<f32>,
+    // The vertex's index in its fur mesh (Bevy packs meshes into shared
+    // buffers: the draw's index counts from the mesh's first vertex).
+    @location(8) @interpolate(flat) probe_index: u32,
+#endif
 };
 
 @vertex
@@ -142,9 +160,20 @@ fn vertex(v: Vertex) -> FurOut {
     out.u_axis = u;
     out.h = h;
     out.layer = v.layer;
+#ifdef FUR_POSITION_PROBE
+    out.probe_world = out.world;
+    out.probe_index = v.index - mesh[v.instance_index].first_vertex_index;
+#endif
     return out;
 }
 
+#ifdef FUR_POSITION_PROBE
+@fragment
+fn fragment(v: FurOut) -> @location(0) vec4<f32> {
+    probed[v.probe_index] = vec4<f32>(v.probe_world, f32(globals.frame_count) + 1.0);
+    return vec4<f32>(0.0);
+}
+#else
 @fragment
 fn fragment(v: FurOut) -> @location(0) vec4<f32> {
     var uv_color = v.uv;
@@ -201,3 +230,4 @@ fn fragment(v: FurOut) -> @location(0) vec4<f32> {
 #endif
     return out;
 }
+#endif
