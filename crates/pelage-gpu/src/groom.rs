@@ -1,7 +1,8 @@
 //! A groom grown on the GPU every frame: a [`GroomRecipe`] uploaded once,
 //! then, each frame, the frame's guides (in rest space) and posed skin in,
 //! every hair's points out, by one compute dispatch a recipe pass
-//! (`shaders/groom.wgsl`, one invocation a hair, its points in registers).
+//! (pelage-shaders' `groom.wgsl` over its `GroomUpload`, one invocation a
+//! hair, its points in registers).
 //! The CPU groom of the same frame (`Generator::part`, or
 //! `AnimatedGroom::part` for a posed frame) is the reference:
 //! `tests/groom.rs` grows both and compares hair by hair.
@@ -10,46 +11,16 @@
 //! point-major (point `j` of hair `h` at `j · hairs + h`, clump centres
 //! first, the render hairs last), ready for a strand renderer to read.
 
-use crate::layout::{UniformRing, compute_pipeline, entry, gpu_struct, group};
+use crate::layout::{UniformRing, compute_pipeline, entry, group};
 use crate::{GpuContext, GpuError, workgroups};
-use glam::{Mat3, Vec3};
+use glam::Vec3;
 use pelage::Curves;
 use pelage::anim::{SkinBinding, SkinPose};
 use pelage::groom::{Generator, GroomError, GroomErrorKind, GroomRecipe};
+pub(crate) use pelage_shaders::groom::GroomPassUniform;
+pub use pelage_shaders::groom::MAX_GPU_HAIR_POINTS;
+use pelage_shaders::groom::{GroomUpload, packed_sdf, skin_vertices};
 use wgpu::util::DeviceExt;
-
-/// The most points a hair has on the GPU (the shader's `MAX_POINTS`: a
-/// hair's points live in registers).
-pub const MAX_GPU_HAIR_POINTS: usize = 32;
-
-gpu_struct! {
-    /// The shader's `GroomPass` block: one recipe pass.
-    pub(crate) struct GroomPassUniform {
-        first: u32,
-        count: u32,
-        steps: u32,
-        points: u32,
-        guide_points: u32,
-        hairs: u32,
-        values_per_hair: u32,
-        posed: u32,
-        resample_at: u32,
-        render_first: u32,
-        width_scale: f32,
-        weights_at: u32,
-        normals_at: u32,
-        values_at: u32,
-        steps_at: u32,
-        tables_at: u32,
-        permutation_at: u32,
-        widths_at: u32,
-        outside: u32,
-        gap: f32,
-        pad0: u32,
-        pad1: u32,
-        pad2: u32,
-    }
-}
 
 /// A [`GroomRecipe`] on the GPU, grown again each [`Self::grow`].
 #[derive(Debug)]
@@ -118,149 +89,44 @@ fn storage(
 /// The groom shader's buffers, bindings 0 to 7: the roots, the packed
 /// data, this frame's guides, the skin and its triangles, the points, the
 /// skin's grids at rest and posed.
-fn groom_buffers(
-    device: &wgpu::Device,
-    recipe: &GroomRecipe,
-    skin: &SkinBinding,
-    (roots, data): (&[[f32; 4]], &[u32]),
-) -> [wgpu::Buffer; 8] {
+fn groom_buffers(device: &wgpu::Device, upload: &GroomUpload) -> [wgpu::Buffer; 8] {
     let dst = wgpu::BufferUsages::COPY_DST;
     let bytes = bytemuck::cast_slice::<[f32; 4], u8>;
-    let (n, gp) = (recipe.points as usize, recipe.guide_points as usize);
-    let triangles: Vec<u32> = skin.triangles().iter().flatten().copied().collect();
-    let rest_grid = recipe
-        .outside_skin
-        .as_ref()
-        .map_or_else(Vec::new, |(o, _)| packed_sdf(o.sdf(), 0));
     [
-        storage(device, "groom roots", bytes(roots), NONE),
-        storage(device, "groom data", bytemuck::cast_slice(data), NONE),
+        storage(device, "groom roots", bytes(&upload.roots), NONE),
+        storage(
+            device,
+            "groom data",
+            bytemuck::cast_slice(&upload.data),
+            NONE,
+        ),
         storage(
             device,
             "groom guide offsets",
-            &vec![0u8; recipe.guides as usize * gp * 16],
+            &vec![0u8; upload.guide_values * 16],
             dst,
         ),
-        storage(
-            device,
-            "groom skin",
-            bytes(&skin_vertices_of(skin.rest())),
-            dst,
-        ),
+        storage(device, "groom skin", bytes(&upload.rest_skin), dst),
         storage(
             device,
             "groom skin triangles",
-            bytemuck::cast_slice(&triangles),
+            bytemuck::cast_slice(&upload.triangles),
             NONE,
         ),
         storage(
             device,
             "groom points",
-            &vec![0u8; recipe.hair_count() * n * 16],
+            &vec![0u8; upload.points_bytes() as usize],
             wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::VERTEX,
         ),
         storage(
             device,
             "groom rest skin grid",
-            bytemuck::cast_slice(&rest_grid),
+            bytemuck::cast_slice(&upload.rest_grid),
             NONE,
         ),
         storage(device, "groom posed skin grid", &[0u8; 64], dst),
     ]
-}
-
-/// Where each section of the shader's `data` starts (its words), and the
-/// guide-to-hair resampling's start within the tables (`u32::MAX`: none).
-struct Sections {
-    weights: u32,
-    normals: u32,
-    values: u32,
-    steps: u32,
-    tables: u32,
-    resample: u32,
-    permutation: u32,
-    widths: u32,
-}
-
-/// Everything of `recipe` that does not change but the roots, as one
-/// array of 32-bit words (floats by their bits): the shader's `data`.
-fn packed(recipe: &GroomRecipe) -> (Vec<u32>, Sections) {
-    let mut data: Vec<u32> = Vec::new();
-    let mut section = |words: &mut dyn Iterator<Item = f32>| {
-        let at = data.len() as u32;
-        data.extend(words.map(f32::to_bits));
-        at
-    };
-    let bits = f32::from_bits;
-    let weights = section(
-        &mut recipe
-            .weights
-            .iter()
-            .flat_map(|w| [bits(w.guide), w.weight]),
-    );
-    let normals = section(&mut recipe.guide_normals.iter().flat_map(|v| v.to_array()));
-    let values = section(&mut recipe.values.iter().copied());
-    let steps = section(&mut recipe.steps.iter().flat_map(|s| {
-        [
-            s.kind as u32,
-            s.values,
-            u32::from(s.masked),
-            s.table,
-            s.permutation,
-            s.vectors,
-            s.centres,
-            0,
-        ]
-        .map(bits)
-    }));
-    let tables = section(&mut recipe.tables.iter().copied());
-    // The guide-to-hair resampling after the steps' tables, as pairs.
-    let resample = if recipe.resampling.is_empty() {
-        u32::MAX
-    } else {
-        let at = recipe.tables.len() as u32;
-        section(&mut recipe.resampling.iter().flat_map(|&(j, f)| [j as f32, f]));
-        at
-    };
-    let permutation = section(&mut recipe.permutations.iter().map(|&p| bits(p)));
-    let widths = section(&mut recipe.widths.iter().copied());
-    let sections = Sections {
-        weights,
-        normals,
-        values,
-        steps,
-        tables,
-        resample,
-        permutation,
-        widths,
-    };
-    (data, sections)
-}
-
-/// Each hair's root record (the shader's `HairRoot`, six `vec4`s): its
-/// rest position and triangle, rest normal and barycentrics, whether it
-/// grows bare, and — for render hairs — the rest skin frame it is carried
-/// from.
-fn root_records(recipe: &GroomRecipe, skin: &SkinBinding) -> Vec<[f32; 4]> {
-    let render = recipe.render_hairs();
-    (0..recipe.hair_count())
-        .flat_map(|i| {
-            let root = recipe.roots[i];
-            let (origin, frame) = if render.contains(&(i as u32)) {
-                skin.rest().frame_at(skin.triangles(), root)
-            } else {
-                (recipe.root_positions[i], Mat3::IDENTITY)
-            };
-            [
-                v4(recipe.root_positions[i], f32::from_bits(root.tri)),
-                v4(recipe.root_normals[i], root.bary[0]),
-                v4(origin, root.bary[1]),
-                v4(frame.x_axis, if recipe.bare[i] { 1.0 } else { 0.0 }),
-                v4(frame.y_axis, 0.0),
-                v4(frame.z_axis, 0.0),
-            ]
-        })
-        .collect()
 }
 
 /// The groom shader's bind group layouts (its buffers; the pass ring) and
@@ -294,39 +160,6 @@ fn groom_pipeline(
         &[&layout, &ring_layout],
     );
     (layout, ring_layout, pipeline)
-}
-
-/// A skin's distance grid as the groom shader reads it (skin_sdf.wgsl's
-/// `Grid` header, then the nodes' distances, their nearest triangles and
-/// the triangles' corners and corner normals, all as words); `which`: 0 at
-/// rest, 1 posed (the header's pad0).
-fn packed_sdf(sdf: &pelage::dynamics::SkinSdf, which: u32) -> Vec<u32> {
-    const HEADER: u32 = 12;
-    let (origin, cell, dims) = sdf.layout();
-    let nodes = sdf.distances().len() as u32;
-    let mut out = vec![
-        origin.x.to_bits(),
-        origin.y.to_bits(),
-        origin.z.to_bits(),
-        cell.to_bits(),
-        dims[0] as u32,
-        dims[1] as u32,
-        dims[2] as u32,
-        sdf.band_depth().to_bits(),
-        HEADER,
-        0,
-        which,
-        HEADER + nodes,
-    ];
-    out.extend(sdf.distances().iter().map(|d| d.to_bits()));
-    out.extend_from_slice(sdf.nearest_triangles());
-    let (corners, normals) = sdf.triangles();
-    for (c, n) in corners.iter().zip(normals) {
-        for v in c.iter().chain(n) {
-            out.extend([v.x, v.y, v.z, 0.0].map(f32::to_bits));
-        }
-    }
-    out
 }
 
 /// The pipeline turning GPU strands into the frame's guide offsets
@@ -371,38 +204,6 @@ fn rest_pipeline(
     (frame, strands, pipeline)
 }
 
-/// Each guide's root as `guides_to_rest` reads it: (triangle bits, b1,
-/// b2, 0), then its rest frame's columns.
-fn guide_root_records(recipe: &GroomRecipe, skin: &SkinBinding) -> Vec<[f32; 4]> {
-    recipe
-        .guide_roots
-        .iter()
-        .flat_map(|&root| {
-            let (_, frame) = skin.rest().frame_at(skin.triangles(), root);
-            [
-                [f32::from_bits(root.tri), root.bary[0], root.bary[1], 0.0],
-                v4(frame.x_axis, 0.0),
-                v4(frame.y_axis, 0.0),
-                v4(frame.z_axis, 0.0),
-            ]
-        })
-        .collect()
-}
-
-/// A pose's vertices as the shaders read them: position, then normal.
-fn skin_vertices_of(pose: &SkinPose) -> Vec<[f32; 4]> {
-    pose.positions()
-        .iter()
-        .zip(pose.normals())
-        .flat_map(|(&p, &n)| [v4(p, 0.0), v4(n, 0.0)])
-        .collect()
-}
-
-/// `v` as a `vec4` with `w`.
-fn v4(v: Vec3, w: f32) -> [f32; 4] {
-    [v.x, v.y, v.z, w]
-}
-
 impl GpuGroom {
     /// Uploads `recipe`. `skin` is the skin the hairs grow on: its rest
     /// pose is the one the groom was grown on, [`Self::grow`] carries the
@@ -417,28 +218,20 @@ impl GpuGroom {
         recipe: &GroomRecipe,
         skin: &SkinBinding,
     ) -> Result<Self, GpuError> {
-        let (n, gp) = (recipe.points as usize, recipe.guide_points as usize);
-        if n > MAX_GPU_HAIR_POINTS || gp > MAX_GPU_HAIR_POINTS {
-            return Err(GpuError::Mismatch(format!(
-                "hairs of {n} points from guides of {gp}: the GPU groom takes at most {MAX_GPU_HAIR_POINTS}; lower [finish] points or resample the guides"
-            )));
-        }
-        let hairs = recipe.hair_count();
-        let hairs32 = u32::try_from(hairs)
-            .map_err(|_| GpuError::Mismatch(format!("{hairs} hairs: too many for a GPU index")))?;
+        let upload =
+            GroomUpload::new(recipe, skin).map_err(|e| GpuError::Mismatch(e.to_string()))?;
         let limit = ctx.device.limits().max_storage_buffer_binding_size;
-        let largest = (hairs * n * 16) as u64;
+        let largest = upload.points_bytes();
         if largest > limit {
             return Err(GpuError::Mismatch(format!(
-                "{hairs} hairs of {n} points need {largest} bytes a buffer; the adapter binds at most {limit}: grow fewer hairs (a fraction) or fewer points"
+                "{} hairs of {} points need {largest} bytes a buffer; the adapter binds at most {limit}: grow fewer hairs (a fraction) or fewer points",
+                upload.hairs, upload.points
             )));
         }
-        let render = recipe.render_hairs();
-        let roots = root_records(recipe, skin);
-        let (data, sections) = packed(recipe);
+        let render = upload.render.clone();
         let skin_vertices = skin.rest().positions().len();
         let device = &ctx.device;
-        let buffers = groom_buffers(device, recipe, skin, (&roots, &data));
+        let buffers = groom_buffers(device, &upload);
         let (layout, ring_layout, pipeline) = groom_pipeline(device);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("groom"),
@@ -451,38 +244,9 @@ impl GpuGroom {
         let guide_roots = storage(
             device,
             "groom guide roots",
-            bytemuck::cast_slice(&guide_root_records(recipe, skin)),
+            bytemuck::cast_slice(&upload.guide_roots),
             NONE,
         );
-        let passes = recipe
-            .passes
-            .iter()
-            .map(|p| GroomPassUniform {
-                first: p.hairs.start,
-                count: p.hairs.len() as u32,
-                steps: p.steps,
-                points: n as u32,
-                guide_points: gp as u32,
-                hairs: hairs32,
-                values_per_hair: recipe.values_per_hair,
-                posed: 0,
-                resample_at: sections.resample,
-                render_first: render.start,
-                width_scale: 1.0,
-                weights_at: sections.weights,
-                normals_at: sections.normals,
-                values_at: sections.values,
-                steps_at: sections.steps,
-                tables_at: sections.tables,
-                permutation_at: sections.permutation,
-                widths_at: sections.widths,
-                outside: u32::from(recipe.outside_skin.is_some()),
-                gap: recipe.outside_skin.as_ref().map_or(0.0, |(o, _)| o.gap()),
-                pad0: 0,
-                pad1: 0,
-                pad2: 0,
-            })
-            .collect();
         let [
             roots_buffer,
             data_buffer,
@@ -495,16 +259,15 @@ impl GpuGroom {
         ] = buffers;
         // A render point's colour (negative: the hairs have none) and
         // opacity, for a strand renderer.
-        let shade: Vec<[f32; 4]> = (0..render.len() * n)
-            .map(|k| {
-                let c = recipe.colors.as_ref().map_or(Vec3::splat(-1.0), |c| c[k]);
-                v4(c, recipe.opacities.as_ref().map_or(1.0, |o| o[k]))
-            })
-            .collect();
-        let colors_buffer = storage(device, "groom colours", bytemuck::cast_slice(&shade), NONE);
+        let colors_buffer = storage(
+            device,
+            "groom colours",
+            bytemuck::cast_slice(&upload.shade),
+            NONE,
+        );
         Ok(Self {
             pipeline,
-            passes,
+            passes: upload.passes,
             ring,
             bind_group,
             layout,
@@ -532,13 +295,13 @@ impl GpuGroom {
             skin: skin_buffer,
             triangles: triangles_buffer,
             triangle_count: skin.triangles().len() as u32,
-            rest_skin: skin_vertices_of(skin.rest()),
+            rest_skin: upload.rest_skin,
             posed: false,
             points,
             colors_buffer,
-            hairs: hairs32,
-            n: n as u32,
-            guide_values: recipe.guides as usize * gp,
+            hairs: upload.hairs,
+            n: upload.points,
+            guide_values: upload.guide_values,
             skin_vertices,
             render: render.clone(),
             ids: recipe.ids[render.start as usize..render.end as usize].to_vec(),
@@ -589,7 +352,7 @@ impl GpuGroom {
                 self.guide_values
             )));
         }
-        let offsets: Vec<[f32; 4]> = guide_offsets.iter().map(|&v| v4(v, 0.0)).collect();
+        let offsets = GroomUpload::guide_words(guide_offsets);
         ctx.queue
             .write_buffer(&self.guide_offsets, 0, bytemuck::cast_slice(&offsets));
         self.record_frame(ctx, encoder, pose, None)
@@ -639,7 +402,7 @@ impl GpuGroom {
                         self.skin_vertices
                     )));
                 }
-                let skin = skin_vertices_of(pose);
+                let skin = skin_vertices(pose);
                 queue.write_buffer(&self.skin, 0, bytemuck::cast_slice(&skin));
                 self.posed = true;
             }

@@ -127,31 +127,11 @@ pub const SHADERS: &[(&str, &str)] = &[
     // Shell fur has its own uniform block; its math is shared (see above).
     ("shells.wgsl", include_str!("shaders/shells.wgsl")),
     // The explicit mass-spring substep (compute).
-    (
-        "dynamics.wgsl",
-        concat!(
-            include_str!("shaders/dynamics.wgsl"),
-            include_str!("shaders/noise.wgsl")
-        ),
-    ),
+    ("dynamics.wgsl", include_str!("shaders/dynamics.wgsl")),
     // Guide strands' substeps (compute).
-    (
-        "strands.wgsl",
-        concat!(
-            include_str!("shaders/strands.wgsl"),
-            include_str!("shaders/skin_sdf.wgsl"),
-            include_str!("shaders/noise.wgsl")
-        ),
-    ),
+    ("strands.wgsl", include_str!("shaders/strands.wgsl")),
     // A groom's hairs grown from the frame's guides and skin (compute).
-    (
-        "groom.wgsl",
-        concat!(
-            include_str!("shaders/groom.wgsl"),
-            include_str!("shaders/skin_sdf.wgsl"),
-            include_str!("shaders/noise.wgsl")
-        ),
-    ),
+    ("groom.wgsl", pelage_shaders::groom::GROOM_WGSL),
     // Real-time strands: the GPU groom's hairs drawn, and their shadows.
     ("hair.wgsl", include_str!("shaders/hair.wgsl")),
     // Linear-blend skinning of shell models (compute).
@@ -170,18 +150,21 @@ pub(crate) fn workgroups(n: u32) -> (u32, u32) {
     (x, groups.div_ceil(x))
 }
 
-/// The WGSL source of the named shader (with its prelude, and for shell
-/// fur the shared math before it).
+/// The WGSL source of the named shader (with its prelude; shell fur with
+/// the shared shell math before it; the compute shaders with the shared
+/// noise and skin-grid queries after them, from pelage-shaders).
 pub(crate) fn shader_source(name: &str) -> std::borrow::Cow<'static, str> {
     let own = SHADERS
         .iter()
         .find(|(n, _)| *n == name)
         .map(|(_, s)| *s)
         .expect("the shader exists");
-    if name == "shells.wgsl" {
-        format!("{}\n{own}", pelage_shaders::shell::MATH_WGSL).into()
-    } else {
-        own.into()
+    use pelage_shaders::groom::{NOISE_WGSL, SKIN_SDF_WGSL};
+    match name {
+        "shells.wgsl" => format!("{}\n{own}", pelage_shaders::shell::MATH_WGSL).into(),
+        "dynamics.wgsl" => format!("{own}{NOISE_WGSL}").into(),
+        "strands.wgsl" => format!("{own}{SKIN_SDF_WGSL}{NOISE_WGSL}").into(),
+        _ => own.into(),
     }
 }
 

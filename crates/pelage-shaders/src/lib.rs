@@ -6,9 +6,12 @@
 //! come from here, so the fur is the same in both and moving either host
 //! to a new wgpu is a version bump, not a port.
 //!
+//! - [`groom`]: a groom grown on the GPU every frame: the compute shader
+//!   and the arrays a host uploads for it;
 //! - [`shell`]: shell fur's math in WGSL, the strand frame's tangents and
 //!   the shell texture's mip chain;
 //! - [`stand_in`]: the shell fur that stands in for a groom far away.
 
+pub mod groom;
 pub mod shell;
 pub mod stand_in;

@@ -9,7 +9,8 @@
 const EXACT_WITHIN: f32 = 1.0;
 const NO_TRIANGLE: u32 = 0xffffffffu;
 
-// Mirrors GridHeader in strands.rs (a test checks names and offsets).
+// Mirrors GridHeader in pelage-gpu's strands.rs (a test checks names and
+// offsets).
 struct Grid {
     origin: vec3<f32>,
     cell: f32,

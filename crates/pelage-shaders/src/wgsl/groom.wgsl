@@ -12,7 +12,8 @@ const TAU: f32 = 6.283185307179586;
 // pelage::groom::ops::noise::VectorNoise::OFF_LATTICE.
 const OFF_LATTICE: vec3<f32> = vec3<f32>(0.371, 0.713, 0.137);
 
-// Mirrors GroomPassUniform in groom.rs (a test checks names and offsets).
+// Mirrors GroomPassUniform in pelage-shaders' groom.rs (pelage-gpu's layout
+// test checks names and offsets).
 struct GroomPass {
     // The pass's first hair and how many.
     first: u32,
