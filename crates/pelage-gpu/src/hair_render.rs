@@ -549,7 +549,7 @@ impl StrandRenderer {
             pad2: 0,
         };
         let offset = self.uniforms.write(queue, &uniforms);
-        let vertices = hairs * binding.points.saturating_sub(1) * 6;
+        let vertices = hairs * pelage_shaders::hair::ribbon_vertices(binding.points);
         let frame = StrandFrame { offset, vertices };
         if params.shadow_layer.is_some() {
             self.record_shadows(encoder, binding, offset, vertices);

@@ -150,8 +150,8 @@ pub(crate) fn workgroups(n: u32) -> (u32, u32) {
     (x, groups.div_ceil(x))
 }
 
-/// The WGSL source of the named shader (with its prelude; shell fur with
-/// the shared shell math before it; the compute shaders with the shared
+/// The WGSL source of the named shader (with its prelude; shell fur and
+/// strands with their shared math before them; the compute shaders with the shared
 /// noise and skin-grid queries after them, from pelage-shaders).
 pub(crate) fn shader_source(name: &str) -> std::borrow::Cow<'static, str> {
     let own = SHADERS
@@ -162,6 +162,7 @@ pub(crate) fn shader_source(name: &str) -> std::borrow::Cow<'static, str> {
     use pelage_shaders::groom::{NOISE_WGSL, SKIN_SDF_WGSL};
     match name {
         "shells.wgsl" => format!("{}\n{own}", pelage_shaders::shell::MATH_WGSL).into(),
+        "hair.wgsl" => format!("{}\n{own}", pelage_shaders::hair::MATH_WGSL).into(),
         "dynamics.wgsl" => format!("{own}{NOISE_WGSL}").into(),
         "strands.wgsl" => format!("{own}{SKIN_SDF_WGSL}{NOISE_WGSL}").into(),
         _ => own.into(),

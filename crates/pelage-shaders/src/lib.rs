@@ -8,10 +8,12 @@
 //!
 //! - [`groom`]: a groom grown on the GPU every frame: the compute shader
 //!   and the arrays a host uploads for it;
+//! - [`hair`]: real-time strands' ribbons and hair model in WGSL;
 //! - [`shell`]: shell fur's math in WGSL, the strand frame's tangents and
 //!   the shell texture's mip chain;
 //! - [`stand_in`]: the shell fur that stands in for a groom far away.
 
 pub mod groom;
+pub mod hair;
 pub mod shell;
 pub mod stand_in;

@@ -3,17 +3,9 @@
 // segment, pulled from the points buffer by vertex index (no vertex
 // buffers: the compute pass's output is drawn as it is).
 //
-// Shading, a real-time hair model: Kajiya & Kay's (1989) diffuse for the
-// light scattered many times, and Marschner et al.'s (2003) three lobes
-// as games approximate them (Scheuermann 2004; Unreal's hair shading):
-// each a Gaussian in the half angle θh = (θi + θo)/2 between the light's
-// and the eye's inclinations to the hair, about a shift α, times an
-// azimuthal factor in φ, the angle between them around the hair:
-// - R, reflected at the surface: white, about α, strongest facing the
-//   light (cos(φ/2));
-// - TRT, reflected inside: the hair's colour, about −3α/2, twice as wide;
-// - TT, transmitted: the hair's colour, about −α/2, half as wide, strongest
-//   straight through (φ = π): the bright rim of a back-lit coat.
+// The ribbons and the hair model are pelage-shaders' hair_math.wgsl
+// (placed before this file), the same Bevy's strands use.
+//
 // Self-shadowing: a deep opacity map (Yuksel & Keyser 2008). From the
 // key light: first the depth of the first hair each texel sees; then every
 // hair's coverage of its texel added into four layers below that depth
@@ -23,9 +15,6 @@
 // hairs under many others are dark, hairs in a sparse halo keep their
 // light. The skin is opaque: its own depth map puts what lies behind it
 // in its shadow.
-// Ribbons thinner than a pixel are drawn a pixel wide with their coverage
-// scaled down (alpha-to-coverage with MSAA): thin hairs thin out instead
-// of shimmering.
 
 // Mirrors StrandUniforms in hair_render.rs (a test checks names and offsets).
 struct Strands {
@@ -112,43 +101,23 @@ struct Corner {
 
 // Vertex `vertex` of the ribbons: its segment's two points and its corner.
 fn corner(vertex: u32) -> Corner {
-    // Two triangles over (t, side): (0,−1) (1,−1) (0,1) / (0,1) (1,−1) (1,1).
-    var ts = array<f32, 6>(0.0, 1.0, 0.0, 0.0, 1.0, 1.0);
-    var sides = array<f32, 6>(-1.0, -1.0, 1.0, 1.0, -1.0, 1.0);
-    let segments = max(u.points, 2u) - 1u;
-    let segment = vertex / 6u;
-    let k = vertex % 6u;
+    let r = ribbon_corner(vertex, u.points);
     var c: Corner;
-    c.hair = segment / segments;
-    c.j = segment % segments;
+    c.hair = r.hair;
+    c.j = r.j;
+    c.t = r.t;
+    c.side = r.side;
     let h = u.first + c.hair;
     c.a = points[c.j * u.stride + h];
     c.b = points[(c.j + 1u) * u.stride + h];
     c.a.w *= u.width_scale;
     c.b.w *= u.width_scale;
-    c.t = ts[k];
-    c.side = sides[k];
     return c;
 }
 
-// The ribbon's corner in clip space: across the segment on screen, at
-// least `min_px` pixels wide; `px_per_unit` turns a width at `clip.w` into
-// pixels. Returns the clip position and the drawn width's share of its
-// true width (coverage).
+// The ribbon's corner in clip space (hair_math's ribbon_clip).
 fn expand(c: Corner, view_proj: mat4x4<f32>, half_size: vec2<f32>, px_per_unit: f32) -> vec4<f32> {
-    let p = mix(c.a.xyz, c.b.xyz, c.t);
-    let width = mix(c.a.w, c.b.w, c.t);
-    let ca = view_proj * vec4<f32>(c.a.xyz, 1.0);
-    let cb = view_proj * vec4<f32>(c.b.xyz, 1.0);
-    let clip = view_proj * vec4<f32>(p, 1.0);
-    var direction = cb.xy / cb.w * half_size - ca.xy / ca.w * half_size;
-    if length(direction) < 1e-6 {
-        direction = vec2<f32>(1.0, 0.0);
-    }
-    let across = normalize(vec2<f32>(-direction.y, direction.x));
-    let width_px = width * px_per_unit / clip.w;
-    let offset_px = across * c.side * 0.5 * max(width_px, 1.0);
-    return vec4<f32>(clip.xy + offset_px / half_size * clip.w, clip.zw);
+    return ribbon_clip(c.a, c.b, c.t, c.side, view_proj, half_size, px_per_unit);
 }
 
 @vertex
@@ -159,7 +128,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
     out.clip = expand(c, u.view_proj, half_size, u.focal_length_px);
     let p = mix(c.a.xyz, c.b.xyz, c.t);
     let clip_w = (u.view_proj * vec4<f32>(p, 1.0)).w;
-    out.coverage = clamp(mix(c.a.w, c.b.w, c.t) * u.focal_length_px / clip_w, 0.0, 1.0);
+    out.coverage = ribbon_coverage(mix(c.a.w, c.b.w, c.t), u.focal_length_px, clip_w);
     out.tangent = c.b.xyz - c.a.xyz;
     out.world = p;
     let at = c.hair * u.points + c.j;
@@ -180,7 +149,7 @@ fn vs_shadow(@builtin(vertex_index) vertex: u32) -> ShadowOut {
     let c = corner(vertex);
     var out: ShadowOut;
     out.clip = expand(c, u.light_view_proj, vec2<f32>(0.5 * u.shadow_size), u.shadow_px_per_unit);
-    out.coverage = u.hair_opacity * clamp(mix(c.a.w, c.b.w, c.t) * u.shadow_px_per_unit, 0.0, 1.0);
+    out.coverage = u.hair_opacity * ribbon_coverage(mix(c.a.w, c.b.w, c.t), u.shadow_px_per_unit, 1.0);
     return out;
 }
 
@@ -247,11 +216,6 @@ fn light_reaching(world: vec3<f32>) -> f32 {
     return sum / 9.0;
 }
 
-// An unnormalised Gaussian lobe: 1 at x = 0, width `beta`.
-fn lobe(x: f32, beta: f32) -> f32 {
-    return exp(-x * x / (2.0 * beta * beta));
-}
-
 @fragment
 fn fs_main(v: VertexOut) -> @location(0) vec4<f32> {
     let t = normalize(v.tangent);
@@ -262,25 +226,13 @@ fn fs_main(v: VertexOut) -> @location(0) vec4<f32> {
         base = v.color.rgb;
     }
     let lit = light_reaching(v.world);
-    // Inclinations to the hair's normal plane, and the azimuth between
-    // the light and the eye around the hair.
-    let sin_i = clamp(dot(t, l), -1.0, 1.0);
-    let sin_o = clamp(dot(t, to_eye), -1.0, 1.0);
-    let theta_h = 0.5 * (asin(sin_i) + asin(sin_o));
-    let across_l = l - t * sin_i;
-    let across_v = to_eye - t * sin_o;
-    let cos_phi = dot(across_l, across_v) / max(length(across_l) * length(across_v), 1e-6);
-    let beta = max(u.roughness, 0.05);
-    let alpha = u.shift;
-    let r = u.specular * lobe(theta_h - alpha, beta) * sqrt(max(0.0, 0.5 + 0.5 * cos_phi));
-    let trt = u.trt * lobe(theta_h + 1.5 * alpha, 2.0 * beta);
-    let tt = u.transmission * lobe(theta_h + 0.5 * alpha, 0.5 * beta)
-        * pow(max(0.0, -cos_phi), u.transmission_exponent);
-    // Kajiya-Kay: sin(T, L), wrapped so light grazing the far side still
-    // reaches it.
-    let cos_across = dot(normalize(across_v), l);
-    let diffuse = sqrt(max(0.0, 1.0 - sin_i * sin_i)) * clamp(0.5 + 0.5 * cos_across, 0.0, 1.0);
-    let color = base * (u.ambient + 0.6 * diffuse * lit)
-        + (vec3<f32>(r) + base * (trt + tt)) * lit;
+    var lobes: HairLobes;
+    lobes.specular = u.specular;
+    lobes.shift = u.shift;
+    lobes.roughness = u.roughness;
+    lobes.trt = u.trt;
+    lobes.transmission = u.transmission;
+    lobes.transmission_exponent = u.transmission_exponent;
+    let color = base * u.ambient + hair_radiance(t, l, to_eye, base, lobes) * lit;
     return vec4<f32>(color, v.coverage * v.color.a * u.opacity);
 }
