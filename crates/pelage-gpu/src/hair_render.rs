@@ -57,50 +57,7 @@ gpu_struct! {
     }
 }
 
-/// How hairs look: the colour of hairs the groom gave none, and the
-/// highlights.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StrandLook {
-    /// Colour of hairs without colours (linear RGB).
-    pub color: Vec3,
-    /// The white highlight's strength (R).
-    pub specular: f32,
-    /// Longitudinal roughness: the highlights' width (Marschner's β_R,
-    /// radians; 0.3 is about 17°).
-    pub roughness: f32,
-    /// Light through back-lit hair (TT), times the hair's colour.
-    pub transmission: f32,
-    /// The share of the key light a hair stops where it crosses it (the
-    /// rest goes on through, mostly forward): how dark hairs under
-    /// others are.
-    pub opacity: f32,
-}
-
-impl Default for StrandLook {
-    fn default() -> Self {
-        Self::from_melanin(0.5, 0.3, 0.3)
-    }
-}
-
-impl StrandLook {
-    /// The look of hair with `melanin` and `redness` (0 to 1, as the
-    /// groom's `[look]` spells them) and `roughness`: its colour from the
-    /// same absorption the offline hair material uses.
-    pub fn from_melanin(melanin: f32, redness: f32, roughness: f32) -> Self {
-        Self {
-            color: pelage::groom::color_of_melanin(melanin, redness, roughness),
-            specular: 0.2,
-            roughness,
-            // Marschner's TT is the strongest lobe of light hair, and
-            // absorbed away in dark hair.
-            transmission: 4.0 * (1.0 - melanin),
-            // The light a hair stops is what it absorbs: most of what
-            // light hair scatters goes on forward (Zinke et al. 2008's
-            // dual scattering), dark hair absorbs it.
-            opacity: 0.1 + 0.7 * melanin,
-        }
-    }
-}
+pub use pelage_shaders::hair::StrandLook;
 
 /// What a frame of strands draws.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -534,13 +491,12 @@ impl StrandRenderer {
             layer_depth: params.shadow_layer.unwrap_or(1.0).max(1e-9),
             shadow_range: 4.0 * radius,
             shadow_px_per_unit: SHADOW_SIZE as f32 / (2.0 * radius),
-            // Marschner's measured shift, about −3° (toward the root).
-            shift: -0.05,
+            shift: StrandLook::SHIFT,
             roughness: look.roughness,
-            trt: 0.3,
-            ambient: 0.08,
+            trt: StrandLook::TRT,
+            ambient: StrandLook::AMBIENT,
             transmission: look.transmission,
-            transmission_exponent: 6.0,
+            transmission_exponent: StrandLook::TRANSMISSION_EXPONENT,
             shadowed: u32::from(params.shadow_layer.is_some()),
             shadow_size: SHADOW_SIZE as f32,
             hair_opacity: look.opacity,

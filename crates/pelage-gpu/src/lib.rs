@@ -29,7 +29,7 @@ mod strands;
 pub use camera::{Camera, OrbitCamera};
 pub use context::GpuContext;
 pub use dynamics::GpuMassSpring;
-pub use fur_lod::{FurLevel, FurLod, ShellStandIn};
+pub use fur_lod::{FurLevel, FurLevelParams, FurLod, ShellStandIn};
 pub use groom::{GpuGroom, GpuPartGrower, MAX_GPU_HAIR_POINTS};
 pub use hair_render::{StrandBinding, StrandFrame, StrandLook, StrandParams, StrandRenderer};
 pub use motion::{FurMotion, SkinMotion};

@@ -8,9 +8,9 @@
 //! ([`FurLod`]).
 
 use crate::{
-    FurLevel, FurLod, GpuContext, GpuError, GpuGroom, GpuStrands, ShellFeatures, ShellModel,
-    ShellParams, ShellRenderer, ShellStandIn, ShellTarget, ShellTargetFormats, ShellUpload,
-    ShellView, StrandBinding, StrandParams, StrandRenderer,
+    FurLevel, FurLevelParams, FurLod, GpuContext, GpuError, GpuGroom, GpuStrands, ShellFeatures,
+    ShellModel, ShellParams, ShellRenderer, ShellStandIn, ShellTarget, ShellTargetFormats,
+    ShellUpload, ShellView, StrandBinding, StrandParams, StrandRenderer,
 };
 use glam::Vec3;
 use pelage::anim::SkinPose;

@@ -15,8 +15,8 @@ use pelage::Curves;
 use pelage::groom::{Generator, Groom, GroomRecipe};
 use pelage::shell::{ShellTextureParams, ShellTextures};
 use pelage_gpu::{
-    Camera, FurLevel, FurLod, GpuContext, GpuGroom, ShellFeatures, ShellParams, ShellRenderer,
-    ShellStandIn, ShellTarget, ShellView, StrandLook, StrandParams, StrandRenderer,
+    Camera, FurLevel, FurLevelParams, FurLod, GpuContext, GpuGroom, ShellFeatures, ShellParams,
+    ShellRenderer, ShellStandIn, ShellTarget, ShellView, StrandLook, StrandParams, StrandRenderer,
 };
 use std::collections::HashMap;
 mod common;

@@ -4,6 +4,14 @@
 //! the skin texture's or the look's, brightened to meet the strands'. Both
 //! GPU hosts draw it: pelage-gpu's `RealtimeFur` and the Bevy plugin's
 //! `GroomFur`.
+//!
+//! [`FurLod`] says when to draw what by a character's height on screen:
+//! every strand near; as it gets smaller, fewer strands, the first hairs
+//! by arrival (`pelage::groom::roots_by_arrival`: the hairs a preview
+//! fraction grows), widths × 1/√F so the coat still covers the skin; at a
+//! floor, a cross-fade to the stand-in; the stand-in alone far away. The
+//! share follows the character's area on screen (`F = (h / full)²`), so
+//! the hairs a pixel holds stay about the same from near to far.
 
 use glam::Vec3;
 use pelage::groom::{Generator, Groom, GroomError};
@@ -95,4 +103,60 @@ pub fn srgb(c: Vec3) -> image::Rgba<u8> {
         .to_array()
         .map(|x| (255.0 * pelage::groom::linear_to_srgb(x)).round() as u8);
     image::Rgba([r, g, b, 255])
+}
+
+/// When to draw what, by a character's height on screen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FurLod {
+    /// At this height in pixels and above, every strand is drawn.
+    pub full_px: f32,
+    /// The smallest share of the strands drawn; below the height it is
+    /// reached at, strands hand over to shells.
+    pub floor: f32,
+    /// The hand-over's length, a share of the height it starts at: the
+    /// strands fade out and the shells in from that height down to
+    /// `(1 − fade)` of it.
+    pub fade: f32,
+}
+
+impl Default for FurLod {
+    /// Every strand at 800 pixels (a character three quarters of a 1080p
+    /// screen), down to a tenth of them at 253 pixels, shells alone below
+    /// 177 pixels.
+    fn default() -> Self {
+        Self {
+            full_px: 800.0,
+            floor: 0.1,
+            fade: 0.5,
+        }
+    }
+}
+
+/// What one level draws.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FurLevel {
+    /// The share of the strands drawn (the first by arrival).
+    pub fraction: f32,
+    /// The strands' opacity (0: none drawn).
+    pub strand_opacity: f32,
+    /// The shells' opacity (0: none drawn).
+    pub shell_opacity: f32,
+}
+
+impl FurLod {
+    /// The level for a character `height_px` pixels high on screen.
+    pub fn level(&self, height_px: f32) -> FurLevel {
+        let floor = self.floor.clamp(1e-6, 1.0);
+        let full = self.full_px.max(1e-3);
+        let fraction = (height_px / full).powi(2).clamp(floor, 1.0);
+        // The height the floor is reached at, and how far below it.
+        let handover = full * floor.sqrt();
+        let fade = self.fade.clamp(1e-3, 1.0);
+        let t = ((handover - height_px) / (fade * handover)).clamp(0.0, 1.0);
+        FurLevel {
+            fraction,
+            strand_opacity: 1.0 - t,
+            shell_opacity: t,
+        }
+    }
 }
