@@ -258,17 +258,54 @@ fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(0.0);
 }
 
+// glam's Mat3::from_quat (a unit quaternion, xyz then w).
+fn mat3_from_quat(q: vec4<f32>) -> mat3x3<f32> {
+    let x2 = q.x + q.x;
+    let y2 = q.y + q.y;
+    let z2 = q.z + q.z;
+    let xx = q.x * x2;
+    let xy = q.x * y2;
+    let xz = q.x * z2;
+    let yy = q.y * y2;
+    let yz = q.y * z2;
+    let zz = q.z * z2;
+    let wx = q.w * x2;
+    let wy = q.w * y2;
+    let wz = q.w * z2;
+    return mat3x3<f32>(
+        vec3<f32>(1.0 - (yy + zz), xy + wz, xz - wy),
+        vec3<f32>(xy - wz, 1.0 - (xx + zz), yz + wx),
+        vec3<f32>(xz + wy, yz - wx, 1.0 - (xx + yy)),
+    );
+}
+
+// glam's Quat::from_rotation_arc as a matrix: the shortest turn from `a`
+// to `b` (unit vectors), a half turn about any perpendicular
+// where they oppose to within two float epsilons.
+fn rotation_arc(a: vec3<f32>, b: vec3<f32>) -> mat3x3<f32> {
+    let one_minus_eps = 1.0 - 2.0 * 1.1920929e-7;
+    let d = dot(a, b);
+    if d > one_minus_eps {
+        return mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+    }
+    if d < -one_minus_eps {
+        // from_axis_angle(axis, π): sin(π/2) = 1, cos(π/2) in f32.
+        return mat3_from_quat(vec4<f32>(any_orthonormal(a), -4.371139e-8));
+    }
+    let c = cross(a, b);
+    let q = vec4<f32>(c, 1.0 + d);
+    return mat3_from_quat(q * (1.0 / length(q)));
+}
+
 // pelage::interp::rotation_between (from `a_dir` to `b_dir`): Rodrigues
-// without trigonometry; a half turn about a perpendicular where the
-// normals nearly oppose.
+// without trigonometry; glam's rotation arc where the normals nearly
+// oppose (1 + cos < 1e-4), as the CPU does.
 fn rotation_between(a_dir: vec3<f32>, b_dir: vec3<f32>) -> mat3x3<f32> {
     let v = cross(a_dir, b_dir);
     let c = dot(a_dir, b_dir);
     let one_plus_c = 1.0 + c;
     if one_plus_c < 1e-4 {
-        let a = any_orthonormal(a_dir);
-        return mat3x3<f32>(2.0 * a.x * a, 2.0 * a.y * a, 2.0 * a.z * a)
-            - mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+        return rotation_arc(a_dir, b_dir);
     }
     let h = 1.0 / one_plus_c;
     let hx = h * v.x;
