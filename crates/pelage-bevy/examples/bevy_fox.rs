@@ -84,7 +84,7 @@ fn setup(
     target.spawn_camera(&mut commands).insert(Orbit {
         yaw: 0.6,
         pitch: 0.3,
-        distance: 190.0,
+        distance: args.distance.unwrap_or(190.0),
     });
 }
 
@@ -109,14 +109,17 @@ fn blow(keys: Res<ButtonInput<KeyCode>>, mut forces: ResMut<pelage_bevy::FurForc
     };
 }
 
-/// Drag to turn, scroll to zoom; left alone, the camera circles slowly.
+/// The camera orbits the running fox: drag to turn, scroll to zoom; left
+/// alone, it circles slowly.
 fn orbit(
     time: Res<Time>,
     buttons: Res<ButtonInput<MouseButton>>,
     motion: Res<AccumulatedMouseMotion>,
     scroll: Res<AccumulatedMouseScroll>,
+    foxes: Query<&Transform, (With<Fox>, Without<Orbit>)>,
     mut cameras: Query<(&mut Orbit, &mut Transform)>,
 ) {
+    let fox = foxes.iter().next().map_or(Vec3::ZERO, |t| t.translation);
     for (mut orbit, mut transform) in &mut cameras {
         if buttons.pressed(MouseButton::Left) {
             orbit.yaw -= motion.delta.x * 0.005;
@@ -125,7 +128,7 @@ fn orbit(
             orbit.yaw += 0.15 * time.delta_secs();
         }
         orbit.distance = (orbit.distance * (1.0 - 0.1 * scroll.delta.y)).clamp(40.0, 3000.0);
-        let target = Vec3::new(0.0, 35.0, 0.0);
+        let target = fox + Vec3::new(0.0, 35.0, 0.0);
         let eye = target
             + orbit.distance
                 * Vec3::new(

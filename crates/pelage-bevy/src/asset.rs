@@ -12,6 +12,8 @@ use bevy::prelude::*;
 use pelage::dynamics::DynamicsParams;
 use pelage::shell::math::{ClumpParams, Coupling, CurlParams, KajiyaKay};
 use pelage::shell::{ShellScene, ShellTextures, WetnessMask};
+use pelage_shaders::groom::GroomUpload;
+use pelage_shaders::hair::StrandLook;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -173,15 +175,87 @@ impl AssetLoader for ShellFurLoader {
 /// Layers of the shell fur that stands in for a groom.
 const STAND_IN_LAYERS: u32 = 16;
 
-/// A groom file as Bevy fur: the shell fur that stands in for it (its
-/// density, length and colour; pelage-gpu's real-time strands hand over
-/// to the same stand-in far away), as a labelled [`ShellFurAsset`].
+/// A groom file as Bevy fur: its hairs as real-time strands, grown on
+/// the GPU every frame near the camera, and the shell fur that stands in
+/// for them far away (their density, length and colour), as a labelled
+/// [`ShellFurAsset`].
 #[derive(Asset, TypePath, Debug, Clone)]
 pub struct GroomFurAsset {
     /// The stand-in, drawn as any shell fur is.
     pub shells: Handle<ShellFurAsset>,
     /// Hairs the groom grows.
     pub hairs: u64,
+    /// What the GPU grows the hairs from (`None`: the groom cannot be
+    /// grown on the GPU, and the loader said why; the stand-in is drawn
+    /// at every distance).
+    pub strands: Option<Arc<GroomStrandsSource>>,
+}
+
+/// A groom made ready to grow on the GPU: the arrays uploaded once
+/// (pelage-shaders' [`GroomUpload`], its hairs ordered by arrival so the
+/// first `k` are a preview fraction's), the guides at rest, the skin it
+/// was grown on (to find its vertices in Bevy's mesh) and the look.
+#[derive(Debug)]
+pub struct GroomStrandsSource {
+    /// The recipe's arrays.
+    pub upload: GroomUpload,
+    /// The guides in rest space, as the shader reads them.
+    pub guides: Vec<[f32; 4]>,
+    /// The groom's skin at rest, pelage's vertices (welded).
+    pub rest: Vec<[f32; 3]>,
+    /// Its triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// The hair model's numbers.
+    pub look: StrandLook,
+    /// The guides' mean length (mesh units).
+    pub length: f32,
+    /// Settings of the groom the GPU leaves out (named, never dropped
+    /// silently).
+    pub left_out: Vec<String>,
+}
+
+impl GroomStrandsSource {
+    /// `groom`'s hairs (its `generator`'s) made ready for the GPU; hairs
+    /// the groom gives no colour take its skin texture's at their roots.
+    ///
+    /// # Errors
+    /// When the recipe cannot be made, or is too large for the GPU's
+    /// registers (more than 32 points a hair).
+    pub fn of(
+        groom: &pelage::groom::Groom,
+        generator: &pelage::groom::Generator,
+        length: f32,
+    ) -> Result<Self, String> {
+        let (roots, ids) = pelage::groom::roots_by_arrival(generator);
+        let recipe =
+            pelage::groom::GroomRecipe::new(generator, &roots, &ids).map_err(|e| e.to_string())?;
+        let mesh = generator.mesh();
+        let triangles = mesh.triangles().to_vec();
+        let rest = pelage::anim::SkinPose::new(mesh.positions().to_vec(), &triangles);
+        let skin = pelage::anim::SkinBinding::new(triangles.clone(), rest);
+        let mut upload = GroomUpload::new(&recipe, &skin).map_err(|e| e.to_string())?;
+        let render = recipe.render_hairs();
+        let render_roots = &recipe.roots[render.start as usize..render.end as usize];
+        if let Some(colors) = pelage_shaders::stand_in::root_colors(groom, mesh, render_roots)
+            .map_err(|e| e.to_string())?
+        {
+            upload.color_hairs(&colors);
+        }
+        let offsets = pelage::groom::GroomRecipe::guide_offsets(generator.guides());
+        Ok(Self {
+            upload,
+            guides: GroomUpload::guide_words(&offsets),
+            rest: mesh.positions().iter().map(|p| p.to_array()).collect(),
+            triangles,
+            look: StrandLook::default(),
+            length,
+            left_out: recipe
+                .left_out
+                .iter()
+                .map(|l| format!("{} ({})", l.key, l.why))
+                .collect(),
+        })
+    }
 }
 
 /// Reads pelage groom files (`*.groom.toml`, or any `*.toml` loaded as a
@@ -209,13 +283,15 @@ impl ShellFurAsset {
     /// groom's density of hairs on the skin, its guides' mean length, its
     /// colour texture brightened to meet the strands'), Kajiya-Kay shaded
     /// as a shells file without `[shading]`, with a level of detail.
-    pub fn stand_in_for(groom: &pelage::groom::Groom) -> Result<(Self, u64), GroomFurLoadError> {
-        let generator = groom.generator(None)?;
+    pub fn stand_in_for(
+        groom: &pelage::groom::Groom,
+        generator: &pelage::groom::Generator,
+    ) -> Result<(Self, u64), GroomFurLoadError> {
         let hairs = generator.parts().iter().map(|p| p.hair_count).sum();
-        let stand_in = pelage_shaders::stand_in::ShellStandIn::of(&generator, STAND_IN_LAYERS);
+        let stand_in = pelage_shaders::stand_in::ShellStandIn::of(generator, STAND_IN_LAYERS);
         // The strands' default look (melanin 0.5, redness 0.3), where the
         // groom has no colour texture.
-        let hair = pelage::groom::color_of_melanin(0.5, 0.3, 0.3);
+        let hair = StrandLook::default().color;
         let color = stand_in.color_texture(groom, hair)?;
         Ok((
             Self {
@@ -258,9 +334,29 @@ impl AssetLoader for GroomFurLoader {
     ) -> Result<GroomFurAsset, GroomFurLoadError> {
         let source = read_settings(&self.folder, reader, load_context).await?;
         let groom = pelage::groom::Groom::from_source(source)?;
-        let (shells, hairs) = ShellFurAsset::stand_in_for(&groom)?;
+        let generator = groom.generator(None)?;
+        let (shells, hairs) = ShellFurAsset::stand_in_for(&groom, &generator)?;
+        let path = load_context.path().to_string();
+        let strands = match GroomStrandsSource::of(&groom, &generator, shells.length) {
+            Ok(source) => {
+                for what in &source.left_out {
+                    bevy::log::warn!("pelage: {path}: the GPU's strands leave out {what}");
+                }
+                Some(Arc::new(source))
+            }
+            Err(why) => {
+                bevy::log::warn!(
+                    "pelage: {path}: no real-time strands ({why}); its shell stand-in is drawn at every distance"
+                );
+                None
+            }
+        };
         let shells = load_context.add_labeled_asset("shells", shells);
-        Ok(GroomFurAsset { shells, hairs })
+        Ok(GroomFurAsset {
+            shells,
+            hairs,
+            strands,
+        })
     }
 
     fn extensions(&self) -> &[&str] {

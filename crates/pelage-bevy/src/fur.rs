@@ -99,7 +99,14 @@ pub(crate) fn attach_fur(
     mut commands: Commands,
     owners: Query<(Entity, &ShellFur, Option<&Mesh3d>)>,
     children: Query<&Children>,
-    skins: Query<SkinItem, Without<FurLayers>>,
+    // Not pelage's own fur: shell levels, or strands' ribbons.
+    skins: Query<
+        SkinItem,
+        (
+            Without<FurLayers>,
+            Without<MeshMaterial3d<crate::hair_material::StrandMaterial>>,
+        ),
+    >,
     assets: Res<Assets<ShellFurAsset>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut images: ResMut<Assets<Image>>,

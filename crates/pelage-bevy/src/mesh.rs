@@ -21,6 +21,11 @@ pub enum FurMeshError {
     /// pelage could not read the mesh (empty, bad indices).
     #[error("{0}")]
     Mesh(String),
+    /// The mesh's vertices are on the GPU only.
+    #[error(
+        "the mesh's vertices went to the GPU only (its RenderAssetUsages lack MAIN_WORLD): fur is grown from them on the CPU"
+    )]
+    RenderWorldOnly,
 }
 
 /// The fur mesh of `skin` with `layers` layers (layer 0 innermost, drawn
@@ -28,6 +33,9 @@ pub enum FurMeshError {
 pub fn fur_mesh(skin: &Mesh, layers: u32) -> Result<Mesh, FurMeshError> {
     if skin.primitive_topology() != PrimitiveTopology::TriangleList {
         return Err(FurMeshError::NotTriangles);
+    }
+    if skin.try_attributes().is_err() {
+        return Err(FurMeshError::RenderWorldOnly);
     }
     let positions = float3(skin, Mesh::ATTRIBUTE_POSITION, "positions")?;
     let normals = float3(skin, Mesh::ATTRIBUTE_NORMAL, "normals")?;

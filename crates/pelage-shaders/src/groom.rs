@@ -251,6 +251,19 @@ impl GroomUpload {
         u64::from(self.hairs) * u64::from(self.points) * 16
     }
 
+    /// Gives every point of render hair `r` the colour `colors[r]`, where
+    /// the groom gave the hairs none.
+    pub fn color_hairs(&mut self, colors: &[Vec3]) {
+        let n = self.points as usize;
+        for (r, c) in colors.iter().enumerate().take(self.render.len()) {
+            for shade in &mut self.shade[r * n..(r + 1) * n] {
+                if shade[0] < 0.0 {
+                    shade[..3].copy_from_slice(&c.to_array());
+                }
+            }
+        }
+    }
+
     /// A frame's guides in rest space as the shader reads them.
     pub fn guide_words(guide_offsets: &[Vec3]) -> Vec<[f32; 4]> {
         guide_offsets.iter().map(|&v| v4(v, 0.0)).collect()

@@ -97,6 +97,42 @@ impl ShellStandIn {
     }
 }
 
+/// Each root's colour in the groom's base colour texture (linear RGB,
+/// the nearest texel at the root's UV), for strands the groom gives no
+/// colour of their own: the texture the stand-in is made of, so strands
+/// near and shells far agree. `None` without a texture or UVs.
+///
+/// # Errors
+/// When the texture cannot be read.
+pub fn root_colors(
+    groom: &Groom,
+    mesh: &pelage::Mesh,
+    roots: &[pelage::mesh::SurfacePoint],
+) -> Result<Option<Vec<Vec3>>, GroomError> {
+    let Some(image) = groom.base_color_texture()? else {
+        return Ok(None);
+    };
+    if !mesh.has_uvs() {
+        return Ok(None);
+    }
+    let image = image.to_rgb8();
+    let (w, h) = image.dimensions();
+    let linear = |x: u8| pelage::groom::srgb_to_linear(f32::from(x) / 255.0);
+    Ok(Some(
+        roots
+            .iter()
+            .map(|root| {
+                // pelage's UVs start at the bottom left, images at the top.
+                let uv = root.uv(mesh).unwrap_or_default();
+                let x = ((uv.x.rem_euclid(1.0) * w as f32) as u32).min(w - 1);
+                let y = (((1.0 - uv.y).rem_euclid(1.0) * h as f32) as u32).min(h - 1);
+                let [r, g, b] = image.get_pixel(x, y).0;
+                Vec3::new(linear(r), linear(g), linear(b))
+            })
+            .collect(),
+    ))
+}
+
 /// sRGB bytes of a linear colour.
 pub fn srgb(c: Vec3) -> image::Rgba<u8> {
     let [r, g, b] = c

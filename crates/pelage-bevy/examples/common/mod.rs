@@ -34,9 +34,11 @@ pub struct Args {
     pub timing: bool,
     /// No window: draw into an image (servers, the benchmark).
     pub headless: bool,
-    /// Fur from a groom file (`GroomFur`: its shell stand-in) rather
-    /// than a shells file.
+    /// Fur from a groom file (`GroomFur`: strands near, its shell
+    /// stand-in far) rather than a shells file.
     pub groom: bool,
+    /// The camera's distance from the character (`None`: the example's).
+    pub distance: Option<f32>,
 }
 
 impl Args {
@@ -50,6 +52,7 @@ impl Args {
             timing: false,
             headless: false,
             groom: false,
+            distance: None,
         };
         let mut it = std::env::args().skip(1);
         while let Some(a) = it.next() {
@@ -71,6 +74,12 @@ impl Args {
                 "--timing" => args.timing = true,
                 "--headless" => args.headless = true,
                 "--groom" => args.groom = true,
+                "--distance" => {
+                    args.distance = Some(value("--distance").parse().unwrap_or_else(|_| {
+                        eprintln!("--distance takes a number (scene units)");
+                        std::process::exit(2)
+                    }))
+                }
                 "--size" => {
                     let v = value("--size");
                     let parsed = v
@@ -83,7 +92,7 @@ impl Args {
                 }
                 "-h" | "--help" => {
                     println!(
-                        "options: --frames N  --screenshot PNG  --no-fur  --groom  --size WxH  --headless  --timing"
+                        "options: --frames N  --screenshot PNG  --no-fur  --groom  --distance D  --size WxH  --headless  --timing"
                     );
                     std::process::exit(0)
                 }
