@@ -9,6 +9,10 @@
 //! `pelage`): the bench looks for them beside this binary
 //! (`target/<profile>/examples/`), or in `PELAGE_BEVY_EXAMPLES`.
 //!
+//! A third row runs `bevy_fox --groom` near the Fox: its groom's hairs
+//! grown on the GPU every frame and drawn as strands, against the same
+//! view without fur.
+//!
 //! Targets (issue "pelage in Bevy"), on an H100-class GPU at 1920×1080:
 //! the Fox with fur ≤ 1.3× the same frame without; the crowd ≥ 60 frames/s.
 
@@ -56,6 +60,7 @@ fn run_example(
     frames: u32,
     size: (u32, u32),
     fur: bool,
+    extra: &[&str],
 ) -> anyhow::Result<Run> {
     let exe = dir.join(example);
     if !exe.exists() {
@@ -73,6 +78,7 @@ fn run_example(
     if !fur {
         cmd.arg("--no-fur");
     }
+    cmd.args(extra);
     let out = cmd.output()?;
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -111,10 +117,14 @@ pub fn run(args: &BevyBenchArgs) -> anyhow::Result<()> {
     let size = scale.pick((1920, 1080), (960, 540), (320, 180));
     let fox_frames = scale.pick(240, 90, 12);
     let crowd_frames = scale.pick(120, 30, 6);
-    let fox = run_example(&dir, "bevy_fox", fox_frames, size, true)?;
-    let fox_bare = run_example(&dir, "bevy_fox", fox_frames, size, false)?;
-    let crowd = run_example(&dir, "bevy_crowd", crowd_frames, size, true)?;
-    let crowd_bare = run_example(&dir, "bevy_crowd", crowd_frames, size, false)?;
+    let fox = run_example(&dir, "bevy_fox", fox_frames, size, true, &[])?;
+    let fox_bare = run_example(&dir, "bevy_fox", fox_frames, size, false, &[])?;
+    let crowd = run_example(&dir, "bevy_crowd", crowd_frames, size, true, &[])?;
+    let crowd_bare = run_example(&dir, "bevy_crowd", crowd_frames, size, false, &[])?;
+    // Near enough for strands: the Fox fills most of the screen's height.
+    let near = ["--groom", "--distance", "120"];
+    let strands = run_example(&dir, "bevy_fox", crowd_frames, size, true, &near)?;
+    let strands_bare = run_example(&dir, "bevy_fox", crowd_frames, size, false, &near)?;
     let software = ["llvmpipe", "lavapipe", "SwiftShader", "softpipe"]
         .iter()
         .any(|s| fox.adapter.contains(s));
@@ -133,6 +143,9 @@ pub fn run(args: &BevyBenchArgs) -> anyhow::Result<()> {
             "crowd_no_fur_ms": crowd_bare.frame_ms,
             "crowd_fps": crowd_fps,
             "crowd_ratio": crowd.frame_ms / crowd_bare.frame_ms,
+            "strands_ms": strands.frame_ms,
+            "strands_no_fur_ms": strands_bare.frame_ms,
+            "strands_ratio": strands.frame_ms / strands_bare.frame_ms,
             "adapter": fox.adapter,
             "software": software,
         });
@@ -170,6 +183,13 @@ pub fn run(args: &BevyBenchArgs) -> anyhow::Result<()> {
         crowd_bare.frame_ms,
         crowd.frame_ms / crowd_bare.frame_ms,
         crowd_fps
+    );
+    println!(
+        "{:>34}  {:>10.2}  {:>10.2}  {:>6.2}×   (no target set)",
+        "bevy_fox --groom (strands, near)",
+        strands.frame_ms,
+        strands_bare.frame_ms,
+        strands.frame_ms / strands_bare.frame_ms
     );
     Ok(())
 }
