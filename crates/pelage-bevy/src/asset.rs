@@ -191,6 +191,51 @@ pub struct GroomFurAsset {
     pub strands: Option<Arc<GroomStrandsSource>>,
 }
 
+impl GroomFurAsset {
+    /// A groom made in code (or edited) as Bevy fur: its stand-in added to
+    /// `shells`, its strands readied for the GPU. A groom file is loaded
+    /// as one by [`GroomFurLoader`].
+    ///
+    /// # Errors
+    /// When pelage cannot grow the groom (its mesh, guides or maps).
+    pub fn from_groom(
+        groom: &pelage::groom::Groom,
+        shells: &mut Assets<ShellFurAsset>,
+    ) -> Result<Self, GroomFurLoadError> {
+        let (stand_in, hairs, strands) = Self::parts(groom)?;
+        Ok(Self {
+            shells: shells.add(stand_in),
+            hairs,
+            strands,
+        })
+    }
+
+    /// The stand-in, the hair count and the strands (`None`, said why in
+    /// a warning, when the GPU cannot grow them).
+    fn parts(
+        groom: &pelage::groom::Groom,
+    ) -> Result<(ShellFurAsset, u64, Option<Arc<GroomStrandsSource>>), GroomFurLoadError> {
+        let generator = groom.generator(None)?;
+        let (shells, hairs) = ShellFurAsset::stand_in_for(groom, &generator)?;
+        let path = groom.path().display();
+        let strands = match GroomStrandsSource::of(groom, &generator, shells.length) {
+            Ok(source) => {
+                for what in &source.left_out {
+                    bevy::log::warn!("pelage: {path}: the GPU's strands leave out {what}");
+                }
+                Some(Arc::new(source))
+            }
+            Err(why) => {
+                bevy::log::warn!(
+                    "pelage: {path}: no real-time strands ({why}); its shell stand-in is drawn at every distance"
+                );
+                None
+            }
+        };
+        Ok((shells, hairs, strands))
+    }
+}
+
 /// A groom made ready to grow on the GPU: the arrays uploaded once
 /// (pelage-shaders' [`GroomUpload`], its hairs ordered by arrival so the
 /// first `k` are a preview fraction's), the guides at rest, the skin it
@@ -334,23 +379,7 @@ impl AssetLoader for GroomFurLoader {
     ) -> Result<GroomFurAsset, GroomFurLoadError> {
         let source = read_settings(&self.folder, reader, load_context).await?;
         let groom = pelage::groom::Groom::from_source(source)?;
-        let generator = groom.generator(None)?;
-        let (shells, hairs) = ShellFurAsset::stand_in_for(&groom, &generator)?;
-        let path = load_context.path().to_string();
-        let strands = match GroomStrandsSource::of(&groom, &generator, shells.length) {
-            Ok(source) => {
-                for what in &source.left_out {
-                    bevy::log::warn!("pelage: {path}: the GPU's strands leave out {what}");
-                }
-                Some(Arc::new(source))
-            }
-            Err(why) => {
-                bevy::log::warn!(
-                    "pelage: {path}: no real-time strands ({why}); its shell stand-in is drawn at every distance"
-                );
-                None
-            }
-        };
+        let (shells, hairs, strands) = GroomFurAsset::parts(&groom)?;
         let shells = load_context.add_labeled_asset("shells", shells);
         Ok(GroomFurAsset {
             shells,
@@ -375,6 +404,36 @@ mod tests {
         })
         .unwrap();
         ShellFurAsset::from_scene(&scene)
+    }
+
+    fn spot_groom(points: u32) -> pelage::groom::Groom {
+        let text = format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 500\nseed = 2\n\
+             [guides]\npoints = 6\ngenerate = {{ count = 30, length = 0.08, seed = 5 }}\n\
+             [finish]\npoints = {points}\n"
+        );
+        pelage::groom::Groom::from_text("spot.toml", &text).unwrap()
+    }
+
+    /// A groom made in code becomes Bevy fur: its stand-in, and its
+    /// strands for the GPU (every hair, in the recipe's order); one the
+    /// GPU cannot grow (over 32 points a hair) keeps its stand-in alone.
+    #[test]
+    fn a_groom_value_becomes_fur_with_strands_where_the_gpu_can_grow_them() {
+        let mut shells = Assets::<ShellFurAsset>::default();
+        let fur = GroomFurAsset::from_groom(&spot_groom(9), &mut shells).unwrap();
+        assert_eq!(fur.hairs, 500);
+        assert_eq!(
+            shells.get(&fur.shells).map(|s| s.layers),
+            Some(STAND_IN_LAYERS)
+        );
+        let strands = fur.strands.expect("strands");
+        assert_eq!(strands.upload.render.len(), 500);
+        assert_eq!(strands.upload.points, 9);
+        assert_eq!(strands.guides.len(), 30 * 6);
+        let too_long = GroomFurAsset::from_groom(&spot_groom(40), &mut shells).unwrap();
+        assert!(too_long.strands.is_none());
+        assert!(shells.get(&too_long.shells).is_some());
     }
 
     /// A file's settings reach the asset, and what Bevy does not draw is
