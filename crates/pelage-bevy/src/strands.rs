@@ -43,9 +43,18 @@ pub struct GroomStrands {
     /// The skin this frame, pelage's vertices in world space (position,
     /// then normal), as the groom shader reads it.
     pub(crate) pose: Arc<Vec<[f32; 4]>>,
-    /// Every hair's points, written by the render world's growth.
+    /// Every hair's points, written by the render world's growth; a
+    /// 16-byte stand-in while the strands are not drawn (a crowd keeps
+    /// buffers only for its near characters).
     pub(crate) points: Handle<ShaderBuffer>,
+    /// Frames the strands have not been drawn (their buffer is let go
+    /// after [`KEEP_HIDDEN_BUFFER`] of them).
+    hidden_frames: u32,
 }
+
+/// Frames strands keep their points buffer while not drawn: a character
+/// crossing the hand-over back and forth does not reallocate it each time.
+const KEEP_HIDDEN_BUFFER: u32 = 120;
 
 impl GroomStrands {
     /// The buffer the GPU grows the hairs into: every hair's points, `xyz`
@@ -246,10 +255,7 @@ pub(crate) fn attach_strands(
                     buffers.add(ShaderBuffer::new(shade, RenderAssetUsages::RENDER_WORLD))
                 })
                 .clone();
-            let points = buffers.add(ShaderBuffer::with_size(
-                source.upload.points_bytes() as usize,
-                RenderAssetUsages::RENDER_WORLD,
-            ));
+            let points = buffers.add(ShaderBuffer::with_size(16, RenderAssetUsages::RENDER_WORLD));
             let material = materials.add(StrandMaterial {
                 strands: strand_uniform(&source),
                 points: points.clone(),
@@ -274,6 +280,7 @@ pub(crate) fn attach_strands(
                         skinning,
                         pose: Arc::default(),
                         points,
+                        hidden_frames: KEEP_HIDDEN_BUFFER,
                     },
                     ChildOf(skin),
                 ))
@@ -388,6 +395,7 @@ pub(crate) fn pose_strands(
     cameras: Query<(&Camera, &Projection, &GlobalTransform)>,
     lod: Res<StrandsLod>,
     mut materials: ResMut<Assets<StrandMaterial>>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
     mut shells: Query<
         (
             &FurLayers,
@@ -431,6 +439,32 @@ pub(crate) fn pose_strands(
             0
         };
         hairs.drawn = drawn;
+        hairs.hidden_frames = if drawn > 0 {
+            0
+        } else {
+            hairs.hidden_frames.saturating_add(1)
+        };
+        let bytes = hairs.source.upload.points_bytes();
+        let has_buffer = buffers
+            .get(&hairs.points)
+            .is_some_and(|b| b.buffer_description.size == bytes);
+        let swap = if drawn > 0 && !has_buffer {
+            Some(ShaderBuffer::with_size(
+                bytes as usize,
+                RenderAssetUsages::RENDER_WORLD,
+            ))
+        } else if hairs.hidden_frames == KEEP_HIDDEN_BUFFER && has_buffer {
+            Some(ShaderBuffer::with_size(16, RenderAssetUsages::RENDER_WORLD))
+        } else {
+            None
+        };
+        if let Some(buffer) = swap {
+            buffers.remove(&hairs.points);
+            hairs.points = buffers.add(buffer);
+            if let Some(mut m) = materials.get_mut(&material.0) {
+                m.points = hairs.points.clone();
+            }
+        }
         let wanted = if drawn > 0 {
             Visibility::Inherited
         } else {
