@@ -437,6 +437,29 @@ def _interrupt_after(seconds):
     return timer
 
 
+def _stopped_by_ctrl_c(call, whole, share, tidy=lambda: None):
+    """Seconds `call()` ran before a Ctrl-C sent `share` of `whole` into it
+    stopped it with KeyboardInterrupt. On a loaded machine the call can
+    finish before the signal (it ran faster than the `whole` it was timed
+    against): then `tidy()` and a sooner signal, three times, before the
+    test fails. A call that ignores Ctrl-C never raises."""
+    import time
+
+    for attempt in range(3):
+        timer = _interrupt_after(whole * share / 4**attempt)
+        started = time.perf_counter()
+        try:
+            call()
+        except KeyboardInterrupt:
+            stopped = time.perf_counter() - started
+            timer.join()
+            return stopped
+        timer.cancel()
+        timer.join()
+        tidy()
+    pytest.fail(f"not stopped by Ctrl-C, even {whole * share / 16:.3f} s into it")
+
+
 def test_ctrl_c_stops_write_and_grow_between_parts(spot, tmp_path):
     """Ctrl-C during a long write() stops it at the next part (the file is
     left absent, no temporary file stays), with or without a progress
@@ -450,19 +473,16 @@ def test_ctrl_c_stops_write_and_grow_between_parts(spot, tmp_path):
     whole = time.perf_counter() - started
     out.unlink()
     for progress in [None, lambda done, total: None]:
-        timer = _interrupt_after(whole / 8)
-        started = time.perf_counter()
-        with pytest.raises(KeyboardInterrupt):
-            groom.write(out, progress=progress)
-        stopped = time.perf_counter() - started
-        timer.join()
+        stopped = _stopped_by_ctrl_c(
+            lambda: groom.write(out, progress=progress), whole, 1 / 8, tidy=out.unlink
+        )
         assert stopped < whole * 0.8, f"stopped after {stopped:.2f} s of {whole:.2f}"
         assert not out.exists()
         assert [p.name for p in tmp_path.iterdir()] == []
-    timer = _interrupt_after(whole / 8)
-    with pytest.raises(KeyboardInterrupt):
-        groom.grow()
-    timer.join()
+    started = time.perf_counter()
+    groom.grow()
+    grown = time.perf_counter() - started
+    _stopped_by_ctrl_c(groom.grow, grown, 1 / 8)
 
 
 def test_ctrl_c_stops_a_simulation_in_simulate_write_and_grow_frame(tmp_path):
@@ -486,15 +506,14 @@ def test_ctrl_c_stops_a_simulation_in_simulate_write_and_grow_frame(tmp_path):
     simulated().simulate()
     whole = time.perf_counter() - started
     guides = tmp_path / "guides.usdc"
+    def tidy():
+        for p in tmp_path.iterdir():
+            p.unlink()
+
     for run in [lambda g: g.simulate(guides), lambda g: g.write(tmp_path / "fox.usdc"),
                 lambda g: g.grow_frame(20)]:
-        groom = simulated()
-        timer = _interrupt_after(whole / 5)
-        started = time.perf_counter()
-        with pytest.raises(KeyboardInterrupt):
-            run(groom)
-        stopped = time.perf_counter() - started
-        timer.join()
+        # A fresh groom each try: a finished one has its guides simulated.
+        stopped = _stopped_by_ctrl_c(lambda: run(simulated()), whole, 1 / 5, tidy=tidy)
         assert stopped < whole * 0.6, f"stopped after {stopped:.2f} s of {whole:.2f}"
     assert [p.name for p in tmp_path.iterdir()] == []
 
