@@ -50,6 +50,8 @@ struct StrandsToGrow {
     source: Arc<GroomStrandsSource>,
     pose: Arc<Vec<[f32; 4]>>,
     points: AssetId<ShaderBuffer>,
+    /// Render hairs drawn: only these (the first by arrival) are grown.
+    drawn: u32,
 }
 
 #[derive(Resource, Default)]
@@ -137,6 +139,7 @@ fn extract_strands(
             source: s.source.clone(),
             pose: s.pose.clone(),
             points: s.points.id(),
+            drawn: s.drawn,
         });
     }
 }
@@ -291,12 +294,20 @@ fn grow_strands(
         });
         pass.set_pipeline(compute);
         pass.set_bind_group(0, group, &[]);
+        let render_first = s.source.upload.render.start;
         for (i, p) in s.source.upload.passes.iter().enumerate() {
-            if p.count == 0 {
+            // The render hairs' pass grows the drawn ones only: a level of
+            // detail draws the first by arrival, which come first.
+            let count = if p.first == render_first {
+                p.count.min(s.drawn)
+            } else {
+                p.count
+            };
+            if count == 0 {
                 continue;
             }
             pass.set_bind_group(1, pass_group, &[i as u32 * b.stride]);
-            let (x, y) = workgroups(p.count);
+            let (x, y) = workgroups(count);
             pass.dispatch_workgroups(x, y, 1);
         }
         grown = true;

@@ -127,6 +127,7 @@ impl Plugin for PelagePlugin {
                 // After Bevy's transforms (and the animation before
                 // them): the pose Bevy skins this frame with.
                 strands::pose_strands.after(bevy::transform::TransformSystems::Propagate),
+                strands::fit_ribbons,
             )
                 .chain(),
         );

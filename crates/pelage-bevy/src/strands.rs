@@ -35,6 +35,8 @@ pub struct GroomStrands {
     pub skin: Entity,
     /// The entity with the [`GroomFur`] they come from.
     pub owner: Entity,
+    /// The groom.
+    pub(crate) asset: AssetId<GroomFurAsset>,
     /// Render hairs drawn this frame, the first by arrival (0: the shell
     /// stand-in alone).
     pub drawn: u32,
@@ -103,7 +105,9 @@ pub(crate) struct StrandsOnSkin {
 /// mesh wearing it.
 #[derive(Resource, Default)]
 pub(crate) struct StrandsCache {
-    ribbons: HashMap<AssetId<GroomFurAsset>, Handle<Mesh>>,
+    /// By groom and hairs: ribbons for the first `k` render hairs (`k` the
+    /// whole groom, a half, a quarter, …).
+    ribbons: HashMap<(AssetId<GroomFurAsset>, u32), Handle<Mesh>>,
     colors: HashMap<AssetId<GroomFurAsset>, Handle<ShaderBuffer>>,
 }
 
@@ -158,11 +162,11 @@ fn skin_weights(source: &GroomStrandsSource, mesh: &Mesh) -> Result<SkinWeights,
     })
 }
 
-/// The ribbon mesh of a groom: six vertices a segment of every render
-/// hair, each holding its own number.
-fn ribbon_mesh(source: &GroomStrandsSource) -> Mesh {
+/// The ribbon mesh of a groom's first `hairs` render hairs: six vertices
+/// a segment, each holding its own number.
+fn ribbon_mesh(source: &GroomStrandsSource, hairs: u32) -> Mesh {
     let u = &source.upload;
-    let count = u.render.len() as u32 * pelage_shaders::hair::ribbon_vertices(u.points);
+    let count = hairs * pelage_shaders::hair::ribbon_vertices(u.points);
     Mesh::new(
         PrimitiveTopology::TriangleList,
         RenderAssetUsages::RENDER_WORLD,
@@ -242,10 +246,11 @@ pub(crate) fn attach_strands(
                     continue;
                 }
             };
+            let all = source.upload.render.len() as u32;
             let ribbons = cache
                 .ribbons
-                .entry(id)
-                .or_insert_with(|| meshes.add(ribbon_mesh(&source)))
+                .entry((id, all))
+                .or_insert_with(|| meshes.add(ribbon_mesh(&source, all)))
                 .clone();
             let colors = cache
                 .colors
@@ -275,6 +280,7 @@ pub(crate) fn attach_strands(
                     GroomStrands {
                         skin,
                         owner,
+                        asset: id,
                         drawn: 0,
                         source: source.clone(),
                         skinning,
@@ -306,7 +312,7 @@ pub(crate) fn detach_strands(
     let mut stale = Vec::new();
     for event in events.read() {
         if let AssetEvent::Modified { id } | AssetEvent::Removed { id } = event {
-            cache.ribbons.remove(id);
+            cache.ribbons.retain(|(asset, _), _| asset != id);
             cache.colors.remove(id);
             stale.push(*id);
         }
@@ -500,6 +506,38 @@ pub(crate) fn pose_strands(
             {
                 m.fur.opacity = opacity;
             }
+        }
+    }
+}
+
+/// Gives each strands entity the ribbon mesh of the fewest hairs that
+/// holds the ones drawn (the whole groom, a half, a quarter, … down to a
+/// 64th): far characters run the vertex stage for about the hairs they
+/// draw, not for every hair of the groom.
+pub(crate) fn fit_ribbons(
+    mut strands: Query<(&GroomStrands, &mut Mesh3d)>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut cache: ResMut<StrandsCache>,
+) {
+    for (hairs, mut mesh) in &mut strands {
+        if hairs.drawn == 0 {
+            continue;
+        }
+        let all = hairs.source.upload.render.len() as u32;
+        let mut k = all;
+        for _ in 0..6 {
+            if k / 2 < hairs.drawn {
+                break;
+            }
+            k /= 2;
+        }
+        let ribbons = cache
+            .ribbons
+            .entry((hairs.asset, k))
+            .or_insert_with(|| meshes.add(ribbon_mesh(&hairs.source, k)))
+            .clone();
+        if mesh.0 != ribbons {
+            mesh.0 = ribbons;
         }
     }
 }
