@@ -162,20 +162,8 @@ mod tests {
     /// size, so encase writes what the shader reads.
     #[test]
     fn the_uniform_block_matches_the_shader() {
-        let source = include_str!("shaders/strands.wgsl");
-        let start = source.find("struct Strands {").expect("the struct");
-        let end = start + source[start..].find("};").expect("its end") + 2;
-        let module = naga::front::wgsl::parse_str(&source[start..end]).expect("WGSL");
-        let ty = module
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some("Strands"))
-            .expect("Strands")
-            .1;
-        let naga::TypeInner::Struct { members, span } = &ty.inner else {
-            panic!("a struct");
-        };
-        let wgsl: Vec<String> = members.iter().map(|m| m.name.clone().unwrap()).collect();
+        let (wgsl, span) =
+            crate::material::tests::wgsl_struct(include_str!("shaders/strands.wgsl"), "Strands");
         let block = StrandUniform {
             stride: 0,
             points: 0,
@@ -196,6 +184,6 @@ mod tests {
             .map(|i| block.name_at(i).unwrap().to_string())
             .collect();
         assert_eq!(rust, wgsl);
-        assert_eq!(StrandUniform::min_size().get(), u64::from(*span));
+        assert_eq!(StrandUniform::min_size().get(), u64::from(span));
     }
 }

@@ -171,22 +171,24 @@ impl Material for ShellFurMaterial {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use bevy::reflect::structs::Struct;
 
-    /// `struct ShellFur` of the shader, as naga lays it out: its field
-    /// names in order, and its size.
-    fn wgsl_struct() -> (Vec<String>, u32) {
-        let source = include_str!("shaders/shell_fur.wgsl");
-        let start = source.find("struct ShellFur {").expect("the struct");
+    /// `struct name` of a shader's `source`, as naga lays it out: its
+    /// field names in order, and its size (the uniform-block tests of both
+    /// materials).
+    pub(crate) fn wgsl_struct(source: &str, name: &str) -> (Vec<String>, u32) {
+        let start = source
+            .find(&format!("struct {name} {{"))
+            .expect("the struct");
         let end = start + source[start..].find("};").expect("its end") + 2;
         let module = naga::front::wgsl::parse_str(&source[start..end]).expect("WGSL");
         let ty = module
             .types
             .iter()
-            .find(|(_, t)| t.name.as_deref() == Some("ShellFur"))
-            .expect("ShellFur")
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .expect("the struct's type")
             .1;
         let naga::TypeInner::Struct { members, span } = &ty.inner else {
             panic!("a struct");
@@ -221,7 +223,7 @@ mod tests {
         let rust: Vec<String> = (0..block.field_len())
             .map(|i| block.name_at(i).unwrap().to_string())
             .collect();
-        let (wgsl, size) = wgsl_struct();
+        let (wgsl, size) = wgsl_struct(include_str!("shaders/shell_fur.wgsl"), "ShellFur");
         assert_eq!(rust, wgsl);
         assert_eq!(ShellFurUniform::min_size().get(), u64::from(size));
     }
