@@ -125,13 +125,15 @@ fn init_pipeline(mut commands: Commands, cache: Res<PipelineCache>) {
     commands.insert_resource(GroomPipeline { buffers, pass, id });
 }
 
+/// The strands some camera sees this frame (a culled character's hairs
+/// are not grown).
 fn extract_strands(
     mut out: ResMut<ExtractedStrands>,
-    strands: Extract<Query<(Entity, &GroomStrands)>>,
+    strands: Extract<Query<(Entity, &GroomStrands, &ViewVisibility)>>,
 ) {
     out.0.clear();
-    for (entity, s) in &strands {
-        if s.drawn == 0 || s.pose.is_empty() {
+    for (entity, s, seen) in &strands {
+        if s.drawn == 0 || s.pose.is_empty() || !seen.get() {
             continue;
         }
         out.0.push(StrandsToGrow {

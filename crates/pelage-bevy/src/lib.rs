@@ -126,7 +126,9 @@ impl Plugin for PelagePlugin {
                 fur::choose_levels,
                 // After Bevy's transforms (and the animation before
                 // them): the pose Bevy skins this frame with.
-                strands::pose_strands.after(bevy::transform::TransformSystems::Propagate),
+                strands::pose_strands
+                    .after(bevy::transform::TransformSystems::Propagate)
+                    .before(bevy::camera::visibility::VisibilitySystems::CheckVisibility),
                 strands::fit_ribbons,
             )
                 .chain(),

@@ -17,7 +17,8 @@ use crate::fur::{FurLayers, GroomFur};
 use crate::hair_material::{ATTRIBUTE_RIBBON_CORNER, StrandMaterial, StrandUniform};
 use crate::material::ShellFurMaterial;
 use bevy::asset::RenderAssetUsages;
-use bevy::camera::visibility::NoFrustumCulling;
+use bevy::camera::primitives::Aabb;
+use bevy::camera::visibility::NoAutoAabb;
 use bevy::mesh::VertexAttributeValues;
 use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
 use bevy::platform::collections::HashMap;
@@ -274,9 +275,11 @@ pub(crate) fn attach_strands(
                     Transform::IDENTITY,
                     // Shown once posed and in range (pose_strands).
                     Visibility::Hidden,
-                    // The hairs are in world space wherever the skin goes:
-                    // Bevy's bounds of the ribbon mesh would not follow.
-                    NoFrustumCulling,
+                    // Bevy's bounds of the ribbon mesh would say nothing
+                    // of where the hairs are: pose_strands sets them from
+                    // the posed skin each frame, so each camera culls.
+                    NoAutoAabb,
+                    Aabb::default(),
                     GroomStrands {
                         skin,
                         owner,
@@ -394,6 +397,7 @@ pub(crate) fn pose_strands(
         &mut GroomStrands,
         &MeshMaterial3d<StrandMaterial>,
         &mut Visibility,
+        &mut Aabb,
     )>,
     skins: Query<(&GlobalTransform, Option<&SkinnedMesh>)>,
     joints: Query<&GlobalTransform>,
@@ -413,7 +417,7 @@ pub(crate) fn pose_strands(
     mut shell_materials: ResMut<Assets<ShellFurMaterial>>,
 ) {
     let camera = first_camera(&cameras);
-    for (mut hairs, material, mut visibility) in &mut strands {
+    for (mut hairs, material, mut visibility, mut bounds) in &mut strands {
         let Ok(skin) = skins.get(hairs.skin) else {
             continue;
         };
@@ -423,6 +427,25 @@ pub(crate) fn pose_strands(
         let (lo, hi) = posed.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
             (lo.min(p), hi.max(p))
         });
+        // The hairs' bounds in the strands entity's space (it sits at its
+        // skin's transform): the posed skin's, grown by a hair's length.
+        let reach = Vec3::splat(hairs.source.length * skin.0.scale().max_element());
+        let local = skin.0.affine().inverse();
+        let (local_lo, local_hi) = (0..8)
+            .map(|corner| {
+                let pick = |bit: usize, a: f32, b: f32| if corner & bit == 0 { a } else { b };
+                let (a, b) = (lo - reach, hi + reach);
+                local.transform_point3(Vec3::new(
+                    pick(1, a.x, b.x),
+                    pick(2, a.y, b.y),
+                    pick(4, a.z, b.z),
+                ))
+            })
+            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        let wanted = Aabb::from_min_max(local_lo, local_hi);
+        if *bounds != wanted {
+            *bounds = wanted;
+        }
         let pelage_posed: Vec<glam::Vec3> = posed
             .iter()
             .map(|p| glam::Vec3::from_array(p.to_array()))

@@ -960,6 +960,23 @@ fn a_groom_grows_as_strands_on_the_gpu_near_and_gives_way_to_its_stand_in_far() 
         changed * 2 > fox_px,
         "strands change only {changed} of {fox_px} pixels"
     );
+    // Looking away: Bevy culls the strands by the bounds the plugin gives
+    // them each frame, and the render world grows none.
+    let world = h.app.world_mut();
+    let mut cameras = world.query_filtered::<&mut Transform, With<Camera3d>>();
+    let mut camera = cameras.single_mut(world).unwrap();
+    let facing = *camera;
+    camera.look_at(facing.translation + facing.back().as_vec3(), Vec3::Y);
+    h.frames(3);
+    let world = h.app.world_mut();
+    let mut q = world.query_filtered::<&ViewVisibility, With<GroomStrands>>();
+    assert!(!q.single(world).unwrap().get(), "culled behind the camera");
+    let mut cameras = world.query_filtered::<&mut Transform, With<Camera3d>>();
+    *cameras.single_mut(world).unwrap() = facing;
+    h.frames(3);
+    let world = h.app.world_mut();
+    let mut q = world.query_filtered::<&ViewVisibility, With<GroomStrands>>();
+    assert!(q.single(world).unwrap().get(), "seen again in front of it");
     // Far, with the default level of detail: the stand-in only.
     h.app.insert_resource(StrandsLod::default());
     let world = h.app.world_mut();
