@@ -443,20 +443,27 @@ def _stopped_by_ctrl_c(call, whole, share, tidy=lambda: None):
     finish before the signal (it ran faster than the `whole` it was timed
     against): then `tidy()` and a sooner signal, three times, before the
     test fails. A call that ignores Ctrl-C never raises."""
+    import signal
     import time
 
-    for attempt in range(3):
-        timer = _interrupt_after(whole * share / 4**attempt)
-        started = time.perf_counter()
-        try:
-            call()
-        except KeyboardInterrupt:
-            stopped = time.perf_counter() - started
+    # Python's own Ctrl-C handler, as in a terminal: a process started in
+    # the background (a CI job, nohup) inherits SIGINT ignored.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        for attempt in range(3):
+            timer = _interrupt_after(whole * share / 4**attempt)
+            started = time.perf_counter()
+            try:
+                call()
+            except KeyboardInterrupt:
+                stopped = time.perf_counter() - started
+                timer.join()
+                return stopped
+            timer.cancel()
             timer.join()
-            return stopped
-        timer.cancel()
-        timer.join()
-        tidy()
+            tidy()
+    finally:
+        signal.signal(signal.SIGINT, previous)
     pytest.fail(f"not stopped by Ctrl-C, even {whole * share / 16:.3f} s into it")
 
 
