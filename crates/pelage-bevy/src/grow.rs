@@ -29,11 +29,9 @@ use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::storage::{GpuShaderBuffer, ShaderBuffer};
 use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderStartup, RenderSystems};
 use pelage_shaders::groom::GroomPassUniform;
+use pelage_shaders::workgroups;
 use std::num::NonZero;
 use std::sync::Arc;
-
-/// Threads a workgroup (the shader's `@workgroup_size(64)`).
-const WORKGROUP: u32 = 64;
 
 /// The groom pipeline and its two layouts.
 #[derive(Resource)]
@@ -218,14 +216,6 @@ fn upload(device: &RenderDevice, source: &Arc<GroomStrandsSource>) -> GrowBuffer
         stride,
         bound: None,
     }
-}
-
-/// Workgroups (x, y) covering `n` invocations (past 65,535 along x the
-/// shader folds y into the index).
-fn workgroups(n: u32) -> (u32, u32) {
-    let groups = n.div_ceil(WORKGROUP).max(1);
-    let x = groups.min(65_535);
-    (x, groups.div_ceil(x))
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -37,15 +37,14 @@ pub(crate) const GROOM_SHADER: Handle<Shader> =
 /// import path, so the composer finds it.
 pub(crate) fn register_shaders(app: &mut App) {
     let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
-    let math = format!(
-        "#define_import_path {}\n{}",
-        pelage_shaders::hair::MATH_IMPORT_PATH,
-        pelage_shaders::hair::MATH_WGSL
-    );
     let sources = [
         (
             &HAIR_MATH_SHADER,
-            Shader::from_wgsl(math, "pelage/hair_math.wgsl"),
+            crate::material::importable(
+                pelage_shaders::hair::MATH_IMPORT_PATH,
+                pelage_shaders::hair::MATH_WGSL,
+                "pelage/hair_math.wgsl",
+            ),
         ),
         (
             &STRANDS_SHADER,

@@ -33,15 +33,14 @@ pub(crate) const SHELL_MATH_SHADER: Handle<Shader> =
 /// path, so the composer finds it.
 pub(crate) fn register_shaders(app: &mut App) {
     let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
-    let math = format!(
-        "#define_import_path {}\n{}",
-        pelage_shaders::shell::MATH_IMPORT_PATH,
-        pelage_shaders::shell::MATH_WGSL
-    );
     shaders
         .insert(
             &SHELL_MATH_SHADER,
-            Shader::from_wgsl(math, "pelage/shell_math.wgsl"),
+            importable(
+                pelage_shaders::shell::MATH_IMPORT_PATH,
+                pelage_shaders::shell::MATH_WGSL,
+                "pelage/shell_math.wgsl",
+            ),
         )
         .expect("a fixed handle");
     shaders
@@ -53,6 +52,12 @@ pub(crate) fn register_shaders(app: &mut App) {
             ),
         )
         .expect("a fixed handle");
+}
+
+/// pelage-shaders' WGSL module `source` as a Bevy shader other shaders
+/// `#import` under `import_path`.
+pub(crate) fn importable(import_path: &str, source: &str, name: &'static str) -> Shader {
+    Shader::from_wgsl(format!("#define_import_path {import_path}\n{source}"), name)
 }
 
 /// The fur's numbers as `shell_fur.wgsl` reads them (`struct ShellFur`;

@@ -373,6 +373,25 @@ fn posed_skin(
     Some(posed)
 }
 
+/// The hairs' bounds in the strands entity's space (it sits at its skin's
+/// `transform`): the posed skin's world bounds, grown by `reach` (a hair's
+/// length).
+fn local_bounds((lo, hi): (Vec3, Vec3), reach: f32, transform: &GlobalTransform) -> Aabb {
+    let (lo, hi) = (lo - Vec3::splat(reach), hi + Vec3::splat(reach));
+    let local = transform.affine().inverse();
+    let (a, b) = (0..8)
+        .map(|corner| {
+            let pick = |bit: usize, a: f32, b: f32| if corner & bit == 0 { a } else { b };
+            local.transform_point3(Vec3::new(
+                pick(1, lo.x, hi.x),
+                pick(2, lo.y, hi.y),
+                pick(4, lo.z, hi.z),
+            ))
+        })
+        .fold((Vec3::MAX, Vec3::MIN), |(a, b), p| (a.min(p), b.max(p)));
+    Aabb::from_min_max(a, b)
+}
+
 /// The first perspective camera's position, field of view and target
 /// height in pixels.
 fn first_camera(
@@ -427,31 +446,11 @@ pub(crate) fn pose_strands(
         let (lo, hi) = posed.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
             (lo.min(p), hi.max(p))
         });
-        // The hairs' bounds in the strands entity's space (it sits at its
-        // skin's transform): the posed skin's, grown by a hair's length.
-        let reach = Vec3::splat(hairs.source.length * skin.0.scale().max_element());
-        let local = skin.0.affine().inverse();
-        let (local_lo, local_hi) = (0..8)
-            .map(|corner| {
-                let pick = |bit: usize, a: f32, b: f32| if corner & bit == 0 { a } else { b };
-                let (a, b) = (lo - reach, hi + reach);
-                local.transform_point3(Vec3::new(
-                    pick(1, a.x, b.x),
-                    pick(2, a.y, b.y),
-                    pick(4, a.z, b.z),
-                ))
-            })
-            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
-        let wanted = Aabb::from_min_max(local_lo, local_hi);
+        let reach = hairs.source.length * skin.0.scale().max_element();
+        let wanted = local_bounds((lo, hi), reach, skin.0);
         if *bounds != wanted {
             *bounds = wanted;
         }
-        let pelage_posed: Vec<glam::Vec3> = posed
-            .iter()
-            .map(|p| glam::Vec3::from_array(p.to_array()))
-            .collect();
-        let pose = pelage::anim::SkinPose::new(pelage_posed, &hairs.source.triangles);
-        hairs.pose = Arc::new(pelage_shaders::groom::skin_vertices(&pose));
         // The character's size on screen (its largest side at its centre's
         // distance), as pelage-gpu's RealtimeFur measures it.
         let height_px = camera.map_or(f32::INFINITY, |(eye, fov, screen)| {
@@ -461,13 +460,22 @@ pub(crate) fn pose_strands(
         });
         let level = lod.0.level(height_px);
         let render = hairs.source.upload.render.len() as u32;
-        let drawn = (render as f32 * level.fraction * level.strand_opacity).round() as u32;
         let drawn = if level.strand_opacity > 0.0 {
-            drawn.min(render)
+            ((render as f32 * level.fraction * level.strand_opacity).round() as u32).min(render)
         } else {
             0
         };
         hairs.drawn = drawn;
+        // The skin's normals and the shader's layout only for strands the
+        // render world grows: a far crowd's are not.
+        if drawn > 0 {
+            let pelage_posed = posed
+                .iter()
+                .map(|p| glam::Vec3::from_array(p.to_array()))
+                .collect();
+            let pose = pelage::anim::SkinPose::new(pelage_posed, &hairs.source.triangles);
+            hairs.pose = Arc::new(pelage_shaders::groom::skin_vertices(&pose));
+        }
         hairs.hidden_frames = if drawn > 0 {
             0
         } else {

@@ -620,7 +620,7 @@ struct Probe {
     /// GPU): the skin's vertices once a layer.
     mesh: Mesh,
     material: ShellFurMaterial,
-    latest: Arc<Mutex<Option<Vec<u8>>>>,
+    buffer: Handle<ShaderBuffer>,
 }
 
 impl Probe {
@@ -663,39 +663,18 @@ impl Probe {
             .entity_mut(fur)
             .remove::<MeshMaterial3d<ShellFurMaterial>>()
             .insert(MeshMaterial3d(probed));
-        let latest: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
-        let into = latest.clone();
-        world
-            .spawn(Readback::buffer(buffer))
-            .observe(move |read: On<ReadbackComplete>| {
-                *into.lock().unwrap() = Some(read.data.clone());
-            });
         Self {
             fur,
             mesh,
             material,
-            latest,
+            buffer,
         }
     }
 
     /// The positions a frame drawn from now on stored (`None`: a vertex
     /// never drawn).
     fn read(&self, h: &mut Headless) -> Vec<Option<Vec3>> {
-        // Frames for the pipeline to compile and for readbacks already
-        // under way to land, then a fresh one.
-        h.frames(5);
-        while h.compiling() {
-            h.frames(1);
-        }
-        h.frames(3);
-        self.latest.lock().unwrap().take();
-        for _ in 0..100 {
-            h.frames(1);
-            if let Some(bytes) = self.latest.lock().unwrap().take() {
-                return FurPositionProbe::positions(&bytes);
-            }
-        }
-        panic!("no readback after 100 frames");
+        FurPositionProbe::positions(&read_buffer(h, self.buffer.clone()))
     }
 
     /// Where the fur's vertices belong by Bevy's skinning of the fox now
@@ -828,7 +807,8 @@ fn fur_vertices_are_where_bevy_skins_the_fox() {
 }
 
 /// The latest readback of `buffer` taken after `h` has drawn a few more
-/// frames (readbacks already under way land first).
+/// frames, with its pipelines compiled (readbacks already under way land
+/// first).
 fn read_buffer(h: &mut Headless, buffer: Handle<ShaderBuffer>) -> Vec<u8> {
     let latest: Arc<Mutex<Option<Vec<u8>>>> = Arc::default();
     let into = latest.clone();
@@ -841,6 +821,10 @@ fn read_buffer(h: &mut Headless, buffer: Handle<ShaderBuffer>) -> Vec<u8> {
         })
         .id();
     h.frames(5);
+    while h.compiling() {
+        h.frames(1);
+    }
+    h.frames(3);
     latest.lock().unwrap().take();
     for _ in 0..100 {
         h.frames(1);

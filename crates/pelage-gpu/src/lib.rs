@@ -138,17 +138,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("skin.wgsl", include_str!("shaders/skin.wgsl")),
 ];
 
-/// Threads a workgroup of every compute shader (their
-/// `@workgroup_size(64)`).
-pub(crate) const WORKGROUP: u32 = 64;
-
-/// Workgroups (x, y) covering `n` invocations: past 65,535 along x, the
-/// compute shaders fold y into the index.
-pub(crate) fn workgroups(n: u32) -> (u32, u32) {
-    let groups = n.div_ceil(WORKGROUP).max(1);
-    let x = groups.min(65_535);
-    (x, groups.div_ceil(x))
-}
+pub(crate) use pelage_shaders::workgroups;
 
 /// The WGSL source of the named shader (with its prelude; shell fur and
 /// strands with their shared math before them; the compute shaders with the shared

@@ -164,7 +164,7 @@ pub struct GroomUpload {
     pub hairs: u32,
     /// Points a hair.
     pub points: u32,
-    /// Guides, and guide points in all.
+    /// Guides.
     pub guides: u32,
     /// Guide points in all (the guide buffer's `vec4`s).
     pub guide_values: usize,

@@ -17,3 +17,15 @@ pub mod groom;
 pub mod hair;
 pub mod shell;
 pub mod stand_in;
+
+/// Threads a workgroup of every compute shader (their
+/// `@workgroup_size(64)`).
+pub const WORKGROUP: u32 = 64;
+
+/// Workgroups (x, y) covering `n` invocations of a compute shader: past
+/// 65,535 along x, the shaders fold y into the index.
+pub fn workgroups(n: u32) -> (u32, u32) {
+    let groups = n.div_ceil(WORKGROUP).max(1);
+    let x = groups.min(65_535);
+    (x, groups.div_ceil(x))
+}
