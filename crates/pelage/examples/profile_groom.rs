@@ -3,7 +3,8 @@
 //! clump centre every 100 hairs, noise, 16 points, normals, widths), HAIRS
 //! hairs (default 400,000) grown in memory.
 //! OPS=none drops the operators, to see interpolation alone; NORMALS=0
-//! drops the per-point normals.
+//! drops the per-point normals; FRACTION=0.1 grows a preview fraction of
+//! them (the bench's `fraction_0_1` row), preparation included.
 use pelage::groom::Groom;
 
 fn main() {
@@ -24,7 +25,11 @@ fn main() {
     let text = format!(
         "[mesh]\npath = \"spot\"\nsubdivide = 2\n[roots]\ncount = {hairs}\ndensity = \"noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4\"\n[guides]\npoints = 8\ngenerate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}\n[interpolation]\nmethod = \"shepard\"\nk = 4\n{ops}[finish]\npoints = 16\nnormals = {normals}\nwidth = {{ root = 0.0015, tip = 0.0002 }}\n"
     );
-    let groom = Groom::from_text("<profile>", text).unwrap();
+    let mut groom = Groom::from_text("<profile>", text).unwrap();
+    if let Some(fraction) = std::env::var("FRACTION").ok().and_then(|f| f.parse().ok()) {
+        groom.set_fraction(fraction).unwrap();
+    }
+    let start = std::time::Instant::now();
     let t = std::time::Instant::now();
     let generator = groom.generator(None).unwrap();
     eprintln!("prepare {:?}", t.elapsed());
@@ -49,6 +54,7 @@ fn main() {
     }
     let s = t.elapsed().as_secs_f64();
     eprintln!("{n} hairs in {s:.3} s: {:.2} M hairs/s", n as f64 / s / 1e6);
+    eprintln!("all of it {:.3} s", start.elapsed().as_secs_f64());
     if checksum {
         eprintln!("checksum {sum:016x}");
     }

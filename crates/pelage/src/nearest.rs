@@ -13,7 +13,13 @@
 //! candidates. A query then costs a dozen or two distances instead of a
 //! tree search.
 //!
-//! The argument holds for any `R`, which gives callers a second way to
+//! The argument holds for any `R`. A list that had to be filled again
+//! after a few queries (the roots of a preview fraction are ten times
+//! sparser than the whole groom's) reaches twice as far at its next fill,
+//! and back after many: fewer tree searches for a few more candidates a
+//! query (module constants).
+//!
+//! It also gives callers a second way to
 //! keep lists: a [`QueryRegion`], a ball known to hold the query (the skin
 //! triangle under a hair's root). A list is then filled at the ball's
 //! centre with `R` at least its radius, and serves every query in the
@@ -34,6 +40,17 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// filled at (a few large triangles under many guides would otherwise
 /// brute-force hundreds of points a hair).
 const MOST_CANDIDATES: usize = 64;
+
+/// A list that answered fewer queries than this before it had to be
+/// filled again reaches twice as far at its next fill (up to
+/// `MOST_WIDENING` times `a`), and one that answered more than
+/// `MANY_SERVED` half as far (down to `a`): a sparse walk (a preview
+/// fraction's hairs, a farm part's few roots a triangle) then pays for a
+/// kd-tree search every few hairs instead of at nearly every hair, and a
+/// dense one keeps short lists.
+const FEW_SERVED: u32 = 4;
+const MANY_SERVED: u32 = 64;
+const MOST_WIDENING: f32 = 2.0;
 
 /// Slack on squared radii handed to the kd-tree, so that its rounding of a
 /// distance and ours can never leave a point out.
@@ -108,6 +125,10 @@ struct CandidateList {
     /// (kept for the next query).
     keys: Vec<u64>,
     best: Vec<u64>,
+    /// Queries answered since the last fill, and the factor on `a` the
+    /// next fill uses (module docs: sized to how sparse the queries are).
+    served: u32,
+    widen: f32,
 }
 
 impl NearestPoints {
@@ -191,6 +212,8 @@ impl NearestPoints {
                     zs: Vec::new(),
                     keys: Vec::new(),
                     best: Vec::new(),
+                    served: 0,
+                    widen: 1.0,
                 });
                 cache.lists.last_mut().expect("just pushed")
             }
@@ -198,6 +221,7 @@ impl NearestPoints {
         if (p - list.centre).length_squared() > list.reach_squared {
             self.refill(list, p, k, region);
         }
+        list.served = list.served.saturating_add(1);
         // The same arithmetic as `(q - p).length_squared()`, so cached and
         // uncached answers agree to the bit.
         let distance_squared = |x: f32, y: f32, z: f32| {
@@ -286,12 +310,27 @@ impl NearestPoints {
         // a = 1 and would otherwise be refilled every few hairs; for
         // larger k the list grows fast.
         let a: f32 = if k == 1 { 1.0 } else { 0.5 };
+        list.widen = match list.served {
+            0..FEW_SERVED => (list.widen * 2.0).min(MOST_WIDENING),
+            MANY_SERVED.. => (list.widen * 0.5).max(1.0),
+            _ => list.widen,
+        };
+        list.served = 0;
         let d_k = kth.sqrt();
-        let reach = (a * d_k).max(least_reach);
-        list.reach_squared = reach * reach;
-        let within = d_k + 2.0 * reach;
-        let candidates = &mut list.candidates;
-        self.visit_within(q, within * within * RADIUS_SLACK, |i| candidates.push(i));
+        let fill = |list: &mut CandidateList, widen: f32| {
+            let reach = (a * widen * d_k).max(least_reach);
+            list.reach_squared = reach * reach;
+            let within = d_k + 2.0 * reach;
+            list.candidates.clear();
+            let candidates = &mut list.candidates;
+            self.visit_within(q, within * within * RADIUS_SLACK, |i| candidates.push(i));
+        };
+        fill(list, list.widen);
+        if list.candidates.len() > MOST_CANDIDATES && list.widen > 1.0 {
+            // Widened too far for this neighbourhood.
+            list.widen = 1.0;
+            fill(list, 1.0);
+        }
         if list.candidates.len() > MOST_CANDIDATES {
             // Too crowded to brute-force: serve `p` alone.
             list.centre = p;
@@ -421,6 +460,43 @@ mod tests {
                 let uncached: Vec<u32> = out.iter().map(|n| n.index).collect();
                 assert_eq!(uncached, got);
             }
+        }
+    }
+
+    #[test]
+    fn widened_lists_stay_exact_on_sparse_and_dense_walks() {
+        // Stretches of steps about the points' spacing (a preview
+        // fraction's roots), where lists widen, then of small steps, where
+        // they narrow again; every answer exact.
+        let points = scattered(500, 5);
+        let set = NearestPoints::new(points.clone());
+        for k in [1, 4] {
+            let mut cache = NeighbourCache::default();
+            let (mut widened, mut narrowed_after) = (false, false);
+            let mut p = Vec3::new(0.5, 0.5, 0.05);
+            for step in 0..4000u64 {
+                let h = mix64(step ^ (k as u64) << 40 ^ 77);
+                let sparse = (step / 500) % 2 == 0;
+                let size = if sparse { 0.06 } else { 0.002 };
+                let d = Vec3::new(
+                    (h & 0xffff) as f32 / 65536.0 - 0.5,
+                    (h >> 16 & 0xffff) as f32 / 65536.0 - 0.5,
+                    0.0,
+                );
+                p = (p + d * size).clamp(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.1));
+                let got: Vec<u32> = set
+                    .nearest_cached(p, k, &mut cache)
+                    .map(|n| n.index)
+                    .collect();
+                assert_eq!(got, brute_force(&points, p, k), "k {k} step {step}");
+                let widen = cache.lists[0].widen;
+                widened |= widen > 1.0;
+                narrowed_after |= widened && widen == 1.0;
+            }
+            assert!(
+                widened && narrowed_after,
+                "k {k}: the lists never widened and narrowed"
+            );
         }
     }
 

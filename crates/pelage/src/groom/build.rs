@@ -244,21 +244,33 @@ impl Generator {
             }
             return old.with_shapes(shapes);
         }
-        let shapes: Vec<Vec<Vec3>> = (0..roots.len())
-            .collect::<Vec<_>>()
+        // Grown in the order of their triangles, as a part's hairs are, so
+        // that each worker's guide and centre searches walk the skin
+        // (centres sampled at random refilled their candidate lists at
+        // almost every one); placed back in the centres' own order.
+        let mut order: Vec<u32> = (0..roots.len() as u32).collect();
+        order.sort_unstable_by_key(|&i| (roots[i as usize].tri, i));
+        let grown: Vec<Vec<Vec3>> = order
             .par_chunks(256)
             .map_init(Workspace::default, |ws, chunk| {
                 let mut out = Vec::with_capacity(chunk.len() * self.points);
                 for &i in chunk {
-                    grow_one(i, ws, &mut out);
+                    grow_one(i as usize, ws, &mut out);
                 }
                 out
             })
             .collect();
+        let mut shapes = vec![Vec3::ZERO; roots.len() * self.points];
+        for (&i, shape) in order
+            .iter()
+            .zip(grown.iter().flat_map(|c| c.chunks(self.points)))
+        {
+            let i = i as usize;
+            shapes[i * self.points..(i + 1) * self.points].copy_from_slice(shape);
+        }
         let normals = roots.iter().map(|r| r.normal(mesh)).collect();
         let regions: Vec<u32> = roots.iter().map(|r| self.region_of(*r)).collect();
-        let centres =
-            ClumpCentres::on_surface(positions, normals, &regions, shapes.concat(), self.points);
+        let centres = ClumpCentres::on_surface(positions, normals, &regions, shapes, self.points);
         let centres = centres.with_surface_roots(roots.to_vec());
         // Reshaped, the centres depend on the guides they did before.
         match previous.and_then(|(old, _)| old.guides_shared()) {
