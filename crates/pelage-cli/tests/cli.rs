@@ -1767,6 +1767,90 @@ fn groom_on_the_gpu_writes_what_the_cpu_writes() {
 }
 
 #[test]
+fn an_animated_groom_grown_on_the_gpu_writes_what_the_cpu_writes() {
+    if std::env::var_os("PELAGE_REQUIRE_GPU").is_none() {
+        eprintln!("SKIPPED: set PELAGE_REQUIRE_GPU=1 to grow on the GPU through the CLI");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let fox = repo("crates/pelage/assets/fox/Fox.gltf");
+    // Deform: the hairs grown once at rest and carried to each pose.
+    // Simulate: every frame's own guides, so every frame's own growth.
+    for mode in ["deform", "simulate"] {
+        let groom = dir.path().join(format!("{mode}.toml"));
+        std::fs::write(
+            &groom,
+            format!(
+                "[mesh]\npath = {:?}\n[roots]\ncount = 1500\n\
+                 [guides]\ngenerate = {{ count = 60, length = 10.0, comb = [0, -0.5, -1] }}\n\
+                 [[ops]]\nclump = {{ count = 40, rate = 0.5 }}\n\
+                 [[ops]]\nnoise = {{ amplitude = 0.5, frequency = 0.2 }}\n\
+                 [finish]\npoints = 8\n\
+                 [animation]\nframes = \"1-3\"\nclip = \"Run\"\nmode = \"{mode}\"\n{simulation}",
+                fox.display(),
+                simulation = match mode {
+                    "simulate" => "[simulation]\ngravity = [0, -500, 0]\npreroll = 1\n",
+                    _ => "",
+                }
+            ),
+        )
+        .unwrap();
+        let cpu = dir.path().join(format!("{mode}-cpu.usdc"));
+        let gpu = dir.path().join(format!("{mode}-gpu.usdc"));
+        for (out, extra) in [(&cpu, None), (&gpu, Some("--gpu"))] {
+            let mut args = vec![
+                "groom",
+                groom.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "-q",
+            ];
+            args.extend(extra);
+            let o = pelage(&args);
+            assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+            if extra.is_some() {
+                assert!(stdout(&o).contains("growing on"), "{}", stdout(&o));
+            }
+        }
+        let first = pelage::io::read_usd_curves_at(&cpu, Some(1.0)).unwrap();
+        let (lo, hi) = first
+            .points()
+            .iter()
+            .fold((glam::Vec3::MAX, glam::Vec3::MIN), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            });
+        let size = (hi - lo).length();
+        let mut moved = 0.0f32;
+        for frame in [1.0, 2.0, 3.0] {
+            let (a, b) = (
+                pelage::io::read_usd_curves_at(&cpu, Some(frame)).unwrap(),
+                pelage::io::read_usd_curves_at(&gpu, Some(frame)).unwrap(),
+            );
+            assert_eq!(a.curve_count(), 1500);
+            assert_eq!(a.ids(), b.ids(), "{mode} frame {frame}: the same hairs");
+            let worst = a
+                .points()
+                .iter()
+                .zip(b.points())
+                .map(|(p, q)| p.distance(*q))
+                .fold(0.0f32, f32::max);
+            assert!(
+                worst <= 1e-4 * size,
+                "{mode} frame {frame}: a point {worst} from the CPU's (size {size})"
+            );
+            moved = moved.max(
+                a.points()
+                    .iter()
+                    .zip(first.points())
+                    .map(|(p, q)| p.distance(*q))
+                    .fold(0.0f32, f32::max),
+            );
+        }
+        assert!(moved > 0.01 * size, "{mode}: the Fox runs, the hairs move");
+    }
+}
+
+#[test]
 fn groom_on_the_gpu_refuses_what_its_evaluator_leaves_out() {
     if std::env::var_os("PELAGE_REQUIRE_GPU").is_none() {
         eprintln!("SKIPPED: set PELAGE_REQUIRE_GPU=1 to grow on the GPU through the CLI");

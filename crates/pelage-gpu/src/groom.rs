@@ -643,7 +643,16 @@ impl<'a> GpuPartGrower<'a> {
     /// # Errors
     /// When the GPU fails, or a hair grew a value that is not finite.
     pub fn part(&self, p: usize) -> Result<Curves, GroomError> {
-        let generator = self.generator;
+        self.part_of(self.generator, p)
+    }
+
+    /// Part `p` of `generator`, grown on the GPU: a generator on the same
+    /// mesh with the same operators as this grower's, in other guide
+    /// shapes (a frame's of an animated groom, [`pelage::groom::GeneratorGrower`]).
+    ///
+    /// # Errors
+    /// As [`Self::part`].
+    pub fn part_of(&self, generator: &Generator, p: usize) -> Result<Curves, GroomError> {
         let (roots, ids) = generator.part_roots(p);
         let recipe = GroomRecipe::new(generator, &roots, &ids)?;
         let evaluator =

@@ -11,8 +11,8 @@ use crate::curves::PyCurves;
 use crate::mesh::PyMesh;
 use crate::to_py_err;
 use pelage::groom::{
-    AnimatedGroom, AnimatedPlanError, Assembly, FarmRun, Generator, Groom, GroomError, GroomInputs,
-    GroomReport, GroomWriteError, PreflightError, ReportBuilder, Timings,
+    AnimatedFiles, AnimatedGroom, AnimatedPlanError, Assembly, FarmRun, Generator, Groom,
+    GroomError, GroomInputs, GroomReport, GroomWriteError, PreflightError, ReportBuilder, Timings,
 };
 use pelage::settings::SettingsSource;
 use pyo3::exceptions::{PyIndexError, PyMemoryError, PyTypeError, PyValueError};
@@ -528,7 +528,8 @@ impl PyGroom {
     /// written. Returns `{"path", "hairs", "points", "report"}`:
     /// `report` (a still groom's) is what `pelage groom --report` writes —
     /// hairs per part and region, the guides left out and why, timings.
-    /// `gpu=True` grows a still groom on the GPU, as `grow(gpu=True)`.
+    /// `gpu=True` grows the hairs on the GPU, as `grow(gpu=True)` (an
+    /// animated groom's at rest, carried to each frame as without it).
     #[pyo3(signature = (path = None, *, part = None, seed = None, progress = None, gpu = false))]
     fn write<'py>(
         &self,
@@ -581,11 +582,6 @@ impl PyGroom {
                 animated.map_err(|e| self.error(e))?.map(Arc::new)
             }
         };
-        if gpu && animated.is_some() {
-            return Err(PyValueError::new_err(
-                "gpu=True grows still grooms for now; write this animated one without it",
-            ));
-        }
         let (summary, written, grown) = if let Some(animated) = animated {
             // The library's plan: a farm run's file is named by its frames,
             // as the CLI names it and `assemble` finds it.
@@ -599,16 +595,28 @@ impl PyGroom {
             let path = plan.outputs[0].path.clone();
             create_folder(&path)?;
             let options = self.groom.run_usd_options(run);
-            let with_skin = self.groom.writes_skin_in(run);
+            let files = AnimatedFiles {
+                outputs: &plan.outputs,
+                parts: plan.parts.clone(),
+                options: &options,
+                with_skin: self.groom.writes_skin_in(run),
+            };
+            // With gpu=True the hairs grow at rest on the GPU (each
+            // frame's in regrow and simulate modes), carried as without.
+            let context = gpu.then(gpu_context).transpose()?;
+            let grower = match &context {
+                Some(ctx) => Some(
+                    pelage_gpu::GpuPartGrower::new(ctx, animated.generator())
+                        .map_err(|e| self.error(e))?,
+                ),
+                None => None,
+            };
+            let grow = |g: &Generator, p: usize| match &grower {
+                Some(gpu) => gpu.part_of(g, p),
+                None => g.part(p),
+            };
             let summary = py.detach(|| {
-                animated.write_files_until(
-                    &plan.outputs,
-                    plan.parts.clone(),
-                    &options,
-                    with_skin,
-                    &cancel,
-                    |p| report(p.done, p.total),
-                )
+                animated.write_files_grown_until(files, &grow, &cancel, |p| report(p.done, p.total))
             });
             (summary, path, None)
         } else {

@@ -674,3 +674,31 @@ def test_the_gpu_grows_the_cpus_hairs(groom, tmp_path):
     assert written["hairs"] == 5_000
     back = pelage.read_curves(tmp_path / "gpu.usdc")
     assert np.abs(back.points - on_cpu.points).max() < 1e-4
+
+
+def test_an_animated_groom_written_on_the_gpu_is_the_cpus(tmp_path):
+    # Every frame of the walking Fox, its hairs grown at rest on the GPU
+    # and carried to each pose as on the CPU.
+    import os
+
+    fox = REPO / "crates" / "pelage" / "assets" / "fox"
+    groom = pelage.Groom(
+        mesh=str(next(fox.glob("*.gl*"))),
+        guides={"generate": {"count": 40, "length": 3.0}},
+        roots=500,
+        animation={"frames": "1-3"},
+    )
+    try:
+        groom.write(tmp_path / "gpu.usdc", gpu=True)
+    except RuntimeError as e:
+        if os.environ.get("PELAGE_REQUIRE_GPU"):
+            raise
+        assert "no GPU" in str(e)
+        pytest.skip(f"no GPU adapter: {e}")
+    groom.write(tmp_path / "cpu.usdc")
+    for frame in (1, 3):
+        on_gpu = pelage.read_curves(tmp_path / "gpu.usdc", time=frame)
+        on_cpu = pelage.read_curves(tmp_path / "cpu.usdc", time=frame)
+        assert np.array_equal(on_gpu.ids, on_cpu.ids)
+        size = np.linalg.norm(on_cpu.points.max(axis=0) - on_cpu.points.min(axis=0))
+        assert np.abs(on_gpu.points - on_cpu.points).max() < 1e-4 * size

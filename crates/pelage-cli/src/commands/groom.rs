@@ -8,8 +8,8 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use pelage::anim::FrameRange;
 use pelage::groom::{
-    AnimatedGroom, AnimatedPlanError, Assembly, FarmRun, Groom, PreflightError, ReportBuilder,
-    Timings,
+    AnimatedFiles, AnimatedGroom, AnimatedPlanError, Assembly, FarmRun, Groom, PreflightError,
+    ReportBuilder, Timings,
 };
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -58,8 +58,10 @@ pub struct GroomArgs {
     pub frame_files: bool,
     /// Grow the hairs on the GPU, with the evaluator real-time strands
     /// use (docs/realtime.md): the same file, every point within 1e-4 of
-    /// the groom's size of the CPU's. Still grooms; without a GPU adapter
-    /// it says so and exits 2.
+    /// the groom's size of the CPU's. Animated grooms grow their hairs at
+    /// rest there (each frame's, in regrow and simulate modes) and carry
+    /// them to each pose as without it. Without a GPU adapter it says so
+    /// and exits 2.
     #[arg(long)]
     pub gpu: bool,
     /// Also draw the hairs on the skin into this PNG (headless GPU; at
@@ -103,11 +105,6 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
         }
     }
     if let Some(animated) = groom.animated(args.seed)? {
-        if args.gpu {
-            bail!(
-                "--gpu grows still grooms for now; grow this animated one without --gpu (or without --frames and [animation])"
-            );
-        }
         if args.report.is_some() {
             bail!(
                 "--report describes still grooms; grow this one without --frames (or without [animation]) to get its report"
@@ -170,20 +167,11 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     let stride = planned.div_ceil(PREVIEW_HAIRS).max(1) as usize;
     let mut shown = Vec::new();
     let mut report = args.report.as_ref().map(|_| ReportBuilder::new(&generator));
-    // On the GPU: an adapter first (none: exit 2 with why), then each
-    // part grown there and finished as the CPU finishes it.
-    let gpu = match args.gpu {
-        true => Some(
-            pelage_gpu::GpuContext::headless()
-                .context("--gpu: no GPU to grow on; grow without --gpu")?,
-        ),
-        false => None,
-    };
+    // On the GPU: each part grown there and finished as the CPU
+    // finishes it.
+    let gpu = gpu_context(args)?;
     let grower = match &gpu {
-        Some(ctx) => {
-            println!("growing on {}", ctx.adapter_name());
-            Some(pelage_gpu::GpuPartGrower::new(ctx, &generator)?)
-        }
+        Some(ctx) => Some(pelage_gpu::GpuPartGrower::new(ctx, &generator)?),
         None => None,
     };
     let grow = |p: usize| match &grower {
@@ -266,6 +254,18 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
 
 /// `pelage groom` for an animated groom: every part over every frame,
 /// into one file with time samples.
+/// With `--gpu`, an adapter to grow on (none: exit 2 with why), named on
+/// stdout.
+fn gpu_context(args: &GroomArgs) -> anyhow::Result<Option<pelage_gpu::GpuContext>> {
+    if !args.gpu {
+        return Ok(None);
+    }
+    let ctx = pelage_gpu::GpuContext::headless()
+        .context("--gpu: no GPU to grow on; grow without --gpu")?;
+    println!("growing on {}", ctx.adapter_name());
+    Ok(Some(ctx))
+}
+
 fn run_animated(
     args: &GroomArgs,
     groom: &Groom,
@@ -326,11 +326,28 @@ fn run_animated(
         bar
     };
     let options = groom.run_usd_options(args.part);
+    // On the GPU: the hairs grown at rest there (each frame's in regrow
+    // and simulate modes), carried to the poses as on the CPU.
+    let gpu = gpu_context(args)?;
+    let grower = match &gpu {
+        Some(ctx) => Some(pelage_gpu::GpuPartGrower::new(ctx, generator)?),
+        None => None,
+    };
+    let grow = |g: &pelage::groom::Generator, p: usize| match &grower {
+        Some(gpu) => gpu.part_of(g, p),
+        None => g.part(p),
+    };
     plan.remove_stale_stitching()?;
     let growing = Instant::now();
     // In a farm, the first run writes the skin.
-    let with_skin = groom.writes_skin_in(args.part);
-    let summary = animated.write_files(outputs, range.clone(), &options, with_skin, |p| {
+    let files = AnimatedFiles {
+        outputs,
+        parts: range.clone(),
+        options: &options,
+        with_skin: groom.writes_skin_in(args.part),
+    };
+    let never = std::sync::atomic::AtomicBool::new(false);
+    let summary = animated.write_files_grown_until(files, &grow, &never, |p| {
         bar.set_message(format!("part {} frame {}", p.part, p.time));
         bar.set_position(p.done as u64);
     })?;

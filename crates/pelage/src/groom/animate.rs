@@ -452,8 +452,9 @@ impl AnimatedGroom {
         })
     }
 
-    /// Part `p` at `time` on `pose`: grown at rest by `generator` (the
-    /// rest generator in deform mode, the frame's in regrow mode), carried
+    /// Part `p` at `time` on `pose`: grown at rest by `grow` from
+    /// `generator` (the rest generator in deform mode, the frame's in
+    /// regrow mode), carried
     /// to the pose and kept out of its skin (`outside`, this pose's
     /// [`Self::outside_skin`]). `rest` caches the rest growth in deform
     /// mode.
@@ -463,7 +464,7 @@ impl AnimatedGroom {
         p: usize,
         time: f64,
         (pose, outside): (&SkinPose, Option<&OutsideSkin>),
-        generator: &Generator,
+        (generator, grow): (&Generator, GeneratorGrower<'_>),
         rest: &mut Option<(Curves, RestFrames)>,
         out: &mut Curves,
     ) -> Result<(), GroomError> {
@@ -472,7 +473,7 @@ impl AnimatedGroom {
                 // Later frames: the same hairs, only moved.
                 Some((curves, frames)) => self.binding.carry_again(curves, frames, pose, out),
                 None => {
-                    let curves = generator.part(p)?;
+                    let curves = grow(generator, p)?;
                     let frames = self.binding.rest_frames(&curves);
                     let carried = self.binding.carry_into(&curves, pose, out);
                     *rest = Some((curves, frames));
@@ -481,7 +482,7 @@ impl AnimatedGroom {
             },
             AnimationMode::Regrow | AnimationMode::Simulate => {
                 // A fresh growth every frame: moved where it lies.
-                let mut grown = generator.part(p)?;
+                let mut grown = grow(generator, p)?;
                 let carried = self.binding.carry_in_place(&mut grown, pose);
                 let spent = std::mem::replace(out, grown);
                 generator.recycle(spent);
@@ -581,7 +582,8 @@ impl AnimatedGroom {
         let mut rest = None;
         let mut out = Curves::default();
         let at = (&pose, outside.as_ref());
-        self.part_at(p, time, at, &self.generator, &mut rest, &mut out)?;
+        let growth = (&self.generator, &CPU_GROWTH as GeneratorGrower<'_>);
+        self.part_at(p, time, at, growth, &mut rest, &mut out)?;
         let (minus, plus, per_second) = self.velocity_poses(time, &pose, fps);
         let (curves, frames) = rest.as_ref().expect("deform grows at rest");
         let velocities = self
@@ -604,12 +606,12 @@ impl AnimatedGroom {
     /// own.
     fn regrown_part(&self, p: usize, time: f64, window: &Window<'_>) -> Result<Curves, GroomError> {
         let Some(k) = window.times.iter().position(|&t| t == time) else {
-            return self.part(p, time);
+            return self.part_grown_by(p, time, window.grow);
         };
         let mut out = Curves::default();
         let generator = window.generators[k].as_ref().unwrap_or(&self.generator);
         let at = (&window.poses[k], window.outsides[k].as_ref());
-        self.part_at(p, time, at, generator, &mut None, &mut out)?;
+        self.part_at(p, time, at, (generator, window.grow), &mut None, &mut out)?;
         Ok(out)
     }
 
@@ -635,6 +637,16 @@ impl AnimatedGroom {
 
     /// Part `p` at time code `time`, alone (tests, previews).
     pub fn part(&self, p: usize, time: f64) -> Result<Curves, GroomError> {
+        self.part_grown_by(p, time, &CPU_GROWTH)
+    }
+
+    /// [`Self::part`] with its hairs grown at rest by `grow`.
+    fn part_grown_by(
+        &self,
+        p: usize,
+        time: f64,
+        grow: GeneratorGrower<'_>,
+    ) -> Result<Curves, GroomError> {
         let pose = self.pose(time)?;
         let outside = self.outside_skin(&pose);
         let regrown = self.frame_generator(time, &pose)?;
@@ -644,7 +656,7 @@ impl AnimatedGroom {
             p,
             time,
             (&pose, outside.as_ref()),
-            generator,
+            (generator, grow),
             &mut None,
             &mut out,
         )?;
@@ -715,17 +727,46 @@ impl AnimatedGroom {
         options: &UsdOptions,
         with_skin: bool,
         cancel: &AtomicBool,
+        progress: impl FnMut(AnimationProgress),
+    ) -> Result<GroomSummary, GroomWriteError> {
+        let files = AnimatedFiles {
+            outputs,
+            parts,
+            options,
+            with_skin,
+        };
+        self.write_files_grown_until(files, &CPU_GROWTH, cancel, progress)
+    }
+
+    /// [`Self::write_files_until`] with each part's hairs grown at rest by
+    /// `grow` instead of [`Generator::part`] (pelage-gpu grows them on a
+    /// GPU); everything after the growth (the carry to each pose, the
+    /// pushes out of the posed skin, the velocities) is the same.
+    pub fn write_files_grown_until(
+        &self,
+        files: AnimatedFiles<'_>,
+        grow: GeneratorGrower<'_>,
+        cancel: &AtomicBool,
         mut progress: impl FnMut(AnimationProgress),
     ) -> Result<GroomSummary, GroomWriteError> {
+        let AnimatedFiles {
+            outputs,
+            parts,
+            options,
+            with_skin,
+        } = files;
         let total = parts.len() * outputs.iter().map(|o| o.times.len()).sum::<usize>();
         let mut done = 0;
         let mut summary = GroomSummary::default();
         for (k, window) in outputs.chunks(MAX_OPEN_FRAME_FILES).enumerate() {
             let counts = self.write_window(
-                window,
-                parts.clone(),
-                options,
-                with_skin,
+                AnimatedFiles {
+                    outputs: window,
+                    parts: parts.clone(),
+                    options,
+                    with_skin,
+                },
+                grow,
                 cancel,
                 &mut |p: AnimationProgress| {
                     progress(AnimationProgress {
@@ -747,13 +788,17 @@ impl AnimatedGroom {
     /// [`Self::write_files`] of one window of files, all open at once.
     fn write_window(
         &self,
-        outputs: &[FrameOutput],
-        parts: Range<usize>,
-        options: &UsdOptions,
-        with_skin: bool,
+        files: AnimatedFiles<'_>,
+        grow: GeneratorGrower<'_>,
         cancel: &AtomicBool,
         progress: &mut dyn FnMut(AnimationProgress),
     ) -> Result<GroomSummary, GroomWriteError> {
+        let AnimatedFiles {
+            outputs,
+            parts,
+            options,
+            with_skin,
+        } = files;
         let mut layers = self.open_layers(outputs, options)?;
         // Poses once for every time of every file (files may share times).
         let mut times: Vec<f64> = outputs
@@ -818,11 +863,12 @@ impl AnimatedGroom {
                             outsides: &outsides,
                             generators: &generators,
                             time_codes_per_second: options.time_codes_per_second,
+                            grow,
                         };
                         Some(self.regrow_at(p, time, &all_times, window, &mut grown, &mut out)?)
                     } else {
                         let at = (&poses[k], outsides[k].as_ref());
-                        self.part_at(p, time, at, generator, &mut rest, &mut out)?;
+                        self.part_at(p, time, at, (generator, grow), &mut rest, &mut out)?;
                         // The last frame's velocities are this one's buffer.
                         let buffer = out.take_velocities().unwrap_or_default();
                         let poses = velocity_poses.get(k);
@@ -1035,6 +1081,29 @@ pub(crate) fn read_guides_at(
     }
 }
 
+/// How [`AnimatedGroom::write_files_grown_until`] grows part `p` of a
+/// generator at rest (the rest generator's in deform mode, each frame's
+/// in regrow and simulate modes): [`Generator::part`] on the CPU, or
+/// another evaluator that gives the same hairs.
+pub type GeneratorGrower<'a> = &'a (dyn Fn(&Generator, usize) -> Result<Curves, GroomError> + Sync);
+
+/// The CPU's growth, [`Generator::part`].
+const CPU_GROWTH: fn(&Generator, usize) -> Result<Curves, GroomError> = |g, p| g.part(p);
+
+/// What [`AnimatedGroom::write_files_grown_until`] writes: the files, the
+/// parts of each, how, and whether the posed skin goes with them.
+#[derive(Debug, Clone)]
+pub struct AnimatedFiles<'a> {
+    /// The files and their time codes.
+    pub outputs: &'a [FrameOutput],
+    /// The parts written (a farm task's range).
+    pub parts: Range<usize>,
+    /// The writer's options.
+    pub options: &'a UsdOptions,
+    /// Whether the posed skin is written too (usdc only).
+    pub with_skin: bool,
+}
+
 /// A file of an animated groom and the time codes it holds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameOutput {
@@ -1054,6 +1123,8 @@ struct Window<'a> {
     outsides: &'a [Option<OutsideSkin>],
     generators: &'a [Option<Generator>],
     time_codes_per_second: f64,
+    /// How the parts' hairs are grown at rest.
+    grow: GeneratorGrower<'a>,
 }
 
 /// A writer's refusal of a prim, as the error of writing `path` (the

@@ -74,8 +74,8 @@ mod spec;
 mod values;
 
 pub use animate::{
-    AnimatedGroom, AnimationMode, AnimationProgress, AnimationSpec, AxisTurn, FrameOutput,
-    GuideMotion,
+    AnimatedFiles, AnimatedGroom, AnimationMode, AnimationProgress, AnimationSpec, AxisTurn,
+    FrameOutput, GeneratorGrower, GuideMotion,
 };
 pub use clips::{ClipAssembly, FrameFile, find_frame_files, frames_file, write_clip_assembly};
 pub use error::{GroomError, GroomErrorKind};
