@@ -326,7 +326,8 @@ pub enum GroomFurLoadError {
 impl ShellFurAsset {
     /// The shell fur standing in for `groom`: pelage's stand-in (the
     /// groom's density of hairs on the skin, its guides' mean length, its
-    /// colour texture brightened to meet the strands'), Kajiya-Kay shaded
+    /// colour texture brightened to meet the strands', its first clump's
+    /// clumps), Kajiya-Kay shaded
     /// as a shells file without `[shading]`, with a level of detail.
     pub fn stand_in_for(
         groom: &pelage::groom::Groom,
@@ -338,6 +339,8 @@ impl ShellFurAsset {
         // groom has no colour texture.
         let hair = StrandLook::default().color;
         let color = stand_in.color_texture(groom, hair)?;
+        // Clumped as the groom's first clump is.
+        let clumps = pelage_shaders::stand_in::clump_mask(generator);
         Ok((
             Self {
                 layers: STAND_IN_LAYERS,
@@ -355,8 +358,8 @@ impl ShellFurAsset {
                     radius: 0.0,
                     frequency: 0.0,
                 },
-                clump: None,
-                wetness: None,
+                clump: clumps.as_ref().map(|(_, params)| *params),
+                wetness: clumps.map(|(mask, _)| Arc::new(mask)),
                 dynamics: None,
                 lod: Some((0.75, 4)),
                 left_out: Vec::new(),

@@ -138,7 +138,14 @@ impl RealtimeFur {
         };
         let hairs = GpuGroom::new(ctx, &recipe, &skin)?;
         let rest_offsets = GroomRecipe::guide_offsets(generator.guides());
-        let shells = ShellRenderer::for_targets(&ctx.device, formats, ShellFeatures::default());
+        // The stand-in clumps as the groom's first clump does.
+        let clumps = pelage_shaders::stand_in::clump_mask(generator);
+        let features = ShellFeatures {
+            clump: clumps.is_some(),
+            ..ShellFeatures::default()
+        };
+        let shells = ShellRenderer::for_targets(&ctx.device, formats, features);
+        let mask_size = clumps.as_ref().map_or(16, |(mask, _)| mask.width());
         let strands = StrandRenderer::new(ctx, formats);
         let binding = strands.bind(ctx, &hairs);
         let stand_in = ShellStandIn::of(generator, STAND_IN_LAYERS);
@@ -158,17 +165,23 @@ impl RealtimeFur {
                     rig: Some(rig),
                     per_corner: false,
                 };
-                let model = shells.upload_with(ctx, &rest, &texture, &textures, 16, upload)?;
+                let model =
+                    shells.upload_with(ctx, &rest, &texture, &textures, mask_size, upload)?;
                 (model, rest.bounds())
             }
             None => {
                 let mesh = generator.mesh();
                 (
-                    shells.upload(ctx, mesh, &texture, &textures, 16)?,
+                    shells.upload(ctx, mesh, &texture, &textures, mask_size)?,
                     mesh.bounds(),
                 )
             }
         };
+        let mut shell_params = ShellParams::plain(0, stand_in.length).for_stand_in(&stand_in);
+        if let Some((mask, clump)) = &clumps {
+            shells.set_wetness(ctx, &model, mask)?;
+            shell_params.clump = *clump;
+        }
         let simulated = match (&animated, simulation) {
             (Some(a), Some(settings)) => {
                 let pose = a.pose(a.animation().frames.first() as f64)?;
@@ -213,7 +226,7 @@ impl RealtimeFur {
             },
             lod: FurLod::default(),
             strand_params: StrandParams::for_length(stand_in.length),
-            shell_params: ShellParams::plain(0, stand_in.length).for_stand_in(&stand_in),
+            shell_params,
             stand_in,
             animated,
         })

@@ -13,16 +13,21 @@
 //! share follows the character's area on screen (`F = (h / full)²`), so
 //! the hairs a pixel holds stay about the same from near to far.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+use pelage::groom::ops::Operator;
 use pelage::groom::{Generator, Groom, GroomError};
+use pelage::map::MapSite;
 use pelage::shell::ShellTextureParams;
+use pelage::shell::math::ClumpParams;
+use pelage::shell::wetness::{Droplet, WetnessMask, mask_coordinates};
 
 /// How much brighter a stand-in's shells are coloured than its hairs.
 const SHELL_GAIN: f32 = 1.8;
 
 /// Shell fur standing in for a groom far away: its texture's density of
 /// hairs per texel matched to the groom's on the skin, its length the
-/// guides' mean length, its clumping from the groom's first clump.
+/// guides' mean length; its clumps, from the groom's first clump, are
+/// [`clump_mask`]'s.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShellStandIn {
     /// The shell texture to generate.
@@ -133,6 +138,69 @@ pub fn root_colors(
     ))
 }
 
+/// Texels of a stand-in's clump mask a clump covers on average (the
+/// mask's side is a power of two between [`LEAST_MASK`] and
+/// [`MOST_MASK`]).
+const TEXELS_A_CLUMP: f32 = 64.0;
+const LEAST_MASK: u32 = 64;
+const MOST_MASK: u32 = 1024;
+
+/// The groom's first clump as the stand-in's shells clump it (Banisch's
+/// Alg. 2 reading a wetness mask): each texel of a square mask over the
+/// skin's UVs belongs to the nearest clump centre's root
+/// ([`WetnessMask::of_clumps`]), within twice the distance to the
+/// centre's nearest neighbour (a clump alone on a UV island does not
+/// cover the square), wet by the clump's rate at the centre; the clump
+/// bends the shells in along their length (`w = 1`: roots stay, tips
+/// gather). `None` when the groom has no clump or the skin no UVs.
+pub fn clump_mask(generator: &Generator) -> Option<(WetnessMask, ClumpParams)> {
+    let mesh = generator.mesh();
+    if !mesh.has_uvs() {
+        return None;
+    }
+    let clump = generator
+        .operators()
+        .iter()
+        .find_map(|op| match op.unmasked() {
+            Operator::Clump(c) if !c.centres().surface_roots().is_empty() => Some(c),
+            _ => None,
+        })?;
+    let roots = clump.centres().surface_roots();
+    let centres: Vec<Vec2> = roots
+        .iter()
+        .map(|r| mask_coordinates(r.uv(mesh).unwrap_or_default()))
+        .collect();
+    let spread =
+        pelage::nearest::NearestPoints::new(centres.iter().map(|c| c.extend(0.0)).collect());
+    let mut nearest = Vec::new();
+    let clumps: Vec<Droplet> = roots
+        .iter()
+        .zip(&centres)
+        .map(|(&root, &centre)| {
+            spread.nearest(centre.extend(0.0), 2, &mut nearest);
+            let radius = nearest
+                .get(1)
+                .map_or(1.0, |n| 2.0 * n.distance_squared.sqrt());
+            let site = MapSite::with_position(mesh, root, root.position(mesh));
+            Droplet {
+                centre,
+                radius,
+                wetness: clump.rate().at(&site),
+            }
+        })
+        .collect();
+    let side = (TEXELS_A_CLUMP * clumps.len() as f32)
+        .sqrt()
+        .ceil()
+        .max(1.0) as u32;
+    let side = side.next_power_of_two().clamp(LEAST_MASK, MOST_MASK);
+    let params = ClumpParams {
+        w: 1.0,
+        strength: 1.0,
+    };
+    Some((WetnessMask::of_clumps(side, side, &clumps), params))
+}
+
 /// sRGB bytes of a linear colour.
 pub fn srgb(c: Vec3) -> image::Rgba<u8> {
     let [r, g, b] = c
@@ -194,5 +262,49 @@ impl FurLod {
             strand_opacity: 1.0 - t,
             shell_opacity: t,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn generator(ops: &str) -> Generator {
+        let text = format!(
+            "[mesh]\npath = \"spot\"\n[roots]\ncount = 2000\n\
+             [guides]\ngenerate = {{ count = 40, length = 0.05 }}\n{ops}"
+        );
+        Groom::from_text("<stand-in>", text)
+            .and_then(|g| g.generator(None))
+            .expect("the test groom grows")
+    }
+
+    #[test]
+    fn the_stand_in_clumps_where_the_grooms_first_clump_does() {
+        let clumped = generator(
+            "[[ops]]\nclump = { count = 50, rate = 0.6 }\n[[ops]]\nclump = { count = 400, rate = 0.3 }\n",
+        );
+        let (mask, params) = clump_mask(&clumped).expect("a clumped groom's stand-in clumps");
+        assert_eq!(params.w, 1.0, "roots stay, tips gather");
+        assert!(params.strength > 0.0);
+        // 50 clumps of about 64 texels: the smallest mask.
+        assert_eq!((mask.width(), mask.height()), (LEAST_MASK, LEAST_MASK));
+        let Operator::Clump(first) = clumped.operators()[0].unmasked() else {
+            panic!("the first operator is the clump");
+        };
+        // Every centre's own texel is its clump's, wet by the first
+        // clump's rate (the second clump's 0.3 is not read).
+        let mesh = clumped.mesh();
+        let mut own = 0;
+        for root in first.centres().surface_roots() {
+            let centre = mask_coordinates(root.uv(mesh).unwrap());
+            let texel = mask.at(centre);
+            assert_eq!(texel.wetness, 0.6);
+            own += usize::from(texel.centre == centre);
+        }
+        // A texel is a 64th of the square: two centres may share one.
+        assert!(own >= 45, "{own} of 50 centres hold their own texel");
+        assert!(mask.wet_fraction() > 0.2, "{}", mask.wet_fraction());
+        assert!(clump_mask(&generator("")).is_none(), "no clump, no clumps");
     }
 }

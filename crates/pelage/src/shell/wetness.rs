@@ -155,6 +155,59 @@ impl WetnessMask {
         )
     }
 
+    /// A mask of clumps standing side by side (a groom's clumps seen as
+    /// shells): each texel belongs to the nearest of the `clumps` whose
+    /// radius reaches it (by centre, ties to the first) and is wet with
+    /// it; texels no clump reaches are dry. Unlike droplets falling one
+    /// after another (Alg. 1), neighbouring clumps never merge: the texels
+    /// between two centres split between them, as the hairs do. A texel
+    /// stores its clump's reach over its own texels (the farthest texel's
+    /// corner) rather than the radius given, so Alg. 2, which discards a
+    /// pixel beyond its clump's radius, never cuts a clump short.
+    pub fn of_clumps(width: u32, height: u32, clumps: &[Droplet]) -> Self {
+        let mut mask = Self::dry_mask(width, height);
+        let (w, h) = (mask.width as f32, mask.height as f32);
+        // Each texel's clump so far and its distance, clump by clump over
+        // the texels its disc covers.
+        let mut owner = vec![(u32::MAX, f32::INFINITY); mask.texels.len()];
+        for (c, clump) in clumps.iter().enumerate() {
+            if !(clump.centre.is_finite() && clump.radius > 0.0 && clump.wetness >= DRY_BELOW) {
+                continue;
+            }
+            let (centre, r) = (clump.centre, clump.radius.min(2.0));
+            let x0 = ((centre.x - r) * w).floor().max(0.0) as u32;
+            let x1 = ((centre.x + r) * w).ceil().clamp(0.0, w) as u32;
+            let y0 = ((centre.y - r) * h).floor().max(0.0) as u32;
+            let y1 = ((centre.y + r) * h).ceil().clamp(0.0, h) as u32;
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let d = mask.texel_centre(x, y).distance(centre);
+                    let slot = &mut owner[(y * mask.width + x) as usize];
+                    if d <= r && d < slot.1 {
+                        *slot = (c as u32, d);
+                    }
+                }
+            }
+        }
+        let corner = 0.5 * Vec2::new(1.0 / w, 1.0 / h).length();
+        let mut reach = vec![0.0f32; clumps.len()];
+        for &(c, d) in &owner {
+            if let Some(r) = reach.get_mut(c as usize) {
+                *r = r.max(d + corner);
+            }
+        }
+        for (texel, &(c, _)) in mask.texels.iter_mut().zip(&owner) {
+            if let Some(clump) = clumps.get(c as usize) {
+                *texel = take(Droplet {
+                    radius: reach[c as usize],
+                    wetness: clump.wetness.clamp(0.0, 1.0),
+                    ..*clump
+                });
+            }
+        }
+        mask
+    }
+
     /// Blends a droplet into every texel whose centre it covers (Alg. 1 per
     /// texel, [`blend_droplet`]).
     pub fn add_droplet(&mut self, drop: Droplet) {
@@ -299,6 +352,46 @@ pub fn droplets_from_image(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clumps_side_by_side_split_the_texels_between_them_and_never_merge() {
+        let clumps = [
+            Droplet {
+                centre: Vec2::new(0.3, 0.5),
+                radius: 0.25,
+                wetness: 0.8,
+            },
+            Droplet {
+                centre: Vec2::new(0.6, 0.5),
+                radius: 0.25,
+                wetness: 0.4,
+            },
+        ];
+        let mask = WetnessMask::of_clumps(64, 64, &clumps);
+        for y in 0..64 {
+            for x in 0..64 {
+                let p = mask.texel_centre(x, y);
+                let texel = mask.texel(x, y);
+                let (a, b) = (p.distance(clumps[0].centre), p.distance(clumps[1].centre));
+                let nearest = if a <= b { clumps[0] } else { clumps[1] };
+                if p.distance(nearest.centre) <= nearest.radius {
+                    assert_eq!(texel.centre, nearest.centre, "({x}, {y})");
+                    // Its clump's reach: no farther than the radius given
+                    // (and a texel's corner), covering this texel.
+                    assert!(texel.radius <= nearest.radius + 0.5 / 64.0 * 2f32.sqrt());
+                    assert!(texel.radius >= p.distance(nearest.centre));
+                    assert_eq!(texel.wetness, nearest.wetness);
+                } else {
+                    assert_eq!(texel, WetTexel::default(), "({x}, {y}) is dry");
+                }
+            }
+        }
+        // Both clumps hold texels, and the far corner is dry.
+        assert_eq!(mask.at(Vec2::new(0.25, 0.5)).wetness, 0.8);
+        assert_eq!(mask.at(Vec2::new(0.65, 0.5)).wetness, 0.4);
+        assert_eq!(mask.at(Vec2::new(0.01, 0.01)).wetness, 0.0);
+        assert!(WetnessMask::of_clumps(8, 8, &[]).wet_fraction() == 0.0);
+    }
 
     fn drop(x: f32, y: f32, r: f32, w: f32) -> Droplet {
         Droplet {

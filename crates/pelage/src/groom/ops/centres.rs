@@ -113,7 +113,7 @@ impl ClumpCentres {
     }
 
     /// The centres' roots on the skin (empty unless a groom grew them).
-    pub(crate) fn surface_roots(&self) -> &[SurfacePoint] {
+    pub fn surface_roots(&self) -> &[SurfacePoint] {
         &self.surface_roots
     }
 

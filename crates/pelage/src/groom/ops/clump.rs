@@ -74,7 +74,12 @@ impl Clump {
         &self.centres
     }
 
-    /// Pulls one hair toward its centre.
+    /// The share of the way a hair's tip is pulled to its centre (a map
+    /// over the skin).
+    pub fn rate(&self) -> &Map {
+        &self.rate
+    }
+
     /// The centre a hair rooted at `root` follows, and how strongly (the
     /// rate, faded by the distance when the clump has a size).
     pub(crate) fn target(
