@@ -1698,6 +1698,26 @@ fn converting_an_animated_file_says_it_writes_the_first_sample() {
     assert_eq!(written.widths(), read.widths());
 }
 
+/// `pelage groom GROOM` written to `cpu` and, with `--gpu`, to `gpu`;
+/// both must succeed. Returns the GPU run.
+fn groom_on_cpu_and_gpu(groom: &Path, cpu: &Path, gpu: &Path) -> Output {
+    let mut on_gpu = None;
+    for (out, extra) in [(cpu, None), (gpu, Some("--gpu"))] {
+        let mut args = vec![
+            "groom",
+            groom.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ];
+        args.extend(extra);
+        let o = pelage(&args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        on_gpu = Some(o);
+    }
+    on_gpu.expect("the GPU run is the last")
+}
+
 #[test]
 fn groom_on_the_gpu_writes_what_the_cpu_writes() {
     // Needs a GPU adapter; in CI (PELAGE_REQUIRE_GPU) it must be there.
@@ -1726,18 +1746,7 @@ fn groom_on_the_gpu_writes_what_the_cpu_writes() {
     .unwrap();
     let cpu = dir.path().join("cpu.usdc");
     let gpu = dir.path().join("gpu.usdc");
-    for (out, extra) in [(&cpu, None), (&gpu, Some("--gpu"))] {
-        let mut args = vec![
-            "groom",
-            groom.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "-q",
-        ];
-        args.extend(extra);
-        let o = pelage(&args);
-        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
-    }
+    groom_on_cpu_and_gpu(&groom, &cpu, &gpu);
     let (a, b) = (
         pelage::io::read_curves(&cpu).unwrap(),
         pelage::io::read_curves(&gpu).unwrap(),
@@ -1797,21 +1806,12 @@ fn an_animated_groom_grown_on_the_gpu_writes_what_the_cpu_writes() {
         .unwrap();
         let cpu = dir.path().join(format!("{mode}-cpu.usdc"));
         let gpu = dir.path().join(format!("{mode}-gpu.usdc"));
-        for (out, extra) in [(&cpu, None), (&gpu, Some("--gpu"))] {
-            let mut args = vec![
-                "groom",
-                groom.to_str().unwrap(),
-                "-o",
-                out.to_str().unwrap(),
-                "-q",
-            ];
-            args.extend(extra);
-            let o = pelage(&args);
-            assert!(o.status.success(), "{args:?}: {}", stderr(&o));
-            if extra.is_some() {
-                assert!(stdout(&o).contains("growing on"), "{}", stdout(&o));
-            }
-        }
+        let on_gpu = groom_on_cpu_and_gpu(&groom, &cpu, &gpu);
+        assert!(
+            stdout(&on_gpu).contains("growing on"),
+            "{}",
+            stdout(&on_gpu)
+        );
         let first = pelage::io::read_usd_curves_at(&cpu, Some(1.0)).unwrap();
         let (lo, hi) = first
             .points()

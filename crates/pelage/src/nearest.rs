@@ -432,6 +432,17 @@ mod tests {
         all.iter().take(k).map(|a| a.1).collect()
     }
 
+    /// `p` moved in the plane by up to `size / 2` along each axis (from
+    /// the random bits `h`), kept in the points' box.
+    fn stepped(p: Vec3, h: u64, size: f32) -> Vec3 {
+        let d = Vec3::new(
+            (h & 0xffff) as f32 / 65536.0 - 0.5,
+            (h >> 16 & 0xffff) as f32 / 65536.0 - 0.5,
+            0.0,
+        );
+        (p + d * size).clamp(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.1))
+    }
+
     #[test]
     fn cached_queries_along_a_path_match_brute_force() {
         let points = scattered(500, 1);
@@ -445,12 +456,7 @@ mod tests {
             for step in 0..3000u64 {
                 let h = mix64(step ^ (k as u64) << 32);
                 let jump = if step % 500 == 0 { 0.4 } else { 0.004 };
-                let d = Vec3::new(
-                    (h & 0xffff) as f32 / 65536.0 - 0.5,
-                    (h >> 16 & 0xffff) as f32 / 65536.0 - 0.5,
-                    0.0,
-                );
-                p = (p + d * jump).clamp(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.1));
+                p = stepped(p, h, jump);
                 let got: Vec<u32> = set
                     .nearest_cached(p, k, &mut cache)
                     .map(|n| n.index)
@@ -477,13 +483,7 @@ mod tests {
             for step in 0..4000u64 {
                 let h = mix64(step ^ (k as u64) << 40 ^ 77);
                 let sparse = (step / 500) % 2 == 0;
-                let size = if sparse { 0.06 } else { 0.002 };
-                let d = Vec3::new(
-                    (h & 0xffff) as f32 / 65536.0 - 0.5,
-                    (h >> 16 & 0xffff) as f32 / 65536.0 - 0.5,
-                    0.0,
-                );
-                p = (p + d * size).clamp(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.1));
+                p = stepped(p, h, if sparse { 0.06 } else { 0.002 });
                 let got: Vec<u32> = set
                     .nearest_cached(p, k, &mut cache)
                     .map(|n| n.index)

@@ -252,8 +252,6 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `pelage groom` for an animated groom: every part over every frame,
-/// into one file with time samples.
 /// With `--gpu`, an adapter to grow on (none: exit 2 with why), named on
 /// stdout.
 fn gpu_context(args: &GroomArgs) -> anyhow::Result<Option<pelage_gpu::GpuContext>> {
@@ -266,6 +264,8 @@ fn gpu_context(args: &GroomArgs) -> anyhow::Result<Option<pelage_gpu::GpuContext
     Ok(Some(ctx))
 }
 
+/// `pelage groom` for an animated groom: every part over every frame,
+/// into one file with time samples.
 fn run_animated(
     args: &GroomArgs,
     groom: &Groom,

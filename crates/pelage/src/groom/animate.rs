@@ -749,22 +749,15 @@ impl AnimatedGroom {
         cancel: &AtomicBool,
         mut progress: impl FnMut(AnimationProgress),
     ) -> Result<GroomSummary, GroomWriteError> {
-        let AnimatedFiles {
-            outputs,
-            parts,
-            options,
-            with_skin,
-        } = files;
-        let total = parts.len() * outputs.iter().map(|o| o.times.len()).sum::<usize>();
+        let parts = files.parts.len();
+        let total = parts * files.outputs.iter().map(|o| o.times.len()).sum::<usize>();
         let mut done = 0;
         let mut summary = GroomSummary::default();
-        for (k, window) in outputs.chunks(MAX_OPEN_FRAME_FILES).enumerate() {
+        for (k, window) in files.outputs.chunks(MAX_OPEN_FRAME_FILES).enumerate() {
             let counts = self.write_window(
                 AnimatedFiles {
                     outputs: window,
-                    parts: parts.clone(),
-                    options,
-                    with_skin,
+                    ..files.clone()
                 },
                 grow,
                 cancel,
@@ -776,7 +769,7 @@ impl AnimatedGroom {
                     })
                 },
             )?;
-            done += parts.len() * window.iter().map(|o| o.times.len()).sum::<usize>();
+            done += parts * window.iter().map(|o| o.times.len()).sum::<usize>();
             // Every window holds the same hairs: count them once.
             if k == 0 {
                 summary = counts;

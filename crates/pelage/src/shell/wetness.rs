@@ -17,6 +17,7 @@ use crate::sample::{
     DensitySampler, DensitySamplerOptions, SampleError, SampleRng, salts, sample_range,
 };
 use glam::Vec2;
+use std::ops::Range;
 
 /// One drop of water: where it hits (mask coordinates), how wide the clump
 /// it makes is, and how wet (ρ_drop in [0, 1]).
@@ -155,6 +156,17 @@ impl WetnessMask {
         )
     }
 
+    /// The columns and rows of the texels a disc of `radius` around mask
+    /// point `centre` can cover (its bounding box, clamped to the mask).
+    fn texels_around(&self, centre: Vec2, radius: f32) -> (Range<u32>, Range<u32>) {
+        let (w, h) = (self.width as f32, self.height as f32);
+        let x0 = ((centre.x - radius) * w).floor().max(0.0) as u32;
+        let x1 = ((centre.x + radius) * w).ceil().min(w) as u32;
+        let y0 = ((centre.y - radius) * h).floor().max(0.0) as u32;
+        let y1 = ((centre.y + radius) * h).ceil().min(h) as u32;
+        (x0..x1, y0..y1)
+    }
+
     /// A mask of clumps standing side by side (a groom's clumps seen as
     /// shells): each texel belongs to the nearest of the `clumps` whose
     /// radius reaches it (by centre, ties to the first) and is wet with
@@ -175,12 +187,9 @@ impl WetnessMask {
                 continue;
             }
             let (centre, r) = (clump.centre, clump.radius.min(2.0));
-            let x0 = ((centre.x - r) * w).floor().max(0.0) as u32;
-            let x1 = ((centre.x + r) * w).ceil().clamp(0.0, w) as u32;
-            let y0 = ((centre.y - r) * h).floor().max(0.0) as u32;
-            let y1 = ((centre.y + r) * h).ceil().clamp(0.0, h) as u32;
-            for y in y0..y1 {
-                for x in x0..x1 {
+            let (xs, ys) = mask.texels_around(centre, r);
+            for y in ys {
+                for x in xs.clone() {
                     let d = mask.texel_centre(x, y).distance(centre);
                     let slot = &mut owner[(y * mask.width + x) as usize];
                     if d <= r && d < slot.1 {
@@ -218,13 +227,9 @@ impl WetnessMask {
             wetness: drop.wetness.clamp(0.0, 1.0),
             ..drop
         };
-        let (w, h) = (self.width as f32, self.height as f32);
-        let x0 = ((drop.centre.x - drop.radius) * w).floor().max(0.0) as u32;
-        let x1 = ((drop.centre.x + drop.radius) * w).ceil().min(w) as u32;
-        let y0 = ((drop.centre.y - drop.radius) * h).floor().max(0.0) as u32;
-        let y1 = ((drop.centre.y + drop.radius) * h).ceil().min(h) as u32;
-        for y in y0..y1 {
-            for x in x0..x1 {
+        let (xs, ys) = self.texels_around(drop.centre, drop.radius);
+        for y in ys {
+            for x in xs.clone() {
                 if self.texel_centre(x, y).distance(drop.centre) <= drop.radius {
                     let i = (y * self.width + x) as usize;
                     self.texels[i] = blend_droplet(self.texels[i], drop);
