@@ -93,6 +93,10 @@ pub(crate) trait OperatorKind: Sized {
     ) -> bool {
         false
     }
+
+    /// Where a mask of 0 leaves the hairs as they were: nothing, unless
+    /// their ids must change with the operator's (a strand's hairs).
+    fn masked_out(&self, _batch: &mut HairBatch) {}
 }
 
 /// Where an operator sits in a groom: its place in the chain and its
@@ -465,6 +469,15 @@ macro_rules! operators {
                 match self {
                     Operator::Masked(_) => false,
                     $( Operator::$Variant(op) => op.apply_faded(batch, root, m, scratch), )*
+                }
+            }
+
+            /// Where a mask of 0 leaves the hairs as they were
+            /// ([`OperatorKind::masked_out`]).
+            pub(crate) fn masked_out(&self, batch: &mut HairBatch) {
+                match self {
+                    Operator::Masked(masked) => masked.operator().masked_out(batch),
+                    $( Operator::$Variant(op) => op.masked_out(batch), )*
                 }
             }
 

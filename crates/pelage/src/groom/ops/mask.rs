@@ -74,7 +74,7 @@ impl Masked {
             self.start_attributes(hair);
         }
         if m == 0.0 {
-            return;
+            return self.op.masked_out(batch);
         }
         if m == 1.0 {
             return self.op.apply(batch, root, scratch);

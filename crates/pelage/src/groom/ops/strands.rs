@@ -42,7 +42,8 @@ operator_settings! {
 }
 
 /// `strands`: hair `k` of the strand of base hair `b` has id
-/// `b.id · count + k` and points `b(t) + s(t) · ρ · (cos θ(t) r + sin θ(t) B)`,
+/// `b.id · count + k` (a hair a mask of 0 leaves whole: `b.id · count`)
+/// and points `b(t) + s(t) · ρ · (cos θ(t) r + sin θ(t) B)`,
 /// where `s(t)` runs from `root_spread` to `tip_spread`, `ρ = √ξ` and
 /// `θ(t) = 2π(ξ' + twist · t)` (a uniform point of the unit disc, turned
 /// `twist` times along the hair), `r, B` the base hair's
@@ -157,6 +158,15 @@ impl OperatorKind for Strands {
 
     fn apply(&self, batch: &mut HairBatch, root: &RootContext, scratch: &mut Scratch) {
         self.split(batch, root, scratch);
+    }
+
+    /// A hair a mask leaves whole is its strand's only hair, with the id
+    /// of its strand's first: ids stay distinct (an unsplit hair's own id
+    /// could be another strand's hair's).
+    fn masked_out(&self, batch: &mut HairBatch) {
+        for hair in batch.hairs_mut() {
+            hair.id = self.strand_id(hair.id, 0);
+        }
     }
 }
 
