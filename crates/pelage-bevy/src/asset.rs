@@ -219,12 +219,7 @@ impl GroomFurAsset {
         let (shells, hairs) = ShellFurAsset::stand_in_for(groom, &generator)?;
         let path = groom.path().display();
         let strands = match GroomStrandsSource::of(groom, &generator, shells.length) {
-            Ok(source) => {
-                for what in &source.left_out {
-                    bevy::log::warn!("pelage: {path}: the GPU's strands leave out {what}");
-                }
-                Some(Arc::new(source))
-            }
+            Ok(source) => Some(Arc::new(source)),
             Err(why) => {
                 bevy::log::warn!(
                     "pelage: {path}: no real-time strands ({why}); its shell stand-in is drawn at every distance"
@@ -254,9 +249,6 @@ pub struct GroomStrandsSource {
     pub look: StrandLook,
     /// The guides' mean length (mesh units).
     pub length: f32,
-    /// Settings of the groom the GPU leaves out (named, never dropped
-    /// silently).
-    pub left_out: Vec<String>,
 }
 
 impl GroomStrandsSource {
@@ -294,11 +286,6 @@ impl GroomStrandsSource {
             triangles,
             look: StrandLook::default(),
             length,
-            left_out: recipe
-                .left_out
-                .iter()
-                .map(|l| format!("{} ({})", l.key, l.why))
-                .collect(),
         })
     }
 }

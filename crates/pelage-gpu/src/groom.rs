@@ -613,29 +613,12 @@ pub struct GpuPartGrower<'a> {
 
 impl<'a> GpuPartGrower<'a> {
     /// The grower of `generator`'s parts on `ctx`.
-    ///
-    /// # Errors
-    /// When the groom has what the GPU evaluator leaves out
-    /// ([`GroomRecipe::left_out`]): growing it there would write a
-    /// different groom.
-    pub fn new(ctx: &'a GpuContext, generator: &'a Generator) -> Result<Self, GroomError> {
-        let probe = GroomRecipe::new(generator, &[], &[])?;
-        if let Some(first) = probe.left_out.first() {
-            let all: Vec<String> = probe.left_out.iter().map(|l| l.key.clone()).collect();
-            return Err(generator.error(
-                &first.key,
-                GroomErrorKind::Conflict(format!(
-                    "the GPU evaluator leaves out {} ({}): grow this groom without --gpu",
-                    all.join(", "),
-                    first.why
-                )),
-            ));
-        }
-        Ok(Self {
+    pub fn new(ctx: &'a GpuContext, generator: &'a Generator) -> Self {
+        Self {
             ctx,
             generator,
             skin: GpuGroom::skin_at_rest(generator.mesh()),
-        })
+        }
     }
 
     /// Part `p`, grown on the GPU.

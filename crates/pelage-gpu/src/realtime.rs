@@ -15,7 +15,7 @@ use crate::{
 use glam::Vec3;
 use pelage::anim::SkinPose;
 use pelage::dynamics::{GuideSimulation, GuideStrandParams};
-use pelage::groom::{AnimatedGroom, AnimationMode, Groom, GroomError, GroomRecipe, LeftOut};
+use pelage::groom::{AnimatedGroom, AnimationMode, Groom, GroomError, GroomRecipe};
 use pelage::guides::Guides;
 use pelage::shell::ShellTextures;
 use std::time::Instant;
@@ -81,7 +81,6 @@ pub struct RealtimeFur {
     model: ShellModel,
     stand_in: ShellStandIn,
     simulated: Option<Simulated>,
-    left_out: Vec<LeftOut>,
     guides: usize,
     bounds: (Vec3, Vec3),
     frame: f64,
@@ -212,7 +211,6 @@ impl RealtimeFur {
             shells,
             model,
             simulated,
-            left_out: recipe.left_out.clone(),
             guides: generator.guides().len(),
             bounds,
             frame: f64::NAN,
@@ -246,12 +244,6 @@ impl RealtimeFur {
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let grow = Vec3::splat(2.0 * self.stand_in.length);
         (self.bounds.0 - grow, self.bounds.1 + grow)
-    }
-
-    /// What of the groom the GPU evaluator leaves out (a front end says
-    /// so: the hairs drawn differ from the groom's there).
-    pub fn left_out(&self) -> &[LeftOut] {
-        &self.left_out
     }
 
     /// The groom's guides.

@@ -394,12 +394,9 @@ impl PyGroom {
         let generator = self.generator(py, seed)?;
         let parts = generator.parts().len();
         let context = gpu.then(gpu_context).transpose()?;
-        let grower = match &context {
-            Some(ctx) => {
-                Some(pelage_gpu::GpuPartGrower::new(ctx, &generator).map_err(|e| self.error(e))?)
-            }
-            None => None,
-        };
+        let grower = context
+            .as_ref()
+            .map(|ctx| pelage_gpu::GpuPartGrower::new(ctx, &generator));
         let grow_part = |p: usize| match &grower {
             Some(g) => g.part(p),
             None => generator.part(p),
@@ -604,13 +601,9 @@ impl PyGroom {
             // With gpu=True the hairs grow at rest on the GPU (each
             // frame's in regrow and simulate modes), carried as without.
             let context = gpu.then(gpu_context).transpose()?;
-            let grower = match &context {
-                Some(ctx) => Some(
-                    pelage_gpu::GpuPartGrower::new(ctx, animated.generator())
-                        .map_err(|e| self.error(e))?,
-                ),
-                None => None,
-            };
+            let grower = context
+                .as_ref()
+                .map(|ctx| pelage_gpu::GpuPartGrower::new(ctx, animated.generator()));
             let grow = |g: &Generator, p: usize| match &grower {
                 Some(gpu) => gpu.part_of(g, p),
                 None => g.part(p),
@@ -634,12 +627,9 @@ impl PyGroom {
             let mut gathered = ReportBuilder::new(&generator);
             let setup = started.elapsed().as_secs_f64();
             let context = gpu.then(gpu_context).transpose()?;
-            let grower = match &context {
-                Some(ctx) => Some(
-                    pelage_gpu::GpuPartGrower::new(ctx, &generator).map_err(|e| self.error(e))?,
-                ),
-                None => None,
-            };
+            let grower = context
+                .as_ref()
+                .map(|ctx| pelage_gpu::GpuPartGrower::new(ctx, &generator));
             let grow_part = |p: usize| match &grower {
                 Some(g) => g.part(p),
                 None => generator.part(p),

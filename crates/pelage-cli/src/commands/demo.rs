@@ -219,12 +219,6 @@ fn run_fox_realtime(out: &std::path::Path) -> anyhow::Result<()> {
     let ctx = GpuContext::headless().context("--realtime draws on the GPU")?;
     let (w, h) = (480, 300);
     let mut fur = RealtimeFur::new(&ctx, groom, pelage_gpu::ShellTargetFormats::own())?;
-    for left_out in fur.left_out() {
-        eprintln!(
-            "warning: not on the GPU: {} ({})",
-            left_out.key, left_out.why
-        );
-    }
     let target = ShellTarget::new(&ctx, fur.shell_renderer(), w, h)?;
     let frames = fur.frames().map_or(vec![1], |f| f.frames().to_vec());
     println!(

@@ -170,10 +170,9 @@ pub fn run(args: &GroomArgs) -> anyhow::Result<()> {
     // On the GPU: each part grown there and finished as the CPU
     // finishes it.
     let gpu = gpu_context(args)?;
-    let grower = match &gpu {
-        Some(ctx) => Some(pelage_gpu::GpuPartGrower::new(ctx, &generator)?),
-        None => None,
-    };
+    let grower = gpu
+        .as_ref()
+        .map(|ctx| pelage_gpu::GpuPartGrower::new(ctx, &generator));
     let grow = |p: usize| match &grower {
         Some(g) => g.part(p),
         None => generator.part(p),
@@ -329,10 +328,9 @@ fn run_animated(
     // On the GPU: the hairs grown at rest there (each frame's in regrow
     // and simulate modes), carried to the poses as on the CPU.
     let gpu = gpu_context(args)?;
-    let grower = match &gpu {
-        Some(ctx) => Some(pelage_gpu::GpuPartGrower::new(ctx, generator)?),
-        None => None,
-    };
+    let grower = gpu
+        .as_ref()
+        .map(|ctx| pelage_gpu::GpuPartGrower::new(ctx, generator));
     let grow = |g: &pelage::groom::Generator, p: usize| match &grower {
         Some(gpu) => gpu.part_of(g, p),
         None => g.part(p),

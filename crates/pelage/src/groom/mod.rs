@@ -95,7 +95,7 @@ pub use outside_skin::OutsideSkin;
 pub use parts::{HAIRS_PER_PART, Part, PartLayout};
 pub use ramp::Ramp;
 pub use recipe::{
-    GroomRecipe, LeftOut, MAX_RECIPE_WEIGHTS, RecipePass, RecipeStep, StepKind, roots_by_arrival,
+    GroomRecipe, MAX_RECIPE_WEIGHTS, RecipePass, RecipeStep, StepKind, roots_by_arrival,
 };
 pub use report::{
     GroomReport, GuideNote, GuidesReport, LostGuideNote, PartReport, RegionReport, ReportBuilder,

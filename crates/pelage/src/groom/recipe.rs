@@ -19,9 +19,13 @@
 //! parameter per hair); the hairs it takes away whole are not in the
 //! recipe, as the CPU drops them. `strands` is a step too: the recipe
 //! holds each strand hair, whose steps before the split read its base
-//! hair's numbers. A second `strands` has no step:
-//! [`GroomRecipe::left_out`] names it, and a front end says so rather than
-//! draw a different groom silently.
+//! hair's numbers. Strands of strands split again: a hair's steps read
+//! the numbers of the hair it was at that point of the chain (its base's
+//! base, its base, itself).
+//!
+//! Every operator has a step or is made once here; the match in
+//! `add_steps` names each, so an operator added to the CPU does not
+//! build until an evaluator grows it too.
 //!
 //! Clump centres are hairs of the recipe too: each clump level's centres
 //! are grown in a pass of their own through the steps before the clump,
@@ -31,7 +35,7 @@
 use super::build::centre_hair_id;
 use super::error::{GroomError, GroomErrorKind};
 use super::generator::Generator;
-use super::ops::{HairBatch, Operator, RootContext, Scratch, param};
+use super::ops::{HairBatch, Operator, RootContext, Scratch, Strands, param};
 use super::outside_skin::OutsideSkin;
 use crate::interp::{GuideWeight, HairRoot, HairScratch, NeighbourCache};
 use crate::mesh::SurfacePoint;
@@ -122,15 +126,6 @@ pub struct RecipePass {
     pub steps: u32,
 }
 
-/// Something of the groom a recipe does not grow.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct LeftOut {
-    /// Its setting in the groom file (`ops[3].cut`, `finish.outside_skin`).
-    pub key: String,
-    /// Why.
-    pub why: &'static str,
-}
-
 /// A groom flattened for an evaluator that runs every frame (module docs).
 /// Hairs are numbered centres first, pass after pass; the render hairs
 /// are the last pass.
@@ -187,11 +182,9 @@ pub struct GroomRecipe {
     /// length, with which an evaluator keeps carried hairs out of a posed
     /// skin (`OutsideSkin::posed`), as an animated groom does.
     pub outside_skin: Option<(OutsideSkin, f32)>,
-    /// What the recipe does not grow.
-    pub left_out: Vec<LeftOut>,
-    /// The chain position of the `strands` operator the recipe splits
-    /// hairs at, if any.
-    strands: Option<usize>,
+    /// The chain positions of the `strands` operators, where the recipe
+    /// splits hairs.
+    strands: Vec<usize>,
 }
 
 /// Every root of `generator`'s groom with its hair's id, ordered so that
@@ -275,8 +268,7 @@ impl GroomRecipe {
             colors: None,
             opacities: None,
             outside_skin: None,
-            left_out: Vec::new(),
-            strands: None,
+            strands: Vec::new(),
         };
         recipe.add_steps(generator);
         // Each clump level's centres, then the render hairs.
@@ -346,8 +338,7 @@ impl GroomRecipe {
         out
     }
 
-    /// The steps of `generator`'s chain, their tables and noise fields;
-    /// what has no step, in [`Self::left_out`].
+    /// The steps of `generator`'s chain, their tables and noise fields.
     fn add_steps(&mut self, generator: &Generator) {
         let n = generator.points;
         let mut offset = 0u32;
@@ -366,17 +357,11 @@ impl GroomRecipe {
                 // Widths, colours and opacities: made once (module docs).
                 Operator::Width(_) | Operator::Color(_) | Operator::Opacity(_) => continue,
                 Operator::Cut(_) => (StepKind::Cut, None),
-                Operator::Strands(_) if self.strands.is_none() => {
-                    self.strands = Some(k);
+                Operator::Strands(_) => {
+                    self.strands.push(k);
                     (StepKind::Strands, None)
                 }
-                Operator::Strands(_) | Operator::Masked(_) => {
-                    self.left_out.push(LeftOut {
-                        key: format!("ops[{k}].{}", op.name()),
-                        why: "a second `strands` (strands of strands); the evaluator splits a hair once",
-                    });
-                    continue;
-                }
+                Operator::Masked(_) => unreachable!("an unmasked operator"),
             };
             let table = self.tables.len() as u32;
             match ramp {
@@ -438,17 +423,28 @@ impl GroomRecipe {
         const CHUNK: usize = 1024;
         let per_hair = self.values_per_hair as usize;
         let steps = &self.steps;
-        // Whether a hair's values cut it away within the pass's steps.
-        // The strands operator the pass splits hairs at, and how many.
-        let strands_at = self
+        // The strands operators the pass splits hairs at, in chain order.
+        let splits: Vec<(usize, &Strands)> = self
             .strands
-            .filter(|&k| steps[..steps_run].iter().any(|s| s.chain_index == k));
-        let split = strands_at.map(|k| {
-            let Operator::Strands(s) = generator.ops[k].unmasked() else {
-                unreachable!("a strands step is a strands operator");
-            };
-            (s, s.count())
-        });
+            .iter()
+            .filter(|&&k| steps[..steps_run].iter().any(|s| s.chain_index == k))
+            .map(|&k| match generator.ops[k].unmasked() {
+                Operator::Strands(s) => (k, s),
+                _ => unreachable!("a strands step is a strands operator"),
+            })
+            .collect();
+        // Which id a hair's values for each step are drawn from: the one
+        // it has after the splits up to that step (0: its root's).
+        let id_after: Vec<usize> = steps
+            .iter()
+            .map(|step| {
+                splits
+                    .iter()
+                    .filter(|(k, _)| *k <= step.chain_index)
+                    .count()
+            })
+            .collect();
+        // Whether a hair's values cut it away within the pass's steps.
         let cut_away = |values: &[f32]| {
             steps[..steps_run]
                 .iter()
@@ -477,6 +473,7 @@ impl GroomRecipe {
                         Vec::with_capacity(roots.len()),
                     );
                     let mut hair_values = Vec::with_capacity(per_hair);
+                    let mut lineages = Lineages::default();
                     for (&root, &base_id) in roots.iter().zip(ids) {
                         let context = generator.root_context(root);
                         let hair_root = HairRoot {
@@ -494,38 +491,24 @@ impl GroomRecipe {
                             guide: 0,
                             weight: 0.0,
                         };
-                        // The strand hairs a root grows in this pass (a
-                        // centre is the first of its strand, as the CPU
-                        // takes it).
-                        // A mask of 0 there leaves the hair whole, as the
-                        // CPU's masked strands do.
-                        let split = split.filter(|_| {
-                            strands_at
-                                .is_some_and(|k| mask_weight(&generator.ops[k], &context) > 0.0)
+                        lineages.split(base_id, &splits, !centres, |k| {
+                            mask_weight(&generator.ops[k], &context) > 0.0
                         });
-                        let copies = match split {
-                            Some((_, count)) if !centres => count,
-                            _ => 1,
-                        };
-                        for k in 0..u64::from(copies) {
-                            let strand = split.map(|(s, _)| s.strand_id(base_id, k));
+                        for lineage in lineages.hairs() {
                             hair_values.clear();
-                            for step in steps {
-                                // From the split on, the strand hair's own.
-                                let id = match (strand, strands_at) {
-                                    (Some(id), Some(k)) if step.chain_index >= k => id,
-                                    _ => base_id,
-                                };
+                            for (step, &at) in steps.iter().zip(&id_after) {
+                                let id = lineage[at];
                                 step_values(generator, step, id, &context, near, &mut hair_values);
                             }
                             let bare = cut_away(&hair_values);
                             if bare && !centres {
                                 continue;
                             }
+                            // A centre keeps its root's id (its clump's).
                             let id = if centres {
                                 base_id
                             } else {
-                                strand.unwrap_or(base_id)
+                                lineage[splits.len()]
                             };
                             out.5.push((root, id, bare));
                             out.3.extend_from_slice(&hair_values);
@@ -635,6 +618,57 @@ impl GroomRecipe {
         }
         self.colors = generator.colors.then_some(colors);
         self.opacities = generator.opacities.then_some(opacities);
+    }
+}
+
+/// The hairs a root grows in a pass, each as the ids it has after each
+/// split (its root's first), in the CPU's order: `Strands::split`
+/// replaces each hair by its strand, base after base.
+#[derive(Default)]
+struct Lineages {
+    ids: Vec<u64>,
+    next: Vec<u64>,
+    stride: usize,
+}
+
+impl Lineages {
+    /// The hairs of the root `base_id` through `splits`. `whole`: each
+    /// split grows its whole strand, or only the first hair (a clump
+    /// centre follows its strand's first). `splits_here(k)`: whether the
+    /// split at chain position `k` splits at this root (a mask of 0 there
+    /// leaves the hair whole, as the CPU's masked strands do).
+    fn split(
+        &mut self,
+        base_id: u64,
+        splits: &[(usize, &Strands)],
+        whole: bool,
+        mut splits_here: impl FnMut(usize) -> bool,
+    ) {
+        self.ids.clear();
+        self.ids.push(base_id);
+        self.stride = 1;
+        for &(k, strands) in splits {
+            let count = match whole && splits_here(k) {
+                true => strands.count(),
+                // A hair left whole takes its strand's first id.
+                false => 1,
+            };
+            self.next.clear();
+            for lineage in self.ids.chunks_exact(self.stride) {
+                let last = lineage[self.stride - 1];
+                for c in 0..u64::from(count) {
+                    self.next.extend_from_slice(lineage);
+                    self.next.push(strands.strand_id(last, c));
+                }
+            }
+            std::mem::swap(&mut self.ids, &mut self.next);
+            self.stride += 1;
+        }
+    }
+
+    /// Each hair's ids, its root's first.
+    fn hairs(&self) -> std::slice::ChunksExact<'_, u64> {
+        self.ids.chunks_exact(self.stride)
     }
 }
 

@@ -38,12 +38,6 @@ impl RealtimeSession {
         let groom = Groom::load(path)?;
         let fur = RealtimeFur::new(ctx, groom, ShellTargetFormats::pelage(format))
             .with_context(|| format!("{}: cannot play it in real time", path.display()))?;
-        for left_out in fur.left_out() {
-            eprintln!(
-                "warning: not on the GPU: {} ({})",
-                left_out.key, left_out.why
-            );
-        }
         let frames = fur
             .frames()
             .map(|f| (f64::from(f.first()), f64::from(f.last())));
