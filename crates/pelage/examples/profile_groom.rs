@@ -35,20 +35,29 @@ fn main() {
     eprintln!("prepare {:?}", t.elapsed());
     let t = std::time::Instant::now();
     let mut n = 0;
-    // A checksum of every point, width and normal, to tell whether a change
-    // altered the output (CHECKSUM=1; it costs a pass over the arrays).
+    // A checksum of every point, width and normal, hair by hair and
+    // independent of the hairs' order, to tell whether a change altered the
+    // output (CHECKSUM=1; it costs a pass over the arrays).
     let checksum = std::env::var("CHECKSUM").as_deref() == Ok("1");
     let mut sum = 0u64;
     for p in 0..generator.parts().len() {
         let part = generator.part(p).expect("the benchmark groom grows");
         n += part.curve_count();
         if checksum {
-            let vectors = part.points().iter().chain(part.normals().unwrap_or(&[]));
-            let bits = vectors
-                .flat_map(|v| v.to_array())
-                .chain(part.widths().iter().copied())
-                .map(f32::to_bits);
-            sum = bits.fold(sum, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
+            // Hair by hair, summed: the same whatever order a part's hairs
+            // are grown in.
+            let ids = part.ids().expect("stable ids");
+            for (c, &id) in ids.iter().enumerate() {
+                let range = part.range(c);
+                let normals = part.normals().map_or(&[][..], |n| &n[range.clone()]);
+                let vectors = part.points()[range.clone()].iter().chain(normals);
+                let bits = vectors
+                    .flat_map(|v| v.to_array())
+                    .chain(part.widths()[range].iter().copied())
+                    .map(f32::to_bits);
+                let h = bits.fold(id, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
+                sum = sum.wrapping_add(h);
+            }
         }
         generator.recycle(part);
     }

@@ -1,7 +1,8 @@
 //! The k nearest of a fixed set of points (guide roots for Shepard, clump
 //! centres for `clump`), for queries that arrive in spatially coherent
-//! order: the generator grows a part's hairs sorted by triangle, so each
-//! root is close to the one before.
+//! order: the generator grows a part's hairs along the skin (root cells
+//! along their Morton curve, or by triangle), so each root is close to the
+//! one before.
 //!
 //! A kd-tree answers any query, but most hairs are answered from a short
 //! list of candidates kept for the last neighbourhood ([`NeighbourCache`]).

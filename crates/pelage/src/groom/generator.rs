@@ -10,8 +10,8 @@ use super::error::{GroomError, GroomErrorKind};
 use super::hair_look::HairLook;
 use super::ops::{Operator, Resampling};
 use super::outside_skin::OutsideSkin;
+use super::parts::sorted_by_triangle;
 use super::parts::{Part, PartLayout};
-use super::parts::{sorted_by_triangle, sorted_by_triangle_with_ids};
 use super::regions::RegionLookup;
 use super::spec::{RootDistribution, SpecOrigin, setting_error};
 use crate::curves::{CurveArrays, Curves};
@@ -107,7 +107,7 @@ pub(crate) struct Reuse<'a> {
     pub(crate) centre_guides: bool,
 }
 
-/// A part's roots, ordered by triangle, and their hairs' ids.
+/// A part's roots, in the order they grow, and their hairs' ids.
 pub(super) type PartRoots = (Vec<SurfacePoint>, Vec<u64>);
 
 /// Parts' arrays kept for reuse: a writer holds one part while the next
@@ -213,11 +213,22 @@ impl Generator {
                     .par_iter()
                     .with_max_len(8)
                     .map(|&(c, n)| {
+                        // A cell's roots by triangle, the cells in their
+                        // Morton order: a walk along the skin that keeps
+                        // the neighbour searches' lists warmer than the
+                        // triangles' own order (a preview fraction's
+                        // sparse roots most), and needs no sort of the
+                        // whole part.
                         let roots = cells.roots(&self.sampler, self.seed, c as usize, n);
-                        let ids = (0..roots.len() as u64)
-                            .map(|k| cells.id(c as usize, k))
+                        let mut keyed: Vec<(SurfacePoint, u64)> = roots
+                            .into_iter()
+                            .enumerate()
+                            .map(|(k, r)| (r, cells.id(c as usize, k as u64)))
                             .collect();
-                        (roots, ids)
+                        keyed.sort_unstable_by_key(|(r, id)| {
+                            (r.tri, r.bary[0].to_bits(), r.bary[1].to_bits(), *id)
+                        });
+                        keyed.into_iter().unzip::<_, _, Vec<_>, Vec<_>>()
                     })
                     .collect();
                 let (mut roots, mut ids) = (Vec::new(), Vec::new());
@@ -225,7 +236,7 @@ impl Generator {
                     roots.extend(r);
                     ids.extend(i);
                 }
-                sorted_by_triangle_with_ids(roots, ids)
+                (roots, ids)
             }
             None => {
                 let Some(sampler) = self.sampler.restricted(&part.triangles) else {

@@ -47,9 +47,11 @@ pub(super) struct Workspace {
 const GROUP: usize = 8;
 
 impl Generator {
-    /// Roots of part `p`, ordered by triangle (so neighbouring hairs are
-    /// grown together), and their hairs' ids. With stable ids each of the
-    /// part's root cells samples its own hairs from its own stream;
+    /// Roots of part `p`, in an order that walks the skin (so neighbouring
+    /// hairs are grown together), and their hairs' ids. With stable ids
+    /// each of the part's root cells samples its own hairs from its own
+    /// stream, and the part walks its cells along their Morton curve, each
+    /// cell's roots by triangle;
     /// otherwise the part samples its hairs in its triangles with its own
     /// stream, numbered from the part's first hair id. Blue-noise roots
     /// are then thinned, all parts together, from four times as many

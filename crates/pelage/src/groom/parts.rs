@@ -188,7 +188,8 @@ pub(crate) fn sorted_by_triangle_with_ids(
 }
 
 /// `roots` ordered by (triangle, first barycentric, second barycentric),
-/// the order [`Generator::part_roots`] grows hairs in: the same order as
+/// the order [`Generator::part_roots`] grows hairs in without root cells
+/// (sequential ids) and with blue-noise roots: the same order as
 /// a comparison sort by that key, found faster. A counting sort by
 /// triangle moves each root once; each triangle's few roots (a dozen or
 /// two) are then sorted among themselves. A comparison sort of the whole

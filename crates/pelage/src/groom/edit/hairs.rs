@@ -430,8 +430,8 @@ impl GrownHairs {
                 cells.id(c, k as u64)
             })
             .collect();
-        // Grown in the order a part grows them (by triangle), which keeps
-        // the guide searches' candidate lists warm.
+        // Grown by triangle, which keeps the guide searches' candidate
+        // lists warm.
         let (roots, ids) = sorted_by_triangle_with_ids(roots, ids);
         // A root listed twice is now next to itself (same root, same id;
         // ids are unique to a root).
