@@ -40,6 +40,10 @@ pub struct RealtimeBenchArgs {
     /// One JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Hairs instead of the case's (100,000; 20,000 with `--quick`), from
+    /// the same guides: `--hairs 1000000` for the million-hair figure.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=pelage::limits::MAX_HAIRS))]
+    pub hairs: Option<u64>,
 }
 
 /// What one run measured: medians over its frames, in milliseconds.
@@ -106,9 +110,10 @@ fn view_from(fur: &RealtimeFur, distance: f32, size: (u32, u32)) -> ShellView {
     )
 }
 
-fn measure(scale: Scale) -> anyhow::Result<Figures> {
-    let (hairs, guides, points) =
+fn measure(scale: Scale, hairs: Option<u64>) -> anyhow::Result<Figures> {
+    let (case_hairs, guides, points) =
         scale.pick((100_000, 2_000, 16), (20_000, 500, 16), (1_000, 50, 8));
+    let hairs = hairs.map_or(case_hairs, |h| h as usize);
     let size = scale.pick((1920, 1080), (640, 360), (160, 90));
     let frames = scale.pick(24, 12, 2);
     let cpu_frames = scale.pick(3, 2, 1);
@@ -222,7 +227,7 @@ fn cpu_groom(
 /// Runs the benchmark and prints its table (or its JSON).
 pub fn run(args: &RealtimeBenchArgs) -> anyhow::Result<()> {
     let scale = Scale::of(args.quick, args.smoke);
-    let f = measure(scale)?;
+    let f = measure(scale, args.hairs)?;
     let frame_ms = f.sim_ms + f.eval_ms + f.draw_ms;
     let speedup = f.cpu_eval_ms / f.eval_ms;
     if args.json {
