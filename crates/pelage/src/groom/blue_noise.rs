@@ -18,7 +18,7 @@
 //! theirs from it (a farm task that grows one part places every root).
 
 use super::generator::{Generator, PartRoots};
-use super::parts::sorted_by_triangle_with_ids;
+use super::parts::{sort_cell_roots, sorted_by_triangle_with_ids};
 use crate::mesh::SurfacePoint;
 use crate::sample::blue_noise::{OVERSAMPLING, Unit, arrival, positions_and_radii, thin};
 use crate::sample::{mix64, salts, sample_range};
@@ -34,6 +34,9 @@ struct PartCandidates {
     ids: Vec<Option<u64>>,
     /// The hairs it keeps: as many as its regular roots.
     keep: usize,
+    /// Where each stream's candidates start (a root cell's, in the cells'
+    /// Morton order, or the part's own).
+    streams: Vec<usize>,
 }
 
 impl PartCandidates {
@@ -41,6 +44,7 @@ impl PartCandidates {
     /// with ids `ids`.
     fn push_stream(&mut self, candidates: Vec<SurfacePoint>, ids: impl Iterator<Item = u64>) {
         let (before, len) = (self.ids.len(), candidates.len());
+        self.streams.push(before);
         self.ids.extend(ids.map(Some));
         self.keep += self.ids.len() - before;
         self.ids.resize(before + len, None);
@@ -49,8 +53,8 @@ impl PartCandidates {
     }
 }
 
-/// Every part's roots thinned to blue noise, ordered by triangle, with
-/// ids.
+/// Every part's roots thinned to blue noise, in the order they grow
+/// (as regular roots), with ids.
 pub(super) fn all_part_roots(generator: &Generator) -> Vec<PartRoots> {
     let parts = candidates(generator);
     let mut all = Vec::with_capacity(parts.iter().map(|p| p.candidates.len()).sum());
@@ -76,20 +80,37 @@ pub(super) fn all_part_roots(generator: &Generator) -> Vec<PartRoots> {
         .collect()
 }
 
-/// A part's survivors, ordered by triangle, with ids.
+/// A part's survivors, in the order a part's regular roots grow (root
+/// cells along their Morton curve, each by triangle; without cells, by
+/// triangle), with ids.
 fn survivors(part: PartCandidates, kept: &[bool]) -> PartRoots {
     let mut free = (0..kept.len())
         .filter(|&k| !kept[k])
         .filter_map(|k| part.ids[k]);
     let mut roots = Vec::with_capacity(part.keep);
-    let mut ids = Vec::with_capacity(part.keep);
+    // Where each stream's survivors start.
+    let mut starts = Vec::with_capacity(part.streams.len() + 1);
+    let mut next_stream = part.streams.iter().peekable();
     for (k, candidate) in part.candidates.into_iter().enumerate() {
+        while next_stream.next_if(|&&s| s <= k).is_some() {
+            starts.push(roots.len());
+        }
         if kept[k] {
-            roots.push(candidate);
-            ids.push(part.ids[k].unwrap_or_else(|| free.next().expect("a free id a new survivor")));
+            let id = part.ids[k].unwrap_or_else(|| free.next().expect("a free id a new survivor"));
+            roots.push((candidate, id));
         }
     }
-    sorted_by_triangle_with_ids(roots, ids)
+    if part.streams.len() <= 1 {
+        return sorted_by_triangle_with_ids(
+            roots.iter().map(|r| r.0).collect(),
+            roots.iter().map(|r| r.1).collect(),
+        );
+    }
+    starts.push(roots.len());
+    for cell in starts.windows(2) {
+        sort_cell_roots(&mut roots[cell[0]..cell[1]]);
+    }
+    roots.into_iter().unzip()
 }
 
 /// Every part's candidates: its root cells' streams (stable ids) or its

@@ -10,8 +10,8 @@ use super::error::{GroomError, GroomErrorKind};
 use super::hair_look::HairLook;
 use super::ops::{Operator, Resampling};
 use super::outside_skin::OutsideSkin;
-use super::parts::sorted_by_triangle;
 use super::parts::{Part, PartLayout};
+use super::parts::{sort_cell_roots, sorted_by_triangle};
 use super::regions::RegionLookup;
 use super::spec::{RootDistribution, SpecOrigin, setting_error};
 use crate::curves::{CurveArrays, Curves};
@@ -213,21 +213,13 @@ impl Generator {
                     .par_iter()
                     .with_max_len(8)
                     .map(|&(c, n)| {
-                        // A cell's roots by triangle, the cells in their
-                        // Morton order: a walk along the skin that keeps
-                        // the neighbour searches' lists warmer than the
-                        // triangles' own order (a preview fraction's
-                        // sparse roots most), and needs no sort of the
-                        // whole part.
                         let roots = cells.roots(&self.sampler, self.seed, c as usize, n);
                         let mut keyed: Vec<(SurfacePoint, u64)> = roots
                             .into_iter()
                             .enumerate()
                             .map(|(k, r)| (r, cells.id(c as usize, k as u64)))
                             .collect();
-                        keyed.sort_unstable_by_key(|(r, id)| {
-                            (r.tri, r.bary[0].to_bits(), r.bary[1].to_bits(), *id)
-                        });
+                        sort_cell_roots(&mut keyed);
                         keyed.into_iter().unzip::<_, _, Vec<_>, Vec<_>>()
                     })
                     .collect();

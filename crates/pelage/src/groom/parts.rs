@@ -176,6 +176,15 @@ pub(crate) fn part_count(mesh: &Mesh, count: u64, parts: Option<u32>, ids: HairI
     wanted.min(most).max(1)
 }
 
+/// Orders one root cell's roots by (triangle, barycentrics, id). A part
+/// with root cells grows its cells along their Morton curve, each cell's
+/// roots in this order: a walk along the skin that keeps the neighbour
+/// searches' candidate lists warmer than the triangles' own order (a
+/// preview fraction's sparse roots most), with no sort of the whole part.
+pub(crate) fn sort_cell_roots(roots: &mut [(SurfacePoint, u64)]) {
+    roots.sort_unstable_by_key(|(r, id)| (r.tri, r.bary[0].to_bits(), r.bary[1].to_bits(), *id));
+}
+
 /// [`sorted_by_triangle`] carrying each root's id along (equal roots keep
 /// ascending ids).
 pub(crate) fn sorted_by_triangle_with_ids(
