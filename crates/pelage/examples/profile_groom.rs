@@ -5,7 +5,8 @@
 //! OPS=none drops the operators, to see interpolation alone; NORMALS=0
 //! drops the per-point normals; FRACTION=0.1 grows a preview fraction of
 //! them (the bench's `fraction_0_1` row), preparation included;
-//! BLUE_NOISE=1 draws blue-noise roots (the `blue_noise_groom` row).
+//! BLUE_NOISE=1 draws blue-noise roots (the `blue_noise_groom` row);
+//! OUTSIDE_SKIN=1 keeps the hairs out of the skin (`outside_skin`).
 use pelage::groom::Groom;
 
 fn main() {
@@ -23,12 +24,16 @@ fn main() {
         )
     };
     let normals = std::env::var("NORMALS").as_deref() != Ok("0");
+    let outside = match std::env::var("OUTSIDE_SKIN").as_deref() {
+        Ok("1") => "outside_skin = true\n",
+        _ => "",
+    };
     let distribution = match std::env::var("BLUE_NOISE").as_deref() {
         Ok("1") => "distribution = \"blue-noise\"\n",
         _ => "",
     };
     let text = format!(
-        "[mesh]\npath = \"spot\"\nsubdivide = 2\n[roots]\ncount = {hairs}\n{distribution}density = \"noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4\"\n[guides]\npoints = 8\ngenerate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}\n[interpolation]\nmethod = \"shepard\"\nk = 4\n{ops}[finish]\npoints = 16\nnormals = {normals}\nwidth = {{ root = 0.0015, tip = 0.0002 }}\n"
+        "[mesh]\npath = \"spot\"\nsubdivide = 2\n[roots]\ncount = {hairs}\n{distribution}density = \"noise:frequency=6,octaves=3,seed=2,offset=0.6,scale=0.4\"\n[guides]\npoints = 8\ngenerate = {{ count = 1000, length = 0.06, comb = [0, -0.5, -1], gravity = 0.3 }}\n[interpolation]\nmethod = \"shepard\"\nk = 4\n{ops}[finish]\npoints = 16\nnormals = {normals}\nwidth = {{ root = 0.0015, tip = 0.0002 }}\n{outside}"
     );
     let mut groom = Groom::from_text("<profile>", text).unwrap();
     if let Some(fraction) = std::env::var("FRACTION").ok().and_then(|f| f.parse().ok()) {
