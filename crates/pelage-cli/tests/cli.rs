@@ -1142,12 +1142,7 @@ fn an_animated_groom_is_one_time_sampled_file_that_usd_and_blender_read_frame_by
     assert_eq!(first.curve_count(), 2000);
     assert_eq!(first.offsets(), later.offsets());
     assert_eq!(first.ids(), later.ids());
-    let moved = first
-        .points()
-        .iter()
-        .zip(later.points())
-        .map(|(a, b)| (*a - *b).length())
-        .fold(0.0f32, f32::max);
+    let moved = farthest_apart(first.points(), later.points());
     assert!(moved > 1.0, "the fur walks with the fox ({moved})");
     if let Some((ok, report)) = usdcheck(&[&out_path]) {
         assert!(ok, "{report}");
@@ -1698,6 +1693,14 @@ fn converting_an_animated_file_says_it_writes_the_first_sample() {
     assert_eq!(written.widths(), read.widths());
 }
 
+/// The largest distance between matching points of `a` and `b`.
+fn farthest_apart(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0f32, f32::max)
+}
+
 /// `pelage groom GROOM` written to `cpu` and, with `--gpu`, to `gpu`;
 /// both must succeed. Returns the GPU run.
 fn groom_on_cpu_and_gpu(groom: &Path, cpu: &Path, gpu: &Path) -> Output {
@@ -1762,13 +1765,8 @@ fn groom_on_the_gpu_writes_what_the_cpu_writes() {
     assert_eq!(a.ids(), b.ids(), "the same hairs in the same order");
     assert_eq!(a.roots(), b.roots());
     assert_eq!(a.colors(), b.colors());
-    let near = |x: &[glam::Vec3], y: &[glam::Vec3], tolerance: f32| {
-        x.iter()
-            .zip(y)
-            .map(|(p, q)| p.distance(*q))
-            .fold(0.0f32, f32::max)
-            <= tolerance
-    };
+    let near =
+        |x: &[glam::Vec3], y: &[glam::Vec3], tolerance: f32| farthest_apart(x, y) <= tolerance;
     // Spot is about a unit across: 1e-4 of the groom's size.
     assert!(near(a.points(), b.points(), 1e-4));
     assert!(near(a.normals().unwrap(), b.normals().unwrap(), 1e-2));
@@ -1833,23 +1831,12 @@ fn an_animated_groom_grown_on_the_gpu_writes_what_the_cpu_writes() {
             );
             assert_eq!(a.curve_count(), 1500);
             assert_eq!(a.ids(), b.ids(), "{mode} frame {frame}: the same hairs");
-            let worst = a
-                .points()
-                .iter()
-                .zip(b.points())
-                .map(|(p, q)| p.distance(*q))
-                .fold(0.0f32, f32::max);
+            let worst = farthest_apart(a.points(), b.points());
             assert!(
                 worst <= 1e-4 * size,
                 "{mode} frame {frame}: a point {worst} from the CPU's (size {size})"
             );
-            moved = moved.max(
-                a.points()
-                    .iter()
-                    .zip(first.points())
-                    .map(|(p, q)| p.distance(*q))
-                    .fold(0.0f32, f32::max),
-            );
+            moved = moved.max(farthest_apart(a.points(), first.points()));
         }
         assert!(moved > 0.01 * size, "{mode}: the Fox runs, the hairs move");
     }

@@ -49,6 +49,14 @@ fn all_roots(generator: &Generator) -> (Vec<pelage::mesh::SurfacePoint>, Vec<u64
     (roots, ids)
 }
 
+/// The largest distance between matching points of `a` and `b`.
+fn farthest_apart(a: &[Vec3], b: &[Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0f32, f32::max)
+}
+
 /// The largest distance, over every point of every hair matched by id,
 /// between `cpu` and `gpu`, and the largest width difference.
 fn farthest(cpu: &[Curves], gpu: &Curves) -> (f32, f32) {
@@ -69,12 +77,10 @@ fn farthest(cpu: &[Curves], gpu: &Curves) -> (f32, f32) {
                 .unwrap_or_else(|| panic!("hair {id} is missing on the GPU"));
             let (a, b) = (part.range(c), gpu.range(g));
             assert_eq!(a.len(), b.len(), "hair {id}: point counts");
-            for (p, q) in part.points()[a.clone()]
-                .iter()
-                .zip(&gpu.points()[b.clone()])
-            {
-                far = far.max(p.distance(*q));
-            }
+            far = far.max(farthest_apart(
+                &part.points()[a.clone()],
+                &gpu.points()[b.clone()],
+            ));
             for (w, v) in part.widths()[a].iter().zip(&gpu.widths()[b]) {
                 wide = wide.max((w - v).abs());
             }
@@ -641,12 +647,7 @@ fn guides_simulated_on_the_gpu_feed_the_hairs_without_a_read_back() {
         .unwrap();
     ctx.queue.submit([encoder.finish()]);
     let b = direct.read_curves(ctx).unwrap();
-    let far = a
-        .points()
-        .iter()
-        .zip(b.points())
-        .map(|(p, q)| p.distance(*q))
-        .fold(0.0f32, f32::max);
+    let far = farthest_apart(a.points(), b.points());
     assert_eq!(a.ids(), b.ids());
     assert!(far <= 1e-4 * size, "a point {far} apart (size {size})");
     // The guides did move: the frame is not the rest groom.
@@ -655,12 +656,7 @@ fn guides_simulated_on_the_gpu_feed_the_hairs_without_a_read_back() {
         .grow(ctx, &GroomRecipe::guide_offsets(rest.guides()), Some(&pose))
         .unwrap();
     let c = at_rest.read_curves(ctx).unwrap();
-    let moved = c
-        .points()
-        .iter()
-        .zip(b.points())
-        .map(|(p, q)| p.distance(*q))
-        .fold(0.0f32, f32::max);
+    let moved = farthest_apart(c.points(), b.points());
     assert!(
         moved > 1e-3 * size,
         "the simulated guides moved the hairs ({moved})"

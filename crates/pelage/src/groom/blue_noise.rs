@@ -18,7 +18,7 @@
 //! theirs from it (a farm task that grows one part places every root).
 
 use super::generator::{Generator, PartRoots};
-use super::parts::{sort_cell_roots, sorted_by_triangle_with_ids};
+use super::parts::{sort_cell_roots, sorted_by_triangle_with_payload};
 use crate::mesh::SurfacePoint;
 use crate::sample::blue_noise::{OVERSAMPLING, Unit, arrival, positions_and_radii, thin};
 use crate::sample::{mix64, salts, sample_range};
@@ -88,27 +88,20 @@ fn survivors(part: PartCandidates, kept: &[bool]) -> PartRoots {
         .filter(|&k| !kept[k])
         .filter_map(|k| part.ids[k]);
     let mut roots = Vec::with_capacity(part.keep);
-    // Where each stream's survivors start.
-    let mut starts = Vec::with_capacity(part.streams.len() + 1);
-    let mut next_stream = part.streams.iter().peekable();
-    for (k, candidate) in part.candidates.into_iter().enumerate() {
-        while next_stream.next_if(|&&s| s <= k).is_some() {
-            starts.push(roots.len());
-        }
-        if kept[k] {
+    let ends = part.streams.iter().skip(1).copied();
+    for (start, end) in part.streams.iter().copied().zip(ends.chain([kept.len()])) {
+        let first = roots.len();
+        for k in (start..end).filter(|&k| kept[k]) {
             let id = part.ids[k].unwrap_or_else(|| free.next().expect("a free id a new survivor"));
-            roots.push((candidate, id));
+            roots.push((part.candidates[k], id));
+        }
+        if part.streams.len() > 1 {
+            sort_cell_roots(&mut roots[first..]);
         }
     }
     if part.streams.len() <= 1 {
-        return sorted_by_triangle_with_ids(
-            roots.iter().map(|r| r.0).collect(),
-            roots.iter().map(|r| r.1).collect(),
-        );
-    }
-    starts.push(roots.len());
-    for cell in starts.windows(2) {
-        sort_cell_roots(&mut roots[cell[0]..cell[1]]);
+        // Without root cells, the part's one stream: by triangle.
+        roots = sorted_by_triangle_with_payload(roots);
     }
     roots.into_iter().unzip()
 }

@@ -191,28 +191,31 @@ pub(crate) fn sorted_by_triangle_with_ids(
     roots: Vec<SurfacePoint>,
     ids: Vec<u64>,
 ) -> (Vec<SurfacePoint>, Vec<u64>) {
-    sorted_with(roots.into_iter().zip(ids).collect())
+    sorted_by_triangle_with_payload(roots.into_iter().zip(ids).collect())
         .into_iter()
         .unzip()
 }
 
 /// `roots` ordered by (triangle, first barycentric, second barycentric),
 /// the order [`Generator::part_roots`] grows hairs in without root cells
-/// (sequential ids) and with blue-noise roots: the same order as
+/// (sequential ids): the same order as
 /// a comparison sort by that key, found faster. A counting sort by
 /// triangle moves each root once; each triangle's few roots (a dozen or
 /// two) are then sorted among themselves. A comparison sort of the whole
 /// part took a tenth of a groom's time on one core.
 pub(crate) fn sorted_by_triangle(roots: Vec<SurfacePoint>) -> Vec<SurfacePoint> {
     // A zero-sized payload: the pairs are the roots' own size.
-    sorted_with(roots.into_iter().map(|r| (r, ())).collect())
+    sorted_by_triangle_with_payload(roots.into_iter().map(|r| (r, ())).collect())
         .into_iter()
         .map(|(r, ())| r)
         .collect()
 }
 
-/// Roots with a payload each, sorted by (triangle, barycentrics, payload).
-fn sorted_with<T: Copy + Default + Ord>(roots: Vec<(SurfacePoint, T)>) -> Vec<(SurfacePoint, T)> {
+/// Roots with a payload each, sorted by (triangle, barycentrics, payload)
+/// ([`sorted_by_triangle`]'s counting sort).
+pub(crate) fn sorted_by_triangle_with_payload<T: Copy + Default + Ord>(
+    roots: Vec<(SurfacePoint, T)>,
+) -> Vec<(SurfacePoint, T)> {
     let (Some(lo), Some(hi)) = (
         roots.iter().map(|r| r.0.tri).min(),
         roots.iter().map(|r| r.0.tri).max(),
